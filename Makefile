@@ -1,0 +1,24 @@
+# Entry points: `make demo`, `make test`, `make bench`. Each runs tools/setup first.
+CARGO ?= cargo
+
+.PHONY: setup build demo test bench lint
+
+setup:
+	@bash tools/setup
+
+build: setup
+	$(CARGO) build --release -p weft-cli
+
+demo: build
+	@mkdir -p out
+	./target/release/weft graph plan graphs/deferred.ron --size 1920x1080
+
+lint: setup
+	$(CARGO) fmt --all -- --check
+	$(CARGO) clippy --workspace --all-targets -- -D warnings
+
+test: lint
+	$(CARGO) test --workspace
+
+bench: setup
+	$(CARGO) bench --workspace

@@ -1,0 +1,1 @@
+//! Vulkan execution of compiled weft render graphs.
