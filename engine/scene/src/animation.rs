@@ -1,0 +1,140 @@
+//! Light animation evaluated at a time: point lights circling, spotlights swivelling, the sun
+//! turning. Pure functions of (light, index, time, seed), so every frame is reproducible.
+
+use crate::light::{Light, PointLight, SpotLight, SunLight};
+use crate::rng::Rng;
+use glam::{Quat, Vec3};
+
+/// Where point light number `index` is at `time` seconds: on a horizontal circle of radius
+/// `amplitude` around its position, at `velocity` radians per second, with a start phase and
+/// a turning sense drawn from `seed` and `index`.
+pub fn point_position_at(light: &PointLight, index: usize, time: f32, seed: u64) -> Vec3 {
+    if light.velocity == 0.0 || light.amplitude == 0.0 {
+        return light.position;
+    }
+    let mut rng = Rng::new(seed ^ (index as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    let phase = rng.range(0.0, std::f32::consts::TAU);
+    let sense = if rng.next_u64() & 1 == 0 { 1.0 } else { -1.0 };
+    let angle = phase + sense * light.velocity * time;
+    // Start on the circle at the phase, so the offset at t=0 is zero.
+    let start = Vec3::new(phase.cos(), 0.0, phase.sin());
+    let now = Vec3::new(angle.cos(), 0.0, angle.sin());
+    light.position + (now - start) * light.amplitude
+}
+
+/// The spotlight's direction at `time`: eased back and forth between the swivel directions.
+pub fn spot_direction_at(light: &SpotLight, time: f32) -> Vec3 {
+    let Some(sw) = light.swivel else {
+        return light.direction;
+    };
+    let s = if sw.period > 0.0 {
+        0.5 - 0.5 * (std::f32::consts::TAU * time / sw.period).cos()
+    } else {
+        0.0
+    };
+    let turn = Quat::from_rotation_arc(sw.from, sw.to);
+    (Quat::IDENTITY.slerp(turn, s) * sw.from).normalize()
+}
+
+/// The sun's direction at `time`, turned about its motion axis.
+pub fn sun_direction_at(light: &SunLight, time: f32) -> Vec3 {
+    match light.motion {
+        Some(m) => {
+            Quat::from_axis_angle(m.axis, (m.degrees_per_second * time).to_radians())
+                * light.direction
+        }
+        None => light.direction,
+    }
+}
+
+/// Every light as it is at `time` for animation seed `seed`; point lights are numbered in
+/// list order among point lights.
+pub fn lights_at(lights: &[Light], time: f32, seed: u64) -> Vec<Light> {
+    let mut point_index = 0;
+    lights
+        .iter()
+        .map(|light| match light {
+            Light::Point(p) => {
+                let mut moved = p.clone();
+                moved.position = point_position_at(p, point_index, time, seed);
+                point_index += 1;
+                Light::Point(moved)
+            }
+            Light::Spot(s) => {
+                let mut turned = s.clone();
+                turned.direction = spot_direction_at(s, time);
+                Light::Spot(turned)
+            }
+            Light::Sun(s) => {
+                let mut turned = s.clone();
+                turned.direction = sun_direction_at(s, time);
+                Light::Sun(turned)
+            }
+            Light::Area(a) => Light::Area(a.clone()),
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::{Attenuation, RadiusSource, SunMotion, Swivel};
+
+    fn point(velocity: f32) -> PointLight {
+        PointLight {
+            position: Vec3::new(1.0, 2.0, 3.0),
+            color: Vec3::ONE,
+            velocity,
+            amplitude: 2.0,
+            attenuation: Attenuation::INVERSE_SQUARE,
+            radius: 10.0,
+            radius_source: RadiusSource::Given,
+        }
+    }
+
+    #[test]
+    fn point_motion_is_deterministic_and_stays_on_its_circle() {
+        let p = point(1.0);
+        assert_eq!(point_position_at(&p, 3, 0.0, 9), p.position);
+        let a = point_position_at(&p, 3, 1.5, 9);
+        assert_eq!(a, point_position_at(&p, 3, 1.5, 9));
+        assert_ne!(a, point_position_at(&p, 3, 1.5, 10));
+        assert_eq!(a.y, 2.0);
+        // Full turn after 2π seconds at 1 rad/s.
+        let back = point_position_at(&p, 3, std::f32::consts::TAU, 9);
+        assert!(back.distance(p.position) < 1e-4);
+        assert_eq!(point_position_at(&point(0.0), 0, 5.0, 1), p.position);
+    }
+
+    #[test]
+    fn swivel_and_sun_motion() {
+        let spot = SpotLight {
+            position: Vec3::ZERO,
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            exponent: 1.0,
+            angle: 30.0,
+            inner_angle: None,
+            length: None,
+            attenuation: Attenuation::NONE,
+            swivel: Some(Swivel {
+                from: Vec3::NEG_Y,
+                to: Vec3::X,
+                period: 4.0,
+            }),
+        };
+        assert!(spot_direction_at(&spot, 0.0).distance(Vec3::NEG_Y) < 1e-6);
+        assert!(spot_direction_at(&spot, 2.0).distance(Vec3::X) < 1e-6);
+        assert!(spot_direction_at(&spot, 4.0).distance(Vec3::NEG_Y) < 1e-6);
+        let sun = SunLight {
+            direction: Vec3::X,
+            color: Vec3::ONE,
+            ambient: Vec3::ZERO,
+            motion: Some(SunMotion {
+                axis: Vec3::Y,
+                degrees_per_second: 90.0,
+            }),
+        };
+        assert!(sun_direction_at(&sun, 1.0).distance(Vec3::NEG_Z) < 1e-6);
+    }
+}

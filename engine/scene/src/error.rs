@@ -1,0 +1,143 @@
+//! Errors and warnings, each located at a file and (where known) a line.
+
+use serde::Serialize;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Where a problem is: a file and, when the problem belongs to one line, that line (1-based).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Location {
+    /// The file, as the user named it (resolved against the including file).
+    pub file: PathBuf,
+    /// The 1-based line, or `None` when the problem concerns the whole file.
+    pub line: Option<usize>,
+}
+
+impl Location {
+    /// A location on one line of a file.
+    pub fn line(file: &Path, line: usize) -> Self {
+        Self {
+            file: file.to_path_buf(),
+            line: Some(line),
+        }
+    }
+
+    /// A location for a whole file.
+    pub fn file(file: &Path) -> Self {
+        Self {
+            file: file.to_path_buf(),
+            line: None,
+        }
+    }
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(line) => write!(f, "{}:{}", self.file.display(), line),
+            None => write!(f, "{}", self.file.display()),
+        }
+    }
+}
+
+/// Something the loader accepted but that the author should look at (unknown names, quirks).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Warning {
+    /// Where it was found.
+    pub at: Location,
+    /// What was found and what the loader did about it.
+    pub message: String,
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: warning: {}", self.at, self.message)
+    }
+}
+
+/// Collects warnings while loading, so every stage reports them the same way.
+#[derive(Debug, Default)]
+pub struct Diagnostics {
+    /// The warnings so far, in the order they were found.
+    pub warnings: Vec<Warning>,
+}
+
+impl Diagnostics {
+    /// Records a warning.
+    pub fn warn(&mut self, at: Location, message: impl Into<String>) {
+        self.warnings.push(Warning {
+            at,
+            message: message.into(),
+        });
+    }
+}
+
+/// Why a scene or model could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// A file could not be read.
+    #[error("{at}: cannot read {}: {source}", path.display())]
+    Io {
+        /// Where the file was asked for (the file itself when it is the top-level one).
+        at: Location,
+        /// The file that could not be read.
+        path: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// A file named by the scene does not exist.
+    #[error("{at}: missing file {}", path.display())]
+    MissingFile {
+        /// The line that names the file.
+        at: Location,
+        /// The resolved path that does not exist.
+        path: PathBuf,
+    },
+    /// A file is larger than the loader accepts.
+    #[error("{at}: file is {size} bytes, over the limit of {limit} bytes")]
+    TooLarge {
+        /// The file.
+        at: Location,
+        /// Its size.
+        size: u64,
+        /// The limit.
+        limit: u64,
+    },
+    /// Text that does not follow the format.
+    #[error("{at}: {message}")]
+    Syntax {
+        /// Where.
+        at: Location,
+        /// What is wrong.
+        message: String,
+    },
+    /// A model file (OBJ, MTL, glTF) that could not be imported.
+    #[error("{at}: {message}")]
+    Model {
+        /// The model file and, when known, the line.
+        at: Location,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl SceneError {
+    /// A syntax error at one line.
+    pub(crate) fn syntax(file: &Path, line: usize, message: impl Into<String>) -> Self {
+        Self::Syntax {
+            at: Location::line(file, line),
+            message: message.into(),
+        }
+    }
+
+    /// Where the error is.
+    pub fn location(&self) -> &Location {
+        match self {
+            Self::Io { at, .. }
+            | Self::MissingFile { at, .. }
+            | Self::TooLarge { at, .. }
+            | Self::Syntax { at, .. }
+            | Self::Model { at, .. } => at,
+        }
+    }
+}

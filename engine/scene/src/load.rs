@@ -1,0 +1,205 @@
+//! Loading a scene file (or a bare model file) into a [`Scene`]: read the description, load
+//! each model file once, place instances, bring glTF lights and cameras into world space,
+//! bound radii, add the default camera.
+
+use crate::bounds::Aabb;
+use crate::camera::default_camera;
+use crate::desc::{read_scene_desc, Placement, SceneDesc};
+use crate::error::{Diagnostics, Location, SceneError};
+use crate::light::Light;
+use crate::model::Model;
+use crate::obj::load_obj;
+use crate::scene::{Instance, Scene};
+use crate::tangents::generate_model_tangents;
+use glam::Mat4;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// Settings for [`load_scene_with`].
+#[derive(Debug, Clone, Default)]
+pub struct LoadOptions {
+    /// Folder for the processed-model cache; `None` disables caching.
+    pub cache_dir: Option<PathBuf>,
+}
+
+/// Loads a `.scene` file, or an `.obj`, `.gltf` or `.glb` file as a scene with one model.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    load_scene_with(path, &LoadOptions::default())
+}
+
+/// [`load_scene`] with options.
+pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
+    let mut diag = Diagnostics::default();
+    let desc = if is_model_file(path) {
+        SceneDesc {
+            models: vec![Placement {
+                file: path.to_path_buf(),
+                at: Location::file(path),
+                transform: Mat4::IDENTITY,
+            }],
+            ..SceneDesc::default()
+        }
+    } else {
+        read_scene_desc(path, &mut diag)?
+    };
+    build(path, desc, options, &mut diag)
+}
+
+/// Whether the path names a model file rather than a scene file.
+fn is_model_file(path: &Path) -> bool {
+    matches!(extension(path).as_str(), "obj" | "gltf" | "glb")
+}
+
+/// The lower-case extension.
+fn extension(path: &Path) -> String {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default()
+}
+
+/// Loads one model file by its extension, with tangents where materials need them.
+pub fn load_model(
+    path: &Path,
+    asked_at: &Location,
+    options: &LoadOptions,
+    diag: &mut Diagnostics,
+) -> Result<Model, SceneError> {
+    let _ = options;
+    {
+        let mut model = match extension(path).as_str() {
+            "obj" => load_obj(path, asked_at, diag)?,
+            other => {
+                return Err(SceneError::Model {
+                    at: asked_at.clone(),
+                    message: format!(
+                        "unsupported model format '.{other}' (use .obj, .gltf or .glb)"
+                    ),
+                })
+            }
+        };
+        let without_uvs = generate_model_tangents(&mut model);
+        if without_uvs > 0 {
+            diag.warn(
+                Location::file(path),
+                format!("{without_uvs} meshes have a normal or bump map but no UVs; no tangents"),
+            );
+        }
+        Ok(model)
+    }
+}
+
+/// Turns a description into a scene.
+fn build(
+    path: &Path,
+    desc: SceneDesc,
+    options: &LoadOptions,
+    diag: &mut Diagnostics,
+) -> Result<Scene, SceneError> {
+    let mut models: Vec<Model> = Vec::new();
+    let mut by_file: HashMap<PathBuf, usize> = HashMap::new();
+    let mut instances = Vec::new();
+    let mut lights = desc.lights;
+    let mut cameras = desc.cameras;
+    for placement in &desc.models {
+        let key = placement
+            .file
+            .canonicalize()
+            .unwrap_or_else(|_| placement.file.clone());
+        let index = match by_file.get(&key) {
+            Some(&i) => i,
+            None => {
+                let model = load_model(&placement.file, &placement.at, options, diag)?;
+                models.push(model);
+                by_file.insert(key, models.len() - 1);
+                models.len() - 1
+            }
+        };
+        let model = &models[index];
+        let m = placement.transform;
+        lights.extend(model.lights.iter().map(|l| transform_light(l, &m)));
+        cameras.extend(model.cameras.iter().map(|c| {
+            let mut c = c.clone();
+            let (_, rotation, translation) =
+                (m * Mat4::from_rotation_translation(c.orientation, c.position))
+                    .to_scale_rotation_translation();
+            c.position = translation;
+            c.orientation = rotation;
+            c
+        }));
+        instances.push(Instance {
+            model: index,
+            transform: m,
+            bounds: model.bounds.transformed(&m),
+        });
+    }
+    let bounds = instances
+        .iter()
+        .fold(Aabb::EMPTY, |b, i| b.union(&i.bounds));
+    let framing = desc.bounding_box.unwrap_or(bounds);
+    bound_radii(&mut lights, &framing, path, diag);
+    if cameras.is_empty() {
+        cameras.push(default_camera(&framing));
+    }
+    Ok(Scene {
+        path: path.to_path_buf(),
+        models,
+        instances,
+        lights,
+        cameras,
+        bounds,
+        declared_bounds: desc.bounding_box,
+        warnings: std::mem::take(&mut diag.warnings),
+    })
+}
+
+/// Replaces unbounded point-light radii (no falloff) by the scene's diagonal, with a warning.
+fn bound_radii(lights: &mut [Light], bounds: &Aabb, path: &Path, diag: &mut Diagnostics) {
+    let extent = bounds.diagonal().max(1.0);
+    let mut count = 0;
+    for light in lights.iter_mut() {
+        if let Light::Point(p) = light {
+            if !p.radius.is_finite() {
+                p.radius = extent;
+                count += 1;
+            }
+        }
+    }
+    if count > 0 {
+        diag.warn(
+            Location::file(path),
+            format!("{count} point lights never fall off (no linear or quadratic attenuation); radius set to the scene diagonal {extent}"),
+        );
+    }
+}
+
+/// A model-space light in world space.
+fn transform_light(light: &Light, m: &Mat4) -> Light {
+    let dir = |d: glam::Vec3| m.transform_vector3(d).try_normalize().unwrap_or(d);
+    match light {
+        Light::Sun(s) => {
+            let mut s = s.clone();
+            s.direction = dir(s.direction);
+            Light::Sun(s)
+        }
+        Light::Spot(s) => {
+            let mut s = s.clone();
+            s.position = m.transform_point3(s.position);
+            s.direction = dir(s.direction);
+            Light::Spot(s)
+        }
+        Light::Point(p) => {
+            let mut p = p.clone();
+            p.position = m.transform_point3(p.position);
+            Light::Point(p)
+        }
+        Light::Area(a) => {
+            let mut a = a.clone();
+            let (_, rotation, translation) = (*m
+                * Mat4::from_rotation_translation(a.orientation, a.position))
+            .to_scale_rotation_translation();
+            a.position = translation;
+            a.orientation = rotation;
+            Light::Area(a)
+        }
+    }
+}

@@ -1,0 +1,178 @@
+//! Materials: Blinn-Phong parameters from MTL and metallic-roughness from glTF in one type,
+//! with texture references resolved to absolute paths or embedded bytes.
+
+use glam::{Vec3, Vec4};
+use std::path::PathBuf;
+
+/// Which parameter set the source defined, so a renderer picks the matching shading.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShadingModel {
+    /// MTL: diffuse, specular, shininess.
+    BlinnPhong,
+    /// glTF: base colour, metallic, roughness.
+    MetallicRoughness,
+}
+
+/// How alpha is used, as glTF defines it (MTL dissolve < 1 maps to `Blend`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored.
+    Opaque,
+    /// Alpha below the cutoff is discarded.
+    Mask(f32),
+    /// Alpha blends.
+    Blend,
+}
+
+/// Where a texture's pixels are.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum TextureSource {
+    /// An image file, as an absolute path.
+    File(PathBuf),
+    /// Image bytes embedded in a glTF buffer or data URI.
+    Embedded {
+        /// The MIME type the glTF file gives (`image/png`, `image/jpeg`).
+        mime_type: String,
+        /// The encoded image.
+        bytes: Vec<u8>,
+    },
+}
+
+/// A texture used by a material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextureRef {
+    /// The image.
+    pub source: TextureSource,
+    /// Which UV set it reads (glTF `texCoord`; 0 for OBJ).
+    pub tex_coord: u32,
+}
+
+impl TextureRef {
+    /// A texture read from a file with the first UV set.
+    pub fn file(path: PathBuf) -> Self {
+        Self {
+            source: TextureSource::File(path),
+            tex_coord: 0,
+        }
+    }
+}
+
+/// The textures of a material, each optional.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MaterialTextures {
+    /// `map_Kd` or `baseColorTexture`.
+    pub base_color: Option<TextureRef>,
+    /// `map_Ks`.
+    pub specular: Option<TextureRef>,
+    /// MTL `norm` or glTF `normalTexture`: a tangent-space normal map.
+    pub normal: Option<TextureRef>,
+    /// MTL `map_bump`/`bump`: a height map (most OBJ exporters write these).
+    pub bump: Option<TextureRef>,
+    /// `map_d`.
+    pub opacity: Option<TextureRef>,
+    /// `metallicRoughnessTexture`.
+    pub metallic_roughness: Option<TextureRef>,
+    /// `map_Ke` or `emissiveTexture`.
+    pub emissive: Option<TextureRef>,
+    /// `occlusionTexture`.
+    pub occlusion: Option<TextureRef>,
+    /// KHR_materials_transmission `transmissionTexture`.
+    pub transmission: Option<TextureRef>,
+    /// KHR_materials_volume `thicknessTexture`.
+    pub thickness: Option<TextureRef>,
+}
+
+impl MaterialTextures {
+    /// Whether a tangent frame is needed (a normal or bump map).
+    pub fn needs_tangents(&self) -> bool {
+        self.normal.is_some() || self.bump.is_some()
+    }
+
+    /// Every texture that is set, for counting and listing.
+    pub fn iter(&self) -> impl Iterator<Item = &TextureRef> {
+        [
+            &self.base_color,
+            &self.specular,
+            &self.normal,
+            &self.bump,
+            &self.opacity,
+            &self.metallic_roughness,
+            &self.emissive,
+            &self.occlusion,
+            &self.transmission,
+            &self.thickness,
+        ]
+        .into_iter()
+        .flatten()
+    }
+}
+
+/// A surface description that either importer fills; fields the source lacks keep defaults.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    /// The name in the source file.
+    pub name: String,
+    /// Which parameter set is authoritative.
+    pub shading: ShadingModel,
+    /// Diffuse (`Kd`) or base colour, with opacity (`d`, `1 - Tr`, or glTF alpha) in `w`.
+    pub base_color: Vec4,
+    /// `Ka`.
+    pub ambient: Vec3,
+    /// `Ks`.
+    pub specular: Vec3,
+    /// `Ns`.
+    pub shininess: f32,
+    /// `Ke`, or glTF emissive factor times KHR_materials_emissive_strength.
+    pub emissive: Vec3,
+    /// `Ni` or KHR_materials_ior.
+    pub ior: f32,
+    /// MTL `illum` model, when given.
+    pub illum: Option<u8>,
+    /// glTF metallic factor (0 for MTL).
+    pub metallic: f32,
+    /// glTF roughness factor (for MTL, derived from `Ns` as `sqrt(2 / (Ns + 2))`).
+    pub roughness: f32,
+    /// KHR_materials_transmission factor.
+    pub transmission: f32,
+    /// KHR_materials_volume thickness factor.
+    pub thickness: f32,
+    /// KHR_materials_volume attenuation distance (`None` = infinite).
+    pub attenuation_distance: Option<f32>,
+    /// KHR_materials_volume attenuation colour.
+    pub attenuation_color: Vec3,
+    /// How alpha is used.
+    pub alpha_mode: AlphaMode,
+    /// Whether back faces are shaded.
+    pub double_sided: bool,
+    /// Normal map strength (glTF `normalTexture.scale`, MTL `-bm`).
+    pub normal_scale: f32,
+    /// The textures.
+    pub textures: MaterialTextures,
+}
+
+impl Default for Material {
+    /// The material for meshes without one: mid grey, rough, opaque.
+    fn default() -> Self {
+        Self {
+            name: "default".to_string(),
+            shading: ShadingModel::BlinnPhong,
+            base_color: Vec4::new(0.8, 0.8, 0.8, 1.0),
+            ambient: Vec3::ZERO,
+            specular: Vec3::ZERO,
+            shininess: 0.0,
+            emissive: Vec3::ZERO,
+            ior: 1.5,
+            illum: None,
+            metallic: 0.0,
+            roughness: 1.0,
+            transmission: 0.0,
+            thickness: 0.0,
+            attenuation_distance: None,
+            attenuation_color: Vec3::ONE,
+            alpha_mode: AlphaMode::Opaque,
+            double_sided: false,
+            normal_scale: 1.0,
+            textures: MaterialTextures::default(),
+        }
+    }
+}

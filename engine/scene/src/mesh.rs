@@ -1,0 +1,72 @@
+//! Triangle meshes in the layout a renderer uploads: separate attribute arrays and u32 indices.
+
+use crate::bounds::Aabb;
+use glam::{Vec2, Vec3, Vec4};
+
+/// One triangle list with one material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// The object or group name from the source file.
+    pub name: String,
+    /// Vertex positions in model space.
+    pub positions: Vec<Vec3>,
+    /// Unit vertex normals, one per position (computed when the source has none).
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates, one per position, or empty when the source has none.
+    pub uvs: Vec<Vec2>,
+    /// MikkTSpace tangents (xyz, w = handedness), one per position, or empty when the
+    /// material has no normal map.
+    pub tangents: Vec<Vec4>,
+    /// Triangle corners, three per triangle.
+    pub indices: Vec<u32>,
+    /// Index into the model's materials, or `None` for the default material.
+    pub material: Option<usize>,
+    /// The box around the positions.
+    pub bounds: Aabb,
+}
+
+impl Mesh {
+    /// The number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+}
+
+/// Area-weighted vertex normals for an indexed triangle list; degenerate vertices get +Y.
+pub(crate) fn compute_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for tri in indices.chunks_exact(3) {
+        let [a, b, c] = [tri[0] as usize, tri[1] as usize, tri[2] as usize];
+        let (Some(&pa), Some(&pb), Some(&pc)) =
+            (positions.get(a), positions.get(b), positions.get(c))
+        else {
+            continue;
+        };
+        let n = (pb - pa).cross(pc - pa);
+        normals[a] += n;
+        normals[b] += n;
+        normals[c] += n;
+    }
+    normals
+        .into_iter()
+        .map(|n| n.try_normalize().unwrap_or(Vec3::Y))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normals_of_a_quad_face_up() {
+        let p = [
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::ONE,
+        ];
+        let n = compute_normals(&p, &[0, 1, 2, 0, 2, 3]);
+        assert_eq!(n, vec![Vec3::Y, Vec3::Y, Vec3::Y, Vec3::Y, Vec3::Y]);
+    }
+}

@@ -1,0 +1,198 @@
+//! MTL materials from tobj into [`Material`], with texture options stripped and texture
+//! paths resolved (backslashes included) against the MTL file's folder.
+
+use crate::error::{Diagnostics, Location};
+use crate::material::{AlphaMode, Material, ShadingModel, TextureRef};
+use glam::{Vec3, Vec4};
+use std::path::Path;
+
+/// Texture statement options and how many arguments each takes (MTL spec, plus `-bm`).
+const OPTIONS: &[(&str, usize)] = &[
+    ("-blendu", 1),
+    ("-blendv", 1),
+    ("-boost", 1),
+    ("-cc", 1),
+    ("-clamp", 1),
+    ("-imfchan", 1),
+    ("-mm", 2),
+    ("-o", 3),
+    ("-s", 3),
+    ("-t", 3),
+    ("-texres", 1),
+    ("-bm", 1),
+    ("-type", 1),
+];
+
+/// Splits a texture statement's argument into its options and the file name (which may
+/// contain spaces); returns the `-bm` multiplier when given.
+pub(crate) fn split_texture_options(arg: &str) -> (String, Option<f32>) {
+    let words: Vec<&str> = arg.split_whitespace().collect();
+    let mut i = 0;
+    let mut bump = None;
+    while i < words.len() {
+        let Some(&(name, count)) = OPTIONS.iter().find(|(o, _)| *o == words[i]) else {
+            break;
+        };
+        if name == "-bm" {
+            bump = words
+                .get(i + 1)
+                .and_then(|w| w.parse::<f32>().ok())
+                .filter(|v| v.is_finite());
+        }
+        // `-o`, `-s` and `-t` allow fewer than three numbers; take only the numeric ones.
+        let optional = matches!(name, "-o" | "-s" | "-t");
+        let mut taken = 0;
+        while taken < count
+            && words
+                .get(i + 1 + taken)
+                .is_some_and(|w| !optional || w.parse::<f32>().is_ok())
+        {
+            taken += 1;
+        }
+        i += 1 + taken;
+    }
+    (words[i.min(words.len())..].join(" "), bump)
+}
+
+/// Resolves a texture statement to an existing file, warning (and returning `None`) when it
+/// is missing.
+fn texture(
+    dir: &Path,
+    arg: Option<&String>,
+    material: &str,
+    mtl: &Path,
+    diag: &mut Diagnostics,
+) -> Option<TextureRef> {
+    let (name, _) = split_texture_options(arg?);
+    if name.is_empty() {
+        diag.warn(
+            Location::file(mtl),
+            format!("material '{material}': texture statement without a file name; ignored"),
+        );
+        return None;
+    }
+    let path = dir.join(name.replace('\\', "/"));
+    if !path.is_file() {
+        diag.warn(
+            Location::file(mtl),
+            format!(
+                "material '{material}': texture {} not found; left out",
+                path.display()
+            ),
+        );
+        return None;
+    }
+    let path = std::path::absolute(&path).unwrap_or(path);
+    Some(TextureRef::file(path))
+}
+
+/// Clamps a value that must lie in [0, 1], treating NaN as `fallback`.
+fn unit(v: f32, fallback: f32) -> f32 {
+    if v.is_nan() {
+        fallback
+    } else {
+        v.clamp(0.0, 1.0)
+    }
+}
+
+/// A colour with non-finite channels replaced by 0.
+fn color(c: Option<[f32; 3]>, fallback: Vec3) -> Vec3 {
+    c.map(Vec3::from_array)
+        .map(|v| if v.is_finite() { v } else { Vec3::ZERO })
+        .unwrap_or(fallback)
+}
+
+/// Converts one tobj material read from `mtl`.
+pub(crate) fn convert(m: &tobj::Material, mtl: &Path, diag: &mut Diagnostics) -> Material {
+    let dir = mtl.parent().unwrap_or(Path::new(""));
+    let name = m.name.as_str();
+    let tr = m
+        .unknown_param
+        .get("Tr")
+        .and_then(|v| v.split_whitespace().next())
+        .and_then(|v| v.parse::<f32>().ok());
+    let opacity = match (m.dissolve, tr) {
+        (Some(d), Some(t)) => {
+            if (d + t - 1.0).abs() > 1e-3 {
+                diag.warn(
+                    Location::file(mtl),
+                    format!("material '{name}': 'd {d}' and 'Tr {t}' disagree (d should be 1 - Tr); 'd' is used"),
+                );
+            }
+            d
+        }
+        (Some(d), None) => d,
+        (None, Some(t)) => 1.0 - t,
+        (None, None) => 1.0,
+    };
+    let opacity = unit(opacity, 1.0);
+    let shininess = m
+        .shininess
+        .filter(|s| s.is_finite())
+        .unwrap_or(0.0)
+        .max(0.0);
+    let kd = color(m.diffuse, Vec3::splat(0.8));
+    let mut out = Material {
+        name: name.to_string(),
+        shading: ShadingModel::BlinnPhong,
+        base_color: Vec4::new(kd.x, kd.y, kd.z, opacity),
+        ambient: color(m.ambient, Vec3::ZERO),
+        specular: color(m.specular, Vec3::ZERO),
+        shininess,
+        emissive: color(m.emissive, Vec3::ZERO),
+        ior: m
+            .optical_density
+            .filter(|n| n.is_finite() && *n > 0.0)
+            .unwrap_or(1.5),
+        illum: m.illumination_model,
+        roughness: (2.0 / (shininess + 2.0)).sqrt(),
+        alpha_mode: if opacity < 1.0 {
+            AlphaMode::Blend
+        } else {
+            AlphaMode::Opaque
+        },
+        ..Material::default()
+    };
+    let unknown = |key: &str| m.unknown_param.get(key);
+    out.textures.base_color = texture(dir, m.diffuse_texture.as_ref(), name, mtl, diag);
+    out.textures.specular = texture(dir, m.specular_texture.as_ref(), name, mtl, diag);
+    out.textures.opacity = texture(dir, m.dissolve_texture.as_ref(), name, mtl, diag);
+    out.textures.emissive = texture(dir, unknown("map_Ke"), name, mtl, diag);
+    out.textures.normal = texture(dir, unknown("norm"), name, mtl, diag);
+    if let Some(arg) = &m.normal_texture {
+        out.textures.bump = texture(dir, Some(arg), name, mtl, diag);
+        if let (_, Some(bm)) = split_texture_options(arg) {
+            out.normal_scale = bm;
+        }
+    }
+    if out.textures.opacity.is_some() && out.alpha_mode == AlphaMode::Opaque {
+        out.alpha_mode = AlphaMode::Mask(0.5);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texture_options_are_stripped() {
+        assert_eq!(
+            split_texture_options("a b.png"),
+            ("a b.png".to_string(), None)
+        );
+        assert_eq!(
+            split_texture_options("-bm 0.5 n.png"),
+            ("n.png".to_string(), Some(0.5))
+        );
+        assert_eq!(
+            split_texture_options("-s 2 2 -clamp on t.png"),
+            ("t.png".to_string(), None)
+        );
+        assert_eq!(
+            split_texture_options("-o 1 2 3 x\\y.png"),
+            ("x\\y.png".to_string(), None)
+        );
+        assert_eq!(split_texture_options("-mm"), (String::new(), None));
+    }
+}
