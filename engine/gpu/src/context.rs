@@ -1,0 +1,492 @@
+//! The Vulkan context: instance (with optional validation and synchronization
+//! validation), the chosen physical device, a device with synchronization2 and
+//! maintenance4, one queue, a command pool and the memory allocator.
+
+use crate::error::{GpuError, VkCall};
+use crate::validation::{self, ValidationCounts, ValidationLog};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use gpu_allocator::{AllocationSizes, AllocatorDebugSettings};
+use std::ffi::{c_void, CStr};
+use std::mem::ManuallyDrop;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// How to create the context.
+#[derive(Debug, Clone, Default)]
+pub struct GpuOptions {
+    /// Enable the Khronos validation layer with synchronization validation.
+    pub validation: bool,
+    /// Pick the first device whose name contains this (case-insensitive).
+    pub device: Option<String>,
+}
+
+/// What was chosen, for printing and reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeviceInfo {
+    pub name: String,
+    pub kind: DeviceKind,
+    /// Nanoseconds per timestamp tick.
+    pub timestamp_period: f32,
+    /// Whether the graphics queue writes timestamps.
+    pub timestamps: bool,
+}
+
+/// The physical device type, in preference order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum DeviceKind {
+    Discrete,
+    Integrated,
+    Virtual,
+    Cpu,
+    Other,
+}
+
+impl DeviceKind {
+    fn from_vk(t: vk::PhysicalDeviceType) -> Self {
+        match t {
+            vk::PhysicalDeviceType::DISCRETE_GPU => Self::Discrete,
+            vk::PhysicalDeviceType::INTEGRATED_GPU => Self::Integrated,
+            vk::PhysicalDeviceType::VIRTUAL_GPU => Self::Virtual,
+            vk::PhysicalDeviceType::CPU => Self::Cpu,
+            _ => Self::Other,
+        }
+    }
+}
+
+/// The Vulkan context every other part of the crate works through.
+pub struct Gpu {
+    entry: ash::Entry,
+    instance: ash::Instance,
+    debug: DebugParts,
+    debug_device: Option<ash::ext::debug_utils::Device>,
+    physical: vk::PhysicalDevice,
+    device: ash::Device,
+    queue: vk::Queue,
+    queue_family: u32,
+    command_pool: vk::CommandPool,
+    allocator: ManuallyDrop<Mutex<Allocator>>,
+    info: DeviceInfo,
+    log: Arc<ValidationLog>,
+}
+
+impl Gpu {
+    /// Creates the instance, picks a device and creates everything on it.
+    pub fn new(options: &GpuOptions) -> Result<Self, GpuError> {
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| GpuError::Loader(e.to_string()))?;
+        let log = ValidationLog::new();
+        let mut guard = InstanceGuard {
+            instance: Some(create_instance(&entry, options.validation, &log)?),
+            debug: None,
+        };
+        if options.validation {
+            let loader = ash::ext::debug_utils::Instance::new(&entry, guard.instance()?);
+            let info = messenger_info(&log);
+            let messenger = unsafe { loader.create_debug_utils_messenger(&info, None) }
+                .call("vkCreateDebugUtilsMessengerEXT")?;
+            guard.debug = Some((loader, messenger));
+        }
+        let (physical, info, queue_family) =
+            choose_device(guard.instance()?, options.device.as_deref())?;
+        let device = create_device(guard.instance()?, physical, queue_family)?;
+        let (instance, debug) = guard.release()?;
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        let command_pool = match unsafe { device.create_command_pool(&pool_info, None) } {
+            Ok(pool) => pool,
+            Err(result) => {
+                destroy_base(&instance, &debug, &device);
+                return Err(GpuError::Vulkan {
+                    call: "vkCreateCommandPool",
+                    result,
+                });
+            }
+        };
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: AllocatorDebugSettings::default(),
+            buffer_device_address: false,
+            allocation_sizes: AllocationSizes::default(),
+        });
+        let allocator = match allocator {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { device.destroy_command_pool(command_pool, None) };
+                destroy_base(&instance, &debug, &device);
+                return Err(GpuError::Allocation {
+                    what: "the allocator".into(),
+                    message: e.to_string(),
+                });
+            }
+        };
+        let debug_device = debug
+            .as_ref()
+            .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
+        Ok(Self {
+            entry,
+            instance,
+            debug,
+            debug_device,
+            physical,
+            device,
+            queue,
+            queue_family,
+            command_pool,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            info,
+            log,
+        })
+    }
+
+    /// The logical device, for recording commands.
+    pub fn device(&self) -> &ash::Device {
+        &self.device
+    }
+
+    /// The instance.
+    pub fn instance(&self) -> &ash::Instance {
+        &self.instance
+    }
+
+    /// The loader entry points.
+    pub fn entry(&self) -> &ash::Entry {
+        &self.entry
+    }
+
+    /// The chosen physical device.
+    pub fn physical_device(&self) -> vk::PhysicalDevice {
+        self.physical
+    }
+
+    /// The one graphics+compute queue.
+    pub fn queue(&self) -> vk::Queue {
+        self.queue
+    }
+
+    /// Family index of `queue`.
+    pub fn queue_family(&self) -> u32 {
+        self.queue_family
+    }
+
+    /// The command pool (resettable buffers) on `queue_family`.
+    pub fn command_pool(&self) -> vk::CommandPool {
+        self.command_pool
+    }
+
+    /// Name, type and timestamp support of the chosen device.
+    pub fn info(&self) -> &DeviceInfo {
+        &self.info
+    }
+
+    /// The memory allocator.
+    pub fn allocator(&self) -> MutexGuard<'_, Allocator> {
+        self.allocator
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// Debug-utils device functions when validation is on (object names, labels).
+    pub fn debug_utils(&self) -> Option<&ash::ext::debug_utils::Device> {
+        self.debug_device.as_ref()
+    }
+
+    /// The validation messages; keep a clone to read leak reports after drop.
+    pub fn validation(&self) -> Arc<ValidationLog> {
+        Arc::clone(&self.log)
+    }
+
+    /// Message counts so far.
+    pub fn validation_counts(&self) -> ValidationCounts {
+        self.log.counts()
+    }
+
+    /// Device memory in use by live allocations, and reserved in blocks.
+    pub fn memory_report(&self) -> MemoryReport {
+        let report = self.allocator().generate_report();
+        MemoryReport {
+            allocated_bytes: report.total_allocated_bytes,
+            reserved_bytes: report.total_capacity_bytes,
+        }
+    }
+
+    /// Waits until the device is idle.
+    pub fn wait_idle(&self) -> Result<(), GpuError> {
+        unsafe { self.device.device_wait_idle() }.call("vkDeviceWaitIdle")
+    }
+
+    /// Records commands into a fresh command buffer, submits them and waits.
+    pub fn one_shot(
+        &self,
+        record: impl FnOnce(vk::CommandBuffer) -> Result<(), GpuError>,
+    ) -> Result<(), GpuError> {
+        let cmd = self.allocate_command_buffer()?;
+        let result = (|| {
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            unsafe { self.device.begin_command_buffer(cmd, &begin) }
+                .call("vkBeginCommandBuffer")?;
+            record(cmd)?;
+            unsafe { self.device.end_command_buffer(cmd) }.call("vkEndCommandBuffer")?;
+            self.submit_and_wait(cmd)
+        })();
+        unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
+        result
+    }
+
+    /// Allocates one primary command buffer from the pool.
+    pub fn allocate_command_buffer(&self) -> Result<vk::CommandBuffer, GpuError> {
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(self.command_pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        let buffers = unsafe { self.device.allocate_command_buffers(&info) }
+            .call("vkAllocateCommandBuffers")?;
+        buffers.into_iter().next().ok_or(GpuError::Vulkan {
+            call: "vkAllocateCommandBuffers",
+            result: vk::Result::ERROR_UNKNOWN,
+        })
+    }
+
+    /// Submits one recorded command buffer and blocks until it has executed.
+    pub fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<(), GpuError> {
+        let fence = unsafe {
+            self.device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+        }
+        .call("vkCreateFence")?;
+        let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        let submit = vk::SubmitInfo2::default().command_buffer_infos(&buffers);
+        let result = unsafe {
+            self.device
+                .queue_submit2(self.queue, &[submit], fence)
+                .call("vkQueueSubmit2")
+                .and_then(|()| {
+                    self.device
+                        .wait_for_fences(&[fence], true, u64::MAX)
+                        .call("vkWaitForFences")
+                })
+        };
+        unsafe { self.device.destroy_fence(fence, None) };
+        result
+    }
+
+    /// Gives a Vulkan object a name that validation messages will show.
+    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
+        let Some(debug) = &self.debug_device else {
+            return;
+        };
+        let Ok(name) = std::ffi::CString::new(name) else {
+            return;
+        };
+        let info = vk::DebugUtilsObjectNameInfoEXT::default()
+            .object_handle(handle)
+            .object_name(&name);
+        // Naming is a debugging aid; a failure changes nothing the user sees.
+        let _ = unsafe { debug.set_debug_utils_object_name(&info) };
+    }
+}
+
+impl Drop for Gpu {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            ManuallyDrop::drop(&mut self.allocator);
+            self.device.destroy_command_pool(self.command_pool, None);
+        }
+        destroy_base(&self.instance, &self.debug, &self.device);
+    }
+}
+
+/// Device memory figures from the allocator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MemoryReport {
+    /// Bytes in live allocations (aliased transient blocks count once).
+    pub allocated_bytes: u64,
+    /// Bytes of device memory the allocator holds.
+    pub reserved_bytes: u64,
+}
+
+type DebugParts = Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>;
+
+/// Owns the instance and messenger until the device exists, destroying them
+/// if creation fails part way.
+struct InstanceGuard {
+    instance: Option<ash::Instance>,
+    debug: DebugParts,
+}
+
+impl InstanceGuard {
+    fn instance(&self) -> Result<&ash::Instance, GpuError> {
+        self.instance.as_ref().ok_or(GpuError::Vulkan {
+            call: "vkCreateInstance",
+            result: vk::Result::ERROR_INITIALIZATION_FAILED,
+        })
+    }
+
+    /// Hands ownership on; the guard then destroys nothing.
+    fn release(mut self) -> Result<(ash::Instance, DebugParts), GpuError> {
+        let instance = self.instance.take().ok_or(GpuError::Vulkan {
+            call: "vkCreateInstance",
+            result: vk::Result::ERROR_INITIALIZATION_FAILED,
+        })?;
+        Ok((instance, self.debug.take()))
+    }
+}
+
+impl Drop for InstanceGuard {
+    fn drop(&mut self) {
+        unsafe {
+            if let Some((loader, messenger)) = &self.debug {
+                loader.destroy_debug_utils_messenger(*messenger, None);
+            }
+            if let Some(instance) = &self.instance {
+                instance.destroy_instance(None);
+            }
+        }
+    }
+}
+
+fn destroy_base(instance: &ash::Instance, debug: &DebugParts, device: &ash::Device) {
+    unsafe {
+        device.destroy_device(None);
+        if let Some((loader, messenger)) = debug {
+            loader.destroy_debug_utils_messenger(*messenger, None);
+        }
+        instance.destroy_instance(None);
+    }
+}
+
+fn messenger_info(log: &Arc<ValidationLog>) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
+    vk::DebugUtilsMessengerCreateInfoEXT::default()
+        .message_severity(
+            vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+        )
+        .message_type(
+            vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+        )
+        .pfn_user_callback(Some(validation::callback))
+        .user_data(Arc::as_ptr(log) as *mut c_void)
+}
+
+fn create_instance(
+    entry: &ash::Entry,
+    validate: bool,
+    log: &Arc<ValidationLog>,
+) -> Result<ash::Instance, GpuError> {
+    let app = vk::ApplicationInfo::default()
+        .application_name(c"weft")
+        .engine_name(c"weft")
+        .api_version(vk::API_VERSION_1_3);
+    let mut layers = Vec::new();
+    let mut extensions = Vec::new();
+    if validate {
+        let available = unsafe { entry.enumerate_instance_layer_properties() }
+            .call("vkEnumerateInstanceLayerProperties")?;
+        let found = available
+            .iter()
+            .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER));
+        if !found {
+            return Err(GpuError::NoValidationLayer);
+        }
+        layers.push(VALIDATION_LAYER.as_ptr());
+        extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+    }
+    let enabled = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled);
+    let mut messenger = messenger_info(log);
+    let mut info = vk::InstanceCreateInfo::default()
+        .application_info(&app)
+        .enabled_layer_names(&layers)
+        .enabled_extension_names(&extensions);
+    if validate {
+        info = info.push_next(&mut features).push_next(&mut messenger);
+    }
+    unsafe { entry.create_instance(&info, None) }.call("vkCreateInstance")
+}
+
+fn choose_device(
+    instance: &ash::Instance,
+    wanted: Option<&str>,
+) -> Result<(vk::PhysicalDevice, DeviceInfo, u32), GpuError> {
+    let devices =
+        unsafe { instance.enumerate_physical_devices() }.call("vkEnumeratePhysicalDevices")?;
+    let mut candidates = Vec::new();
+    let mut names = Vec::new();
+    for physical in devices {
+        let props = unsafe { instance.get_physical_device_properties(physical) };
+        let name = props
+            .device_name_as_c_str()
+            .map(|c| c.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        names.push(name.clone());
+        if props.api_version < vk::API_VERSION_1_3 {
+            continue;
+        }
+        if let Some(w) = wanted {
+            if !name.to_lowercase().contains(&w.to_lowercase()) {
+                continue;
+            }
+        }
+        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+        let needed = vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE;
+        let Some((family, props_family)) = families
+            .iter()
+            .enumerate()
+            .find(|(_, f)| f.queue_flags.contains(needed))
+        else {
+            continue;
+        };
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+        let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+        unsafe { instance.get_physical_device_features2(physical, &mut f2) };
+        if f13.synchronization2 == vk::FALSE || f13.maintenance4 == vk::FALSE {
+            continue;
+        }
+        let info = DeviceInfo {
+            name,
+            kind: DeviceKind::from_vk(props.device_type),
+            timestamp_period: props.limits.timestamp_period,
+            timestamps: props_family.timestamp_valid_bits > 0,
+        };
+        candidates.push((physical, info, family as u32));
+    }
+    candidates.sort_by_key(|(_, info, _)| info.kind);
+    candidates
+        .into_iter()
+        .next()
+        .ok_or_else(|| GpuError::NoDevice {
+            wanted: wanted.map(str::to_string),
+            available: if names.is_empty() {
+                "none".into()
+            } else {
+                names.join(", ")
+            },
+        })
+}
+
+fn create_device(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    family: u32,
+) -> Result<ash::Device, GpuError> {
+    let priorities = [1.0];
+    let queues = [vk::DeviceQueueCreateInfo::default()
+        .queue_family_index(family)
+        .queue_priorities(&priorities)];
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
+        .synchronization2(true)
+        .maintenance4(true);
+    let mut features = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+    let info = vk::DeviceCreateInfo::default()
+        .queue_create_infos(&queues)
+        .push_next(&mut features);
+    unsafe { instance.create_device(physical, &info, None) }.call("vkCreateDevice")
+}

@@ -1,0 +1,53 @@
+//! Errors of the Vulkan context and the executor.
+
+use ash::vk;
+
+/// Anything that can go wrong creating the context or running a plan.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// The Vulkan loader library could not be loaded.
+    #[error("cannot load the Vulkan loader: {0}")]
+    Loader(String),
+    /// A Vulkan call failed.
+    #[error("{call} failed: {result}")]
+    Vulkan {
+        call: &'static str,
+        result: vk::Result,
+    },
+    /// Validation was requested but the Khronos layer is not installed.
+    #[error(
+        "validation requested but VK_LAYER_KHRONOS_validation is not installed (run tools/setup)"
+    )]
+    NoValidationLayer,
+    /// No device matched (or none supports Vulkan 1.3 with what weft needs).
+    #[error("no suitable Vulkan 1.3 device{}; available: {available}", match .wanted { Some(w) => format!(" matching \"{w}\""), None => String::new() })]
+    NoDevice {
+        wanted: Option<String>,
+        available: String,
+    },
+    /// Device memory could not be allocated.
+    #[error("memory allocation for {what} failed: {message}")]
+    Allocation { what: String, message: String },
+    /// A shader failed to compile or reflect.
+    #[error(transparent)]
+    Shader(#[from] crate::shader::ShaderError),
+    /// The plan asks for something the executor cannot do, or is inconsistent
+    /// with its shaders.
+    #[error("pass `{pass}`: {message}")]
+    Pass { pass: String, message: String },
+    /// The plan itself is inconsistent.
+    #[error("plan: {0}")]
+    Plan(String),
+}
+
+/// Extension that turns `VkResult` errors into `GpuError::Vulkan` naming the call.
+pub(crate) trait VkCall<T> {
+    /// Labels a failed call.
+    fn call(self, call: &'static str) -> Result<T, GpuError>;
+}
+
+impl<T> VkCall<T> for Result<T, vk::Result> {
+    fn call(self, call: &'static str) -> Result<T, GpuError> {
+        self.map_err(|result| GpuError::Vulkan { call, result })
+    }
+}

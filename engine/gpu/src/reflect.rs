@@ -1,0 +1,289 @@
+//! Reflection of SPIR-V with spirq: the descriptor bindings, push-constant
+//! block and fragment outputs a shader declares, so pipeline layouts come
+//! from the shaders themselves and can be cross-checked against the graph.
+
+use crate::shader::{CompiledShader, ShaderError, ShaderStage};
+use ash::vk;
+use spirq::prelude::*;
+use spirq::ty::{DescriptorType, ScalarType, Type};
+use std::collections::BTreeMap;
+
+/// What kind of descriptor a shader binding is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum DescriptorKind {
+    CombinedImageSampler,
+    StorageImage,
+    UniformBuffer,
+    StorageBuffer,
+}
+
+impl DescriptorKind {
+    /// The Vulkan descriptor type.
+    pub fn vk(self) -> vk::DescriptorType {
+        match self {
+            Self::CombinedImageSampler => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+            Self::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+            Self::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
+            Self::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+        }
+    }
+}
+
+/// One descriptor binding a shader declares.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ShaderBinding {
+    pub set: u32,
+    pub binding: u32,
+    /// The GLSL variable name, or the block name for buffer blocks without an
+    /// instance name; the executor matches it to a graph resource of that name.
+    pub name: String,
+    pub kind: DescriptorKind,
+    pub count: u32,
+}
+
+/// Scalar type of a push-constant member.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ScalarKind {
+    Float,
+    Int,
+    Uint,
+}
+
+/// One member of the push-constant block: a graph parameter lands here by name.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PushMember {
+    pub name: String,
+    pub offset: u32,
+    pub scalar: ScalarKind,
+    /// 1 for scalars, 2 to 4 for vectors.
+    pub components: u32,
+}
+
+/// The push-constant block of a shader.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct PushBlock {
+    pub size: u32,
+    pub members: Vec<PushMember>,
+}
+
+/// A fragment shader output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FragmentOutput {
+    pub location: u32,
+    pub scalar: ScalarKind,
+    pub components: u32,
+}
+
+/// The resource interface of one shader stage.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ShaderInterface {
+    pub stage: ShaderStage,
+    pub bindings: Vec<ShaderBinding>,
+    pub push: Option<PushBlock>,
+    /// Colour outputs of fragment shaders, by location.
+    pub outputs: Vec<FragmentOutput>,
+}
+
+impl ShaderInterface {
+    /// Reflects a compiled shader's `main` entry point.
+    pub fn reflect(shader: &CompiledShader) -> Result<Self, ShaderError> {
+        let fail = |message: String| ShaderError::Reflect {
+            path: shader.path.clone(),
+            message,
+        };
+        let entries = ReflectConfig::new()
+            .spv(shader.spirv.as_slice())
+            .ref_all_rscs(false)
+            .combine_img_samplers(true)
+            .reflect()
+            .map_err(|e| fail(format!("SPIR-V reflection failed: {e}")))?;
+        let entry = entries
+            .into_iter()
+            .find(|e| e.name == "main")
+            .ok_or_else(|| fail("no `main` entry point".into()))?;
+        let mut bindings = Vec::new();
+        let mut push = None;
+        let mut outputs = Vec::new();
+        for var in entry.vars {
+            match var {
+                Variable::Descriptor {
+                    name,
+                    desc_bind,
+                    desc_ty,
+                    ty,
+                    nbind,
+                } => {
+                    let kind = match desc_ty {
+                        DescriptorType::CombinedImageSampler() => {
+                            DescriptorKind::CombinedImageSampler
+                        }
+                        DescriptorType::StorageImage(_) => DescriptorKind::StorageImage,
+                        DescriptorType::UniformBuffer() => DescriptorKind::UniformBuffer,
+                        DescriptorType::StorageBuffer(_) => DescriptorKind::StorageBuffer,
+                        other => {
+                            return Err(fail(format!(
+                                "binding {} uses unsupported descriptor type {other:?}",
+                                desc_bind.bind()
+                            )))
+                        }
+                    };
+                    let name = name
+                        .filter(|n| !n.is_empty())
+                        .or_else(|| struct_name(&ty))
+                        .unwrap_or_default();
+                    bindings.push(ShaderBinding {
+                        set: desc_bind.set(),
+                        binding: desc_bind.bind(),
+                        name,
+                        kind,
+                        count: nbind.max(1),
+                    });
+                }
+                Variable::PushConstant { ty, .. } => {
+                    push = Some(push_block(&ty).map_err(fail)?);
+                }
+                Variable::Output { location, ty, .. } if shader.stage == ShaderStage::Fragment => {
+                    let (scalar, components) = scalar_shape(&ty).ok_or_else(|| {
+                        fail(format!("output {} has an unsupported type", location.loc()))
+                    })?;
+                    outputs.push(FragmentOutput {
+                        location: location.loc(),
+                        scalar,
+                        components,
+                    });
+                }
+                _ => {}
+            }
+        }
+        bindings.sort_by_key(|b| (b.set, b.binding));
+        outputs.sort_by_key(|o| o.location);
+        Ok(Self {
+            stage: shader.stage,
+            bindings,
+            push,
+            outputs,
+        })
+    }
+}
+
+fn struct_name(ty: &Type) -> Option<String> {
+    match ty {
+        Type::Struct(s) => s.name.clone(),
+        _ => None,
+    }
+}
+
+fn scalar_kind(s: &ScalarType) -> Option<ScalarKind> {
+    match s {
+        ScalarType::Float { .. } => Some(ScalarKind::Float),
+        ScalarType::Integer {
+            is_signed: true, ..
+        } => Some(ScalarKind::Int),
+        ScalarType::Integer {
+            is_signed: false, ..
+        } => Some(ScalarKind::Uint),
+        _ => None,
+    }
+}
+
+fn scalar_shape(ty: &Type) -> Option<(ScalarKind, u32)> {
+    match ty {
+        Type::Scalar(s) => Some((scalar_kind(s)?, 1)),
+        Type::Vector(v) => Some((scalar_kind(&v.scalar_ty)?, v.nscalar)),
+        _ => None,
+    }
+}
+
+fn push_block(ty: &Type) -> Result<PushBlock, String> {
+    let Type::Struct(s) = ty else {
+        return Err("push constant is not a block".into());
+    };
+    let size = ty.nbyte().ok_or("push-constant block has no size")? as u32;
+    let mut members = Vec::new();
+    for m in &s.members {
+        let name = m.name.clone().unwrap_or_default();
+        let (scalar, components) = scalar_shape(&m.ty).ok_or_else(|| {
+            format!("push-constant member `{name}` must be a 32-bit scalar or vector")
+        })?;
+        let offset = m.offset.ok_or("push-constant member without an offset")? as u32;
+        members.push(PushMember {
+            name,
+            offset,
+            scalar,
+            components,
+        });
+    }
+    Ok(PushBlock { size, members })
+}
+
+/// The merged interface of a pipeline's stages: one descriptor set layout per
+/// set and one push-constant range covering every stage that uses it.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct PipelineInterface {
+    /// (set, binding) to the binding and the stages that use it.
+    pub bindings: BTreeMap<(u32, u32), (ShaderBinding, vk::ShaderStageFlags)>,
+    /// Push-constant block shared by the stages, with the stages using it.
+    pub push: Option<(PushBlock, vk::ShaderStageFlags)>,
+    /// Fragment outputs.
+    pub outputs: Vec<FragmentOutput>,
+}
+
+impl PipelineInterface {
+    /// Merges stage interfaces; the same binding must have the same kind in all stages.
+    pub fn merge(stages: &[&ShaderInterface]) -> Result<Self, String> {
+        let mut merged = Self::default();
+        for stage in stages {
+            let flag = stage_flag(stage.stage);
+            for b in &stage.bindings {
+                match merged.bindings.get_mut(&(b.set, b.binding)) {
+                    Some((existing, flags)) => {
+                        if existing.kind != b.kind {
+                            return Err(format!(
+                                "set {} binding {} is {:?} in one stage and {:?} in another",
+                                b.set, b.binding, existing.kind, b.kind
+                            ));
+                        }
+                        *flags |= flag;
+                    }
+                    None => {
+                        merged
+                            .bindings
+                            .insert((b.set, b.binding), (b.clone(), flag));
+                    }
+                }
+            }
+            if let Some(p) = &stage.push {
+                merged.push = Some(match merged.push.take() {
+                    Some((mut block, flags)) => {
+                        block.size = block.size.max(p.size);
+                        for m in &p.members {
+                            if !block.members.iter().any(|x| x.name == m.name) {
+                                block.members.push(m.clone());
+                            }
+                        }
+                        (block, flags | flag)
+                    }
+                    None => (p.clone(), flag),
+                });
+            }
+            if stage.stage == ShaderStage::Fragment {
+                merged.outputs.clone_from(&stage.outputs);
+            }
+        }
+        Ok(merged)
+    }
+
+    /// The descriptor set numbers used, highest first set included.
+    pub fn set_count(&self) -> u32 {
+        self.bindings.keys().map(|(s, _)| s + 1).max().unwrap_or(0)
+    }
+}
+
+/// The Vulkan stage flag of a stage.
+pub fn stage_flag(stage: ShaderStage) -> vk::ShaderStageFlags {
+    match stage {
+        ShaderStage::Vertex => vk::ShaderStageFlags::VERTEX,
+        ShaderStage::Fragment => vk::ShaderStageFlags::FRAGMENT,
+        ShaderStage::Compute => vk::ShaderStageFlags::COMPUTE,
+    }
+}

@@ -1,0 +1,60 @@
+//! The Vulkan context comes up with validation and goes down without leaks.
+
+use weft_gpu::{DeviceKind, Gpu, GpuError, GpuOptions};
+
+#[test]
+fn creates_and_destroys_cleanly_under_validation() {
+    let gpu = Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("a Vulkan 1.3 device");
+    assert!(!gpu.info().name.is_empty());
+    assert!(gpu.debug_utils().is_some());
+    gpu.one_shot(|_| Ok(())).expect("an empty submission");
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}
+
+#[test]
+fn picks_a_device_by_name_substring() {
+    let any = Gpu::new(&GpuOptions::default()).expect("a device");
+    let name = any.info().name.clone();
+    let kind = any.info().kind;
+    drop(any);
+    let fragment: String = name.chars().take(4).collect::<String>().to_uppercase();
+    let picked = Gpu::new(&GpuOptions {
+        validation: false,
+        device: Some(fragment),
+    })
+    .expect("the same device by substring");
+    assert_eq!(picked.info().name, name);
+    assert_eq!(picked.info().kind, kind);
+    assert!(matches!(
+        kind,
+        DeviceKind::Discrete
+            | DeviceKind::Integrated
+            | DeviceKind::Cpu
+            | DeviceKind::Virtual
+            | DeviceKind::Other
+    ));
+}
+
+#[test]
+fn unknown_device_name_lists_what_exists() {
+    let err = Gpu::new(&GpuOptions {
+        validation: false,
+        device: Some("no-such-gpu-xyz".into()),
+    })
+    .err()
+    .expect("no match");
+    let GpuError::NoDevice { wanted, available } = &err else {
+        panic!("expected NoDevice, got {err}");
+    };
+    assert_eq!(wanted.as_deref(), Some("no-such-gpu-xyz"));
+    assert!(!available.is_empty());
+    assert!(err
+        .to_string()
+        .starts_with("no suitable Vulkan 1.3 device matching \"no-such-gpu-xyz\""));
+}
