@@ -68,6 +68,7 @@ pub fn load_model(
     {
         let mut model = match extension(path).as_str() {
             "obj" => load_obj(path, asked_at, diag)?,
+            "gltf" | "glb" => crate::gltf_import::load_gltf(path, asked_at, diag)?,
             other => {
                 return Err(SceneError::Model {
                     at: asked_at.clone(),

@@ -3,6 +3,7 @@
 
 use glam::{Vec3, Vec4};
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Which parameter set the source defined, so a renderer picks the matching shading.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,10 +32,12 @@ pub enum TextureSource {
     File(PathBuf),
     /// Image bytes embedded in a glTF buffer or data URI.
     Embedded {
+        /// Identifies the image for sharing: `FILE#imageN`.
+        id: String,
         /// The MIME type the glTF file gives (`image/png`, `image/jpeg`).
         mime_type: String,
-        /// The encoded image.
-        bytes: Vec<u8>,
+        /// The encoded image, shared by every material that uses it.
+        bytes: Arc<[u8]>,
     },
 }
 

@@ -1,0 +1,456 @@
+//! glTF 2.0 import (`.gltf` with external or embedded buffers, `.glb`): meshes with node
+//! transforms baked in, metallic-roughness materials with the emissive-strength,
+//! transmission, IOR and volume extensions, KHR_lights_punctual lights and cameras.
+
+use crate::bounds::Aabb;
+use crate::camera::{Camera, CameraOrigin};
+use crate::error::{Diagnostics, Location, SceneError};
+use crate::light::{
+    derive_radius, Attenuation, Light, PointLight, RadiusSource, SpotLight, SunLight,
+    DEFAULT_LUMINANCE_THRESHOLD,
+};
+use crate::material::{AlphaMode, Material, ShadingModel, TextureRef, TextureSource};
+use crate::mesh::{compute_normals, Mesh};
+use crate::model::Model;
+use crate::source::{read_bytes, MAX_MODEL_BYTES};
+use crate::uri::{decode_data_uri, percent_decode};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use std::path::{Path, PathBuf};
+
+/// Loads a `.gltf` or `.glb` file; `asked_at` is where it was named.
+pub fn load_gltf(
+    path: &Path,
+    asked_at: &Location,
+    diag: &mut Diagnostics,
+) -> Result<Model, SceneError> {
+    let bytes = read_bytes(path, asked_at, MAX_MODEL_BYTES)?;
+    let model_error = |message: String| SceneError::Model {
+        at: Location::file(path),
+        message,
+    };
+    let gltf = gltf::Gltf::from_slice(&bytes)
+        .map_err(|e| model_error(format!("glTF does not parse: {e}")))?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let buffers = load_buffers(&gltf, dir, path)?;
+    let doc = &gltf.document;
+    let images = image_sources(doc, &buffers, dir, path, diag);
+    let materials: Vec<Material> = doc.materials().map(|m| material(&m, &images)).collect();
+    let mut out = Model {
+        path: path.to_path_buf(),
+        meshes: Vec::new(),
+        materials,
+        lights: Vec::new(),
+        cameras: Vec::new(),
+        bounds: Aabb::EMPTY,
+    };
+    let roots: Vec<gltf::Node<'_>> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(scene) => scene.nodes().collect(),
+        None => doc.nodes().collect(),
+    };
+    // Depth-first in document order: children are pushed reversed so the first pops first.
+    let mut stack: Vec<(gltf::Node<'_>, Mat4, usize)> = roots
+        .into_iter()
+        .rev()
+        .map(|n| (n, Mat4::IDENTITY, 0))
+        .collect();
+    while let Some((node, parent, depth)) = stack.pop() {
+        if depth > 256 {
+            return Err(model_error(
+                "node hierarchy deeper than 256 (a cycle?)".to_string(),
+            ));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(mesh) = node.mesh() {
+            for (i, primitive) in mesh.primitives().enumerate() {
+                let name = format!("{}#{i}", mesh.name().or(node.name()).unwrap_or("mesh"));
+                if let Some(m) = primitive_mesh(&primitive, &buffers, &world, name, path, diag)? {
+                    out.meshes.push(m);
+                }
+            }
+        }
+        if let Some(light) = node.light() {
+            out.lights.push(punctual(&light, &world));
+        }
+        if let Some(camera) = node.camera() {
+            if let Some(c) = camera_of(&camera, &node, &world, out.cameras.len(), path, diag) {
+                out.cameras.push(c);
+            }
+        }
+        let children: Vec<gltf::Node<'_>> = node.children().collect();
+        stack.extend(children.into_iter().rev().map(|c| (c, world, depth + 1)));
+    }
+    out.update_bounds();
+    Ok(out)
+}
+
+/// Every buffer's bytes: the GLB chunk, a data URI, or a file beside the glTF.
+fn load_buffers(gltf: &gltf::Gltf, dir: &Path, path: &Path) -> Result<Vec<Vec<u8>>, SceneError> {
+    gltf.document
+        .buffers()
+        .map(|buffer| {
+            let data = match buffer.source() {
+                gltf::buffer::Source::Bin => {
+                    gltf.blob.clone().ok_or_else(|| SceneError::Model {
+                        at: Location::file(path),
+                        message: "buffer refers to a GLB chunk the file lacks".to_string(),
+                    })?
+                }
+                gltf::buffer::Source::Uri(uri) => match decode_data_uri(uri) {
+                    Some(decoded) => {
+                        decoded
+                            .map_err(|e| SceneError::Model {
+                                at: Location::file(path),
+                                message: format!("buffer {}: {e}", buffer.index()),
+                            })?
+                            .1
+                    }
+                    None => read_bytes(
+                        &dir.join(percent_decode(uri)),
+                        &Location::file(path),
+                        MAX_MODEL_BYTES,
+                    )?,
+                },
+            };
+            if data.len() < buffer.length() {
+                return Err(SceneError::Model {
+                    at: Location::file(path),
+                    message: format!(
+                        "buffer {} has {} bytes, fewer than the {} declared",
+                        buffer.index(),
+                        data.len(),
+                        buffer.length()
+                    ),
+                });
+            }
+            Ok(data)
+        })
+        .collect()
+}
+
+/// One triangle primitive as a mesh in model space; `None` (with a warning) for points,
+/// lines and primitives without positions.
+fn primitive_mesh(
+    primitive: &gltf::Primitive<'_>,
+    buffers: &[Vec<u8>],
+    world: &Mat4,
+    name: String,
+    path: &Path,
+    diag: &mut Diagnostics,
+) -> Result<Option<Mesh>, SceneError> {
+    if primitive.mode() != gltf::mesh::Mode::Triangles {
+        diag.warn(
+            Location::file(path),
+            format!(
+                "primitive '{name}' has mode {:?}; only triangle lists are imported",
+                primitive.mode()
+            ),
+        );
+        return Ok(None);
+    }
+    let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let Some(positions) = reader.read_positions() else {
+        diag.warn(
+            Location::file(path),
+            format!("primitive '{name}' has no positions; skipped"),
+        );
+        return Ok(None);
+    };
+    let local: Vec<Vec3> = positions.map(Vec3::from_array).collect();
+    let indices: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..local.len() as u32).collect(),
+    };
+    let bad = |message: String| SceneError::Model {
+        at: Location::file(path),
+        message: format!("primitive '{name}': {message}"),
+    };
+    if !indices.len().is_multiple_of(3) {
+        return Err(bad(format!(
+            "{} indices is not a whole number of triangles",
+            indices.len()
+        )));
+    }
+    if indices.iter().any(|&i| i as usize >= local.len()) {
+        return Err(bad("an index is past the vertex count".to_string()));
+    }
+    if local.iter().any(|p| !p.is_finite()) {
+        return Err(bad("a position is NaN or infinite".to_string()));
+    }
+    let normal_matrix = Mat3::from_mat4(*world).inverse().transpose();
+    let flip = world.determinant() < 0.0;
+    let positions: Vec<Vec3> = local.iter().map(|&p| world.transform_point3(p)).collect();
+    let mut indices = indices;
+    if flip {
+        for tri in indices.chunks_exact_mut(3) {
+            tri.swap(1, 2);
+        }
+    }
+    let normals = match reader.read_normals() {
+        Some(n) => n
+            .map(|n| {
+                (normal_matrix * Vec3::from_array(n))
+                    .try_normalize()
+                    .unwrap_or(Vec3::Y)
+            })
+            .collect::<Vec<_>>(),
+        None => compute_normals(&positions, &indices),
+    };
+    let uvs: Vec<Vec2> = reader
+        .read_tex_coords(0)
+        .map(|t| t.into_f32().map(Vec2::from_array).collect())
+        .unwrap_or_default();
+    let handedness = if flip { -1.0 } else { 1.0 };
+    let tangents: Vec<Vec4> = reader
+        .read_tangents()
+        .map(|t| {
+            t.map(|t| {
+                let xyz = (Mat3::from_mat4(*world) * Vec3::new(t[0], t[1], t[2]))
+                    .try_normalize()
+                    .unwrap_or(Vec3::X);
+                xyz.extend(t[3] * handedness)
+            })
+            .collect()
+        })
+        .unwrap_or_default();
+    let count = positions.len();
+    if normals.len() != count
+        || (!uvs.is_empty() && uvs.len() != count)
+        || (!tangents.is_empty() && tangents.len() != count)
+    {
+        return Err(bad("attribute counts differ".to_string()));
+    }
+    let bounds = Aabb::from_points(&positions);
+    Ok(Some(Mesh {
+        name,
+        positions,
+        normals,
+        uvs,
+        tangents,
+        indices,
+        material: primitive.material().index(),
+        bounds,
+    }))
+}
+
+/// Every image as a texture source, decoded once so materials share the bytes; `None`
+/// (with a warning) for images that cannot be found.
+fn image_sources(
+    doc: &gltf::Document,
+    buffers: &[Vec<u8>],
+    dir: &Path,
+    path: &Path,
+    diag: &mut Diagnostics,
+) -> Vec<Option<TextureSource>> {
+    doc.images()
+        .map(|image| {
+            let id = format!("{}#image{}", path.display(), image.index());
+            match image.source() {
+                gltf::image::Source::View { view, mime_type } => {
+                    let bytes = buffers
+                        .get(view.buffer().index())
+                        .and_then(|b| b.get(view.offset()..view.offset() + view.length()));
+                    if bytes.is_none() {
+                        diag.warn(
+                            Location::file(path),
+                            format!("image {} lies outside its buffer; left out", image.index()),
+                        );
+                    }
+                    bytes.map(|bytes| TextureSource::Embedded {
+                        id,
+                        mime_type: mime_type.to_string(),
+                        bytes: bytes.into(),
+                    })
+                }
+                gltf::image::Source::Uri { uri, mime_type } => match decode_data_uri(uri) {
+                    Some(Ok((mime, bytes))) => Some(TextureSource::Embedded {
+                        id,
+                        mime_type: mime_type.map_or(mime, str::to_string),
+                        bytes: bytes.into(),
+                    }),
+                    Some(Err(e)) => {
+                        diag.warn(
+                            Location::file(path),
+                            format!("image {}: {e}; left out", image.index()),
+                        );
+                        None
+                    }
+                    None => {
+                        let file: PathBuf = dir.join(percent_decode(uri));
+                        if file.is_file() {
+                            Some(TextureSource::File(
+                                std::path::absolute(&file).unwrap_or(file),
+                            ))
+                        } else {
+                            diag.warn(
+                                Location::file(path),
+                                format!("texture {} not found; left out", file.display()),
+                            );
+                            None
+                        }
+                    }
+                },
+            }
+        })
+        .collect()
+}
+
+/// A texture reference to an already-decoded image.
+fn texture(
+    texture: gltf::Texture<'_>,
+    tex_coord: u32,
+    images: &[Option<TextureSource>],
+) -> Option<TextureRef> {
+    let source = images.get(texture.source().index())?.clone()?;
+    Some(TextureRef { source, tex_coord })
+}
+
+/// A glTF material.
+fn material(m: &gltf::Material<'_>, images: &[Option<TextureSource>]) -> Material {
+    let pbr = m.pbr_metallic_roughness();
+    let tex = |t: Option<gltf::texture::Info<'_>>| {
+        t.and_then(|info| texture(info.texture(), info.tex_coord(), images))
+    };
+    let mut out = Material {
+        name: m.name().map_or_else(
+            || format!("material{}", m.index().unwrap_or(0)),
+            str::to_string,
+        ),
+        shading: ShadingModel::MetallicRoughness,
+        base_color: Vec4::from_array(pbr.base_color_factor()),
+        emissive: Vec3::from_array(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0),
+        ior: m.ior().unwrap_or(1.5),
+        metallic: pbr.metallic_factor(),
+        roughness: pbr.roughness_factor(),
+        alpha_mode: match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        },
+        double_sided: m.double_sided(),
+        ..Material::default()
+    };
+    out.textures.base_color = tex(pbr.base_color_texture());
+    out.textures.metallic_roughness = tex(pbr.metallic_roughness_texture());
+    out.textures.emissive = tex(m.emissive_texture());
+    if let Some(n) = m.normal_texture() {
+        out.normal_scale = n.scale();
+        out.textures.normal = texture(n.texture(), n.tex_coord(), images);
+    }
+    if let Some(o) = m.occlusion_texture() {
+        out.textures.occlusion = texture(o.texture(), o.tex_coord(), images);
+    }
+    if let Some(t) = m.transmission() {
+        out.transmission = t.transmission_factor();
+        out.textures.transmission = tex(t.transmission_texture());
+    }
+    if let Some(v) = m.volume() {
+        out.thickness = v.thickness_factor();
+        out.textures.thickness = tex(v.thickness_texture());
+        let d = v.attenuation_distance();
+        out.attenuation_distance = (d.is_finite() && d > 0.0).then_some(d);
+        out.attenuation_color = Vec3::from_array(v.attenuation_color());
+    }
+    out
+}
+
+/// A KHR_lights_punctual light placed by its node (lights shine down the node's -Z).
+fn punctual(light: &gltf::khr_lights_punctual::Light<'_>, world: &Mat4) -> Light {
+    let color = Vec3::from_array(light.color()) * light.intensity();
+    let position = world.transform_point3(Vec3::ZERO);
+    let direction = world
+        .transform_vector3(Vec3::NEG_Z)
+        .try_normalize()
+        .unwrap_or(Vec3::NEG_Z);
+    let (radius, radius_source) = match light.range() {
+        Some(r) => (r, RadiusSource::Range),
+        None => (
+            derive_radius(
+                color,
+                &Attenuation::INVERSE_SQUARE,
+                DEFAULT_LUMINANCE_THRESHOLD,
+            )
+            .unwrap_or(f32::INFINITY),
+            RadiusSource::Derived,
+        ),
+    };
+    match light.kind() {
+        gltf::khr_lights_punctual::Kind::Directional => Light::Sun(SunLight {
+            direction,
+            color,
+            ambient: Vec3::ZERO,
+            motion: None,
+        }),
+        gltf::khr_lights_punctual::Kind::Point => Light::Point(PointLight {
+            position,
+            color,
+            velocity: 0.0,
+            amplitude: 0.0,
+            attenuation: Attenuation::INVERSE_SQUARE,
+            radius,
+            radius_source,
+        }),
+        gltf::khr_lights_punctual::Kind::Spot {
+            inner_cone_angle,
+            outer_cone_angle,
+        } => Light::Spot(SpotLight {
+            position,
+            direction,
+            color,
+            exponent: 0.0,
+            angle: outer_cone_angle.to_degrees(),
+            inner_angle: Some(inner_cone_angle.to_degrees()),
+            length: light.range(),
+            attenuation: Attenuation::INVERSE_SQUARE,
+            swivel: None,
+        }),
+    }
+}
+
+/// A perspective camera node; orthographic ones are skipped with a warning.
+fn camera_of(
+    camera: &gltf::Camera<'_>,
+    node: &gltf::Node<'_>,
+    world: &Mat4,
+    index: usize,
+    path: &Path,
+    diag: &mut Diagnostics,
+) -> Option<Camera> {
+    let name = camera
+        .name()
+        .or(node.name())
+        .map_or_else(|| format!("gltf-camera{index}"), str::to_string);
+    let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+        diag.warn(
+            Location::file(path),
+            format!("camera '{name}' is orthographic; skipped"),
+        );
+        return None;
+    };
+    let (_, rotation, translation) = world.to_scale_rotation_translation();
+    Some(Camera {
+        name,
+        position: translation,
+        orientation: rotation.normalize(),
+        fov_y: p.yfov(),
+        near: p.znear(),
+        far: p.zfar().unwrap_or(p.znear() * 1e6),
+        path: Vec::new(),
+        origin: CameraOrigin::Gltf,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Quat;
+
+    #[test]
+    fn punctual_directions_follow_the_node() {
+        let world = Mat4::from_rotation_translation(
+            Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+            Vec3::Y,
+        );
+        assert!(world.transform_vector3(Vec3::NEG_Z).distance(Vec3::NEG_Y) < 1e-6);
+        assert_eq!(world.transform_point3(Vec3::ZERO), Vec3::Y);
+    }
+}

@@ -1,0 +1,244 @@
+//! `weft scene check`: a summary of a loaded scene for people (`Display`) and tools (serde).
+
+use crate::bounds::Aabb;
+use crate::error::{SceneError, Warning};
+use crate::light::{energy_cut_share, Light, RadiusSource};
+use crate::load::{load_scene_with, LoadOptions};
+use crate::material::TextureSource;
+use crate::scene::Scene;
+use serde::Serialize;
+use std::collections::BTreeSet;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// One model file in the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModelSummary {
+    /// The file.
+    pub file: PathBuf,
+    /// How many times the scene places it.
+    pub instances: usize,
+    /// Its meshes.
+    pub meshes: usize,
+    /// Its triangles (once, not per instance).
+    pub triangles: usize,
+    /// Its materials.
+    pub materials: usize,
+    /// Distinct textures its materials use.
+    pub textures: usize,
+}
+
+/// Lights by type.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct LightCounts {
+    /// Directional lights.
+    pub sun: usize,
+    /// Spotlights.
+    pub spot: usize,
+    /// Point lights.
+    pub point: usize,
+    /// Area lights.
+    pub area: usize,
+}
+
+/// How point-light radii were chosen and what the cutoff costs.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RadiusSummary {
+    /// Radii given in the scene.
+    pub given: usize,
+    /// Radii derived from attenuation and the luminance threshold.
+    pub derived: usize,
+    /// Radii from glTF `range`.
+    pub range: usize,
+    /// The largest share of a light's energy (within the scene's extent) that its cutoff drops.
+    pub max_energy_cut: f32,
+    /// The mean of those shares.
+    pub mean_energy_cut: f32,
+}
+
+/// Everything `weft scene check` prints.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SceneReport {
+    /// The checked file.
+    pub file: PathBuf,
+    /// Model files, in first-use order.
+    pub models: Vec<ModelSummary>,
+    /// Placed models.
+    pub instances: usize,
+    /// Meshes over all model files.
+    pub meshes: usize,
+    /// Triangles drawn, counting every instance.
+    pub triangles: usize,
+    /// Materials over all model files.
+    pub materials: usize,
+    /// Distinct textures over the scene.
+    pub textures: usize,
+    /// Lights by type.
+    pub lights: LightCounts,
+    /// Point-light radii, when there are point lights.
+    pub point_light_radius: Option<RadiusSummary>,
+    /// Camera names; the first is the starting camera.
+    pub cameras: Vec<String>,
+    /// World bounds of the geometry, `None` when there is none.
+    pub bounds: Option<Aabb>,
+    /// Warnings, in the order found.
+    pub warnings: Vec<Warning>,
+}
+
+/// Loads `path` and summarises it; an `Err` is the located reason it does not load.
+pub fn check_report(path: &Path) -> Result<SceneReport, SceneError> {
+    check_report_with(path, &LoadOptions::default())
+}
+
+/// [`check_report`] with load options (e.g. a cache folder).
+pub fn check_report_with(path: &Path, options: &LoadOptions) -> Result<SceneReport, SceneError> {
+    Ok(SceneReport::of(&load_scene_with(path, options)?))
+}
+
+/// A stable key for a texture, to count distinct ones.
+fn texture_key(source: &TextureSource) -> String {
+    match source {
+        TextureSource::File(p) => p.display().to_string(),
+        TextureSource::Embedded { id, .. } => id.clone(),
+    }
+}
+
+impl SceneReport {
+    /// Summarises a loaded scene.
+    pub fn of(scene: &Scene) -> Self {
+        let mut all_textures = BTreeSet::new();
+        let models: Vec<ModelSummary> = scene
+            .models
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let textures: BTreeSet<String> = m
+                    .materials
+                    .iter()
+                    .flat_map(|mat| mat.textures.iter())
+                    .map(|t| texture_key(&t.source))
+                    .collect();
+                all_textures.extend(textures.iter().cloned());
+                ModelSummary {
+                    file: m.path.clone(),
+                    instances: scene
+                        .instances
+                        .iter()
+                        .filter(|inst| inst.model == i)
+                        .count(),
+                    meshes: m.meshes.len(),
+                    triangles: m.triangle_count(),
+                    materials: m.materials.len(),
+                    textures: textures.len(),
+                }
+            })
+            .collect();
+        let mut lights = LightCounts::default();
+        let extent = scene.effective_bounds().diagonal();
+        let (mut radius, mut cut_sum) = (
+            RadiusSummary {
+                given: 0,
+                derived: 0,
+                range: 0,
+                max_energy_cut: 0.0,
+                mean_energy_cut: 0.0,
+            },
+            0.0f64,
+        );
+        for light in &scene.lights {
+            match light {
+                Light::Sun(_) => lights.sun += 1,
+                Light::Spot(_) => lights.spot += 1,
+                Light::Area(_) => lights.area += 1,
+                Light::Point(p) => {
+                    lights.point += 1;
+                    match p.radius_source {
+                        RadiusSource::Given => radius.given += 1,
+                        RadiusSource::Derived => radius.derived += 1,
+                        RadiusSource::Range => radius.range += 1,
+                    }
+                    let cut = energy_cut_share(&p.attenuation, p.radius, extent);
+                    radius.max_energy_cut = radius.max_energy_cut.max(cut);
+                    cut_sum += f64::from(cut);
+                }
+            }
+        }
+        let point_light_radius = (lights.point > 0).then(|| RadiusSummary {
+            mean_energy_cut: (cut_sum / lights.point as f64) as f32,
+            ..radius
+        });
+        SceneReport {
+            file: scene.path.clone(),
+            instances: scene.instances.len(),
+            meshes: models.iter().map(|m| m.meshes).sum(),
+            triangles: scene.triangle_count(),
+            materials: models.iter().map(|m| m.materials).sum(),
+            textures: all_textures.len(),
+            models,
+            lights,
+            point_light_radius,
+            cameras: scene.cameras.iter().map(|c| c.name.clone()).collect(),
+            bounds: (!scene.bounds.is_empty()).then_some(scene.bounds),
+            warnings: scene.warnings.clone(),
+        }
+    }
+}
+
+impl fmt::Display for SceneReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "{}", self.file.display())?;
+        writeln!(
+            f,
+            "  models: {} files, {} instances; {} meshes, {} triangles, {} materials, {} textures",
+            self.models.len(),
+            self.instances,
+            self.meshes,
+            self.triangles,
+            self.materials,
+            self.textures
+        )?;
+        for m in &self.models {
+            writeln!(
+                f,
+                "    {} x{}: {} meshes, {} triangles, {} materials, {} textures",
+                m.file.display(),
+                m.instances,
+                m.meshes,
+                m.triangles,
+                m.materials,
+                m.textures
+            )?;
+        }
+        let l = &self.lights;
+        writeln!(
+            f,
+            "  lights: {} sun, {} spot, {} point, {} area",
+            l.sun, l.spot, l.point, l.area
+        )?;
+        if let Some(r) = &self.point_light_radius {
+            writeln!(
+                f,
+                "  point-light radii: {} given, {} derived, {} from glTF range; energy cut off: max {:.1}%, mean {:.1}%",
+                r.given,
+                r.derived,
+                r.range,
+                r.max_energy_cut * 100.0,
+                r.mean_energy_cut * 100.0
+            )?;
+        }
+        writeln!(f, "  cameras: {}", self.cameras.join(", "))?;
+        match &self.bounds {
+            Some(b) => writeln!(
+                f,
+                "  bounds: ({}, {}, {}) .. ({}, {}, {})",
+                b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
+            )?,
+            None => writeln!(f, "  bounds: empty")?,
+        }
+        writeln!(f, "  warnings: {}", self.warnings.len())?;
+        for w in &self.warnings {
+            writeln!(f, "    {w}")?;
+        }
+        Ok(())
+    }
+}
