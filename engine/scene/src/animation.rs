@@ -32,6 +32,9 @@ pub fn spot_direction_at(light: &SpotLight, time: f32) -> Vec3 {
     } else {
         0.0
     };
+    if s == 0.0 {
+        return sw.from;
+    }
     let turn = Quat::from_rotation_arc(sw.from, sw.to);
     (Quat::IDENTITY.slerp(turn, s) * sw.from).normalize()
 }

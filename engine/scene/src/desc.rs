@@ -334,12 +334,25 @@ fn spotlight(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<SpotLight,
         });
     }
     if let Some(p) = props.last("swivel") {
-        let v = props.exactly(p, 6)?;
+        let v = props.numbers(p)?;
+        if v.len() != 6 && v.len() != 7 {
+            return Err(props.error(
+                p,
+                format!(
+                    "'swivel' expects 6 numbers (two directions) and an optional period, found {}",
+                    v.len()
+                ),
+            ));
+        }
         let from = Vec3::new(v[0], v[1], v[2]).try_normalize();
         let to = Vec3::new(v[3], v[4], v[5]).try_normalize();
         let (Some(from), Some(to)) = (from, to) else {
             return Err(props.error(p, "'swivel' directions must not be zero vectors"));
         };
+        let period = v.get(6).copied().unwrap_or(period);
+        if period <= 0.0 {
+            return Err(props.error(p, "'swivel' period must be > 0"));
+        }
         swivel = Some(Swivel { from, to, period });
     }
     for p in props.all("correction") {
@@ -348,6 +361,8 @@ fn spotlight(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<SpotLight,
             "spotlight 'correction' has no documented meaning; ignored",
         );
     }
+    // A swivelling light points at its first direction at time 0.
+    let direction = swivel.map_or(direction, |sw| sw.from);
     let angle = props.f32("angle")?.unwrap_or(45.0);
     if !(0.0..=180.0).contains(&angle) {
         let p = props.last("angle");
