@@ -1,0 +1,35 @@
+//! The `weft` command.
+
+mod graph_cmd;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// weft: a data-driven render-graph engine on Vulkan.
+#[derive(Parser)]
+#[command(name = "weft", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Check, plan and draw render graphs.
+    #[command(subcommand)]
+    Graph(graph_cmd::GraphCommand),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Graph(cmd) => graph_cmd::run(cmd),
+    };
+    match result {
+        Ok(code) => code,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

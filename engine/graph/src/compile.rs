@@ -1,0 +1,939 @@
+//! The compiler: features decide which passes and reads are live, data decides the
+//! order, the output decides what is culled, and then resources, memory, barriers
+//! and render passes are derived for one output size.
+
+use crate::diagnostic::Diagnostic;
+use crate::load::LoadedGraph;
+use crate::memory::{place, MemoryRequirements, Transient};
+use crate::order::{contributing, order, pass_uses, OrderError, PassUse};
+use crate::plan::{
+    AttachmentDesc, Barrier, Binding, BindingKind, BufferDesc, CulledPass, Extent, ImageDesc,
+    LoadOp, Plan, PlanPass, PlanResource, RenderPassDesc, Residency, ResourceDesc, StoreOp,
+};
+use crate::resolve::{
+    access_path, expression_vars, image_extent, resolve, BufferSize, Ir, IrDispatch, IrKind, Usage,
+};
+use crate::schema::{LoadDecl, PassKind, StoreDecl};
+use crate::spans::Seg;
+use crate::sync::{sampled_layout, shader_stages, GpuAccess, ResourceState};
+use crate::vk::{Access, BufferUsage, ImageUsage, Layout, Stage};
+use std::collections::BTreeSet;
+
+/// What to compile a graph for.
+pub struct CompileOptions<'a> {
+    pub extent: Extent,
+    /// Scene features and user toggles that are on.
+    pub features: BTreeSet<String>,
+    /// Light count, for buffer size expressions.
+    pub lights: u32,
+    /// Memory requirements of an image; the executor passes the device's.
+    pub memory: &'a dyn Fn(&ImageDesc) -> MemoryRequirements,
+}
+
+impl Default for CompileOptions<'_> {
+    fn default() -> Self {
+        CompileOptions {
+            extent: Extent {
+                width: 1280,
+                height: 720,
+            },
+            features: BTreeSet::new(),
+            lights: 1,
+            memory: &crate::memory::estimate_requirements,
+        }
+    }
+}
+
+/// Loads nothing: compiles an already loaded graph, or returns every error found.
+pub fn compile(graph: &LoadedGraph, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
+    if graph.has_errors() {
+        return Err(graph.diagnostics.clone());
+    }
+    if graph.is_fragment {
+        let file = graph
+            .sources
+            .first()
+            .map(|s| s.file.clone())
+            .unwrap_or_default();
+        return Err(vec![Diagnostic::error(
+            file,
+            crate::spans::Pos { line: 1, col: 1 },
+            "this file is a fragment (`fragment: true`) and cannot be compiled on its own",
+        )
+        .with_hint(
+            "include it from a graph that declares its inputs and an output",
+        )]);
+    }
+    let (ir, mut diags) = resolve(graph);
+    if diags.iter().any(Diagnostic::is_error) {
+        diags.retain(Diagnostic::is_error);
+        return Err(diags);
+    }
+    compile_ir(graph, &ir, options)
+}
+
+/// Whether every condition (`"name"` on, `"!name"` off) holds.
+pub fn conditions_hold(conditions: &[String], features: &BTreeSet<String>) -> bool {
+    conditions.iter().all(|c| match c.strip_prefix('!') {
+        Some(name) => !features.contains(name),
+        None => features.contains(c),
+    })
+}
+
+/// Every feature name a graph's conditions mention.
+pub fn feature_names(ir: &Ir) -> BTreeSet<String> {
+    let mut names = BTreeSet::new();
+    for pass in &ir.passes {
+        let conditions = pass
+            .enabled_if
+            .iter()
+            .chain(pass.accesses.iter().flat_map(|a| a.conditions.iter()));
+        for c in conditions {
+            names.insert(c.trim_start_matches('!').to_string());
+        }
+    }
+    names
+}
+
+fn locate(graph: &LoadedGraph, ir: &Ir, pass: usize, rest: &[Seg]) -> Diagnostic {
+    let p = &ir.passes[pass];
+    let mut path = vec![Seg::Field("passes"), Seg::Index(p.index)];
+    path.extend_from_slice(rest);
+    let (file, pos) = graph.locate(p.source, &path);
+    Diagnostic::error(file, pos, String::new())
+}
+
+fn order_error(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    uses: &[Vec<PassUse>],
+    e: &OrderError,
+    disabled: &[usize],
+) -> Diagnostic {
+    let name = |p: usize| ir.passes[p].name.as_str();
+    match e {
+        OrderError::Cycle(cycle) => {
+            let first = cycle.first().copied().unwrap_or(0);
+            let mut names: Vec<&str> = cycle.iter().map(|&p| name(p)).collect();
+            names.push(name(first));
+            let mut d = locate(graph, ir, first, &[Seg::Field("name")]);
+            d.message = format!("passes form a cycle: {}", names.join(" -> "));
+            d.with_hint("break the cycle: remove an `after` or read a different resource")
+        }
+        OrderError::UnorderedWriters {
+            resource,
+            first,
+            second,
+        } => {
+            let mut d = locate(graph, ir, *second, &[Seg::Field("name")]);
+            d.message = format!(
+                "passes \"{}\" and \"{}\" both write \"{}\" with no order between them",
+                name(*first),
+                name(*second),
+                ir.resources[*resource].name
+            );
+            d.with_hint(format!(
+                "add `after: [\"{}\"]` to \"{}\"",
+                name(*first),
+                name(*second)
+            ))
+        }
+        OrderError::ReadBeforeWrite { resource, pass } => {
+            let access = uses[*pass]
+                .iter()
+                .find(|u| u.resource == *resource)
+                .and_then(|u| u.accesses.first())
+                .map(|&i| &ir.passes[*pass].accesses[i]);
+            let path = access
+                .map(|a| access_path(ir.passes[*pass].index, a))
+                .unwrap_or_default();
+            let (file, pos) = graph.locate(ir.passes[*pass].source, &path);
+            let rname = &ir.resources[*resource].name;
+            let disabled_writers: Vec<&str> = disabled
+                .iter()
+                .filter(|&&p| {
+                    ir.passes[p]
+                        .accesses
+                        .iter()
+                        .any(|a| a.resource == *resource && a.usage.writes())
+                })
+                .map(|&p| name(p))
+                .collect();
+            let mut d = Diagnostic::error(
+                file,
+                pos,
+                format!(
+                    "pass \"{}\" reads \"{rname}\" before anything writes it",
+                    name(*pass)
+                ),
+            );
+            d.hint = Some(if let Some(w) = disabled_writers.first() {
+                format!("its writer \"{w}\" is disabled by its `enabled_if`; make this read conditional with `(name: \"{rname}\", enabled_if: [...])`")
+            } else if matches!(
+                access.map(|a| &a.usage),
+                Some(Usage::Color { .. } | Usage::Depth { .. })
+            ) {
+                "use `load: Clear(...)` or `load: DontCare` for the first pass that writes it"
+                    .into()
+            } else {
+                "add a pass that writes it, or mark it `history: true` to read last frame's contents".into()
+            });
+            d
+        }
+    }
+}
+
+/// Compiles a resolved graph for one feature set and size.
+pub fn compile_ir(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    options: &CompileOptions,
+) -> Result<Plan, Vec<Diagnostic>> {
+    let features = &options.features;
+    let Some(output) = ir.output else {
+        return Err(vec![Diagnostic::error(
+            graph
+                .sources
+                .first()
+                .map(|s| s.file.clone())
+                .unwrap_or_default(),
+            crate::spans::Pos { line: 1, col: 1 },
+            "the graph has no output",
+        )]);
+    };
+    let n = ir.passes.len();
+    let live: Vec<bool> = ir
+        .passes
+        .iter()
+        .map(|p| conditions_hold(&p.enabled_if, features))
+        .collect();
+    let disabled: Vec<usize> = (0..n).filter(|&p| !live[p]).collect();
+    let uses: Vec<Vec<PassUse>> = (0..n)
+        .map(|p| {
+            if live[p] {
+                pass_uses(ir, p, |c| conditions_hold(c, features))
+            } else {
+                Vec::new()
+            }
+        })
+        .collect();
+    let order = order(ir, &live, &uses).map_err(|errors| {
+        errors
+            .iter()
+            .map(|e| order_error(graph, ir, &uses, e, &disabled))
+            .collect::<Vec<_>>()
+    })?;
+    if order.writers[output].is_empty() {
+        let (file, pos) = graph.locate(0, &[Seg::Field("output")]);
+        return Err(vec![Diagnostic::error(
+            file,
+            pos,
+            format!(
+                "no pass writes the output \"{}\"",
+                ir.resources[output].name
+            ),
+        )
+        .with_hint(
+            "the passes that write it may be disabled by `enabled_if` for these features",
+        )]);
+    }
+    let needed = contributing(ir, &order, &uses, output);
+
+    let mut culled = Vec::new();
+    let mut warnings = Vec::new();
+    for (p, pass) in ir.passes.iter().enumerate() {
+        let reason = if !live[p] {
+            let failing: Vec<&str> = pass
+                .enabled_if
+                .iter()
+                .filter(|c| !conditions_hold(std::slice::from_ref(c), features))
+                .map(String::as_str)
+                .collect();
+            format!("enabled_if [{}] is false", failing.join(", "))
+        } else if !needed[p] {
+            let mut d = locate(graph, ir, p, &[Seg::Field("name")]);
+            d.severity = crate::diagnostic::Severity::Warning;
+            d.message = format!(
+                "pass \"{}\" is culled: it contributes nothing to the output",
+                pass.name
+            );
+            warnings.push(d);
+            "contributes nothing to the output".to_string()
+        } else {
+            continue;
+        };
+        culled.push(CulledPass {
+            name: pass.name.clone(),
+            reason,
+        });
+    }
+    let sequence: Vec<usize> = order
+        .sequence
+        .iter()
+        .copied()
+        .filter(|&p| needed[p])
+        .collect();
+
+    // Resources used by the remaining passes, in declaration order.
+    let mut used = vec![false; ir.resources.len()];
+    for &p in &sequence {
+        for u in &uses[p] {
+            used[u.resource] = true;
+        }
+    }
+    used[output] = true;
+    let mut new_index = vec![usize::MAX; ir.resources.len()];
+    let mut kept: Vec<usize> = Vec::new();
+    for r in (0..ir.resources.len()).filter(|&r| used[r]) {
+        new_index[r] = kept.len();
+        kept.push(r);
+    }
+    warn_unread(graph, ir, &sequence, &uses, output, &mut warnings);
+    check_discarding_stores(graph, ir, &sequence, &uses, output)?;
+
+    let mut resources: Vec<PlanResource> = Vec::with_capacity(kept.len());
+    for &r in &kept {
+        let res = &ir.resources[r];
+        let residency = if r == output {
+            Residency::Output
+        } else if res.history {
+            Residency::History
+        } else {
+            Residency::Transient
+        };
+        let mut first = usize::MAX;
+        let mut last = 0;
+        for (i, &p) in sequence.iter().enumerate() {
+            if uses[p].iter().any(|u| u.resource == r) {
+                first = first.min(i);
+                last = i;
+            }
+        }
+        let desc = match &res.kind {
+            IrKind::Image {
+                format,
+                mips,
+                layers,
+                samples,
+                ..
+            } => {
+                let extent = image_extent(ir, r, options.extent).unwrap_or(options.extent);
+                let mut usage = ImageUsage::empty();
+                for &p in &sequence {
+                    for u in uses[p].iter().filter(|u| u.resource == r) {
+                        for &a in &u.accesses {
+                            usage |= match ir.passes[p].accesses[a].usage {
+                                Usage::Sampled => ImageUsage::SAMPLED,
+                                Usage::StorageRead | Usage::StorageWrite => ImageUsage::STORAGE,
+                                Usage::Color { .. } => ImageUsage::COLOR_ATTACHMENT,
+                                Usage::Depth { .. } => ImageUsage::DEPTH_STENCIL_ATTACHMENT,
+                                Usage::TransferSrc => ImageUsage::TRANSFER_SRC,
+                                Usage::TransferDst => ImageUsage::TRANSFER_DST,
+                            };
+                        }
+                    }
+                }
+                if residency == Residency::Output {
+                    usage |= ImageUsage::TRANSFER_SRC;
+                }
+                ResourceDesc::Image(ImageDesc {
+                    format: format.name.to_string(),
+                    format_raw: format.raw,
+                    aspect: format.aspect,
+                    extent,
+                    mips: *mips,
+                    layers: *layers,
+                    samples: *samples,
+                    usage,
+                    texel_bytes: format.bytes,
+                })
+            }
+            IrKind::External => unreachable!(
+                "only fragments have external resources, and fragments are not compiled"
+            ),
+            IrKind::Buffer { size } => {
+                let bytes = match size {
+                    BufferSize::Bytes(b) => *b,
+                    BufferSize::Expression(text) => {
+                        let vars = expression_vars(
+                            &graph.sources[res.source].params,
+                            options.extent,
+                            options.lights,
+                        );
+                        crate::expr::eval(text, &vars)
+                            .map(|v| v.max(1.0).ceil() as u64)
+                            .unwrap_or(1)
+                    }
+                };
+                let mut usage = BufferUsage::empty();
+                for &p in &sequence {
+                    for u in uses[p].iter().filter(|u| u.resource == r) {
+                        for &a in &u.accesses {
+                            usage |= match ir.passes[p].accesses[a].usage {
+                                Usage::Sampled => BufferUsage::UNIFORM,
+                                Usage::TransferSrc => BufferUsage::TRANSFER_SRC,
+                                Usage::TransferDst => BufferUsage::TRANSFER_DST,
+                                _ => BufferUsage::STORAGE,
+                            };
+                        }
+                    }
+                }
+                ResourceDesc::Buffer(BufferDesc { size: bytes, usage })
+            }
+        };
+        resources.push(PlanResource {
+            name: res.name.clone(),
+            desc,
+            residency,
+            lifetime: (first.min(sequence.len().saturating_sub(1)), last),
+            placement: None,
+            frame_start_layout: Layout::Undefined,
+        });
+    }
+
+    // Transient images share memory.
+    let transient: Vec<usize> = (0..resources.len())
+        .filter(|&i| {
+            resources[i].residency == Residency::Transient
+                && matches!(resources[i].desc, ResourceDesc::Image(_))
+        })
+        .collect();
+    let requests: Vec<Transient> = transient
+        .iter()
+        .map(|&i| match &resources[i].desc {
+            ResourceDesc::Image(desc) => Transient {
+                requirements: (options.memory)(desc),
+                lifetime: resources[i].lifetime,
+            },
+            ResourceDesc::Buffer(_) => unreachable!("filtered to images"),
+        })
+        .collect();
+    let (memory, placements) = place(&requests);
+    for (k, &i) in transient.iter().enumerate() {
+        resources[i].placement = Some(placements[k]);
+    }
+
+    // Per-pass GPU accesses, then barriers.
+    let gpu_uses: Vec<Vec<(usize, GpuAccess)>> = sequence
+        .iter()
+        .map(|&p| {
+            uses[p]
+                .iter()
+                .map(|u| (new_index[u.resource], gpu_access(ir, p, u)))
+                .collect()
+        })
+        .collect();
+    let scopes = read_scopes(&gpu_uses);
+    let mut states: Vec<ResourceState> = resources
+        .iter()
+        .map(|r| ResourceState::fresh(matches!(r.desc, ResourceDesc::Image(_))))
+        .collect();
+    for (i, r) in resources.iter_mut().enumerate() {
+        match r.residency {
+            Residency::Transient => {}
+            Residency::Output => {
+                states[i].layout = Layout::TransferSrcOptimal;
+                states[i].reads = Stage::ALL_TRANSFER;
+                r.frame_start_layout = Layout::TransferSrcOptimal;
+            }
+            Residency::History => {
+                if let Some((first, scope)) = first_access(&gpu_uses, &scopes, i) {
+                    if states[i].image {
+                        states[i].layout = first.layout;
+                        r.frame_start_layout = first.layout;
+                    }
+                    states[i].write = Some((scope.0, Access::empty()));
+                    states[i].visible = vec![scope];
+                }
+            }
+        }
+    }
+    let mut passes = Vec::with_capacity(sequence.len());
+    for (i, &p) in sequence.iter().enumerate() {
+        let mut barriers = Vec::new();
+        for (k, &(r, access)) in gpu_uses[i].iter().enumerate() {
+            if resources[r].lifetime.0 == i && resources[r].residency == Residency::Transient {
+                let (stage, acc) = aliased_predecessors(&resources, &states, r);
+                states[r].inherit(stage, acc);
+            }
+            if let Some(b) = states[r].access(r, access, scopes[i][k]) {
+                barriers.push(b);
+            }
+        }
+        passes.push(plan_pass(
+            ir, p, i, &uses, &new_index, &resources, &sequence, barriers, options,
+        ));
+    }
+    let mut epilogue = Vec::new();
+    for (i, r) in resources.iter().enumerate() {
+        let target = match r.residency {
+            Residency::Transient => continue,
+            Residency::Output => GpuAccess {
+                stage: Stage::ALL_TRANSFER,
+                access: Access::TRANSFER_READ,
+                layout: Layout::TransferSrcOptimal,
+                discards: false,
+            },
+            Residency::History => match first_access(&gpu_uses, &scopes, i) {
+                Some((first, (stage, access))) => GpuAccess {
+                    stage,
+                    access,
+                    discards: false,
+                    ..first
+                },
+                None => continue,
+            },
+        };
+        let (src_stage, src_access) = states[i].pending();
+        epilogue.push(Barrier {
+            resource: i,
+            src_stage,
+            src_access,
+            dst_stage: target.stage,
+            dst_access: target.access,
+            layouts: states[i].image.then_some((states[i].layout, target.layout)),
+        });
+    }
+
+    let mut feature_list: Vec<String> = features.iter().cloned().collect();
+    feature_list.sort();
+    Ok(Plan {
+        name: graph.name.clone(),
+        file: graph
+            .sources
+            .first()
+            .map(|s| s.file.clone())
+            .unwrap_or_default(),
+        files: graph.files(),
+        extent: options.extent,
+        features: feature_list,
+        output: new_index[output],
+        resources,
+        passes,
+        culled,
+        memory,
+        epilogue,
+        warnings,
+    })
+}
+
+type Scope = (Stage, Access);
+
+fn first_access(
+    gpu_uses: &[Vec<(usize, GpuAccess)>],
+    scopes: &[Vec<Scope>],
+    r: usize,
+) -> Option<(GpuAccess, Scope)> {
+    gpu_uses
+        .iter()
+        .zip(scopes)
+        .flat_map(|(u, s)| u.iter().zip(s))
+        .find(|((i, _), _)| *i == r)
+        .map(|((_, a), s)| (*a, *s))
+}
+
+/// For every access, the destination scope its barrier should have: its own, or for a
+/// read, the union with the reads after it in the same layout up to the next write.
+fn read_scopes(gpu_uses: &[Vec<(usize, GpuAccess)>]) -> Vec<Vec<Scope>> {
+    let mut scopes: Vec<Vec<Scope>> = gpu_uses
+        .iter()
+        .map(|u| u.iter().map(|(_, a)| (a.stage, a.access)).collect())
+        .collect();
+    let mut run: std::collections::HashMap<usize, (Layout, Scope)> =
+        std::collections::HashMap::new();
+    for i in (0..gpu_uses.len()).rev() {
+        for (k, &(r, a)) in gpu_uses[i].iter().enumerate() {
+            if a.access.is_write() {
+                run.remove(&r);
+                continue;
+            }
+            let mut scope = (a.stage, a.access);
+            if let Some((layout, later)) = run.get(&r) {
+                if *layout == a.layout {
+                    scope = (scope.0 | later.0, scope.1 | later.1);
+                }
+            }
+            scopes[i][k] = scope;
+            run.insert(r, (a.layout, scope));
+        }
+    }
+    scopes
+}
+
+/// Stages and accesses of images that used this image's memory before it.
+fn aliased_predecessors(
+    resources: &[PlanResource],
+    states: &[ResourceState],
+    r: usize,
+) -> (Stage, Access) {
+    let Some(mine) = resources[r].placement else {
+        return (Stage::empty(), Access::empty());
+    };
+    let mut stage = Stage::empty();
+    let mut access = Access::empty();
+    for (j, other) in resources.iter().enumerate() {
+        let Some(theirs) = other.placement else {
+            continue;
+        };
+        let overlap = theirs.block == mine.block
+            && theirs.offset < mine.offset + mine.size
+            && mine.offset < theirs.offset + theirs.size;
+        if j != r && overlap && other.lifetime.1 < resources[r].lifetime.0 {
+            let (s, a) = states[j].pending();
+            stage |= s;
+            access |= a;
+        }
+    }
+    (stage, access)
+}
+
+/// How the GPU sees a pass's merged use of a resource.
+fn gpu_access(ir: &Ir, pass: usize, u: &PassUse) -> GpuAccess {
+    let p = &ir.passes[pass];
+    let aspect = match ir.resources[u.resource].kind {
+        IrKind::Image { format, .. } => Some(format.aspect),
+        IrKind::Buffer { .. } | IrKind::External => None,
+    };
+    let mut stage = Stage::empty();
+    let mut access = Access::empty();
+    let mut layout = Layout::General;
+    for &a in &u.accesses {
+        let (s, acc, l) = match &p.accesses[a].usage {
+            Usage::Sampled => match aspect {
+                Some(aspect) => (
+                    image_read_stages(p.kind),
+                    Access::SHADER_SAMPLED_READ,
+                    sampled_layout(aspect),
+                ),
+                None => (shader_stages(p.kind), Access::UNIFORM_READ, Layout::General),
+            },
+            Usage::StorageRead => (
+                shader_stages(p.kind),
+                Access::SHADER_STORAGE_READ,
+                Layout::General,
+            ),
+            Usage::StorageWrite => (
+                shader_stages(p.kind),
+                Access::SHADER_STORAGE_WRITE,
+                Layout::General,
+            ),
+            Usage::Color { load, .. } => {
+                let read = if *load == LoadDecl::Load {
+                    Access::COLOR_ATTACHMENT_READ
+                } else {
+                    Access::empty()
+                };
+                (
+                    Stage::COLOR_ATTACHMENT_OUTPUT,
+                    Access::COLOR_ATTACHMENT_WRITE | read,
+                    Layout::ColorAttachmentOptimal,
+                )
+            }
+            Usage::Depth {
+                read_only: true, ..
+            } => (
+                Stage::EARLY_FRAGMENT_TESTS | Stage::LATE_FRAGMENT_TESTS,
+                Access::DEPTH_STENCIL_ATTACHMENT_READ,
+                Layout::DepthStencilReadOnlyOptimal,
+            ),
+            Usage::Depth { .. } => (
+                Stage::EARLY_FRAGMENT_TESTS | Stage::LATE_FRAGMENT_TESTS,
+                Access::DEPTH_STENCIL_ATTACHMENT_READ | Access::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                Layout::DepthStencilAttachmentOptimal,
+            ),
+            Usage::TransferSrc => (
+                shader_stages(p.kind),
+                Access::TRANSFER_READ,
+                Layout::TransferSrcOptimal,
+            ),
+            Usage::TransferDst => (
+                shader_stages(p.kind),
+                Access::TRANSFER_WRITE,
+                Layout::TransferDstOptimal,
+            ),
+        };
+        stage |= s;
+        access |= acc;
+        layout = l;
+    }
+    if aspect.is_none() {
+        layout = Layout::General;
+    }
+    GpuAccess {
+        stage,
+        access,
+        layout,
+        discards: u.discards,
+    }
+}
+
+/// Images are sampled in fragment shaders in raster passes (vertex shaders read buffers).
+fn image_read_stages(kind: PassKind) -> Stage {
+    match kind {
+        PassKind::Raster => Stage::FRAGMENT_SHADER,
+        other => shader_stages(other),
+    }
+}
+
+/// Whether anything after pass `i` (in plan order) needs what it left in resource `r`.
+fn needed_later(
+    ir: &Ir,
+    sequence: &[usize],
+    uses: &[Vec<PassUse>],
+    i: usize,
+    r: usize,
+    output: usize,
+) -> bool {
+    for &p in &sequence[i + 1..] {
+        if let Some(u) = uses[p].iter().find(|u| u.resource == r) {
+            return u.reads_previous || !u.discards;
+        }
+    }
+    r == output || ir.resources[r].history
+}
+
+fn warn_unread(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    sequence: &[usize],
+    uses: &[Vec<PassUse>],
+    output: usize,
+    warnings: &mut Vec<Diagnostic>,
+) {
+    for (r, res) in ir.resources.iter().enumerate() {
+        if r == output || res.history {
+            continue;
+        }
+        let written = sequence
+            .iter()
+            .any(|&p| uses[p].iter().any(|u| u.resource == r && u.writes));
+        // A depth attachment is read by its own depth test.
+        let read = sequence.iter().any(|&p| {
+            uses[p].iter().any(|u| u.resource == r && u.reads_previous)
+                || ir.passes[p]
+                    .accesses
+                    .iter()
+                    .any(|a| a.resource == r && matches!(a.usage, Usage::Depth { .. }))
+        });
+        if written && !read {
+            let (file, pos) = graph.locate(
+                res.source,
+                &[
+                    Seg::Field("resources"),
+                    Seg::Index(res.index),
+                    Seg::Field("name"),
+                ],
+            );
+            warnings.push(Diagnostic::warning(
+                file,
+                pos,
+                format!("resource \"{}\" is written and never read", res.name),
+            ));
+        }
+    }
+}
+
+/// A declared `store: DontCare` whose contents a later pass needs is an error.
+fn check_discarding_stores(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    sequence: &[usize],
+    uses: &[Vec<PassUse>],
+    output: usize,
+) -> Result<(), Vec<Diagnostic>> {
+    let mut errors = Vec::new();
+    for (i, &p) in sequence.iter().enumerate() {
+        for access in &ir.passes[p].accesses {
+            let store = match &access.usage {
+                Usage::Color { store, .. }
+                | Usage::Depth {
+                    store,
+                    read_only: false,
+                    ..
+                } => *store,
+                _ => continue,
+            };
+            if store == StoreDecl::DontCare
+                && needed_later(ir, sequence, uses, i, access.resource, output)
+            {
+                let mut path = access_path(ir.passes[p].index, access);
+                path.pop();
+                path.push(Seg::Field("store"));
+                let (file, pos) = graph.locate(ir.passes[p].source, &path);
+                errors.push(
+                    Diagnostic::error(file, pos, format!(
+                        "pass \"{}\" discards \"{}\" with `store: DontCare` but later work needs it",
+                        ir.passes[p].name, ir.resources[access.resource].name))
+                    .with_hint("use `store: Store` (the compiler already drops stores nothing reads)"),
+                );
+            }
+        }
+    }
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors)
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn plan_pass(
+    ir: &Ir,
+    p: usize,
+    i: usize,
+    all_uses: &[Vec<PassUse>],
+    new_index: &[usize],
+    resources: &[PlanResource],
+    sequence: &[usize],
+    barriers: Vec<Barrier>,
+    options: &CompileOptions,
+) -> PlanPass {
+    let pass = &ir.passes[p];
+    let uses = &all_uses[p];
+    let active = |a: &crate::resolve::IrAccess| {
+        uses.iter().any(|u| {
+            u.accesses
+                .iter()
+                .any(|&k| std::ptr::eq(&pass.accesses[k], a))
+        })
+    };
+    let mut bindings = Vec::new();
+    let mut defines: BTreeSet<String> = BTreeSet::new();
+    for access in pass.accesses.iter().filter(|a| active(a)) {
+        let kind = match access.usage {
+            Usage::Sampled => BindingKind::Sampled,
+            Usage::StorageRead => BindingKind::StorageRead,
+            Usage::StorageWrite => BindingKind::StorageWrite,
+            _ => continue,
+        };
+        let r = new_index[access.resource];
+        if let Some(existing) = bindings.iter_mut().find(|b: &&mut Binding| b.resource == r) {
+            if matches!(
+                (existing.kind, kind),
+                (BindingKind::StorageRead, BindingKind::StorageWrite)
+                    | (BindingKind::StorageWrite, BindingKind::StorageRead)
+            ) {
+                existing.kind = BindingKind::StorageReadWrite;
+            }
+            continue;
+        }
+        bindings.push(Binding { resource: r, kind });
+        if !access.conditions.is_empty() {
+            defines.insert(format!(
+                "HAS_{}",
+                ir.resources[access.resource].name.to_ascii_uppercase()
+            ));
+        }
+    }
+    let render_pass = matches!(pass.kind, PassKind::Raster | PassKind::Fullscreen).then(|| {
+        let mut attachments = Vec::new();
+        let mut color = Vec::new();
+        let mut depth = None;
+        let mut extent = options.extent;
+        for access in pass.accesses.iter().filter(|a| active(a)) {
+            let (load, store, blend, read_only, is_depth) = match &access.usage {
+                Usage::Color { load, store, blend } => (load, *store, *blend, false, false),
+                Usage::Depth {
+                    load,
+                    store,
+                    read_only,
+                } => (load, *store, None, *read_only, true),
+                _ => continue,
+            };
+            let r = new_index[access.resource];
+            let ResourceDesc::Image(desc) = &resources[r].desc else {
+                continue;
+            };
+            extent = desc.extent;
+            let layout = if read_only {
+                Layout::DepthStencilReadOnlyOptimal
+            } else if is_depth {
+                Layout::DepthStencilAttachmentOptimal
+            } else {
+                Layout::ColorAttachmentOptimal
+            };
+            let store = if read_only {
+                StoreOp::None
+            } else if store == StoreDecl::Store
+                && needed_later(
+                    ir,
+                    sequence,
+                    all_uses,
+                    i,
+                    access.resource,
+                    ir.output.unwrap_or(usize::MAX),
+                )
+            {
+                StoreOp::Store
+            } else {
+                StoreOp::DontCare
+            };
+            let (load, clear) = match load {
+                LoadDecl::Load => (LoadOp::Load, Vec::new()),
+                LoadDecl::Clear(v) => (LoadOp::Clear, v.clone()),
+                LoadDecl::DontCare => (LoadOp::DontCare, Vec::new()),
+            };
+            let index = attachments.len();
+            if is_depth {
+                depth = Some(index);
+            } else {
+                color.push(index);
+            }
+            attachments.push(AttachmentDesc {
+                resource: r,
+                format_raw: desc.format_raw,
+                samples: desc.samples,
+                load,
+                store,
+                clear,
+                initial_layout: layout,
+                layout,
+                final_layout: layout,
+                blend,
+                read_only,
+            });
+        }
+        RenderPassDesc {
+            extent,
+            attachments,
+            color,
+            depth,
+        }
+    });
+    let dispatch = pass.dispatch.map(|d| match d {
+        IrDispatch::Groups(x, y, z) => [x, y, z],
+        IrDispatch::Output(x, y) => [
+            options.extent.width.div_ceil(x.max(1)),
+            options.extent.height.div_ceil(y.max(1)),
+            1,
+        ],
+        IrDispatch::Image(r, x, y) => {
+            let e = image_extent(ir, r, options.extent).unwrap_or(options.extent);
+            [e.width.div_ceil(x.max(1)), e.height.div_ceil(y.max(1)), 1]
+        }
+    });
+    let transfer = if matches!(pass.kind, PassKind::Copy | PassKind::Blit) {
+        let find = |want: fn(&Usage) -> bool| {
+            pass.accesses
+                .iter()
+                .find(|a| want(&a.usage))
+                .map(|a| new_index[a.resource])
+        };
+        find(|u| *u == Usage::TransferSrc).zip(find(|u| *u == Usage::TransferDst))
+    } else {
+        None
+    };
+    PlanPass {
+        name: pass.name.clone(),
+        kind: pass.kind,
+        shaders: pass.shaders.clone(),
+        draw: pass.draw.clone(),
+        dispatch,
+        params: pass.params.clone(),
+        defines: defines.into_iter().collect(),
+        barriers,
+        render_pass,
+        bindings,
+        transfer,
+    }
+}

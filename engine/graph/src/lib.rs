@@ -1,0 +1,27 @@
+//! weft render graphs as data. A graph is a RON file of resources and passes; this
+//! crate loads it with its includes, validates it with located diagnostics, and
+//! compiles it into a [`Plan`]: pass order, culling, transient memory aliasing,
+//! synchronization2 barriers and render-pass descriptions. No Vulkan calls.
+
+pub mod check;
+pub mod compile;
+pub mod diagnostic;
+pub mod dot;
+pub mod expr;
+pub mod load;
+pub mod memory;
+pub mod order;
+pub mod plan;
+pub mod resolve;
+pub mod schema;
+pub mod spans;
+pub mod sync;
+pub mod text;
+pub mod vk;
+
+pub use check::check;
+pub use compile::{compile, CompileOptions};
+pub use diagnostic::{Diagnostic, Severity};
+pub use load::{load, load_with, LoadedGraph};
+pub use memory::{estimate_requirements, MemoryRequirements};
+pub use plan::{Extent, Plan};

@@ -1,0 +1,362 @@
+//! Reading graph files: RON parsing with positions, includes resolved relative to
+//! the including file, and parameters resolved per file with include-site overrides.
+
+use crate::diagnostic::Diagnostic;
+use crate::schema::{GraphFile, ParamValue, PassDecl, ResourceDecl};
+use crate::spans::{Pos, Seg, SpanTree};
+use ron::extensions::Extensions;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// One file that contributed to a graph.
+#[derive(Debug, Clone)]
+pub struct Source {
+    /// Path as given or as resolved from the including file.
+    pub file: PathBuf,
+    /// Positions of every value in the file.
+    pub spans: SpanTree,
+    /// The file's parameters after include-site overrides and `$reference` resolution.
+    pub params: BTreeMap<String, ParamValue>,
+}
+
+/// An item declared in some source file, with where to point diagnostics.
+#[derive(Debug, Clone)]
+pub struct Located<T> {
+    pub item: T,
+    /// Index into [`LoadedGraph::sources`].
+    pub source: usize,
+    /// Index of the item in its file's list.
+    pub index: usize,
+}
+
+/// A graph file and its includes, merged, before validation.
+#[derive(Debug, Clone, Default)]
+pub struct LoadedGraph {
+    /// Source 0 is the root file; the rest are includes in the order met.
+    pub sources: Vec<Source>,
+    pub resources: Vec<Located<ResourceDecl>>,
+    pub passes: Vec<Located<PassDecl>>,
+    /// The output image name, from the root file.
+    pub output: Option<String>,
+    /// Human-readable name.
+    pub name: String,
+    /// Toggles declared on by default by the graph and its fragments.
+    pub default_features: Vec<String>,
+    /// Whether the root file is a fragment (checked alone, never compiled alone).
+    pub is_fragment: bool,
+    /// Per source: the resources it expects its includer to declare.
+    pub inputs: Vec<Vec<String>>,
+    /// Problems met while loading (syntax, includes, parameters).
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl LoadedGraph {
+    /// Where the value at `path` inside `source` is, as a file and position.
+    pub fn locate(&self, source: usize, path: &[Seg]) -> (PathBuf, Pos) {
+        match self.sources.get(source) {
+            Some(s) => (s.file.clone(), s.spans.locate(path)),
+            None => (PathBuf::new(), Pos::default()),
+        }
+    }
+
+    /// Every file the graph was built from, for hot reload.
+    pub fn files(&self) -> Vec<PathBuf> {
+        self.sources.iter().map(|s| s.file.clone()).collect()
+    }
+
+    /// Whether loading found any error.
+    pub fn has_errors(&self) -> bool {
+        self.diagnostics.iter().any(Diagnostic::is_error)
+    }
+}
+
+/// Reads the contents of a file; tests substitute an in-memory file system.
+pub type ReadFile<'a> = &'a dyn Fn(&Path) -> std::io::Result<String>;
+
+/// Loads a graph file from disk with its includes.
+pub fn load(path: &Path) -> LoadedGraph {
+    load_with(path, &|p: &Path| std::fs::read_to_string(p))
+}
+
+/// Loads a graph with a custom file reader.
+pub fn load_with(path: &Path, read: ReadFile) -> LoadedGraph {
+    let mut graph = LoadedGraph::default();
+    let mut stack = Vec::new();
+    load_file(&mut graph, read, path, BTreeMap::new(), None, &mut stack);
+    if let Some(root) = graph.sources.first() {
+        if graph.name.is_empty() {
+            graph.name = root
+                .file
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+        }
+    }
+    graph
+}
+
+/// Where an include was requested, for errors about the included file.
+struct IncludeSite {
+    source: usize,
+    index: usize,
+}
+
+fn ron_options() -> ron::Options {
+    ron::Options::default()
+        .with_default_extension(Extensions::IMPLICIT_SOME | Extensions::UNWRAP_VARIANT_NEWTYPES)
+}
+
+fn load_file(
+    graph: &mut LoadedGraph,
+    read: ReadFile,
+    path: &Path,
+    overrides: BTreeMap<String, ParamValue>,
+    site: Option<IncludeSite>,
+    stack: &mut Vec<PathBuf>,
+) {
+    let site_location = |graph: &LoadedGraph| match &site {
+        Some(s) => graph.locate(
+            s.source,
+            &[
+                Seg::Field("include"),
+                Seg::Index(s.index),
+                Seg::Field("file"),
+            ],
+        ),
+        None => (path.to_path_buf(), Pos { line: 1, col: 1 }),
+    };
+    let canonical = std::fs::canonicalize(path).unwrap_or_else(|_| normalize(path));
+    if let Some(first) = stack.iter().position(|p| *p == canonical) {
+        let (file, pos) = site_location(graph);
+        let chain: Vec<String> = stack[first..]
+            .iter()
+            .chain(std::iter::once(&canonical))
+            .map(|p| file_name(p))
+            .collect();
+        graph.diagnostics.push(
+            Diagnostic::error(
+                file,
+                pos,
+                format!(
+                    "\"{}\" includes itself: {}",
+                    path.display(),
+                    chain.join(" -> ")
+                ),
+            )
+            .with_hint("remove one of the includes in this chain"),
+        );
+        return;
+    }
+    let text = match read(path) {
+        Ok(text) => text,
+        Err(err) => {
+            let (file, pos) = site_location(graph);
+            let message = match &site {
+                Some(_) => format!("included file \"{}\" cannot be read: {err}", path.display()),
+                None => format!("cannot read graph file: {err}"),
+            };
+            graph.diagnostics.push(
+                Diagnostic::error(file, pos, message)
+                    .with_hint("include paths are relative to the including file"),
+            );
+            return;
+        }
+    };
+    let spans = SpanTree::parse(&text);
+    let parsed: GraphFile = match ron_options().from_str(&text) {
+        Ok(parsed) => parsed,
+        Err(err) => {
+            let pos = Pos {
+                line: err.span.start.line as u32,
+                col: err.span.start.col as u32,
+            };
+            graph.diagnostics.push(Diagnostic::error(
+                path,
+                pos,
+                format!("RON syntax: {}", err.code),
+            ));
+            return;
+        }
+    };
+    let source = graph.sources.len();
+    graph.sources.push(Source {
+        file: path.to_path_buf(),
+        spans,
+        params: BTreeMap::new(),
+    });
+    graph.inputs.push(parsed.inputs.clone());
+    if !parsed.fragment && !parsed.inputs.is_empty() {
+        let (file, pos) = graph.locate(source, &[Seg::Field("inputs")]);
+        graph.diagnostics.push(
+            Diagnostic::error(file, pos, "`inputs` is only meaningful in a fragment")
+                .with_hint("add `fragment: true`, or declare these resources here"),
+        );
+    }
+    if site.is_none() {
+        graph.output = parsed.output.clone();
+        graph.name = parsed.name.clone().unwrap_or_default();
+        graph.is_fragment = parsed.fragment;
+    }
+    if (site.is_some() || parsed.fragment) && parsed.output.is_some() {
+        let (file, pos) = graph.locate(source, &[Seg::Field("output")]);
+        graph.diagnostics.push(
+            Diagnostic::warning(file, pos, "a fragment's output is ignored")
+                .with_hint("only the including graph chooses the output"),
+        );
+    }
+
+    for feature in &parsed.features {
+        if !graph.default_features.contains(feature) {
+            graph.default_features.push(feature.clone());
+        }
+    }
+    let params = resolve_params(graph, source, &parsed.params, overrides, site.as_ref());
+    graph.sources[source].params = params;
+
+    stack.push(canonical);
+    let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    for (index, include) in parsed.include.iter().enumerate() {
+        let mut child_overrides = BTreeMap::new();
+        for (name, value) in &include.params {
+            match resolve_value(&graph.sources[source].params, value) {
+                Ok(v) => {
+                    child_overrides.insert(name.clone(), v);
+                }
+                Err(missing) => {
+                    let (file, pos) = graph.locate(
+                        source,
+                        &[
+                            Seg::Field("include"),
+                            Seg::Index(index),
+                            Seg::Field("params"),
+                            Seg::Key(name),
+                        ],
+                    );
+                    let names: Vec<&str> = graph.sources[source]
+                        .params
+                        .keys()
+                        .map(String::as_str)
+                        .collect();
+                    graph.diagnostics.push(
+                        Diagnostic::error(file, pos, format!("unknown parameter \"${missing}\""))
+                            .suggest(&missing, names),
+                    );
+                }
+            }
+        }
+        load_file(
+            graph,
+            read,
+            &dir.join(&include.file),
+            child_overrides,
+            Some(IncludeSite { source, index }),
+            stack,
+        );
+    }
+    stack.pop();
+
+    for (index, resource) in parsed.resources.into_iter().enumerate() {
+        graph.resources.push(Located {
+            item: resource,
+            source,
+            index,
+        });
+    }
+    for (index, pass) in parsed.passes.into_iter().enumerate() {
+        graph.passes.push(Located {
+            item: pass,
+            source,
+            index,
+        });
+    }
+}
+
+/// Applies include-site overrides to a file's declared parameters and resolves
+/// `$references` between them; unknown overrides are reported at the include site.
+fn resolve_params(
+    graph: &mut LoadedGraph,
+    source: usize,
+    declared: &BTreeMap<String, ParamValue>,
+    overrides: BTreeMap<String, ParamValue>,
+    site: Option<&IncludeSite>,
+) -> BTreeMap<String, ParamValue> {
+    let mut params: BTreeMap<String, ParamValue> = declared.clone();
+    for (name, value) in overrides {
+        if let Some(slot) = params.get_mut(&name) {
+            *slot = value;
+        } else if let Some(site) = site {
+            let (file, pos) = graph.locate(
+                site.source,
+                &[
+                    Seg::Field("include"),
+                    Seg::Index(site.index),
+                    Seg::Field("params"),
+                    Seg::KeyOf(&name),
+                ],
+            );
+            let names: Vec<&str> = declared.keys().map(String::as_str).collect();
+            let fragment = file_name(&graph.sources[source].file);
+            graph.diagnostics.push(
+                Diagnostic::error(
+                    file,
+                    pos,
+                    format!("unknown parameter \"{name}\" for \"{fragment}\""),
+                )
+                .suggest(&name, names),
+            );
+        }
+    }
+    let snapshot = params.clone();
+    for (name, value) in params.iter_mut() {
+        if let Err(missing) = resolve_value(&snapshot, value).map(|v| *value = v) {
+            let (file, pos) = graph.locate(source, &[Seg::Field("params"), Seg::Key(name)]);
+            let names: Vec<&str> = snapshot.keys().map(String::as_str).collect();
+            graph.diagnostics.push(
+                Diagnostic::error(file, pos, format!("unknown parameter \"${missing}\""))
+                    .suggest(&missing, names),
+            );
+        }
+    }
+    params
+}
+
+/// Resolves a `"$name"` reference (one level; parameters may not chain) to its value.
+pub fn resolve_value(
+    params: &BTreeMap<String, ParamValue>,
+    value: &ParamValue,
+) -> Result<ParamValue, String> {
+    match value {
+        ParamValue::Reference(text) => match text.strip_prefix('$') {
+            Some(name) => match params.get(name) {
+                Some(ParamValue::Reference(inner)) if inner.starts_with('$') => {
+                    Err(name.to_string())
+                }
+                Some(v) => Ok(v.clone()),
+                None => Err(name.to_string()),
+            },
+            None => Ok(value.clone()),
+        },
+        other => Ok(other.clone()),
+    }
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+/// Lexically normalises a path (for files that do not exist, so cannot be canonicalised).
+fn normalize(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for part in path.components() {
+        match part {
+            std::path::Component::ParentDir => {
+                out.pop();
+            }
+            std::path::Component::CurDir => {}
+            other => out.push(other),
+        }
+    }
+    out
+}

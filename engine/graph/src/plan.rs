@@ -1,0 +1,270 @@
+//! The compiled plan: plain, serialisable data that says exactly what the GPU
+//! executor creates, in what order passes run, and every barrier and layout
+//! transition between them. Nothing here needs Vulkan.
+
+use crate::diagnostic::Diagnostic;
+use crate::schema::{Blend, Draw, ParamValue, PassKind};
+use crate::vk::{Access, Aspect, BufferUsage, ImageUsage, Layout, Stage};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// Width and height in pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub struct Extent {
+    pub width: u32,
+    pub height: u32,
+}
+
+/// A compiled graph, ready to execute for one output size and feature set.
+#[derive(Debug, Clone, Serialize)]
+pub struct Plan {
+    pub name: String,
+    /// The root graph file.
+    pub file: PathBuf,
+    /// Every file the graph was built from (root first), for hot reload.
+    pub files: Vec<PathBuf>,
+    pub extent: Extent,
+    /// Features that were on while compiling.
+    pub features: Vec<String>,
+    pub resources: Vec<PlanResource>,
+    /// Passes in execution order.
+    pub passes: Vec<PlanPass>,
+    /// Passes left out, and why.
+    pub culled: Vec<CulledPass>,
+    /// Index of the output image in `resources`.
+    pub output: usize,
+    /// Where transient images live.
+    pub memory: MemoryPlan,
+    /// Barriers after the last pass: the output to `TRANSFER_SRC_OPTIMAL` for presenting or
+    /// saving, history resources back to the state the next frame starts from.
+    pub epilogue: Vec<Barrier>,
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// A resource the executor creates.
+#[derive(Debug, Clone, Serialize)]
+pub struct PlanResource {
+    pub name: String,
+    pub desc: ResourceDesc,
+    pub residency: Residency,
+    /// First and last pass (indices into `Plan::passes`) that use it.
+    pub lifetime: (usize, usize),
+    /// Where a transient image lives inside the shared memory blocks.
+    pub placement: Option<Placement>,
+    /// For persistent resources: the layout it must be in when a frame starts
+    /// (the executor puts it there when it creates it).
+    pub frame_start_layout: Layout,
+}
+
+/// Image or buffer creation parameters.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub enum ResourceDesc {
+    Image(ImageDesc),
+    Buffer(BufferDesc),
+}
+
+/// Image creation parameters.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize)]
+pub struct ImageDesc {
+    /// Vulkan format name.
+    pub format: String,
+    /// `VkFormat` value.
+    pub format_raw: i32,
+    pub aspect: Aspect,
+    pub extent: Extent,
+    pub mips: u32,
+    pub layers: u32,
+    pub samples: u32,
+    pub usage: ImageUsage,
+    /// Bytes per texel, for memory estimates.
+    pub texel_bytes: u32,
+}
+
+/// Buffer creation parameters.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct BufferDesc {
+    pub size: u64,
+    pub usage: BufferUsage,
+}
+
+/// How long a resource lives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Residency {
+    /// Only within a frame; images may share memory with others.
+    Transient,
+    /// Persists from one frame to the next.
+    History,
+    /// The image presented or saved.
+    Output,
+}
+
+/// A transient image's place in memory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Placement {
+    pub block: usize,
+    pub offset: u64,
+    pub size: u64,
+}
+
+/// Memory blocks shared by transient images, and what aliasing saved.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct MemoryPlan {
+    pub blocks: Vec<MemoryBlock>,
+    /// Bytes of all blocks.
+    pub transient_bytes: u64,
+    /// Bytes if every transient image had its own memory.
+    pub transient_bytes_unaliased: u64,
+}
+
+/// One block of device memory that transient images are bound into.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct MemoryBlock {
+    pub size: u64,
+    pub alignment: u64,
+}
+
+/// A pass that will run.
+#[derive(Debug, Clone, Serialize)]
+pub struct PlanPass {
+    pub name: String,
+    pub kind: PassKind,
+    /// Shader files, resolved relative to the graph file that declared the pass.
+    pub shaders: ShaderFiles,
+    pub draw: Option<Draw>,
+    /// Work groups for compute passes.
+    pub dispatch: Option<[u32; 3]>,
+    /// Parameter values for the shaders, with `$references` resolved.
+    pub params: BTreeMap<String, ParamValue>,
+    /// Preprocessor defines selecting the shader variant (`HAS_SHADOW_MAP`, ...).
+    pub defines: Vec<String>,
+    /// Barriers recorded before the pass, batched into one `vkCmdPipelineBarrier2`.
+    pub barriers: Vec<Barrier>,
+    /// The render pass for raster and fullscreen passes.
+    pub render_pass: Option<RenderPassDesc>,
+    /// Sampled and storage bindings in declaration order.
+    pub bindings: Vec<Binding>,
+    /// Source and destination of copy and blit passes.
+    pub transfer: Option<(usize, usize)>,
+}
+
+/// Shader file paths.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct ShaderFiles {
+    pub vertex: Option<PathBuf>,
+    pub fragment: Option<PathBuf>,
+    pub compute: Option<PathBuf>,
+}
+
+/// A resource bound to a pass's shaders.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Binding {
+    pub resource: usize,
+    pub kind: BindingKind,
+}
+
+/// How a bound resource is accessed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum BindingKind {
+    /// A combined image sampler, or a uniform buffer.
+    Sampled,
+    StorageRead,
+    StorageWrite,
+    StorageReadWrite,
+}
+
+/// A pass left out of the plan.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct CulledPass {
+    pub name: String,
+    pub reason: String,
+}
+
+/// A synchronization2 barrier.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Barrier {
+    /// Index into `Plan::resources`.
+    pub resource: usize,
+    pub src_stage: Stage,
+    pub src_access: Access,
+    pub dst_stage: Stage,
+    pub dst_access: Access,
+    /// Image layouts; `None` for buffers.
+    pub layouts: Option<(Layout, Layout)>,
+}
+
+/// A render pass built from the graph: attachments with their load/store ops and layouts.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RenderPassDesc {
+    pub extent: Extent,
+    pub attachments: Vec<AttachmentDesc>,
+    /// Indices into `attachments`.
+    pub color: Vec<usize>,
+    pub depth: Option<usize>,
+}
+
+/// `VkAttachmentLoadOp`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum LoadOp {
+    Load,
+    Clear,
+    DontCare,
+}
+
+/// `VkAttachmentStoreOp`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum StoreOp {
+    Store,
+    DontCare,
+    /// Nothing is written back (read-only attachments).
+    None,
+}
+
+/// One attachment of a render pass.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AttachmentDesc {
+    pub resource: usize,
+    pub format_raw: i32,
+    pub samples: u32,
+    pub load: LoadOp,
+    pub store: StoreOp,
+    /// One value for depth, four for colour.
+    pub clear: Vec<f64>,
+    pub initial_layout: Layout,
+    /// The layout during the subpass.
+    pub layout: Layout,
+    pub final_layout: Layout,
+    pub blend: Option<Blend>,
+    pub read_only: bool,
+}
+
+/// Counts that summarise a plan, printed by `weft graph plan --json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlanStats {
+    pub passes: usize,
+    pub culled: usize,
+    pub barriers: usize,
+    pub transient_bytes: u64,
+    pub transient_bytes_unaliased: u64,
+    pub compile_us: f64,
+}
+
+impl Plan {
+    /// The summary counts; `compile_us` is measured by the caller.
+    pub fn stats(&self, compile_us: f64) -> PlanStats {
+        PlanStats {
+            passes: self.passes.len(),
+            culled: self.culled.len(),
+            barriers: self.passes.iter().map(|p| p.barriers.len()).sum::<usize>()
+                + self.epilogue.len(),
+            transient_bytes: self.memory.transient_bytes,
+            transient_bytes_unaliased: self.memory.transient_bytes_unaliased,
+            compile_us,
+        }
+    }
+
+    /// Looks up a resource index by name.
+    pub fn resource(&self, name: &str) -> Option<usize> {
+        self.resources.iter().position(|r| r.name == name)
+    }
+}

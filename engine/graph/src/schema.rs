@@ -1,0 +1,373 @@
+//! The RON schema users write, as serde types. These mirror the file one to one;
+//! resolution (includes, parameters, names) happens in `load` and `validate`.
+
+use serde::de::{self, Deserializer, EnumAccess, VariantAccess, Visitor};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// A graph file: a whole configuration or a fragment meant to be included.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, rename = "Graph")]
+pub struct GraphFile {
+    /// Human-readable name shown in plans and the viewer.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Marks a file meant to be included: it has no output, and can be checked on its own.
+    #[serde(default)]
+    pub fragment: bool,
+    /// Resources a fragment uses that the including graph must declare.
+    #[serde(default)]
+    pub inputs: Vec<String>,
+    /// Fragments merged into this graph, in order.
+    #[serde(default)]
+    pub include: Vec<Include>,
+    /// User toggles that are on unless turned off (`--features !bloom`).
+    #[serde(default)]
+    pub features: Vec<String>,
+    /// Parameters with defaults; passes and sizes refer to them as `"$name"`.
+    #[serde(default)]
+    pub params: BTreeMap<String, ParamValue>,
+    /// Images and buffers.
+    #[serde(default)]
+    pub resources: Vec<ResourceDecl>,
+    /// Passes, in any order; execution order comes from data dependencies.
+    #[serde(default)]
+    pub passes: Vec<PassDecl>,
+    /// The image presented or saved. Fragments leave it out.
+    #[serde(default)]
+    pub output: Option<String>,
+}
+
+/// An included fragment and the parameter values it is given.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Include {
+    /// Path relative to the including file.
+    pub file: String,
+    /// Overrides for the fragment's declared parameters.
+    #[serde(default)]
+    pub params: BTreeMap<String, ParamValue>,
+}
+
+/// A parameter value: a number, a vector, a boolean, or a reference `"$name"`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ParamValue {
+    Bool(bool),
+    Number(f64),
+    Vector(Vec<f64>),
+    Reference(String),
+}
+
+/// A dimension that is either a number or a `"$param"` reference.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Dim {
+    Number(f64),
+    Reference(String),
+}
+
+/// A declared resource.
+#[derive(Debug, Clone, Deserialize)]
+pub enum ResourceDecl {
+    /// A 2D image (optionally layered, mipmapped, multisampled).
+    Image(ImageDecl),
+    /// A buffer.
+    Buffer(BufferDecl),
+}
+
+/// An image declaration.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageDecl {
+    pub name: String,
+    /// Vulkan format name, e.g. `R16G16B16A16_SFLOAT`.
+    pub format: FormatName,
+    #[serde(default)]
+    pub size: SizeDecl,
+    #[serde(default = "one_dim")]
+    pub mips: Dim,
+    #[serde(default = "one_dim")]
+    pub layers: Dim,
+    #[serde(default = "one_dim")]
+    pub samples: Dim,
+    /// Persists from the previous frame: reads before this frame's writer see last frame's contents.
+    #[serde(default)]
+    pub history: bool,
+}
+
+fn one_dim() -> Dim {
+    Dim::Number(1.0)
+}
+
+/// How big an image is.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub enum SizeDecl {
+    /// The output size.
+    #[default]
+    Output,
+    /// The output size times a factor per axis.
+    Scale(Dim, Dim),
+    /// A fixed size in pixels.
+    Absolute(Dim, Dim),
+    /// Another image's size times a factor per axis.
+    Like(String, Dim, Dim),
+}
+
+/// A buffer declaration.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BufferDecl {
+    pub name: String,
+    /// Bytes: a number, or an expression over `width`, `height`, `pixels`, `lights` and parameters,
+    /// e.g. `"lights * 32 + 16"`.
+    pub size: Expr,
+    #[serde(default)]
+    pub history: bool,
+}
+
+/// A byte count or an arithmetic expression in a string.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum Expr {
+    Number(f64),
+    Text(String),
+}
+
+/// A format name given as a bare identifier (`D32_SFLOAT`) or a string, checked by validation
+/// so that every misspelling is reported with a hint, not just the first.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FormatName(pub String);
+
+impl<'de> Deserialize<'de> for FormatName {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct FormatVisitor;
+        impl<'de> Visitor<'de> for FormatVisitor {
+            type Value = FormatName;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a Vulkan format name such as R16G16B16A16_SFLOAT")
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<FormatName, E> {
+                Ok(FormatName(v.to_string()))
+            }
+            fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<FormatName, A::Error> {
+                let (name, variant): (Identifier, _) = data.variant()?;
+                variant.unit_variant()?;
+                Ok(FormatName(name.0))
+            }
+        }
+        deserializer.deserialize_enum("Format", &[], FormatVisitor)
+    }
+}
+
+/// A bare identifier, read through `deserialize_identifier` as RON requires for enum variants.
+struct Identifier(String);
+
+impl<'de> Deserialize<'de> for Identifier {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct IdentifierVisitor;
+        impl Visitor<'_> for IdentifierVisitor {
+            type Value = Identifier;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("an identifier")
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Identifier, E> {
+                Ok(Identifier(v.to_string()))
+            }
+        }
+        deserializer.deserialize_identifier(IdentifierVisitor)
+    }
+}
+
+/// What a pass is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum PassKind {
+    /// Draws geometry into colour/depth attachments.
+    Raster,
+    /// Draws one fullscreen triangle.
+    Fullscreen,
+    /// Dispatches a compute shader.
+    Compute,
+    /// Copies one image or buffer to another of the same size.
+    Copy,
+    /// Blits (scaled, filtered copy) one image to another.
+    Blit,
+}
+
+/// A pass declaration.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, rename = "Pass")]
+pub struct PassDecl {
+    pub name: String,
+    pub kind: PassKind,
+    /// Shader files relative to the graph file.
+    #[serde(default)]
+    pub shaders: Shaders,
+    #[serde(default)]
+    pub color: Vec<AttachmentDecl>,
+    #[serde(default)]
+    pub depth: Option<AttachmentDecl>,
+    /// Images and buffers read through samplers or uniform buffers.
+    #[serde(default)]
+    pub sampled: Vec<ReadDecl>,
+    /// Storage images/buffers read.
+    #[serde(default)]
+    pub storage_read: Vec<ReadDecl>,
+    /// Storage images/buffers written (read-modify-write when also in `storage_read`).
+    #[serde(default)]
+    pub storage_write: Vec<ReadDecl>,
+    /// Source of a copy or blit.
+    #[serde(default)]
+    pub src: Option<String>,
+    /// Destination of a copy or blit.
+    #[serde(default)]
+    pub dst: Option<String>,
+    /// What a raster pass draws.
+    #[serde(default)]
+    pub draw: Option<Draw>,
+    /// How a compute pass is dispatched.
+    #[serde(default)]
+    pub dispatch: Option<Dispatch>,
+    /// Values handed to the shaders.
+    #[serde(default)]
+    pub params: BTreeMap<String, ParamValue>,
+    /// Features that must all hold (`"name"`) or not hold (`"!name"`) for the pass to run.
+    #[serde(default)]
+    pub enabled_if: Vec<String>,
+    /// Passes this one must run after, beyond what its data implies.
+    #[serde(default)]
+    pub after: Vec<String>,
+}
+
+/// Shader stages of a pass.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(deny_unknown_fields)]
+pub struct Shaders {
+    #[serde(default)]
+    pub vertex: Option<String>,
+    #[serde(default)]
+    pub fragment: Option<String>,
+    #[serde(default)]
+    pub compute: Option<String>,
+}
+
+/// A colour or depth attachment.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AttachmentDecl {
+    pub image: String,
+    #[serde(default)]
+    pub load: LoadDecl,
+    #[serde(default)]
+    pub store: StoreDecl,
+    /// Colour blending.
+    #[serde(default)]
+    pub blend: Option<Blend>,
+    /// Depth attachment used for testing only (no depth writes), so it can be sampled too.
+    #[serde(default)]
+    pub read_only: bool,
+}
+
+/// What happens to an attachment's contents when a pass begins.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize, Serialize)]
+pub enum LoadDecl {
+    /// Keep what earlier passes wrote.
+    Load,
+    /// Clear to a value: one number for depth, four for colour.
+    Clear(Vec<f64>),
+    /// Contents are undefined; the pass overwrites every pixel.
+    #[default]
+    DontCare,
+}
+
+/// Whether an attachment's contents are kept after the pass. The compiler
+/// downgrades `Store` to `DONT_CARE` where nothing reads the result later.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+pub enum StoreDecl {
+    #[default]
+    Store,
+    DontCare,
+}
+
+/// Colour blend modes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+pub enum Blend {
+    /// dst + src (light accumulation).
+    Additive,
+    /// Source-over with source alpha.
+    Alpha,
+}
+
+/// A sampled or storage read, optionally only under some features.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum ReadDecl {
+    Name(String),
+    Conditional(ConditionalRead),
+}
+
+/// A read that only happens when its features hold; the shader sees `HAS_<NAME>`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConditionalRead {
+    pub name: String,
+    pub enabled_if: Vec<String>,
+}
+
+impl ReadDecl {
+    /// The resource read.
+    pub fn name(&self) -> &str {
+        match self {
+            ReadDecl::Name(n) => n,
+            ReadDecl::Conditional(c) => &c.name,
+        }
+    }
+
+    /// The features this read depends on.
+    pub fn conditions(&self) -> &[String] {
+        match self {
+            ReadDecl::Name(_) => &[],
+            ReadDecl::Conditional(c) => &c.enabled_if,
+        }
+    }
+}
+
+/// What a raster pass draws.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+pub enum Draw {
+    /// Scene meshes whose material matches the filter.
+    Meshes(MaterialFilter),
+    /// One proxy volume per light of a kind.
+    LightVolumes(LightKind),
+    /// One triangle covering the target.
+    FullscreenTriangle,
+}
+
+/// Which scene meshes a raster pass draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+pub enum MaterialFilter {
+    All,
+    Opaque,
+    Transparent,
+    Emissive,
+    ShadowCasters,
+}
+
+/// Light kinds that get proxy volumes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+pub enum LightKind {
+    Point,
+    Spot,
+}
+
+/// How a compute pass is dispatched.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+pub enum Dispatch {
+    /// One invocation per output pixel, in groups of the given size.
+    Output(u32, u32),
+    /// One invocation per pixel of the named image, in groups of the given size.
+    Image(String, u32, u32),
+    /// A fixed number of work groups.
+    Groups(u32, u32, u32),
+}
