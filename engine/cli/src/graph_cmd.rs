@@ -2,7 +2,6 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
-use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -63,21 +62,6 @@ fn parse_size(text: &str) -> Result<Extent, String> {
     })
 }
 
-fn features(graph: &LoadedGraph, requested: &[String]) -> BTreeSet<String> {
-    let mut on: BTreeSet<String> = graph.default_features.iter().cloned().collect();
-    for f in requested.iter().map(|f| f.trim()).filter(|f| !f.is_empty()) {
-        match f.strip_prefix('!') {
-            Some(off) => {
-                on.remove(off);
-            }
-            None => {
-                on.insert(f.to_string());
-            }
-        }
-    }
-    on
-}
-
 fn print_diagnostics(diags: &[Diagnostic]) {
     for d in diags {
         eprintln!("{d}");
@@ -88,7 +72,7 @@ fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Pla
     let graph = weft_graph::load(file);
     let options = CompileOptions {
         extent: target.size,
-        features: features(&graph, &target.features),
+        features: graph.features(&target.features),
         lights: target.lights,
         ..CompileOptions::default()
     };

@@ -433,7 +433,7 @@ pub fn compile_ir(
             Residency::Transient => {}
             Residency::Output => {
                 states[i].layout = Layout::TransferSrcOptimal;
-                states[i].reads = Stage::ALL_TRANSFER;
+                states[i].reads = Stage::COPY | Stage::BLIT;
                 r.frame_start_layout = Layout::TransferSrcOptimal;
             }
             Residency::History => {
@@ -448,28 +448,33 @@ pub fn compile_ir(
             }
         }
     }
-    let mut passes = Vec::with_capacity(sequence.len());
-    for (i, &p) in sequence.iter().enumerate() {
-        let mut barriers = Vec::new();
-        for (k, &(r, access)) in gpu_uses[i].iter().enumerate() {
-            if resources[r].lifetime.0 == i && resources[r].residency == Residency::Transient {
-                let (stage, acc) = aliased_predecessors(&resources, &states, r);
-                states[r].inherit(stage, acc);
-            }
-            if let Some(b) = states[r].access(r, access, scopes[i][k]) {
-                barriers.push(b);
-            }
+    // The first frame starts from `states`; every later frame starts where the previous
+    // one ended, so a transient image's first barrier must also wait for the previous
+    // frame's last use of its memory. Simulate one frame to learn that, then record.
+    let (_, end_of_frame) = record_barriers(&resources, &gpu_uses, &scopes, states.clone());
+    for (r, state) in states.iter_mut().enumerate() {
+        if resources[r].residency == Residency::Transient {
+            let (stage, access) = overlapping_pending(&resources, &end_of_frame, r);
+            state.inherit(stage, access);
         }
-        passes.push(plan_pass(
-            ir, p, i, &uses, &new_index, &resources, &sequence, barriers, options,
-        ));
     }
+    let (pass_barriers, states) = record_barriers(&resources, &gpu_uses, &scopes, states);
+    let passes: Vec<PlanPass> = sequence
+        .iter()
+        .zip(pass_barriers)
+        .enumerate()
+        .map(|(i, (&p, barriers))| {
+            plan_pass(
+                ir, p, i, &uses, &new_index, &resources, &sequence, barriers, options,
+            )
+        })
+        .collect();
     let mut epilogue = Vec::new();
     for (i, r) in resources.iter().enumerate() {
         let target = match r.residency {
             Residency::Transient => continue,
             Residency::Output => GpuAccess {
-                stage: Stage::ALL_TRANSFER,
+                stage: Stage::COPY | Stage::BLIT,
                 access: Access::TRANSFER_READ,
                 layout: Layout::TransferSrcOptimal,
                 discards: false,
@@ -558,6 +563,58 @@ fn read_scopes(gpu_uses: &[Vec<(usize, GpuAccess)>]) -> Vec<Vec<Scope>> {
         }
     }
     scopes
+}
+
+/// Walks the passes once, returning each pass's barriers and the final states.
+fn record_barriers(
+    resources: &[PlanResource],
+    gpu_uses: &[Vec<(usize, GpuAccess)>],
+    scopes: &[Vec<Scope>],
+    mut states: Vec<ResourceState>,
+) -> (Vec<Vec<Barrier>>, Vec<ResourceState>) {
+    let mut all = Vec::with_capacity(gpu_uses.len());
+    for (i, accesses) in gpu_uses.iter().enumerate() {
+        let mut barriers = Vec::new();
+        for (k, &(r, access)) in accesses.iter().enumerate() {
+            if resources[r].lifetime.0 == i && resources[r].residency == Residency::Transient {
+                let (stage, acc) = aliased_predecessors(resources, &states, r);
+                states[r].inherit(stage, acc);
+            }
+            if let Some(b) = states[r].access(r, access, scopes[i][k]) {
+                barriers.push(b);
+            }
+        }
+        all.push(barriers);
+    }
+    (all, states)
+}
+
+/// Pending stages and accesses, at the end of a frame, of every transient image
+/// sharing memory with `r` (itself included).
+fn overlapping_pending(
+    resources: &[PlanResource],
+    states: &[ResourceState],
+    r: usize,
+) -> (Stage, Access) {
+    let Some(mine) = resources[r].placement else {
+        return states[r].pending();
+    };
+    let mut stage = Stage::empty();
+    let mut access = Access::empty();
+    for (j, other) in resources.iter().enumerate() {
+        let Some(theirs) = other.placement else {
+            continue;
+        };
+        if theirs.block == mine.block
+            && theirs.offset < mine.offset + mine.size
+            && mine.offset < theirs.offset + theirs.size
+        {
+            let (s, a) = states[j].pending();
+            stage |= s;
+            access |= a;
+        }
+    }
+    (stage, access)
 }
 
 /// Stages and accesses of images that used this image's memory before it.

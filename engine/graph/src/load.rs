@@ -64,6 +64,24 @@ impl LoadedGraph {
         self.sources.iter().map(|s| s.file.clone()).collect()
     }
 
+    /// The features to compile with: the graph's defaults, plus each requested
+    /// name, minus each `!name`.
+    pub fn features<S: AsRef<str>>(&self, requested: &[S]) -> std::collections::BTreeSet<String> {
+        let mut on: std::collections::BTreeSet<String> =
+            self.default_features.iter().cloned().collect();
+        for f in requested
+            .iter()
+            .map(|f| f.as_ref().trim())
+            .filter(|f| !f.is_empty())
+        {
+            match f.strip_prefix('!') {
+                Some(off) => on.remove(off),
+                None => on.insert(f.to_string()),
+            };
+        }
+        on
+    }
+
     /// Whether loading found any error.
     pub fn has_errors(&self) -> bool {
         self.diagnostics.iter().any(Diagnostic::is_error)

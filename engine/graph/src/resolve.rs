@@ -44,7 +44,8 @@ pub enum IrKind {
     Buffer {
         size: BufferSize,
     },
-    /// A fragment's input, when the fragment is checked on its own.
+    /// A fragment's input when the fragment is checked on its own, or an image
+    /// whose format is unknown: names resolve, but nothing more is checked.
     External,
 }
 
@@ -388,28 +389,32 @@ impl<'a> Resolver<'a> {
         let (source, index) = (r.source, r.index);
         match &r.item {
             ResourceDecl::Image(img) => {
-                let format = match format_by_name(&img.format.0) {
-                    Some(f) => f,
-                    None => {
-                        let names = FORMATS.iter().map(|f| f.name);
-                        let d = Diagnostic::error(
-                            self.graph
-                                .locate(source, &resource_path(index, &[Seg::Field("format")]))
-                                .0,
-                            self.graph
-                                .locate(source, &resource_path(index, &[Seg::Field("format")]))
-                                .1,
-                            format!("unknown format \"{}\"", img.format.0),
+                let Some(format) = format_by_name(&img.format.0) else {
+                    let (file, pos) = self
+                        .graph
+                        .locate(source, &resource_path(index, &[Seg::Field("format")]));
+                    let d = Diagnostic::error(
+                        file,
+                        pos,
+                        format!("unknown format \"{}\"", img.format.0),
+                    )
+                    .suggest(&img.format.0, FORMATS.iter().map(|f| f.name));
+                    let d = if d.hint.is_none() {
+                        d.with_hint(
+                            "use a Vulkan format name such as R16G16B16A16_SFLOAT or D32_SFLOAT",
                         )
-                        .suggest(&img.format.0, names);
-                        let d = if d.hint.is_none() {
-                            d.with_hint("use a Vulkan format name such as R16G16B16A16_SFLOAT or D32_SFLOAT")
-                        } else {
-                            d
-                        };
-                        self.diags.push(d);
-                        &FORMATS[0]
-                    }
+                    } else {
+                        d
+                    };
+                    self.diags.push(d);
+                    // Checked no further, so one typo gives one error.
+                    return IrResource {
+                        name: img.name.clone(),
+                        source,
+                        index,
+                        kind: IrKind::External,
+                        history: img.history,
+                    };
                 };
                 let size_path = resource_path(index, &[Seg::Field("size")]);
                 let size = match &img.size {

@@ -1,0 +1,163 @@
+//! Every graph in `graphs/`: it checks clean, its text plans match the reviewed
+//! snapshots in `tests/snapshots/` (run with `WEFT_BLESS=1` to accept a change),
+//! and every plan passes the independent synchronization checker.
+
+mod support;
+
+use std::path::PathBuf;
+use support::checker::{check_aliasing, check_plan};
+use support::repo_root;
+use weft_graph::{CompileOptions, Extent};
+
+const FEATURE_SETS: &[(&str, &[&str])] = &[
+    ("default", &[]),
+    ("no-bloom", &["!bloom"]),
+    (
+        "all",
+        &[
+            "shadow_casters",
+            "point_lights",
+            "spot_lights",
+            "depth_prepass",
+        ],
+    ),
+];
+
+fn graph_files() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(repo_root().join("graphs"))
+        .expect("graphs/ exists")
+        .map(|e| e.expect("readable entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn every_shipped_graph_checks_clean() {
+    let files = graph_files();
+    assert!(
+        files.len() >= 4,
+        "expected the shipped graphs, found {files:?}"
+    );
+    for file in files {
+        let diags = weft_graph::check(&weft_graph::load(&file));
+        assert!(diags.is_empty(), "{}: {diags:#?}", file.display());
+    }
+}
+
+#[test]
+fn plans_match_snapshots_and_pass_the_checker() {
+    let bless = std::env::var_os("WEFT_BLESS").is_some();
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots");
+    let mut mismatches = Vec::new();
+    let mut compared = 0;
+    for file in graph_files() {
+        let graph = weft_graph::load(&file);
+        if graph.is_fragment {
+            continue;
+        }
+        let stem = file
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .expect("utf-8 name");
+        for (label, requested) in FEATURE_SETS {
+            let options = CompileOptions {
+                extent: Extent {
+                    width: 1920,
+                    height: 1080,
+                },
+                features: graph.features(requested),
+                ..CompileOptions::default()
+            };
+            let plan = weft_graph::compile(&graph, &options)
+                .unwrap_or_else(|e| panic!("{stem} {label}: {e:#?}"));
+            check_plan(&plan, 3).unwrap_or_else(|e| panic!("{stem} {label}: {e}"));
+            check_aliasing(&plan).unwrap_or_else(|e| panic!("{stem} {label}: {e}"));
+            let text = weft_graph::text::render(&plan);
+            let path = dir.join(format!("{stem}-{label}.txt"));
+            compared += 1;
+            if bless {
+                std::fs::create_dir_all(&dir).expect("create snapshot dir");
+                std::fs::write(&path, &text).expect("write snapshot");
+            } else {
+                let expected = std::fs::read_to_string(&path).unwrap_or_default();
+                if expected != text {
+                    mismatches.push(format!("{}:\n{text}", path.display()));
+                }
+            }
+        }
+    }
+    assert_eq!(compared, 6);
+    assert!(
+        mismatches.is_empty(),
+        "plans differ from snapshots (review, then WEFT_BLESS=1 to accept):\n{}",
+        mismatches.join("\n")
+    );
+}
+
+#[test]
+fn removing_any_barrier_makes_the_checker_fail() {
+    let graph = weft_graph::load(&repo_root().join("graphs/deferred.ron"));
+    let options = CompileOptions {
+        features: graph.features(&["shadow_casters", "point_lights", "spot_lights"]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("deferred compiles");
+    let mut removed = 0;
+    for p in 0..plan.passes.len() {
+        for b in 0..plan.passes[p].barriers.len() {
+            let mut broken = plan.clone();
+            let barrier = broken.passes[p].barriers.remove(b);
+            let name = &plan.resources[barrier.resource].name;
+            assert!(
+                check_plan(&broken, 2).is_err(),
+                "removing the barrier on \"{name}\" before \"{}\" went unnoticed",
+                plan.passes[p].name
+            );
+            removed += 1;
+        }
+    }
+    for e in 0..plan.epilogue.len() {
+        let mut broken = plan.clone();
+        broken.epilogue.remove(e);
+        assert!(
+            check_plan(&broken, 2).is_err(),
+            "removing epilogue barrier {e} went unnoticed"
+        );
+    }
+    assert!(removed > 15, "only {removed} barriers");
+}
+
+#[test]
+fn scene_features_cull_passes_and_variants() {
+    let graph = weft_graph::load(&repo_root().join("graphs/deferred.ron"));
+    let options = CompileOptions {
+        features: graph.features::<&str>(&[]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let culled: Vec<(&str, &str)> = plan
+        .culled
+        .iter()
+        .map(|c| (c.name.as_str(), c.reason.as_str()))
+        .collect();
+    assert_eq!(
+        culled,
+        [
+            ("shadow_sun", "enabled_if [shadow_casters] is false"),
+            ("point_lights", "enabled_if [point_lights] is false"),
+            ("spot_lights", "enabled_if [spot_lights] is false"),
+        ]
+    );
+    let sun = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "sun")
+        .expect("sun pass");
+    assert!(
+        sun.defines.is_empty(),
+        "no shadow variant without shadow casters"
+    );
+    assert!(plan.resource("shadow_map").is_none());
+}
