@@ -1,6 +1,9 @@
-//! Helpers shared by the graph crate's integration tests.
+//! Helpers shared by the graph crate's integration tests (each test crate uses a
+//! different subset, hence `dead_code` is allowed).
+#![allow(dead_code)]
 
 pub mod checker;
+pub mod random_graph;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
