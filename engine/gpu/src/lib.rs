@@ -1,13 +1,27 @@
 //! Vulkan execution of compiled weft render graphs: the context, run-time
 //! shader compilation and reflection, and the executor that runs a `Plan`.
 
+pub mod bind;
 pub mod context;
+pub mod convert;
 pub mod error;
+pub mod executor;
+pub mod pipeline;
+pub mod readback;
+pub mod record;
 pub mod reflect;
+pub mod renderpass;
+pub mod resources;
 pub mod shader;
 pub mod validation;
 
 pub use context::{DeviceInfo, DeviceKind, Gpu, GpuOptions, MemoryReport};
 pub use error::GpuError;
+pub use executor::{
+    DrawRecorder, FrameOptions, FrameReport, NoDraws, PassTiming, RasterContext, Renderer,
+    TimingMode, TimingSource,
+};
+pub use readback::{Pixels, Readback};
+pub use resources::{image_requirements, FrameResources};
 pub use shader::{CompiledShader, ShaderCompiler, ShaderDiagnostic, ShaderError, ShaderStage};
 pub use validation::{Severity, ValidationCounts, ValidationLog, ValidationMessage};

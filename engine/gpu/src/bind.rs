@@ -1,0 +1,276 @@
+//! Cross-checks a pass's shaders against the graph: which graph resource
+//! feeds each shader binding, whether the kinds agree, whether fragment
+//! outputs match the colour attachments; and packs graph parameters into the
+//! push-constant block by member name.
+
+use crate::reflect::{DescriptorKind, PipelineInterface, PushBlock, ScalarKind, ShaderBinding};
+use std::collections::BTreeMap;
+use weft_graph::plan::{Binding, BindingKind, Plan, PlanPass, ResourceDesc};
+use weft_graph::schema::ParamValue;
+
+/// A shader binding and the graph binding that feeds it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ResolvedBinding {
+    pub shader: ShaderBinding,
+    pub graph: Binding,
+}
+
+/// Matches shader bindings to the pass's graph bindings. A shader variable
+/// named like a resource the pass binds gets that resource; any other binding
+/// number N gets the pass's N-th binding (so one shader can serve passes that
+/// read different resources). Every problem is returned, not just the first.
+pub fn resolve_bindings(
+    plan: &Plan,
+    pass: &PlanPass,
+    interface: &PipelineInterface,
+) -> Result<Vec<ResolvedBinding>, Vec<String>> {
+    let mut problems = Vec::new();
+    let mut resolved = Vec::new();
+    let mut used = vec![false; pass.bindings.len()];
+    let name_of = |b: &Binding| {
+        plan.resources
+            .get(b.resource)
+            .map(|r| r.name.as_str())
+            .unwrap_or("?")
+    };
+    for (shader, _) in interface.bindings.values() {
+        if shader.set != 0 {
+            problems.push(format!(
+                "shader binding `{}` is in set {}; graph resources are bound in set 0",
+                shader.name, shader.set
+            ));
+            continue;
+        }
+        let by_name = pass.bindings.iter().position(|b| name_of(b) == shader.name);
+        let Some(index) = by_name.or_else(|| {
+            let n = shader.binding as usize;
+            (n < pass.bindings.len()).then_some(n)
+        }) else {
+            problems.push(format!(
+                "shader binding {} `{}` is fed by no graph resource (the pass binds {})",
+                shader.binding,
+                shader.name,
+                describe(plan, &pass.bindings)
+            ));
+            continue;
+        };
+        let graph = pass.bindings[index];
+        let Some(resource) = plan.resources.get(graph.resource) else {
+            problems.push(format!(
+                "binding refers to missing resource {}",
+                graph.resource
+            ));
+            continue;
+        };
+        let is_image = matches!(resource.desc, ResourceDesc::Image(_));
+        let expected = match (graph.kind, is_image) {
+            (BindingKind::Sampled, true) => DescriptorKind::CombinedImageSampler,
+            (BindingKind::Sampled, false) => DescriptorKind::UniformBuffer,
+            (_, true) => DescriptorKind::StorageImage,
+            (_, false) => DescriptorKind::StorageBuffer,
+        };
+        if shader.kind != expected {
+            problems.push(format!(
+                "shader binding {} `{}` is a {:?} but graph resource `{}` is bound as {:?} ({:?})",
+                shader.binding, shader.name, shader.kind, resource.name, graph.kind, expected
+            ));
+            continue;
+        }
+        used[index] = true;
+        resolved.push(ResolvedBinding {
+            shader: shader.clone(),
+            graph,
+        });
+    }
+    for (b, _) in pass.bindings.iter().zip(&used).filter(|(_, u)| !**u) {
+        problems.push(format!(
+            "graph resource `{}` is bound to nothing in the pass's shaders",
+            name_of(b)
+        ));
+    }
+    if problems.is_empty() {
+        Ok(resolved)
+    } else {
+        Err(problems)
+    }
+}
+
+fn describe(plan: &Plan, bindings: &[Binding]) -> String {
+    if bindings.is_empty() {
+        return "nothing".into();
+    }
+    bindings
+        .iter()
+        .map(|b| {
+            format!(
+                "`{}`",
+                plan.resources
+                    .get(b.resource)
+                    .map(|r| r.name.as_str())
+                    .unwrap_or("?")
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Checks that a fragment shader writes exactly the pass's colour attachments.
+pub fn check_outputs(pass: &PlanPass, interface: &PipelineInterface) -> Vec<String> {
+    let Some(rp) = &pass.render_pass else {
+        return Vec::new();
+    };
+    let locations: Vec<u32> = interface.outputs.iter().map(|o| o.location).collect();
+    let expected: Vec<u32> = (0..rp.color.len() as u32).collect();
+    if locations == expected {
+        Vec::new()
+    } else {
+        vec![format!(
+            "the fragment shader writes outputs at locations {locations:?} but the pass has {} colour attachment(s)",
+            rp.color.len()
+        )]
+    }
+}
+
+/// Values the executor supplies to push-constant members no parameter names.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FrameValues {
+    /// Seconds since the animation started (`time`).
+    pub time: f32,
+    /// Frame number (`frame`).
+    pub frame: u32,
+    /// Target size of the pass (`extent`, a vec2 or uvec2).
+    pub extent: [u32; 2],
+}
+
+/// Packs parameters into the push-constant block; every member must be a
+/// graph parameter of the pass or one of `time`, `frame`, `extent`.
+pub fn pack_push(
+    block: &PushBlock,
+    params: &BTreeMap<String, ParamValue>,
+    frame: &FrameValues,
+) -> Result<Vec<u8>, Vec<String>> {
+    let mut bytes = vec![0u8; block.size as usize];
+    let mut problems = Vec::new();
+    for m in &block.members {
+        let values: Vec<f64> = match params.get(&m.name) {
+            Some(ParamValue::Number(n)) => vec![*n],
+            Some(ParamValue::Vector(v)) => v.clone(),
+            Some(ParamValue::Bool(b)) => vec![if *b { 1.0 } else { 0.0 }],
+            Some(ParamValue::Reference(r)) => {
+                problems.push(format!(
+                    "parameter `{}` is an unresolved reference `{r}`",
+                    m.name
+                ));
+                continue;
+            }
+            None => match m.name.as_str() {
+                "time" => vec![f64::from(frame.time)],
+                "frame" => vec![f64::from(frame.frame)],
+                "extent" => frame.extent.iter().map(|&v| f64::from(v)).collect(),
+                _ => {
+                    problems.push(format!(
+                        "push-constant member `{}` has no graph parameter of that name",
+                        m.name
+                    ));
+                    continue;
+                }
+            },
+        };
+        if values.len() != m.components as usize {
+            problems.push(format!(
+                "parameter `{}` has {} component(s) but the shader member has {}",
+                m.name,
+                values.len(),
+                m.components
+            ));
+            continue;
+        }
+        for (i, v) in values.iter().enumerate() {
+            let word: [u8; 4] = match m.scalar {
+                ScalarKind::Float => (*v as f32).to_ne_bytes(),
+                ScalarKind::Int => (*v as i32).to_ne_bytes(),
+                ScalarKind::Uint => (*v as u32).to_ne_bytes(),
+            };
+            let at = m.offset as usize + 4 * i;
+            match bytes.get_mut(at..at + 4) {
+                Some(slot) => slot.copy_from_slice(&word),
+                None => problems.push(format!(
+                    "push-constant member `{}` lies outside the block",
+                    m.name
+                )),
+            }
+        }
+    }
+    if problems.is_empty() {
+        Ok(bytes)
+    } else {
+        Err(problems)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reflect::PushMember;
+
+    fn member(name: &str, offset: u32, scalar: ScalarKind, components: u32) -> PushMember {
+        PushMember {
+            name: name.into(),
+            offset,
+            scalar,
+            components,
+        }
+    }
+
+    #[test]
+    fn packs_params_and_frame_values_by_name() {
+        let block = PushBlock {
+            size: 28,
+            members: vec![
+                member("tint", 0, ScalarKind::Float, 4),
+                member("radius", 16, ScalarKind::Int, 1),
+                member("frame", 20, ScalarKind::Uint, 1),
+                member("enabled", 24, ScalarKind::Uint, 1),
+            ],
+        };
+        let params = BTreeMap::from([
+            (
+                "tint".to_string(),
+                ParamValue::Vector(vec![0.5, 1.0, 2.0, 4.0]),
+            ),
+            ("radius".to_string(), ParamValue::Number(21.0)),
+            ("enabled".to_string(), ParamValue::Bool(true)),
+        ]);
+        let frame = FrameValues {
+            time: 0.0,
+            frame: 7,
+            extent: [4, 4],
+        };
+        let bytes = pack_push(&block, &params, &frame).expect("packs");
+        let word = |i: usize| [bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]];
+        assert_eq!(f32::from_ne_bytes(word(8)), 2.0);
+        assert_eq!(i32::from_ne_bytes(word(16)), 21);
+        assert_eq!(u32::from_ne_bytes(word(20)), 7);
+        assert_eq!(u32::from_ne_bytes(word(24)), 1);
+    }
+
+    #[test]
+    fn reports_missing_and_misshapen_params() {
+        let block = PushBlock {
+            size: 20,
+            members: vec![
+                member("direction", 0, ScalarKind::Float, 2),
+                member("sigma", 8, ScalarKind::Float, 1),
+            ],
+        };
+        let params = BTreeMap::from([("direction".to_string(), ParamValue::Number(1.0))]);
+        let problems = pack_push(&block, &params, &FrameValues::default()).expect_err("fails");
+        assert_eq!(
+            problems,
+            vec![
+                "parameter `direction` has 1 component(s) but the shader member has 2".to_string(),
+                "push-constant member `sigma` has no graph parameter of that name".to_string(),
+            ]
+        );
+    }
+}

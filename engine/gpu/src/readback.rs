@@ -1,0 +1,137 @@
+//! The output image copied back to the CPU, converted to 8-bit RGBA or linear
+//! float RGBA, and saved as PNG.
+
+use std::path::Path;
+
+/// Pixels read back from the device, row-major, top row first, RGBA.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Pixels {
+    /// 8-bit channels as stored (sRGB-encoded for `_SRGB` formats).
+    Rgba8(Vec<u8>),
+    /// Linear floats (from 16- or 32-bit float formats).
+    RgbaF32(Vec<f32>),
+}
+
+/// An image read back from the device.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Readback {
+    pub width: u32,
+    pub height: u32,
+    /// The Vulkan format name it came from.
+    pub format: String,
+    pub pixels: Pixels,
+}
+
+/// Why a readback could not be converted or saved.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadbackError {
+    /// The output format has no conversion.
+    #[error("cannot read back images of format {0}")]
+    Format(String),
+    /// Writing the PNG failed.
+    #[error("cannot write {path}: {message}")]
+    Write { path: String, message: String },
+}
+
+/// Bytes per texel of the formats that can be read back.
+pub fn texel_bytes(format: &str) -> Option<u32> {
+    match format {
+        "R8G8B8A8_UNORM" | "R8G8B8A8_SRGB" | "B8G8R8A8_UNORM" | "B8G8R8A8_SRGB" => Some(4),
+        "R16G16B16A16_SFLOAT" => Some(8),
+        "R32G32B32A32_SFLOAT" => Some(16),
+        _ => None,
+    }
+}
+
+/// Converts raw texels (tightly packed) of `format` into `Pixels`.
+pub fn decode(format: &str, bytes: &[u8]) -> Result<Pixels, ReadbackError> {
+    match format {
+        "R8G8B8A8_UNORM" | "R8G8B8A8_SRGB" => Ok(Pixels::Rgba8(bytes.to_vec())),
+        "B8G8R8A8_UNORM" | "B8G8R8A8_SRGB" => Ok(Pixels::Rgba8(
+            bytes
+                .chunks_exact(4)
+                .flat_map(|p| [p[2], p[1], p[0], p[3]])
+                .collect(),
+        )),
+        "R16G16B16A16_SFLOAT" => Ok(Pixels::RgbaF32(
+            bytes
+                .chunks_exact(2)
+                .map(|h| half_to_f32(u16::from_le_bytes([h[0], h[1]])))
+                .collect(),
+        )),
+        "R32G32B32A32_SFLOAT" => Ok(Pixels::RgbaF32(
+            bytes
+                .chunks_exact(4)
+                .map(|f| f32::from_le_bytes([f[0], f[1], f[2], f[3]]))
+                .collect(),
+        )),
+        other => Err(ReadbackError::Format(other.to_string())),
+    }
+}
+
+/// IEEE 754 half to single precision.
+pub fn half_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exponent = i32::from((h >> 10) & 0x1f);
+    let mantissa = f32::from(h & 0x3ff);
+    match exponent {
+        0 => sign * mantissa * 2f32.powi(-24),
+        31 if mantissa == 0.0 => sign * f32::INFINITY,
+        31 => f32::NAN,
+        e => sign * (1.0 + mantissa / 1024.0) * 2f32.powi(e - 15),
+    }
+}
+
+impl Readback {
+    /// 8-bit RGBA: stored bytes, or floats clamped to [0, 1] and rounded.
+    pub fn to_rgba8(&self) -> image::RgbaImage {
+        let data = match &self.pixels {
+            Pixels::Rgba8(v) => v.clone(),
+            Pixels::RgbaF32(v) => v
+                .iter()
+                .map(|&f| (f.clamp(0.0, 1.0) * 255.0).round() as u8)
+                .collect(),
+        };
+        image::RgbaImage::from_raw(self.width, self.height, data)
+            .unwrap_or_else(|| image::RgbaImage::new(self.width, self.height))
+    }
+
+    /// The pixel at (x, y) as RGBA bytes.
+    pub fn rgba8_at(&self, x: u32, y: u32) -> [u8; 4] {
+        self.to_rgba8().get_pixel(x, y).0
+    }
+
+    /// Saves the 8-bit image as PNG.
+    pub fn save_png(&self, path: &Path) -> Result<(), ReadbackError> {
+        self.to_rgba8()
+            .save_with_format(path, image::ImageFormat::Png)
+            .map_err(|e| ReadbackError::Write {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decodes_halves_exactly() {
+        assert_eq!(half_to_f32(0x3c00), 1.0);
+        assert_eq!(half_to_f32(0xc000), -2.0);
+        assert_eq!(half_to_f32(0x3800), 0.5);
+        assert_eq!(half_to_f32(0x0001), 2f32.powi(-24));
+        assert_eq!(half_to_f32(0x7c00), f32::INFINITY);
+    }
+
+    #[test]
+    fn swizzles_bgra() {
+        let p = decode("B8G8R8A8_UNORM", &[1, 2, 3, 4]).expect("decodes");
+        assert_eq!(p, Pixels::Rgba8(vec![3, 2, 1, 4]));
+        assert!(matches!(
+            decode("D32_SFLOAT", &[0; 4]),
+            Err(ReadbackError::Format(_))
+        ));
+    }
+}

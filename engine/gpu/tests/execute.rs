@@ -1,0 +1,134 @@
+//! Runs compiled graphs on the device under validation and synchronization
+//! validation and checks the exact pixels.
+
+mod common;
+
+use weft_gpu::{FrameOptions, NoDraws, Renderer, Severity, TimingMode, TimingSource};
+
+/// Expected pixel of the `mixed` fixture at (x, y): red from the pattern,
+/// green from the inverted pattern, blue from the parameter via the buffer.
+fn mixed_pixel(x: u32, y: u32) -> [u8; 4] {
+    [(x * 32) as u8, (255 - y * 32) as u8, 51, 255]
+}
+
+#[test]
+fn fullscreen_compute_blit_graph_renders_exact_pixels() {
+    let gpu = common::gpu();
+    let plan = common::compile(&gpu, &common::graph("mixed.ron"), 8, 8);
+    let mut renderer = Renderer::new(&gpu).expect("renderer");
+    let mut resources = renderer.create_resources(&plan).expect("resources");
+    let report = renderer
+        .execute(
+            &plan,
+            &mut resources,
+            &mut NoDraws,
+            &FrameOptions {
+                readback: true,
+                ..FrameOptions::default()
+            },
+        )
+        .expect("frame");
+    let output = report.output.expect("readback");
+    assert_eq!((output.width, output.height), (8, 8));
+    for y in 0..8 {
+        for x in 0..8 {
+            assert_eq!(output.rgba8_at(x, y), mixed_pixel(x, y), "pixel ({x}, {y})");
+        }
+    }
+    assert!(report.resource_bytes > 0);
+    drop(resources);
+    drop(renderer);
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}
+
+#[test]
+fn dropping_a_barrier_is_reported_as_a_hazard() {
+    let gpu = common::gpu();
+    let mut plan = common::compile(&gpu, &common::graph("mixed.ron"), 8, 8);
+    let stats = plan.resource("stats").expect("stats buffer");
+    let combine = plan
+        .passes
+        .iter_mut()
+        .find(|p| p.name == "combine")
+        .expect("combine pass");
+    let before = combine.barriers.len();
+    combine.barriers.retain(|b| b.resource != stats);
+    assert_eq!(combine.barriers.len(), before - 1);
+    let mut renderer = Renderer::new(&gpu).expect("renderer");
+    let mut resources = renderer.create_resources(&plan).expect("resources");
+    renderer
+        .execute(
+            &plan,
+            &mut resources,
+            &mut NoDraws,
+            &FrameOptions::default(),
+        )
+        .expect("frame records and runs");
+    let errors = gpu.validation().of(Severity::Error);
+    let ids: Vec<&str> = errors.iter().map(|m| m.id.as_str()).collect();
+    assert_eq!(ids, vec!["SYNC-HAZARD-READ-AFTER-WRITE"], "{errors:#?}");
+    let text = &errors[0].text;
+    assert!(text.contains("name = stats"), "{text}");
+    assert!(
+        text.contains("usage: SYNC_FRAGMENT_SHADER_UNIFORM_READ, prior_usage: SYNC_COMPUTE_SHADER_SHADER_STORAGE_WRITE"),
+        "{text}"
+    );
+}
+
+#[test]
+fn renders_several_frames_with_cached_pipelines_and_timings() {
+    let gpu = common::gpu();
+    let plan = common::compile(&gpu, &common::graph("mixed.ron"), 8, 8);
+    let mut renderer = Renderer::new(&gpu).expect("renderer");
+    let mut resources = renderer.create_resources(&plan).expect("resources");
+    for (frame, timing) in [
+        TimingMode::GpuTimestamps,
+        TimingMode::CpuPerPass,
+        TimingMode::Off,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let report = renderer
+            .execute(
+                &plan,
+                &mut resources,
+                &mut NoDraws,
+                &FrameOptions {
+                    timing,
+                    readback: true,
+                    frame: frame as u32,
+                    ..FrameOptions::default()
+                },
+            )
+            .expect("frame");
+        assert_eq!(
+            report.output.expect("readback").rgba8_at(3, 5),
+            mixed_pixel(3, 5)
+        );
+        let names: Vec<&str> = report.timings.iter().map(|t| t.pass.as_str()).collect();
+        match timing {
+            TimingMode::Off => assert!(names.is_empty()),
+            _ => assert_eq!(names, vec!["fill", "shrink", "invert", "combine"]),
+        }
+        let expected_source = match timing {
+            TimingMode::CpuPerPass => Some(TimingSource::CpuWall),
+            TimingMode::GpuTimestamps => Some(TimingSource::GpuTimestamp),
+            TimingMode::Off => None,
+        };
+        assert!(report
+            .timings
+            .iter()
+            .all(|t| Some(t.source) == expected_source && t.ms >= 0.0));
+    }
+    assert_eq!(renderer.pipelines().pipeline_count(), 3);
+    assert_eq!(renderer.render_pass_count(), 2);
+    assert_eq!(renderer.check_shaders(&plan), Vec::new());
+    drop(resources);
+    drop(renderer);
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}
