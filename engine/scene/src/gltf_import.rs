@@ -31,9 +31,10 @@ pub fn load_gltf(
     let gltf = gltf::Gltf::from_slice(&bytes)
         .map_err(|e| model_error(format!("glTF does not parse: {e}")))?;
     let dir = path.parent().unwrap_or(Path::new(""));
-    let buffers = load_buffers(&gltf, dir, path)?;
+    let mut sources = vec![path.to_path_buf()];
+    let buffers = load_buffers(&gltf, dir, path, &mut sources)?;
     let doc = &gltf.document;
-    let images = image_sources(doc, &buffers, dir, path, diag);
+    let images = image_sources(doc, &buffers, dir, path, diag, &mut sources);
     let materials: Vec<Material> = doc.materials().map(|m| material(&m, &images)).collect();
     let mut out = Model {
         path: path.to_path_buf(),
@@ -42,6 +43,7 @@ pub fn load_gltf(
         lights: Vec::new(),
         cameras: Vec::new(),
         bounds: Aabb::EMPTY,
+        sources,
     };
     let roots: Vec<gltf::Node<'_>> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
@@ -84,7 +86,12 @@ pub fn load_gltf(
 }
 
 /// Every buffer's bytes: the GLB chunk, a data URI, or a file beside the glTF.
-fn load_buffers(gltf: &gltf::Gltf, dir: &Path, path: &Path) -> Result<Vec<Vec<u8>>, SceneError> {
+fn load_buffers(
+    gltf: &gltf::Gltf,
+    dir: &Path,
+    path: &Path,
+    sources: &mut Vec<PathBuf>,
+) -> Result<Vec<Vec<u8>>, SceneError> {
     gltf.document
         .buffers()
         .map(|buffer| {
@@ -104,11 +111,11 @@ fn load_buffers(gltf: &gltf::Gltf, dir: &Path, path: &Path) -> Result<Vec<Vec<u8
                             })?
                             .1
                     }
-                    None => read_bytes(
-                        &dir.join(percent_decode(uri)),
-                        &Location::file(path),
-                        MAX_MODEL_BYTES,
-                    )?,
+                    None => {
+                        let file = dir.join(percent_decode(uri));
+                        sources.push(file.clone());
+                        read_bytes(&file, &Location::file(path), MAX_MODEL_BYTES)?
+                    }
                 },
             };
             if data.len() < buffer.length() {
@@ -240,6 +247,7 @@ fn image_sources(
     dir: &Path,
     path: &Path,
     diag: &mut Diagnostics,
+    sources: &mut Vec<PathBuf>,
 ) -> Vec<Option<TextureSource>> {
     doc.images()
         .map(|image| {
@@ -276,6 +284,7 @@ fn image_sources(
                     }
                     None => {
                         let file: PathBuf = dir.join(percent_decode(uri));
+                        sources.push(file.clone());
                         if file.is_file() {
                             Some(TextureSource::File(
                                 std::path::absolute(&file).unwrap_or(file),

@@ -1,8 +1,11 @@
 //! Scenes for weft: `.scene` files, OBJ/MTL and glTF models, lights and animation.
 
 pub mod animation;
+mod binio;
 pub mod bounds;
+pub mod cache;
 pub mod camera;
+mod codec;
 pub mod desc;
 pub mod error;
 pub mod gltf_import;

@@ -64,8 +64,7 @@ pub fn load_model(
     options: &LoadOptions,
     diag: &mut Diagnostics,
 ) -> Result<Model, SceneError> {
-    let _ = options;
-    {
+    crate::cache::load_cached(path, options.cache_dir.as_deref(), diag, |diag| {
         let mut model = match extension(path).as_str() {
             "obj" => load_obj(path, asked_at, diag)?,
             "gltf" | "glb" => crate::gltf_import::load_gltf(path, asked_at, diag)?,
@@ -86,7 +85,7 @@ pub fn load_model(
             );
         }
         Ok(model)
-    }
+    })
 }
 
 /// Turns a description into a scene.

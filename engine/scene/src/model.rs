@@ -22,6 +22,9 @@ pub struct Model {
     pub cameras: Vec<Camera>,
     /// The box around all meshes.
     pub bounds: Aabb,
+    /// Every file the import looked at, the model file first (material libraries, buffers,
+    /// textures, including ones that were missing): the cache checks them for changes.
+    pub sources: Vec<PathBuf>,
 }
 
 impl Model {

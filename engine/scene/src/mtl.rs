@@ -4,7 +4,7 @@
 use crate::error::{Diagnostics, Location};
 use crate::material::{AlphaMode, Material, ShadingModel, TextureRef};
 use glam::{Vec3, Vec4};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Texture statement options and how many arguments each takes (MTL spec, plus `-bm`).
 const OPTIONS: &[(&str, usize)] = &[
@@ -62,6 +62,7 @@ fn texture(
     material: &str,
     mtl: &Path,
     diag: &mut Diagnostics,
+    sources: &mut Vec<PathBuf>,
 ) -> Option<TextureRef> {
     let (name, _) = split_texture_options(arg?);
     if name.is_empty() {
@@ -72,6 +73,7 @@ fn texture(
         return None;
     }
     let path = dir.join(name.replace('\\', "/"));
+    sources.push(path.clone());
     if !path.is_file() {
         diag.warn(
             Location::file(mtl),
@@ -102,8 +104,44 @@ fn color(c: Option<[f32; 3]>, fallback: Vec3) -> Vec3 {
         .unwrap_or(fallback)
 }
 
+/// Colour statements whose fields tobj cannot take (it panics on fewer than three):
+/// `Kd r` is widened to `Kd r r r` as the MTL spec allows; other short or non-numeric
+/// statements are blanked. Returns the text to parse and `(line, warning)` for each blanked line.
+pub(crate) fn sanitize(text: &str) -> (String, Vec<(usize, String)>) {
+    let mut out = String::with_capacity(text.len());
+    let mut dropped = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let keyword = words.next().unwrap_or_default();
+        let fields: Vec<&str> = words.collect();
+        if matches!(keyword, "Ka" | "Kd" | "Ks" | "Ke") && fields.len() < 3 {
+            let numeric = fields.iter().all(|f| f.parse::<f32>().is_ok());
+            match fields.as_slice() {
+                [r] if numeric => out.push_str(&format!("{keyword} {r} {r} {r}")),
+                _ => dropped.push((
+                    i + 1,
+                    format!(
+                        "'{keyword}' needs 1 or 3 numbers, found {}; line ignored",
+                        fields.len()
+                    ),
+                )),
+            }
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    (out, dropped)
+}
+
 /// Converts one tobj material read from `mtl`.
-pub(crate) fn convert(m: &tobj::Material, mtl: &Path, diag: &mut Diagnostics) -> Material {
+/// Every texture path it looks at is added to `sources`.
+pub(crate) fn convert(
+    m: &tobj::Material,
+    mtl: &Path,
+    diag: &mut Diagnostics,
+    sources: &mut Vec<PathBuf>,
+) -> Material {
     let dir = mtl.parent().unwrap_or(Path::new(""));
     let name = m.name.as_str();
     let tr = m
@@ -154,13 +192,13 @@ pub(crate) fn convert(m: &tobj::Material, mtl: &Path, diag: &mut Diagnostics) ->
         ..Material::default()
     };
     let unknown = |key: &str| m.unknown_param.get(key);
-    out.textures.base_color = texture(dir, m.diffuse_texture.as_ref(), name, mtl, diag);
-    out.textures.specular = texture(dir, m.specular_texture.as_ref(), name, mtl, diag);
-    out.textures.opacity = texture(dir, m.dissolve_texture.as_ref(), name, mtl, diag);
-    out.textures.emissive = texture(dir, unknown("map_Ke"), name, mtl, diag);
-    out.textures.normal = texture(dir, unknown("norm"), name, mtl, diag);
+    out.textures.base_color = texture(dir, m.diffuse_texture.as_ref(), name, mtl, diag, sources);
+    out.textures.specular = texture(dir, m.specular_texture.as_ref(), name, mtl, diag, sources);
+    out.textures.opacity = texture(dir, m.dissolve_texture.as_ref(), name, mtl, diag, sources);
+    out.textures.emissive = texture(dir, unknown("map_Ke"), name, mtl, diag, sources);
+    out.textures.normal = texture(dir, unknown("norm"), name, mtl, diag, sources);
     if let Some(arg) = &m.normal_texture {
-        out.textures.bump = texture(dir, Some(arg), name, mtl, diag);
+        out.textures.bump = texture(dir, Some(arg), name, mtl, diag, sources);
         if let (_, Some(bm)) = split_texture_options(arg) {
             out.normal_scale = bm;
         }
@@ -174,6 +212,25 @@ pub(crate) fn convert(m: &tobj::Material, mtl: &Path, diag: &mut Diagnostics) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn short_colour_statements() {
+        let (text, dropped) = sanitize("newmtl a\nKd 0.5\nKs 1 2\nKa\nKe 1 2 3\n");
+        assert_eq!(text, "newmtl a\nKd 0.5 0.5 0.5\n\n\nKe 1 2 3\n");
+        assert_eq!(
+            dropped,
+            vec![
+                (
+                    3,
+                    "'Ks' needs 1 or 3 numbers, found 2; line ignored".to_string()
+                ),
+                (
+                    4,
+                    "'Ka' needs 1 or 3 numbers, found 0; line ignored".to_string()
+                ),
+            ]
+        );
+    }
 
     #[test]
     fn texture_options_are_stripped() {

@@ -30,24 +30,24 @@ pub fn load_obj(
     // Each library read, with how many materials it added (tobj appends them in order).
     let libraries: RefCell<Vec<(PathBuf, usize)>> = RefCell::new(Vec::new());
     let mtl_warnings: RefCell<Vec<Warning>> = RefCell::new(Vec::new());
+    let looked_at: RefCell<Vec<PathBuf>> = RefCell::new(vec![path.to_path_buf()]);
     let loader = |name: &Path| -> tobj::MTLLoadResult {
         let file = dir.join(name.to_string_lossy().replace('\\', "/"));
-        match load_mtl_text(&file, path) {
-            Ok(parsed) => {
+        looked_at.borrow_mut().push(file.clone());
+        match load_mtl_text(&file, path, &mut mtl_warnings.borrow_mut()) {
+            Some(parsed) => {
                 libraries.borrow_mut().push((file, parsed.0.len()));
                 Ok(parsed)
             }
-            Err(w) => {
-                mtl_warnings.borrow_mut().push(w);
-                Ok((Vec::new(), HashMap::new()))
-            }
+            None => Ok((Vec::new(), HashMap::new())),
         }
     };
     let result = tobj::load_obj_buf(&mut &bytes[..], &options, loader);
     diag.warnings.extend(mtl_warnings.into_inner());
     let (models, materials) = result.map_err(|e| locate_obj_error(path, &bytes, &e.to_string()))?;
     let materials = materials.unwrap_or_default();
-    let sources: Vec<PathBuf> = libraries
+    let mut sources = looked_at.into_inner();
+    let libraries: Vec<PathBuf> = libraries
         .into_inner()
         .into_iter()
         .flat_map(|(file, count)| std::iter::repeat_n(file, count))
@@ -55,7 +55,14 @@ pub fn load_obj(
     let materials: Vec<Material> = materials
         .iter()
         .enumerate()
-        .map(|(i, m)| mtl::convert(m, sources.get(i).map_or(path, PathBuf::as_path), diag))
+        .map(|(i, m)| {
+            mtl::convert(
+                m,
+                libraries.get(i).map_or(path, PathBuf::as_path),
+                diag,
+                &mut sources,
+            )
+        })
         .collect();
     warn_unknown_usemtl(path, &bytes, &materials, diag);
     let mut meshes = Vec::with_capacity(models.len());
@@ -71,6 +78,7 @@ pub fn load_obj(
         lights: Vec::new(),
         cameras: Vec::new(),
         bounds: Aabb::EMPTY,
+        sources,
     };
     model.update_bounds();
     Ok(model)
@@ -80,21 +88,36 @@ pub fn load_obj(
 fn load_mtl_text(
     file: &Path,
     obj: &Path,
-) -> Result<(Vec<tobj::Material>, HashMap<String, usize>), Warning> {
-    let bytes = read_bytes(file, &Location::file(obj), MAX_MODEL_BYTES).map_err(|e| Warning {
-        at: Location::file(obj),
-        message: format!("material library unusable ({e}); default material used"),
-    })?;
-    tobj::load_mtl_buf(&mut &bytes[..]).map_err(|e| {
-        let line = locate_mtl_error(&bytes);
-        Warning {
-            at: Location {
-                file: file.to_path_buf(),
-                line,
-            },
-            message: format!("material library does not parse ({e}); default material used"),
+    warnings: &mut Vec<Warning>,
+) -> Option<(Vec<tobj::Material>, HashMap<String, usize>)> {
+    let bytes = match read_bytes(file, &Location::file(obj), MAX_MODEL_BYTES) {
+        Ok(bytes) => bytes,
+        Err(e) => {
+            warnings.push(Warning {
+                at: Location::file(obj),
+                message: format!("material library unusable ({e}); default material used"),
+            });
+            return None;
         }
-    })
+    };
+    let (text, dropped) = mtl::sanitize(&String::from_utf8_lossy(&bytes));
+    warnings.extend(dropped.into_iter().map(|(line, message)| Warning {
+        at: Location::line(file, line),
+        message,
+    }));
+    match tobj::load_mtl_buf(&mut text.as_bytes()) {
+        Ok(parsed) => Some(parsed),
+        Err(e) => {
+            warnings.push(Warning {
+                at: Location {
+                    file: file.to_path_buf(),
+                    line: locate_mtl_error(text.as_bytes()),
+                },
+                message: format!("material library does not parse ({e}); default material used"),
+            });
+            None
+        }
+    }
 }
 
 /// The first MTL line tobj rejects on its own, found by parsing lines one at a time.
