@@ -73,8 +73,10 @@ pub struct FrameReport {
     pub output: Option<Readback>,
     /// Host time spent preparing and recording commands (excluding GPU waits).
     pub record_ms: f64,
-    /// Device memory of the plan's resources.
-    pub resource_bytes: u64,
+    /// Device memory of the plan's transient blocks (aliased images count once).
+    pub transient_bytes: u64,
+    /// Device memory of resources with their own allocations.
+    pub dedicated_bytes: u64,
     /// The allocator's view of all device memory in use.
     pub memory: MemoryReport,
 }
@@ -351,7 +353,8 @@ impl<'g> Renderer<'g> {
             timings,
             output,
             record_ms,
-            resource_bytes: resources.device_bytes,
+            transient_bytes: resources.transient_bytes,
+            dedicated_bytes: resources.dedicated_bytes,
             memory: self.gpu.memory_report(),
         })
     }

@@ -6,6 +6,7 @@ pub mod context;
 pub mod convert;
 pub mod error;
 pub mod executor;
+pub mod golden;
 pub mod pipeline;
 pub mod readback;
 pub mod record;
@@ -21,6 +22,7 @@ pub use executor::{
     DrawRecorder, FrameOptions, FrameReport, NoDraws, PassTiming, RasterContext, Renderer,
     TimingMode, TimingSource,
 };
+pub use golden::{check_golden, Comparison, GoldenError, Tolerance};
 pub use readback::{Pixels, Readback};
 pub use resources::{image_requirements, FrameResources};
 pub use shader::{CompiledShader, ShaderCompiler, ShaderDiagnostic, ShaderError, ShaderStage};

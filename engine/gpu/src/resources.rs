@@ -48,8 +48,10 @@ pub struct FrameResources<'g> {
     allocations: Vec<Allocation>,
     /// Framebuffers over these resources' views, by render pass and views.
     framebuffers: HashMap<(vk::RenderPass, Vec<vk::ImageView>), vk::Framebuffer>,
-    /// Bytes of device memory these resources occupy.
-    pub device_bytes: u64,
+    /// Bytes of the shared transient blocks (aliased images count once).
+    pub transient_bytes: u64,
+    /// Bytes of resources with memory of their own (history, output, buffers).
+    pub dedicated_bytes: u64,
 }
 
 /// The memory requirements the device reports for an image, without creating
@@ -98,7 +100,8 @@ impl<'g> FrameResources<'g> {
             resources: Vec::with_capacity(plan.resources.len()),
             allocations: Vec::new(),
             framebuffers: HashMap::new(),
-            device_bytes: 0,
+            transient_bytes: 0,
+            dedicated_bytes: 0,
         };
         for r in &plan.resources {
             let created = match &r.desc {
@@ -213,7 +216,10 @@ impl<'g> FrameResources<'g> {
                 what: name.to_string(),
                 message: e.to_string(),
             })?;
-        self.device_bytes += requirements.size;
+        match scheme {
+            AllocationScheme::GpuAllocatorManaged => self.transient_bytes += requirements.size,
+            _ => self.dedicated_bytes += requirements.size,
+        }
         self.allocations.push(allocation);
         Ok(self.allocations.len() - 1)
     }
