@@ -54,6 +54,18 @@ fn sibenik_scene_loads_once_its_model_is_in_place() {
         .find(|m| m.name == "staklo")
         .expect("glass");
     assert_eq!(glass.base_color.w, 0.1);
+    // Meshes whose material has a bump map get MikkTSpace tangents; the others get none.
+    let model = &scene.models[0];
+    let mut with_tangents = 0;
+    for mesh in &model.meshes {
+        let bumpy = mesh
+            .material
+            .is_some_and(|m| model.materials[m].textures.bump.is_some());
+        let expected = if bumpy { mesh.positions.len() } else { 0 };
+        assert_eq!(mesh.tangents.len(), expected, "{}", mesh.name);
+        with_tangents += usize::from(bumpy);
+    }
+    assert_eq!(with_tangents, 412);
     assert!(glass.textures.base_color.is_none());
 }
 

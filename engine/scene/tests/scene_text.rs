@@ -1,0 +1,190 @@
+//! The `.scene` extensions and their errors, from small texts: exact values, exact messages.
+
+mod common;
+
+use common::{short_warnings, temp_dir};
+use glam::Vec3;
+use std::path::Path;
+use weft_scene::{load_scene, scene_desc_from_str, Diagnostics, Light, SceneDesc, SceneReport};
+
+fn desc(text: &str) -> (SceneDesc, Vec<String>) {
+    let mut diag = Diagnostics::default();
+    let d = scene_desc_from_str(text, Path::new("t.scene"), &mut diag)
+        .unwrap_or_else(|e| panic!("{e}"));
+    (d, short_warnings(&diag.warnings))
+}
+
+fn error(text: &str) -> String {
+    let mut diag = Diagnostics::default();
+    scene_desc_from_str(text, Path::new("t.scene"), &mut diag)
+        .expect_err(text)
+        .to_string()
+}
+
+#[test]
+fn unknown_objects_and_properties_are_skipped_with_warnings() {
+    let (d, warnings) =
+        desc("fog\n{\n density 2\n}\npointlight\n{\n colour 1 0 0\n position 1 2 3\n}\n");
+    assert_eq!(d.lights.len(), 1);
+    assert_eq!(
+        warnings,
+        vec![
+            "t.scene:1: unknown object 'fog'; skipped",
+            "t.scene:7: unknown property 'colour' in 'pointlight'; skipped",
+        ]
+    );
+}
+
+#[test]
+fn later_duplicates_override() {
+    let (d, _) = desc("pointlight\n{\n position 1 2 3\n position 4 5 6\n}\n");
+    let Light::Point(p) = &d.lights[0] else {
+        panic!("point")
+    };
+    assert_eq!(p.position, Vec3::new(4.0, 5.0, 6.0));
+}
+
+#[test]
+fn model_orientation_and_scale() {
+    let (d, warnings) =
+        desc("model\n{\n file \"a\\\\b.obj\"\n position 1 0 0\n orientation 0 90 0\n scale 2\n}\n");
+    assert!(warnings.is_empty());
+    let m = &d.models[0];
+    assert!(m.file.ends_with("a/b.obj"), "{}", m.file.display());
+    let moved = m.transform.transform_point3(Vec3::X);
+    assert!(moved.distance(Vec3::new(1.0, 0.0, -2.0)) < 1e-6, "{moved}");
+}
+
+#[test]
+fn extension_errors_are_located() {
+    let cases = [
+        ("camera\n{\n fov 45\n}\n", "t.scene:3: 'fov' is in radians and must be in (0, pi), found 45; use 'fov_deg' for degrees"),
+        ("camera\n{\n target 0 0 0\n orientation 0 0 0\n}\n", "t.scene:4: give 'orientation' or 'target', not both"),
+        ("camera\n{\n key 1 0 0 0 0 0 -1\n key 1 1 0 0 0 0 -1\n}\n", "t.scene:4: camera 'key' times must increase"),
+        ("camera\n{\n near 5\n far 1\n}\n", "t.scene:1: camera clip distances must satisfy 0 < near < far, found near 5 far 1"),
+        ("arealight\n{\n shape hexagon\n}\n", "t.scene:1: arealight 'shape' must be rect or disc, found 'hexagon'"),
+        ("pointlights\n{\n count 2.5\n}\n", "t.scene:3: 'count' must be a whole number from 0 to 1000000"),
+        ("pointlights\n{\n count 2000000\n}\n", "t.scene:3: 'count' must be a whole number from 0 to 1000000"),
+        ("pointlight\n{\n attenuation 0 0 0\n}\n", "t.scene:3: 'attenuation' terms must be >= 0 and not all 0"),
+        ("pointlight\n{\n radius -1\n}\n", "t.scene:3: 'radius' must be > 0, found -1"),
+        ("pointlight\n{\n position 1 2\n}\n", "t.scene:3: 'position' expects 3 numbers, found 2"),
+        ("pointlight\n{\n position 1 nan 2\n}\n", "t.scene:3: 'position' expects numbers, found 'nan'"),
+        ("sunlight\n{\n direction 0 0 0\n}\n", "t.scene:3: 'direction' must not be a zero vector"),
+        ("spotlight\n{\n angle 200\n}\n", "t.scene:3: 'angle' must be within 0..180 degrees, found 200"),
+        ("spotlight\n{\n swivel 0 -1 0 1 0 0 -2\n}\n", "t.scene:3: 'swivel' period must be > 0"),
+        ("model\n{\n orientation 1 0 0 0\n}\n", "t.scene:3: 'orientation' has a zero rotation axis"),
+        ("model\n{\n orientation 1 2\n}\n", "t.scene:3: 'orientation' expects 3 numbers (pitch yaw roll, degrees) or 4 (angle in radians, axis x y z), found 2"),
+    ];
+    for (text, expected) in cases {
+        assert_eq!(error(text), expected, "{text}");
+    }
+}
+
+#[test]
+fn generator_is_seeded() {
+    let text = "pointlights\n{\n count 3\n seed 7\n min 0 0 0\n max 1 1 1\n}\n";
+    let (a, _) = desc(text);
+    let (b, _) = desc(text);
+    let (c, _) = desc(&text.replace("seed 7", "seed 8"));
+    assert_eq!(a.lights.len(), 3);
+    assert_eq!(a.lights, b.lights);
+    assert_ne!(a.lights, c.lights);
+    for l in &a.lights {
+        let Light::Point(p) = l else { panic!("point") };
+        assert_eq!(p.attenuation, weft_scene::Attenuation::INVERSE_SQUARE);
+        assert_eq!(p.radius_source, weft_scene::light::RadiusSource::Derived);
+        assert!(
+            (p.radius - 16.0).abs() < 1e-4,
+            "white light, 1/d^2 = 1/256 at 16: {}",
+            p.radius
+        );
+    }
+}
+
+#[test]
+fn includes_nest_and_cycles_are_errors() {
+    let dir = temp_dir("includes");
+    std::fs::create_dir_all(dir.join("sub")).expect("dir");
+    std::fs::write(
+        dir.join("main.scene"),
+        "include \"sub/lights.scene\"\nsunlight\n{\n}\n",
+    )
+    .expect("write");
+    std::fs::write(
+        dir.join("sub/lights.scene"),
+        "pointlight\n{\n}\ninclude \"more.scene\"\n",
+    )
+    .expect("write");
+    std::fs::write(dir.join("sub/more.scene"), "spotlight\n{\n bogus 1\n}\n").expect("write");
+    let scene = load_scene(&dir.join("main.scene")).expect("loads");
+    assert_eq!(scene.lights.len(), 3);
+    assert_eq!(
+        short_warnings(&scene.warnings)[0],
+        "more.scene:3: unknown property 'bogus' in 'spotlight'; skipped"
+    );
+
+    std::fs::write(dir.join("sub/more.scene"), "include \"../main.scene\"\n").expect("write");
+    let err = load_scene(&dir.join("main.scene")).expect_err("cycle");
+    let shown = err.to_string();
+    assert!(shown.contains("more.scene:1: include cycle:"), "{shown}");
+
+    std::fs::write(dir.join("sub/more.scene"), "include \"gone.scene\"\n").expect("write");
+    let err = load_scene(&dir.join("main.scene")).expect_err("missing");
+    assert!(
+        matches!(&err, weft_scene::SceneError::MissingFile { at, path }
+        if at.line == Some(1) && path.ends_with("gone.scene")),
+        "{err}"
+    );
+}
+
+#[test]
+fn lights_without_falloff_get_the_scene_diagonal() {
+    let dir = temp_dir("falloff");
+    std::fs::write(
+        dir.join("s.scene"),
+        "boundingbox\n{\n min 0 0 0\n max 3 4 0\n}\npointlight\n{\n attenuation 1 0 0\n}\n",
+    )
+    .expect("write");
+    let scene = load_scene(&dir.join("s.scene")).expect("loads");
+    let Light::Point(p) = &scene.lights[0] else {
+        panic!("point")
+    };
+    assert_eq!(p.radius, 5.0);
+    assert_eq!(
+        short_warnings(&scene.warnings),
+        vec!["s.scene: 1 point lights never fall off (no linear or quadratic attenuation); radius set to the scene diagonal 5"]
+    );
+    assert_eq!(scene.cameras[0].name, "default");
+    assert!(
+        scene.cameras[0]
+            .forward()
+            .distance((Vec3::new(1.5, 2.0, 0.0) - scene.cameras[0].position).normalize())
+            < 1e-5
+    );
+}
+
+#[test]
+fn report_text_and_json() {
+    let scene = load_scene(&common::asset("462/scenes/cube.scene")).expect("loads");
+    let report = SceneReport::of(&scene);
+    let text = report.to_string();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(
+        lines[1],
+        "  models: 2 files, 3 instances; 2 meshes, 26 triangles, 10 materials, 5 textures"
+    );
+    assert_eq!(lines[4], "  lights: 1 sun, 1 spot, 3 point, 0 area");
+    assert!(lines[5].starts_with(
+        "  point-light radii: 0 given, 3 derived, 0 from glTF range; energy cut off: max "
+    ));
+    assert_eq!(lines[6], "  cameras: camera0");
+    assert_eq!(lines[7], "  bounds: (-200, 0, -200) .. (200, 6, 200)");
+    assert_eq!(lines[8], "  warnings: 5");
+    let json: serde_json::Value = serde_json::to_value(&report).expect("json");
+    assert_eq!(json["triangles"], 26);
+    assert_eq!(json["lights"]["point"], 3);
+    assert_eq!(json["cameras"][0], "camera0");
+    assert_eq!(json["warnings"][0]["at"]["line"], 5);
+    assert_eq!(json["bounds"]["max"][1], 6.0);
+    assert_eq!(json["point_light_radius"]["derived"], 3);
+}
