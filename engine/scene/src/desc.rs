@@ -363,16 +363,13 @@ fn spotlight(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<SpotLight,
     }
     // A swivelling light points at its first direction at time 0.
     let direction = swivel.map_or(direction, |sw| sw.from);
-    let angle = props.f32("angle")?.unwrap_or(45.0);
-    if !(0.0..=180.0).contains(&angle) {
-        let p = props.last("angle");
-        if let Some(p) = p {
-            return Err(props.error(
-                p,
-                format!("'angle' must be within 0..180 degrees, found {angle}"),
-            ));
-        }
-    }
+    let angle = props
+        .f32_where(
+            "angle",
+            |a| (0.0..=180.0).contains(&a),
+            "within 0..180 degrees",
+        )?
+        .unwrap_or(45.0);
     Ok(SpotLight {
         position,
         direction,
@@ -446,13 +443,7 @@ fn pointlight(props: &mut Props<'_>) -> Result<PointLight, SceneError> {
 
 /// A number property that must be > 0.
 fn positive(props: &mut Props<'_>, name: &str) -> Result<Option<f32>, SceneError> {
-    let value = props.f32(name)?;
-    if let (Some(v), Some(p)) = (value, props.last(name)) {
-        if v <= 0.0 {
-            return Err(props.error(p, format!("'{name}' must be > 0, found {v}")));
-        }
-    }
-    Ok(value)
+    props.f32_where(name, |v| v > 0.0, "> 0")
 }
 
 /// An `arealight` block: `shape rect` with `size W H`, or `shape disc` with `radius R`.
@@ -507,16 +498,13 @@ fn arealight(props: &mut Props<'_>) -> Result<AreaLight, SceneError> {
 
 /// A `pointlights` generator: `count` lights at seeded random places in the `min`..`max` box.
 fn generate(props: &mut Props<'_>) -> Result<Vec<PointLight>, SceneError> {
-    let count_prop = props.last("count");
-    let count = props.f32("count")?.unwrap_or(0.0);
-    if count < 0.0 || count.fract() != 0.0 || count > MAX_GENERATED_LIGHTS as f32 {
-        let at = count_prop.map(|p| p.line).unwrap_or(0);
-        return Err(SceneError::syntax(
-            props.file(),
-            at,
-            format!("'count' must be a whole number from 0 to {MAX_GENERATED_LIGHTS}"),
-        ));
-    }
+    let count = props
+        .f32_where(
+            "count",
+            |c| c >= 0.0 && c.fract() == 0.0 && c <= MAX_GENERATED_LIGHTS as f32,
+            &format!("a whole number from 0 to {MAX_GENERATED_LIGHTS}"),
+        )?
+        .unwrap_or(0.0);
     let seed = props.f32("seed")?.unwrap_or(0.0);
     let min = props.vec3("min")?.unwrap_or(Vec3::splat(-1.0));
     let max = props.vec3("max")?.unwrap_or(Vec3::splat(1.0));

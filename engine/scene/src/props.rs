@@ -93,6 +93,25 @@ impl<'a> Props<'a> {
         }
     }
 
+    /// The last `name` as one number that must pass `valid`; otherwise an error at its line
+    /// saying `expected`.
+    pub(crate) fn f32_where(
+        &mut self,
+        name: &str,
+        valid: impl Fn(f32) -> bool,
+        expected: &str,
+    ) -> Result<Option<f32>, SceneError> {
+        let Some(p) = self.last(name) else {
+            return Ok(None);
+        };
+        let v = self.exactly(p, 1)?[0];
+        if valid(v) {
+            Ok(Some(v))
+        } else {
+            Err(self.error(p, format!("'{name}' must be {expected}, found {v}")))
+        }
+    }
+
     /// The last `name` as three numbers.
     pub(crate) fn vec3(&mut self, name: &str) -> Result<Option<Vec3>, SceneError> {
         match self.last(name) {
