@@ -124,7 +124,12 @@ fn write_entry(
     let mut w = Writer::default();
     w.bytes.extend_from_slice(&MAGIC);
     CACHE_FORMAT_VERSION.write(&mut w);
-    let stamps: Vec<Stamp> = model.sources.iter().map(|s| Stamp::of(s)).collect();
+    // Absolute paths, so an entry stays valid when read from another working folder.
+    let stamps: Vec<Stamp> = model
+        .sources
+        .iter()
+        .map(|s| Stamp::of(&std::path::absolute(s).unwrap_or_else(|_| s.clone())))
+        .collect();
     stamps.write(&mut w);
     warnings.to_vec().write(&mut w);
     model.write(&mut w);

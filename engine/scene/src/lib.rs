@@ -1,4 +1,27 @@
 //! Scenes for weft: `.scene` files, OBJ/MTL and glTF models, lights and animation.
+//!
+//! A renderer calls [`load_scene`] (or [`load_scene_with`] for the model cache) and gets a
+//! [`Scene`]: each model file once ([`Model`]: [`Mesh`]es with positions, normals, UVs,
+//! tangents and `u32` indices, and [`Material`]s), the [`Instance`]s that place them, world-space
+//! [`Light`]s, named [`Camera`]s (never empty) and bounds. [`animation::lights_at`] gives the
+//! lights at a time. `weft scene check` uses [`check_report`]. The format is documented in
+//! `scenes/FORMAT.md`.
+//!
+//! ```no_run
+//! let scene = weft_scene::load_scene("scenes/demo.scene".as_ref())?;
+//! for instance in &scene.instances {
+//!     let model = &scene.models[instance.model];
+//!     for mesh in &model.meshes {
+//!         let _material = mesh.material.map(|i| &model.materials[i]);
+//!         // upload mesh.positions, mesh.normals, mesh.uvs, mesh.tangents, mesh.indices;
+//!         // draw with instance.transform
+//!     }
+//! }
+//! let _lights_now = weft_scene::animation::lights_at(&scene.lights, 1.5, 0);
+//! # Ok::<(), weft_scene::SceneError>(())
+//! ```
+
+#![warn(missing_docs)]
 
 pub mod animation;
 mod binio;

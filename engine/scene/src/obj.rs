@@ -42,7 +42,9 @@ pub fn load_obj(
             None => Ok((Vec::new(), HashMap::new())),
         }
     };
-    let result = tobj::load_obj_buf(&mut &bytes[..], &options, loader);
+    // Exporters write comments in legacy encodings; read those bytes as U+FFFD, not as an error.
+    let text = String::from_utf8_lossy(&bytes);
+    let result = tobj::load_obj_buf(&mut text.as_bytes(), &options, loader);
     diag.warnings.extend(mtl_warnings.into_inner());
     let (models, materials) = result.map_err(|e| locate_obj_error(path, &bytes, &e.to_string()))?;
     let materials = materials.unwrap_or_default();
