@@ -35,6 +35,9 @@ pub enum GpuError {
     /// with its shaders.
     #[error("pass `{pass}`: {message}")]
     Pass { pass: String, message: String },
+    /// A pass's shaders disagree with the graph (bindings, outputs, parameters).
+    #[error("pass `{pass}`: {}", problems.join("; "))]
+    Mismatch { pass: String, problems: Vec<String> },
     /// The plan itself is inconsistent.
     #[error("plan: {0}")]
     Plan(String),

@@ -174,6 +174,13 @@ impl<'g> Renderer<'g> {
         &mut self.pipelines
     }
 
+    /// Drops every shader and pipeline built from `changed` so the next frame
+    /// recompiles them (hot reload); returns how many pipelines were dropped.
+    pub fn reload(&mut self, changed: &std::path::Path) -> Result<usize, GpuError> {
+        self.gpu.wait_idle()?;
+        Ok(self.pipelines.invalidate(self.gpu.device(), changed))
+    }
+
     /// Number of distinct render passes created so far.
     pub fn render_pass_count(&self) -> usize {
         self.render_passes.len()
@@ -185,34 +192,53 @@ impl<'g> Renderer<'g> {
     }
 
     /// Compiles and reflects every pass's shaders and cross-checks them with
-    /// the graph, returning each problem as (pass, message); nothing is recorded.
+    /// the graph, returning each problem as (pass, message); no pipeline is built.
     pub fn check_shaders(&mut self, plan: &Plan) -> Vec<(String, String)> {
         let mut problems = Vec::new();
         for pass in &plan.passes {
-            match self.pipeline_for(plan, pass) {
-                Ok(Some(p)) => {
-                    if let Err(list) = bind::resolve_bindings(plan, pass, &p.interface) {
-                        problems.extend(list.into_iter().map(|m| (pass.name.clone(), m)));
-                    }
-                    problems.extend(
-                        bind::check_outputs(pass, &p.interface)
-                            .into_iter()
-                            .filter(|_| p.bind_point == vk::PipelineBindPoint::GRAPHICS)
-                            .map(|m| (pass.name.clone(), m)),
-                    );
-                }
-                Ok(None) => {}
-                Err(e) => problems.push((pass.name.clone(), e.to_string())),
-            }
+            let list = match self.checked_interface(plan, pass) {
+                Ok(_) => continue,
+                Err(GpuError::Mismatch { problems, .. }) => problems,
+                Err(e) => vec![e.to_string()],
+            };
+            problems.extend(list.into_iter().map(|m| (pass.name.clone(), m)));
         }
         problems
     }
 
-    fn pipeline_for(
+    /// The pass's pipeline key and shader interface, after checking that the
+    /// shaders agree with the graph; `None` for passes without shaders of ours.
+    fn checked_interface(
         &mut self,
         plan: &Plan,
         pass: &PlanPass,
-    ) -> Result<Option<Arc<Pipeline>>, GpuError> {
+    ) -> Result<Option<(PipelineKey, Vec<ResolvedBinding>)>, GpuError> {
+        let Some(key) = self.pipeline_key(pass)? else {
+            return Ok(None);
+        };
+        let interface = self.pipelines.interface(&key)?;
+        let (bindings, mut problems) = match bind::resolve_bindings(plan, pass, &interface) {
+            Ok(bindings) => (bindings, Vec::new()),
+            Err(list) => (Vec::new(), list),
+        };
+        if matches!(key, PipelineKey::Fullscreen { .. }) {
+            problems.extend(bind::check_outputs(pass, &interface));
+        }
+        if let Some((block, _)) = &interface.push {
+            if let Err(list) = bind::pack_push(block, &pass.params, &FrameValues::default()) {
+                problems.extend(list);
+            }
+        }
+        if !problems.is_empty() {
+            return Err(GpuError::Mismatch {
+                pass: pass.name.clone(),
+                problems,
+            });
+        }
+        Ok(Some((key, bindings)))
+    }
+
+    fn pipeline_key(&mut self, pass: &PlanPass) -> Result<Option<PipelineKey>, GpuError> {
         let device = self.gpu.device();
         let missing = |what: &str| GpuError::Pass {
             pass: pass.name.clone(),
@@ -262,8 +288,32 @@ impl<'g> Renderer<'g> {
             }
             _ => return Ok(None),
         };
-        let _ = plan;
-        self.pipelines.pipeline(device, &key).map(Some)
+        Ok(Some(key))
+    }
+
+    /// Creates the plan's resources, runs `frames` frames (numbered from 0,
+    /// `time` advancing by `frame_time` seconds) and returns the last frame's
+    /// report; what `weft render` needs in one call.
+    pub fn render(
+        &mut self,
+        plan: &Plan,
+        draws: &mut dyn DrawRecorder,
+        frames: u32,
+        frame_time: f32,
+        options: &FrameOptions,
+    ) -> Result<FrameReport, GpuError> {
+        let mut resources = self.create_resources(plan)?;
+        let mut last = None;
+        for frame in 0..frames.max(1) {
+            let options = FrameOptions {
+                frame,
+                time: options.time + frame as f32 * frame_time,
+                readback: options.readback && frame + 1 == frames.max(1),
+                timing: options.timing,
+            };
+            last = Some(self.execute(plan, &mut resources, draws, &options)?);
+        }
+        last.ok_or_else(|| GpuError::Plan("no frame was rendered".into()))
     }
 
     /// Runs one frame of the plan on `resources` (made by `create_resources`
@@ -370,9 +420,9 @@ impl<'g> Renderer<'g> {
             pass: pass.name.clone(),
             message: problems.join("; "),
         };
-        let pipeline = self.pipeline_for(plan, pass)?;
+        let checked = self.checked_interface(plan, pass)?;
         let mut prepared = Prepared {
-            pipeline: pipeline.clone(),
+            pipeline: None,
             render_pass: vk::RenderPass::null(),
             framebuffer: vk::Framebuffer::null(),
             extent: vk::Extent2D {
@@ -384,6 +434,10 @@ impl<'g> Renderer<'g> {
             push: Vec::new(),
             set: vk::DescriptorSet::null(),
         };
+        if let Some((key, bindings)) = checked {
+            prepared.pipeline = Some(self.pipelines.pipeline(self.gpu.device(), &key)?);
+            prepared.bindings = bindings;
+        }
         if let Some(rp) = &pass.render_pass {
             prepared.render_pass = self.render_passes.get(self.gpu.device(), rp)?;
             prepared.extent = vk::Extent2D {
@@ -400,14 +454,7 @@ impl<'g> Renderer<'g> {
             prepared.framebuffer =
                 resources.framebuffer(prepared.render_pass, views, prepared.extent)?;
         }
-        if let Some(p) = &pipeline {
-            prepared.bindings = bind::resolve_bindings(plan, pass, &p.interface).map_err(fail)?;
-            if p.bind_point == vk::PipelineBindPoint::GRAPHICS {
-                let problems = bind::check_outputs(pass, &p.interface);
-                if !problems.is_empty() {
-                    return Err(fail(problems));
-                }
-            }
+        if let Some(p) = &prepared.pipeline {
             if let Some((block, _)) = &p.interface.push {
                 let frame = FrameValues {
                     time: options.time,

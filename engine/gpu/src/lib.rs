@@ -24,6 +24,6 @@ pub use executor::{
 };
 pub use golden::{check_golden, Comparison, GoldenError, Tolerance};
 pub use readback::{Pixels, Readback};
-pub use resources::{image_requirements, FrameResources};
+pub use resources::{image_requirements, memory_requirements, FrameResources};
 pub use shader::{CompiledShader, ShaderCompiler, ShaderDiagnostic, ShaderError, ShaderStage};
 pub use validation::{Severity, ValidationCounts, ValidationLog, ValidationMessage};

@@ -133,6 +133,24 @@ impl PipelineCache {
         Ok(module)
     }
 
+    /// The merged interface of a pipeline's shaders, compiling and reflecting
+    /// them if needed but creating no Vulkan objects.
+    pub fn interface(&mut self, key: &PipelineKey) -> Result<PipelineInterface, GpuError> {
+        if let Some(p) = self.pipelines.get(key) {
+            return Ok(p.interface.clone());
+        }
+        match key {
+            PipelineKey::Fullscreen {
+                vertex, fragment, ..
+            } => {
+                let vs = self.shader(vertex)?;
+                let fs = self.shader(fragment)?;
+                merged(&[&vs, &fs])
+            }
+            PipelineKey::Compute { shader } => merged(&[&*self.shader(shader)?]),
+        }
+    }
+
     /// A cached pipeline, if built.
     pub fn get(&self, key: &PipelineKey) -> Option<Arc<Pipeline>> {
         self.pipelines.get(key).cloned()

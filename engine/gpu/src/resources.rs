@@ -70,6 +70,11 @@ pub fn image_requirements(gpu: &Gpu, desc: &ImageDesc) -> MemoryRequirements {
     }
 }
 
+/// `image_requirements` as the closure `weft_graph::CompileOptions::memory` takes.
+pub fn memory_requirements(gpu: &Gpu) -> impl Fn(&ImageDesc) -> MemoryRequirements + '_ {
+    move |desc| image_requirements(gpu, desc)
+}
+
 fn image_info(desc: &ImageDesc, output: bool) -> vk::ImageCreateInfo<'static> {
     let mut usage = vk::ImageUsageFlags::from_raw(desc.usage.bits());
     if output {

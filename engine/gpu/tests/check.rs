@@ -1,0 +1,85 @@
+//! Shader/graph cross-checks and hot reload.
+
+mod common;
+
+use weft_gpu::{FrameOptions, NoDraws, Renderer};
+
+#[test]
+fn reports_every_disagreement_between_shaders_and_graph() {
+    let gpu = common::gpu();
+    let plan = common::compile(&gpu, &common::graph("mismatch.ron"), 4, 4);
+    let mut renderer = Renderer::new(&gpu).expect("renderer");
+    let problems = renderer.check_shaders(&plan);
+    let expected: Vec<(String, String)> = [
+        (
+            "produce",
+            "the fragment shader writes outputs at locations [0] but the pass has 2 colour attachment(s)",
+        ),
+        (
+            "consume",
+            "shader binding 1 `b` is a StorageImage but graph resource `b` is bound as Sampled (CombinedImageSampler)",
+        ),
+        (
+            "consume",
+            "shader binding 3 `extra` is fed by no graph resource (the pass binds `a`, `b`)",
+        ),
+        (
+            "consume",
+            "graph resource `b` is bound to nothing in the pass's shaders",
+        ),
+    ]
+    .iter()
+    .map(|(p, m)| (p.to_string(), m.to_string()))
+    .collect();
+    assert_eq!(problems, expected);
+    let mut resources = renderer.create_resources(&plan).expect("resources");
+    let err = renderer
+        .execute(
+            &plan,
+            &mut resources,
+            &mut NoDraws,
+            &FrameOptions::default(),
+        )
+        .expect_err("the executor refuses the mismatched pass");
+    assert_eq!(
+        err.to_string(),
+        "pass `produce`: the fragment shader writes outputs at locations [0] but the pass has 2 colour attachment(s)"
+    );
+    drop(resources);
+    drop(renderer);
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}
+
+#[test]
+fn reload_drops_pipelines_built_from_a_changed_file() {
+    let gpu = common::gpu();
+    let plan = common::compile(&gpu, &common::graph("mixed.ron"), 8, 8);
+    let mut renderer = Renderer::new(&gpu).expect("renderer");
+    let options = FrameOptions {
+        readback: true,
+        ..FrameOptions::default()
+    };
+    renderer
+        .render(&plan, &mut NoDraws, 1, 0.0, &options)
+        .expect("first frame");
+    assert_eq!(renderer.pipelines().pipeline_count(), 3);
+    let fill = common::graph("shaders/fill.frag");
+    assert_eq!(renderer.reload(&fill).expect("reload"), 1);
+    assert_eq!(renderer.pipelines().pipeline_count(), 2);
+    let unrelated = common::graph("shaders/show.frag");
+    assert_eq!(renderer.reload(&unrelated).expect("reload"), 0);
+    let report = renderer
+        .render(&plan, &mut NoDraws, 2, 0.5, &options)
+        .expect("after reload");
+    assert_eq!(renderer.pipelines().pipeline_count(), 3);
+    assert_eq!(
+        report.output.expect("readback").rgba8_at(1, 2),
+        [32, 191, 51, 255]
+    );
+    drop(renderer);
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}
