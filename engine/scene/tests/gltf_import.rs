@@ -205,6 +205,12 @@ fn node_transforms_are_baked_into_vertices() {
         "{b:?}"
     );
     let scene = load_scene(&asset("gltf/renderling/light_tiling_test.glb")).expect("loads");
+    let base = scene.models[0]
+        .materials
+        .iter()
+        .find(|m| m.name == "base.020")
+        .expect("material");
+    assert_eq!(base.ior, 1.45, "KHR_materials_ior");
     let Light::Sun(sun) = &scene.lights[0] else {
         panic!("sun")
     };
