@@ -1,6 +1,7 @@
 //! Compile-time benchmarks (`make bench`): the shipped deferred graph with shadows
-//! and bloom, and a random 1,000-pass graph. Loading and parsing are excluded;
-//! `load_and_compile` measures them together for reference.
+//! and bloom, and a random 1,000-pass graph: compiling a validated graph (what a
+//! resize or feature toggle costs), validation plus compilation, and for the
+//! deferred graph also loading (RON parsing) plus both.
 
 #[path = "../tests/support/random_graph.rs"]
 mod random_graph;
@@ -23,7 +24,11 @@ fn bench(c: &mut Criterion) {
         features: graph.features(&["shadow_casters", "point_lights", "spot_lights"]),
         ..CompileOptions::default()
     };
+    let prepared = weft_graph::Prepared::new(&graph).expect("valid");
     c.bench_function("compile deferred+shadows+bloom 1920x1080", |b| {
+        b.iter(|| black_box(&prepared).compile(&options).expect("compiles"))
+    });
+    c.bench_function("validate+compile deferred+shadows+bloom 1920x1080", |b| {
         b.iter(|| weft_graph::compile(black_box(&graph), &options).expect("compiles"))
     });
     c.bench_function("load+compile deferred+shadows+bloom 1920x1080", |b| {
@@ -43,7 +48,15 @@ fn bench(c: &mut Criterion) {
             .collect(),
         ..CompileOptions::default()
     };
+    let prepared = weft_graph::Prepared::new(&random).expect("valid");
     c.bench_function("compile random 1000-pass graph", |b| {
+        b.iter(|| {
+            black_box(&prepared)
+                .compile(&random_options)
+                .expect("compiles")
+        })
+    });
+    c.bench_function("validate+compile random 1000-pass graph", |b| {
         b.iter(|| weft_graph::compile(black_box(&random), &random_options).expect("compiles"))
     });
 }

@@ -44,32 +44,51 @@ impl Default for CompileOptions<'_> {
     }
 }
 
-/// Loads nothing: compiles an already loaded graph, or returns every error found.
+/// A loaded graph that passed the checks that do not depend on features or size,
+/// ready to compile many times (on resize, on a feature toggle) without re-validating.
+pub struct Prepared<'g> {
+    graph: &'g LoadedGraph,
+    ir: Ir,
+}
+
+impl<'g> Prepared<'g> {
+    /// Validates names, formats, parameters and per-pass rules; returns every error found.
+    pub fn new(graph: &'g LoadedGraph) -> Result<Self, Vec<Diagnostic>> {
+        if graph.has_errors() {
+            return Err(graph.diagnostics.clone());
+        }
+        if graph.is_fragment {
+            let file = graph
+                .sources
+                .first()
+                .map(|s| s.file.clone())
+                .unwrap_or_default();
+            return Err(vec![Diagnostic::error(
+                file,
+                crate::spans::Pos { line: 1, col: 1 },
+                "this file is a fragment (`fragment: true`) and cannot be compiled on its own",
+            )
+            .with_hint(
+                "include it from a graph that declares its inputs and an output",
+            )]);
+        }
+        let (ir, mut diags) = resolve(graph);
+        if diags.iter().any(Diagnostic::is_error) {
+            diags.retain(Diagnostic::is_error);
+            return Err(diags);
+        }
+        Ok(Prepared { graph, ir })
+    }
+
+    /// Compiles for one size and feature set.
+    pub fn compile(&self, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
+        compile_ir(self.graph, &self.ir, options)
+    }
+}
+
+/// Validates and compiles a loaded graph, or returns every error found.
 pub fn compile(graph: &LoadedGraph, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
-    if graph.has_errors() {
-        return Err(graph.diagnostics.clone());
-    }
-    if graph.is_fragment {
-        let file = graph
-            .sources
-            .first()
-            .map(|s| s.file.clone())
-            .unwrap_or_default();
-        return Err(vec![Diagnostic::error(
-            file,
-            crate::spans::Pos { line: 1, col: 1 },
-            "this file is a fragment (`fragment: true`) and cannot be compiled on its own",
-        )
-        .with_hint(
-            "include it from a graph that declares its inputs and an output",
-        )]);
-    }
-    let (ir, mut diags) = resolve(graph);
-    if diags.iter().any(Diagnostic::is_error) {
-        diags.retain(Diagnostic::is_error);
-        return Err(diags);
-    }
-    compile_ir(graph, &ir, options)
+    Prepared::new(graph)?.compile(options)
 }
 
 /// Whether every condition (`"name"` on, `"!name"` off) holds.
@@ -274,13 +293,13 @@ pub fn compile_ir(
         .filter(|&p| needed[p])
         .collect();
 
+    let timeline = Timeline::new(ir, &sequence, &uses);
     // Resources used by the remaining passes, in declaration order.
-    let mut used = vec![false; ir.resources.len()];
-    for &p in &sequence {
-        for u in &uses[p] {
-            used[u.resource] = true;
-        }
-    }
+    let mut used: Vec<bool> = timeline
+        .per_resource
+        .iter()
+        .map(|t| !t.is_empty())
+        .collect();
     used[output] = true;
     let mut new_index = vec![usize::MAX; ir.resources.len()];
     let mut kept: Vec<usize> = Vec::new();
@@ -288,8 +307,8 @@ pub fn compile_ir(
         new_index[r] = kept.len();
         kept.push(r);
     }
-    warn_unread(graph, ir, &sequence, &uses, output, &mut warnings);
-    check_discarding_stores(graph, ir, &sequence, &uses, output)?;
+    warn_unread(graph, ir, &timeline, &uses, output, &mut warnings);
+    check_discarding_stores(graph, ir, &sequence, &timeline, &uses, output)?;
 
     let mut resources: Vec<PlanResource> = Vec::with_capacity(kept.len());
     for &r in &kept {
@@ -301,14 +320,17 @@ pub fn compile_ir(
         } else {
             Residency::Transient
         };
-        let mut first = usize::MAX;
-        let mut last = 0;
-        for (i, &p) in sequence.iter().enumerate() {
-            if uses[p].iter().any(|u| u.resource == r) {
-                first = first.min(i);
-                last = i;
-            }
-        }
+        let touches = &timeline.per_resource[r];
+        let first = touches.first().map_or(usize::MAX, |t| t.0);
+        let last = touches.last().map_or(0, |t| t.0);
+        let accesses = || {
+            touches.iter().flat_map(|&(_, p, k)| {
+                uses[p][k]
+                    .accesses
+                    .iter()
+                    .map(move |&a| &ir.passes[p].accesses[a].usage)
+            })
+        };
         let desc = match &res.kind {
             IrKind::Image {
                 format,
@@ -319,19 +341,15 @@ pub fn compile_ir(
             } => {
                 let extent = image_extent(ir, r, options.extent).unwrap_or(options.extent);
                 let mut usage = ImageUsage::empty();
-                for &p in &sequence {
-                    for u in uses[p].iter().filter(|u| u.resource == r) {
-                        for &a in &u.accesses {
-                            usage |= match ir.passes[p].accesses[a].usage {
-                                Usage::Sampled => ImageUsage::SAMPLED,
-                                Usage::StorageRead | Usage::StorageWrite => ImageUsage::STORAGE,
-                                Usage::Color { .. } => ImageUsage::COLOR_ATTACHMENT,
-                                Usage::Depth { .. } => ImageUsage::DEPTH_STENCIL_ATTACHMENT,
-                                Usage::TransferSrc => ImageUsage::TRANSFER_SRC,
-                                Usage::TransferDst => ImageUsage::TRANSFER_DST,
-                            };
-                        }
-                    }
+                for u in accesses() {
+                    usage |= match u {
+                        Usage::Sampled => ImageUsage::SAMPLED,
+                        Usage::StorageRead | Usage::StorageWrite => ImageUsage::STORAGE,
+                        Usage::Color { .. } => ImageUsage::COLOR_ATTACHMENT,
+                        Usage::Depth { .. } => ImageUsage::DEPTH_STENCIL_ATTACHMENT,
+                        Usage::TransferSrc => ImageUsage::TRANSFER_SRC,
+                        Usage::TransferDst => ImageUsage::TRANSFER_DST,
+                    };
                 }
                 if residency == Residency::Output {
                     usage |= ImageUsage::TRANSFER_SRC;
@@ -366,17 +384,13 @@ pub fn compile_ir(
                     }
                 };
                 let mut usage = BufferUsage::empty();
-                for &p in &sequence {
-                    for u in uses[p].iter().filter(|u| u.resource == r) {
-                        for &a in &u.accesses {
-                            usage |= match ir.passes[p].accesses[a].usage {
-                                Usage::Sampled => BufferUsage::UNIFORM,
-                                Usage::TransferSrc => BufferUsage::TRANSFER_SRC,
-                                Usage::TransferDst => BufferUsage::TRANSFER_DST,
-                                _ => BufferUsage::STORAGE,
-                            };
-                        }
-                    }
+                for u in accesses() {
+                    usage |= match u {
+                        Usage::Sampled => BufferUsage::UNIFORM,
+                        Usage::TransferSrc => BufferUsage::TRANSFER_SRC,
+                        Usage::TransferDst => BufferUsage::TRANSFER_DST,
+                        _ => BufferUsage::STORAGE,
+                    };
                 }
                 ResourceDesc::Buffer(BufferDesc { size: bytes, usage })
             }
@@ -424,6 +438,7 @@ pub fn compile_ir(
         })
         .collect();
     let scopes = read_scopes(&gpu_uses);
+    let sharing = memory_sharing(&resources);
     let mut states: Vec<ResourceState> = resources
         .iter()
         .map(|r| ResourceState::fresh(matches!(r.desc, ResourceDesc::Image(_))))
@@ -451,21 +466,22 @@ pub fn compile_ir(
     // The first frame starts from `states`; every later frame starts where the previous
     // one ended, so a transient image's first barrier must also wait for the previous
     // frame's last use of its memory. Simulate one frame to learn that, then record.
-    let (_, end_of_frame) = record_barriers(&resources, &gpu_uses, &scopes, states.clone());
+    let (_, end_of_frame) =
+        record_barriers(&resources, &sharing, &gpu_uses, &scopes, states.clone());
     for (r, state) in states.iter_mut().enumerate() {
         if resources[r].residency == Residency::Transient {
-            let (stage, access) = overlapping_pending(&resources, &end_of_frame, r);
+            let (stage, access) = pending_of(&end_of_frame, sharing[r].iter().copied().chain([r]));
             state.inherit(stage, access);
         }
     }
-    let (pass_barriers, states) = record_barriers(&resources, &gpu_uses, &scopes, states);
+    let (pass_barriers, states) = record_barriers(&resources, &sharing, &gpu_uses, &scopes, states);
     let passes: Vec<PlanPass> = sequence
         .iter()
         .zip(pass_barriers)
         .enumerate()
         .map(|(i, (&p, barriers))| {
             plan_pass(
-                ir, p, i, &uses, &new_index, &resources, &sequence, barriers, options,
+                ir, p, i, &uses, &new_index, &resources, &timeline, barriers, options,
             )
         })
         .collect();
@@ -568,6 +584,7 @@ fn read_scopes(gpu_uses: &[Vec<(usize, GpuAccess)>]) -> Vec<Vec<Scope>> {
 /// Walks the passes once, returning each pass's barriers and the final states.
 fn record_barriers(
     resources: &[PlanResource],
+    sharing: &[Vec<usize>],
     gpu_uses: &[Vec<(usize, GpuAccess)>],
     scopes: &[Vec<Scope>],
     mut states: Vec<ResourceState>,
@@ -577,7 +594,11 @@ fn record_barriers(
         let mut barriers = Vec::new();
         for (k, &(r, access)) in accesses.iter().enumerate() {
             if resources[r].lifetime.0 == i && resources[r].residency == Residency::Transient {
-                let (stage, acc) = aliased_predecessors(resources, &states, r);
+                let before = sharing[r]
+                    .iter()
+                    .copied()
+                    .filter(|&j| resources[j].lifetime.1 < resources[r].lifetime.0);
+                let (stage, acc) = pending_of(&states, before);
                 states[r].inherit(stage, acc);
             }
             if let Some(b) = states[r].access(r, access, scopes[i][k]) {
@@ -589,59 +610,36 @@ fn record_barriers(
     (all, states)
 }
 
-/// Pending stages and accesses, at the end of a frame, of every transient image
-/// sharing memory with `r` (itself included).
-fn overlapping_pending(
-    resources: &[PlanResource],
-    states: &[ResourceState],
-    r: usize,
-) -> (Stage, Access) {
-    let Some(mine) = resources[r].placement else {
-        return states[r].pending();
-    };
-    let mut stage = Stage::empty();
-    let mut access = Access::empty();
-    for (j, other) in resources.iter().enumerate() {
-        let Some(theirs) = other.placement else {
-            continue;
-        };
-        if theirs.block == mine.block
-            && theirs.offset < mine.offset + mine.size
-            && mine.offset < theirs.offset + theirs.size
-        {
-            let (s, a) = states[j].pending();
-            stage |= s;
-            access |= a;
+/// For each resource, the other transient images whose memory overlaps its own.
+fn memory_sharing(resources: &[PlanResource]) -> Vec<Vec<usize>> {
+    let mut placed: Vec<(usize, u64, u64, usize)> = resources
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| {
+            r.placement
+                .map(|p| (p.block, p.offset, p.offset + p.size, i))
+        })
+        .collect();
+    placed.sort_unstable();
+    let mut sharing = vec![Vec::new(); resources.len()];
+    for (k, &(block, _, end, i)) in placed.iter().enumerate() {
+        for &(other_block, start, _, j) in &placed[k + 1..] {
+            if other_block != block || start >= end {
+                break;
+            }
+            sharing[i].push(j);
+            sharing[j].push(i);
         }
     }
-    (stage, access)
+    sharing
 }
 
-/// Stages and accesses of images that used this image's memory before it.
-fn aliased_predecessors(
-    resources: &[PlanResource],
-    states: &[ResourceState],
-    r: usize,
-) -> (Stage, Access) {
-    let Some(mine) = resources[r].placement else {
-        return (Stage::empty(), Access::empty());
-    };
-    let mut stage = Stage::empty();
-    let mut access = Access::empty();
-    for (j, other) in resources.iter().enumerate() {
-        let Some(theirs) = other.placement else {
-            continue;
-        };
-        let overlap = theirs.block == mine.block
-            && theirs.offset < mine.offset + mine.size
-            && mine.offset < theirs.offset + theirs.size;
-        if j != r && overlap && other.lifetime.1 < resources[r].lifetime.0 {
-            let (s, a) = states[j].pending();
-            stage |= s;
-            access |= a;
-        }
-    }
-    (stage, access)
+/// The union of the pending stages and accesses of some resources.
+fn pending_of(states: &[ResourceState], which: impl Iterator<Item = usize>) -> (Stage, Access) {
+    which.fold((Stage::empty(), Access::empty()), |(s, a), j| {
+        let (js, ja) = states[j].pending();
+        (s | js, a | ja)
+    })
 }
 
 /// How the GPU sees a pass's merged use of a resource.
@@ -732,27 +730,46 @@ fn image_read_stages(kind: PassKind) -> Stage {
     }
 }
 
-/// Whether anything after pass `i` (in plan order) needs what it left in resource `r`.
-fn needed_later(
-    ir: &Ir,
-    sequence: &[usize],
-    uses: &[Vec<PassUse>],
-    i: usize,
-    r: usize,
-    output: usize,
-) -> bool {
-    for &p in &sequence[i + 1..] {
-        if let Some(u) = uses[p].iter().find(|u| u.resource == r) {
-            return u.reads_previous || !u.discards;
+/// For each resource, the passes that use it in plan order, so per-resource questions
+/// cost the resource's uses, not the whole plan.
+struct Timeline {
+    /// `(plan index, IR pass, index into that pass's uses)` per resource.
+    per_resource: Vec<Vec<(usize, usize, usize)>>,
+}
+
+impl Timeline {
+    fn new(ir: &Ir, sequence: &[usize], uses: &[Vec<PassUse>]) -> Self {
+        let mut per_resource = vec![Vec::new(); ir.resources.len()];
+        for (i, &p) in sequence.iter().enumerate() {
+            for (k, u) in uses[p].iter().enumerate() {
+                per_resource[u.resource].push((i, p, k));
+            }
+        }
+        Timeline { per_resource }
+    }
+
+    /// Whether anything after plan pass `i` needs what it left in resource `r`.
+    fn needed_later(
+        &self,
+        ir: &Ir,
+        uses: &[Vec<PassUse>],
+        i: usize,
+        r: usize,
+        output: usize,
+    ) -> bool {
+        let touches = &self.per_resource[r];
+        let next = touches.partition_point(|t| t.0 <= i);
+        match touches.get(next) {
+            Some(&(_, p, k)) => uses[p][k].reads_previous || !uses[p][k].discards,
+            None => r == output || ir.resources[r].history,
         }
     }
-    r == output || ir.resources[r].history
 }
 
 fn warn_unread(
     graph: &LoadedGraph,
     ir: &Ir,
-    sequence: &[usize],
+    timeline: &Timeline,
     uses: &[Vec<PassUse>],
     output: usize,
     warnings: &mut Vec<Diagnostic>,
@@ -761,16 +778,15 @@ fn warn_unread(
         if r == output || res.history {
             continue;
         }
-        let written = sequence
-            .iter()
-            .any(|&p| uses[p].iter().any(|u| u.resource == r && u.writes));
+        let touches = &timeline.per_resource[r];
+        let written = touches.iter().any(|&(_, p, k)| uses[p][k].writes);
         // A depth attachment is read by its own depth test.
-        let read = sequence.iter().any(|&p| {
-            uses[p].iter().any(|u| u.resource == r && u.reads_previous)
-                || ir.passes[p]
-                    .accesses
+        let read = touches.iter().any(|&(_, p, k)| {
+            let u = &uses[p][k];
+            u.reads_previous
+                || u.accesses
                     .iter()
-                    .any(|a| a.resource == r && matches!(a.usage, Usage::Depth { .. }))
+                    .any(|&a| matches!(ir.passes[p].accesses[a].usage, Usage::Depth { .. }))
         });
         if written && !read {
             let (file, pos) = graph.locate(
@@ -795,6 +811,7 @@ fn check_discarding_stores(
     graph: &LoadedGraph,
     ir: &Ir,
     sequence: &[usize],
+    timeline: &Timeline,
     uses: &[Vec<PassUse>],
     output: usize,
 ) -> Result<(), Vec<Diagnostic>> {
@@ -811,7 +828,7 @@ fn check_discarding_stores(
                 _ => continue,
             };
             if store == StoreDecl::DontCare
-                && needed_later(ir, sequence, uses, i, access.resource, output)
+                && timeline.needed_later(ir, uses, i, access.resource, output)
             {
                 let mut path = access_path(ir.passes[p].index, access);
                 path.pop();
@@ -841,22 +858,28 @@ fn plan_pass(
     all_uses: &[Vec<PassUse>],
     new_index: &[usize],
     resources: &[PlanResource],
-    sequence: &[usize],
+    timeline: &Timeline,
     barriers: Vec<Barrier>,
     options: &CompileOptions,
 ) -> PlanPass {
     let pass = &ir.passes[p];
     let uses = &all_uses[p];
-    let active = |a: &crate::resolve::IrAccess| {
-        uses.iter().any(|u| {
-            u.accesses
-                .iter()
-                .any(|&k| std::ptr::eq(&pass.accesses[k], a))
-        })
+    let mut is_active = vec![false; pass.accesses.len()];
+    for u in uses {
+        for &k in &u.accesses {
+            is_active[k] = true;
+        }
+    }
+    let active_accesses = || {
+        pass.accesses
+            .iter()
+            .zip(&is_active)
+            .filter(|(_, on)| **on)
+            .map(|(a, _)| a)
     };
     let mut bindings = Vec::new();
     let mut defines: BTreeSet<String> = BTreeSet::new();
-    for access in pass.accesses.iter().filter(|a| active(a)) {
+    for access in active_accesses() {
         let kind = match access.usage {
             Usage::Sampled => BindingKind::Sampled,
             Usage::StorageRead => BindingKind::StorageRead,
@@ -887,7 +910,7 @@ fn plan_pass(
         let mut color = Vec::new();
         let mut depth = None;
         let mut extent = options.extent;
-        for access in pass.accesses.iter().filter(|a| active(a)) {
+        for access in active_accesses() {
             let (load, store, blend, read_only, is_depth) = match &access.usage {
                 Usage::Color { load, store, blend } => (load, *store, *blend, false, false),
                 Usage::Depth {
@@ -912,9 +935,8 @@ fn plan_pass(
             let store = if read_only {
                 StoreOp::None
             } else if store == StoreDecl::Store
-                && needed_later(
+                && timeline.needed_later(
                     ir,
-                    sequence,
                     all_uses,
                     i,
                     access.resource,

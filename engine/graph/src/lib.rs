@@ -20,7 +20,7 @@ pub mod text;
 pub mod vk;
 
 pub use check::check;
-pub use compile::{compile, CompileOptions};
+pub use compile::{compile, CompileOptions, Prepared};
 pub use diagnostic::{Diagnostic, Severity};
 pub use load::{load, load_with, LoadedGraph};
 pub use memory::{estimate_requirements, MemoryRequirements};

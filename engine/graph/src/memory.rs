@@ -58,25 +58,19 @@ pub fn place(images: &[Transient]) -> (MemoryPlan, Vec<Placement>) {
         };
         images.len()
     ];
-    let mut placed: Vec<usize> = Vec::with_capacity(images.len());
+    // Placed images as (offset, end, lifetime), kept sorted by offset.
+    let mut placed: Vec<(u64, u64, (usize, usize))> = Vec::with_capacity(images.len());
     let mut block_size = 0u64;
     let mut block_alignment = 1u64;
     for &i in &by_size {
         let req = images[i].requirements;
         let align = req.alignment.max(1);
-        let mut conflicts: Vec<(u64, u64)> = placed
-            .iter()
-            .filter(|&&j| overlaps(images[i].lifetime, images[j].lifetime))
-            .map(|&j| {
-                (
-                    placements[j].offset,
-                    placements[j].offset + placements[j].size,
-                )
-            })
-            .collect();
-        conflicts.sort_unstable();
         let mut offset = 0u64;
-        for (start, end) in conflicts {
+        let lifetime = images[i].lifetime;
+        for &(start, end, other) in &placed {
+            if !overlaps(lifetime, other) {
+                continue;
+            }
             if offset + req.size <= start {
                 break;
             }
@@ -87,7 +81,8 @@ pub fn place(images: &[Transient]) -> (MemoryPlan, Vec<Placement>) {
             offset,
             size: req.size,
         };
-        placed.push(i);
+        let at = placed.partition_point(|p| p.0 <= offset);
+        placed.insert(at, (offset, offset + req.size, lifetime));
         block_size = block_size.max(offset + req.size);
         block_alignment = block_alignment.max(align);
     }
