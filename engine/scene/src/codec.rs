@@ -20,6 +20,8 @@ bin_struct!(Mesh {
     positions,
     normals,
     uvs,
+    uvs1,
+    colors,
     tangents,
     indices,
     material,

@@ -206,6 +206,14 @@ fn primitive_mesh(
         .read_tex_coords(0)
         .map(|t| t.into_f32().map(Vec2::from_array).collect())
         .unwrap_or_default();
+    let uvs1: Vec<Vec2> = reader
+        .read_tex_coords(1)
+        .map(|t| t.into_f32().map(Vec2::from_array).collect())
+        .unwrap_or_default();
+    let colors: Vec<Vec4> = reader
+        .read_colors(0)
+        .map(|c| c.into_rgba_f32().map(Vec4::from_array).collect())
+        .unwrap_or_default();
     let handedness = if flip { -1.0 } else { 1.0 };
     let tangents: Vec<Vec4> = reader
         .read_tangents()
@@ -223,6 +231,8 @@ fn primitive_mesh(
     if normals.len() != count
         || (!uvs.is_empty() && uvs.len() != count)
         || (!tangents.is_empty() && tangents.len() != count)
+        || (!uvs1.is_empty() && uvs1.len() != count)
+        || (!colors.is_empty() && colors.len() != count)
     {
         return Err(bad("attribute counts differ".to_string()));
     }
@@ -232,6 +242,8 @@ fn primitive_mesh(
         positions,
         normals,
         uvs,
+        uvs1,
+        colors,
         tangents,
         indices,
         material: primitive.material().index(),

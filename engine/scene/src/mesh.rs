@@ -12,8 +12,13 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     /// Unit vertex normals, one per position (computed when the source has none).
     pub normals: Vec<Vec3>,
-    /// Texture coordinates, one per position, or empty when the source has none.
+    /// Texture coordinates (top-left origin, as glTF and Vulkan use), one per position, or
+    /// empty when the source has none.
     pub uvs: Vec<Vec2>,
+    /// A second UV set (glTF `TEXCOORD_1`, for textures whose `tex_coord` is 1), or empty.
+    pub uvs1: Vec<Vec2>,
+    /// Vertex colours (glTF `COLOR_0`, OBJ `v x y z r g b`) as linear RGBA, or empty.
+    pub colors: Vec<Vec4>,
     /// MikkTSpace tangents (xyz, w = handedness), one per position, or empty when the
     /// material has no normal map.
     pub tangents: Vec<Vec4>,

@@ -202,6 +202,14 @@ fn convert_mesh(
     } else {
         Vec::new()
     };
+    let colors = if mesh.vertex_color.len() == mesh.positions.len() {
+        mesh.vertex_color
+            .chunks_exact(3)
+            .map(|c| Vec3::from_slice(c).extend(1.0))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let material = match mesh.material_id {
         Some(id) if id < material_count => Some(id),
         Some(_) => {
@@ -222,6 +230,8 @@ fn convert_mesh(
         positions,
         normals,
         uvs,
+        uvs1: Vec::new(),
+        colors,
         tangents: Vec::new(),
         indices: mesh.indices,
         material,

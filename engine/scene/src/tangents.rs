@@ -97,6 +97,8 @@ mod tests {
                 Vec2::new(1.0, 0.0),
                 Vec2::new(0.0, 0.0),
             ],
+            uvs1: Vec::new(),
+            colors: Vec::new(),
             tangents: Vec::new(),
             indices: vec![0, 1, 2, 0, 2, 3],
             material: None,

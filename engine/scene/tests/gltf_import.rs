@@ -220,3 +220,32 @@ fn node_transforms_are_baked_into_vertices() {
             < 1e-5
     );
 }
+
+#[test]
+fn second_uv_set_and_vertex_colours() {
+    let scene = load_scene(&asset("gltf/rise/MultiUVTest.glb")).expect("loads");
+    let model = &scene.models[0];
+    let mesh = &model.meshes[0];
+    assert_eq!(
+        (mesh.uvs.len(), mesh.uvs1.len()),
+        (mesh.positions.len(), mesh.positions.len())
+    );
+    assert_ne!(mesh.uvs, mesh.uvs1);
+    let coords: Vec<u32> = model.materials[0]
+        .textures
+        .iter()
+        .map(|t| t.tex_coord)
+        .collect();
+    assert!(coords.contains(&1), "{coords:?}");
+
+    let scene = load_scene(&asset("gltf/rise/VertexColorTest.glb")).expect("loads");
+    let with_colors: Vec<usize> = scene.models[0]
+        .meshes
+        .iter()
+        .map(|m| m.colors.len())
+        .collect();
+    assert!(with_colors.iter().any(|&n| n > 0), "{with_colors:?}");
+    for mesh in &scene.models[0].meshes {
+        assert!(mesh.colors.is_empty() || mesh.colors.len() == mesh.positions.len());
+    }
+}

@@ -218,3 +218,24 @@ fn malformed_obj_is_a_located_error() {
         assert_eq!(shown, expected);
     }
 }
+
+#[test]
+fn obj_vertex_colours() {
+    let dir = temp_dir("obj-colours");
+    let path = dir.join("c.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n",
+    )
+    .expect("write");
+    let (model, warnings) = load(&path);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(
+        model.meshes[0].colors,
+        vec![
+            Vec4::new(1.0, 0.0, 0.0, 1.0),
+            Vec4::new(0.0, 1.0, 0.0, 1.0),
+            Vec4::new(0.0, 0.0, 1.0, 1.0)
+        ]
+    );
+}
