@@ -1,9 +1,8 @@
 //! Helpers shared by the GPU tests: a validating context and plan compilation
 //! with the device's real memory requirements.
 
-use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use weft_gpu::{image_requirements, Gpu, GpuOptions};
+use weft_gpu::{memory_requirements, Gpu, GpuOptions};
 use weft_graph::plan::{Extent, Plan};
 use weft_graph::CompileOptions;
 
@@ -23,13 +22,25 @@ pub fn graph(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// Compiles a fixture graph for the device, at the given size.
+/// Path of a graph shipped in the repository's `graphs/`.
+pub fn shipped(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../graphs")
+        .join(name)
+}
+
+/// Compiles a graph for the device at the given size with its default features.
 pub fn compile(gpu: &Gpu, path: &Path, width: u32, height: u32) -> Plan {
+    compile_with(gpu, path, width, height, &[])
+}
+
+/// Compiles a graph with features requested as on the command line (`name`, `!name`).
+pub fn compile_with(gpu: &Gpu, path: &Path, width: u32, height: u32, features: &[&str]) -> Plan {
     let loaded = weft_graph::load(path);
-    let memory = |d: &weft_graph::plan::ImageDesc| image_requirements(gpu, d);
+    let memory = memory_requirements(gpu);
     let options = CompileOptions {
         extent: Extent { width, height },
-        features: BTreeSet::new(),
+        features: loaded.features(features),
         lights: 1,
         memory: &memory,
     };
