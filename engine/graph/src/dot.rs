@@ -8,7 +8,11 @@ use crate::resolve::{resolve, usage_name};
 use std::fmt::Write;
 
 fn quote(s: &str) -> String {
-    format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
+    let escaped = s
+        .replace('\\', "\\\\")
+        .replace('"', "\\\"")
+        .replace('\n', "\\n");
+    format!("\"{escaped}\"")
 }
 
 /// DOT text for a graph; passes absent from `plan` are drawn as culled.
@@ -42,7 +46,7 @@ pub fn render(graph: &LoadedGraph, plan: &Plan) -> String {
         let (style, label) = match culled {
             Some(c) => (
                 ", style=\"filled,dashed\", fillcolor=\"#eeeeee\", color=grey, fontcolor=grey",
-                format!("{}\\n(culled: {})", p.name, c.reason),
+                format!("{}\n(culled: {})", p.name, c.reason),
             ),
             None => (", style=filled, fillcolor=\"#dde8ff\"", p.name.clone()),
         };

@@ -314,7 +314,7 @@ impl<'a> Resolver<'a> {
         };
         match self.resource_index.get(name.as_str()) {
             Some(&i) => {
-                if !matches!(resources[i].kind, IrKind::Image { .. }) {
+                if matches!(resources[i].kind, IrKind::Buffer { .. }) {
                     self.error(
                         0,
                         &[Seg::Field("output")],

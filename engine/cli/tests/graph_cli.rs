@@ -1,0 +1,162 @@
+//! The `weft graph` commands as a user runs them: exit codes, messages on stderr,
+//! JSON stats, and DOT output.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn weft(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_weft"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .expect("weft runs")
+}
+
+fn temp_graph(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("weft-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("g.ron");
+    std::fs::write(&path, text).expect("write graph");
+    path
+}
+
+#[test]
+fn check_passes_on_shipped_graphs() {
+    let out = weft(&[
+        "graph",
+        "check",
+        "graphs/forward.ron",
+        "graphs/deferred.ron",
+        "graphs/shadows.ron",
+        "graphs/bloom.ron",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert_eq!(
+        stderr
+            .lines()
+            .filter(|l| l.ends_with(": ok (0 warning(s))"))
+            .count(),
+        4,
+        "{stderr}"
+    );
+}
+
+#[test]
+fn check_fails_with_located_errors_on_stderr() {
+    let path = temp_graph(
+        "bad",
+        r#"Graph(
+    resources: [Image(name: "hdr", format: R16G16B16A16_SFLOT)],
+    passes: [Pass(name: "a", kind: Fullscreen, shaders: (fragment: "a.frag"), color: [(image: "hrd")])],
+    output: "hdr",
+)"#,
+    );
+    let out = weft(&["graph", "check", path.to_str().expect("utf-8 path")]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stdout.is_empty());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let file = path.display();
+    assert!(stderr.contains(&format!("{file}:2:44: error: unknown format \"R16G16B16A16_SFLOT\"\n  hint: did you mean \"R16G16B16A16_SFLOAT\"?")), "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "{file}:3:95: error: unknown resource \"hrd\"\n  hint: did you mean \"hdr\"?"
+        )),
+        "{stderr}"
+    );
+    assert!(stderr.contains("2 error(s), 0 warning(s)"), "{stderr}");
+}
+
+#[test]
+fn plan_json_has_stats() {
+    let out = weft(&[
+        "graph",
+        "plan",
+        "graphs/deferred.ron",
+        "--size",
+        "1920x1080",
+        "--features",
+        "shadow_casters,point_lights",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    let stats = &json["stats"];
+    assert_eq!(stats["passes"], 8);
+    assert_eq!(stats["culled"], 1);
+    assert!(stats["barriers"].as_u64().expect("barriers") > 10);
+    let aliased = stats["transient_bytes"].as_u64().expect("bytes");
+    let unaliased = stats["transient_bytes_unaliased"].as_u64().expect("bytes");
+    assert!(aliased < unaliased, "{aliased} < {unaliased}");
+    assert!(stats["compile_us"].as_f64().expect("time") > 0.0);
+    assert_eq!(json["extent"]["width"], 1920);
+    assert_eq!(json["culled"][0]["name"], "spot_lights");
+}
+
+#[test]
+fn plan_text_lists_culled_passes_and_barriers() {
+    let out = weft(&[
+        "graph",
+        "plan",
+        "graphs/forward.ron",
+        "--features",
+        "!bloom",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(
+        text.starts_with("plan \"forward\" at 1280x720, features []\n"),
+        "{text}"
+    );
+    assert!(
+        text.contains("culled:\n  shadow_sun: enabled_if [shadow_casters] is false\n"),
+        "{text}"
+    );
+    assert!(text.contains("     barrier hdr: COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE -> FRAGMENT_SHADER/SHADER_SAMPLED_READ COLOR_ATTACHMENT_OPTIMAL -> SHADER_READ_ONLY_OPTIMAL\n"), "{text}");
+}
+
+#[test]
+fn plan_of_a_broken_graph_fails() {
+    let out = weft(&["graph", "plan", "graphs/shadows.ron"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(
+            "this file is a fragment (`fragment: true`) and cannot be compiled on its own"
+        ),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn dot_greys_culled_passes() {
+    let out = weft(&["graph", "dot", "graphs/deferred.ron"]);
+    assert!(out.status.success());
+    let dot = String::from_utf8_lossy(&out.stdout);
+    assert!(dot.starts_with("digraph \"deferred\" {\n"), "{dot}");
+    assert!(dot.contains("\"pass:shadow_sun\" [shape=box, label=\"shadow_sun\\n(culled: enabled_if [shadow_casters] is false)\", style=\"filled,dashed\""), "{dot}");
+    assert!(
+        dot.contains("\"pass:gbuffer\" -> \"res:gbuffer_albedo\" [label=\"colour attachment\"];"),
+        "{dot}"
+    );
+    assert!(
+        dot.contains("\"res:hdr\" -> \"pass:tonemap\" [label=\"sampled read\"];"),
+        "{dot}"
+    );
+    assert!(dot.trim_end().ends_with('}'));
+}
+
+#[test]
+fn bad_size_is_rejected_by_the_argument_parser() {
+    let out = weft(&["graph", "plan", "graphs/forward.ron", "--size", "wide"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("expected WIDTHxHEIGHT, found \"wide\""));
+}
