@@ -1,5 +1,7 @@
 //! Helpers shared by the GPU tests: a validating context and plan compilation
 //! with the device's real memory requirements.
+// Each test crate compiles this module and uses only some of it.
+#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use weft_gpu::{memory_requirements, Gpu, GpuOptions};
