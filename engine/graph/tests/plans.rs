@@ -161,3 +161,23 @@ fn scene_features_cull_passes_and_variants() {
     );
     assert!(plan.resource("shadow_map").is_none());
 }
+
+#[test]
+fn the_annotated_example_in_graphs_readme_checks_clean() {
+    let readme = std::fs::read_to_string(repo_root().join("graphs/README.md")).expect("README");
+    let start = readme.find("```ron\n").expect("a ron block") + "```ron\n".len();
+    let end = start + readme[start..].find("```").expect("closed block");
+    let example = readme[start..end].to_string();
+    let graphs = repo_root().join("graphs");
+    let root = graphs.join("README-example.ron");
+    let read = |p: &std::path::Path| {
+        if p == root {
+            Ok(example.clone())
+        } else {
+            std::fs::read_to_string(p)
+        }
+    };
+    let graph = weft_graph::load_with(&root, &read);
+    assert_eq!(weft_graph::check(&graph), Vec::new());
+    assert_eq!(graph.sources.len(), 3);
+}
