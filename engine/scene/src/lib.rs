@@ -32,6 +32,7 @@ mod codec;
 pub mod desc;
 pub mod error;
 pub mod gltf_import;
+mod guard;
 pub mod light;
 pub mod load;
 pub mod material;

@@ -6,6 +6,7 @@ use crate::bounds::Aabb;
 use crate::camera::default_camera;
 use crate::desc::{read_scene_desc, Placement, SceneDesc};
 use crate::error::{Diagnostics, Location, SceneError};
+use crate::guard::without_panics;
 use crate::light::Light;
 use crate::model::Model;
 use crate::obj::load_obj;
@@ -66,8 +67,10 @@ pub fn load_model(
 ) -> Result<Model, SceneError> {
     crate::cache::load_cached(path, options.cache_dir.as_deref(), diag, |diag| {
         let mut model = match extension(path).as_str() {
-            "obj" => load_obj(path, asked_at, diag)?,
-            "gltf" | "glb" => crate::gltf_import::load_gltf(path, asked_at, diag)?,
+            "obj" => without_panics(path, || load_obj(path, asked_at, diag))?,
+            "gltf" | "glb" => {
+                without_panics(path, || crate::gltf_import::load_gltf(path, asked_at, diag))?
+            }
             other => {
                 return Err(SceneError::Model {
                     at: asked_at.clone(),

@@ -1,12 +1,12 @@
-//! Random and mutated `.scene`, `.obj` and `.mtl` text must give a result or a located error,
-//! never a panic.
+//! Random and mutated `.scene`, `.obj`, `.mtl` and `.glb` input must give a result or a located
+//! error, never a panic.
 
 mod common;
 
 use common::{asset, temp_dir};
 use proptest::prelude::*;
 use std::path::Path;
-use weft_scene::{load_obj, scene_desc_from_str, Diagnostics, Location, SceneError};
+use weft_scene::{scene_desc_from_str, Diagnostics, Location, SceneError};
 
 /// Tokens that stress the parsers: structure, numbers in odd spellings, non-finite values.
 const PIECES: &[&str] = &[
@@ -139,7 +139,8 @@ fn load_obj_text(dir: &Path, obj: &str, mtl: &str) {
     let path = dir.join("f.obj");
     std::fs::write(&path, format!("mtllib f.mtl\n{obj}")).expect("write obj");
     let mut diag = Diagnostics::default();
-    let _ = load_obj(&path, &Location::file(&path), &mut diag);
+    // Unguarded on purpose: a panic in the OBJ path (ours or tobj's) must fail this test.
+    let _ = weft_scene::load_obj(&path, &Location::file(&path), &mut diag);
 }
 
 proptest! {
@@ -196,4 +197,23 @@ fn unreadable_and_binary_files_are_errors() {
     assert_eq!(err.location().line, Some(3));
     let err = weft_scene::load_scene(&dir.join("absent.scene")).expect_err("missing");
     assert!(matches!(err, SceneError::MissingFile { .. }));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    #[test]
+    fn mutated_glb_never_panics(edits in proptest::collection::vec((0usize..100_000, any::<u8>()), 1..8)) {
+        let dir = temp_dir("fuzz-glb");
+        let mut bytes = std::fs::read(asset("gltf/rise/BoxTextured.glb")).expect("read");
+        for (at, value) in edits {
+            let at = at % bytes.len();
+            bytes[at] = value;
+        }
+        let path = dir.join("m.glb");
+        std::fs::write(&path, &bytes).expect("write");
+        let mut diag = Diagnostics::default();
+        let options = weft_scene::LoadOptions::default();
+        let _ = weft_scene::load_model(&path, &Location::file(&path), &options, &mut diag);
+    }
 }
