@@ -66,7 +66,11 @@ pub fn load_obj(
             )
         })
         .collect();
-    warn_unknown_usemtl(path, &bytes, &materials, diag);
+    // Only a mesh without a material, while materials exist, can come from an unknown usemtl:
+    // scan the text for names only then.
+    if !materials.is_empty() && models.iter().any(|m| m.mesh.material_id.is_none()) {
+        warn_unknown_usemtl(path, &bytes, &materials, diag);
+    }
     let mut meshes = Vec::with_capacity(models.len());
     for m in models {
         if let Some(mesh) = convert_mesh(m, materials.len(), path, &bytes, diag)? {
