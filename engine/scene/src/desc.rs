@@ -448,10 +448,9 @@ fn positive(props: &mut Props<'_>, name: &str) -> Result<Option<f32>, SceneError
 
 /// An `arealight` block: `shape rect` with `size W H`, or `shape disc` with `radius R`.
 fn arealight(props: &mut Props<'_>) -> Result<AreaLight, SceneError> {
-    let shape_name = props
+    let (shape_name, shape_line) = props
         .text("shape")?
-        .map(|(s, _)| s)
-        .unwrap_or_else(|| "rect".to_string());
+        .unwrap_or_else(|| ("rect".to_string(), props.block_at().line.unwrap_or(1)));
     let shape = match shape_name.as_str() {
         "rect" => {
             let (width, height) = match props.last("size") {
@@ -467,11 +466,11 @@ fn arealight(props: &mut Props<'_>) -> Result<AreaLight, SceneError> {
             radius: positive(props, "radius")?.unwrap_or(0.5),
         },
         other => {
-            let at = props.block_at();
-            return Err(SceneError::Syntax {
-                at,
-                message: format!("arealight 'shape' must be rect or disc, found '{other}'"),
-            });
+            return Err(SceneError::syntax(
+                props.file(),
+                shape_line,
+                format!("arealight 'shape' must be rect or disc, found '{other}'"),
+            ));
         }
     };
     let position = props.vec3("position")?.unwrap_or(Vec3::ZERO);
@@ -570,7 +569,10 @@ fn camera(
             return Err(props.error(p, "give 'orientation' or 'target', not both"))
         }
     };
-    let fov_y = match (props.last("fov"), props.f32("fov_deg")?) {
+    let fov_y = match (
+        props.last("fov"),
+        props.f32_where("fov_deg", |d| d > 0.0 && d < 180.0, "in (0, 180)")?,
+    ) {
         (Some(p), None) => {
             let f = props.exactly(p, 1)?[0];
             if !(f > 0.0 && f < std::f32::consts::PI) {
@@ -578,15 +580,7 @@ fn camera(
             }
             f
         }
-        (None, Some(d)) => {
-            if !(d > 0.0 && d < 180.0) {
-                return Err(SceneError::Syntax {
-                    at: props.block_at(),
-                    message: format!("'fov_deg' must be in (0, 180), found {d}"),
-                });
-            }
-            d.to_radians()
-        }
+        (None, Some(d)) => d.to_radians(),
         (None, None) => DEFAULT_FOV_Y,
         (Some(p), Some(_)) => return Err(props.error(p, "give 'fov' or 'fov_deg', not both")),
     };
