@@ -85,6 +85,12 @@ impl Camera {
         )
     }
 
+    /// The projection for a viewport of `aspect` = width / height: right-handed, depth 0..1
+    /// (Vulkan's range), +Y up in clip space (flip Y with a negative viewport height).
+    pub fn projection(&self, aspect: f32) -> Mat4 {
+        Mat4::perspective_rh(self.fov_y, aspect, self.near, self.far)
+    }
+
     /// The world-to-view matrix at `time`.
     pub fn view_at(&self, time: f32) -> Mat4 {
         let (p, q) = self.pose_at(time);
@@ -144,6 +150,24 @@ mod tests {
         let distance = c.position.length();
         assert!((distance - 3.0f32.sqrt() / (std::f32::consts::FRAC_PI_8).sin()).abs() < 1e-4);
         assert!(c.near > 0.0 && c.far > distance + 1.7);
+    }
+
+    #[test]
+    fn projection_maps_near_and_far_to_vulkan_depth() {
+        let c = Camera {
+            near: 0.5,
+            far: 10.0,
+            ..default_camera(&Aabb::EMPTY)
+        };
+        let p = c.projection(16.0 / 9.0);
+        let near = p.project_point3(Vec3::new(0.0, 0.0, -0.5));
+        let far = p.project_point3(Vec3::new(0.0, 0.0, -10.0));
+        assert!(
+            near.z.abs() < 1e-6 && (far.z - 1.0).abs() < 1e-6,
+            "{near} {far}"
+        );
+        let view = c.view_at(0.0);
+        assert!(view.transform_point3(c.position).length() < 1e-4);
     }
 
     #[test]
