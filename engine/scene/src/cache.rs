@@ -110,7 +110,11 @@ fn decode(bytes: &[u8]) -> Option<(Model, Vec<Warning>)> {
     }
     let warnings = Vec::<Warning>::read(&mut r)?;
     let model = Model::read(&mut r)?;
-    r.is_empty().then_some((model, warnings))
+    let sound = model
+        .meshes
+        .iter()
+        .all(|m| m.is_consistent() && m.material.is_none_or(|i| i < model.materials.len()));
+    (r.is_empty() && sound).then_some((model, warnings))
 }
 
 /// Writes an entry atomically (a temporary file renamed into place).

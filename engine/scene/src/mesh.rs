@@ -35,6 +35,20 @@ impl Mesh {
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }
+
+    /// Whether the arrays agree: whole triangles, indices in range, and every attribute array
+    /// either empty (where allowed) or one entry per position.
+    pub fn is_consistent(&self) -> bool {
+        let n = self.positions.len();
+        let per_vertex = |len: usize| len == 0 || len == n;
+        self.indices.len() % 3 == 0
+            && self.indices.iter().all(|&i| (i as usize) < n)
+            && self.normals.len() == n
+            && per_vertex(self.uvs.len())
+            && per_vertex(self.uvs1.len())
+            && per_vertex(self.colors.len())
+            && per_vertex(self.tangents.len())
+    }
 }
 
 /// Area-weighted vertex normals for an indexed triangle list; degenerate vertices get +Y.
