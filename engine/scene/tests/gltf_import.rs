@@ -61,6 +61,7 @@ fn sample_files_have_exact_counts() {
                 .materials
                 .iter()
                 .all(|m| m.shading == ShadingModel::MetallicRoughness));
+            assert!(model.meshes.iter().all(|m| m.is_consistent()), "{file}");
         }
     }
 }

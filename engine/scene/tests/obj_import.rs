@@ -42,13 +42,7 @@ fn cornell_boxes_have_exact_counts() {
             usize::from(file == "CornellBox-Glossy.obj"),
             "{file}: {warnings:?}"
         );
-        for mesh in &model.meshes {
-            assert_eq!(mesh.normals.len(), mesh.positions.len());
-            assert!(mesh
-                .indices
-                .iter()
-                .all(|&i| (i as usize) < mesh.positions.len()));
-        }
+        assert!(model.meshes.iter().all(|m| m.is_consistent()), "{file}");
     }
 }
 
