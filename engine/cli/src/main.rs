@@ -1,6 +1,7 @@
 //! The `weft` command.
 
 mod graph_cmd;
+mod scene_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -18,12 +19,16 @@ enum Command {
     /// Check, plan and draw render graphs.
     #[command(subcommand)]
     Graph(graph_cmd::GraphCommand),
+    /// Check scenes.
+    #[command(subcommand)]
+    Scene(scene_cmd::SceneCommand),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Graph(cmd) => graph_cmd::run(cmd),
+        Command::Scene(cmd) => scene_cmd::run(cmd),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,39 @@
+//! `weft scene check`.
+
+use anyhow::Result;
+use clap::Subcommand;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Scene subcommands.
+#[derive(Subcommand)]
+pub enum SceneCommand {
+    /// Load a scene and summarise it: models, triangles, materials, textures, lights,
+    /// bounds and warnings; exit 1 when it does not load.
+    Check {
+        file: PathBuf,
+        /// Print the summary as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Runs a scene subcommand.
+pub fn run(cmd: SceneCommand) -> Result<ExitCode> {
+    match cmd {
+        SceneCommand::Check { file, json } => match weft_scene::check_report(&file) {
+            Ok(report) => {
+                if json {
+                    println!("{}", serde_json::to_string_pretty(&report)?);
+                } else {
+                    print!("{report}");
+                }
+                Ok(ExitCode::SUCCESS)
+            }
+            Err(err) => {
+                eprintln!("error: {err}");
+                Ok(ExitCode::FAILURE)
+            }
+        },
+    }
+}

@@ -1,0 +1,60 @@
+//! `weft scene check` as a user runs it.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn weft(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_weft"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .expect("weft runs")
+}
+
+#[test]
+fn check_summarises_a_real_scene_with_its_quirk_warning() {
+    let out = weft(&["scene", "check", "../shared/assets/462/scenes/dragon.scene"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("1 meshes, 100000 triangles"), "{text}");
+    assert!(
+        text.contains("lights: 1 sun, 0 spot, 0 point, 0 area"),
+        "{text}"
+    );
+    assert!(
+        text.contains("dragon.scene:6: warning: 'orientation' has 4 values"),
+        "{text}"
+    );
+}
+
+#[test]
+fn check_json_has_counts() {
+    let out = weft(&["scene", "check", "scenes/demo.scene", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    assert_eq!(json["lights"]["sun"], 1);
+    assert!(json["triangles"].as_u64().expect("triangles") > 100_000);
+}
+
+#[test]
+fn check_fails_on_a_missing_file() {
+    let out = weft(&["scene", "check", "scenes/no-such.scene"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with("error: ") && stderr.contains("no-such.scene"),
+        "{stderr}"
+    );
+}
