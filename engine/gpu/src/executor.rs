@@ -5,54 +5,23 @@
 
 use crate::bind::{self, FrameValues, ResolvedBinding};
 use crate::context::{Gpu, MemoryReport};
+use crate::download::ReadbackBuffer;
+use crate::draw::{DrawRecorder, RasterContext};
 use crate::error::{GpuError, VkCall};
+use crate::frame::{CommandBuffers, DescriptorPool, Label};
 use crate::pipeline::{Pipeline, PipelineCache, PipelineKey, ShaderKey};
-use crate::readback::{self, Readback};
+use crate::readback::Readback;
 use crate::record;
 use crate::renderpass::RenderPassCache;
 use crate::resources::{FrameResources, GpuResource};
 use crate::shader::ShaderStage;
+use crate::timing::{PassTiming, QueryPool, TimingMode, TimingSource};
 use ash::vk;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
-use gpu_allocator::MemoryLocation;
-use std::ffi::CString;
 use std::sync::Arc;
 use std::time::Instant;
 use weft_graph::plan::{Plan, PlanPass, PlanResource, Residency, ResourceDesc};
 use weft_graph::schema::{Draw, PassKind};
 use weft_graph::vk::Layout;
-
-/// How per-pass times are measured.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum TimingMode {
-    /// No timing.
-    #[default]
-    Off,
-    /// GPU timestamps around each pass, one submission per frame.
-    GpuTimestamps,
-    /// CPU wall time of each pass submitted and waited for on its own
-    /// (profiling mode: slower frames, but honest figures where timestamps
-    /// are not, like compute on lavapipe).
-    CpuPerPass,
-}
-
-/// What a timing figure measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum TimingSource {
-    /// Difference of GPU timestamps around the pass.
-    GpuTimestamp,
-    /// Host wall time from submitting the pass alone to its fence signalling.
-    CpuWall,
-}
-
-/// The time one pass took.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PassTiming {
-    pub pass: String,
-    pub kind: PassKind,
-    pub source: TimingSource,
-    pub ms: f64,
-}
 
 /// Options for one frame.
 #[derive(Debug, Clone, Default)]
@@ -79,47 +48,6 @@ pub struct FrameReport {
     pub dedicated_bytes: u64,
     /// The allocator's view of all device memory in use.
     pub memory: MemoryReport,
-}
-
-/// What a draw recorder gets for a raster pass that draws scene content: it
-/// records draws inside the already begun render pass (viewport and scissor
-/// set to `extent`), with pipelines it builds against `render_pass` subpass 0.
-pub struct RasterContext<'a> {
-    pub gpu: &'a Gpu,
-    pub cmd: vk::CommandBuffer,
-    pub plan: &'a Plan,
-    pub pass_index: usize,
-    pub render_pass: vk::RenderPass,
-    pub extent: vk::Extent2D,
-    pub resources: &'a FrameResources<'a>,
-    /// The linear clamp sampler graph resources are sampled with.
-    pub sampler: vk::Sampler,
-}
-
-impl RasterContext<'_> {
-    /// The pass being recorded.
-    pub fn pass(&self) -> &PlanPass {
-        &self.plan.passes[self.pass_index]
-    }
-}
-
-/// Records the draws of raster passes whose content comes from outside the
-/// graph (scene meshes, light volumes); the render crate implements it.
-pub trait DrawRecorder {
-    /// Records the pass's draws into `ctx.cmd`.
-    fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError>;
-}
-
-/// A recorder for graphs without scene draws: any such pass is an error.
-pub struct NoDraws;
-
-impl DrawRecorder for NoDraws {
-    fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError> {
-        Err(GpuError::Pass {
-            pass: ctx.pass().name.clone(),
-            message: "draws scene content but no draw recorder was given".into(),
-        })
-    }
 }
 
 /// Everything a pass needs at record time.
@@ -330,7 +258,7 @@ impl<'g> Renderer<'g> {
         for pass in &plan.passes {
             prepared.push(self.prepare(plan, pass, resources, options)?);
         }
-        let pool = DescriptorPool::new(self.gpu, &prepared)?;
+        let pool = descriptor_pool(self.gpu, &prepared)?;
         self.write_descriptors(plan, resources, &pool, &mut prepared)?;
         let readback = if options.readback {
             Some(ReadbackBuffer::new(self.gpu, plan)?)
@@ -655,6 +583,26 @@ impl Drop for Renderer<'_> {
     }
 }
 
+/// A pool with room for every prepared pass's descriptor set.
+fn descriptor_pool<'g>(
+    gpu: &'g Gpu,
+    prepared: &[Prepared],
+) -> Result<DescriptorPool<'g>, GpuError> {
+    let mut counts: Vec<(vk::DescriptorType, u32)> = Vec::new();
+    let mut sets = 0;
+    for p in prepared.iter().filter(|p| p.pipeline.is_some()) {
+        sets += 1;
+        for b in &p.bindings {
+            let ty = b.shader.kind.vk();
+            match counts.iter_mut().find(|(t, _)| *t == ty) {
+                Some((_, n)) => *n += b.shader.count,
+                None => counts.push((ty, b.shader.count)),
+            }
+        }
+    }
+    DescriptorPool::new(gpu, sets, &counts)
+}
+
 /// Whether a raster/fullscreen pass draws one fullscreen triangle.
 fn is_fullscreen(pass: &PlanPass) -> bool {
     pass.kind == PassKind::Fullscreen || pass.draw == Some(Draw::FullscreenTriangle)
@@ -676,326 +624,6 @@ fn clear_value(resource: &PlanResource, clear: &[f64]) -> vk::ClearValue {
         }
         vk::ClearValue {
             color: vk::ClearColorValue { float32: c },
-        }
-    }
-}
-
-/// A debug-utils label around a pass, so validation messages name it.
-struct Label(bool);
-
-impl Label {
-    fn begin(gpu: &Gpu, cmd: vk::CommandBuffer, name: &str) -> Self {
-        let (Some(debug), Ok(name)) = (gpu.debug_utils(), CString::new(name)) else {
-            return Self(false);
-        };
-        let label = vk::DebugUtilsLabelEXT::default().label_name(&name);
-        unsafe { debug.cmd_begin_debug_utils_label(cmd, &label) };
-        Self(true)
-    }
-
-    fn end(self, gpu: &Gpu, cmd: vk::CommandBuffer) {
-        if let (true, Some(debug)) = (self.0, gpu.debug_utils()) {
-            unsafe { debug.cmd_end_debug_utils_label(cmd) };
-        }
-    }
-}
-
-/// One frame's descriptor pool, sized for every pass's set.
-struct DescriptorPool<'g> {
-    gpu: &'g Gpu,
-    pool: vk::DescriptorPool,
-}
-
-impl<'g> DescriptorPool<'g> {
-    fn new(gpu: &'g Gpu, prepared: &[Prepared]) -> Result<Self, GpuError> {
-        let mut counts: std::collections::HashMap<vk::DescriptorType, u32> = Default::default();
-        let mut sets = 0;
-        for p in prepared.iter().filter(|p| p.pipeline.is_some()) {
-            sets += 1;
-            for b in &p.bindings {
-                *counts.entry(b.shader.kind.vk()).or_default() += b.shader.count;
-            }
-        }
-        let sizes: Vec<_> = counts
-            .into_iter()
-            .map(|(ty, n)| vk::DescriptorPoolSize {
-                ty,
-                descriptor_count: n,
-            })
-            .collect();
-        let info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(sets.max(1))
-            .pool_sizes(&sizes);
-        let pool = unsafe { gpu.device().create_descriptor_pool(&info, None) }
-            .call("vkCreateDescriptorPool")?;
-        Ok(Self { gpu, pool })
-    }
-
-    fn allocate(
-        &self,
-        gpu: &Gpu,
-        layout: vk::DescriptorSetLayout,
-    ) -> Result<vk::DescriptorSet, GpuError> {
-        let layouts = [layout];
-        let info = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(self.pool)
-            .set_layouts(&layouts);
-        let sets = unsafe { gpu.device().allocate_descriptor_sets(&info) }
-            .call("vkAllocateDescriptorSets")?;
-        sets.into_iter().next().ok_or(GpuError::Vulkan {
-            call: "vkAllocateDescriptorSets",
-            result: vk::Result::ERROR_OUT_OF_POOL_MEMORY,
-        })
-    }
-}
-
-impl Drop for DescriptorPool<'_> {
-    fn drop(&mut self) {
-        unsafe { self.gpu.device().destroy_descriptor_pool(self.pool, None) };
-    }
-}
-
-/// The command buffers of one frame, freed on drop.
-struct CommandBuffers<'g> {
-    gpu: &'g Gpu,
-    buffers: Vec<vk::CommandBuffer>,
-}
-
-impl<'g> CommandBuffers<'g> {
-    fn new(gpu: &'g Gpu) -> Self {
-        Self {
-            gpu,
-            buffers: Vec::new(),
-        }
-    }
-
-    fn begin(&mut self) -> Result<vk::CommandBuffer, GpuError> {
-        let cmd = self.gpu.allocate_command_buffer()?;
-        self.buffers.push(cmd);
-        let info = vk::CommandBufferBeginInfo::default()
-            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-        unsafe { self.gpu.device().begin_command_buffer(cmd, &info) }
-            .call("vkBeginCommandBuffer")?;
-        Ok(cmd)
-    }
-
-    fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<(), GpuError> {
-        unsafe { self.gpu.device().end_command_buffer(cmd) }.call("vkEndCommandBuffer")?;
-        self.gpu.submit_and_wait(cmd)
-    }
-}
-
-impl Drop for CommandBuffers<'_> {
-    fn drop(&mut self) {
-        if self.buffers.is_empty() {
-            return;
-        }
-        unsafe {
-            let _ = self.gpu.device().device_wait_idle();
-            self.gpu
-                .device()
-                .free_command_buffers(self.gpu.command_pool(), &self.buffers);
-        }
-    }
-}
-
-/// Timestamp queries around every pass.
-struct QueryPool<'g> {
-    gpu: &'g Gpu,
-    pool: vk::QueryPool,
-    count: u32,
-}
-
-impl<'g> QueryPool<'g> {
-    fn new(gpu: &'g Gpu, count: u32) -> Result<Self, GpuError> {
-        let info = vk::QueryPoolCreateInfo::default()
-            .query_type(vk::QueryType::TIMESTAMP)
-            .query_count(count.max(1));
-        let pool =
-            unsafe { gpu.device().create_query_pool(&info, None) }.call("vkCreateQueryPool")?;
-        Ok(Self {
-            gpu,
-            pool,
-            count: count.max(1),
-        })
-    }
-
-    fn write(&self, gpu: &Gpu, cmd: vk::CommandBuffer, query: u32, stage: vk::PipelineStageFlags2) {
-        unsafe {
-            gpu.device()
-                .cmd_write_timestamp2(cmd, stage, self.pool, query)
-        };
-    }
-
-    fn timings(&self, gpu: &Gpu, plan: &Plan) -> Result<Vec<PassTiming>, GpuError> {
-        let mut ticks = vec![0u64; self.count as usize];
-        unsafe {
-            gpu.device().get_query_pool_results(
-                self.pool,
-                0,
-                &mut ticks,
-                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
-            )
-        }
-        .call("vkGetQueryPoolResults")?;
-        let period = f64::from(gpu.info().timestamp_period);
-        Ok(plan
-            .passes
-            .iter()
-            .enumerate()
-            .map(|(i, pass)| PassTiming {
-                pass: pass.name.clone(),
-                kind: pass.kind,
-                source: TimingSource::GpuTimestamp,
-                ms: ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period / 1e6,
-            })
-            .collect())
-    }
-}
-
-impl Drop for QueryPool<'_> {
-    fn drop(&mut self) {
-        unsafe { self.gpu.device().destroy_query_pool(self.pool, None) };
-    }
-}
-
-/// A host-visible buffer the output image is copied into.
-struct ReadbackBuffer<'g> {
-    gpu: &'g Gpu,
-    buffer: vk::Buffer,
-    allocation: Option<Allocation>,
-    size: u64,
-}
-
-impl<'g> ReadbackBuffer<'g> {
-    fn new(gpu: &'g Gpu, plan: &Plan) -> Result<Self, GpuError> {
-        let ResourceDesc::Image(desc) = &plan
-            .resources
-            .get(plan.output)
-            .ok_or_else(|| GpuError::Plan("the output resource does not exist".into()))?
-            .desc
-        else {
-            return Err(GpuError::Plan("the output is not an image".into()));
-        };
-        let texel = readback::texel_bytes(&desc.format).ok_or_else(|| {
-            GpuError::Plan(format!(
-                "cannot read back an output of format {}",
-                desc.format
-            ))
-        })?;
-        let size = u64::from(desc.extent.width) * u64::from(desc.extent.height) * u64::from(texel);
-        let info = vk::BufferCreateInfo::default()
-            .size(size)
-            .usage(vk::BufferUsageFlags::TRANSFER_DST)
-            .sharing_mode(vk::SharingMode::EXCLUSIVE);
-        let buffer = unsafe { gpu.device().create_buffer(&info, None) }.call("vkCreateBuffer")?;
-        let mut this = Self {
-            gpu,
-            buffer,
-            allocation: None,
-            size,
-        };
-        let requirements = unsafe { gpu.device().get_buffer_memory_requirements(buffer) };
-        let allocation = gpu
-            .allocator()
-            .allocate(&AllocationCreateDesc {
-                name: "readback",
-                requirements,
-                location: MemoryLocation::GpuToCpu,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .map_err(|e| GpuError::Allocation {
-                what: "the readback buffer".into(),
-                message: e.to_string(),
-            })?;
-        unsafe {
-            gpu.device()
-                .bind_buffer_memory(buffer, allocation.memory(), allocation.offset())
-        }
-        .call("vkBindBufferMemory")?;
-        this.allocation = Some(allocation);
-        Ok(this)
-    }
-
-    /// Copies the output (in TRANSFER_SRC_OPTIMAL after the epilogue) into
-    /// the buffer and makes the bytes visible to the host.
-    fn record(
-        &self,
-        gpu: &Gpu,
-        cmd: vk::CommandBuffer,
-        plan: &Plan,
-        resources: &FrameResources<'_>,
-    ) -> Result<(), GpuError> {
-        let img = resources.image(plan.output)?;
-        let region = vk::BufferImageCopy2::default()
-            .image_subresource(vk::ImageSubresourceLayers {
-                aspect_mask: vk::ImageAspectFlags::COLOR,
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            })
-            .image_extent(vk::Extent3D {
-                width: img.desc.extent.width,
-                height: img.desc.extent.height,
-                depth: 1,
-            });
-        let regions = [region];
-        let info = vk::CopyImageToBufferInfo2::default()
-            .src_image(img.image)
-            .src_image_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-            .dst_buffer(self.buffer)
-            .regions(&regions);
-        let host = [vk::BufferMemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::COPY)
-            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-            .dst_access_mask(vk::AccessFlags2::HOST_READ)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .buffer(self.buffer)
-            .offset(0)
-            .size(vk::WHOLE_SIZE)];
-        unsafe {
-            gpu.device().cmd_copy_image_to_buffer2(cmd, &info);
-            gpu.device().cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().buffer_memory_barriers(&host),
-            );
-        }
-        Ok(())
-    }
-
-    fn read(&self, plan: &Plan) -> Result<Readback, GpuError> {
-        let ResourceDesc::Image(desc) = &plan.resources[plan.output].desc else {
-            return Err(GpuError::Plan("the output is not an image".into()));
-        };
-        let bytes = self
-            .allocation
-            .as_ref()
-            .and_then(|a| a.mapped_slice())
-            .and_then(|s| s.get(..self.size as usize))
-            .ok_or_else(|| GpuError::Allocation {
-                what: "the readback buffer".into(),
-                message: "memory is not host-mapped".into(),
-            })?;
-        let pixels =
-            readback::decode(&desc.format, bytes).map_err(|e| GpuError::Plan(e.to_string()))?;
-        Ok(Readback {
-            width: desc.extent.width,
-            height: desc.extent.height,
-            format: desc.format.clone(),
-            pixels,
-        })
-    }
-}
-
-impl Drop for ReadbackBuffer<'_> {
-    fn drop(&mut self) {
-        unsafe { self.gpu.device().destroy_buffer(self.buffer, None) };
-        if let Some(a) = self.allocation.take() {
-            // Freeing only fails for allocations this allocator did not make.
-            let _ = self.gpu.allocator().free(a);
         }
     }
 }

@@ -4,8 +4,11 @@
 pub mod bind;
 pub mod context;
 pub mod convert;
+pub mod download;
+pub mod draw;
 pub mod error;
 pub mod executor;
+pub mod frame;
 pub mod golden;
 pub mod pipeline;
 pub mod readback;
@@ -14,16 +17,16 @@ pub mod reflect;
 pub mod renderpass;
 pub mod resources;
 pub mod shader;
+pub mod timing;
 pub mod validation;
 
 pub use context::{DeviceInfo, DeviceKind, Gpu, GpuOptions, MemoryReport};
+pub use draw::{DrawRecorder, NoDraws, RasterContext};
 pub use error::GpuError;
-pub use executor::{
-    DrawRecorder, FrameOptions, FrameReport, NoDraws, PassTiming, RasterContext, Renderer,
-    TimingMode, TimingSource,
-};
+pub use executor::{FrameOptions, FrameReport, Renderer};
 pub use golden::{check_golden, Comparison, GoldenError, Tolerance};
 pub use readback::{Pixels, Readback};
 pub use resources::{image_requirements, memory_requirements, FrameResources};
 pub use shader::{CompiledShader, ShaderCompiler, ShaderDiagnostic, ShaderError, ShaderStage};
+pub use timing::{format_timings, PassTiming, TimingMode, TimingSource};
 pub use validation::{Severity, ValidationCounts, ValidationLog, ValidationMessage};

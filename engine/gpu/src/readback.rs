@@ -28,7 +28,10 @@ pub enum ReadbackError {
     /// The output format has no conversion.
     #[error("cannot read back images of format {0}")]
     Format(String),
-    /// Writing the PNG failed.
+    /// The file name ends in neither `.png` nor `.exr`.
+    #[error("cannot save {0}: use a .png or .exr file name")]
+    Extension(String),
+    /// Writing the file failed.
     #[error("cannot write {path}: {message}")]
     Write { path: String, message: String },
 }
@@ -82,6 +85,15 @@ pub fn half_to_f32(h: u16) -> f32 {
     }
 }
 
+/// The sRGB transfer function's inverse.
+pub fn srgb_to_linear(x: f32) -> f32 {
+    if x <= 0.04045 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 impl Readback {
     /// 8-bit RGBA: stored bytes, or floats clamped to [0, 1] and rounded.
     pub fn to_rgba8(&self) -> image::RgbaImage {
@@ -99,6 +111,52 @@ impl Readback {
     /// The pixel at (x, y) as RGBA bytes.
     pub fn rgba8_at(&self, x: u32, y: u32) -> [u8; 4] {
         self.to_rgba8().get_pixel(x, y).0
+    }
+
+    /// Linear float RGBA: floats as read, 8-bit values divided by 255 and,
+    /// for `_SRGB` formats, decoded to linear.
+    pub fn to_rgba_f32(&self) -> image::Rgba32FImage {
+        let srgb = self.format.ends_with("_SRGB");
+        let data = match &self.pixels {
+            Pixels::RgbaF32(v) => v.clone(),
+            Pixels::Rgba8(v) => v
+                .iter()
+                .enumerate()
+                .map(|(i, &b)| {
+                    let x = f32::from(b) / 255.0;
+                    if srgb && i % 4 != 3 {
+                        srgb_to_linear(x)
+                    } else {
+                        x
+                    }
+                })
+                .collect(),
+        };
+        image::Rgba32FImage::from_raw(self.width, self.height, data)
+            .unwrap_or_else(|| image::Rgba32FImage::new(self.width, self.height))
+    }
+
+    /// Saves as PNG (8-bit, as stored) or OpenEXR (linear floats), by extension.
+    pub fn save(&self, path: &Path) -> Result<(), ReadbackError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("png") => self.save_png(path),
+            Some("exr") => self.save_exr(path),
+            _ => Err(ReadbackError::Extension(path.display().to_string())),
+        }
+    }
+
+    /// Saves linear floats as OpenEXR.
+    pub fn save_exr(&self, path: &Path) -> Result<(), ReadbackError> {
+        self.to_rgba_f32()
+            .save_with_format(path, image::ImageFormat::OpenExr)
+            .map_err(|e| ReadbackError::Write {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            })
     }
 
     /// Saves the 8-bit image as PNG.
@@ -123,6 +181,48 @@ mod tests {
         assert_eq!(half_to_f32(0x3800), 0.5);
         assert_eq!(half_to_f32(0x0001), 2f32.powi(-24));
         assert_eq!(half_to_f32(0x7c00), f32::INFINITY);
+    }
+
+    #[test]
+    fn saves_png_and_exr_by_extension() {
+        let image = Readback {
+            width: 2,
+            height: 1,
+            format: "R16G16B16A16_SFLOAT".into(),
+            pixels: Pixels::RgbaF32(vec![0.25, 2.0, 0.0, 1.0, 1.0, 0.5, 0.0, 1.0]),
+        };
+        let dir = std::env::temp_dir().join(format!("weft-readback-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        image.save(&dir.join("a.exr")).expect("exr");
+        let back = image::open(dir.join("a.exr"))
+            .expect("reads exr")
+            .to_rgba32f();
+        assert_eq!(back.get_pixel(0, 0).0, [0.25, 2.0, 0.0, 1.0]);
+        image.save(&dir.join("a.png")).expect("png");
+        let png = image::open(dir.join("a.png"))
+            .expect("reads png")
+            .to_rgba8();
+        assert_eq!(png.get_pixel(0, 0).0, [64, 255, 0, 255]);
+        assert!(matches!(
+            image.save(&dir.join("a.bmp")),
+            Err(ReadbackError::Extension(_))
+        ));
+        std::fs::remove_dir_all(&dir).expect("clean up");
+    }
+
+    #[test]
+    fn decodes_srgb_bytes_to_linear() {
+        let image = Readback {
+            width: 1,
+            height: 1,
+            format: "R8G8B8A8_SRGB".into(),
+            pixels: Pixels::Rgba8(vec![255, 0, 188, 128]),
+        };
+        let p = image.to_rgba_f32().get_pixel(0, 0).0;
+        assert_eq!(p[0], 1.0);
+        assert_eq!(p[1], 0.0);
+        assert!((p[2] - 0.503).abs() < 0.001, "{}", p[2]);
+        assert_eq!(p[3], 128.0 / 255.0);
     }
 
     #[test]

@@ -1,0 +1,49 @@
+//! The hook through which callers record scene draws (meshes, light
+//! volumes) inside the render passes the executor begins.
+
+use crate::context::Gpu;
+use crate::error::GpuError;
+use crate::resources::FrameResources;
+use ash::vk;
+use weft_graph::plan::{Plan, PlanPass};
+
+/// What a draw recorder gets for a raster pass that draws scene content: it
+/// records draws inside the already begun render pass (viewport and scissor
+/// set to `extent`), with pipelines it builds against `render_pass` subpass 0.
+pub struct RasterContext<'a> {
+    pub gpu: &'a Gpu,
+    pub cmd: vk::CommandBuffer,
+    pub plan: &'a Plan,
+    pub pass_index: usize,
+    pub render_pass: vk::RenderPass,
+    pub extent: vk::Extent2D,
+    pub resources: &'a FrameResources<'a>,
+    /// The linear clamp sampler graph resources are sampled with.
+    pub sampler: vk::Sampler,
+}
+
+impl RasterContext<'_> {
+    /// The pass being recorded.
+    pub fn pass(&self) -> &PlanPass {
+        &self.plan.passes[self.pass_index]
+    }
+}
+
+/// Records the draws of raster passes whose content comes from outside the
+/// graph (scene meshes, light volumes); the render crate implements it.
+pub trait DrawRecorder {
+    /// Records the pass's draws into `ctx.cmd`.
+    fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError>;
+}
+
+/// A recorder for graphs without scene draws: any such pass is an error.
+pub struct NoDraws;
+
+impl DrawRecorder for NoDraws {
+    fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError> {
+        Err(GpuError::Pass {
+            pass: ctx.pass().name.clone(),
+            message: "draws scene content but no draw recorder was given".into(),
+        })
+    }
+}
