@@ -1,5 +1,6 @@
 //! Errors and warnings, each located at a file and (where known) a line.
 
+use serde::ser::SerializeStruct;
 use serde::Serialize;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -130,6 +131,14 @@ impl SceneError {
         }
     }
 
+    /// The reason without the location prefix (for JSON output next to [`SceneError::location`]).
+    pub fn message(&self) -> String {
+        let full = self.to_string();
+        let prefix = format!("{}: ", self.location());
+        full.strip_prefix(&prefix)
+            .map_or(full.clone(), str::to_string)
+    }
+
     /// Where the error is.
     pub fn location(&self) -> &Location {
         match self {
@@ -139,5 +148,32 @@ impl SceneError {
             | Self::Syntax { at, .. }
             | Self::Model { at, .. } => at,
         }
+    }
+}
+
+/// Serialises as `{"at": {"file", "line"}, "message"}`, for `weft scene check --json`.
+impl Serialize for SceneError {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut s = serializer.serialize_struct("SceneError", 2)?;
+        s.serialize_field("at", self.location())?;
+        s.serialize_field("message", &self.message())?;
+        s.end()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn message_and_json() {
+        let e = SceneError::syntax(Path::new("a.scene"), 3, "malformed number '1x'");
+        assert_eq!(e.to_string(), "a.scene:3: malformed number '1x'");
+        assert_eq!(e.message(), "malformed number '1x'");
+        let json = serde_json::to_string(&e).expect("json");
+        assert_eq!(
+            json,
+            r#"{"at":{"file":"a.scene","line":3},"message":"malformed number '1x'"}"#
+        );
     }
 }
