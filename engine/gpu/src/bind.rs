@@ -18,7 +18,8 @@ pub struct ResolvedBinding {
 /// Matches shader bindings to the pass's graph bindings. A shader variable
 /// named like a resource the pass binds gets that resource; any other binding
 /// number N gets the pass's N-th binding (so one shader can serve passes that
-/// read different resources). Every problem is returned, not just the first.
+/// read different resources). Set 1 (scene data) is left to the draw recorder.
+/// Every problem is returned, not just the first.
 pub fn resolve_bindings(
     plan: &Plan,
     pass: &PlanPass,
@@ -34,9 +35,12 @@ pub fn resolve_bindings(
             .unwrap_or("?")
     };
     for (shader, _) in interface.bindings.values() {
+        if shader.set == crate::draw::SCENE_SET {
+            continue;
+        }
         if shader.set != 0 {
             problems.push(format!(
-                "shader binding `{}` is in set {}; graph resources are bound in set 0",
+                "shader binding `{}` is in set {}; graph resources are bound in set 0 (scene data in set 1)",
                 shader.name, shader.set
             ));
             continue;

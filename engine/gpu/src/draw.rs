@@ -29,11 +29,33 @@ impl RasterContext<'_> {
     }
 }
 
+/// The descriptor set number reserved for scene data (camera, lights): graph
+/// resources are bound in set 0, and a fullscreen pass whose shaders declare
+/// set 1 gets it from the draw recorder, so deferred lighting can read the scene.
+pub const SCENE_SET: u32 = 1;
+
 /// Records the draws of raster passes whose content comes from outside the
 /// graph (scene meshes, light volumes); the render crate implements it.
 pub trait DrawRecorder {
     /// Records the pass's draws into `ctx.cmd`.
     fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError>;
+
+    /// Binds scene data at set [`SCENE_SET`] for a fullscreen pass whose
+    /// shaders declare it; `set_layout` is that set's layout in `layout`.
+    fn bind_scene(
+        &mut self,
+        ctx: &RasterContext<'_>,
+        layout: vk::PipelineLayout,
+        set_layout: vk::DescriptorSetLayout,
+    ) -> Result<(), GpuError> {
+        let _ = (layout, set_layout);
+        Err(GpuError::Pass {
+            pass: ctx.pass().name.clone(),
+            message: format!(
+                "its shaders read scene data (set {SCENE_SET}) but no draw recorder supplies it"
+            ),
+        })
+    }
 }
 
 /// A recorder for graphs without scene draws: any such pass is an error.

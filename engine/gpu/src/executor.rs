@@ -6,7 +6,7 @@
 use crate::bind::{self, FrameValues, ResolvedBinding};
 use crate::context::{Gpu, MemoryReport};
 use crate::download::ReadbackBuffer;
-use crate::draw::{DrawRecorder, RasterContext};
+use crate::draw::{DrawRecorder, RasterContext, SCENE_SET};
 use crate::error::{GpuError, VkCall};
 use crate::frame::{CommandBuffers, DescriptorPool, Label};
 use crate::pipeline::{Pipeline, PipelineCache, PipelineKey, ShaderKey};
@@ -530,21 +530,30 @@ impl<'g> Renderer<'g> {
                     );
                     device.cmd_set_scissor(cmd, 0, &[area]);
                 }
-                let drawn = if prep.pipeline.is_some() {
-                    self.bind(cmd, prep);
-                    unsafe { device.cmd_draw(cmd, 3, 1, 0, 0) };
-                    Ok(())
-                } else {
-                    draws.record(&RasterContext {
-                        gpu: self.gpu,
-                        cmd,
-                        plan,
-                        pass_index: index,
-                        render_pass: prep.render_pass,
-                        extent: prep.extent,
-                        resources,
-                        sampler: self.sampler,
-                    })
+                let ctx = RasterContext {
+                    gpu: self.gpu,
+                    cmd,
+                    plan,
+                    pass_index: index,
+                    render_pass: prep.render_pass,
+                    extent: prep.extent,
+                    resources,
+                    sampler: self.sampler,
+                };
+                let drawn = match &prep.pipeline {
+                    Some(p) => {
+                        self.bind(cmd, prep);
+                        let scene = p
+                            .set_layouts
+                            .get(SCENE_SET as usize)
+                            .filter(|_| p.interface.bindings.keys().any(|(s, _)| *s == SCENE_SET));
+                        let bound = match scene {
+                            Some(&set_layout) => draws.bind_scene(&ctx, p.layout, set_layout),
+                            None => Ok(()),
+                        };
+                        bound.map(|()| unsafe { device.cmd_draw(cmd, 3, 1, 0, 0) })
+                    }
+                    None => draws.record(&ctx),
                 };
                 unsafe { device.cmd_end_render_pass2(cmd, &vk::SubpassEndInfo::default()) };
                 drawn

@@ -21,7 +21,7 @@ pub mod timing;
 pub mod validation;
 
 pub use context::{DeviceInfo, DeviceKind, Gpu, GpuOptions, MemoryReport};
-pub use draw::{DrawRecorder, NoDraws, RasterContext};
+pub use draw::{DrawRecorder, NoDraws, RasterContext, SCENE_SET};
 pub use error::GpuError;
 pub use executor::{FrameOptions, FrameReport, Renderer};
 pub use golden::{check_golden, Comparison, GoldenError, Tolerance};
