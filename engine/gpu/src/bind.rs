@@ -119,19 +119,49 @@ fn describe(plan: &Plan, bindings: &[Binding]) -> String {
 }
 
 /// Checks that a fragment shader writes exactly the pass's colour attachments.
-pub fn check_outputs(pass: &PlanPass, interface: &PipelineInterface) -> Vec<String> {
+pub fn check_outputs(plan: &Plan, pass: &PlanPass, interface: &PipelineInterface) -> Vec<String> {
     let Some(rp) = &pass.render_pass else {
         return Vec::new();
     };
     let locations: Vec<u32> = interface.outputs.iter().map(|o| o.location).collect();
     let expected: Vec<u32> = (0..rp.color.len() as u32).collect();
-    if locations == expected {
-        Vec::new()
-    } else {
-        vec![format!(
+    if locations != expected {
+        return vec![format!(
             "the fragment shader writes outputs at locations {locations:?} but the pass has {} colour attachment(s)",
             rp.color.len()
-        )]
+        )];
+    }
+    let mut problems = Vec::new();
+    for (output, &index) in interface.outputs.iter().zip(&rp.color) {
+        let Some(resource) = rp
+            .attachments
+            .get(index)
+            .and_then(|a| plan.resources.get(a.resource))
+        else {
+            continue;
+        };
+        let ResourceDesc::Image(desc) = &resource.desc else {
+            continue;
+        };
+        let wanted = attachment_scalar(&desc.format);
+        if output.scalar != wanted {
+            problems.push(format!(
+                "fragment output {} is {:?} but colour attachment `{}` ({}) takes {:?}",
+                output.location, output.scalar, resource.name, desc.format, wanted
+            ));
+        }
+    }
+    problems
+}
+
+/// The shader scalar type that writes a colour format.
+fn attachment_scalar(format: &str) -> ScalarKind {
+    if format.ends_with("_UINT") {
+        ScalarKind::Uint
+    } else if format.ends_with("_SINT") {
+        ScalarKind::Int
+    } else {
+        ScalarKind::Float
     }
 }
 

@@ -3,6 +3,7 @@
 
 use crate::context::Gpu;
 use crate::error::GpuError;
+use crate::pipeline::Pipeline;
 use crate::resources::FrameResources;
 use ash::vk;
 use weft_graph::plan::{Plan, PlanPass};
@@ -41,14 +42,10 @@ pub trait DrawRecorder {
     fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError>;
 
     /// Binds scene data at set [`SCENE_SET`] for a fullscreen pass whose
-    /// shaders declare it; `set_layout` is that set's layout in `layout`.
-    fn bind_scene(
-        &mut self,
-        ctx: &RasterContext<'_>,
-        layout: vk::PipelineLayout,
-        set_layout: vk::DescriptorSetLayout,
-    ) -> Result<(), GpuError> {
-        let _ = (layout, set_layout);
+    /// shaders declare it (`pipeline.interface` lists the bindings, and
+    /// `pipeline.set_layouts[SCENE_SET]` is the layout to allocate from).
+    fn bind_scene(&mut self, ctx: &RasterContext<'_>, pipeline: &Pipeline) -> Result<(), GpuError> {
+        let _ = pipeline;
         Err(GpuError::Pass {
             pass: ctx.pass().name.clone(),
             message: format!(

@@ -150,7 +150,7 @@ impl<'g> Renderer<'g> {
             Err(list) => (Vec::new(), list),
         };
         if matches!(key, PipelineKey::Fullscreen { .. }) {
-            problems.extend(bind::check_outputs(pass, &interface));
+            problems.extend(bind::check_outputs(plan, pass, &interface));
         }
         if let Some((block, _)) = &interface.push {
             if let Err(list) = bind::pack_push(block, &pass.params, &FrameValues::default()) {
@@ -543,13 +543,11 @@ impl<'g> Renderer<'g> {
                 let drawn = match &prep.pipeline {
                     Some(p) => {
                         self.bind(cmd, prep);
-                        let scene = p
-                            .set_layouts
-                            .get(SCENE_SET as usize)
-                            .filter(|_| p.interface.bindings.keys().any(|(s, _)| *s == SCENE_SET));
-                        let bound = match scene {
-                            Some(&set_layout) => draws.bind_scene(&ctx, p.layout, set_layout),
-                            None => Ok(()),
+                        let scene = p.interface.bindings.keys().any(|(s, _)| *s == SCENE_SET);
+                        let bound = if scene {
+                            draws.bind_scene(&ctx, p)
+                        } else {
+                            Ok(())
                         };
                         bound.map(|()| unsafe { device.cmd_draw(cmd, 3, 1, 0, 0) })
                     }

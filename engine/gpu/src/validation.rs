@@ -40,6 +40,22 @@ impl ValidationCounts {
     }
 }
 
+impl std::fmt::Display for ValidationCounts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let plural = |n: usize| if n == 1 { "" } else { "s" };
+        write!(
+            f,
+            "{} error{}, {} warning{}, {} performance warning{}",
+            self.errors,
+            plural(self.errors),
+            self.warnings,
+            plural(self.warnings),
+            self.performance,
+            plural(self.performance)
+        )
+    }
+}
+
 /// Thread-safe store of every message the layer reported, shared with the
 /// debug-utils callback; it outlives the `Gpu` so destruction-time leak
 /// reports can still be read.
@@ -190,6 +206,10 @@ mod tests {
             }
         );
         assert!(!counts.is_clean());
+        assert_eq!(
+            counts.to_string(),
+            "1 error, 0 warnings, 2 performance warnings"
+        );
         assert_eq!(log.take().len(), 3);
         assert!(log.counts().is_clean());
     }

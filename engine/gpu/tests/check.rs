@@ -27,6 +27,14 @@ fn reports_every_disagreement_between_shaders_and_graph() {
             "consume",
             "graph resource `b` is bound to nothing in the pass's shaders",
         ),
+        (
+            "label",
+            "graph resource `out` is bound to nothing in the pass's shaders",
+        ),
+        (
+            "label",
+            "fragment output 0 is Float but colour attachment `ids` (R32_UINT) takes Uint",
+        ),
     ]
     .iter()
     .map(|(p, m)| (p.to_string(), m.to_string()))
