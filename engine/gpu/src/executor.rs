@@ -4,23 +4,23 @@
 //! output back.
 
 use crate::bind::{self, FrameValues, ResolvedBinding};
+use crate::check::{self, PassShaders, ShaderProblem};
 use crate::context::{Gpu, MemoryReport};
 use crate::download::ReadbackBuffer;
 use crate::draw::{DrawRecorder, RasterContext, SCENE_SET};
 use crate::error::{GpuError, VkCall};
 use crate::frame::{CommandBuffers, DescriptorPool, Label};
-use crate::pipeline::{Pipeline, PipelineCache, PipelineKey, ShaderKey};
+use crate::pipeline::{Pipeline, PipelineCache, PipelineKey};
 use crate::readback::Readback;
 use crate::record;
 use crate::renderpass::RenderPassCache;
 use crate::resources::{FrameResources, GpuResource};
-use crate::shader::ShaderStage;
 use crate::timing::{PassTiming, QueryPool, TimingMode, TimingSource};
 use ash::vk;
 use std::sync::Arc;
 use std::time::Instant;
 use weft_graph::plan::{Plan, PlanPass, PlanResource, Residency, ResourceDesc};
-use weft_graph::schema::{Draw, PassKind};
+use weft_graph::schema::PassKind;
 use weft_graph::vk::Layout;
 
 /// Options for one frame.
@@ -120,92 +120,40 @@ impl<'g> Renderer<'g> {
     }
 
     /// Compiles and reflects every pass's shaders and cross-checks them with
-    /// the graph, returning each problem as (pass, message); no pipeline is built.
-    pub fn check_shaders(&mut self, plan: &Plan) -> Vec<(String, String)> {
-        let mut problems = Vec::new();
-        for pass in &plan.passes {
-            let list = match self.checked_interface(plan, pass) {
-                Ok(_) => continue,
-                Err(GpuError::Mismatch { problems, .. }) => problems,
-                Err(e) => vec![e.to_string()],
-            };
-            problems.extend(list.into_iter().map(|m| (pass.name.clone(), m)));
-        }
-        problems
+    /// the graph (see `check::check_shaders`); no pipeline is built.
+    pub fn check_shaders(&mut self, plan: &Plan) -> Vec<ShaderProblem> {
+        check::check_with(&mut self.pipelines, plan)
     }
 
-    /// The pass's pipeline key and shader interface, after checking that the
-    /// shaders agree with the graph; `None` for passes without shaders of ours.
+    /// The pass's pipeline key and resolved bindings, after checking that
+    /// its shaders agree with the graph; `None` for passes without shaders of ours.
     fn checked_interface(
         &mut self,
         plan: &Plan,
         pass: &PlanPass,
     ) -> Result<Option<(PipelineKey, Vec<ResolvedBinding>)>, GpuError> {
-        let Some(key) = self.pipeline_key(pass)? else {
+        let Some(shaders) = check::pass_shaders(pass)? else {
             return Ok(None);
         };
-        let interface = self.pipelines.interface(&key)?;
-        let (bindings, mut problems) = match bind::resolve_bindings(plan, pass, &interface) {
-            Ok(bindings) => (bindings, Vec::new()),
-            Err(list) => (Vec::new(), list),
-        };
-        if matches!(key, PipelineKey::Fullscreen { .. }) {
-            problems.extend(bind::check_outputs(plan, pass, &interface));
-        }
-        if let Some((block, _)) = &interface.push {
-            if let Err(list) = bind::pack_push(block, &pass.params, &FrameValues::default()) {
-                problems.extend(list);
-            }
-        }
-        if !problems.is_empty() {
-            return Err(GpuError::Mismatch {
-                pass: pass.name.clone(),
-                problems,
-            });
-        }
-        Ok(Some((key, bindings)))
-    }
-
-    fn pipeline_key(&mut self, pass: &PlanPass) -> Result<Option<PipelineKey>, GpuError> {
-        let device = self.gpu.device();
-        let missing = |what: &str| GpuError::Pass {
-            pass: pass.name.clone(),
-            message: format!("needs a {what} shader"),
-        };
-        let key = |path: &std::path::Path, stage| ShaderKey {
-            path: path.to_path_buf(),
-            stage,
-            defines: pass.defines.clone(),
-        };
-        let key = match pass.kind {
-            PassKind::Compute => {
-                let cs = pass
-                    .shaders
-                    .compute
-                    .as_deref()
-                    .ok_or_else(|| missing("compute"))?;
-                PipelineKey::Compute {
-                    shader: key(cs, ShaderStage::Compute),
+        let interface = self.pipelines.interface(&shaders.keys())?;
+        let bindings =
+            check::pass_problems(plan, pass, &shaders, &interface).map_err(|problems| {
+                GpuError::Mismatch {
+                    pass: pass.name.clone(),
+                    problems,
                 }
-            }
-            PassKind::Fullscreen | PassKind::Raster if is_fullscreen(pass) => {
+            })?;
+        let key = match shaders {
+            PassShaders::Compute(shader) => PipelineKey::Compute { shader },
+            PassShaders::Fullscreen { vertex, fragment } => {
                 let rp = pass.render_pass.as_ref().ok_or_else(|| GpuError::Pass {
                     pass: pass.name.clone(),
                     message: "has no render pass description".into(),
                 })?;
-                let fs = pass
-                    .shaders
-                    .fragment
-                    .as_deref()
-                    .ok_or_else(|| missing("fragment"))?;
-                let vertex = match pass.shaders.vertex.as_deref() {
-                    Some(vs) => key(vs, ShaderStage::Vertex),
-                    None => ShaderKey::fullscreen_vertex(),
-                };
                 PipelineKey::Fullscreen {
                     vertex,
-                    fragment: key(fs, ShaderStage::Fragment),
-                    render_pass: self.render_passes.get(device, rp)?,
+                    fragment,
+                    render_pass: self.render_passes.get(self.gpu.device(), rp)?,
                     blends: rp
                         .color
                         .iter()
@@ -214,9 +162,8 @@ impl<'g> Renderer<'g> {
                     samples: rp.attachments.first().map(|a| a.samples).unwrap_or(1),
                 }
             }
-            _ => return Ok(None),
         };
-        Ok(Some(key))
+        Ok(Some((key, bindings)))
     }
 
     /// Creates the plan's resources, runs `frames` frames (numbered from 0,
@@ -608,11 +555,6 @@ fn descriptor_pool<'g>(
         }
     }
     DescriptorPool::new(gpu, sets, &counts)
-}
-
-/// Whether a raster/fullscreen pass draws one fullscreen triangle.
-fn is_fullscreen(pass: &PlanPass) -> bool {
-    pass.kind == PassKind::Fullscreen || pass.draw == Some(Draw::FullscreenTriangle)
 }
 
 fn clear_value(resource: &PlanResource, clear: &[f64]) -> vk::ClearValue {

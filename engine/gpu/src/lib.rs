@@ -2,6 +2,7 @@
 //! shader compilation and reflection, and the executor that runs a `Plan`.
 
 pub mod bind;
+pub mod check;
 pub mod context;
 pub mod convert;
 pub mod download;
@@ -20,6 +21,7 @@ pub mod shader;
 pub mod timing;
 pub mod validation;
 
+pub use check::{check_shaders, ShaderProblem};
 pub use context::{DeviceInfo, DeviceKind, Gpu, GpuOptions, MemoryReport};
 pub use draw::{DrawRecorder, NoDraws, RasterContext, SCENE_SET};
 pub use error::GpuError;

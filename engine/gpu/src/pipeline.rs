@@ -133,22 +133,15 @@ impl PipelineCache {
         Ok(module)
     }
 
-    /// The merged interface of a pipeline's shaders, compiling and reflecting
-    /// them if needed but creating no Vulkan objects.
-    pub fn interface(&mut self, key: &PipelineKey) -> Result<PipelineInterface, GpuError> {
-        if let Some(p) = self.pipelines.get(key) {
-            return Ok(p.interface.clone());
+    /// The merged interface of shader stages, compiling and reflecting them
+    /// if needed but creating no Vulkan objects.
+    pub fn interface(&mut self, keys: &[&ShaderKey]) -> Result<PipelineInterface, GpuError> {
+        let mut modules = Vec::with_capacity(keys.len());
+        for key in keys {
+            modules.push(self.shader(key)?);
         }
-        match key {
-            PipelineKey::Fullscreen {
-                vertex, fragment, ..
-            } => {
-                let vs = self.shader(vertex)?;
-                let fs = self.shader(fragment)?;
-                merged(&[&vs, &fs])
-            }
-            PipelineKey::Compute { shader } => merged(&[&*self.shader(shader)?]),
-        }
+        let refs: Vec<&ShaderModule> = modules.iter().map(|m| &**m).collect();
+        merged(&refs)
     }
 
     /// A cached pipeline, if built.

@@ -9,7 +9,17 @@ fn reports_every_disagreement_between_shaders_and_graph() {
     let gpu = common::gpu();
     let plan = common::compile(&gpu, &common::graph("mismatch.ron"), 4, 4);
     let mut renderer = Renderer::new(&gpu).expect("renderer");
-    let problems = renderer.check_shaders(&plan);
+    let problems: Vec<(String, String)> = renderer
+        .check_shaders(&plan)
+        .into_iter()
+        .map(|p| (p.pass, p.message))
+        .collect();
+    let without_device: Vec<(String, String)> = weft_gpu::check_shaders(&plan)
+        .expect("shaderc")
+        .into_iter()
+        .map(|p| (p.pass, p.message))
+        .collect();
+    assert_eq!(without_device, problems);
     let expected: Vec<(String, String)> = [
         (
             "produce",

@@ -76,6 +76,7 @@ fn render_forward(features: &[&str]) -> ([u8; 4], Vec<String>) {
     let passes = plan.passes.iter().map(|p| p.name.clone()).collect();
     let mut renderer = Renderer::new(&gpu).expect("renderer");
     assert_eq!(renderer.check_shaders(&plan), Vec::new());
+    assert_eq!(weft_gpu::check_shaders(&plan).expect("shaderc"), Vec::new());
     let report = renderer
         .render(
             &plan,

@@ -1,0 +1,150 @@
+//! Which shaders a pass runs and whether they agree with the graph, without
+//! a device: `weft graph check --shaders` uses this, and the executor runs
+//! the same checks before it builds a pipeline.
+
+use crate::bind::{self, FrameValues, ResolvedBinding};
+use crate::error::GpuError;
+use crate::pipeline::{PipelineCache, ShaderKey};
+use crate::reflect::PipelineInterface;
+use crate::shader::ShaderStage;
+use weft_graph::plan::{Plan, PlanPass};
+use weft_graph::schema::{Draw, PassKind};
+
+/// The shader variants a pass runs through the executor's own pipelines.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PassShaders {
+    /// Built-in or given vertex shader plus fragment shader, one triangle.
+    Fullscreen {
+        vertex: ShaderKey,
+        fragment: ShaderKey,
+    },
+    /// One compute shader.
+    Compute(ShaderKey),
+}
+
+impl PassShaders {
+    /// The stages in pipeline order.
+    pub fn keys(&self) -> Vec<&ShaderKey> {
+        match self {
+            Self::Fullscreen { vertex, fragment } => vec![vertex, fragment],
+            Self::Compute(shader) => vec![shader],
+        }
+    }
+}
+
+/// Whether a raster/fullscreen pass draws one fullscreen triangle.
+pub fn is_fullscreen(pass: &PlanPass) -> bool {
+    pass.kind == PassKind::Fullscreen || pass.draw == Some(Draw::FullscreenTriangle)
+}
+
+/// The pass's shaders; `None` for copies, blits and scene draws (which a
+/// draw recorder supplies).
+pub fn pass_shaders(pass: &PlanPass) -> Result<Option<PassShaders>, GpuError> {
+    let missing = |what: &str| GpuError::Pass {
+        pass: pass.name.clone(),
+        message: format!("needs a {what} shader"),
+    };
+    let key = |path: &std::path::Path, stage| ShaderKey {
+        path: path.to_path_buf(),
+        stage,
+        defines: pass.defines.clone(),
+    };
+    Ok(Some(match pass.kind {
+        PassKind::Compute => {
+            let cs = pass
+                .shaders
+                .compute
+                .as_deref()
+                .ok_or_else(|| missing("compute"))?;
+            PassShaders::Compute(key(cs, ShaderStage::Compute))
+        }
+        PassKind::Fullscreen | PassKind::Raster if is_fullscreen(pass) => {
+            let fs = pass
+                .shaders
+                .fragment
+                .as_deref()
+                .ok_or_else(|| missing("fragment"))?;
+            PassShaders::Fullscreen {
+                vertex: match pass.shaders.vertex.as_deref() {
+                    Some(vs) => key(vs, ShaderStage::Vertex),
+                    None => ShaderKey::fullscreen_vertex(),
+                },
+                fragment: key(fs, ShaderStage::Fragment),
+            }
+        }
+        _ => return Ok(None),
+    }))
+}
+
+/// Cross-checks a pass's merged shader interface with the graph: bindings,
+/// fragment outputs (for fullscreen passes) and push-constant parameters.
+/// Returns the resolved bindings, or every problem found.
+pub fn pass_problems(
+    plan: &Plan,
+    pass: &PlanPass,
+    shaders: &PassShaders,
+    interface: &PipelineInterface,
+) -> Result<Vec<ResolvedBinding>, Vec<String>> {
+    let (bindings, mut problems) = match bind::resolve_bindings(plan, pass, interface) {
+        Ok(bindings) => (bindings, Vec::new()),
+        Err(list) => (Vec::new(), list),
+    };
+    if matches!(shaders, PassShaders::Fullscreen { .. }) {
+        problems.extend(bind::check_outputs(plan, pass, interface));
+    }
+    if let Some((block, _)) = &interface.push {
+        if let Err(list) = bind::pack_push(block, &pass.params, &FrameValues::default()) {
+            problems.extend(list);
+        }
+    }
+    if problems.is_empty() {
+        Ok(bindings)
+    } else {
+        Err(problems)
+    }
+}
+
+/// A problem with a pass's shaders.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ShaderProblem {
+    /// The pass, as named in the graph.
+    pub pass: String,
+    /// One line; compile errors keep their file:line.
+    pub message: String,
+}
+
+/// Compiles and reflects every pass's shaders and checks them against the
+/// graph, with no Vulkan device; every problem is returned.
+pub fn check_shaders(plan: &Plan) -> Result<Vec<ShaderProblem>, GpuError> {
+    let mut cache = PipelineCache::new()?;
+    Ok(check_with(&mut cache, plan))
+}
+
+/// `check_shaders` with a given cache (the executor's).
+pub fn check_with(cache: &mut PipelineCache, plan: &Plan) -> Vec<ShaderProblem> {
+    let mut problems = Vec::new();
+    for pass in &plan.passes {
+        let found = pass_shaders(pass).and_then(|shaders| match shaders {
+            None => Ok(Vec::new()),
+            Some(shaders) => {
+                let interface = cache.interface(&shaders.keys())?;
+                Ok(pass_problems(plan, pass, &shaders, &interface)
+                    .err()
+                    .unwrap_or_default())
+            }
+        });
+        let messages = match found {
+            Ok(list) => list,
+            Err(GpuError::Shader(crate::shader::ShaderError::Compile(diagnostics))) => {
+                diagnostics.iter().map(ToString::to_string).collect()
+            }
+            Err(GpuError::Pass { message, .. }) => vec![message],
+            Err(e) => vec![e.to_string()],
+        };
+        problems.extend(messages.into_iter().map(|message| ShaderProblem {
+            pass: pass.name.clone(),
+            message,
+        }));
+    }
+    problems
+}
