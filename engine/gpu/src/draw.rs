@@ -28,6 +28,16 @@ impl RasterContext<'_> {
     pub fn pass(&self) -> &PlanPass {
         &self.plan.passes[self.pass_index]
     }
+
+    /// The layout a graph image is in during this pass, for the recorder's
+    /// own descriptors (e.g. a shadow map sampled while drawing meshes).
+    pub fn image_layout(&self, resource: usize) -> vk::ImageLayout {
+        crate::convert::layout(crate::layouts::layout_at(
+            self.plan,
+            self.pass_index,
+            resource,
+        ))
+    }
 }
 
 /// The descriptor set number reserved for scene data (camera, lights): graph

@@ -10,6 +10,7 @@ use crate::download::ReadbackBuffer;
 use crate::draw::{DrawRecorder, RasterContext, SCENE_SET};
 use crate::error::{GpuError, VkCall};
 use crate::frame::{CommandBuffers, DescriptorPool, Label};
+use crate::layouts;
 use crate::pipeline::{Pipeline, PipelineCache, PipelineKey};
 use crate::readback::Readback;
 use crate::record;
@@ -19,9 +20,8 @@ use crate::timing::{PassTiming, QueryPool, TimingMode, TimingSource};
 use ash::vk;
 use std::sync::Arc;
 use std::time::Instant;
-use weft_graph::plan::{Plan, PlanPass, PlanResource, Residency, ResourceDesc};
+use weft_graph::plan::{Plan, PlanPass, PlanResource, ResourceDesc};
 use weft_graph::schema::PassKind;
-use weft_graph::vk::Layout;
 
 /// Options for one frame.
 #[derive(Debug, Clone, Default)]
@@ -351,20 +351,9 @@ impl<'g> Renderer<'g> {
         pool: &DescriptorPool,
         prepared: &mut [Prepared],
     ) -> Result<(), GpuError> {
-        let mut layouts: Vec<Layout> = plan
-            .resources
-            .iter()
-            .map(|r| match r.residency {
-                Residency::Transient => Layout::Undefined,
-                _ => r.frame_start_layout,
-            })
-            .collect();
-        for (pass, prep) in plan.passes.iter().zip(prepared.iter_mut()) {
-            for b in &pass.barriers {
-                if let (Some((_, new)), Some(slot)) = (b.layouts, layouts.get_mut(b.resource)) {
-                    *slot = new;
-                }
-            }
+        let mut layouts = layouts::frame_start(plan);
+        for (index, prep) in prepared.iter_mut().enumerate() {
+            layouts::apply_pass(plan, index, &mut layouts);
             let Some(pipeline) = &prep.pipeline else {
                 continue;
             };

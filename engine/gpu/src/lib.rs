@@ -11,6 +11,7 @@ pub mod error;
 pub mod executor;
 pub mod frame;
 pub mod golden;
+pub mod layouts;
 pub mod pipeline;
 pub mod readback;
 pub mod record;
