@@ -14,6 +14,10 @@ pub enum GraphCommand {
     Check {
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// Also compile and reflect every pass's shaders and cross-check them with
+        /// the graph: bindings, push constants, outputs.
+        #[arg(long)]
+        shaders: bool,
     },
     /// Compile a graph and print its plan: pass order, culled passes, barriers, render-pass ops.
     Plan {
@@ -62,6 +66,40 @@ fn parse_size(text: &str) -> Result<Extent, String> {
     })
 }
 
+/// Shader problems of a graph, compiled with every feature off and every feature on,
+/// each located at the declaration of the pass whose shaders disagree with it.
+fn check_shaders(graph: &LoadedGraph) -> Result<Vec<Diagnostic>> {
+    let prepared = match weft_graph::Prepared::new(graph) {
+        Ok(p) => p,
+        Err(diags) => return Ok(diags),
+    };
+    let mentioned = weft_graph::compile::feature_names(prepared.ir());
+    let mut found: Vec<Diagnostic> = Vec::new();
+    for features in [Default::default(), mentioned] {
+        let options = CompileOptions {
+            features,
+            ..CompileOptions::default()
+        };
+        let plan = match prepared.compile(&options) {
+            Ok(plan) => plan,
+            Err(diags) => return Ok(diags),
+        };
+        for weft_gpu::ShaderProblem { pass, message } in weft_gpu::check_shaders(&plan)? {
+            let at = plan
+                .passes
+                .iter()
+                .find(|p| p.name == pass)
+                .map(|p| p.declared_at.clone())
+                .unwrap_or_default();
+            let d = Diagnostic::error(at.file, at.pos, format!("pass \"{pass}\": {message}"));
+            if !found.contains(&d) {
+                found.push(d);
+            }
+        }
+    }
+    Ok(found)
+}
+
 fn print_diagnostics(diags: &[Diagnostic]) {
     for d in diags {
         eprintln!("{d}");
@@ -95,11 +133,14 @@ fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Pla
 /// Runs a graph subcommand.
 pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
     match cmd {
-        GraphCommand::Check { files } => {
+        GraphCommand::Check { files, shaders } => {
             let mut failed = false;
             for file in &files {
                 let graph = weft_graph::load(file);
-                let diags = weft_graph::check(&graph);
+                let mut diags = weft_graph::check(&graph);
+                if shaders && !graph.is_fragment && !diags.iter().any(Diagnostic::is_error) {
+                    diags.extend(check_shaders(&graph)?);
+                }
                 print_diagnostics(&diags);
                 let errors = diags.iter().filter(|d| d.is_error()).count();
                 let warnings = diags.len() - errors;

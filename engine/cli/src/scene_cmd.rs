@@ -31,7 +31,12 @@ pub fn run(cmd: SceneCommand) -> Result<ExitCode> {
                 Ok(ExitCode::SUCCESS)
             }
             Err(err) => {
-                eprintln!("error: {err}");
+                if json {
+                    let value = serde_json::json!({ "error": err });
+                    println!("{}", serde_json::to_string_pretty(&value)?);
+                } else {
+                    eprintln!("error: {err}");
+                }
                 Ok(ExitCode::FAILURE)
             }
         },

@@ -160,3 +160,34 @@ fn bad_size_is_rejected_by_the_argument_parser() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("expected WIDTHxHEIGHT, found \"wide\""));
 }
+
+#[test]
+fn check_shaders_locates_a_mismatch_at_the_pass() {
+    let path = temp_graph(
+        "shaders",
+        r#"Graph(
+    resources: [Image(name: "ldr", format: R8G8B8A8_UNORM)],
+    passes: [
+        Pass(name: "paint", kind: Fullscreen, shaders: (fragment: "paint.frag"), color: [(image: "ldr")]),
+    ],
+    output: "ldr",
+)"#,
+    );
+    let shader = path.with_file_name("paint.frag");
+    std::fs::write(
+        &shader,
+        "#version 450\nlayout(set = 0, binding = 0) uniform sampler2D albedo;\nlayout(location = 0) in vec2 uv;\nlayout(location = 0) out vec4 color;\nvoid main() { color = texture(albedo, uv); }\n",
+    )
+    .expect("write shader");
+    let graph = path.to_str().expect("utf-8 path");
+    assert!(weft(&["graph", "check", graph]).status.success());
+    let out = weft(&["graph", "check", "--shaders", graph]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let first = stderr.lines().next().unwrap_or_default();
+    assert!(
+        first.starts_with(&format!("{}:4:20: error: pass \"paint\": ", path.display())),
+        "{stderr}"
+    );
+    assert!(first.contains("albedo"), "{stderr}");
+}

@@ -8,7 +8,8 @@ use crate::memory::{place, MemoryRequirements, Transient};
 use crate::order::{contributing, order, pass_uses, OrderError, PassUse};
 use crate::plan::{
     AttachmentDesc, Barrier, Binding, BindingKind, BufferDesc, CulledPass, Extent, ImageDesc,
-    LoadOp, Plan, PlanPass, PlanResource, RenderPassDesc, Residency, ResourceDesc, StoreOp,
+    LoadOp, Location, Plan, PlanPass, PlanResource, RenderPassDesc, Residency, ResourceDesc,
+    StoreOp,
 };
 use crate::resolve::{
     access_path, expression_vars, image_extent, resolve, BufferSize, Ir, IrDispatch, IrKind, Usage,
@@ -78,6 +79,11 @@ impl<'g> Prepared<'g> {
             return Err(diags);
         }
         Ok(Prepared { graph, ir })
+    }
+
+    /// The resolved graph.
+    pub fn ir(&self) -> &Ir {
+        &self.ir
     }
 
     /// Compiles for one size and feature set.
@@ -481,7 +487,7 @@ pub fn compile_ir(
         .enumerate()
         .map(|(i, (&p, barriers))| {
             plan_pass(
-                ir, p, i, &uses, &new_index, &resources, &timeline, barriers, options,
+                graph, ir, p, i, &uses, &new_index, &resources, &timeline, barriers, options,
             )
         })
         .collect();
@@ -852,6 +858,7 @@ fn check_discarding_stores(
 
 #[allow(clippy::too_many_arguments)]
 fn plan_pass(
+    graph: &LoadedGraph,
     ir: &Ir,
     p: usize,
     i: usize,
@@ -1002,8 +1009,17 @@ fn plan_pass(
     } else {
         None
     };
+    let (file, pos) = graph.locate(
+        pass.source,
+        &[
+            Seg::Field("passes"),
+            Seg::Index(pass.index),
+            Seg::Field("name"),
+        ],
+    );
     PlanPass {
         name: pass.name.clone(),
+        declared_at: Location { file, pos },
         kind: pass.kind,
         shaders: pass.shaders.clone(),
         draw: pass.draw.clone(),

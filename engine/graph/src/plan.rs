@@ -124,10 +124,20 @@ pub struct MemoryBlock {
     pub alignment: u64,
 }
 
+/// Where something was declared, so errors found later (shader checks, hot reload)
+/// can name the file, line and column.
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
+pub struct Location {
+    pub file: PathBuf,
+    pub pos: crate::spans::Pos,
+}
+
 /// A pass that will run.
 #[derive(Debug, Clone, Serialize)]
 pub struct PlanPass {
     pub name: String,
+    /// The pass's `name` in its graph file.
+    pub declared_at: Location,
     pub kind: PassKind,
     /// Shader files, resolved relative to the graph file that declared the pass.
     pub shaders: ShaderFiles,

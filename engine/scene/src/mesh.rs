@@ -41,7 +41,7 @@ impl Mesh {
     pub fn is_consistent(&self) -> bool {
         let n = self.positions.len();
         let per_vertex = |len: usize| len == 0 || len == n;
-        self.indices.len() % 3 == 0
+        self.indices.len().is_multiple_of(3)
             && self.indices.iter().all(|&i| (i as usize) < n)
             && self.normals.len() == n
             && per_vertex(self.uvs.len())
