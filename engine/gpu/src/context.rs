@@ -214,6 +214,20 @@ impl Gpu {
         }
     }
 
+    /// Whether optimally tiled images of a format can be sampled (and blitted)
+    /// with linear filtering.
+    pub fn linear_filter(&self, format_raw: i32) -> bool {
+        let props = unsafe {
+            self.instance.get_physical_device_format_properties(
+                self.physical,
+                vk::Format::from_raw(format_raw),
+            )
+        };
+        props
+            .optimal_tiling_features
+            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR)
+    }
+
     /// Waits until the device is idle.
     pub fn wait_idle(&self) -> Result<(), GpuError> {
         unsafe { self.device.device_wait_idle() }.call("vkDeviceWaitIdle")

@@ -21,6 +21,9 @@ pub struct RasterContext<'a> {
     pub resources: &'a FrameResources<'a>,
     /// The linear clamp sampler graph resources are sampled with.
     pub sampler: vk::Sampler,
+    /// The nearest clamp sampler, for formats without linear filtering
+    /// (`Gpu::linear_filter`), such as depth formats on lavapipe.
+    pub nearest_sampler: vk::Sampler,
 }
 
 impl RasterContext<'_> {

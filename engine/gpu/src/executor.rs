@@ -8,7 +8,7 @@ use crate::check::{self, PassShaders, ShaderProblem};
 use crate::context::{Gpu, MemoryReport};
 use crate::download::ReadbackBuffer;
 use crate::draw::{DrawRecorder, RasterContext, SCENE_SET};
-use crate::error::{GpuError, VkCall};
+use crate::error::GpuError;
 use crate::frame::{CommandBuffers, DescriptorPool, Label};
 use crate::layouts;
 use crate::pipeline::{Pipeline, PipelineCache, PipelineKey};
@@ -16,6 +16,7 @@ use crate::readback::Readback;
 use crate::record;
 use crate::renderpass::RenderPassCache;
 use crate::resources::{FrameResources, GpuResource};
+use crate::samplers::Samplers;
 use crate::timing::{PassTiming, QueryPool, TimingMode, TimingSource};
 use ash::vk;
 use std::sync::Arc;
@@ -62,33 +63,24 @@ struct Prepared {
     set: vk::DescriptorSet,
 }
 
-/// Executes plans; owns the render-pass and pipeline caches and the sampler.
+/// Executes plans; owns the render-pass and pipeline caches and the samplers.
 pub struct Renderer<'g> {
     gpu: &'g Gpu,
     render_passes: RenderPassCache,
     pipelines: PipelineCache,
-    sampler: vk::Sampler,
+    samplers: Samplers,
 }
 
 impl<'g> Renderer<'g> {
     /// A renderer with empty caches.
     pub fn new(gpu: &'g Gpu) -> Result<Self, GpuError> {
         let pipelines = PipelineCache::new()?;
-        let info = vk::SamplerCreateInfo::default()
-            .mag_filter(vk::Filter::LINEAR)
-            .min_filter(vk::Filter::LINEAR)
-            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
-            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .max_lod(vk::LOD_CLAMP_NONE);
-        let sampler =
-            unsafe { gpu.device().create_sampler(&info, None) }.call("vkCreateSampler")?;
+        let samplers = Samplers::new(gpu)?;
         Ok(Self {
             gpu,
             render_passes: RenderPassCache::default(),
             pipelines,
-            sampler,
+            samplers,
         })
     }
 
@@ -368,7 +360,7 @@ impl<'g> Renderer<'g> {
                     Some(GpuResource::Image(img)) => image_infos.push((
                         rb,
                         [vk::DescriptorImageInfo {
-                            sampler: self.sampler,
+                            sampler: self.samplers.for_format(self.gpu, img.desc.format_raw),
                             image_view: img.shader_view,
                             image_layout: crate::convert::layout(layouts[rb.graph.resource]),
                         }],
@@ -428,8 +420,8 @@ impl<'g> Renderer<'g> {
         let label = Label::begin(self.gpu, cmd, &pass.name);
         record::barriers(device, cmd, &pass.barriers, resources)?;
         let result = match pass.kind {
-            PassKind::Copy => record::transfer(device, cmd, plan, pass, resources, false),
-            PassKind::Blit => record::transfer(device, cmd, plan, pass, resources, true),
+            PassKind::Copy => record::transfer(self.gpu, cmd, plan, pass, resources, false),
+            PassKind::Blit => record::transfer(self.gpu, cmd, plan, pass, resources, true),
             PassKind::Compute => {
                 let dispatch = pass.dispatch.ok_or_else(|| GpuError::Pass {
                     pass: pass.name.clone(),
@@ -474,7 +466,8 @@ impl<'g> Renderer<'g> {
                     render_pass: prep.render_pass,
                     extent: prep.extent,
                     resources,
-                    sampler: self.sampler,
+                    sampler: self.samplers.linear,
+                    nearest_sampler: self.samplers.nearest,
                 };
                 let drawn = match &prep.pipeline {
                     Some(p) => {
@@ -519,8 +512,8 @@ impl Drop for Renderer<'_> {
         let device = self.gpu.device();
         unsafe {
             let _ = device.device_wait_idle();
-            device.destroy_sampler(self.sampler, None);
         }
+        self.samplers.destroy(self.gpu);
         self.pipelines.destroy(device);
         self.render_passes.destroy(device);
     }

@@ -18,6 +18,7 @@ pub mod record;
 pub mod reflect;
 pub mod renderpass;
 pub mod resources;
+pub mod samplers;
 pub mod shader;
 pub mod timing;
 pub mod validation;

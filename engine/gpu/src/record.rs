@@ -1,6 +1,7 @@
 //! Recording of the plan's own commands: barriers exactly as the plan lists
 //! them, copies and blits, and the readback copy.
 
+use crate::context::Gpu;
 use crate::convert;
 use crate::error::GpuError;
 use crate::resources::{full_range, FrameResources, GpuResource};
@@ -90,7 +91,7 @@ fn corner(w: u32, h: u32) -> vk::Offset3D {
 /// Records a copy or blit pass: source in TRANSFER_SRC_OPTIMAL, destination in
 /// TRANSFER_DST_OPTIMAL, as the plan's barriers left them.
 pub fn transfer(
-    device: &ash::Device,
+    gpu: &Gpu,
     cmd: vk::CommandBuffer,
     plan: &Plan,
     pass: &PlanPass,
@@ -101,6 +102,7 @@ pub fn transfer(
         pass: pass.name.clone(),
         message: "copy/blit pass without a source and destination".into(),
     })?;
+    let device = gpu.device();
     let fail = |message: String| GpuError::Pass {
         pass: pass.name.clone(),
         message,
@@ -110,11 +112,12 @@ pub fn transfer(
             let aspect = convert::full_aspect(s.desc.aspect);
             let layer_count = s.desc.layers.min(d.desc.layers);
             if blit {
-                let filter = if s.desc.aspect == Aspect::Color {
-                    vk::Filter::LINEAR
-                } else {
-                    vk::Filter::NEAREST
-                };
+                let filter =
+                    if s.desc.aspect == Aspect::Color && gpu.linear_filter(s.desc.format_raw) {
+                        vk::Filter::LINEAR
+                    } else {
+                        vk::Filter::NEAREST
+                    };
                 let region = vk::ImageBlit2::default()
                     .src_subresource(layers(aspect, 0, layer_count))
                     .src_offsets([

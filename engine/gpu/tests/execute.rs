@@ -208,3 +208,29 @@ fn transient_images_share_memory_as_planned() {
     drop(gpu);
     assert_eq!(log.messages(), Vec::new());
 }
+
+#[test]
+fn depth_attachments_clear_and_are_sampled() {
+    let gpu = common::gpu();
+    let plan = common::compile(&gpu, &common::graph("depth.ron"), 4, 4);
+    let mut renderer = Renderer::new(&gpu).expect("renderer");
+    let report = renderer
+        .render(
+            &plan,
+            &mut NoDraws,
+            1,
+            0.0,
+            &FrameOptions {
+                readback: true,
+                ..FrameOptions::default()
+            },
+        )
+        .expect("frame");
+    let output = report.output.expect("readback");
+    // Depth cleared to 0.25 and never written: 0.25 * 255 = 63.75.
+    assert_eq!(output.rgba8_at(2, 1), [64, 0, 0, 255]);
+    drop(renderer);
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}
