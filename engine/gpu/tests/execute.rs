@@ -234,3 +234,31 @@ fn depth_attachments_clear_and_are_sampled() {
     drop(gpu);
     assert_eq!(log.messages(), Vec::new());
 }
+
+#[test]
+fn image_and_buffer_copies_carry_data_between_passes() {
+    let gpu = common::gpu();
+    let plan = common::compile(&gpu, &common::graph("copies.ron"), 8, 8);
+    let mut renderer = Renderer::new(&gpu).expect("renderer");
+    let report = renderer
+        .render(
+            &plan,
+            &mut NoDraws,
+            2,
+            0.0,
+            &FrameOptions {
+                readback: true,
+                ..FrameOptions::default()
+            },
+        )
+        .expect("frames");
+    let output = report.output.expect("readback");
+    for (x, y) in [(0, 0), (3, 6), (7, 7)] {
+        let expected = [(x / 2 * 32) as u8, (y / 2 * 32) as u8, 153, 255];
+        assert_eq!(output.rgba8_at(x, y), expected, "pixel ({x}, {y})");
+    }
+    drop(renderer);
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}
