@@ -11,7 +11,9 @@ use weft_graph::schema::ParamValue;
 /// A shader binding and the graph binding that feeds it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ResolvedBinding {
+    /// The shader side: set, binding, descriptor kind.
     pub shader: ShaderBinding,
+    /// The graph side: which resource, read how.
     pub graph: Binding,
 }
 

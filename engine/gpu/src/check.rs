@@ -15,7 +15,9 @@ use weft_graph::schema::{Draw, PassKind};
 pub enum PassShaders {
     /// Built-in or given vertex shader plus fragment shader, one triangle.
     Fullscreen {
+        /// The given vertex shader, or the built-in fullscreen triangle.
         vertex: ShaderKey,
+        /// The pass's fragment shader.
         fragment: ShaderKey,
     },
     /// One compute shader.

@@ -25,7 +25,9 @@ pub struct GpuOptions {
 /// What was chosen, for printing and reports.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DeviceInfo {
+    /// The driver's device name, as `--device` matches it.
     pub name: String,
+    /// Discrete, integrated, CPU (lavapipe), ...
     pub kind: DeviceKind,
     /// Nanoseconds per timestamp tick.
     pub timestamp_period: f32,
@@ -36,10 +38,15 @@ pub struct DeviceInfo {
 /// The physical device type, in preference order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum DeviceKind {
+    /// A separate GPU: preferred.
     Discrete,
+    /// A GPU sharing memory with the CPU.
     Integrated,
+    /// A GPU exposed by a hypervisor.
     Virtual,
+    /// A software rasteriser such as lavapipe: the fallback.
     Cpu,
+    /// Anything else the driver reports.
     Other,
 }
 

@@ -12,12 +12,19 @@ use weft_graph::plan::{Plan, PlanPass};
 /// records draws inside the already begun render pass (viewport and scissor
 /// set to `extent`), with pipelines it builds against `render_pass` subpass 0.
 pub struct RasterContext<'a> {
+    /// The context, for the device and allocator.
     pub gpu: &'a Gpu,
+    /// The command buffer being recorded, inside the render pass.
     pub cmd: vk::CommandBuffer,
+    /// The plan being executed.
     pub plan: &'a Plan,
+    /// Index of the pass in `plan.passes`.
     pub pass_index: usize,
+    /// The render pass the recorder's pipelines must be compatible with (subpass 0).
     pub render_pass: vk::RenderPass,
+    /// The render area, also set as viewport and scissor.
     pub extent: vk::Extent2D,
+    /// The frame's images and buffers, by plan resource index.
     pub resources: &'a FrameResources<'a>,
     /// The linear clamp sampler graph resources are sampled with.
     pub sampler: vk::Sampler,

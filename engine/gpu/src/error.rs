@@ -11,7 +11,9 @@ pub enum GpuError {
     /// A Vulkan call failed.
     #[error("{call} failed: {result}")]
     Vulkan {
+        /// The Vulkan entry point that failed.
         call: &'static str,
+        /// What it returned.
         result: vk::Result,
     },
     /// Validation was requested but the Khronos layer is not installed.
@@ -22,22 +24,39 @@ pub enum GpuError {
     /// No device matched (or none supports Vulkan 1.3 with what weft needs).
     #[error("no suitable Vulkan 1.3 device{}; available: {available}", match .wanted { Some(w) => format!(" matching \"{w}\""), None => String::new() })]
     NoDevice {
+        /// The `--device` substring asked for, if any.
         wanted: Option<String>,
+        /// Names of every device found.
         available: String,
     },
     /// Device memory could not be allocated.
     #[error("memory allocation for {what} failed: {message}")]
-    Allocation { what: String, message: String },
+    Allocation {
+        /// What the memory was for.
+        what: String,
+        /// The allocator's reason.
+        message: String,
+    },
     /// A shader failed to compile or reflect.
     #[error(transparent)]
     Shader(#[from] crate::shader::ShaderError),
     /// The plan asks for something the executor cannot do, or is inconsistent
     /// with its shaders.
     #[error("pass `{pass}`: {message}")]
-    Pass { pass: String, message: String },
+    Pass {
+        /// The pass, as named in the graph.
+        pass: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A pass's shaders disagree with the graph (bindings, outputs, parameters).
     #[error("pass `{pass}`: {}", problems.join("; "))]
-    Mismatch { pass: String, problems: Vec<String> },
+    Mismatch {
+        /// The pass, as named in the graph.
+        pass: String,
+        /// Every disagreement found.
+        problems: Vec<String>,
+    },
     /// The plan itself is inconsistent.
     #[error("plan: {0}")]
     Plan(String),

@@ -27,6 +27,7 @@ use weft_graph::schema::PassKind;
 /// Options for one frame.
 #[derive(Debug, Clone, Default)]
 pub struct FrameOptions {
+    /// Whether and how per-pass times are measured.
     pub timing: TimingMode,
     /// Copy the output image back to the CPU.
     pub readback: bool,
@@ -39,7 +40,9 @@ pub struct FrameOptions {
 /// What a frame produced.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameReport {
+    /// Per-pass times, labelled with how they were measured.
     pub timings: Vec<PassTiming>,
+    /// The output image, when `readback` was asked for.
     pub output: Option<Readback>,
     /// Host time spent preparing and recording commands (excluding GPU waits).
     pub record_ms: f64,

@@ -17,7 +17,9 @@ pub struct Tolerance {
 /// Measured differences between two images.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Comparison {
+    /// Largest absolute channel difference of any pixel.
     pub max_difference: u8,
+    /// Mean absolute channel difference over the image.
     pub mean_difference: f64,
     /// Pixels with a channel over the per-channel tolerance.
     pub pixels_over: usize,
@@ -32,21 +34,33 @@ pub enum GoldenError {
     /// The images differ in size.
     #[error("image is {actual:?} but golden {} is {expected:?}", path.display())]
     Size {
+        /// The golden image.
         path: PathBuf,
+        /// Width and height of the rendering.
         actual: (u32, u32),
+        /// Width and height of the golden image.
         expected: (u32, u32),
     },
     /// The images differ by more than the tolerance.
     #[error("{} differs: max channel difference {} (allowed {}), mean {:.4} (allowed {}), {} pixel(s) over; difference image: {}", path.display(), comparison.max_difference, tolerance.per_channel, comparison.mean_difference, tolerance.mean, comparison.pixels_over, diff.display())]
     Mismatch {
+        /// The golden image.
         path: PathBuf,
+        /// What was measured.
         comparison: Comparison,
+        /// What was allowed.
         tolerance: Tolerance,
+        /// Where the difference image was written.
         diff: PathBuf,
     },
     /// Reading or writing an image failed.
     #[error("{}: {message}", path.display())]
-    Io { path: PathBuf, message: String },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 /// Compares two images of equal size channel by channel.

@@ -1,6 +1,7 @@
 //! Vulkan execution of compiled weft render graphs: the context, run-time
 //! shader compilation and reflection, and the executor that runs a `Plan`.
 
+#![warn(missing_docs)]
 pub mod bind;
 pub mod check;
 pub mod context;

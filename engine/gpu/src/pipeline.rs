@@ -19,8 +19,11 @@ const FULLSCREEN_NAME: &str = "<weft>/fullscreen.vert";
 /// Identifies one compiled shader variant.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct ShaderKey {
+    /// The GLSL file (or the built-in shader's name).
     pub path: PathBuf,
+    /// The stage it is compiled for.
     pub stage: ShaderStage,
+    /// Preprocessor defines selecting the variant.
     pub defines: Vec<String>,
 }
 
@@ -38,22 +41,31 @@ impl ShaderKey {
 /// A compiled shader with its reflected interface.
 #[derive(Debug)]
 pub struct ShaderModule {
+    /// The SPIR-V and the files it was built from.
     pub compiled: CompiledShader,
+    /// Its reflected bindings, push constants and outputs.
     pub interface: ShaderInterface,
 }
 
 /// Identifies a pipeline.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub enum PipelineKey {
+    /// A fullscreen-triangle graphics pipeline.
     Fullscreen {
+        /// Vertex shader variant.
         vertex: ShaderKey,
+        /// Fragment shader variant.
         fragment: ShaderKey,
+        /// The render pass it is built against.
         render_pass: vk::RenderPass,
         /// Blend mode per colour attachment, as `BlendCode`s.
         blends: Vec<BlendCode>,
+        /// Rasterisation samples of the attachments.
         samples: u32,
     },
+    /// A compute pipeline.
     Compute {
+        /// Compute shader variant.
         shader: ShaderKey,
     },
 }
@@ -61,8 +73,11 @@ pub enum PipelineKey {
 /// A colour attachment's blend mode as a hashable key part.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum BlendCode {
+    /// No blending: the output replaces the attachment.
     Off,
+    /// dst + src.
     Additive,
+    /// Source-over with source alpha.
     Alpha,
 }
 
@@ -79,10 +94,15 @@ impl From<Option<Blend>> for BlendCode {
 /// A pipeline with its layout and the interface it was built from.
 #[derive(Debug)]
 pub struct Pipeline {
+    /// The pipeline object.
     pub pipeline: vk::Pipeline,
+    /// Its layout (descriptor sets and push constants).
     pub layout: vk::PipelineLayout,
+    /// One descriptor set layout per set number the shaders use.
     pub set_layouts: Vec<vk::DescriptorSetLayout>,
+    /// The merged interface the layout was built from.
     pub interface: PipelineInterface,
+    /// Graphics or compute.
     pub bind_point: vk::PipelineBindPoint,
     /// Every file the pipeline's shaders were built from.
     pub dependencies: BTreeSet<PathBuf>,

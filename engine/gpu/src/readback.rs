@@ -15,10 +15,13 @@ pub enum Pixels {
 /// An image read back from the device.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Readback {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// The Vulkan format name it came from.
     pub format: String,
+    /// The pixel values.
     pub pixels: Pixels,
 }
 
@@ -33,7 +36,12 @@ pub enum ReadbackError {
     Extension(String),
     /// Writing the file failed.
     #[error("cannot write {path}: {message}")]
-    Write { path: String, message: String },
+    Write {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 /// Bytes per texel of the formats that can be read back.

@@ -11,9 +11,13 @@ use std::collections::BTreeMap;
 /// What kind of descriptor a shader binding is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum DescriptorKind {
+    /// `sampler2D` and friends: sampled graph images.
     CombinedImageSampler,
+    /// `image2D`: storage images.
     StorageImage,
+    /// `uniform` blocks: sampled graph buffers.
     UniformBuffer,
+    /// `buffer` blocks: storage buffers.
     StorageBuffer,
 }
 
@@ -32,28 +36,38 @@ impl DescriptorKind {
 /// One descriptor binding a shader declares.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ShaderBinding {
+    /// Descriptor set number.
     pub set: u32,
+    /// Binding number within the set.
     pub binding: u32,
     /// The GLSL variable name, or the block name for buffer blocks without an
     /// instance name; the executor matches it to a graph resource of that name.
     pub name: String,
+    /// Descriptor type.
     pub kind: DescriptorKind,
+    /// Array size (1 for a single descriptor).
     pub count: u32,
 }
 
 /// Scalar type of a push-constant member.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ScalarKind {
+    /// 32-bit float.
     Float,
+    /// 32-bit signed integer.
     Int,
+    /// 32-bit unsigned integer.
     Uint,
 }
 
 /// One member of the push-constant block: a graph parameter lands here by name.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PushMember {
+    /// Member name, matched to a parameter name.
     pub name: String,
+    /// Byte offset in the block.
     pub offset: u32,
+    /// Scalar type of each component.
     pub scalar: ScalarKind,
     /// 1 for scalars, 2 to 4 for vectors.
     pub components: u32,
@@ -62,23 +76,31 @@ pub struct PushMember {
 /// The push-constant block of a shader.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct PushBlock {
+    /// Block size in bytes.
     pub size: u32,
+    /// Members in declaration order.
     pub members: Vec<PushMember>,
 }
 
 /// A fragment shader output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FragmentOutput {
+    /// Output location (colour attachment index).
     pub location: u32,
+    /// Scalar type.
     pub scalar: ScalarKind,
+    /// Number of components.
     pub components: u32,
 }
 
 /// The resource interface of one shader stage.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ShaderInterface {
+    /// The stage this interface belongs to.
     pub stage: ShaderStage,
+    /// Descriptor bindings, sorted by set and binding.
     pub bindings: Vec<ShaderBinding>,
+    /// The push-constant block, if declared.
     pub push: Option<PushBlock>,
     /// Colour outputs of fragment shaders, by location.
     pub outputs: Vec<FragmentOutput>,

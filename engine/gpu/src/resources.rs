@@ -18,25 +18,31 @@ use weft_graph::vk::{Aspect, Layout};
 /// A created image with the views passes need.
 #[derive(Debug)]
 pub struct GpuImage {
+    /// The image.
     pub image: vk::Image,
     /// View over every aspect, for attachments.
     pub attachment_view: vk::ImageView,
     /// Single-aspect view for sampling and storage (the same handle for colour).
     pub shader_view: vk::ImageView,
+    /// What it was created from.
     pub desc: ImageDesc,
 }
 
 /// A created buffer.
 #[derive(Debug)]
 pub struct GpuBuffer {
+    /// The buffer.
     pub buffer: vk::Buffer,
+    /// What it was created from.
     pub desc: BufferDesc,
 }
 
 /// One plan resource on the device.
 #[derive(Debug)]
 pub enum GpuResource {
+    /// An image resource.
     Image(GpuImage),
+    /// A buffer resource.
     Buffer(GpuBuffer),
 }
 

@@ -7,7 +7,9 @@ use ash::vk;
 
 /// Linear and nearest clamp-to-edge samplers.
 pub struct Samplers {
+    /// Linear filtering, linear mips.
     pub linear: vk::Sampler,
+    /// Nearest filtering, for formats without linear filtering.
     pub nearest: vk::Sampler,
 }
 

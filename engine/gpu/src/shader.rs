@@ -13,8 +13,11 @@ const MAX_INCLUDE_DEPTH: usize = 32;
 /// A pipeline stage a GLSL file is compiled for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum ShaderStage {
+    /// Vertex shader (`.vert`).
     Vertex,
+    /// Fragment shader (`.frag`).
     Fragment,
+    /// Compute shader (`.comp`).
     Compute,
 }
 
@@ -32,9 +35,11 @@ impl ShaderStage {
 /// (which may be an included file).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ShaderDiagnostic {
+    /// The file the problem is in.
     pub file: PathBuf,
     /// 1-based line, when the compiler gave one.
     pub line: Option<u32>,
+    /// The compiler's message, starting with `error:` or `warning:`.
     pub message: String,
 }
 
@@ -55,7 +60,12 @@ pub enum ShaderError {
     Init(String),
     /// The source file could not be read.
     #[error("{}: cannot read: {message}", path.display())]
-    Read { path: PathBuf, message: String },
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        message: String,
+    },
     /// A define is not a valid preprocessor name (or value).
     #[error("invalid shader define `{0}`")]
     Define(String),
@@ -64,7 +74,12 @@ pub enum ShaderError {
     Compile(Vec<ShaderDiagnostic>),
     /// The SPIR-V could not be reflected, or uses something weft does not support.
     #[error("{}: {message}", path.display())]
-    Reflect { path: PathBuf, message: String },
+    Reflect {
+        /// The shader.
+        path: PathBuf,
+        /// What is unsupported or failed.
+        message: String,
+    },
 }
 
 fn join_lines(diagnostics: &[ShaderDiagnostic]) -> String {
@@ -78,9 +93,11 @@ fn join_lines(diagnostics: &[ShaderDiagnostic]) -> String {
 /// SPIR-V for one stage and what it was built from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CompiledShader {
+    /// The stage it was compiled for.
     pub stage: ShaderStage,
     /// The root file (or the name given for in-memory source).
     pub path: PathBuf,
+    /// SPIR-V words.
     pub spirv: Vec<u32>,
     /// The root file and every file it includes, directly or not.
     pub dependencies: BTreeSet<PathBuf>,

@@ -33,9 +33,13 @@ pub enum TimingSource {
 /// The time one pass took.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PassTiming {
+    /// The pass name.
     pub pass: String,
+    /// Its kind, so compute figures can be judged (lavapipe timestamps).
     pub kind: PassKind,
+    /// How the figure was measured.
     pub source: TimingSource,
+    /// Milliseconds.
     pub ms: f64,
 }
 

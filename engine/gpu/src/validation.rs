@@ -19,17 +19,22 @@ pub enum Severity {
 /// One message from the validation layer.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ValidationMessage {
+    /// Error, warning or performance warning.
     pub severity: Severity,
     /// The VUID or message id name, e.g. `SYNC-HAZARD-WRITE-AFTER-READ`.
     pub id: String,
+    /// The full message text.
     pub text: String,
 }
 
 /// Counts of messages by severity.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ValidationCounts {
+    /// Errors, including synchronization hazards.
     pub errors: usize,
+    /// Warnings other than performance warnings.
     pub warnings: usize,
+    /// Performance warnings, reported separately.
     pub performance: usize,
 }
 
