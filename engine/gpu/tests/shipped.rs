@@ -46,6 +46,63 @@ impl DrawRecorder for Paint {
     }
 }
 
+/// Paints a dim background with one bright square in the middle, so bloom
+/// has something to spread.
+struct BrightSquare;
+
+impl DrawRecorder for BrightSquare {
+    fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError> {
+        let colors = ctx
+            .pass()
+            .render_pass
+            .as_ref()
+            .map_or(0, |rp| rp.color.len());
+        if colors == 0 {
+            return Ok(());
+        }
+        let clear = |c: [f32; 4]| {
+            [vk::ClearAttachment {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                color_attachment: 0,
+                clear_value: vk::ClearValue {
+                    color: vk::ClearColorValue { float32: c },
+                },
+            }]
+        };
+        let rect = |x: u32, y: u32, w: u32, h: u32| {
+            [vk::ClearRect {
+                rect: vk::Rect2D {
+                    offset: vk::Offset2D {
+                        x: x as i32,
+                        y: y as i32,
+                    },
+                    extent: vk::Extent2D {
+                        width: w,
+                        height: h,
+                    },
+                },
+                base_array_layer: 0,
+                layer_count: 1,
+            }]
+        };
+        let (w, h) = (ctx.extent.width, ctx.extent.height);
+        let device = ctx.gpu.device();
+        unsafe {
+            device.cmd_clear_attachments(
+                ctx.cmd,
+                &clear([0.05, 0.05, 0.1, 1.0]),
+                &rect(0, 0, w, h),
+            );
+            device.cmd_clear_attachments(
+                ctx.cmd,
+                &clear([8.0, 6.0, 2.0, 1.0]),
+                &rect(w / 2 - 4, h / 2 - 4, 8, 8),
+            );
+        }
+        Ok(())
+    }
+}
+
 /// sRGB encoding of a linear value to 8 bits, as an `_SRGB` attachment stores it.
 fn srgb8(linear: f64) -> u8 {
     let v = if linear <= 0.0031308 {
@@ -132,4 +189,40 @@ fn forward_without_bloom_with_prepass_and_shadows() {
         ]
     );
     assert_close(pixel, tonemapped([1.0, 3.0, 0.0]));
+}
+
+#[test]
+fn forward_bloom_matches_its_golden_image() {
+    let gpu = common::gpu();
+    let plan = common::compile(&gpu, &common::shipped("forward.ron"), 64, 36);
+    let mut renderer = Renderer::new(&gpu).expect("renderer");
+    let report = renderer
+        .render(
+            &plan,
+            &mut BrightSquare,
+            1,
+            0.0,
+            &FrameOptions {
+                readback: true,
+                ..FrameOptions::default()
+            },
+        )
+        .expect("frame");
+    let image = report.output.expect("readback").to_rgba8();
+    let golden = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/golden/forward_bloom_64x36.png");
+    let tolerance = weft_gpu::Tolerance {
+        per_channel: 2,
+        mean: 0.5,
+    };
+    if let Err(e) = weft_gpu::check_golden(&image, &golden, &tolerance) {
+        panic!("{e}");
+    }
+    // The square saturates towards white; bloom lifts pixels well outside it.
+    assert_eq!(image.get_pixel(32, 18).0[3], 255);
+    assert!(image.get_pixel(32, 8).0[0] > image.get_pixel(2, 2).0[0]);
+    drop(renderer);
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
 }
