@@ -1,6 +1,7 @@
 //! The `weft` command.
 
 mod graph_cmd;
+mod render_cmd;
 mod scene_cmd;
 
 use clap::{Parser, Subcommand};
@@ -22,6 +23,8 @@ enum Command {
     /// Check scenes.
     #[command(subcommand)]
     Scene(scene_cmd::SceneCommand),
+    /// Render a scene through a graph to an image.
+    Render(render_cmd::RenderArgs),
 }
 
 fn main() -> ExitCode {
@@ -29,6 +32,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Graph(cmd) => graph_cmd::run(cmd),
         Command::Scene(cmd) => scene_cmd::run(cmd),
+        Command::Render(args) => render_cmd::run(args),
     };
     match result {
         Ok(code) => code,

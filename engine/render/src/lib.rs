@@ -1,1 +1,30 @@
-//! Pass kinds and the frame loop: scene meshes, materials, lights and cameras drawn by compiled weft graphs.
+//! Pass kinds and the frame loop: scene meshes, materials, lights and cameras
+//! drawn by compiled weft graphs.
+//!
+//! [`GpuScene`] uploads a `weft_scene::Scene`; [`SceneRecorder`] is the
+//! `weft_gpu::DrawRecorder` that draws it in raster passes (`Meshes(filter)`,
+//! `LightVolumes(kind)`) and binds scene data (set 1) for fullscreen lighting
+//! passes; [`render`] runs a graph over a scene for some frames. The GLSL side
+//! of every layout here is `shaders/include/scene.glsl`.
+
+pub mod buffer;
+pub mod camera;
+pub mod error;
+pub mod features;
+pub mod frame;
+pub mod geometry;
+pub mod lights;
+pub mod materials;
+pub mod packing;
+pub mod pipelines;
+pub mod recorder;
+pub mod scene_gpu;
+pub mod state;
+pub mod texture;
+pub mod volumes;
+
+pub use error::RenderError;
+pub use features::scene_features;
+pub use frame::{compile_for_scene, render, RenderSettings, Rendered};
+pub use recorder::SceneRecorder;
+pub use scene_gpu::GpuScene;

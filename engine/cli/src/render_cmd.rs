@@ -1,0 +1,203 @@
+//! `weft render`: a scene through a graph to an image, with validation,
+//! per-pass timings and a JSON summary.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, ValueEnum};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use weft_gpu::{format_timings, Gpu, GpuOptions, TimingMode};
+use weft_graph::plan::Extent;
+use weft_render::{render, RenderSettings};
+
+/// Which per-pass times `--timings` measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Timings {
+    /// GPU timestamps around each pass, one submission per frame.
+    Gpu,
+    /// Host wall time of each pass submitted and waited for alone.
+    Cpu,
+}
+
+/// Arguments of `weft render`.
+#[derive(Args)]
+pub struct RenderArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// The render graph.
+    #[arg(long, default_value = "graphs/forward.ron")]
+    graph: PathBuf,
+    /// Output size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    size: Extent,
+    /// Frames to render; the last one is saved.
+    #[arg(long, default_value_t = 1)]
+    frames: u32,
+    /// Scene time in seconds at the first frame (frames are 1/60 s apart).
+    #[arg(long, default_value_t = 0.0)]
+    time: f32,
+    /// Camera name; the scene's first camera by default.
+    #[arg(long)]
+    camera: Option<String>,
+    /// Output image: .png (tonemapped sRGB output) or .exr (linear floats);
+    /// default out/<scene stem>.png.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Enable the validation layer with synchronization validation; any error or
+    /// warning makes the command fail.
+    #[arg(long)]
+    validate: bool,
+    /// Print per-pass times: `gpu` timestamps (default) or `cpu` wall time per pass.
+    #[arg(long, num_args = 0..=1, default_missing_value = "gpu")]
+    timings: Option<Timings>,
+    /// Print a JSON summary instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Feature toggles added after the scene's features (`name` on, `!name` off).
+    #[arg(long, value_delimiter = ',')]
+    features: Vec<String>,
+    /// Use the first device whose name contains this.
+    #[arg(long)]
+    device: Option<String>,
+}
+
+fn parse_size(text: &str) -> Result<Extent, String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("size must look like 1280x720, found \"{text}\""))?;
+    let parse = |v: &str| match v.trim().parse::<u32>() {
+        Ok(n) if (1..=16384).contains(&n) => Ok(n),
+        _ => Err(format!("size must be 1..=16384, found \"{v}\"")),
+    };
+    Ok(Extent {
+        width: parse(w)?,
+        height: parse(h)?,
+    })
+}
+
+fn default_out(scene: &Path) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "render".into());
+    Path::new("out").join(format!("{stem}.png"))
+}
+
+/// Runs `weft render`.
+pub fn run(args: RenderArgs) -> Result<ExitCode> {
+    let out = args.out.clone().unwrap_or_else(|| default_out(&args.scene));
+    match out.extension().and_then(|e| e.to_str()) {
+        Some("png" | "exr") => {}
+        _ => bail!("--out {}: use a .png or .exr file name", out.display()),
+    }
+    let scene = weft_scene::load_scene(&args.scene)
+        .with_context(|| format!("loading {}", args.scene.display()))?;
+    let gpu = Gpu::new(&GpuOptions {
+        validation: args.validate,
+        device: args.device.clone(),
+    })?;
+    let log = gpu.validation();
+    let device = gpu.info().name.clone();
+    if !args.json {
+        println!("device: {device} ({:?})", gpu.info().kind);
+    }
+    let settings = RenderSettings {
+        graph: args.graph.clone(),
+        extent: args.size,
+        frames: args.frames,
+        time: args.time,
+        camera: args.camera.clone(),
+        features: args.features.clone(),
+        timing: match args.timings {
+            None => TimingMode::Off,
+            Some(Timings::Gpu) => TimingMode::GpuTimestamps,
+            Some(Timings::Cpu) => TimingMode::CpuPerPass,
+        },
+        readback: true,
+        ..RenderSettings::default()
+    };
+    let rendered = render(&gpu, &scene, &settings)?;
+    drop(gpu);
+    let output = rendered
+        .report
+        .output
+        .as_ref()
+        .context("the frame produced no output image")?;
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    output.save(&out)?;
+    for w in &rendered.warnings {
+        eprintln!("warning: {w}");
+    }
+    let counts = log.counts();
+    for m in log.messages() {
+        eprintln!("validation {:?}: {}: {}", m.severity, m.id, m.text);
+    }
+    let passes: Vec<&str> = rendered
+        .plan
+        .passes
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect();
+    let mean_record_ms =
+        rendered.record_ms.iter().sum::<f64>() / rendered.record_ms.len().max(1) as f64;
+    if args.json {
+        let timings: Vec<_> = rendered
+            .report
+            .timings
+            .iter()
+            .map(|t| serde_json::json!({ "pass": t.pass, "source": t.source.label(), "ms": t.ms }))
+            .collect();
+        let summary = serde_json::json!({
+            "device": device,
+            "scene": args.scene,
+            "graph": args.graph,
+            "size": [args.size.width, args.size.height],
+            "frames": args.frames.max(1),
+            "camera": rendered.camera,
+            "features": rendered.plan.features,
+            "passes": passes,
+            "culled": rendered.plan.culled.iter().map(|c| &c.name).collect::<Vec<_>>(),
+            "output": out,
+            "draw_calls": rendered.draw_calls,
+            "record_ms": mean_record_ms,
+            "timings": timings,
+            "transient_bytes": rendered.report.transient_bytes,
+            "device_memory_bytes": rendered.report.memory.allocated_bytes,
+            "validation": {
+                "enabled": args.validate,
+                "errors": counts.errors,
+                "warnings": counts.warnings,
+                "performance": counts.performance,
+            },
+        });
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        println!(
+            "{} through {} at {}x{} ({} frame(s), camera \"{}\"): {}",
+            args.scene.display(),
+            args.graph.display(),
+            args.size.width,
+            args.size.height,
+            args.frames.max(1),
+            rendered.camera,
+            passes.join(" -> ")
+        );
+        println!(
+            "draw calls: {}; host recording + submission: {mean_record_ms:.3} ms per frame",
+            rendered.draw_calls
+        );
+        if !rendered.report.timings.is_empty() {
+            print!("{}", format_timings(&rendered.report.timings));
+        }
+        if args.validate {
+            println!("validation: {counts}");
+        }
+        println!("wrote {}", out.display());
+    }
+    Ok(if counts.is_clean() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}

@@ -1,0 +1,155 @@
+//! Buffers for scene data through the gpu crate's allocator: device-local ones
+//! filled once through a staging copy (geometry, draws, materials), and
+//! host-visible ones rewritten every frame (camera, animated lights).
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+use weft_gpu::{Gpu, GpuError};
+
+/// A buffer and its memory, freed on drop.
+pub struct Buffer<'g> {
+    gpu: &'g Gpu,
+    pub buffer: vk::Buffer,
+    allocation: Option<Allocation>,
+    /// Size in bytes.
+    pub size: u64,
+}
+
+fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
+    move |result| GpuError::Vulkan { call, result }
+}
+
+impl<'g> Buffer<'g> {
+    /// A buffer of `size` bytes (at least 16) in `location`.
+    pub fn new(
+        gpu: &'g Gpu,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Self, GpuError> {
+        let size = size.max(16);
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let device = gpu.device();
+        let buffer =
+            unsafe { device.create_buffer(&info, None) }.map_err(vk_err("vkCreateBuffer"))?;
+        let mut this = Self {
+            gpu,
+            buffer,
+            allocation: None,
+            size,
+        };
+        let requirements = unsafe { device.get_buffer_memory_requirements(buffer) };
+        let allocation = gpu
+            .allocator()
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear: true,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .map_err(|e| GpuError::Allocation {
+                what: name.to_string(),
+                message: e.to_string(),
+            })?;
+        unsafe { device.bind_buffer_memory(buffer, allocation.memory(), allocation.offset()) }
+            .map_err(vk_err("vkBindBufferMemory"))?;
+        this.allocation = Some(allocation);
+        gpu.set_name(buffer, name);
+        Ok(this)
+    }
+
+    /// A host-visible buffer for data rewritten every frame.
+    pub fn host(
+        gpu: &'g Gpu,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+    ) -> Result<Self, GpuError> {
+        Self::new(gpu, name, size, usage, MemoryLocation::CpuToGpu)
+    }
+
+    /// A device-local buffer holding `bytes`, copied through a staging buffer; the copy
+    /// is followed by a barrier that makes it visible to every later shader and vertex read.
+    pub fn device_local(
+        gpu: &'g Gpu,
+        name: &str,
+        bytes: &[u8],
+        usage: vk::BufferUsageFlags,
+    ) -> Result<Self, GpuError> {
+        let target = Self::new(
+            gpu,
+            name,
+            bytes.len() as u64,
+            usage | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?;
+        if bytes.is_empty() {
+            return Ok(target);
+        }
+        let mut staging = Self::host(
+            gpu,
+            &format!("{name} (staging)"),
+            bytes.len() as u64,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+        )?;
+        staging.write(bytes)?;
+        gpu.one_shot(|cmd| {
+            let region = vk::BufferCopy::default().size(bytes.len() as u64);
+            let barrier = vk::BufferMemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .dst_access_mask(vk::AccessFlags2::MEMORY_READ)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .buffer(target.buffer)
+                .offset(0)
+                .size(vk::WHOLE_SIZE);
+            let barriers = [barrier];
+            let dep = vk::DependencyInfo::default().buffer_memory_barriers(&barriers);
+            unsafe {
+                gpu.device()
+                    .cmd_copy_buffer(cmd, staging.buffer, target.buffer, &[region]);
+                gpu.device().cmd_pipeline_barrier2(cmd, &dep);
+            }
+            Ok(())
+        })?;
+        Ok(target)
+    }
+
+    /// Copies `bytes` to the start of a host-visible buffer.
+    pub fn write(&mut self, bytes: &[u8]) -> Result<(), GpuError> {
+        let slice = self
+            .allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .ok_or_else(|| GpuError::Allocation {
+                what: "a scene buffer".into(),
+                message: "buffer is not host-visible".into(),
+            })?;
+        let dst = slice
+            .get_mut(..bytes.len())
+            .ok_or_else(|| GpuError::Allocation {
+                what: "a scene buffer".into(),
+                message: format!("{} bytes do not fit in {}", bytes.len(), self.size),
+            })?;
+        dst.copy_from_slice(bytes);
+        Ok(())
+    }
+}
+
+impl Drop for Buffer<'_> {
+    fn drop(&mut self) {
+        unsafe { self.gpu.device().destroy_buffer(self.buffer, None) };
+        if let Some(a) = self.allocation.take() {
+            // Freeing only fails for allocations this allocator did not make.
+            let _ = self.gpu.allocator().free(a);
+        }
+    }
+}

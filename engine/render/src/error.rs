@@ -1,0 +1,24 @@
+//! Errors of the render crate: what can fail turning a scene and a graph into frames.
+
+use std::path::PathBuf;
+use weft_gpu::GpuError;
+
+/// Anything that can go wrong uploading a scene or rendering it through a graph.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// A Vulkan call, shader or plan problem from the executor.
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    /// The graph failed to load or compile; every diagnostic, one per line.
+    #[error("{}", .0.iter().map(ToString::to_string).collect::<Vec<_>>().join("\n"))]
+    Graph(Vec<weft_graph::Diagnostic>),
+    /// No scene camera has the requested name.
+    #[error("no camera named \"{name}\"; the scene has: {available}")]
+    Camera { name: String, available: String },
+    /// A texture could not be read or decoded (the material falls back to white).
+    #[error("{}: {message}", path.display())]
+    Texture { path: PathBuf, message: String },
+    /// The scene has more of something than the GPU layouts can index.
+    #[error("scene too large: {0}")]
+    TooLarge(String),
+}

@@ -1,0 +1,157 @@
+//! The frame loop: compile a graph for a scene (its features merged with the
+//! graph's defaults and the caller's toggles), upload the scene, and run frames
+//! with the camera and lights animated to each frame's time.
+
+use crate::error::RenderError;
+use crate::features::scene_features;
+use crate::recorder::SceneRecorder;
+use crate::scene_gpu::GpuScene;
+use std::path::PathBuf;
+use weft_gpu::{memory_requirements, FrameOptions, FrameReport, Gpu, Renderer, TimingMode};
+use weft_graph::plan::{Extent, Plan};
+use weft_graph::CompileOptions;
+use weft_scene::Scene;
+
+/// What to render.
+#[derive(Debug, Clone)]
+pub struct RenderSettings {
+    /// The graph file.
+    pub graph: PathBuf,
+    pub extent: Extent,
+    /// Frames to run; the last one is reported.
+    pub frames: u32,
+    /// Seconds at the first frame.
+    pub time: f32,
+    /// Seconds between frames.
+    pub frame_time: f32,
+    /// Camera name; the scene's first camera when `None`.
+    pub camera: Option<String>,
+    /// Toggles as on the command line (`name`, `!name`), applied after scene features.
+    pub features: Vec<String>,
+    pub timing: TimingMode,
+    /// Copy the output back.
+    pub readback: bool,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            graph: PathBuf::from("graphs/forward.ron"),
+            extent: Extent {
+                width: 1280,
+                height: 720,
+            },
+            frames: 1,
+            time: 0.0,
+            frame_time: 1.0 / 60.0,
+            camera: None,
+            features: Vec::new(),
+            timing: TimingMode::Off,
+            readback: true,
+        }
+    }
+}
+
+/// What a render produced.
+pub struct Rendered {
+    pub plan: Plan,
+    /// The last frame's report (output, timings, memory).
+    pub report: FrameReport,
+    /// Name of the camera used.
+    pub camera: String,
+    /// Draw calls of the last frame.
+    pub draw_calls: u64,
+    /// Host milliseconds per frame spent recording and submitting (the executor's
+    /// `record_ms`), one entry per frame.
+    pub record_ms: Vec<f64>,
+    /// Textures that could not be loaded, meshes skipped.
+    pub warnings: Vec<String>,
+}
+
+/// Compiles `settings.graph` for `scene` on `gpu`'s memory requirements.
+pub fn compile_for_scene(
+    gpu: &Gpu,
+    scene: &Scene,
+    settings: &RenderSettings,
+) -> Result<Plan, RenderError> {
+    let loaded = weft_graph::load(&settings.graph);
+    let mut requested = scene_features(scene);
+    requested.extend(settings.features.iter().cloned());
+    let memory = memory_requirements(gpu);
+    let options = CompileOptions {
+        extent: settings.extent,
+        features: loaded.features(&requested),
+        lights: scene.lights.len().max(1) as u32,
+        memory: &memory,
+    };
+    let prepared = weft_graph::Prepared::new(&loaded).map_err(RenderError::Graph)?;
+    prepared.compile(&options).map_err(RenderError::Graph)
+}
+
+/// Renders `scene` through the graph in `settings`.
+pub fn render(
+    gpu: &Gpu,
+    scene: &Scene,
+    settings: &RenderSettings,
+) -> Result<Rendered, RenderError> {
+    let camera = match &settings.camera {
+        Some(name) => scene.camera(name).ok_or_else(|| RenderError::Camera {
+            name: name.clone(),
+            available: scene
+                .cameras
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })?,
+        None => scene.cameras.first().ok_or_else(|| RenderError::Camera {
+            name: "(first)".into(),
+            available: "none".into(),
+        })?,
+    };
+    let plan = compile_for_scene(gpu, scene, settings)?;
+    let mut renderer = Renderer::new(gpu)?;
+    let uploaded = GpuScene::new(gpu, scene)?;
+    let warnings = uploaded.warnings.clone();
+    let mut recorder = SceneRecorder::new(gpu, uploaded)?;
+    let mut resources = renderer.create_resources(&plan)?;
+    let frames = settings.frames.max(1);
+    let mut record_ms = Vec::with_capacity(frames as usize);
+    let mut last = None;
+    for frame in 0..frames {
+        let time = settings.time + frame as f32 * settings.frame_time;
+        recorder.scene.update(
+            camera,
+            time,
+            [settings.extent.width, settings.extent.height],
+        )?;
+        recorder.set_frame(time, frame);
+        let report = renderer.execute(
+            &plan,
+            &mut resources,
+            &mut recorder,
+            &FrameOptions {
+                timing: settings.timing,
+                readback: settings.readback && frame + 1 == frames,
+                time,
+                frame,
+            },
+        )?;
+        record_ms.push(report.record_ms);
+        last = Some(report);
+    }
+    let report =
+        last.ok_or_else(|| RenderError::Gpu(weft_gpu::GpuError::Plan("no frame".into())))?;
+    let draw_calls = recorder.draw_calls;
+    drop(resources);
+    drop(recorder);
+    drop(renderer);
+    Ok(Rendered {
+        plan,
+        report,
+        camera: camera.name.clone(),
+        draw_calls,
+        record_ms,
+        warnings,
+    })
+}

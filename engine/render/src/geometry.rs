@@ -1,0 +1,177 @@
+//! The scene flattened for drawing: every model's meshes in one vertex and one
+//! index array (plus the light-volume meshes), one draw record per placed mesh
+//! (transform and material), and draws sorted by material so a pass rebinds
+//! textures as rarely as possible.
+
+use crate::materials;
+use crate::packing::Words;
+use crate::volumes::{self, VolumeMesh};
+use glam::{Mat4, Vec2, Vec3};
+use weft_graph::schema::MaterialFilter;
+use weft_scene::{Material, Scene};
+
+/// Bytes per vertex: position (3 floats), normal (3), uv (2).
+pub const VERTEX_BYTES: u32 = 32;
+/// Bytes of one draw record (`struct Draw` in `shaders/include/scene.glsl`).
+pub const DRAW_BYTES: usize = 144;
+
+/// Where a mesh lies in the shared arrays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct MeshRange {
+    pub first_index: u32,
+    pub index_count: u32,
+    pub vertex_offset: i32,
+}
+
+/// One placed mesh: what to draw, its record in the draw buffer (the draw's
+/// `firstInstance`), and its material (index into the scene's material list).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DrawItem {
+    pub range: MeshRange,
+    pub draw_id: u32,
+    pub material: u32,
+}
+
+/// The flattened scene, ready to upload.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SceneGeometry {
+    /// `VERTEX_BYTES` per vertex.
+    pub vertices: Words,
+    pub indices: Vec<u32>,
+    /// Draw records (model matrix, normal matrix, material).
+    pub draw_records: Words,
+    /// Draws sorted by material.
+    pub draws: Vec<DrawItem>,
+    /// Every material, index 0 being the default for meshes without one.
+    pub materials: Vec<Material>,
+    pub sphere: MeshRange,
+    pub cone: MeshRange,
+    /// Meshes left out because their arrays disagree, as `model file: mesh name`.
+    pub skipped: Vec<String>,
+}
+
+impl SceneGeometry {
+    /// Flattens `scene`.
+    pub fn new(scene: &Scene) -> Self {
+        let mut g = SceneGeometry {
+            materials: vec![Material::default()],
+            ..Self::default()
+        };
+        let mut ranges = Vec::with_capacity(scene.models.len());
+        let mut material_base = Vec::with_capacity(scene.models.len());
+        for model in &scene.models {
+            material_base.push(g.materials.len() as u32);
+            g.materials.extend(model.materials.iter().cloned());
+            let mut model_ranges = Vec::with_capacity(model.meshes.len());
+            for mesh in &model.meshes {
+                if !mesh.is_consistent() || mesh.indices.is_empty() {
+                    g.skipped
+                        .push(format!("{}: {}", model.path.display(), mesh.name));
+                    model_ranges.push(None);
+                    continue;
+                }
+                let range = g.append(&mesh.positions, &mesh.normals, &mesh.uvs, &mesh.indices);
+                let material = mesh
+                    .material
+                    .filter(|&i| i < model.materials.len())
+                    .map_or(0, |i| material_base[material_base.len() - 1] + i as u32);
+                model_ranges.push(Some((range, material)));
+            }
+            ranges.push(model_ranges);
+        }
+        for instance in &scene.instances {
+            let Some(model_ranges) = ranges.get(instance.model) else {
+                continue;
+            };
+            let normal = instance.transform.inverse().transpose();
+            for &(range, material) in model_ranges.iter().flatten() {
+                let draw_id = g.draws.len() as u32;
+                g.draw_records
+                    .mat4(&instance.transform)
+                    .mat4(&normal)
+                    .u32(material)
+                    .u32(0)
+                    .u32(0)
+                    .u32(0);
+                g.draws.push(DrawItem {
+                    range,
+                    draw_id,
+                    material,
+                });
+            }
+        }
+        g.draws.sort_by_key(|d| (d.material, d.draw_id));
+        g.sphere = g.append_volume(&volumes::sphere());
+        g.cone = g.append_volume(&volumes::cone());
+        g
+    }
+
+    fn append(
+        &mut self,
+        positions: &[Vec3],
+        normals: &[Vec3],
+        uvs: &[Vec2],
+        indices: &[u32],
+    ) -> MeshRange {
+        let range = MeshRange {
+            first_index: self.indices.len() as u32,
+            index_count: indices.len() as u32,
+            vertex_offset: (self.vertices.0.len() as u32 * 4 / VERTEX_BYTES) as i32,
+        };
+        for (i, p) in positions.iter().enumerate() {
+            let n = normals.get(i).copied().unwrap_or(Vec3::Y);
+            let uv = uvs.get(i).copied().unwrap_or(Vec2::ZERO);
+            self.vertices
+                .f32(p.x)
+                .f32(p.y)
+                .f32(p.z)
+                .f32(n.x)
+                .f32(n.y)
+                .f32(n.z)
+                .f32(uv.x)
+                .f32(uv.y);
+        }
+        self.indices.extend_from_slice(indices);
+        range
+    }
+
+    fn append_volume(&mut self, mesh: &VolumeMesh) -> MeshRange {
+        let normals: Vec<Vec3> = mesh
+            .positions
+            .iter()
+            .map(|p| p.try_normalize().unwrap_or(Vec3::Y))
+            .collect();
+        self.append(&mesh.positions, &normals, &[], &mesh.indices)
+    }
+
+    /// The draws a pass with `filter` makes, in material order.
+    pub fn filtered(&self, filter: MaterialFilter) -> impl Iterator<Item = &DrawItem> + '_ {
+        self.draws.iter().filter(move |d| {
+            self.materials
+                .get(d.material as usize)
+                .is_some_and(|m| materials::matches(filter, m))
+        })
+    }
+
+    /// Whether any drawn mesh casts a shadow.
+    pub fn has_shadow_casters(&self) -> bool {
+        self.filtered(MaterialFilter::ShadowCasters)
+            .next()
+            .is_some()
+    }
+
+    /// Triangles drawn by a pass with `filter`.
+    pub fn triangles(&self, filter: MaterialFilter) -> u64 {
+        self.filtered(filter)
+            .map(|d| u64::from(d.range.index_count / 3))
+            .sum()
+    }
+
+    /// Helper for tests and reports: the model matrix of a draw record.
+    pub fn model_matrix(&self, draw_id: u32) -> Option<Mat4> {
+        let start = draw_id as usize * DRAW_BYTES / 4;
+        let words = self.draw_records.0.get(start..start + 16)?;
+        let cols: Vec<f32> = words.iter().map(|w| f32::from_bits(*w)).collect();
+        Some(Mat4::from_cols_slice(&cols))
+    }
+}

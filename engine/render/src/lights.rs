@@ -1,0 +1,245 @@
+//! Light records for the GPU: suns, then point lights, then spots, each with the
+//! cutoff range both forward and deferred shading apply, so the light volumes
+//! and the per-pixel loop cut light off at the same distance.
+
+use crate::packing::Words;
+use glam::Vec3;
+use weft_scene::light::{derive_radius, DEFAULT_LUMINANCE_THRESHOLD};
+use weft_scene::{Aabb, Attenuation, Light};
+
+/// Bytes of one light record (`struct Light` in `shaders/include/scene.glsl`).
+pub const LIGHT_BYTES: usize = 64;
+/// Type code of a sun.
+pub const SUN: f32 = 0.0;
+/// Type code of a point light.
+pub const POINT: f32 = 1.0;
+/// Type code of a spot drawn with a cone volume.
+pub const SPOT_CONE: f32 = 2.0;
+/// Type code of a spot too wide for a cone, drawn with a sphere volume.
+pub const SPOT_SPHERE: f32 = 3.0;
+/// Widest half-angle (degrees) drawn as a cone; wider cones would be huge or inverted.
+pub const CONE_MAX_ANGLE: f32 = 70.0;
+
+/// The scene's sun, point and spot lights packed for the shaders (area lights are
+/// left out: real-time shading does not approximate them yet).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LightSet {
+    /// Records in order: suns, points, spot cones, spot spheres.
+    pub words: Words,
+    pub suns: u32,
+    pub points: u32,
+    pub spot_cones: u32,
+    pub spot_spheres: u32,
+    /// Sum of the suns' ambient terms.
+    pub ambient: Vec3,
+    /// Direction of the first sun, for its shadow map.
+    pub sun_direction: Option<Vec3>,
+}
+
+impl LightSet {
+    /// Number of records.
+    pub fn len(&self) -> u32 {
+        self.suns + self.points + self.spot_cones + self.spot_spheres
+    }
+
+    /// Whether there is no light at all.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Index of the first point light record.
+    pub fn first_point(&self) -> u32 {
+        self.suns
+    }
+
+    /// Index of the first spot record drawn as a cone.
+    pub fn first_spot_cone(&self) -> u32 {
+        self.suns + self.points
+    }
+
+    /// Index of the first spot record drawn as a sphere.
+    pub fn first_spot_sphere(&self) -> u32 {
+        self.suns + self.points + self.spot_cones
+    }
+}
+
+/// Distance beyond which a light with this colour and falloff is dimmer than
+/// one 8-bit step, or `fallback` when it never falls that low.
+pub fn cutoff_range(color: Vec3, attenuation: &Attenuation, fallback: f32) -> f32 {
+    derive_radius(color, attenuation, DEFAULT_LUMINANCE_THRESHOLD)
+        .filter(|r| r.is_finite() && *r > 0.0)
+        .unwrap_or(fallback)
+}
+
+/// One light as the shaders see it.
+struct Record {
+    position: Vec3,
+    range: f32,
+    direction: Vec3,
+    kind: f32,
+    color: Vec3,
+    exponent: f32,
+    attenuation: Attenuation,
+    cos_cutoff: f32,
+}
+
+impl Record {
+    fn pack(&self, words: &mut Words) {
+        words
+            .vec3w(self.position, self.range)
+            .vec3w(self.direction, self.kind)
+            .vec3w(self.color, self.exponent)
+            .f32(self.attenuation.constant)
+            .f32(self.attenuation.linear)
+            .f32(self.attenuation.quadratic)
+            .f32(self.cos_cutoff);
+    }
+}
+
+/// Packs `lights` (already animated to the frame's time); `bounds` gives the range of
+/// lights that never fade out.
+pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
+    let fallback = if bounds.is_empty() {
+        100.0
+    } else {
+        (bounds.diagonal() * 2.0).max(1.0)
+    };
+    let mut set = LightSet::default();
+    for light in lights {
+        if let Light::Sun(s) = light {
+            let dir = s.direction.try_normalize().unwrap_or(Vec3::NEG_Y);
+            Record {
+                position: Vec3::ZERO,
+                range: 0.0,
+                direction: dir,
+                kind: SUN,
+                color: s.color,
+                exponent: 0.0,
+                attenuation: Attenuation::NONE,
+                cos_cutoff: -1.0,
+            }
+            .pack(&mut set.words);
+            set.suns += 1;
+            set.ambient += s.ambient;
+            set.sun_direction.get_or_insert(dir);
+        }
+    }
+    for light in lights {
+        if let Light::Point(p) = light {
+            let range = if p.radius.is_finite() && p.radius > 0.0 {
+                p.radius
+            } else {
+                cutoff_range(p.color, &p.attenuation, fallback)
+            };
+            Record {
+                position: p.position,
+                range,
+                direction: Vec3::ZERO,
+                kind: POINT,
+                color: p.color,
+                exponent: 0.0,
+                attenuation: p.attenuation,
+                cos_cutoff: -1.0,
+            }
+            .pack(&mut set.words);
+            set.points += 1;
+        }
+    }
+    for wide in [false, true] {
+        for light in lights {
+            let Light::Spot(s) = light else { continue };
+            if (s.angle > CONE_MAX_ANGLE) != wide {
+                continue;
+            }
+            let range = s
+                .length
+                .filter(|l| l.is_finite() && *l > 0.0)
+                .unwrap_or_else(|| cutoff_range(s.color, &s.attenuation, fallback));
+            let dir = s.direction.try_normalize().unwrap_or(Vec3::NEG_Y);
+            let kind = if wide { SPOT_SPHERE } else { SPOT_CONE };
+            let cos_cutoff = s.angle.clamp(0.0, 180.0).to_radians().cos();
+            Record {
+                position: s.position,
+                range,
+                direction: dir,
+                kind,
+                color: s.color,
+                exponent: s.exponent,
+                attenuation: s.attenuation,
+                cos_cutoff,
+            }
+            .pack(&mut set.words);
+            if wide {
+                set.spot_spheres += 1;
+            } else {
+                set.spot_cones += 1;
+            }
+        }
+    }
+    set
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use weft_scene::light::{RadiusSource, SpotLight, SunLight};
+    use weft_scene::PointLight;
+
+    fn spot(angle: f32, length: Option<f32>) -> Light {
+        Light::Spot(SpotLight {
+            position: Vec3::Y,
+            direction: Vec3::new(0.0, -2.0, 0.0),
+            color: Vec3::ONE,
+            exponent: 2.0,
+            angle,
+            inner_angle: None,
+            length,
+            attenuation: Attenuation {
+                constant: 1.0,
+                linear: 1.0,
+                quadratic: 0.0,
+            },
+            swivel: None,
+        })
+    }
+
+    #[test]
+    fn orders_suns_points_cones_spheres_with_ranges() {
+        let lights = vec![
+            spot(80.0, Some(5.0)),
+            Light::Point(PointLight {
+                position: Vec3::X,
+                color: Vec3::ONE,
+                velocity: 0.0,
+                amplitude: 0.0,
+                attenuation: Attenuation::NONE,
+                radius: 3.0,
+                radius_source: RadiusSource::Given,
+            }),
+            spot(30.0, None),
+            Light::Sun(SunLight {
+                direction: Vec3::new(0.0, -3.0, 0.0),
+                color: Vec3::ONE,
+                ambient: Vec3::splat(0.1),
+                motion: None,
+            }),
+        ];
+        let set = pack_lights(&lights, &Aabb::EMPTY);
+        assert_eq!(
+            (set.suns, set.points, set.spot_cones, set.spot_spheres),
+            (1, 1, 1, 1)
+        );
+        assert_eq!(set.words.byte_len(), 4 * LIGHT_BYTES);
+        let word = |record: usize, i: usize| f32::from_bits(set.words.0[record * 16 + i]);
+        assert_eq!(word(0, 5), -1.0, "sun direction normalised");
+        assert_eq!(word(1, 3), 3.0, "point range is its radius");
+        assert_eq!(word(1, 7), POINT);
+        // luminance 1 / (1 + d) = 1/256 at d = 255
+        assert!((word(2, 3) - 255.0).abs() < 1e-2, "{}", word(2, 3));
+        assert_eq!(word(2, 7), SPOT_CONE);
+        assert!((word(2, 15) - 30f32.to_radians().cos()).abs() < 1e-6);
+        assert_eq!(word(3, 3), 5.0, "spot length");
+        assert_eq!(word(3, 7), SPOT_SPHERE);
+        assert_eq!(set.ambient, Vec3::splat(0.1));
+    }
+}

@@ -1,0 +1,357 @@
+//! Graphics pipelines for scene passes: the pass's shaders (compiled and
+//! reflected by the gpu crate's cache), the shared vertex layout, set 0 from
+//! reflection (graph resources), set 1 and 2 from the scene, push constants
+//! from reflection, and the fixed-function state the plan implies.
+
+use crate::geometry::VERTEX_BYTES;
+use crate::state::{Cull, DepthTest, PassState};
+use ash::vk;
+use std::collections::HashMap;
+use std::sync::Arc;
+use weft_gpu::pipeline::{BlendCode, PipelineCache, ShaderKey, ShaderModule};
+use weft_gpu::reflect::PipelineInterface;
+use weft_gpu::{GpuError, SCENE_SET};
+
+/// Set number of a material's texture.
+pub const MATERIAL_SET: u32 = 2;
+
+/// Identifies a scene pipeline.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct ScenePipelineKey {
+    pub vertex: ShaderKey,
+    pub fragment: Option<ShaderKey>,
+    pub render_pass: vk::RenderPass,
+    pub state: PassState,
+    /// Whether the vertex shader reads only the position (location 0): depth-only
+    /// passes and light volumes; mesh shading reads normal and UV too.
+    pub position_only: bool,
+}
+
+/// A built scene pipeline.
+pub struct ScenePipeline {
+    pub pipeline: vk::Pipeline,
+    pub layout: vk::PipelineLayout,
+    /// Set 0: the graph resources the pass samples (may be empty).
+    pub graph_layout: vk::DescriptorSetLayout,
+    /// The merged shader interface, for binding graph resources and push constants.
+    pub interface: PipelineInterface,
+}
+
+/// Scene pipelines by key, with the shader cache they are built from.
+pub struct ScenePipelines {
+    shaders: PipelineCache,
+    pipelines: HashMap<ScenePipelineKey, Arc<ScenePipeline>>,
+}
+
+fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
+    move |result| GpuError::Vulkan { call, result }
+}
+
+fn stage_create_info(
+    stage: vk::ShaderStageFlags,
+    module: vk::ShaderModule,
+) -> vk::PipelineShaderStageCreateInfo<'static> {
+    vk::PipelineShaderStageCreateInfo::default()
+        .stage(stage)
+        .module(module)
+        .name(c"main")
+}
+
+fn blend_state(blend: BlendCode) -> vk::PipelineColorBlendAttachmentState {
+    let state = vk::PipelineColorBlendAttachmentState::default()
+        .color_write_mask(vk::ColorComponentFlags::RGBA);
+    match blend {
+        BlendCode::Off => state,
+        BlendCode::Additive => state
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+            .alpha_blend_op(vk::BlendOp::ADD),
+        BlendCode::Alpha => state
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
+            .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .alpha_blend_op(vk::BlendOp::ADD),
+    }
+}
+
+fn depth_state(test: DepthTest) -> vk::PipelineDepthStencilStateCreateInfo<'static> {
+    let (enable, write, op) = match test {
+        DepthTest::Off => (false, false, vk::CompareOp::ALWAYS),
+        DepthTest::Greater { write } => (true, write, vk::CompareOp::GREATER_OR_EQUAL),
+        DepthTest::Less { write } => (true, write, vk::CompareOp::LESS_OR_EQUAL),
+        DepthTest::Equal => (true, false, vk::CompareOp::EQUAL),
+        DepthTest::BehindSurface => (true, false, vk::CompareOp::LESS_OR_EQUAL),
+    };
+    vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(enable)
+        .depth_write_enable(write)
+        .depth_compare_op(op)
+}
+
+impl ScenePipelines {
+    /// An empty cache.
+    pub fn new() -> Result<Self, GpuError> {
+        Ok(Self {
+            shaders: PipelineCache::new()?,
+            pipelines: HashMap::new(),
+        })
+    }
+
+    /// Number of pipelines built.
+    pub fn len(&self) -> usize {
+        self.pipelines.len()
+    }
+
+    /// Whether none was built yet.
+    pub fn is_empty(&self) -> bool {
+        self.pipelines.is_empty()
+    }
+
+    /// The pipeline for `key`, built on first use against the scene's set layouts.
+    pub fn get(
+        &mut self,
+        device: &ash::Device,
+        key: &ScenePipelineKey,
+        scene_layout: vk::DescriptorSetLayout,
+        material_layout: vk::DescriptorSetLayout,
+    ) -> Result<Arc<ScenePipeline>, GpuError> {
+        if let Some(p) = self.pipelines.get(key) {
+            return Ok(Arc::clone(p));
+        }
+        let vs = self.shaders.shader(&key.vertex)?;
+        let fs = key
+            .fragment
+            .as_ref()
+            .map(|k| self.shaders.shader(k))
+            .transpose()?;
+        let pipeline = build(
+            device,
+            key,
+            &vs,
+            fs.as_deref(),
+            scene_layout,
+            material_layout,
+        )?;
+        let pipeline = Arc::new(pipeline);
+        self.pipelines.insert(key.clone(), Arc::clone(&pipeline));
+        Ok(pipeline)
+    }
+
+    /// Destroys every pipeline.
+    pub fn destroy(&mut self, device: &ash::Device) {
+        for (_, p) in self.pipelines.drain() {
+            destroy(device, &p);
+        }
+    }
+}
+
+fn destroy(device: &ash::Device, p: &ScenePipeline) {
+    unsafe {
+        device.destroy_pipeline(p.pipeline, None);
+        device.destroy_pipeline_layout(p.layout, None);
+        device.destroy_descriptor_set_layout(p.graph_layout, None);
+    }
+}
+
+fn reflect_error(key: &ScenePipelineKey, message: String) -> GpuError {
+    GpuError::Shader(weft_gpu::ShaderError::Reflect {
+        path: key.vertex.path.clone(),
+        message,
+    })
+}
+
+fn build(
+    device: &ash::Device,
+    key: &ScenePipelineKey,
+    vs: &ShaderModule,
+    fs: Option<&ShaderModule>,
+    scene_layout: vk::DescriptorSetLayout,
+    material_layout: vk::DescriptorSetLayout,
+) -> Result<ScenePipeline, GpuError> {
+    let mut stages = vec![&vs.interface];
+    stages.extend(fs.map(|f| &f.interface));
+    let interface = PipelineInterface::merge(&stages).map_err(|m| reflect_error(key, m))?;
+    if let Some(((set, binding), _)) = interface
+        .bindings
+        .iter()
+        .find(|((s, _), _)| *s > MATERIAL_SET)
+    {
+        return Err(reflect_error(
+            key,
+            format!("binding {binding} in set {set}: scene shaders use sets 0 (graph), {SCENE_SET} (scene) and {MATERIAL_SET} (material)"),
+        ));
+    }
+    let graph_bindings: Vec<_> = interface
+        .bindings
+        .iter()
+        .filter(|((s, _), _)| *s == 0)
+        .map(|(_, (b, stages))| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(b.binding)
+                .descriptor_type(b.kind.vk())
+                .descriptor_count(b.count)
+                .stage_flags(*stages)
+        })
+        .collect();
+    let graph_layout = unsafe {
+        device.create_descriptor_set_layout(
+            &vk::DescriptorSetLayoutCreateInfo::default().bindings(&graph_bindings),
+            None,
+        )
+    }
+    .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
+    let set_layouts = [graph_layout, scene_layout, material_layout];
+    let ranges: Vec<_> = interface
+        .push
+        .iter()
+        .map(|(block, stages)| {
+            vk::PushConstantRange::default()
+                .stage_flags(*stages)
+                .offset(0)
+                .size(block.size)
+        })
+        .collect();
+    let layout = match unsafe {
+        device.create_pipeline_layout(
+            &vk::PipelineLayoutCreateInfo::default()
+                .set_layouts(&set_layouts)
+                .push_constant_ranges(&ranges),
+            None,
+        )
+    } {
+        Ok(l) => l,
+        Err(result) => {
+            unsafe { device.destroy_descriptor_set_layout(graph_layout, None) };
+            return Err(GpuError::Vulkan {
+                call: "vkCreatePipelineLayout",
+                result,
+            });
+        }
+    };
+    let mut pipeline = ScenePipeline {
+        pipeline: vk::Pipeline::null(),
+        layout,
+        graph_layout,
+        interface,
+    };
+    match create_pipeline(device, key, vs, fs, layout) {
+        Ok(p) => {
+            pipeline.pipeline = p;
+            Ok(pipeline)
+        }
+        Err(e) => {
+            destroy(device, &pipeline);
+            Err(e)
+        }
+    }
+}
+
+fn create_pipeline(
+    device: &ash::Device,
+    key: &ScenePipelineKey,
+    vs: &ShaderModule,
+    fs: Option<&ShaderModule>,
+    layout: vk::PipelineLayout,
+) -> Result<vk::Pipeline, GpuError> {
+    let mut modules = Vec::new();
+    let result = (|| {
+        let mut stages = Vec::new();
+        for (module, stage) in [(Some(vs), vk::ShaderStageFlags::VERTEX)]
+            .into_iter()
+            .chain([(fs, vk::ShaderStageFlags::FRAGMENT)])
+        {
+            let Some(module) = module else { continue };
+            let info = vk::ShaderModuleCreateInfo::default().code(&module.compiled.spirv);
+            let m = unsafe { device.create_shader_module(&info, None) }
+                .map_err(vk_err("vkCreateShaderModule"))?;
+            modules.push(m);
+            stages.push(stage_create_info(stage, m));
+        }
+        let bindings = [vk::VertexInputBindingDescription {
+            binding: 0,
+            stride: VERTEX_BYTES,
+            input_rate: vk::VertexInputRate::VERTEX,
+        }];
+        let attribute = |location, offset, format| vk::VertexInputAttributeDescription {
+            location,
+            binding: 0,
+            format,
+            offset,
+        };
+        let all = [
+            attribute(0, 0, vk::Format::R32G32B32_SFLOAT),
+            attribute(1, 12, vk::Format::R32G32B32_SFLOAT),
+            attribute(2, 24, vk::Format::R32G32_SFLOAT),
+        ];
+        let attributes = if key.position_only {
+            &all[..1]
+        } else {
+            &all[..]
+        };
+        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&bindings)
+            .vertex_attribute_descriptions(attributes);
+        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let viewport = vk::PipelineViewportStateCreateInfo::default()
+            .viewport_count(1)
+            .scissor_count(1);
+        let state = &key.state;
+        let (bias, constant, slope) = match state.depth_bias {
+            Some((c, s)) => (true, f32::from_bits(c), f32::from_bits(s)),
+            None => (false, 0.0, 0.0),
+        };
+        // Every projection flips Y for Vulkan's downward framebuffer Y, which keeps
+        // counter-clockwise model triangles counter-clockwise in Vulkan's convention.
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(match state.cull {
+                Cull::None => vk::CullModeFlags::NONE,
+                Cull::Front => vk::CullModeFlags::FRONT,
+            })
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .depth_bias_enable(bias)
+            .depth_bias_constant_factor(constant)
+            .depth_bias_slope_factor(slope)
+            .line_width(1.0);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::from_raw(state.samples.max(1)));
+        let depth = depth_state(state.depth);
+        let attachments: Vec<_> = state.blends.iter().map(|b| blend_state(*b)).collect();
+        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
+        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let info = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .depth_stencil_state(&depth)
+            .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
+            .layout(layout)
+            .render_pass(key.render_pass)
+            .subpass(0);
+        let created =
+            unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
+                .map_err(|(_, r)| r)
+                .map_err(vk_err("vkCreateGraphicsPipelines"))?;
+        created.into_iter().next().ok_or(GpuError::Vulkan {
+            call: "vkCreateGraphicsPipelines",
+            result: vk::Result::ERROR_UNKNOWN,
+        })
+    })();
+    for m in modules {
+        unsafe { device.destroy_shader_module(m, None) };
+    }
+    result
+}

@@ -1,0 +1,374 @@
+//! The draw recorder the executor calls for scene passes: binds the pass's
+//! pipeline, the graph resources it samples (set 0), the scene (set 1) and each
+//! material's texture (set 2), then draws the meshes the pass's material filter
+//! selects or one instanced light volume per light.
+
+use crate::pipelines::{ScenePipelineKey, ScenePipelines, MATERIAL_SET};
+use crate::scene_gpu::GpuScene;
+use crate::state::pass_state;
+use ash::vk;
+use weft_gpu::bind::{pack_push, resolve_bindings, FrameValues};
+use weft_gpu::pipeline::{Pipeline, ShaderKey};
+use weft_gpu::reflect::PipelineInterface;
+use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, ShaderStage, SCENE_SET};
+use weft_graph::schema::{Draw, LightKind};
+
+/// Descriptor sets for graph resources one frame may need.
+const FRAME_SETS: u32 = 64;
+
+fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
+    move |result| GpuError::Vulkan { call, result }
+}
+
+/// Draws a [`GpuScene`] into the scene passes of any plan.
+pub struct SceneRecorder<'g> {
+    gpu: &'g Gpu,
+    pub scene: GpuScene<'g>,
+    pipelines: ScenePipelines,
+    pool: vk::DescriptorPool,
+    last_pass: Option<usize>,
+    frame: FrameValues,
+    /// Draw calls recorded in the current frame.
+    pub draw_calls: u64,
+}
+
+impl<'g> SceneRecorder<'g> {
+    /// A recorder for an uploaded scene.
+    pub fn new(gpu: &'g Gpu, scene: GpuScene<'g>) -> Result<Self, GpuError> {
+        let sizes = [
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                descriptor_count: FRAME_SETS * 8,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::UNIFORM_BUFFER,
+                descriptor_count: FRAME_SETS,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_BUFFER,
+                descriptor_count: FRAME_SETS * 4,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_IMAGE,
+                descriptor_count: FRAME_SETS,
+            },
+        ];
+        let pool = unsafe {
+            gpu.device().create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(FRAME_SETS)
+                    .pool_sizes(&sizes),
+                None,
+            )
+        }
+        .map_err(vk_err("vkCreateDescriptorPool"))?;
+        Ok(Self {
+            gpu,
+            scene,
+            pipelines: ScenePipelines::new()?,
+            pool,
+            last_pass: None,
+            frame: FrameValues::default(),
+            draw_calls: 0,
+        })
+    }
+
+    /// Sets the `time` and `frame` values push constants receive.
+    pub fn set_frame(&mut self, time: f32, frame: u32) {
+        self.frame.time = time;
+        self.frame.frame = frame;
+    }
+
+    /// Number of scene pipelines built.
+    pub fn pipeline_count(&self) -> usize {
+        self.pipelines.len()
+    }
+
+    /// Passes come in increasing order within a frame, so a pass index not above the
+    /// last one starts a new frame; the executor has waited for the previous one, so
+    /// its descriptor sets can be recycled.
+    fn begin_pass(&mut self, index: usize) -> Result<(), GpuError> {
+        if self.last_pass.is_some_and(|last| index <= last) {
+            unsafe {
+                self.gpu
+                    .device()
+                    .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
+            }
+            .map_err(vk_err("vkResetDescriptorPool"))?;
+            self.draw_calls = 0;
+        }
+        self.last_pass = Some(index);
+        Ok(())
+    }
+
+    /// Allocates and writes set 0: the graph resources the pass samples or stores.
+    fn graph_set(
+        &self,
+        ctx: &RasterContext<'_>,
+        layout: vk::DescriptorSetLayout,
+        interface: &PipelineInterface,
+    ) -> Result<Option<vk::DescriptorSet>, GpuError> {
+        let mut graph_only = interface.clone();
+        graph_only.bindings.retain(|(set, _), _| *set == 0);
+        let pass = ctx.pass();
+        if graph_only.bindings.is_empty() && pass.bindings.is_empty() {
+            return Ok(None);
+        }
+        let resolved = resolve_bindings(ctx.plan, pass, &graph_only).map_err(|problems| {
+            GpuError::Mismatch {
+                pass: pass.name.clone(),
+                problems,
+            }
+        })?;
+        let layouts = [layout];
+        let set = unsafe {
+            self.gpu.device().allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(self.pool)
+                    .set_layouts(&layouts),
+            )
+        }
+        .map_err(vk_err("vkAllocateDescriptorSets"))?
+        .into_iter()
+        .next()
+        .ok_or(GpuError::Vulkan {
+            call: "vkAllocateDescriptorSets",
+            result: vk::Result::ERROR_OUT_OF_POOL_MEMORY,
+        })?;
+        let mut images = Vec::new();
+        let mut buffers = Vec::new();
+        for rb in &resolved {
+            let resource = rb.graph.resource;
+            match ctx.resources.get(resource) {
+                Some(weft_gpu::resources::GpuResource::Image(img)) => images.push((
+                    rb,
+                    [vk::DescriptorImageInfo {
+                        sampler: if ctx.gpu.linear_filter(img.desc.format_raw) {
+                            ctx.sampler
+                        } else {
+                            ctx.nearest_sampler
+                        },
+                        image_view: img.shader_view,
+                        image_layout: ctx.image_layout(resource),
+                    }],
+                )),
+                Some(weft_gpu::resources::GpuResource::Buffer(buf)) => buffers.push((
+                    rb,
+                    [vk::DescriptorBufferInfo {
+                        buffer: buf.buffer,
+                        offset: 0,
+                        range: vk::WHOLE_SIZE,
+                    }],
+                )),
+                None => return Err(GpuError::Plan(format!("resource {resource} missing"))),
+            }
+        }
+        let mut writes = Vec::new();
+        for (rb, info) in &images {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(rb.shader.binding)
+                    .descriptor_type(rb.shader.kind.vk())
+                    .image_info(info),
+            );
+        }
+        for (rb, info) in &buffers {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(rb.shader.binding)
+                    .descriptor_type(rb.shader.kind.vk())
+                    .buffer_info(info),
+            );
+        }
+        unsafe { self.gpu.device().update_descriptor_sets(&writes, &[]) };
+        Ok(Some(set))
+    }
+}
+
+impl DrawRecorder for SceneRecorder<'_> {
+    fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError> {
+        self.begin_pass(ctx.pass_index)?;
+        let pass = ctx.pass();
+        let fail = |message: String| GpuError::Pass {
+            pass: pass.name.clone(),
+            message,
+        };
+        let draw = pass
+            .draw
+            .clone()
+            .ok_or_else(|| fail("raster pass without a `draw`".into()))?;
+        let shader = |path: &std::path::Path, stage| ShaderKey {
+            path: path.to_path_buf(),
+            stage,
+            defines: pass.defines.clone(),
+        };
+        let vertex = pass
+            .shaders
+            .vertex
+            .as_deref()
+            .ok_or_else(|| fail("needs a vertex shader".into()))?;
+        let key = ScenePipelineKey {
+            vertex: shader(vertex, ShaderStage::Vertex),
+            fragment: pass
+                .shaders
+                .fragment
+                .as_deref()
+                .map(|f| shader(f, ShaderStage::Fragment)),
+            render_pass: ctx.render_pass,
+            state: pass_state(pass),
+            position_only: matches!(draw, Draw::LightVolumes(_)) || pass.shaders.fragment.is_none(),
+        };
+        let device = self.gpu.device();
+        let p = self.pipelines.get(
+            device,
+            &key,
+            self.scene.scene_layout,
+            self.scene.material_layout,
+        )?;
+        let graph_set = self.graph_set(ctx, p.graph_layout, &p.interface)?;
+        let push = match &p.interface.push {
+            Some((block, stages)) => {
+                let frame = FrameValues {
+                    extent: [ctx.extent.width, ctx.extent.height],
+                    ..self.frame
+                };
+                let bytes = pack_push(block, &pass.params, &frame)
+                    .map_err(|problems| fail(problems.join("; ")))?;
+                Some((*stages, bytes))
+            }
+            None => None,
+        };
+        let textured = p
+            .interface
+            .bindings
+            .keys()
+            .any(|(set, _)| *set == MATERIAL_SET);
+        let cmd = ctx.cmd;
+        let bind = vk::PipelineBindPoint::GRAPHICS;
+        let scene = &self.scene;
+        let g = &scene.geometry;
+        unsafe {
+            device.cmd_bind_pipeline(cmd, bind, p.pipeline);
+            if let Some(set) = graph_set {
+                device.cmd_bind_descriptor_sets(cmd, bind, p.layout, 0, &[set], &[]);
+            }
+            device.cmd_bind_descriptor_sets(
+                cmd,
+                bind,
+                p.layout,
+                SCENE_SET,
+                &[scene.scene_set],
+                &[],
+            );
+            if let Some((stages, bytes)) = &push {
+                device.cmd_push_constants(cmd, p.layout, *stages, 0, bytes);
+            }
+            device.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
+            device.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
+        }
+        let mut calls = 0u64;
+        match draw {
+            Draw::Meshes(filter) => {
+                let mut bound = None;
+                for d in g.filtered(filter) {
+                    unsafe {
+                        if textured && bound != Some(d.material) {
+                            let set = scene.material_sets[d.material as usize];
+                            device.cmd_bind_descriptor_sets(
+                                cmd,
+                                bind,
+                                p.layout,
+                                MATERIAL_SET,
+                                &[set],
+                                &[],
+                            );
+                            bound = Some(d.material);
+                        }
+                        device.cmd_draw_indexed(
+                            cmd,
+                            d.range.index_count,
+                            1,
+                            d.range.first_index,
+                            d.range.vertex_offset,
+                            d.draw_id,
+                        );
+                    }
+                    calls += 1;
+                }
+            }
+            Draw::LightVolumes(kind) => {
+                let lights = &scene.light_set;
+                let groups = match kind {
+                    LightKind::Point => vec![(g.sphere, lights.points, lights.first_point())],
+                    LightKind::Spot => vec![
+                        (g.cone, lights.spot_cones, lights.first_spot_cone()),
+                        (g.sphere, lights.spot_spheres, lights.first_spot_sphere()),
+                    ],
+                };
+                for (mesh, count, first) in groups.into_iter().filter(|g| g.1 > 0) {
+                    unsafe {
+                        device.cmd_draw_indexed(
+                            cmd,
+                            mesh.index_count,
+                            count,
+                            mesh.first_index,
+                            mesh.vertex_offset,
+                            first,
+                        );
+                    }
+                    calls += 1;
+                }
+            }
+            Draw::FullscreenTriangle => {
+                return Err(fail(
+                    "a fullscreen triangle is drawn by the executor".into(),
+                ))
+            }
+        }
+        self.draw_calls += calls;
+        Ok(())
+    }
+
+    fn bind_scene(&mut self, ctx: &RasterContext<'_>, pipeline: &Pipeline) -> Result<(), GpuError> {
+        let bindings: Vec<u32> = pipeline
+            .interface
+            .bindings
+            .keys()
+            .filter(|(set, _)| *set == SCENE_SET)
+            .map(|(_, b)| *b)
+            .collect();
+        let layout = pipeline
+            .set_layouts
+            .get(SCENE_SET as usize)
+            .copied()
+            .ok_or_else(|| GpuError::Pass {
+                pass: ctx.pass().name.clone(),
+                message: "pipeline has no scene set layout".into(),
+            })?;
+        let set = self.scene.foreign_set(layout, &bindings)?;
+        unsafe {
+            self.gpu.device().cmd_bind_descriptor_sets(
+                ctx.cmd,
+                pipeline.bind_point,
+                pipeline.layout,
+                SCENE_SET,
+                &[set],
+                &[],
+            )
+        };
+        Ok(())
+    }
+}
+
+impl Drop for SceneRecorder<'_> {
+    fn drop(&mut self) {
+        let device = self.gpu.device();
+        unsafe {
+            let _ = device.device_wait_idle();
+            device.destroy_descriptor_pool(self.pool, None);
+        }
+        self.pipelines.destroy(device);
+    }
+}

@@ -1,0 +1,400 @@
+//! The scene on the device: geometry, draw records and materials uploaded once,
+//! textures, and the per-frame camera and light buffers; descriptor set 1 (scene
+//! data) and set 2 (a material's texture) that every scene shader binds.
+
+use crate::buffer::Buffer;
+use crate::camera;
+use crate::error::RenderError;
+use crate::geometry::SceneGeometry;
+use crate::lights::{pack_lights, LightSet, LIGHT_BYTES};
+use crate::materials::pack_material;
+use crate::packing::Words;
+use crate::texture::{self, Pixels, Texture};
+use ash::vk;
+use glam::Mat4;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use weft_gpu::{Gpu, GpuError};
+use weft_scene::material::TextureSource;
+use weft_scene::{Camera, Scene};
+
+/// Binding of the per-frame uniform block (`Frame` in `scene.glsl`).
+pub const FRAME_BINDING: u32 = 0;
+/// Binding of the light records.
+pub const LIGHTS_BINDING: u32 = 1;
+/// Binding of the draw records.
+pub const DRAWS_BINDING: u32 = 2;
+/// Binding of the material records.
+pub const MATERIALS_BINDING: u32 = 3;
+/// Bytes of the `Frame` uniform block.
+pub const FRAME_BYTES: usize = 3 * 64 + 4 * 16;
+/// Scene sets that fullscreen pipelines built by the executor may ask for.
+const FOREIGN_SETS: u32 = 32;
+
+fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
+    move |result| GpuError::Vulkan { call, result }
+}
+
+/// Everything the scene shaders read, on the device.
+pub struct GpuScene<'g> {
+    gpu: &'g Gpu,
+    pub geometry: SceneGeometry,
+    pub vertices: Buffer<'g>,
+    pub indices: Buffer<'g>,
+    draws: Buffer<'g>,
+    materials: Buffer<'g>,
+    frame: Buffer<'g>,
+    lights: Buffer<'g>,
+    textures: Vec<Texture<'g>>,
+    sampler: vk::Sampler,
+    pool: vk::DescriptorPool,
+    /// Layout of set 1 (scene data) in pipelines built here.
+    pub scene_layout: vk::DescriptorSetLayout,
+    /// Layout of set 2 (one material's texture).
+    pub material_layout: vk::DescriptorSetLayout,
+    /// Set 1 for `scene_layout`.
+    pub scene_set: vk::DescriptorSet,
+    /// Set 2 per material.
+    pub material_sets: Vec<vk::DescriptorSet>,
+    /// Set 1 for layouts the executor built from reflection.
+    foreign_sets: HashMap<vk::DescriptorSetLayout, vk::DescriptorSet>,
+    source_lights: Vec<weft_scene::Light>,
+    bounds: weft_scene::Aabb,
+    /// Light counts by kind (stable over time; animation moves lights only).
+    pub light_set: LightSet,
+    /// Textures that could not be loaded (their materials use white), and skipped meshes.
+    pub warnings: Vec<String>,
+}
+
+impl<'g> GpuScene<'g> {
+    /// Uploads `scene`.
+    pub fn new(gpu: &'g Gpu, scene: &Scene) -> Result<Self, RenderError> {
+        let geometry = SceneGeometry::new(scene);
+        let mut warnings: Vec<String> = geometry
+            .skipped
+            .iter()
+            .map(|m| format!("mesh skipped (inconsistent arrays): {m}"))
+            .collect();
+        if geometry.draws.len() > u32::MAX as usize / 2 {
+            return Err(RenderError::TooLarge(format!(
+                "{} draws",
+                geometry.draws.len()
+            )));
+        }
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let vertices = Buffer::device_local(
+            gpu,
+            "scene vertices",
+            &geometry.vertices.bytes(),
+            vk::BufferUsageFlags::VERTEX_BUFFER,
+        )?;
+        let index_bytes: Vec<u8> = geometry
+            .indices
+            .iter()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
+        let indices = Buffer::device_local(
+            gpu,
+            "scene indices",
+            &index_bytes,
+            vk::BufferUsageFlags::INDEX_BUFFER,
+        )?;
+        let draws =
+            Buffer::device_local(gpu, "scene draws", &geometry.draw_records.bytes(), storage)?;
+        let mut textures = vec![Texture::upload(gpu, "white", &Pixels::white())?];
+        let mut by_source: HashMap<String, usize> = HashMap::new();
+        let mut material_texture = Vec::with_capacity(geometry.materials.len());
+        let mut material_words = Words::default();
+        for m in &geometry.materials {
+            let slot = match &m.textures.base_color {
+                None => 0,
+                Some(t) => {
+                    let key = source_key(&t.source);
+                    match by_source.get(&key) {
+                        Some(&i) => i,
+                        None => {
+                            let i = match texture::decode(&t.source) {
+                                Ok(pixels) => {
+                                    textures.push(Texture::upload(gpu, &key, &pixels)?);
+                                    textures.len() - 1
+                                }
+                                Err(e) => {
+                                    warnings.push(format!("texture left white: {e}"));
+                                    0
+                                }
+                            };
+                            by_source.insert(key, i);
+                            i
+                        }
+                    }
+                }
+            };
+            pack_material(&mut material_words, m, slot != 0);
+            material_texture.push(slot);
+        }
+        let materials =
+            Buffer::device_local(gpu, "scene materials", &material_words.bytes(), storage)?;
+        let frame = Buffer::host(
+            gpu,
+            "frame",
+            FRAME_BYTES as u64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let bounds = scene.effective_bounds();
+        let light_set = pack_lights(
+            &weft_scene::animation::lights_at(&scene.lights, 0.0, 0),
+            &bounds,
+        );
+        let lights = Buffer::host(
+            gpu,
+            "lights",
+            (light_set.len() as usize * LIGHT_BYTES) as u64,
+            storage,
+        )?;
+        let device = gpu.device();
+        let sampler_info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+            .address_mode_u(vk::SamplerAddressMode::REPEAT)
+            .address_mode_v(vk::SamplerAddressMode::REPEAT)
+            .address_mode_w(vk::SamplerAddressMode::REPEAT);
+        let sampler = unsafe { device.create_sampler(&sampler_info, None) }
+            .map_err(vk_err("vkCreateSampler"))?;
+        let mut this = Self {
+            gpu,
+            geometry,
+            vertices,
+            indices,
+            draws,
+            materials,
+            frame,
+            lights,
+            textures,
+            sampler,
+            pool: vk::DescriptorPool::null(),
+            scene_layout: vk::DescriptorSetLayout::null(),
+            material_layout: vk::DescriptorSetLayout::null(),
+            scene_set: vk::DescriptorSet::null(),
+            material_sets: Vec::new(),
+            foreign_sets: HashMap::new(),
+            source_lights: scene.lights.clone(),
+            bounds,
+            light_set,
+            warnings,
+        };
+        this.create_sets(&material_texture)?;
+        Ok(this)
+    }
+
+    fn create_sets(&mut self, material_texture: &[usize]) -> Result<(), GpuError> {
+        let device = self.gpu.device();
+        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+        let scene_bindings: Vec<_> = [
+            (FRAME_BINDING, vk::DescriptorType::UNIFORM_BUFFER),
+            (LIGHTS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
+            (DRAWS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
+            (MATERIALS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
+        ]
+        .iter()
+        .map(|&(b, ty)| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(b)
+                .descriptor_type(ty)
+                .descriptor_count(1)
+                .stage_flags(stages)
+        })
+        .collect();
+        self.scene_layout = unsafe {
+            device.create_descriptor_set_layout(
+                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&scene_bindings),
+                None,
+            )
+        }
+        .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
+        let material_bindings = [vk::DescriptorSetLayoutBinding::default()
+            .binding(0)
+            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+            .descriptor_count(1)
+            .stage_flags(vk::ShaderStageFlags::FRAGMENT)];
+        self.material_layout = unsafe {
+            device.create_descriptor_set_layout(
+                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&material_bindings),
+                None,
+            )
+        }
+        .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
+        let materials = material_texture.len() as u32;
+        let scene_sets = 1 + FOREIGN_SETS;
+        let sizes = [
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::UNIFORM_BUFFER,
+                descriptor_count: scene_sets,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_BUFFER,
+                descriptor_count: 3 * scene_sets,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                descriptor_count: materials.max(1),
+            },
+        ];
+        self.pool = unsafe {
+            device.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(scene_sets + materials)
+                    .pool_sizes(&sizes),
+                None,
+            )
+        }
+        .map_err(vk_err("vkCreateDescriptorPool"))?;
+        self.scene_set = self.allocate(self.scene_layout)?;
+        self.write_scene_set(
+            self.scene_set,
+            &[
+                FRAME_BINDING,
+                LIGHTS_BINDING,
+                DRAWS_BINDING,
+                MATERIALS_BINDING,
+            ],
+        );
+        for &slot in material_texture {
+            let set = self.allocate(self.material_layout)?;
+            let info = [vk::DescriptorImageInfo {
+                sampler: self.sampler,
+                image_view: self.textures[slot].view,
+                image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            }];
+            let write = vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(0)
+                .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                .image_info(&info);
+            unsafe { device.update_descriptor_sets(&[write], &[]) };
+            self.material_sets.push(set);
+        }
+        Ok(())
+    }
+
+    fn allocate(&self, layout: vk::DescriptorSetLayout) -> Result<vk::DescriptorSet, GpuError> {
+        let layouts = [layout];
+        let info = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(self.pool)
+            .set_layouts(&layouts);
+        let sets = unsafe { self.gpu.device().allocate_descriptor_sets(&info) }
+            .map_err(vk_err("vkAllocateDescriptorSets"))?;
+        sets.into_iter().next().ok_or(GpuError::Vulkan {
+            call: "vkAllocateDescriptorSets",
+            result: vk::Result::ERROR_OUT_OF_POOL_MEMORY,
+        })
+    }
+
+    /// Writes the scene buffers into the listed bindings of `set`.
+    fn write_scene_set(&self, set: vk::DescriptorSet, bindings: &[u32]) {
+        let infos: Vec<(u32, vk::DescriptorType, [vk::DescriptorBufferInfo; 1])> = bindings
+            .iter()
+            .filter_map(|&b| {
+                let (buffer, ty) = match b {
+                    FRAME_BINDING => (&self.frame, vk::DescriptorType::UNIFORM_BUFFER),
+                    LIGHTS_BINDING => (&self.lights, vk::DescriptorType::STORAGE_BUFFER),
+                    DRAWS_BINDING => (&self.draws, vk::DescriptorType::STORAGE_BUFFER),
+                    MATERIALS_BINDING => (&self.materials, vk::DescriptorType::STORAGE_BUFFER),
+                    _ => return None,
+                };
+                Some((
+                    b,
+                    ty,
+                    [vk::DescriptorBufferInfo {
+                        buffer: buffer.buffer,
+                        offset: 0,
+                        range: vk::WHOLE_SIZE,
+                    }],
+                ))
+            })
+            .collect();
+        let writes: Vec<_> = infos
+            .iter()
+            .map(|(b, ty, info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(*b)
+                    .descriptor_type(*ty)
+                    .buffer_info(info)
+            })
+            .collect();
+        unsafe { self.gpu.device().update_descriptor_sets(&writes, &[]) };
+    }
+
+    /// Set 1 for a pipeline the executor built: allocated from its reflected layout
+    /// once, with the scene bindings its shaders use (`bindings`).
+    pub fn foreign_set(
+        &mut self,
+        layout: vk::DescriptorSetLayout,
+        bindings: &[u32],
+    ) -> Result<vk::DescriptorSet, GpuError> {
+        if let Some(&set) = self.foreign_sets.get(&layout) {
+            return Ok(set);
+        }
+        let set = self.allocate(layout)?;
+        self.write_scene_set(set, bindings);
+        self.foreign_sets.insert(layout, set);
+        Ok(set)
+    }
+
+    /// Writes the camera and the lights as they are at `time` for a target of `extent`;
+    /// call it before each frame (the previous frame must have finished).
+    pub fn update(&mut self, camera: &Camera, time: f32, extent: [u32; 2]) -> Result<(), GpuError> {
+        let [w, h] = [extent[0].max(1) as f32, extent[1].max(1) as f32];
+        let view_proj = camera::view_projection(camera, time, w / h);
+        let lights = pack_lights(
+            &weft_scene::animation::lights_at(&self.source_lights, time, 0),
+            &self.bounds,
+        );
+        let shadow = lights
+            .sun_direction
+            .map(|d| camera::sun_shadow_matrix(d, &self.bounds))
+            .unwrap_or(Mat4::IDENTITY);
+        let mut words = Words::default();
+        words
+            .mat4(&view_proj)
+            .mat4(&view_proj.inverse())
+            .mat4(&shadow)
+            .vec3w(camera::camera_position(camera, time), 1.0)
+            .vec3w(lights.ambient, 0.0)
+            .u32(lights.suns)
+            .u32(lights.points)
+            .u32(lights.spot_cones + lights.spot_spheres)
+            .u32(lights.len())
+            .f32(w)
+            .f32(h)
+            .f32(1.0 / w)
+            .f32(1.0 / h);
+        self.frame.write(&words.bytes())?;
+        if !lights.is_empty() {
+            self.lights.write(&lights.words.bytes())?;
+        }
+        self.light_set = lights;
+        Ok(())
+    }
+}
+
+fn source_key(source: &TextureSource) -> String {
+    match source {
+        TextureSource::File(p) => PathBuf::from(p).display().to_string(),
+        TextureSource::Embedded { id, .. } => id.clone(),
+    }
+}
+
+impl Drop for GpuScene<'_> {
+    fn drop(&mut self) {
+        let device = self.gpu.device();
+        unsafe {
+            let _ = device.device_wait_idle();
+            device.destroy_descriptor_pool(self.pool, None);
+            device.destroy_descriptor_set_layout(self.scene_layout, None);
+            device.destroy_descriptor_set_layout(self.material_layout, None);
+            device.destroy_sampler(self.sampler, None);
+        }
+    }
+}

@@ -1,0 +1,19 @@
+#version 450
+// Deferred point lights: one light volume per light, blended additively into
+// the HDR buffer; each covered pixel is shaded with that light only.
+layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
+layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
+layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
+layout(set = 0, binding = 3) uniform sampler2D depth;
+#include "include/deferred.glsl"
+
+layout(location = 0) flat in uint light_index;
+layout(location = 0) out vec4 color;
+
+void main() {
+    Surface s;
+    if (!read_surface(s)) {
+        discard;
+    }
+    color = vec4(shade_light(light_index, s), 0.0);
+}

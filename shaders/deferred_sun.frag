@@ -1,0 +1,27 @@
+#version 450
+// Deferred sun pass (fullscreen): ambient, emission and every sun for each
+// covered pixel; background pixels stay black like forward's clear.
+layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
+layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
+layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
+layout(set = 0, binding = 3) uniform sampler2D depth;
+#ifdef HAS_SHADOW_MAP
+layout(set = 0, binding = 4) uniform sampler2D shadow_map;
+#endif
+#include "include/deferred.glsl"
+
+layout(location = 0) in vec2 uv;
+layout(location = 0) out vec4 color;
+
+void main() {
+    Surface s;
+    if (!read_surface(s)) {
+        color = vec4(0.0, 0.0, 0.0, 1.0);
+        return;
+    }
+    vec3 c = shade_ambient_emissive(s);
+    for (uint i = 0u; i < frame.counts.x; ++i) {
+        c += shade_light(i, s);
+    }
+    color = vec4(c, 1.0);
+}

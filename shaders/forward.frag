@@ -1,0 +1,26 @@
+#version 450
+// Forward shading: every light evaluated per pixel with the shared lighting
+// code (include/lighting.glsl), plus ambient and emission, into linear HDR.
+#ifdef HAS_SHADOW_MAP
+layout(set = 0, binding = 0) uniform sampler2D shadow_map;
+#endif
+#include "include/lighting.glsl"
+
+layout(set = 2, binding = 0) uniform sampler2D base_color;
+
+layout(location = 0) in vec3 world;
+layout(location = 1) in vec3 world_normal;
+layout(location = 2) in vec2 texcoord;
+layout(location = 3) flat in uint material;
+
+layout(location = 0) out vec4 color;
+
+void main() {
+    vec3 n = normalize(world_normal);
+    Surface s = Surface(world, gl_FrontFacing ? n : -n, texture(base_color, texcoord).rgb, material);
+    vec3 c = shade_ambient_emissive(s);
+    for (uint i = 0u; i < frame.counts.w; ++i) {
+        c += shade_light(i, s);
+    }
+    color = vec4(c, 1.0);
+}

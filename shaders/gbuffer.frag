@@ -1,0 +1,22 @@
+#version 450
+// Deferred geometry pass: what lighting needs, in the compact encoding of
+// include/gbuffer.glsl (12 bytes per pixel plus depth).
+#include "include/gbuffer.glsl"
+
+layout(set = 2, binding = 0) uniform sampler2D base_color;
+
+layout(location = 0) in vec3 world;
+layout(location = 1) in vec3 world_normal;
+layout(location = 2) in vec2 texcoord;
+layout(location = 3) flat in uint material;
+
+layout(location = 0) out vec4 albedo;
+layout(location = 1) out vec2 normal;
+layout(location = 2) out vec4 material_out;
+
+void main() {
+    vec3 n = normalize(world_normal);
+    albedo = vec4(texture(base_color, texcoord).rgb, 1.0);
+    normal = octahedral_encode(gl_FrontFacing ? n : -n);
+    material_out = encode_material(material);
+}

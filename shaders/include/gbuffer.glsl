@@ -1,0 +1,43 @@
+// The deferred G-buffer encoding (graphs/deferred.ron): albedo = base-colour
+// texture sample (sRGB 8-bit), normal = octahedral in two 16-bit floats,
+// material = material index in r (low byte) and g (high byte); position comes
+// from reverse-Z depth. Shared by gbuffer.frag and the lighting passes.
+#ifndef WEFT_GBUFFER_GLSL
+#define WEFT_GBUFFER_GLSL
+#include "lighting.glsl"
+
+vec2 sign_not_zero(vec2 v) {
+    return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);
+}
+
+// Unit vector to the octahedral square [-1, 1]^2.
+vec2 octahedral_encode(vec3 n) {
+    vec2 p = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
+    return n.z <= 0.0 ? (1.0 - abs(p.yx)) * sign_not_zero(p) : p;
+}
+
+vec3 octahedral_decode(vec2 e) {
+    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+    if (n.z < 0.0) {
+        n.xy = (1.0 - abs(n.yx)) * sign_not_zero(n.xy);
+    }
+    return normalize(n);
+}
+
+vec4 encode_material(uint index) {
+    return vec4(float(index & 255u), float((index >> 8) & 255u), 0.0, 255.0) / 255.0;
+}
+
+uint decode_material(vec4 m) {
+    uvec2 b = uvec2(round(m.rg * 255.0));
+    return b.x | (b.y << 8);
+}
+
+// World position of the pixel at `frag` with reverse-Z `depth`.
+vec3 position_from_depth(vec2 frag, float depth) {
+    vec2 ndc = frag * frame.viewport.zw * 2.0 - 1.0;
+    vec4 p = frame.inv_view_proj * vec4(ndc, depth, 1.0);
+    return p.xyz / p.w;
+}
+
+#endif

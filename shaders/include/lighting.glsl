@@ -1,0 +1,116 @@
+// Shading shared by forward and deferred: material decoding, Blinn-Phong, and
+// sun / point / spot light evaluation with the same cutoffs the light volumes
+// use. Both paths call `shade_light` and `shade_ambient_emissive` with the same
+// inputs, so they cannot drift apart. An includer that defines HAS_SHADOW_MAP
+// must declare `uniform sampler2D shadow_map` before including this file.
+#ifndef WEFT_LIGHTING_GLSL
+#define WEFT_LIGHTING_GLSL
+#include "scene.glsl"
+
+// What shading needs about a surface point.
+struct Surface {
+    vec3 position;   // world
+    vec3 normal;     // unit, facing the viewer
+    vec3 texel;      // base-colour texture sample (white without a texture)
+    uint material;
+};
+
+// Blinn-Phong: Kd * texture * (N.L) + Ks * (N.H)^Ns, times the light's radiance.
+vec3 blinn_phong(Material m, Surface s, vec3 l, vec3 radiance) {
+    float ndl = dot(s.normal, l);
+    if (ndl <= 0.0) {
+        return vec3(0.0);
+    }
+    vec3 v = normalize(frame.camera_position.xyz - s.position);
+    vec3 h = normalize(l + v);
+    float ndh = max(dot(s.normal, h), 0.0);
+    float shininess = m.specular.w;
+    vec3 specular = shininess > 0.0 ? m.specular.rgb * pow(ndh, shininess) : vec3(0.0);
+    return radiance * (m.diffuse.rgb * s.texel * ndl + specular * ndl);
+}
+
+// Distance falloff 1 / (c + l d + q d^2), never above 1 / 1e-4.
+float attenuate(Light light, float d) {
+    vec3 k = light.attenuation_cos.xyz;
+    return 1.0 / max(k.x + k.y * d + k.z * d * d, 1e-4);
+}
+
+#ifdef HAS_SHADOW_MAP
+// Fraction of the first sun's light reaching `p`: 3x3 percentage-closer filtering of
+// the forward-Z shadow map, with the lookup pushed out along the normal by 1.5 texels.
+float sun_visibility(vec3 p, vec3 n) {
+    vec2 size = vec2(textureSize(shadow_map, 0));
+    // The orthographic x scale is 1 / half-width, so one texel spans 2 / (size * scale).
+    float scale = length(vec3(frame.sun_shadow[0][0], frame.sun_shadow[1][0], frame.sun_shadow[2][0]));
+    vec4 c = frame.sun_shadow * vec4(p + n * (3.0 / (size.x * scale)), 1.0);
+    vec3 ndc = c.xyz / c.w;
+    vec2 uv = ndc.xy * 0.5 + 0.5;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || ndc.z > 1.0) {
+        return 1.0;
+    }
+    ivec2 centre = ivec2(uv * size);
+    float lit = 0.0;
+    for (int y = -1; y <= 1; ++y) {
+        for (int x = -1; x <= 1; ++x) {
+            ivec2 t = clamp(centre + ivec2(x, y), ivec2(0), ivec2(size) - 1);
+            lit += ndc.z <= texelFetch(shadow_map, t, 0).r ? 1.0 : 0.0;
+        }
+    }
+    return lit / 9.0;
+}
+#endif
+
+// Radiance arriving at the surface from `light` and the unit direction towards it;
+// zero beyond the light's cutoff range or outside a spot's cone.
+vec3 incoming(Light light, uint index, Surface s, out vec3 l) {
+    float type = light.direction_type.w;
+    if (type == LIGHT_SUN) {
+        l = -light.direction_type.xyz;
+        float visible = 1.0;
+#ifdef HAS_SHADOW_MAP
+        if (index == 0u) {
+            visible = sun_visibility(s.position, s.normal);
+        }
+#endif
+        return light.color_exponent.rgb * visible;
+    }
+    vec3 to_light = light.position_range.xyz - s.position;
+    float d = length(to_light);
+    l = to_light / max(d, 1e-6);
+    float range = light.position_range.w;
+    if (type == LIGHT_POINT) {
+        if (d > range) {
+            return vec3(0.0);
+        }
+        return light.color_exponent.rgb * attenuate(light, d);
+    }
+    // Spot: cut off beyond `range` along the axis and outside the cone.
+    vec3 axis = light.direction_type.xyz;
+    float along = dot(-to_light, axis);
+    float cosine = dot(-l, axis);
+    if (along > range || cosine < light.attenuation_cos.w) {
+        return vec3(0.0);
+    }
+    float spot = light.color_exponent.w > 0.0 ? pow(max(cosine, 0.0), light.color_exponent.w) : 1.0;
+    return light.color_exponent.rgb * spot * attenuate(light, d);
+}
+
+// One light's contribution to the surface.
+vec3 shade_light(uint index, Surface s) {
+    Light light = lights[index];
+    vec3 l;
+    vec3 radiance = incoming(light, index, s, l);
+    if (all(equal(radiance, vec3(0.0)))) {
+        return vec3(0.0);
+    }
+    return blinn_phong(materials[s.material], s, l, radiance);
+}
+
+// What the surface shows without any direct light: the suns' ambient on its
+// ambient reflectance (modulated by the texture), plus its emission.
+vec3 shade_ambient_emissive(Surface s) {
+    Material m = materials[s.material];
+    return frame.ambient.rgb * m.ambient.rgb * s.texel + m.emissive.rgb;
+}
+
+#endif
