@@ -262,3 +262,30 @@ fn image_and_buffer_copies_carry_data_between_passes() {
     drop(gpu);
     assert_eq!(log.messages(), Vec::new());
 }
+
+#[test]
+fn a_pass_without_bindings_renders_its_parameter() {
+    let gpu = common::gpu();
+    let plan = common::compile(&gpu, &common::graph("solid.ron"), 3, 2);
+    let mut renderer = Renderer::new(&gpu).expect("renderer");
+    let report = renderer
+        .render(
+            &plan,
+            &mut NoDraws,
+            1,
+            0.0,
+            &FrameOptions {
+                readback: true,
+                ..FrameOptions::default()
+            },
+        )
+        .expect("frame");
+    let output = report.output.expect("readback");
+    assert_eq!(output.format, "B8G8R8A8_UNORM");
+    // 0.2, 0.4, 0.6 of 255, read back from BGRA and swizzled to RGBA.
+    assert_eq!(output.rgba8_at(2, 1), [51, 102, 153, 255]);
+    drop(renderer);
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}
