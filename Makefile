@@ -11,7 +11,7 @@ build: setup
 
 demo: build
 	@mkdir -p out
-	./target/release/weft graph plan graphs/deferred.ron --size 1920x1080
+	./target/release/weft render scenes/demo.scene --graph graphs/forward.ron --out out/demo.png
 
 lint: setup
 	$(CARGO) fmt --all -- --check

@@ -26,5 +26,9 @@ void main() {
         world = light.position_range.xyz + position * range;
     }
     light_index = gl_InstanceIndex;
-    gl_Position = frame.view_proj * vec4(world, 1.0);
+    vec4 clip = frame.view_proj * vec4(world, 1.0);
+    // Depth clamp by hand: parts of a volume beyond the far plane (reverse-Z depth
+    // below 0) keep their screen footprint at depth 0 instead of being clipped away.
+    clip.z = max(clip.z, 0.0);
+    gl_Position = clip;
 }

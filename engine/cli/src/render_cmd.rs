@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_gpu::{format_timings, Gpu, GpuOptions, TimingMode};
 use weft_graph::plan::Extent;
-use weft_render::{render, RenderSettings};
+use weft_render::{render, RenderSettings, Rendered};
 
 /// Which per-pass times `--timings` measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -139,8 +139,8 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         .iter()
         .map(|p| p.name.as_str())
         .collect();
-    let mean_record_ms =
-        rendered.record_ms.iter().sum::<f64>() / rendered.record_ms.len().max(1) as f64;
+    let record_ms = Rendered::steady_mean(&rendered.record_ms);
+    let frame_ms = Rendered::steady_mean(&rendered.frame_ms);
     if args.json {
         let timings: Vec<_> = rendered
             .report
@@ -160,7 +160,8 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             "culled": rendered.plan.culled.iter().map(|c| &c.name).collect::<Vec<_>>(),
             "output": out,
             "draw_calls": rendered.draw_calls,
-            "record_ms": mean_record_ms,
+            "record_ms": record_ms,
+            "frame_ms": frame_ms,
             "timings": timings,
             "transient_bytes": rendered.report.transient_bytes,
             "device_memory_bytes": rendered.report.memory.allocated_bytes,
@@ -184,8 +185,13 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             passes.join(" -> ")
         );
         println!(
-            "draw calls: {}; host recording + submission: {mean_record_ms:.3} ms per frame",
-            rendered.draw_calls
+            "draw calls: {}; host recording: {record_ms:.3} ms per frame; frame: {frame_ms:.3} ms wall{}",
+            rendered.draw_calls,
+            if rendered.frame_ms.len() > 1 {
+                " (mean after the first frame)"
+            } else {
+                " (one frame, includes pipeline builds)"
+            }
         );
         if !rendered.report.timings.is_empty() {
             print!("{}", format_timings(&rendered.report.timings));

@@ -61,11 +61,27 @@ pub struct Rendered {
     pub camera: String,
     /// Draw calls of the last frame.
     pub draw_calls: u64,
-    /// Host milliseconds per frame spent recording and submitting (the executor's
-    /// `record_ms`), one entry per frame.
+    /// Host milliseconds per frame spent preparing and recording commands (the
+    /// executor's `record_ms`, no GPU wait), one entry per frame.
     pub record_ms: Vec<f64>,
+    /// Wall-clock milliseconds per frame from starting to record to the GPU
+    /// finishing (and the readback, on the last frame), one entry per frame.
+    pub frame_ms: Vec<f64>,
     /// Textures that could not be loaded, meshes skipped.
     pub warnings: Vec<String>,
+}
+
+impl Rendered {
+    /// Mean of `values` after the first entry (the first frame compiles shaders and
+    /// builds pipelines), or the only entry.
+    pub fn steady_mean(values: &[f64]) -> f64 {
+        let steady = if values.len() > 1 {
+            &values[1..]
+        } else {
+            values
+        };
+        steady.iter().sum::<f64>() / steady.len().max(1) as f64
+    }
 }
 
 /// Compiles `settings.graph` for `scene` on `gpu`'s memory requirements.
@@ -117,6 +133,7 @@ pub fn render(
     let mut resources = renderer.create_resources(&plan)?;
     let frames = settings.frames.max(1);
     let mut record_ms = Vec::with_capacity(frames as usize);
+    let mut frame_ms = Vec::with_capacity(frames as usize);
     let mut last = None;
     for frame in 0..frames {
         let time = settings.time + frame as f32 * settings.frame_time;
@@ -126,6 +143,7 @@ pub fn render(
             [settings.extent.width, settings.extent.height],
         )?;
         recorder.set_frame(time, frame);
+        let started = std::time::Instant::now();
         let report = renderer.execute(
             &plan,
             &mut resources,
@@ -137,6 +155,7 @@ pub fn render(
                 frame,
             },
         )?;
+        frame_ms.push(started.elapsed().as_secs_f64() * 1e3);
         record_ms.push(report.record_ms);
         last = Some(report);
     }
@@ -152,6 +171,7 @@ pub fn render(
         camera: camera.name.clone(),
         draw_calls,
         record_ms,
+        frame_ms,
         warnings,
     })
 }

@@ -1,0 +1,109 @@
+//! Helpers shared by the render tests: scenes rendered through shipped graphs on
+//! a validating context, and image agreement measured in 8-bit units.
+// Each test crate compiles this module and uses only part of it.
+#![allow(dead_code)]
+
+use image::RgbaImage;
+use std::path::{Path, PathBuf};
+use weft_gpu::{Gpu, GpuOptions, ValidationMessage};
+use weft_graph::plan::Extent;
+use weft_render::{render, RenderSettings};
+
+/// The repository root.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The project's demo scene.
+pub fn demo_scene() -> PathBuf {
+    root().join("scenes/demo.scene")
+}
+
+/// The 15-462 `cube.scene`, read in place from the shared assets.
+pub fn cube_scene() -> PathBuf {
+    root().join("../shared/assets/462/scenes/cube.scene")
+}
+
+/// A shipped graph.
+pub fn graph(name: &str) -> PathBuf {
+    root().join("graphs").join(name)
+}
+
+/// What one validated render produced.
+pub struct Output {
+    pub image: RgbaImage,
+    /// Every validation message, creation and destruction included.
+    pub messages: Vec<ValidationMessage>,
+    /// Passes that ran, in order.
+    pub passes: Vec<String>,
+    pub draw_calls: u64,
+}
+
+/// Renders `scene` through `graph` at `width`x`height` with validation and
+/// synchronization validation on.
+pub fn render_validated(
+    scene: &Path,
+    graph: &Path,
+    width: u32,
+    height: u32,
+    features: &[&str],
+) -> Output {
+    let scene = weft_scene::load_scene(scene).expect("scene loads");
+    let gpu = Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("a Vulkan 1.3 device with the validation layer (run tools/setup)");
+    let log = gpu.validation();
+    let settings = RenderSettings {
+        graph: graph.to_path_buf(),
+        extent: Extent { width, height },
+        features: features.iter().map(|f| f.to_string()).collect(),
+        ..RenderSettings::default()
+    };
+    let rendered = match render(&gpu, &scene, &settings) {
+        Ok(r) => r,
+        Err(e) => panic!("render failed: {e}"),
+    };
+    drop(gpu);
+    Output {
+        image: rendered.report.output.expect("readback").to_rgba8(),
+        messages: log.messages(),
+        passes: rendered
+            .plan
+            .passes
+            .iter()
+            .map(|p| p.name.clone())
+            .collect(),
+        draw_calls: rendered.draw_calls,
+    }
+}
+
+/// Agreement of two images over their RGB channels, in 8-bit units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Agreement {
+    pub mean: f64,
+    pub p99: u8,
+    pub max: u8,
+}
+
+/// Mean, 99th percentile and maximum of the absolute RGB channel differences.
+pub fn agreement(a: &RgbaImage, b: &RgbaImage) -> Agreement {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let mut diffs: Vec<u8> = a
+        .pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..3).map(move |c| p.0[c].abs_diff(q.0[c])))
+        .collect();
+    diffs.sort_unstable();
+    let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len().max(1) as f64;
+    let p99 = diffs
+        .get((diffs.len() * 99).div_ceil(100).saturating_sub(1))
+        .copied()
+        .unwrap_or(0);
+    Agreement {
+        mean,
+        p99,
+        max: diffs.last().copied().unwrap_or(0),
+    }
+}
