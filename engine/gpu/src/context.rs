@@ -324,7 +324,7 @@ impl Drop for Gpu {
 }
 
 /// Device memory figures from the allocator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub struct MemoryReport {
     /// Bytes in live allocations (aliased transient blocks count once).
     pub allocated_bytes: u64,

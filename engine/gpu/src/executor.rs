@@ -37,12 +37,13 @@ pub struct FrameOptions {
     pub frame: u32,
 }
 
-/// What a frame produced.
-#[derive(Debug, Clone, PartialEq)]
+/// What a frame produced; serialises (without the image) for `--json`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct FrameReport {
     /// Per-pass times, labelled with how they were measured.
     pub timings: Vec<PassTiming>,
     /// The output image, when `readback` was asked for.
+    #[serde(skip)]
     pub output: Option<Readback>,
     /// Host time spent preparing and recording commands (excluding GPU waits).
     pub record_ms: f64,

@@ -22,7 +22,7 @@ pub enum TimingMode {
 }
 
 /// What a timing figure measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum TimingSource {
     /// Difference of GPU timestamps around the pass.
     GpuTimestamp,
@@ -31,7 +31,7 @@ pub enum TimingSource {
 }
 
 /// The time one pass took.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct PassTiming {
     /// The pass name.
     pub pass: String,

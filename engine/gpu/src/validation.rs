@@ -28,7 +28,7 @@ pub struct ValidationMessage {
 }
 
 /// Counts of messages by severity.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct ValidationCounts {
     /// Errors, including synchronization hazards.
     pub errors: usize,

@@ -28,7 +28,7 @@ fn fullscreen_compute_blit_graph_renders_exact_pixels() {
             },
         )
         .expect("frame");
-    let output = report.output.expect("readback");
+    let output = report.output.as_ref().expect("readback");
     assert_eq!((output.width, output.height), (8, 8));
     for y in 0..8 {
         for x in 0..8 {
@@ -36,6 +36,24 @@ fn fullscreen_compute_blit_graph_renders_exact_pixels() {
         }
     }
     assert_eq!(report.transient_bytes, plan.memory.transient_bytes);
+    let json = serde_json::to_value(&report).expect("serialises");
+    let keys: Vec<&str> = json
+        .as_object()
+        .expect("object")
+        .keys()
+        .map(String::as_str)
+        .collect();
+    assert_eq!(
+        keys,
+        vec![
+            "dedicated_bytes",
+            "memory",
+            "record_ms",
+            "timings",
+            "transient_bytes"
+        ]
+    );
+    assert_eq!(json["transient_bytes"], plan.memory.transient_bytes);
     drop(resources);
     drop(renderer);
     let log = gpu.validation();
