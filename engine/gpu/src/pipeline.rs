@@ -246,34 +246,14 @@ fn build_layout(
     let mut set_layouts = Vec::new();
     let result = (|| {
         for set in 0..interface.set_count() {
-            let bindings: Vec<_> = interface
-                .bindings
-                .iter()
-                .filter(|((s, _), _)| *s == set)
-                .map(|(_, (b, stages))| {
-                    vk::DescriptorSetLayoutBinding::default()
-                        .binding(b.binding)
-                        .descriptor_type(b.kind.vk())
-                        .descriptor_count(b.count)
-                        .stage_flags(*stages)
-                })
-                .collect();
+            let bindings = interface.set_layout_bindings(set);
             let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
             set_layouts.push(
                 unsafe { device.create_descriptor_set_layout(&info, None) }
                     .call("vkCreateDescriptorSetLayout")?,
             );
         }
-        let ranges: Vec<_> = interface
-            .push
-            .iter()
-            .map(|(block, stages)| {
-                vk::PushConstantRange::default()
-                    .stage_flags(*stages)
-                    .offset(0)
-                    .size(block.size)
-            })
-            .collect();
+        let ranges = interface.push_constant_ranges();
         let info = vk::PipelineLayoutCreateInfo::default()
             .set_layouts(&set_layouts)
             .push_constant_ranges(&ranges);

@@ -295,7 +295,36 @@ impl PipelineInterface {
         Ok(merged)
     }
 
-    /// The descriptor set numbers used, highest first set included.
+    /// The `VkDescriptorSetLayoutBinding`s of one set, each visible to the
+    /// stages that declare it.
+    pub fn set_layout_bindings(&self, set: u32) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
+        self.bindings
+            .iter()
+            .filter(|((s, _), _)| *s == set)
+            .map(|(_, (b, stages))| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(b.binding)
+                    .descriptor_type(b.kind.vk())
+                    .descriptor_count(b.count)
+                    .stage_flags(*stages)
+            })
+            .collect()
+    }
+
+    /// The push-constant range (one, from offset 0, for every stage using the block).
+    pub fn push_constant_ranges(&self) -> Vec<vk::PushConstantRange> {
+        self.push
+            .iter()
+            .map(|(block, stages)| {
+                vk::PushConstantRange::default()
+                    .stage_flags(*stages)
+                    .offset(0)
+                    .size(block.size)
+            })
+            .collect()
+    }
+
+    /// The number of descriptor set layouts a pipeline needs (highest set + 1).
     pub fn set_count(&self) -> u32 {
         self.bindings.keys().map(|(s, _)| s + 1).max().unwrap_or(0)
     }

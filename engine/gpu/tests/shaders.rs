@@ -158,3 +158,61 @@ fn reflects_vulkan_1_3_compute_storage() {
     assert_eq!(push.members[0].scalar, ScalarKind::Uint);
     assert_eq!(push.members[0].components, 2);
 }
+
+#[test]
+fn merged_stages_give_set_layout_bindings_and_push_ranges() {
+    use ash::vk;
+    let vs = compiler()
+        .compile_file(&dir().join("shared.vert"), ShaderStage::Vertex, &[])
+        .expect("vertex compiles");
+    let fs = compiler()
+        .compile_file(&dir().join("tint.frag"), ShaderStage::Fragment, &[])
+        .expect("fragment compiles");
+    let vi = ShaderInterface::reflect(&vs).expect("reflects");
+    let fi = ShaderInterface::reflect(&fs).expect("reflects");
+    let merged = PipelineInterface::merge(&[&vi, &fi]).expect("merges");
+    let bindings: Vec<(u32, vk::DescriptorType, u32, vk::ShaderStageFlags)> = merged
+        .set_layout_bindings(0)
+        .iter()
+        .map(|b| {
+            (
+                b.binding,
+                b.descriptor_type,
+                b.descriptor_count,
+                b.stage_flags,
+            )
+        })
+        .collect();
+    assert_eq!(
+        bindings,
+        vec![
+            (
+                0,
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                1,
+                vk::ShaderStageFlags::FRAGMENT
+            ),
+            (
+                1,
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                1,
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT
+            ),
+        ]
+    );
+    let ranges: Vec<(vk::ShaderStageFlags, u32, u32)> = merged
+        .push_constant_ranges()
+        .iter()
+        .map(|r| (r.stage_flags, r.offset, r.size))
+        .collect();
+    assert_eq!(
+        ranges,
+        vec![(
+            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+            0,
+            24
+        )]
+    );
+    assert_eq!(merged.set_count(), 1);
+    assert!(merged.set_layout_bindings(1).is_empty());
+}
