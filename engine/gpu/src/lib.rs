@@ -2,15 +2,16 @@
 //! shader compilation and reflection, and the executor that runs a `Plan`.
 
 #![warn(missing_docs)]
+
 pub mod bind;
 pub mod check;
 pub mod context;
 pub mod convert;
-pub mod download;
+mod download;
 pub mod draw;
 pub mod error;
 pub mod executor;
-pub mod frame;
+mod frame;
 pub mod golden;
 pub mod layouts;
 pub mod pipeline;
