@@ -218,9 +218,6 @@ fn forward_bloom_matches_its_golden_image() {
     if let Err(e) = weft_gpu::check_golden(&image, &golden, &tolerance) {
         panic!("{e}");
     }
-    // The square saturates towards white; bloom lifts pixels well outside it.
-    assert_eq!(image.get_pixel(32, 18).0[3], 255);
-    assert!(image.get_pixel(32, 8).0[0] > image.get_pixel(2, 2).0[0]);
     drop(renderer);
     let log = gpu.validation();
     drop(gpu);
