@@ -111,6 +111,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         record_ms / f64::from(frames.max(1))
     );
     println!("\n{}", format_timings(&gpu_report.timings));
+    for s in &gpu_report.statistics {
+        println!(
+            "{:<14} primitives {:>8}  vertices {:>8}  fragments {:>10}  compute {:>8}",
+            s.pass,
+            s.input_primitives,
+            s.vertex_invocations,
+            s.fragment_invocations,
+            s.compute_invocations
+        );
+    }
+    println!();
     println!("{}", format_timings(&cpu_report.timings));
     println!(
         "device memory: transient blocks {} bytes (plan: {} aliased, {} unaliased), dedicated {} bytes, allocator total {} bytes",

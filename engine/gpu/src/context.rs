@@ -33,6 +33,8 @@ pub struct DeviceInfo {
     pub timestamp_period: f32,
     /// Whether the graphics queue writes timestamps.
     pub timestamps: bool,
+    /// Whether pipeline-statistics queries are available (and enabled).
+    pub pipeline_statistics: bool,
 }
 
 /// The physical device type, in preference order.
@@ -96,7 +98,12 @@ impl Gpu {
         }
         let (physical, info, queue_family) =
             choose_device(guard.instance()?, options.device.as_deref())?;
-        let device = create_device(guard.instance()?, physical, queue_family)?;
+        let device = create_device(
+            guard.instance()?,
+            physical,
+            queue_family,
+            info.pipeline_statistics,
+        )?;
         let (instance, debug) = guard.release()?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let pool_info = vk::CommandPoolCreateInfo::default()
@@ -468,6 +475,7 @@ fn choose_device(
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
         let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
         unsafe { instance.get_physical_device_features2(physical, &mut f2) };
+        let f2 = f2.features;
         if f13.synchronization2 == vk::FALSE || f13.maintenance4 == vk::FALSE {
             continue;
         }
@@ -476,6 +484,7 @@ fn choose_device(
             kind: DeviceKind::from_vk(props.device_type),
             timestamp_period: props.limits.timestamp_period,
             timestamps: props_family.timestamp_valid_bits > 0,
+            pipeline_statistics: f2.pipeline_statistics_query == vk::TRUE,
         };
         candidates.push((physical, info, family as u32));
     }
@@ -497,6 +506,7 @@ fn create_device(
     instance: &ash::Instance,
     physical: vk::PhysicalDevice,
     family: u32,
+    pipeline_statistics: bool,
 ) -> Result<ash::Device, GpuError> {
     let priorities = [1.0];
     let queues = [vk::DeviceQueueCreateInfo::default()
@@ -505,7 +515,10 @@ fn create_device(
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .synchronization2(true)
         .maintenance4(true);
-    let mut features = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+    let core = vk::PhysicalDeviceFeatures::default().pipeline_statistics_query(pipeline_statistics);
+    let mut features = vk::PhysicalDeviceFeatures2::default()
+        .features(core)
+        .push_next(&mut f13);
     let info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)
         .push_next(&mut features);

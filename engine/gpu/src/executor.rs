@@ -17,6 +17,7 @@ use crate::record;
 use crate::renderpass::RenderPassCache;
 use crate::resources::{FrameResources, GpuResource};
 use crate::samplers::Samplers;
+use crate::statistics::{PassStatistics, StatisticsPool};
 use crate::timing::{PassTiming, QueryPool, TimingMode, TimingSource};
 use ash::vk;
 use std::sync::Arc;
@@ -42,6 +43,8 @@ pub struct FrameOptions {
 pub struct FrameReport {
     /// Per-pass times, labelled with how they were measured.
     pub timings: Vec<PassTiming>,
+    /// Per-pass pipeline statistics, collected with GPU timestamps.
+    pub statistics: Vec<PassStatistics>,
     /// The output image, when `readback` was asked for.
     #[serde(skip)]
     pub output: Option<Readback>,
@@ -213,6 +216,12 @@ impl<'g> Renderer<'g> {
         } else {
             None
         };
+        let stats =
+            if options.timing == TimingMode::GpuTimestamps && self.gpu.info().pipeline_statistics {
+                Some(StatisticsPool::new(self.gpu, plan.passes.len() as u32)?)
+            } else {
+                None
+            };
         let mut record_ms = started.elapsed().as_secs_f64() * 1e3;
         let mut timings = Vec::new();
         let per_pass = options.timing == TimingMode::CpuPerPass;
@@ -225,6 +234,9 @@ impl<'g> Renderer<'g> {
                     .cmd_reset_query_pool(cmd, q.pool, 0, q.count)
             };
         }
+        if let Some(s) = &stats {
+            s.reset(cmd);
+        }
         for (i, pass) in plan.passes.iter().enumerate() {
             let t = Instant::now();
             if let Some(q) = &queries {
@@ -235,7 +247,13 @@ impl<'g> Renderer<'g> {
                     vk::PipelineStageFlags2::TOP_OF_PIPE,
                 );
             }
+            if let Some(s) = &stats {
+                s.begin(cmd, i as u32);
+            }
             self.record_pass(plan, i, pass, &prepared[i], resources, draws, cmd)?;
+            if let Some(s) = &stats {
+                s.end(cmd, i as u32);
+            }
             if let Some(q) = &queries {
                 q.write(
                     self.gpu,
@@ -267,11 +285,16 @@ impl<'g> Renderer<'g> {
         if let Some(q) = &queries {
             timings = q.timings(self.gpu, plan)?;
         }
+        let statistics = match &stats {
+            Some(s) => s.read(plan)?,
+            None => Vec::new(),
+        };
         let output = readback.as_ref().map(|rb| rb.read(plan)).transpose()?;
         drop(buffers);
         drop(pool);
         Ok(FrameReport {
             timings,
+            statistics,
             output,
             record_ms,
             transient_bytes: resources.transient_bytes,

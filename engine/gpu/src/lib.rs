@@ -22,6 +22,7 @@ pub mod renderpass;
 pub mod resources;
 pub mod samplers;
 pub mod shader;
+pub mod statistics;
 pub mod timing;
 pub mod validation;
 
@@ -34,5 +35,6 @@ pub use golden::{check_golden, Comparison, GoldenError, Tolerance};
 pub use readback::{Pixels, Readback};
 pub use resources::{image_requirements, memory_requirements, FrameResources};
 pub use shader::{CompiledShader, ShaderCompiler, ShaderDiagnostic, ShaderError, ShaderStage};
+pub use statistics::PassStatistics;
 pub use timing::{format_timings, PassTiming, TimingMode, TimingSource};
 pub use validation::{Severity, ValidationCounts, ValidationLog, ValidationMessage};

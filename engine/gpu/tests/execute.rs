@@ -49,6 +49,7 @@ fn fullscreen_compute_blit_graph_renders_exact_pixels() {
             "dedicated_bytes",
             "memory",
             "record_ms",
+            "statistics",
             "timings",
             "transient_bytes"
         ]
@@ -130,6 +131,33 @@ fn renders_several_frames_with_cached_pipelines_and_timings() {
         match timing {
             TimingMode::Off => assert!(names.is_empty()),
             _ => assert_eq!(names, vec!["fill", "shrink", "invert", "combine"]),
+        }
+        if timing == TimingMode::GpuTimestamps {
+            // Counts the API defines exactly (fragment and clipping counts
+            // depend on the rasteriser): (primitives, vertices, compute invocations).
+            let counts: Vec<(&str, u64, u64, u64)> = report
+                .statistics
+                .iter()
+                .map(|s| {
+                    (
+                        s.pass.as_str(),
+                        s.input_primitives,
+                        s.vertex_invocations,
+                        s.compute_invocations,
+                    )
+                })
+                .collect();
+            assert_eq!(
+                counts,
+                vec![
+                    ("fill", 1, 3, 0),
+                    ("shrink", 0, 0, 0),
+                    ("invert", 0, 0, 64),
+                    ("combine", 1, 3, 0)
+                ]
+            );
+        } else {
+            assert!(report.statistics.is_empty());
         }
         let expected_source = match timing {
             TimingMode::CpuPerPass => Some(TimingSource::CpuWall),
