@@ -17,6 +17,6 @@ layout(location = 2) out vec4 material_out;
 void main() {
     vec3 n = normalize(world_normal);
     albedo = vec4(texture(base_color, texcoord).rgb, 1.0);
-    normal = octahedral_encode(gl_FrontFacing ? n : -n);
+    normal = octahedral_encode_half(gl_FrontFacing ? n : -n);
     material_out = encode_material(material);
 }

@@ -1,7 +1,8 @@
 // The deferred G-buffer encoding (graphs/deferred.ron): albedo = base-colour
-// texture sample (sRGB 8-bit), normal = octahedral in two 16-bit floats,
-// material = material index in r (low byte) and g (high byte); position comes
-// from reverse-Z depth. Shared by gbuffer.frag and the lighting passes.
+// texture sample (sRGB 8-bit), normal = octahedral in two 16-bit floats (the
+// closest half-float pair), material = material index in r (low byte) and g
+// (high byte); position comes from reverse-Z depth. Shared by gbuffer.frag and
+// the lighting passes.
 #ifndef WEFT_GBUFFER_GLSL
 #define WEFT_GBUFFER_GLSL
 #include "lighting.glsl"
@@ -22,6 +23,31 @@ vec3 octahedral_decode(vec2 e) {
         n.xy = (1.0 - abs(n.yx)) * sign_not_zero(n.xy);
     }
     return normalize(n);
+}
+
+// The half-float pair closest in angle to `n`: the rounded encoding and its
+// neighbours one half-float step either way on each axis are decoded and the
+// best kept, which roughly halves the worst quantization error.
+vec2 octahedral_encode_half(vec3 n) {
+    uint rounded = packHalf2x16(octahedral_encode(n));
+    vec2 best = unpackHalf2x16(rounded);
+    float best_dot = dot(octahedral_decode(best), n);
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            uint x = uint(int(rounded & 0xFFFFu) + dx) & 0xFFFFu;
+            uint y = uint(int(rounded >> 16) + dy) & 0xFFFFu;
+            vec2 candidate = unpackHalf2x16(x | (y << 16));
+            if (any(isnan(candidate)) || any(isinf(candidate))) {
+                continue;
+            }
+            float d = dot(octahedral_decode(candidate), n);
+            if (d > best_dot) {
+                best_dot = d;
+                best = candidate;
+            }
+        }
+    }
+    return best;
 }
 
 vec4 encode_material(uint index) {

@@ -10,6 +10,7 @@ use weft_gpu::{Gpu, GpuError};
 /// A buffer and its memory, freed on drop.
 pub struct Buffer<'g> {
     gpu: &'g Gpu,
+    /// The Vulkan buffer, for binding and copies.
     pub buffer: vk::Buffer,
     allocation: Option<Allocation>,
     /// Size in bytes.

@@ -14,10 +14,20 @@ pub enum RenderError {
     Graph(Vec<weft_graph::Diagnostic>),
     /// No scene camera has the requested name.
     #[error("no camera named \"{name}\"; the scene has: {available}")]
-    Camera { name: String, available: String },
+    Camera {
+        /// The name asked for.
+        name: String,
+        /// The scene's camera names, comma-separated.
+        available: String,
+    },
     /// A texture could not be read or decoded (the material falls back to white).
     #[error("{}: {message}", path.display())]
-    Texture { path: PathBuf, message: String },
+    Texture {
+        /// The file, or the embedded image's id.
+        path: PathBuf,
+        /// What the decoder said.
+        message: String,
+    },
     /// The scene has more of something than the GPU layouts can index.
     #[error("scene too large: {0}")]
     TooLarge(String),

@@ -17,6 +17,7 @@ use weft_scene::Scene;
 pub struct RenderSettings {
     /// The graph file.
     pub graph: PathBuf,
+    /// Output size in pixels.
     pub extent: Extent,
     /// Frames to run; the last one is reported.
     pub frames: u32,
@@ -28,6 +29,7 @@ pub struct RenderSettings {
     pub camera: Option<String>,
     /// Toggles as on the command line (`name`, `!name`), applied after scene features.
     pub features: Vec<String>,
+    /// How per-pass times are measured.
     pub timing: TimingMode,
     /// Copy the output back.
     pub readback: bool,
@@ -54,6 +56,7 @@ impl Default for RenderSettings {
 
 /// What a render produced.
 pub struct Rendered {
+    /// The compiled plan that ran.
     pub plan: Plan,
     /// The last frame's report (output, timings, memory).
     pub report: FrameReport,

@@ -18,8 +18,11 @@ pub const DRAW_BYTES: usize = 144;
 /// Where a mesh lies in the shared arrays.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct MeshRange {
+    /// First index in the shared index buffer.
     pub first_index: u32,
+    /// Number of indices (three per triangle).
     pub index_count: u32,
+    /// Added to every index: where the mesh's vertices start.
     pub vertex_offset: i32,
 }
 
@@ -27,8 +30,11 @@ pub struct MeshRange {
 /// `firstInstance`), and its material (index into the scene's material list).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DrawItem {
+    /// The mesh's indices and vertices.
     pub range: MeshRange,
+    /// Index of its draw record, passed as `firstInstance`.
     pub draw_id: u32,
+    /// Index into [`SceneGeometry::materials`].
     pub material: u32,
 }
 
@@ -37,6 +43,7 @@ pub struct DrawItem {
 pub struct SceneGeometry {
     /// `VERTEX_BYTES` per vertex.
     pub vertices: Words,
+    /// Triangle corners of every mesh, each range relative to its vertex offset.
     pub indices: Vec<u32>,
     /// Draw records (model matrix, normal matrix, material).
     pub draw_records: Words,
@@ -44,7 +51,9 @@ pub struct SceneGeometry {
     pub draws: Vec<DrawItem>,
     /// Every material, index 0 being the default for meshes without one.
     pub materials: Vec<Material>,
+    /// The point-light volume (see [`crate::volumes::sphere`]).
     pub sphere: MeshRange,
+    /// The spot-light volume (see [`crate::volumes::cone`]).
     pub cone: MeshRange,
     /// Meshes left out because their arrays disagree, as `model file: mesh name`.
     pub skipped: Vec<String>,

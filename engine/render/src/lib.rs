@@ -7,6 +7,8 @@
 //! passes; [`render`] runs a graph over a scene for some frames. The GLSL side
 //! of every layout here is `shaders/include/scene.glsl`.
 
+#![warn(missing_docs)]
+
 pub mod buffer;
 pub mod camera;
 pub mod error;

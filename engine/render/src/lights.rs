@@ -26,9 +26,13 @@ pub const CONE_MAX_ANGLE: f32 = 70.0;
 pub struct LightSet {
     /// Records in order: suns, points, spot cones, spot spheres.
     pub words: Words,
+    /// Number of suns.
     pub suns: u32,
+    /// Number of point lights.
     pub points: u32,
+    /// Number of spots drawn with cone volumes.
     pub spot_cones: u32,
+    /// Number of spots too wide for a cone, drawn with sphere volumes.
     pub spot_spheres: u32,
     /// Sum of the suns' ambient terms.
     pub ambient: Vec3,

@@ -18,9 +18,13 @@ pub const MATERIAL_SET: u32 = 2;
 /// Identifies a scene pipeline.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct ScenePipelineKey {
+    /// The vertex shader variant.
     pub vertex: ShaderKey,
+    /// The fragment shader variant; `None` for depth-only passes.
     pub fragment: Option<ShaderKey>,
+    /// The render pass it must be compatible with.
     pub render_pass: vk::RenderPass,
+    /// Depth, culling, blending and bias.
     pub state: PassState,
     /// Whether the vertex shader reads only the position (location 0): depth-only
     /// passes and light volumes; mesh shading reads normal and UV too.
@@ -29,7 +33,9 @@ pub struct ScenePipelineKey {
 
 /// A built scene pipeline.
 pub struct ScenePipeline {
+    /// The graphics pipeline.
     pub pipeline: vk::Pipeline,
+    /// Its layout: graph set, scene set, material set and push constants.
     pub layout: vk::PipelineLayout,
     /// Set 0: the graph resources the pass samples (may be empty).
     pub graph_layout: vk::DescriptorSetLayout,

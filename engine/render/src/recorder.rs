@@ -23,6 +23,7 @@ fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
 /// Draws a [`GpuScene`] into the scene passes of any plan.
 pub struct SceneRecorder<'g> {
     gpu: &'g Gpu,
+    /// The uploaded scene; update it before each frame.
     pub scene: GpuScene<'g>,
     pipelines: ScenePipelines,
     pool: vk::DescriptorPool,

@@ -38,8 +38,11 @@ fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
 /// Everything the scene shaders read, on the device.
 pub struct GpuScene<'g> {
     gpu: &'g Gpu,
+    /// The flattened scene the buffers were filled from.
     pub geometry: SceneGeometry,
+    /// Every vertex ([`crate::geometry::VERTEX_BYTES`] each).
     pub vertices: Buffer<'g>,
+    /// Every index, `u32`.
     pub indices: Buffer<'g>,
     draws: Buffer<'g>,
     materials: Buffer<'g>,

@@ -12,9 +12,15 @@ pub enum DepthTest {
     /// No depth attachment.
     Off,
     /// Nearer is greater (reverse-Z, cleared to 0).
-    Greater { write: bool },
+    Greater {
+        /// Whether depth is written.
+        write: bool,
+    },
     /// Nearer is smaller (forward Z, cleared to 1: shadow maps).
-    Less { write: bool },
+    Less {
+        /// Whether depth is written.
+        write: bool,
+    },
     /// Only where depth equals what a pre-pass laid down.
     Equal,
     /// Light volumes: back faces that lie behind the surface (reverse-Z `<=`).
@@ -24,6 +30,7 @@ pub enum DepthTest {
 /// Which faces are culled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Cull {
+    /// Both faces drawn: meshes may be open or one-sided (shading flips back faces).
     None,
     /// Front faces: light volumes draw their back faces so the camera may be inside.
     Front,
@@ -32,13 +39,16 @@ pub enum Cull {
 /// Everything about a scene pass's pipeline that is not its shaders.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct PassState {
+    /// Depth test and write.
     pub depth: DepthTest,
+    /// Face culling.
     pub cull: Cull,
     /// Blend per colour attachment.
     pub blends: Vec<BlendCode>,
     /// Constant and slope-scaled depth bias, as `f32` bits, from the pass's
     /// `depth_bias` and `slope_bias` parameters.
     pub depth_bias: Option<(u32, u32)>,
+    /// Samples per pixel of the attachments.
     pub samples: u32,
 }
 

@@ -13,8 +13,11 @@ use weft_scene::material::TextureSource;
 /// Decoded RGBA8 pixels, top row first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pixels {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
+    /// Four bytes per texel, rows top to bottom.
     pub rgba: Vec<u8>,
 }
 
@@ -51,7 +54,9 @@ pub fn decode(source: &TextureSource) -> Result<Pixels, RenderError> {
 /// A sampled image on the device, destroyed on drop.
 pub struct Texture<'g> {
     gpu: &'g Gpu,
+    /// The image.
     pub image: vk::Image,
+    /// A 2D colour view for sampling.
     pub view: vk::ImageView,
     allocation: Option<Allocation>,
 }

@@ -10,7 +10,9 @@ const CONE_SEGMENTS: u32 = 24;
 /// A triangle list with outward-facing, counter-clockwise triangles.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VolumeMesh {
+    /// Vertex positions.
     pub positions: Vec<Vec3>,
+    /// Three indices per triangle.
     pub indices: Vec<u32>,
 }
 
