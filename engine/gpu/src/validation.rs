@@ -27,6 +27,17 @@ pub struct ValidationMessage {
     pub text: String,
 }
 
+impl std::fmt::Display for ValidationMessage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let kind = match self.severity {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+            Severity::Performance => "performance warning",
+        };
+        write!(f, "validation {kind} {}: {}", self.id, self.text)
+    }
+}
+
 /// Counts of messages by severity.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct ValidationCounts {
@@ -214,6 +225,10 @@ mod tests {
         assert_eq!(
             counts.to_string(),
             "1 error, 0 warnings, 2 performance warnings"
+        );
+        assert_eq!(
+            log.messages()[1].to_string(),
+            "validation performance warning id: t"
         );
         assert_eq!(log.take().len(), 3);
         assert!(log.counts().is_clean());
