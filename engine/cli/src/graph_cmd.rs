@@ -45,9 +45,13 @@ pub struct Target {
     /// Features on (comma-separated); `!name` turns off a graph default.
     #[arg(long, value_delimiter = ',')]
     features: Vec<String>,
-    /// Light count for buffer size expressions.
+    /// Light count for buffer size expressions (a `--scene` supplies its own).
     #[arg(long, default_value_t = 1)]
     lights: u32,
+    /// Take features (spot_lights, shadow_casters, ...) and the light count from a scene,
+    /// so the plan shows what this scene culls and why.
+    #[arg(long)]
+    scene: Option<PathBuf>,
 }
 
 fn parse_size(text: &str) -> Result<Extent, String> {
@@ -108,10 +112,25 @@ fn print_diagnostics(diags: &[Diagnostic]) {
 
 fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Plan, f64)> {
     let graph = weft_graph::load(file);
+    let mut requested = Vec::new();
+    let mut lights = target.lights;
+    if let Some(path) = &target.scene {
+        let scene = weft_scene::load_scene(path)
+            .with_context(|| format!("loading scene {}", path.display()))?;
+        let from_scene = weft_render::scene_features(&scene);
+        eprintln!(
+            "scene {}: features [{}]",
+            path.display(),
+            from_scene.join(", ")
+        );
+        requested.extend(from_scene);
+        lights = u32::try_from(scene.lights.len()).unwrap_or(u32::MAX);
+    }
+    requested.extend(target.features.iter().cloned());
     let options = CompileOptions {
         extent: target.size,
-        features: graph.features(&target.features),
-        lights: target.lights,
+        features: graph.features(&requested),
+        lights,
         ..CompileOptions::default()
     };
     let start = Instant::now();

@@ -191,3 +191,30 @@ fn check_shaders_locates_a_mismatch_at_the_pass() {
     );
     assert!(first.contains("albedo"), "{stderr}");
 }
+
+#[test]
+fn plan_with_a_scene_culls_what_the_scene_lacks() {
+    let out = weft(&[
+        "graph",
+        "plan",
+        "graphs/deferred.ron",
+        "--scene",
+        "../shared/assets/462/scenes/dragon.scene",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("dragon.scene: features [shadow_casters]"),
+        "{stderr}"
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("culled:\n  point_lights: enabled_if [point_lights] is false\n  spot_lights: enabled_if [spot_lights] is false\n"),
+        "{text}"
+    );
+    assert!(text.contains("  0. shadow_sun (Raster)"), "{text}");
+}
