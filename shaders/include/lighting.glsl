@@ -68,7 +68,8 @@ vec3 incoming(Light light, uint index, Surface s, out vec3 l) {
         l = -light.direction_type.xyz;
         float visible = 1.0;
 #ifdef HAS_SHADOW_MAP
-        if (index == 0u) {
+        // Surfaces facing away get no light anyway: skip their shadow lookups.
+        if (index == 0u && dot(s.normal, l) > 0.0) {
             visible = sun_visibility(s.position, s.normal);
         }
 #endif
