@@ -29,6 +29,9 @@ pub struct CompileOptions<'a> {
     pub lights: u32,
     /// Memory requirements of an image; the executor passes the device's.
     pub memory: &'a dyn Fn(&ImageDesc) -> MemoryRequirements,
+    /// Images to keep readable after the frame besides the output (e.g. the HDR
+    /// buffer for EXR output): never aliased, left in `TRANSFER_SRC_OPTIMAL`.
+    pub readback: Vec<String>,
 }
 
 impl Default for CompileOptions<'_> {
@@ -41,6 +44,7 @@ impl Default for CompileOptions<'_> {
             features: BTreeSet::new(),
             lights: 1,
             memory: &crate::memory::estimate_requirements,
+            readback: Vec::new(),
         }
     }
 }
@@ -248,21 +252,50 @@ pub fn compile_ir(
             .map(|e| order_error(graph, ir, &uses, e, &disabled))
             .collect::<Vec<_>>()
     })?;
-    if order.writers[output].is_empty() {
+    let root_file = graph
+        .sources
+        .first()
+        .map(|s| s.file.clone())
+        .unwrap_or_default();
+    let mut roots = vec![output];
+    for name in &options.readback {
+        match ir
+            .resources
+            .iter()
+            .position(|r| r.name == *name && matches!(r.kind, IrKind::Image { .. }))
+        {
+            Some(r) if !roots.contains(&r) => roots.push(r),
+            Some(_) => {}
+            None => {
+                let names = ir.resources.iter().map(|r| r.name.as_str());
+                return Err(vec![Diagnostic::error(
+                    root_file,
+                    crate::spans::Pos { line: 1, col: 1 },
+                    format!("cannot read back \"{name}\": the graph has no image of that name"),
+                )
+                .suggest(name, names)]);
+            }
+        }
+    }
+    let mut is_root = vec![false; ir.resources.len()];
+    for &r in &roots {
+        is_root[r] = true;
+    }
+    if let Some(&unwritten) = roots.iter().find(|&&r| order.writers[r].is_empty()) {
         let (file, pos) = graph.locate(0, &[Seg::Field("output")]);
         return Err(vec![Diagnostic::error(
             file,
             pos,
             format!(
-                "no pass writes the output \"{}\"",
-                ir.resources[output].name
+                "no pass writes \"{}\", which is read back after the frame",
+                ir.resources[unwritten].name
             ),
         )
         .with_hint(
             "the passes that write it may be disabled by `enabled_if` for these features",
         )]);
     }
-    let needed = contributing(ir, &order, &uses, output);
+    let needed = contributing(ir, &order, &uses, &roots);
 
     let mut culled = Vec::new();
     let mut warnings = Vec::new();
@@ -306,20 +339,22 @@ pub fn compile_ir(
         .iter()
         .map(|t| !t.is_empty())
         .collect();
-    used[output] = true;
+    for &r in &roots {
+        used[r] = true;
+    }
     let mut new_index = vec![usize::MAX; ir.resources.len()];
     let mut kept: Vec<usize> = Vec::new();
     for r in (0..ir.resources.len()).filter(|&r| used[r]) {
         new_index[r] = kept.len();
         kept.push(r);
     }
-    warn_unread(graph, ir, &timeline, &uses, output, &mut warnings);
-    check_discarding_stores(graph, ir, &sequence, &timeline, &uses, output)?;
+    warn_unread(graph, ir, &timeline, &uses, &is_root, &mut warnings);
+    check_discarding_stores(graph, ir, &sequence, &timeline, &uses, &is_root)?;
 
     let mut resources: Vec<PlanResource> = Vec::with_capacity(kept.len());
     for &r in &kept {
         let res = &ir.resources[r];
-        let residency = if r == output {
+        let residency = if is_root[r] {
             Residency::Output
         } else if res.history {
             Residency::History
@@ -487,7 +522,8 @@ pub fn compile_ir(
         .enumerate()
         .map(|(i, (&p, barriers))| {
             plan_pass(
-                graph, ir, p, i, &uses, &new_index, &resources, &timeline, barriers, options,
+                graph, ir, p, i, &uses, &new_index, &resources, &timeline, &is_root, barriers,
+                options,
             )
         })
         .collect();
@@ -535,6 +571,7 @@ pub fn compile_ir(
         extent: options.extent,
         features: feature_list,
         output: new_index[output],
+        readback: roots[1..].iter().map(|&r| new_index[r]).collect(),
         resources,
         passes,
         culled,
@@ -761,13 +798,13 @@ impl Timeline {
         uses: &[Vec<PassUse>],
         i: usize,
         r: usize,
-        output: usize,
+        is_root: &[bool],
     ) -> bool {
         let touches = &self.per_resource[r];
         let next = touches.partition_point(|t| t.0 <= i);
         match touches.get(next) {
             Some(&(_, p, k)) => uses[p][k].reads_previous || !uses[p][k].discards,
-            None => r == output || ir.resources[r].history,
+            None => is_root[r] || ir.resources[r].history,
         }
     }
 }
@@ -777,11 +814,11 @@ fn warn_unread(
     ir: &Ir,
     timeline: &Timeline,
     uses: &[Vec<PassUse>],
-    output: usize,
+    is_root: &[bool],
     warnings: &mut Vec<Diagnostic>,
 ) {
     for (r, res) in ir.resources.iter().enumerate() {
-        if r == output || res.history {
+        if is_root[r] || res.history {
             continue;
         }
         let touches = &timeline.per_resource[r];
@@ -819,7 +856,7 @@ fn check_discarding_stores(
     sequence: &[usize],
     timeline: &Timeline,
     uses: &[Vec<PassUse>],
-    output: usize,
+    is_root: &[bool],
 ) -> Result<(), Vec<Diagnostic>> {
     let mut errors = Vec::new();
     for (i, &p) in sequence.iter().enumerate() {
@@ -834,7 +871,7 @@ fn check_discarding_stores(
                 _ => continue,
             };
             if store == StoreDecl::DontCare
-                && timeline.needed_later(ir, uses, i, access.resource, output)
+                && timeline.needed_later(ir, uses, i, access.resource, is_root)
             {
                 let mut path = access_path(ir.passes[p].index, access);
                 path.pop();
@@ -866,6 +903,7 @@ fn plan_pass(
     new_index: &[usize],
     resources: &[PlanResource],
     timeline: &Timeline,
+    is_root: &[bool],
     barriers: Vec<Barrier>,
     options: &CompileOptions,
 ) -> PlanPass {
@@ -942,13 +980,7 @@ fn plan_pass(
             let store = if read_only {
                 StoreOp::None
             } else if store == StoreDecl::Store
-                && timeline.needed_later(
-                    ir,
-                    all_uses,
-                    i,
-                    access.resource,
-                    ir.output.unwrap_or(usize::MAX),
-                )
+                && timeline.needed_later(ir, all_uses, i, access.resource, is_root)
             {
                 StoreOp::Store
             } else {

@@ -257,17 +257,20 @@ pub fn reachability(sequence: &[usize], succ: &[Vec<usize>], n: usize) -> Vec<Bi
     reach
 }
 
-/// Passes that contribute to the output: its writers, and transitively the writers
+/// Passes that contribute to the roots (the output and images read back): their writers, and transitively the writers
 /// of everything a contributing pass reads (history resources: all their writers,
 /// since the next frame reads them).
-pub fn contributing(ir: &Ir, order: &Order, uses: &[Vec<PassUse>], output: usize) -> Vec<bool> {
+pub fn contributing(ir: &Ir, order: &Order, uses: &[Vec<PassUse>], roots: &[usize]) -> Vec<bool> {
     let n = ir.passes.len();
     let mut position = vec![usize::MAX; n];
     for (i, &p) in order.sequence.iter().enumerate() {
         position[p] = i;
     }
     let mut needed = vec![false; n];
-    let mut stack: Vec<usize> = order.writers[output].clone();
+    let mut stack: Vec<usize> = roots
+        .iter()
+        .flat_map(|&r| order.writers[r].iter().copied())
+        .collect();
     while let Some(p) = stack.pop() {
         if needed[p] {
             continue;

@@ -34,6 +34,8 @@ pub struct Plan {
     pub culled: Vec<CulledPass>,
     /// Index of the output image in `resources`.
     pub output: usize,
+    /// Further images left readable after the frame (`CompileOptions::readback`).
+    pub readback: Vec<usize>,
     /// Where transient images live.
     pub memory: MemoryPlan,
     /// Barriers after the last pass: the output to `TRANSFER_SRC_OPTIMAL` for presenting or
@@ -214,7 +216,7 @@ pub struct RenderPassDesc {
 }
 
 /// `VkAttachmentLoadOp`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 pub enum LoadOp {
     Load,
     Clear,
@@ -222,7 +224,7 @@ pub enum LoadOp {
 }
 
 /// `VkAttachmentStoreOp`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 pub enum StoreOp {
     Store,
     DontCare,

@@ -291,7 +291,7 @@ pub enum StoreDecl {
 }
 
 /// Colour blend modes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize, Serialize)]
 pub enum Blend {
     /// dst + src (light accumulation).
     Additive,

@@ -181,3 +181,42 @@ fn the_annotated_example_in_graphs_readme_checks_clean() {
     assert_eq!(weft_graph::check(&graph), Vec::new());
     assert_eq!(graph.sources.len(), 3);
 }
+
+#[test]
+fn images_read_back_after_the_frame_are_kept_and_left_readable() {
+    let graph = weft_graph::load(&repo_root().join("graphs/forward.ron"));
+    let options = CompileOptions {
+        features: graph.features::<&str>(&[]),
+        readback: vec!["hdr".into()],
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let hdr = plan.resource("hdr").expect("hdr");
+    assert_eq!(plan.readback, vec![hdr]);
+    assert_eq!(
+        plan.resources[hdr].residency,
+        weft_graph::plan::Residency::Output
+    );
+    assert_eq!(plan.resources[hdr].placement, None);
+    let last = plan
+        .epilogue
+        .iter()
+        .find(|b| b.resource == hdr)
+        .expect("epilogue barrier");
+    assert_eq!(
+        last.layouts.map(|l| l.1),
+        Some(weft_graph::vk::Layout::TransferSrcOptimal)
+    );
+    check_plan(&plan, 3).expect("synchronized");
+
+    let unknown = CompileOptions {
+        readback: vec!["hdrr".into()],
+        ..CompileOptions::default()
+    };
+    let errors = weft_graph::compile(&graph, &unknown).expect_err("unknown image");
+    assert_eq!(
+        errors[0].message,
+        "cannot read back \"hdrr\": the graph has no image of that name"
+    );
+    assert_eq!(errors[0].hint.as_deref(), Some("did you mean \"hdr\"?"));
+}

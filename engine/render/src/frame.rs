@@ -102,6 +102,7 @@ pub fn compile_for_scene(
         features: loaded.features(&requested),
         lights: scene.lights.len().max(1) as u32,
         memory: &memory,
+        ..CompileOptions::default()
     };
     let prepared = weft_graph::Prepared::new(&loaded).map_err(RenderError::Graph)?;
     prepared.compile(&options).map_err(RenderError::Graph)
