@@ -1,0 +1,117 @@
+//! `weft render` as a user runs it: device and output path printed, the image
+//! written at the requested size, validation clean, bad input reported.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn weft(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_weft"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .expect("weft runs")
+}
+
+fn temp_png(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("weft-render-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir.join(name)
+}
+
+#[test]
+fn renders_the_demo_through_deferred_with_validation_and_json() {
+    let out_path = temp_png("demo.png");
+    let out_arg = out_path.to_string_lossy().into_owned();
+    let out = weft(&[
+        "render",
+        "scenes/demo.scene",
+        "--graph",
+        "graphs/deferred.ron",
+        "--size",
+        "64x36",
+        "--frames",
+        "2",
+        "--camera",
+        "closeup",
+        "--validate",
+        "--json",
+        "--out",
+        &out_arg,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(json["camera"], "closeup");
+    assert_eq!(json["size"], serde_json::json!([64, 36]));
+    assert_eq!(json["frames"], 2);
+    assert_eq!(json["validation"]["errors"], 0);
+    assert_eq!(json["validation"]["warnings"], 0);
+    assert_eq!(json["passes"][1], "gbuffer");
+    let image = image_size(&out_path);
+    assert_eq!(image, (64, 36));
+}
+
+#[test]
+fn prints_the_device_and_where_the_image_went() {
+    let out_path = temp_png("text.png");
+    let out_arg = out_path.to_string_lossy().into_owned();
+    let out = weft(&[
+        "render",
+        "scenes/demo.scene",
+        "--size",
+        "32x18",
+        "--features",
+        "!bloom",
+        "--timings",
+        "cpu",
+        "--out",
+        &out_arg,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("device: "), "{text}");
+    assert!(text.contains(&format!("wrote {out_arg}")), "{text}");
+    assert!(text.contains("cpu wall (submit+wait)"), "{text}");
+    assert!(text.contains("shadow_sun -> forward -> tonemap"), "{text}");
+}
+
+#[test]
+fn unknown_camera_and_bad_output_name_fail_with_a_message() {
+    let out = weft(&[
+        "render",
+        "scenes/demo.scene",
+        "--camera",
+        "nope",
+        "--size",
+        "8x8",
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no camera named \"nope\"; the scene has: front, closeup, flythrough"),
+        "{err}"
+    );
+    let out = weft(&["render", "scenes/demo.scene", "--out", "x.jpg"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("use a .png or .exr file name"));
+}
+
+/// Width and height from a PNG's IHDR chunk.
+fn image_size(path: &Path) -> (u32, u32) {
+    let bytes = std::fs::read(path).expect("png written");
+    assert_eq!(&bytes[1..4], b"PNG");
+    let word =
+        |at: usize| u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    (word(16), word(20))
+}
