@@ -29,10 +29,13 @@ vec3 blinn_phong(Material m, Surface s, vec3 l, vec3 radiance) {
     return radiance * (m.diffuse.rgb * s.texel * ndl + specular * ndl);
 }
 
-// Distance falloff 1 / (c + l d + q d^2), never above 1 / 1e-4.
+// Distance falloff 1 / (c + l d + q d^2), never above 1 / 1e-4, faded to zero
+// at the cutoff range by (1 - (d / range)^4)^2 so the cutoff leaves no visible edge.
 float attenuate(Light light, float d) {
     vec3 k = light.attenuation_cos.xyz;
-    return 1.0 / max(k.x + k.y * d + k.z * d * d, 1e-4);
+    float ratio = d / max(light.position_range.w, 1e-6);
+    float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
+    return window * window / max(k.x + k.y * d + k.z * d * d, 1e-4);
 }
 
 #ifdef HAS_SHADOW_MAP
