@@ -75,6 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         features: loaded.features::<&str>(&[]),
         lights: 1,
         memory: &memory,
+        ..CompileOptions::default()
     };
     let plan = weft_graph::compile(&loaded, &options).map_err(|d| format!("{d:?}"))?;
     let mut renderer = Renderer::new(&gpu)?;

@@ -13,25 +13,27 @@ use weft_graph::plan::{Plan, ResourceDesc};
 /// A host-visible buffer the output image is copied into.
 pub(crate) struct ReadbackBuffer<'g> {
     gpu: &'g Gpu,
+    /// The image copied: the output or one of `Plan::readback`.
+    resource: usize,
     buffer: vk::Buffer,
     allocation: Option<Allocation>,
     size: u64,
 }
 
 impl<'g> ReadbackBuffer<'g> {
-    pub(crate) fn new(gpu: &'g Gpu, plan: &Plan) -> Result<Self, GpuError> {
+    pub(crate) fn new(gpu: &'g Gpu, plan: &Plan, resource: usize) -> Result<Self, GpuError> {
         let ResourceDesc::Image(desc) = &plan
             .resources
-            .get(plan.output)
-            .ok_or_else(|| GpuError::Plan("the output resource does not exist".into()))?
+            .get(resource)
+            .ok_or_else(|| GpuError::Plan("the image to read back does not exist".into()))?
             .desc
         else {
-            return Err(GpuError::Plan("the output is not an image".into()));
+            return Err(GpuError::Plan("only images can be read back".into()));
         };
         let texel = readback::texel_bytes(&desc.format).ok_or_else(|| {
             GpuError::Plan(format!(
-                "cannot read back an output of format {}",
-                desc.format
+                "cannot read back \"{}\" of format {}",
+                plan.resources[resource].name, desc.format
             ))
         })?;
         let size = u64::from(desc.extent.width) * u64::from(desc.extent.height) * u64::from(texel);
@@ -42,6 +44,7 @@ impl<'g> ReadbackBuffer<'g> {
         let buffer = unsafe { gpu.device().create_buffer(&info, None) }.call("vkCreateBuffer")?;
         let mut this = Self {
             gpu,
+            resource,
             buffer,
             allocation: None,
             size,
@@ -69,16 +72,15 @@ impl<'g> ReadbackBuffer<'g> {
         Ok(this)
     }
 
-    /// Copies the output (in TRANSFER_SRC_OPTIMAL after the epilogue) into
+    /// Copies the image (in TRANSFER_SRC_OPTIMAL after the epilogue) into
     /// the buffer and makes the bytes visible to the host.
     pub(crate) fn record(
         &self,
         gpu: &Gpu,
         cmd: vk::CommandBuffer,
-        plan: &Plan,
         resources: &FrameResources<'_>,
     ) -> Result<(), GpuError> {
-        let img = resources.image(plan.output)?;
+        let img = resources.image(self.resource)?;
         let region = vk::BufferImageCopy2::default()
             .image_subresource(vk::ImageSubresourceLayers {
                 aspect_mask: vk::ImageAspectFlags::COLOR,
@@ -118,8 +120,8 @@ impl<'g> ReadbackBuffer<'g> {
     }
 
     pub(crate) fn read(&self, plan: &Plan) -> Result<Readback, GpuError> {
-        let ResourceDesc::Image(desc) = &plan.resources[plan.output].desc else {
-            return Err(GpuError::Plan("the output is not an image".into()));
+        let ResourceDesc::Image(desc) = &plan.resources[self.resource].desc else {
+            return Err(GpuError::Plan("only images can be read back".into()));
         };
         let bytes = self
             .allocation

@@ -48,6 +48,10 @@ pub struct FrameReport {
     /// The output image, when `readback` was asked for.
     #[serde(skip)]
     pub output: Option<Readback>,
+    /// The plan's other images to read back (`Plan::readback`, e.g. the HDR buffer
+    /// for EXR output), by name, when `readback` was asked for.
+    #[serde(skip)]
+    pub readbacks: Vec<(String, Readback)>,
     /// Host time spent preparing and recording commands (excluding GPU waits).
     pub record_ms: f64,
     /// Device memory of the plan's transient blocks (aliased images count once).
@@ -206,10 +210,13 @@ impl<'g> Renderer<'g> {
         }
         let pool = descriptor_pool(self.gpu, &prepared)?;
         self.write_descriptors(plan, resources, &pool, &mut prepared)?;
-        let readback = if options.readback {
-            Some(ReadbackBuffer::new(self.gpu, plan)?)
+        let readbacks = if options.readback {
+            std::iter::once(plan.output)
+                .chain(plan.readback.iter().copied())
+                .map(|r| ReadbackBuffer::new(self.gpu, plan, r))
+                .collect::<Result<Vec<_>, _>>()?
         } else {
-            None
+            Vec::new()
         };
         let queries = if options.timing == TimingMode::GpuTimestamps && self.gpu.info().timestamps {
             Some(QueryPool::new(self.gpu, 2 * plan.passes.len() as u32)?)
@@ -277,8 +284,8 @@ impl<'g> Renderer<'g> {
         }
         let t = Instant::now();
         record::barriers(self.gpu.device(), cmd, &plan.epilogue, resources)?;
-        if let Some(rb) = &readback {
-            rb.record(self.gpu, cmd, plan, resources)?;
+        for rb in &readbacks {
+            rb.record(self.gpu, cmd, resources)?;
         }
         record_ms += t.elapsed().as_secs_f64() * 1e3;
         buffers.submit_and_wait(cmd)?;
@@ -289,13 +296,25 @@ impl<'g> Renderer<'g> {
             Some(s) => s.read(plan)?,
             None => Vec::new(),
         };
-        let output = readback.as_ref().map(|rb| rb.read(plan)).transpose()?;
+        let mut images = readbacks
+            .iter()
+            .map(|rb| rb.read(plan))
+            .collect::<Result<Vec<_>, _>>()?
+            .into_iter();
+        let output = images.next();
+        let readbacks: Vec<(String, Readback)> = plan
+            .readback
+            .iter()
+            .map(|&r| plan.resources[r].name.clone())
+            .zip(images)
+            .collect();
         drop(buffers);
         drop(pool);
         Ok(FrameReport {
             timings,
             statistics,
             output,
+            readbacks,
             record_ms,
             transient_bytes: resources.transient_bytes,
             dedicated_bytes: resources.dedicated_bytes,

@@ -45,6 +45,7 @@ pub fn compile_with(gpu: &Gpu, path: &Path, width: u32, height: u32, features: &
         features: loaded.features(features),
         lights: 1,
         memory: &memory,
+        ..CompileOptions::default()
     };
     match weft_graph::compile(&loaded, &options) {
         Ok(plan) => plan,
