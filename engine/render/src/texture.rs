@@ -66,7 +66,8 @@ fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
 }
 
 impl<'g> Texture<'g> {
-    /// Uploads `pixels` as an `R8G8B8A8_SRGB` image ready for sampling in fragment shaders.
+    /// Uploads `pixels` as an `R8G8B8A8_SRGB` image with a full mip chain (made by
+    /// linear blits, where the format can be filtered) ready for sampling in fragment shaders.
     pub fn upload(gpu: &'g Gpu, name: &str, pixels: &Pixels) -> Result<Self, GpuError> {
         let device = gpu.device();
         let format = vk::Format::R8G8B8A8_SRGB;
@@ -75,15 +76,24 @@ impl<'g> Texture<'g> {
             height: pixels.height.max(1),
             depth: 1,
         };
+        let levels = if gpu.linear_filter(format.as_raw()) {
+            mip_levels(extent.width, extent.height)
+        } else {
+            1
+        };
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
             .extent(extent)
-            .mip_levels(1)
+            .mip_levels(levels)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST)
+            .usage(
+                vk::ImageUsageFlags::SAMPLED
+                    | vk::ImageUsageFlags::TRANSFER_DST
+                    | vk::ImageUsageFlags::TRANSFER_SRC,
+            )
             .initial_layout(vk::ImageLayout::UNDEFINED);
         let image = unsafe { device.create_image(&info, None) }.map_err(vk_err("vkCreateImage"))?;
         let mut this = Self {
@@ -113,7 +123,7 @@ impl<'g> Texture<'g> {
         let range = vk::ImageSubresourceRange {
             aspect_mask: vk::ImageAspectFlags::COLOR,
             base_mip_level: 0,
-            level_count: 1,
+            level_count: levels,
             base_array_layer: 0,
             layer_count: 1,
         };
@@ -132,54 +142,7 @@ impl<'g> Texture<'g> {
         )?;
         staging.write(&pixels.rgba)?;
         gpu.one_shot(|cmd| {
-            let to_dst = vk::ImageMemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::NONE)
-                .dst_stage_mask(vk::PipelineStageFlags2::COPY)
-                .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .old_layout(vk::ImageLayout::UNDEFINED)
-                .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .image(image)
-                .subresource_range(range);
-            let to_read = vk::ImageMemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::COPY)
-                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
-                .dst_access_mask(vk::AccessFlags2::SHADER_SAMPLED_READ)
-                .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-                .new_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .image(image)
-                .subresource_range(range);
-            let region = vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    mip_level: 0,
-                    base_array_layer: 0,
-                    layer_count: 1,
-                })
-                .image_extent(extent);
-            let first = [to_dst];
-            let second = [to_read];
-            unsafe {
-                device.cmd_pipeline_barrier2(
-                    cmd,
-                    &vk::DependencyInfo::default().image_memory_barriers(&first),
-                );
-                device.cmd_copy_buffer_to_image(
-                    cmd,
-                    staging.buffer,
-                    image,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &[region],
-                );
-                device.cmd_pipeline_barrier2(
-                    cmd,
-                    &vk::DependencyInfo::default().image_memory_barriers(&second),
-                );
-            }
+            record_upload(device, cmd, staging.buffer, image, extent, levels);
             Ok(())
         })?;
         Ok(this)
@@ -199,5 +162,148 @@ impl Drop for Texture<'_> {
             // Freeing only fails for allocations this allocator did not make.
             let _ = self.gpu.allocator().free(a);
         }
+    }
+}
+
+/// Levels of a full mip chain for a `width` x `height` image.
+pub fn mip_levels(width: u32, height: u32) -> u32 {
+    32 - width.max(height).max(1).leading_zeros()
+}
+
+fn level_barrier(
+    image: vk::Image,
+    level: u32,
+    (src_stage, src_access, old): (vk::PipelineStageFlags2, vk::AccessFlags2, vk::ImageLayout),
+    (dst_stage, dst_access, new): (vk::PipelineStageFlags2, vk::AccessFlags2, vk::ImageLayout),
+) -> vk::ImageMemoryBarrier2<'static> {
+    vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(src_stage)
+        .src_access_mask(src_access)
+        .dst_stage_mask(dst_stage)
+        .dst_access_mask(dst_access)
+        .old_layout(old)
+        .new_layout(new)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(vk::ImageSubresourceRange {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            base_mip_level: level,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        })
+}
+
+fn barrier(device: &ash::Device, cmd: vk::CommandBuffer, barriers: &[vk::ImageMemoryBarrier2]) {
+    let dep = vk::DependencyInfo::default().image_memory_barriers(barriers);
+    unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };
+}
+
+/// Copies the staging buffer into level 0, blits each level from the one above,
+/// and leaves every level in `SHADER_READ_ONLY_OPTIMAL` for fragment shaders.
+fn record_upload(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    staging: vk::Buffer,
+    image: vk::Image,
+    extent: vk::Extent3D,
+    levels: u32,
+) {
+    let none = (
+        vk::PipelineStageFlags2::NONE,
+        vk::AccessFlags2::NONE,
+        vk::ImageLayout::UNDEFINED,
+    );
+    let written = (
+        vk::PipelineStageFlags2::TRANSFER,
+        vk::AccessFlags2::TRANSFER_WRITE,
+        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+    );
+    let source = (
+        vk::PipelineStageFlags2::TRANSFER,
+        vk::AccessFlags2::TRANSFER_READ,
+        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+    );
+    let sampled = (
+        vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        vk::AccessFlags2::SHADER_SAMPLED_READ,
+        vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+    );
+    let to_dst: Vec<_> = (0..levels)
+        .map(|l| level_barrier(image, l, none, written))
+        .collect();
+    barrier(device, cmd, &to_dst);
+    let layers = |level| vk::ImageSubresourceLayers {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        mip_level: level,
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    let region = vk::BufferImageCopy::default()
+        .image_subresource(layers(0))
+        .image_extent(extent);
+    unsafe {
+        device.cmd_copy_buffer_to_image(
+            cmd,
+            staging,
+            image,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            &[region],
+        );
+    }
+    let size = |level: u32| {
+        [
+            (extent.width >> level).max(1) as i32,
+            (extent.height >> level).max(1) as i32,
+        ]
+    };
+    for level in 1..levels {
+        barrier(
+            device,
+            cmd,
+            &[level_barrier(image, level - 1, written, source)],
+        );
+        let [sw, sh] = size(level - 1);
+        let [dw, dh] = size(level);
+        let blit = vk::ImageBlit::default()
+            .src_subresource(layers(level - 1))
+            .src_offsets([vk::Offset3D::default(), vk::Offset3D { x: sw, y: sh, z: 1 }])
+            .dst_subresource(layers(level))
+            .dst_offsets([vk::Offset3D::default(), vk::Offset3D { x: dw, y: dh, z: 1 }]);
+        unsafe {
+            device.cmd_blit_image(
+                cmd,
+                image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                image,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[blit],
+                vk::Filter::LINEAR,
+            );
+        }
+        barrier(
+            device,
+            cmd,
+            &[level_barrier(image, level - 1, source, sampled)],
+        );
+    }
+    barrier(
+        device,
+        cmd,
+        &[level_barrier(image, levels - 1, written, sampled)],
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mip_chain_goes_down_to_one_texel() {
+        assert_eq!(mip_levels(1, 1), 1);
+        assert_eq!(mip_levels(256, 256), 9);
+        assert_eq!(mip_levels(300, 20), 9);
+        assert_eq!(mip_levels(2, 1), 2);
     }
 }
