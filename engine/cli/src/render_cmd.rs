@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_gpu::{format_timings, Gpu, GpuOptions, TimingMode};
 use weft_graph::plan::Extent;
+use weft_graph::schema::ResourceDecl;
 use weft_render::{render, RenderSettings, Rendered};
 
 /// Which per-pass times `--timings` measures.
@@ -38,7 +39,8 @@ pub struct RenderArgs {
     /// Camera name; the scene's first camera by default.
     #[arg(long)]
     camera: Option<String>,
-    /// Output image: .png (tonemapped sRGB output) or .exr (linear floats);
+    /// Output image: .png (the graph's tonemapped sRGB output) or .exr (the linear
+    /// HDR image `hdr` where the graph has one, else the output as floats);
     /// default out/<scene stem>.png.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -74,6 +76,14 @@ fn parse_size(text: &str) -> Result<Extent, String> {
     })
 }
 
+/// Whether the graph declares an image called `name` (EXR output reads it back).
+fn graph_has_image(graph: &Path, name: &str) -> bool {
+    weft_graph::load(graph)
+        .resources
+        .iter()
+        .any(|r| matches!(&r.item, ResourceDecl::Image(image) if image.name == name))
+}
+
 fn default_out(scene: &Path) -> PathBuf {
     let stem = scene
         .file_stem()
@@ -85,10 +95,17 @@ fn default_out(scene: &Path) -> PathBuf {
 /// Runs `weft render`.
 pub fn run(args: RenderArgs) -> Result<ExitCode> {
     let out = args.out.clone().unwrap_or_else(|| default_out(&args.scene));
-    match out.extension().and_then(|e| e.to_str()) {
-        Some("png" | "exr") => {}
+    let exr = match out.extension().and_then(|e| e.to_str()) {
+        Some("png") => false,
+        Some("exr") => true,
         _ => bail!("--out {}: use a .png or .exr file name", out.display()),
-    }
+    };
+    let hdr_name = "hdr";
+    let extra_readback = if exr && graph_has_image(&args.graph, hdr_name) {
+        vec![hdr_name.to_string()]
+    } else {
+        Vec::new()
+    };
     let scene = weft_scene::load_scene(&args.scene)
         .with_context(|| format!("loading {}", args.scene.display()))?;
     let gpu = Gpu::new(&GpuOptions {
@@ -113,14 +130,19 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             Some(Timings::Cpu) => TimingMode::CpuPerPass,
         },
         readback: true,
+        extra_readback,
         ..RenderSettings::default()
     };
     let rendered = render(&gpu, &scene, &settings)?;
     drop(gpu);
-    let output = rendered
+    let hdr = rendered
         .report
-        .output
-        .as_ref()
+        .readbacks
+        .iter()
+        .find(|(name, _)| name == hdr_name)
+        .map(|(_, image)| image);
+    let output = hdr
+        .or(rendered.report.output.as_ref())
         .context("the frame produced no output image")?;
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;

@@ -33,6 +33,8 @@ pub struct RenderSettings {
     pub timing: TimingMode,
     /// Copy the output back.
     pub readback: bool,
+    /// Other images to copy back with the output (e.g. `hdr` for EXR files).
+    pub extra_readback: Vec<String>,
 }
 
 impl Default for RenderSettings {
@@ -50,6 +52,7 @@ impl Default for RenderSettings {
             features: Vec::new(),
             timing: TimingMode::Off,
             readback: true,
+            extra_readback: Vec::new(),
         }
     }
 }
@@ -102,7 +105,7 @@ pub fn compile_for_scene(
         features: loaded.features(&requested),
         lights: scene.lights.len().max(1) as u32,
         memory: &memory,
-        ..CompileOptions::default()
+        readback: settings.extra_readback.clone(),
     };
     let prepared = weft_graph::Prepared::new(&loaded).map_err(RenderError::Graph)?;
     prepared.compile(&options).map_err(RenderError::Graph)

@@ -116,3 +116,35 @@ fn forward_and_deferred_agree_on_the_15_462_cube_scene() {
     eprintln!("forward vs deferred: {a:?}");
     assert!(a.mean <= 0.25 && a.p99 <= 1, "{a:?}");
 }
+
+#[test]
+fn the_hdr_image_reads_back_as_linear_floats_for_exr() {
+    let scene = weft_scene::load_scene(&demo_scene()).expect("scene loads");
+    let gpu = weft_gpu::Gpu::new(&weft_gpu::GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("device");
+    let log = gpu.validation();
+    let settings = weft_render::RenderSettings {
+        graph: graph("forward.ron"),
+        extent: weft_graph::plan::Extent {
+            width: 64,
+            height: 36,
+        },
+        extra_readback: vec!["hdr".into()],
+        ..weft_render::RenderSettings::default()
+    };
+    let rendered = weft_render::render(&gpu, &scene, &settings).expect("renders");
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+    let (name, hdr) = &rendered.report.readbacks[0];
+    assert_eq!((name.as_str(), hdr.width, hdr.height), ("hdr", 64, 36));
+    let weft_gpu::Pixels::RgbaF32(values) = &hdr.pixels else {
+        panic!("hdr reads back as floats, got {:?}", hdr.format);
+    };
+    // The background is cleared to black; lit surfaces are positive and finite.
+    assert_eq!(&values[..4], &[0.0, 0.0, 0.0, 1.0]);
+    assert!(values.iter().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(values.iter().any(|v| *v > 0.1));
+}
