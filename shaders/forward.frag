@@ -1,6 +1,7 @@
 #version 450
 // Forward shading: every light evaluated per pixel with the shared lighting
-// code (include/lighting.glsl), plus ambient and emission, into linear HDR.
+// code (include/lighting.glsl), plus ambient and emission, into linear HDR;
+// alpha is the material's opacity, which transparent meshes blend with.
 #ifdef HAS_SHADOW_MAP
 layout(set = 0, binding = 0) uniform sampler2D shadow_map;
 #endif
@@ -17,10 +18,12 @@ layout(location = 0) out vec4 color;
 
 void main() {
     vec3 n = normalize(world_normal);
-    Surface s = Surface(world, gl_FrontFacing ? n : -n, texture(base_color, texcoord).rgb, material);
+    vec4 texel = texture(base_color, texcoord);
+    Surface s = Surface(world, gl_FrontFacing ? n : -n, texel.rgb, material);
     vec3 c = shade_ambient_emissive(s);
     for (uint i = 0u; i < frame.counts.w; ++i) {
         c += shade_light(i, s);
     }
-    color = vec4(c, 1.0);
+    // Alpha matters only where weft-render blends transparent materials.
+    color = vec4(c, materials[material].diffuse.a * texel.a);
 }

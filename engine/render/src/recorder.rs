@@ -3,21 +3,49 @@
 //! material's texture (set 2), then draws the meshes the pass's material filter
 //! selects or one instanced light volume per light.
 
-use crate::pipelines::{ScenePipelineKey, ScenePipelines, MATERIAL_SET};
+use crate::geometry::DrawItem;
+use crate::pipelines::{ScenePipeline, ScenePipelineKey, ScenePipelines, MATERIAL_SET};
 use crate::scene_gpu::GpuScene;
-use crate::state::pass_state;
+use crate::state::{pass_state, DepthTest, PassState};
 use ash::vk;
+use glam::Vec3;
 use weft_gpu::bind::{pack_push, resolve_bindings, FrameValues};
-use weft_gpu::pipeline::{Pipeline, ShaderKey};
+use weft_gpu::pipeline::{BlendCode, Pipeline, ShaderKey};
 use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, ShaderStage, SCENE_SET};
-use weft_graph::schema::{Draw, LightKind};
+use weft_graph::schema::{Draw, LightKind, MaterialFilter};
 
 /// Descriptor sets for graph resources one frame may need.
 const FRAME_SETS: u32 = 64;
 
 fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
     move |result| GpuError::Vulkan { call, result }
+}
+
+/// What a scene pass binds besides its pipeline.
+struct PassBindings {
+    graph_set: Option<vk::DescriptorSet>,
+    push: Option<(vk::ShaderStageFlags, Vec<u8>)>,
+}
+
+/// Whether a pass drawing every mesh must blend its transparent ones itself: it
+/// shades colour (a fragment stage writing attachments) that the graph does not blend.
+fn blends_transparency(state: &PassState) -> bool {
+    !state.blends.is_empty() && state.blends.iter().all(|b| *b == BlendCode::Off)
+}
+
+/// The state for transparent meshes in such a pass: alpha blending, depth tested
+/// but not written, so they do not hide each other or what lies behind them.
+fn transparent_state(state: &PassState) -> PassState {
+    PassState {
+        blends: vec![BlendCode::Alpha; state.blends.len()],
+        depth: match state.depth {
+            DepthTest::Off => DepthTest::Off,
+            DepthTest::Less { .. } => DepthTest::Less { write: false },
+            _ => DepthTest::Greater { write: false },
+        },
+        ..state.clone()
+    }
 }
 
 /// Draws a [`GpuScene`] into the scene passes of any plan.
@@ -100,6 +128,94 @@ impl<'g> SceneRecorder<'g> {
         }
         self.last_pass = Some(index);
         Ok(())
+    }
+
+    /// Binds a scene pipeline with the pass's graph set, the scene set, push
+    /// constants and the shared vertex and index buffers.
+    fn bind(&self, cmd: vk::CommandBuffer, p: &ScenePipeline, b: &PassBindings) {
+        let device = self.gpu.device();
+        let point = vk::PipelineBindPoint::GRAPHICS;
+        unsafe {
+            device.cmd_bind_pipeline(cmd, point, p.pipeline);
+            if let Some(set) = b.graph_set {
+                device.cmd_bind_descriptor_sets(cmd, point, p.layout, 0, &[set], &[]);
+            }
+            device.cmd_bind_descriptor_sets(
+                cmd,
+                point,
+                p.layout,
+                SCENE_SET,
+                &[self.scene.scene_set],
+                &[],
+            );
+            if let Some((stages, bytes)) = &b.push {
+                device.cmd_push_constants(cmd, p.layout, *stages, 0, bytes);
+            }
+            device.cmd_bind_vertex_buffers(cmd, 0, &[self.scene.vertices.buffer], &[0]);
+            device.cmd_bind_index_buffer(cmd, self.scene.indices.buffer, 0, vk::IndexType::UINT32);
+        }
+    }
+
+    /// Draws meshes one indexed draw each (the draw record as `firstInstance`),
+    /// binding a material's texture set when the material changes; returns the draw count.
+    fn draw_meshes<'a>(
+        &self,
+        cmd: vk::CommandBuffer,
+        p: &ScenePipeline,
+        draws: impl Iterator<Item = &'a DrawItem>,
+    ) -> u64 {
+        let device = self.gpu.device();
+        let textured = p
+            .interface
+            .bindings
+            .keys()
+            .any(|(set, _)| *set == MATERIAL_SET);
+        let mut bound = None;
+        let mut calls = 0;
+        for d in draws {
+            unsafe {
+                if textured && bound != Some(d.material) {
+                    let set = self.scene.material_sets[d.material as usize];
+                    device.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        p.layout,
+                        MATERIAL_SET,
+                        &[set],
+                        &[],
+                    );
+                    bound = Some(d.material);
+                }
+                device.cmd_draw_indexed(
+                    cmd,
+                    d.range.index_count,
+                    1,
+                    d.range.first_index,
+                    d.range.vertex_offset,
+                    d.draw_id,
+                );
+            }
+            calls += 1;
+        }
+        calls
+    }
+
+    /// The draws a filter selects, farthest from the camera first (by the placed
+    /// model's origin), the order alpha blending needs.
+    fn back_to_front(&self, filter: MaterialFilter) -> Vec<DrawItem> {
+        let g = &self.scene.geometry;
+        let eye = self.scene.camera_position;
+        let mut draws: Vec<(f32, DrawItem)> = g
+            .filtered(filter)
+            .map(|d| {
+                let origin = g
+                    .model_matrix(d.draw_id)
+                    .map_or(Vec3::ZERO, |m| m.w_axis.truncate());
+                (origin.distance_squared(eye), *d)
+            })
+            .collect();
+        draws.sort_by(|a, b| b.0.total_cmp(&a.0));
+        draws.into_iter().map(|(_, d)| d).collect()
     }
 
     /// Allocates and writes set 0: the graph resources the pass samples or stores.
@@ -241,66 +357,35 @@ impl DrawRecorder for SceneRecorder<'_> {
             }
             None => None,
         };
-        let textured = p
-            .interface
-            .bindings
-            .keys()
-            .any(|(set, _)| *set == MATERIAL_SET);
-        let cmd = ctx.cmd;
-        let bind = vk::PipelineBindPoint::GRAPHICS;
-        let scene = &self.scene;
-        let g = &scene.geometry;
-        unsafe {
-            device.cmd_bind_pipeline(cmd, bind, p.pipeline);
-            if let Some(set) = graph_set {
-                device.cmd_bind_descriptor_sets(cmd, bind, p.layout, 0, &[set], &[]);
-            }
-            device.cmd_bind_descriptor_sets(
-                cmd,
-                bind,
-                p.layout,
-                SCENE_SET,
-                &[scene.scene_set],
-                &[],
-            );
-            if let Some((stages, bytes)) = &push {
-                device.cmd_push_constants(cmd, p.layout, *stages, 0, bytes);
-            }
-            device.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
-            device.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
-        }
+        let bindings = PassBindings { graph_set, push };
+        self.bind(ctx.cmd, &p, &bindings);
+        let g = &self.scene.geometry;
         let mut calls = 0u64;
         match draw {
-            Draw::Meshes(filter) => {
-                let mut bound = None;
-                for d in g.filtered(filter) {
-                    unsafe {
-                        if textured && bound != Some(d.material) {
-                            let set = scene.material_sets[d.material as usize];
-                            device.cmd_bind_descriptor_sets(
-                                cmd,
-                                bind,
-                                p.layout,
-                                MATERIAL_SET,
-                                &[set],
-                                &[],
-                            );
-                            bound = Some(d.material);
-                        }
-                        device.cmd_draw_indexed(
-                            cmd,
-                            d.range.index_count,
-                            1,
-                            d.range.first_index,
-                            d.range.vertex_offset,
-                            d.draw_id,
-                        );
-                    }
-                    calls += 1;
+            Draw::Meshes(MaterialFilter::All) if blends_transparency(&key.state) => {
+                // Opaque first, then transparent meshes blended over them, farthest first.
+                calls += self.draw_meshes(ctx.cmd, &p, g.filtered(MaterialFilter::Opaque));
+                let transparent = self.back_to_front(MaterialFilter::Transparent);
+                if !transparent.is_empty() {
+                    let blended = ScenePipelineKey {
+                        state: transparent_state(&key.state),
+                        ..key.clone()
+                    };
+                    let q = self.pipelines.get(
+                        device,
+                        &blended,
+                        self.scene.scene_layout,
+                        self.scene.material_layout,
+                    )?;
+                    self.bind(ctx.cmd, &q, &bindings);
+                    calls += self.draw_meshes(ctx.cmd, &q, transparent.iter());
                 }
             }
+            Draw::Meshes(filter) => {
+                calls += self.draw_meshes(ctx.cmd, &p, g.filtered(filter));
+            }
             Draw::LightVolumes(kind) => {
-                let lights = &scene.light_set;
+                let lights = &self.scene.light_set;
                 let groups = match kind {
                     LightKind::Point => vec![(g.sphere, lights.points, lights.first_point())],
                     LightKind::Spot => vec![
@@ -311,7 +396,7 @@ impl DrawRecorder for SceneRecorder<'_> {
                 for (mesh, count, first) in groups.into_iter().filter(|g| g.1 > 0) {
                     unsafe {
                         device.cmd_draw_indexed(
-                            cmd,
+                            ctx.cmd,
                             mesh.index_count,
                             count,
                             mesh.first_index,

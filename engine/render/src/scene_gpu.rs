@@ -63,6 +63,8 @@ pub struct GpuScene<'g> {
     foreign_sets: HashMap<vk::DescriptorSetLayout, vk::DescriptorSet>,
     source_lights: Vec<weft_scene::Light>,
     bounds: weft_scene::Aabb,
+    /// Camera position at the last update, for sorting transparent meshes.
+    pub camera_position: glam::Vec3,
     /// Light counts by kind (stable over time; animation moves lights only).
     pub light_set: LightSet,
     /// Textures that could not be loaded (their materials use white), and skipped meshes.
@@ -184,6 +186,7 @@ impl<'g> GpuScene<'g> {
             foreign_sets: HashMap::new(),
             source_lights: scene.lights.clone(),
             bounds,
+            camera_position: glam::Vec3::ZERO,
             light_set,
             warnings,
         };
@@ -351,6 +354,8 @@ impl<'g> GpuScene<'g> {
     pub fn update(&mut self, camera: &Camera, time: f32, extent: [u32; 2]) -> Result<(), GpuError> {
         let [w, h] = [extent[0].max(1) as f32, extent[1].max(1) as f32];
         let view_proj = camera::view_projection(camera, time, w / h);
+        let eye = camera::camera_position(camera, time);
+        self.camera_position = eye;
         let lights = pack_lights(
             &weft_scene::animation::lights_at(&self.source_lights, time, 0),
             &self.bounds,
@@ -364,7 +369,7 @@ impl<'g> GpuScene<'g> {
             .mat4(&view_proj)
             .mat4(&view_proj.inverse())
             .mat4(&shadow)
-            .vec3w(camera::camera_position(camera, time), 1.0)
+            .vec3w(eye, 1.0)
             .vec3w(lights.ambient, 0.0)
             .u32(lights.suns)
             .u32(lights.points)
