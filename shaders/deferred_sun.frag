@@ -19,9 +19,10 @@ void main() {
         color = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
-    vec3 c = shade_ambient_emissive(s);
+    Material m = materials[s.material];
+    vec3 c = shade_ambient_emissive(s, m);
     for (uint i = 0u; i < frame.counts.x; ++i) {
-        c += shade_light(i, s);
+        c += shade_light(i, s, m);
     }
     color = vec4(c, 1.0);
 }

@@ -20,9 +20,10 @@ void main() {
     vec3 n = normalize(world_normal);
     vec4 texel = texture(base_color, texcoord);
     Surface s = Surface(world, gl_FrontFacing ? n : -n, texel.rgb, material);
-    vec3 c = shade_ambient_emissive(s);
+    Material m = materials[material];
+    vec3 c = shade_ambient_emissive(s, m);
     for (uint i = 0u; i < frame.counts.w; ++i) {
-        c += shade_light(i, s);
+        c += shade_light(i, s, m);
     }
     // Alpha matters only where weft-render blends transparent materials.
     color = vec4(c, materials[material].diffuse.a * texel.a);

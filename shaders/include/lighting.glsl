@@ -1,8 +1,9 @@
 // Shading shared by forward and deferred: material decoding, Blinn-Phong, and
 // sun / point / spot light evaluation with the same cutoffs the light volumes
 // use. Both paths call `shade_light` and `shade_ambient_emissive` with the same
-// inputs, so they cannot drift apart. An includer that defines HAS_SHADOW_MAP
-// must declare `uniform sampler2D shadow_map` before including this file.
+// inputs (the surface and its material, loaded once per pixel), so they cannot
+// drift apart. An includer that defines HAS_SHADOW_MAP must declare
+// `uniform sampler2D shadow_map` before including this file.
 #ifndef WEFT_LIGHTING_GLSL
 #define WEFT_LIGHTING_GLSL
 #include "scene.glsl"
@@ -100,20 +101,19 @@ vec3 incoming(Light light, uint index, Surface s, out vec3 l) {
 }
 
 // One light's contribution to the surface.
-vec3 shade_light(uint index, Surface s) {
+vec3 shade_light(uint index, Surface s, Material m) {
     Light light = lights[index];
     vec3 l;
     vec3 radiance = incoming(light, index, s, l);
     if (all(equal(radiance, vec3(0.0)))) {
         return vec3(0.0);
     }
-    return blinn_phong(materials[s.material], s, l, radiance);
+    return blinn_phong(m, s, l, radiance);
 }
 
 // What the surface shows without any direct light: the suns' ambient on its
 // ambient reflectance (modulated by the texture), plus its emission.
-vec3 shade_ambient_emissive(Surface s) {
-    Material m = materials[s.material];
+vec3 shade_ambient_emissive(Surface s, Material m) {
     return frame.ambient.rgb * m.ambient.rgb * s.texel + m.emissive.rgb;
 }
 
