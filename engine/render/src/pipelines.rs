@@ -7,6 +7,7 @@ use crate::geometry::VERTEX_BYTES;
 use crate::state::{Cull, DepthTest, PassState};
 use ash::vk;
 use std::collections::HashMap;
+use std::path::Path;
 use std::sync::Arc;
 use weft_gpu::pipeline::{BlendCode, PipelineCache, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
@@ -148,6 +149,31 @@ impl ScenePipelines {
         let pipeline = Arc::new(pipeline);
         self.pipelines.insert(key.clone(), Arc::clone(&pipeline));
         Ok(pipeline)
+    }
+
+    /// Forgets every shader and pipeline built from `file` (hot reload) so the next
+    /// frame rebuilds them; the caller must make sure the device no longer uses them.
+    /// Returns how many pipelines were dropped.
+    pub fn invalidate(&mut self, device: &ash::Device, file: &Path) -> usize {
+        let shaders = &mut self.shaders;
+        let mut uses = |key: &ShaderKey| {
+            shaders
+                .shader(key)
+                .map_or(true, |m| m.compiled.dependencies.contains(file))
+        };
+        let stale: Vec<ScenePipelineKey> = self
+            .pipelines
+            .keys()
+            .filter(|k| uses(&k.vertex) || k.fragment.as_ref().is_some_and(&mut uses))
+            .cloned()
+            .collect();
+        for key in &stale {
+            if let Some(p) = self.pipelines.remove(key) {
+                destroy(device, &p);
+            }
+        }
+        self.shaders.invalidate(device, file);
+        stale.len()
     }
 
     /// Destroys every pipeline.
