@@ -162,21 +162,7 @@ impl SceneGeometry {
         })
     }
 
-    /// Whether any drawn mesh casts a shadow.
-    pub fn has_shadow_casters(&self) -> bool {
-        self.filtered(MaterialFilter::ShadowCasters)
-            .next()
-            .is_some()
-    }
-
-    /// Triangles drawn by a pass with `filter`.
-    pub fn triangles(&self, filter: MaterialFilter) -> u64 {
-        self.filtered(filter)
-            .map(|d| u64::from(d.range.index_count / 3))
-            .sum()
-    }
-
-    /// Helper for tests and reports: the model matrix of a draw record.
+    /// The model matrix of a draw record (transparent meshes sort by its origin).
     pub fn model_matrix(&self, draw_id: u32) -> Option<Mat4> {
         let start = draw_id as usize * DRAW_BYTES / 4;
         let words = self.draw_records.0.get(start..start + 16)?;

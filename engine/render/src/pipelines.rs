@@ -111,16 +111,6 @@ impl ScenePipelines {
         })
     }
 
-    /// Number of pipelines built.
-    pub fn len(&self) -> usize {
-        self.pipelines.len()
-    }
-
-    /// Whether none was built yet.
-    pub fn is_empty(&self) -> bool {
-        self.pipelines.is_empty()
-    }
-
     /// The pipeline for `key`, built on first use against the scene's set layouts.
     pub fn get(
         &mut self,

@@ -108,18 +108,6 @@ impl<'g> SceneRecorder<'g> {
         self.frame.frame = frame;
     }
 
-    /// Number of scene pipelines built.
-    pub fn pipeline_count(&self) -> usize {
-        self.pipelines.len()
-    }
-
-    /// Drops every scene pipeline built from `changed` so the next frame rebuilds
-    /// it (hot reload); waits for the device first. Returns how many were dropped.
-    pub fn reload(&mut self, changed: &std::path::Path) -> Result<usize, GpuError> {
-        self.gpu.wait_idle()?;
-        Ok(self.pipelines.invalidate(self.gpu.device(), changed))
-    }
-
     /// Passes come in increasing order within a frame, so a pass index not above the
     /// last one starts a new frame; the executor has waited for the previous one, so
     /// its descriptor sets can be recycled.
