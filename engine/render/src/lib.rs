@@ -20,13 +20,17 @@ pub mod materials;
 pub mod packing;
 pub mod pipelines;
 pub mod recorder;
+pub mod reload;
 pub mod scene_gpu;
+pub mod sources;
 pub mod state;
 pub mod texture;
 pub mod volumes;
+pub mod watch;
 
 pub use error::RenderError;
 pub use features::scene_features;
 pub use frame::{compile_for_scene, render, RenderSettings, Rendered};
 pub use recorder::SceneRecorder;
+pub use reload::{LiveRender, ReloadError};
 pub use scene_gpu::GpuScene;

@@ -108,6 +108,14 @@ impl<'g> SceneRecorder<'g> {
         self.frame.frame = frame;
     }
 
+    /// Drops every scene pipeline built from `changed` so the next frame rebuilds
+    /// it (hot reload, see `reload::LiveRender`); waits for the device first.
+    /// Returns how many were dropped.
+    pub fn reload(&mut self, changed: &std::path::Path) -> Result<usize, GpuError> {
+        self.gpu.wait_idle()?;
+        Ok(self.pipelines.invalidate(self.gpu.device(), changed))
+    }
+
     /// Passes come in increasing order within a frame, so a pass index not above the
     /// last one starts a new frame; the executor has waited for the previous one, so
     /// its descriptor sets can be recycled.

@@ -1,0 +1,153 @@
+//! Every file a live render was built from, so hot reload knows what to watch
+//! and what a change touches: the graph and its includes, each shader with its
+//! `#include`s, and the scene with its includes, models and what they read.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use weft_gpu::pipeline::{PipelineCache, ShaderKey};
+use weft_gpu::{GpuError, ShaderStage};
+use weft_graph::plan::Plan;
+use weft_scene::Scene;
+
+/// How deep scene `include`s are followed (the loader's own limit).
+const MAX_SCENE_INCLUDE_DEPTH: usize = 32;
+
+/// The files behind a live render, as absolute paths (canonical where they exist),
+/// grouped by what a change to them means.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Sources {
+    /// The graph file and its includes: a change recompiles the plan.
+    pub graph: BTreeSet<PathBuf>,
+    /// Each shader file and `#include` the plan uses, mapped to the spellings the
+    /// shader caches recorded it under: a change drops what was built from it.
+    pub shaders: BTreeMap<PathBuf, BTreeSet<PathBuf>>,
+    /// The scene file, its includes, models, material libraries and textures: a
+    /// change reloads and re-uploads the scene.
+    pub scene: BTreeSet<PathBuf>,
+}
+
+impl Sources {
+    /// Every file, for the watcher.
+    pub fn all(&self) -> BTreeSet<PathBuf> {
+        self.graph
+            .iter()
+            .chain(self.shaders.keys())
+            .chain(&self.scene)
+            .cloned()
+            .collect()
+    }
+}
+
+/// `path` made absolute and canonical, or just absolute when it does not exist
+/// (a file being replaced by rename); events name files this way.
+pub fn normalize(path: &Path) -> PathBuf {
+    path.canonicalize()
+        .or_else(|_| std::path::absolute(path))
+        .unwrap_or_else(|_| path.to_path_buf())
+}
+
+/// The shader variants the plan's passes run: fullscreen and compute passes as
+/// the executor builds them, scene passes as the scene recorder does.
+pub fn plan_shader_keys(plan: &Plan) -> Result<Vec<ShaderKey>, GpuError> {
+    let mut keys = Vec::new();
+    for pass in &plan.passes {
+        if let Some(shaders) = weft_gpu::check::pass_shaders(pass)? {
+            keys.extend(shaders.keys().into_iter().cloned());
+            continue;
+        }
+        let key = |path: &Path, stage| ShaderKey {
+            path: path.to_path_buf(),
+            stage,
+            defines: pass.defines.clone(),
+        };
+        keys.extend(
+            pass.shaders
+                .vertex
+                .as_deref()
+                .map(|p| key(p, ShaderStage::Vertex)),
+        );
+        keys.extend(
+            pass.shaders
+                .fragment
+                .as_deref()
+                .map(|p| key(p, ShaderStage::Fragment)),
+        );
+    }
+    Ok(keys)
+}
+
+/// Every file the plan's shaders depend on, by normalized path, compiled through
+/// `cache` (already cached variants cost nothing).
+pub fn shader_files(
+    cache: &mut PipelineCache,
+    plan: &Plan,
+) -> Result<BTreeMap<PathBuf, BTreeSet<PathBuf>>, GpuError> {
+    let mut files: BTreeMap<PathBuf, BTreeSet<PathBuf>> = BTreeMap::new();
+    for key in plan_shader_keys(plan)? {
+        let module = cache.shader(&key)?;
+        for dep in &module.compiled.dependencies {
+            if dep.is_file() {
+                files.entry(normalize(dep)).or_default().insert(dep.clone());
+            }
+        }
+    }
+    Ok(files)
+}
+
+/// The files a loaded scene was read from. The scene loader does not record its
+/// `include`s, so they are found again by reading each `include "FILE"` line;
+/// models list what they read themselves (`Model::sources`).
+pub fn scene_files(scene: &Scene) -> BTreeSet<PathBuf> {
+    let mut files = BTreeSet::new();
+    scene_includes(&scene.path, 0, &mut files);
+    for model in &scene.models {
+        files.insert(normalize(&model.path));
+        files.extend(model.sources.iter().map(|p| normalize(p)));
+    }
+    files
+}
+
+/// Adds `path` and, recursively, the files its `include` lines name.
+fn scene_includes(path: &Path, depth: usize, files: &mut BTreeSet<PathBuf>) {
+    if !files.insert(normalize(path)) || depth >= MAX_SCENE_INCLUDE_DEPTH {
+        return;
+    }
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return;
+    };
+    let base = path.parent().unwrap_or(Path::new(""));
+    for line in text.lines() {
+        let Some(rest) = line.trim().strip_prefix("include") else {
+            continue;
+        };
+        let name = rest.trim();
+        if let Some(name) = name.strip_prefix('"').and_then(|n| n.strip_suffix('"')) {
+            scene_includes(&base.join(name.replace('\\', "/")), depth + 1, files);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn follows_scene_includes() {
+        let dir = std::env::temp_dir().join(format!("weft-sources-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("sub")).expect("temp dir");
+        std::fs::write(
+            dir.join("a.scene"),
+            "# include \"ignored.scene\"\ninclude \"sub/b.scene\"\n",
+        )
+        .expect("write a");
+        std::fs::write(dir.join("sub/b.scene"), "include \"../a.scene\"\n").expect("write b");
+        let mut files = BTreeSet::new();
+        scene_includes(&dir.join("a.scene"), 0, &mut files);
+        let expected: BTreeSet<PathBuf> = [dir.join("a.scene"), dir.join("sub/b.scene")]
+            .iter()
+            .map(|p| normalize(p))
+            .collect();
+        assert_eq!(files, expected);
+        std::fs::remove_dir_all(&dir).expect("clean up");
+    }
+}
