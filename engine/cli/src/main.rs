@@ -3,6 +3,7 @@
 mod graph_cmd;
 mod render_cmd;
 mod scene_cmd;
+mod watch_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

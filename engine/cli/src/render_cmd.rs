@@ -60,6 +60,11 @@ pub struct RenderArgs {
     /// Use the first device whose name contains this.
     #[arg(long)]
     device: Option<String>,
+    /// Keep running: re-render whenever the graph, its includes, its shaders or the
+    /// scene change, replacing --out atomically and printing one line per change;
+    /// stop with Ctrl-C (SIGINT) or SIGTERM.
+    #[arg(long)]
+    watch: bool,
 }
 
 fn parse_size(text: &str) -> Result<Extent, String> {
@@ -92,32 +97,9 @@ fn default_out(scene: &Path) -> PathBuf {
     Path::new("out").join(format!("{stem}.png"))
 }
 
-/// Runs `weft render`.
-pub fn run(args: RenderArgs) -> Result<ExitCode> {
-    let out = args.out.clone().unwrap_or_else(|| default_out(&args.scene));
-    let exr = match out.extension().and_then(|e| e.to_str()) {
-        Some("png") => false,
-        Some("exr") => true,
-        _ => bail!("--out {}: use a .png or .exr file name", out.display()),
-    };
-    let hdr_name = "hdr";
-    let extra_readback = if exr && graph_has_image(&args.graph, hdr_name) {
-        vec![hdr_name.to_string()]
-    } else {
-        Vec::new()
-    };
-    let scene = weft_scene::load_scene(&args.scene)
-        .with_context(|| format!("loading {}", args.scene.display()))?;
-    let gpu = Gpu::new(&GpuOptions {
-        validation: args.validate,
-        device: args.device.clone(),
-    })?;
-    let log = gpu.validation();
-    let device = gpu.info().name.clone();
-    if !args.json {
-        println!("device: {device} ({:?})", gpu.info().kind);
-    }
-    let settings = RenderSettings {
+/// The render settings the arguments ask for.
+fn settings(args: &RenderArgs, extra_readback: Vec<String>) -> RenderSettings {
+    RenderSettings {
         graph: args.graph.clone(),
         extent: args.size,
         frames: args.frames,
@@ -132,7 +114,51 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         readback: true,
         extra_readback,
         ..RenderSettings::default()
+    }
+}
+
+/// Runs `weft render`.
+pub fn run(args: RenderArgs) -> Result<ExitCode> {
+    let out = args.out.clone().unwrap_or_else(|| default_out(&args.scene));
+    let exr = match out.extension().and_then(|e| e.to_str()) {
+        Some("png") => false,
+        Some("exr") => true,
+        _ => bail!("--out {}: use a .png or .exr file name", out.display()),
     };
+    let hdr_name = "hdr";
+    let extra_readback = if exr && graph_has_image(&args.graph, hdr_name) {
+        vec![hdr_name.to_string()]
+    } else {
+        Vec::new()
+    };
+    let settings = settings(&args, extra_readback);
+    if args.watch {
+        return crate::watch_cmd::run(crate::watch_cmd::WatchRequest {
+            scene: &args.scene,
+            out: &out,
+            image: settings
+                .extra_readback
+                .iter()
+                .any(|n| n == hdr_name)
+                .then_some(hdr_name),
+            settings,
+            gpu: GpuOptions {
+                validation: args.validate,
+                device: args.device.clone(),
+            },
+        });
+    }
+    let scene = weft_scene::load_scene(&args.scene)
+        .with_context(|| format!("loading {}", args.scene.display()))?;
+    let gpu = Gpu::new(&GpuOptions {
+        validation: args.validate,
+        device: args.device.clone(),
+    })?;
+    let log = gpu.validation();
+    let device = gpu.info().name.clone();
+    if !args.json {
+        println!("device: {device} ({:?})", gpu.info().kind);
+    }
     let rendered = render(&gpu, &scene, &settings)?;
     drop(gpu);
     let hdr = rendered

@@ -42,7 +42,12 @@ impl ReloadError {
         Self {
             file: file.to_path_buf(),
             line,
-            message: message.lines().next().unwrap_or_default().to_string(),
+            message: message
+                .lines()
+                .next()
+                .map(|l| l.strip_prefix("error: ").unwrap_or(l).trim())
+                .unwrap_or_default()
+                .to_string(),
         }
     }
 
