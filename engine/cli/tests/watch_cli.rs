@@ -58,6 +58,37 @@ fn shader_edit_error_and_fix() {
 }
 
 #[test]
+fn shader_include_error_is_located_in_the_include() {
+    let _serial = serial();
+    let fixture = Fixture::new("include");
+    let mut watch = Watch::start(&fixture, &[]);
+    let include = "shaders/include/lighting.glsl";
+    let original = fixture.read(include);
+    let first = fixture.pixels();
+
+    let broken_line = original.lines().count() + 1;
+    fixture.save_in_place(include, &format!("{original}this is not glsl\n"));
+    let line = watch.line();
+    assert!(
+        line.starts_with("error: ")
+            && line.contains(&format!("lighting.glsl:{broken_line}: "))
+            && line.ends_with("(kept last good)"),
+        "{line}"
+    );
+    assert_eq!(fixture.pixels(), first, "the last good image is kept");
+
+    fixture.save_by_rename(include, &format!("{original}// edited\n"));
+    let line = watch.line();
+    assert!(
+        line.starts_with("reloaded ") && line.contains("lighting.glsl"),
+        "{line}"
+    );
+    assert_eq!(fixture.pixels(), first, "a comment changes nothing");
+    let status = watch.terminate();
+    assert!(status.success(), "{status:?}");
+}
+
+#[test]
 fn graph_edit_validation_error_and_fix() {
     let _serial = serial();
     let fixture = Fixture::new("graph");

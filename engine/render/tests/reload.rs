@@ -1,0 +1,136 @@
+//! `LiveRender` hot reload on a private copy of the forward graph, the shaders and
+//! a tiny scene: a refused reload changes nothing that renders, files changed
+//! meanwhile are reloaded with the next good version, and the watched sources
+//! cover graph includes, shader includes and the scene's model.
+
+mod common;
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use weft_gpu::{Gpu, GpuOptions};
+use weft_graph::plan::Extent;
+use weft_render::sources::normalize;
+use weft_render::{LiveRender, RenderSettings};
+
+const QUAD_OBJ: &str =
+    "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nvn 0 1 0\nf 1//1 3//1 2//1\nf 1//1 4//1 3//1\n";
+const SCENE: &str = "model\n{\n\tfile \"quad.obj\"\n}\n\ncamera\n{\n\tposition 0 3 5\n\ttarget 0 0 0\n}\n\nsunlight\n{\n\tdirection -0.3 -1 -0.4\n\tcolor 0.3 0.3 0.3\n}\n";
+const TONEMAP_OUT: &str = "color = vec4(c / (1.0 + c), 1.0);";
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("create folder");
+    for entry in std::fs::read_dir(from).expect("read folder") {
+        let entry = entry.expect("entry");
+        let target = to.join(entry.file_name());
+        if entry.path().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).expect("copy");
+        }
+    }
+}
+
+/// A temporary copy of `graphs/` and `shaders/` with the tiny scene.
+fn fixture(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("weft-reload-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    copy_dir(&common::root().join("graphs"), &dir.join("graphs"));
+    copy_dir(&common::root().join("shaders"), &dir.join("shaders"));
+    std::fs::create_dir_all(dir.join("scenes")).expect("scenes");
+    std::fs::write(dir.join("scenes/quad.obj"), QUAD_OBJ).expect("obj");
+    std::fs::write(dir.join("scenes/tiny.scene"), SCENE).expect("scene");
+    dir
+}
+
+fn settings(dir: &Path) -> RenderSettings {
+    RenderSettings {
+        graph: dir.join("graphs/forward.ron"),
+        extent: Extent {
+            width: 64,
+            height: 36,
+        },
+        ..RenderSettings::default()
+    }
+}
+
+fn pixels(live: &mut LiveRender<'_>) -> Vec<u8> {
+    let report = live.frame().expect("frame");
+    report.output.expect("output").to_rgba8().into_raw()
+}
+
+fn edit(path: &Path, from: &str, to: &str) {
+    let text = std::fs::read_to_string(path).expect("read");
+    assert!(text.contains(from), "{} lacks {from}", path.display());
+    std::fs::write(path, text.replace(from, to)).expect("write");
+}
+
+#[test]
+fn a_refused_reload_keeps_the_last_good_version_and_the_next_good_one_takes_every_change() {
+    let dir = fixture("refused");
+    let gpu = Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("gpu");
+    let mut live =
+        LiveRender::new(&gpu, &dir.join("scenes/tiny.scene"), settings(&dir)).expect("live");
+    let first = pixels(&mut live);
+
+    let tonemap = dir.join("shaders/tonemap.frag");
+    let graph = dir.join("graphs/forward.ron");
+    edit(&tonemap, TONEMAP_OUT, "color = vec4(1.0, 0.0, 0.0, 1.0);");
+    edit(&graph, "sampled: [\"hdr\",", "sampled: [\"hdx\",");
+    let both = BTreeSet::from([normalize(&tonemap), normalize(&graph)]);
+    let err = live
+        .apply(&both)
+        .expect_err("the graph names an unknown image");
+    assert_eq!(err.file, graph);
+    assert!(err.line.is_some() && err.message.contains("hdx"), "{err}");
+    assert_eq!(
+        pixels(&mut live),
+        first,
+        "neither the graph nor the shader edit goes live"
+    );
+
+    edit(&graph, "sampled: [\"hdx\",", "sampled: [\"hdr\",");
+    let reloaded = live
+        .apply(&BTreeSet::from([normalize(&graph)]))
+        .expect("fixed");
+    assert_eq!(reloaded, both.iter().cloned().collect::<Vec<_>>());
+    assert!(
+        pixels(&mut live)
+            .chunks_exact(4)
+            .all(|p| p == [255, 0, 0, 255]),
+        "the shader edit made while the graph was broken is live now"
+    );
+
+    let unrelated = BTreeSet::from([normalize(&dir.join("graphs/README.md"))]);
+    assert_eq!(
+        live.apply(&unrelated).expect("ignored"),
+        Vec::<PathBuf>::new()
+    );
+    drop(live);
+    assert!(gpu.validation().messages().is_empty());
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
+#[test]
+fn sources_cover_graph_includes_shader_includes_and_the_scene_model() {
+    let dir = fixture("sources");
+    let gpu = Gpu::new(&GpuOptions::default()).expect("gpu");
+    let live = LiveRender::new(&gpu, &dir.join("scenes/tiny.scene"), settings(&dir)).expect("live");
+    let sources = live.sources();
+    let has = |set: &BTreeSet<PathBuf>, file: &str| set.contains(&normalize(&dir.join(file)));
+    assert!(has(&sources.graph, "graphs/forward.ron"));
+    assert!(has(&sources.graph, "graphs/bloom.ron"));
+    assert!(has(&sources.graph, "graphs/shadows.ron"));
+    let shaders: BTreeSet<PathBuf> = sources.shaders.keys().cloned().collect();
+    assert!(has(&shaders, "shaders/forward.frag"));
+    assert!(has(&shaders, "shaders/include/lighting.glsl"));
+    assert!(has(&shaders, "shaders/include/scene.glsl"));
+    assert!(has(&shaders, "shaders/tonemap.frag"));
+    assert!(has(&sources.scene, "scenes/tiny.scene"));
+    assert!(has(&sources.scene, "scenes/quad.obj"));
+    drop(live);
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}

@@ -1,0 +1,76 @@
+//! The debounced file watcher as editors exercise it: rename-over saves, bursts
+//! of writes handed out as one batch after the quiet period, files outside the
+//! watched set ignored.
+
+use std::collections::BTreeSet;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+use weft_render::sources::normalize;
+use weft_render::watch::{FileWatcher, QUIET};
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("weft-watch-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn watching(files: &[&PathBuf]) -> FileWatcher {
+    let mut watcher = FileWatcher::new(QUIET).expect("watcher");
+    let set: BTreeSet<PathBuf> = files.iter().map(|f| normalize(f)).collect();
+    watcher.watch(&set).expect("watch");
+    watcher
+}
+
+#[test]
+fn rename_over_is_seen_and_other_files_are_not() {
+    let dir = temp_dir("rename");
+    let file = dir.join("a.frag");
+    std::fs::write(&file, "one").expect("write");
+    let mut watcher = watching(&[&file]);
+    std::fs::write(dir.join("other.txt"), "noise").expect("write other");
+    assert!(watcher
+        .next_batch(Duration::from_millis(300))
+        .expect("batch")
+        .is_empty());
+    let tmp = dir.join(".a.frag.swp");
+    std::fs::write(&tmp, "two").expect("write temp");
+    std::fs::rename(&tmp, &file).expect("rename over");
+    let batch = watcher.next_batch(Duration::from_secs(10)).expect("batch");
+    assert_eq!(batch, BTreeSet::from([normalize(&file)]));
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
+#[test]
+fn a_burst_of_writes_is_one_batch_after_the_quiet_period() {
+    let dir = temp_dir("burst");
+    let a = dir.join("a.ron");
+    let b = dir.join("b.ron");
+    std::fs::write(&a, "").expect("write a");
+    std::fs::write(&b, "").expect("write b");
+    let mut watcher = watching(&[&a, &b]);
+    let writer = {
+        let (a, b) = (a.clone(), b.clone());
+        std::thread::spawn(move || {
+            for i in 0..5 {
+                std::fs::write(&a, format!("part {i}")).expect("write a");
+                std::fs::write(&b, format!("part {i}")).expect("write b");
+                std::thread::sleep(QUIET / 10);
+            }
+            Instant::now()
+        })
+    };
+    let batch = watcher.next_batch(Duration::from_secs(10)).expect("batch");
+    let returned = Instant::now();
+    let last_write = writer.join().expect("writer");
+    assert_eq!(batch, BTreeSet::from([normalize(&a), normalize(&b)]));
+    assert!(
+        returned.duration_since(last_write) >= QUIET / 2,
+        "the batch waits for the writes to stop"
+    );
+    assert!(watcher
+        .next_batch(Duration::from_millis(200))
+        .expect("batch")
+        .is_empty());
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
