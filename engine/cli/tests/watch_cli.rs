@@ -1,6 +1,6 @@
 //! `weft render --watch`: edits to a shader, the graph and the scene are picked
 //! up; broken edits leave the process alive with the last good image and print
-//! the error at file:line; fixing them recovers; SIGTERM exits with status 0.
+//! the error at file:line; fixing them recovers; SIGTERM and SIGINT exit with status 0.
 
 mod watch_support;
 
@@ -144,7 +144,7 @@ fn graph_edit_validation_error_and_fix() {
         first,
         "restoring the graph recovers the image"
     );
-    let status = watch.terminate();
+    let status = watch.interrupt();
     assert!(status.success(), "{status:?}");
 }
 
