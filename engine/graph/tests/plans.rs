@@ -19,6 +19,7 @@ const FEATURE_SETS: &[(&str, &[&str])] = &[
             "point_lights",
             "spot_lights",
             "depth_prepass",
+            "transparent",
         ],
     ),
 ];
@@ -100,7 +101,12 @@ fn plans_match_snapshots_and_pass_the_checker() {
 fn removing_any_barrier_makes_the_checker_fail() {
     let graph = weft_graph::load(&repo_root().join("graphs/deferred.ron"));
     let options = CompileOptions {
-        features: graph.features(&["shadow_casters", "point_lights", "spot_lights"]),
+        features: graph.features(&[
+            "shadow_casters",
+            "point_lights",
+            "spot_lights",
+            "transparent",
+        ]),
         ..CompileOptions::default()
     };
     let plan = weft_graph::compile(&graph, &options).expect("deferred compiles");
@@ -148,6 +154,7 @@ fn scene_features_cull_passes_and_variants() {
             ("shadow_sun", "enabled_if [shadow_casters] is false"),
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
+            ("transparent", "enabled_if [transparent] is false"),
         ]
     );
     let sun = plan

@@ -7,7 +7,7 @@ use weft_scene::{Light, Scene};
 
 /// The features `scene` switches on: `shadow_casters` when a placed mesh casts,
 /// `point_lights` / `spot_lights` when there are such lights, `emissive` when a
-/// placed mesh glows.
+/// placed mesh glows, `transparent` when a placed mesh blends.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
     let placed = || {
         scene
@@ -29,6 +29,9 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     }
     if placed().any(|m| matches(MaterialFilter::Emissive, &m)) {
         features.push("emissive".to_string());
+    }
+    if placed().any(|m| matches(MaterialFilter::Transparent, &m)) {
+        features.push("transparent".to_string());
     }
     if scene.lights.iter().any(|l| matches!(l, Light::Point(_))) {
         features.push("point_lights".to_string());

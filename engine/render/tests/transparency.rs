@@ -1,5 +1,6 @@
-//! Transparent materials in a forward pass that draws every mesh: blended over
-//! what lies behind them with their opacity (MTL `d`), in linear HDR.
+//! Transparent materials, in forward's pass that draws every mesh and in
+//! deferred's transparent pass after lighting: blended over what lies behind them
+//! with their opacity (MTL `d`), in linear HDR.
 
 use std::path::Path;
 use weft_gpu::{Gpu, GpuOptions, Pixels};
@@ -8,7 +9,7 @@ use weft_render::{render, RenderSettings};
 
 /// Writes a scene with one white quad facing the camera, lit head-on by a white
 /// sun, with dissolve `d`, and returns the HDR value at the centre.
-fn centre_hdr(dir: &Path, d: f32) -> [f32; 4] {
+fn centre_hdr(dir: &Path, graph: &str, d: f32) -> [f32; 4] {
     std::fs::create_dir_all(dir).expect("temp dir");
     std::fs::write(
         dir.join("quad.obj"),
@@ -33,7 +34,9 @@ fn centre_hdr(dir: &Path, d: f32) -> [f32; 4] {
     .expect("device");
     let log = gpu.validation();
     let settings = RenderSettings {
-        graph: Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs/forward.ron"),
+        graph: Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../graphs")
+            .join(graph),
         extent: Extent {
             width: 16,
             height: 16,
@@ -56,11 +59,13 @@ fn centre_hdr(dir: &Path, d: f32) -> [f32; 4] {
 #[test]
 fn a_half_transparent_quad_lets_half_the_background_through() {
     let dir = std::env::temp_dir().join(format!("weft-transparency-{}", std::process::id()));
-    let opaque = centre_hdr(&dir.join("opaque"), 1.0);
-    let glass = centre_hdr(&dir.join("glass"), 0.5);
+    for graph in ["forward.ron", "deferred.ron"] {
+        let opaque = centre_hdr(&dir.join("opaque"), graph, 1.0);
+        let glass = centre_hdr(&dir.join("glass"), graph, 0.5);
+        // Kd 1 lit head-on by a unit sun: 1.0; half of it over the black clear colour:
+        // 0.5 (R16G16B16A16_SFLOAT stores both exactly).
+        assert_eq!(opaque[..3], [1.0, 1.0, 1.0], "{graph}");
+        assert_eq!(glass[..3], [0.5, 0.5, 0.5], "{graph}");
+    }
     std::fs::remove_dir_all(&dir).expect("clean up");
-    // Kd 1 lit head-on by a unit sun: 1.0; half of it over the black clear colour: 0.5
-    // (R16G16B16A16_SFLOAT stores both exactly).
-    assert_eq!(opaque[..3], [1.0, 1.0, 1.0]);
-    assert_eq!(glass[..3], [0.5, 0.5, 0.5]);
 }
