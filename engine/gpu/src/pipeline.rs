@@ -295,7 +295,9 @@ fn dependencies(modules: &[&ShaderModule]) -> BTreeSet<PathBuf> {
         .collect()
 }
 
-fn blend_state(blend: BlendCode) -> vk::PipelineColorBlendAttachmentState {
+/// The colour-blend state of a blend mode, shared by the executor's pipelines and
+/// the render crate's scene pipelines.
+pub fn blend_state(blend: BlendCode) -> vk::PipelineColorBlendAttachmentState {
     let state = vk::PipelineColorBlendAttachmentState::default()
         .color_write_mask(vk::ColorComponentFlags::RGBA);
     match blend {

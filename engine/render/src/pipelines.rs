@@ -9,7 +9,7 @@ use ash::vk;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
-use weft_gpu::pipeline::{BlendCode, PipelineCache, ShaderKey, ShaderModule};
+use weft_gpu::pipeline::{blend_state, PipelineCache, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::{GpuError, SCENE_SET};
 
@@ -62,30 +62,6 @@ fn stage_create_info(
         .stage(stage)
         .module(module)
         .name(c"main")
-}
-
-fn blend_state(blend: BlendCode) -> vk::PipelineColorBlendAttachmentState {
-    let state = vk::PipelineColorBlendAttachmentState::default()
-        .color_write_mask(vk::ColorComponentFlags::RGBA);
-    match blend {
-        BlendCode::Off => state,
-        BlendCode::Additive => state
-            .blend_enable(true)
-            .src_color_blend_factor(vk::BlendFactor::ONE)
-            .dst_color_blend_factor(vk::BlendFactor::ONE)
-            .color_blend_op(vk::BlendOp::ADD)
-            .src_alpha_blend_factor(vk::BlendFactor::ONE)
-            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-            .alpha_blend_op(vk::BlendOp::ADD),
-        BlendCode::Alpha => state
-            .blend_enable(true)
-            .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
-            .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-            .color_blend_op(vk::BlendOp::ADD)
-            .src_alpha_blend_factor(vk::BlendFactor::ONE)
-            .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-            .alpha_blend_op(vk::BlendOp::ADD),
-    }
 }
 
 fn depth_state(test: DepthTest) -> vk::PipelineDepthStencilStateCreateInfo<'static> {
