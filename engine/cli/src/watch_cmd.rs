@@ -12,7 +12,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 use weft_gpu::{Gpu, GpuOptions, ValidationLog};
 use weft_render::watch::{FileWatcher, QUIET};
-use weft_render::{LiveRender, RenderSettings};
+use weft_render::{startup_files, LiveRender, RenderSettings};
 
 /// How often the loop looks for an interrupt while no file changes.
 const POLL: Duration = Duration::from_millis(100);
@@ -31,8 +31,8 @@ pub struct WatchRequest<'a> {
     pub gpu: GpuOptions,
 }
 
-/// Runs the watch loop; returns success when interrupted, failure when the first
-/// version does not load or validation reported anything.
+/// Runs the watch loop; returns success when interrupted, failure when validation
+/// reported anything. A first version that does not load is waited for, not fatal.
 pub fn run(request: WatchRequest) -> Result<ExitCode> {
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
@@ -41,11 +41,12 @@ pub fn run(request: WatchRequest) -> Result<ExitCode> {
     let gpu = Gpu::new(&request.gpu)?;
     let log = gpu.validation();
     let graph = request.settings.graph.clone();
-    let mut live =
-        LiveRender::new(&gpu, request.scene, request.settings).map_err(|e| anyhow!("{e}"))?;
+    let mut watcher = FileWatcher::new(QUIET)?;
+    let Some(mut live) = first_version(&gpu, &request, &mut watcher, &stop)? else {
+        return Ok(exit_code(report_validation(&log)));
+    };
     let started = Instant::now();
     write_frame(&mut live, request.out, request.image).map_err(|e| anyhow!("{e}"))?;
-    let mut watcher = FileWatcher::new(QUIET)?;
     watcher.watch(&live.sources().all())?;
     println!(
         "wrote {} in {:.1} ms; watching {} files (Ctrl-C to stop)",
@@ -59,19 +60,58 @@ pub fn run(request: WatchRequest) -> Result<ExitCode> {
         if changed.is_empty() {
             continue;
         }
-        println!(
-            "{}",
-            reload(&mut live, &changed, request.out, request.image, &graph)
-        );
+        let line = reload(&mut live, &changed, request.out, request.image, &graph);
+        // Watch the new set before saying so: an edit made on seeing the line is caught.
+        if let Err(err) = watcher.watch(&live.sources().all()) {
+            println!("error: {err} (still watching the other files)");
+        }
+        println!("{line}");
         std::io::stdout().flush()?;
-        watcher.watch(&live.sources().all())?;
         clean &= report_validation(&log);
     }
-    Ok(if clean {
+    Ok(exit_code(clean))
+}
+
+/// Success unless validation reported something.
+fn exit_code(clean: bool) -> ExitCode {
+    if clean {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE
-    })
+    }
+}
+
+/// Loads the first version; while it fails, prints the error and waits for one of
+/// the files it reads to change. `None` when interrupted first.
+fn first_version<'g>(
+    gpu: &'g Gpu,
+    request: &WatchRequest,
+    watcher: &mut FileWatcher,
+    stop: &AtomicBool,
+) -> Result<Option<LiveRender<'g>>> {
+    let mut watched = BTreeSet::new();
+    loop {
+        let err = match LiveRender::new(gpu, request.scene, request.settings.clone()) {
+            Ok(live) => return Ok(Some(live)),
+            Err(err) => err,
+        };
+        let files = startup_files(gpu, request.scene, &request.settings, &err);
+        if files != watched {
+            watcher.watch(&files)?;
+            watched = files;
+            // A fix saved before the watch was set raises no event: try again first.
+            continue;
+        }
+        println!("error: {err} (no good version yet; waiting for a fix)");
+        loop {
+            if stop.load(Ordering::SeqCst) {
+                return Ok(None);
+            }
+            if !watcher.next_batch(POLL)?.is_empty() {
+                break;
+            }
+        }
+    }
 }
 
 /// Applies one batch of changes and writes the new image; the line to print.

@@ -58,6 +58,31 @@ fn shader_edit_error_and_fix() {
 }
 
 #[test]
+fn a_broken_first_version_is_waited_for() {
+    let _serial = serial();
+    let fixture = Fixture::new("startup");
+    let original = fixture.read(TONEMAP);
+    let broken_line = original.lines().count() + 1;
+    fixture.save_in_place(TONEMAP, &format!("{original}this is not glsl\n"));
+    let mut watch = Watch::spawn(&fixture, &[]);
+    let line = watch.line();
+    assert!(
+        line.starts_with("error: ")
+            && line.contains(&format!("tonemap.frag:{broken_line}: "))
+            && line.ends_with("(no good version yet; waiting for a fix)"),
+        "{line}"
+    );
+    assert!(!fixture.path("out/live.png").exists());
+
+    fixture.save_by_rename(TONEMAP, &original);
+    let line = watch.line();
+    assert!(line.starts_with("wrote out/live.png"), "{line}");
+    assert!(brightness(&fixture.pixels()) > 0.0);
+    let status = watch.terminate();
+    assert!(status.success(), "{status:?}");
+}
+
+#[test]
 fn shader_include_error_is_located_in_the_include() {
     let _serial = serial();
     let fixture = Fixture::new("include");

@@ -32,5 +32,5 @@ pub use error::RenderError;
 pub use features::scene_features;
 pub use frame::{compile_for_scene, render, RenderSettings, Rendered};
 pub use recorder::SceneRecorder;
-pub use reload::{LiveRender, ReloadError};
+pub use reload::{startup_files, LiveRender, ReloadError};
 pub use scene_gpu::GpuScene;

@@ -8,7 +8,9 @@ use crate::error::RenderError;
 use crate::frame::{compile_for_scene, RenderSettings};
 use crate::recorder::SceneRecorder;
 use crate::scene_gpu::GpuScene;
-use crate::sources::{normalize, plan_shader_keys, scene_files, shader_files, Sources};
+use crate::sources::{
+    normalize, plan_shader_keys, scene_files, scene_path_files, shader_files, Sources,
+};
 use std::collections::BTreeSet;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -313,6 +315,36 @@ impl<'g> LiveRender<'g> {
         self.pending.clear();
         Ok(pending.into_iter().collect())
     }
+}
+
+/// The files a render that failed to start reads, as far as they can be found
+/// (the graph and its includes, the scene and its includes and models, the shader
+/// files of the plan when it compiles, and the file the error is in), so a watcher
+/// can wait for the fix.
+pub fn startup_files(
+    gpu: &Gpu,
+    scene_path: &Path,
+    settings: &RenderSettings,
+    error: &ReloadError,
+) -> BTreeSet<PathBuf> {
+    let mut files = graph_files(&settings.graph);
+    files.insert(normalize(&error.file));
+    files.extend(scene_path_files(scene_path));
+    let Ok(scene) = weft_scene::load_scene(scene_path) else {
+        return files;
+    };
+    files.extend(scene_files(&scene));
+    if let Ok(keys) = compile_for_scene(gpu, &scene, settings)
+        .map_err(|e| e.to_string())
+        .and_then(|plan| plan_shader_keys(&plan).map_err(|e| e.to_string()))
+    {
+        files.extend(
+            keys.iter()
+                .filter(|k| k.path.is_file())
+                .map(|k| normalize(&k.path)),
+        );
+    }
+    files
 }
 
 /// The graph file and its includes, normalized.

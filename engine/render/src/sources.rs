@@ -107,6 +107,14 @@ pub fn scene_files(scene: &Scene) -> BTreeSet<PathBuf> {
     files
 }
 
+/// The scene file and the files its `include` lines name, recursively, for a scene
+/// that may not load.
+pub fn scene_path_files(path: &Path) -> BTreeSet<PathBuf> {
+    let mut files = BTreeSet::new();
+    scene_includes(path, 0, &mut files);
+    files
+}
+
 /// Adds `path` and, recursively, the files its `include` lines name.
 fn scene_includes(path: &Path, depth: usize, files: &mut BTreeSet<PathBuf>) {
     if !files.insert(normalize(path)) || depth >= MAX_SCENE_INCLUDE_DEPTH {

@@ -73,11 +73,13 @@ impl FileWatcher {
     }
 
     /// Watches exactly `files` (normalized paths) from now on: their folders are
-    /// watched, folders no longer needed are let go.
+    /// watched, folders no longer needed are let go; files in folders that do not
+    /// exist are skipped (an include naming a missing folder is the loader's error).
     pub fn watch(&mut self, files: &BTreeSet<PathBuf>) -> Result<(), WatchError> {
         let dirs: BTreeSet<PathBuf> = files
             .iter()
             .filter_map(|f| f.parent())
+            .filter(|d| d.is_dir())
             .map(Path::to_path_buf)
             .collect();
         for gone in self.dirs.difference(&dirs) {

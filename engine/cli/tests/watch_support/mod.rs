@@ -125,6 +125,14 @@ impl Watch {
     /// Starts the child on the fixture (64x36, forward graph, `extra` arguments) and
     /// waits for its first image.
     pub fn start(fixture: &Fixture, extra: &[&str]) -> Self {
+        let mut watch = Self::spawn(fixture, extra);
+        let first = watch.line();
+        assert!(first.starts_with("wrote out/live.png"), "{first}");
+        watch
+    }
+
+    /// Starts the child on the fixture without waiting for anything.
+    pub fn spawn(fixture: &Fixture, extra: &[&str]) -> Self {
         let mut child = Command::new(env!("CARGO_BIN_EXE_weft"))
             .args([
                 "render",
@@ -166,14 +174,11 @@ impl Watch {
                 }
             }
         });
-        let mut watch = Self {
+        Self {
             child,
             lines,
             stderr,
-        };
-        let first = watch.line();
-        assert!(first.starts_with("wrote out/live.png"), "{first}");
-        watch
+        }
     }
 
     /// The next line the child prints.
