@@ -65,9 +65,7 @@ fn reports_every_disagreement_between_shaders_and_graph() {
     );
     drop(resources);
     drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }
 
 #[test]
@@ -97,7 +95,5 @@ fn reload_drops_pipelines_built_from_a_changed_file() {
         [32, 191, 51, 255]
     );
     drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }

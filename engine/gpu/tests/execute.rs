@@ -57,9 +57,7 @@ fn fullscreen_compute_blit_graph_renders_exact_pixels() {
     assert_eq!(json["transient_bytes"], plan.memory.transient_bytes);
     drop(resources);
     drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }
 
 #[test]
@@ -174,9 +172,7 @@ fn renders_several_frames_with_cached_pipelines_and_timings() {
     assert_eq!(renderer.check_shaders(&plan), Vec::new());
     drop(resources);
     drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }
 
 #[test]
@@ -210,9 +206,7 @@ fn history_images_carry_values_across_frames() {
     );
     drop(resources);
     drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }
 
 #[test]
@@ -257,88 +251,41 @@ fn transient_images_share_memory_as_planned() {
     );
     drop(resources);
     drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }
 
 #[test]
 fn depth_attachments_clear_and_are_sampled() {
     let gpu = common::gpu();
     let plan = common::compile(&gpu, &common::graph("depth.ron"), 4, 4);
-    let mut renderer = Renderer::new(&gpu).expect("renderer");
-    let report = renderer
-        .render(
-            &plan,
-            &mut NoDraws,
-            1,
-            0.0,
-            &FrameOptions {
-                readback: true,
-                ..FrameOptions::default()
-            },
-        )
-        .expect("frame");
+    let report = common::render_readback(&gpu, &plan, 1);
     let output = report.output.expect("readback");
     // Depth cleared to 0.25 and never written: 0.25 * 255 = 63.75.
     assert_eq!(output.rgba8_at(2, 1), [64, 0, 0, 255]);
-    drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }
 
 #[test]
 fn image_and_buffer_copies_carry_data_between_passes() {
     let gpu = common::gpu();
     let plan = common::compile(&gpu, &common::graph("copies.ron"), 8, 8);
-    let mut renderer = Renderer::new(&gpu).expect("renderer");
-    let report = renderer
-        .render(
-            &plan,
-            &mut NoDraws,
-            2,
-            0.0,
-            &FrameOptions {
-                readback: true,
-                ..FrameOptions::default()
-            },
-        )
-        .expect("frames");
+    let report = common::render_readback(&gpu, &plan, 2);
     let output = report.output.expect("readback");
     for (x, y) in [(0, 0), (3, 6), (7, 7)] {
         let expected = [(x / 2 * 32) as u8, (y / 2 * 32) as u8, 153, 255];
         assert_eq!(output.rgba8_at(x, y), expected, "pixel ({x}, {y})");
     }
-    drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }
 
 #[test]
 fn a_pass_without_bindings_renders_its_parameter() {
     let gpu = common::gpu();
     let plan = common::compile(&gpu, &common::graph("solid.ron"), 3, 2);
-    let mut renderer = Renderer::new(&gpu).expect("renderer");
-    let report = renderer
-        .render(
-            &plan,
-            &mut NoDraws,
-            1,
-            0.0,
-            &FrameOptions {
-                readback: true,
-                ..FrameOptions::default()
-            },
-        )
-        .expect("frame");
+    let report = common::render_readback(&gpu, &plan, 1);
     let output = report.output.expect("readback");
     assert_eq!(output.format, "B8G8R8A8_UNORM");
     // 0.2, 0.4, 0.6 of 255, read back from BGRA and swizzled to RGBA.
     assert_eq!(output.rgba8_at(2, 1), [51, 102, 153, 255]);
-    drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }

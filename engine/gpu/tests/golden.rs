@@ -35,7 +35,5 @@ fn mixed_graph_matches_its_golden_image() {
     }
     drop(resources);
     drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }

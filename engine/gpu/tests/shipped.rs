@@ -152,9 +152,7 @@ fn render_forward(features: &[&str]) -> ([u8; 4], Vec<String>) {
         assert_eq!(output.rgba8_at(x, y), centre, "pixel ({x}, {y})");
     }
     drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
     (centre, passes)
 }
 
@@ -219,7 +217,5 @@ fn forward_bloom_matches_its_golden_image() {
         panic!("{e}");
     }
     drop(renderer);
-    let log = gpu.validation();
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    common::assert_no_validation_messages(gpu);
 }

@@ -52,3 +52,23 @@ pub fn compile_with(gpu: &Gpu, path: &Path, width: u32, height: u32, features: &
         Err(diagnostics) => panic!("{} does not compile: {diagnostics:?}", path.display()),
     }
 }
+
+/// Renders `frames` frames of a plan without scene draws and reads the output back.
+pub fn render_readback(gpu: &Gpu, plan: &Plan, frames: u32) -> weft_gpu::FrameReport {
+    let mut renderer = weft_gpu::Renderer::new(gpu).expect("renderer");
+    let options = weft_gpu::FrameOptions {
+        readback: true,
+        ..weft_gpu::FrameOptions::default()
+    };
+    renderer
+        .render(plan, &mut weft_gpu::NoDraws, frames, 0.0, &options)
+        .expect("frames render")
+}
+
+/// Destroys the context (so leak reports at destruction count too) and asserts
+/// the validation layer said nothing.
+pub fn assert_no_validation_messages(gpu: Gpu) {
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}
