@@ -1,6 +1,9 @@
 //! The `weft` command.
 
+mod bench_cmd;
+mod bench_lights;
 mod graph_cmd;
+mod plot;
 mod render_cmd;
 mod scene_cmd;
 mod watch_cmd;
@@ -26,6 +29,9 @@ enum Command {
     Scene(scene_cmd::SceneCommand),
     /// Render a scene through a graph to an image.
     Render(render_cmd::RenderArgs),
+    /// Benchmarks that write figures and plots (into docs/ by default).
+    #[command(subcommand)]
+    Bench(bench_cmd::BenchCommand),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +40,7 @@ fn main() -> ExitCode {
         Command::Graph(cmd) => graph_cmd::run(cmd),
         Command::Scene(cmd) => scene_cmd::run(cmd),
         Command::Render(args) => render_cmd::run(args),
+        Command::Bench(cmd) => bench_cmd::run(cmd),
     };
     match result {
         Ok(code) => code,

@@ -67,7 +67,7 @@ pub struct RenderArgs {
     watch: bool,
 }
 
-fn parse_size(text: &str) -> Result<Extent, String> {
+pub(crate) fn parse_size(text: &str) -> Result<Extent, String> {
     let (w, h) = text
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("size must look like 1280x720, found \"{text}\""))?;

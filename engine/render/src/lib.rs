@@ -15,6 +15,7 @@ pub mod error;
 pub mod features;
 pub mod frame;
 pub mod geometry;
+pub mod light_scene;
 pub mod lights;
 pub mod materials;
 pub mod packing;

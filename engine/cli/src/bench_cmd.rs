@@ -1,0 +1,21 @@
+//! `weft bench`: benchmarks that render generated scenes, write their figures
+//! (CSV and a PNG plot, see `plot.rs`) and print a table. Each benchmark is one
+//! variant of [`BenchCommand`] in a module of its own.
+
+use anyhow::Result;
+use clap::Subcommand;
+use std::process::ExitCode;
+
+/// The benchmarks.
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// Frame time against the number of point lights, one line per graph.
+    Lights(crate::bench_lights::LightsArgs),
+}
+
+/// Runs `weft bench ...`.
+pub fn run(cmd: BenchCommand) -> Result<ExitCode> {
+    match cmd {
+        BenchCommand::Lights(args) => crate::bench_lights::run(args),
+    }
+}
