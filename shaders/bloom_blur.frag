@@ -1,37 +1,27 @@
 #version 450
-// One direction of a separable Gaussian: `radius` taps either side along
-// `direction` (in texels), weights exp(-x^2 / (2 sigma^2)) normalised to 1.
-// Neighbouring taps are paired into one linear-filtered fetch between them
-// (weight w1 + w2 at offset (x1 w1 + x2 w2) / (w1 + w2)), halving the fetches.
+// One direction of a separable Gaussian (bloom). The engine derives the taps
+// from the pass's `sigma` and `radius` parameters (engine/gpu/src/gaussian.rs):
+// neighbouring texels are paired into one linear-filtered fetch between them,
+// so radius 21 (a 43-texel footprint) takes 12 taps: the centre and 11 offsets
+// applied on both sides, 23 fetches instead of 43. Weights sum to 1.
 // Binding 0 is whatever image the pass samples (bloom_bright or bloom_blur_h).
 layout(set = 0, binding = 0) uniform sampler2D source;
 layout(push_constant) uniform Params {
-    vec2 direction;
-    float sigma;
-    int radius;
+    vec2 direction;          // (1, 0) or (0, 1)
+    int gauss_taps;          // taps used, centre included
+    float gauss_weights[12];
+    float gauss_offsets[12]; // in texels; 0 for the centre
 } params;
 
 layout(location = 0) in vec2 uv;
 layout(location = 0) out vec4 color;
 
-float weight(float x, float two_sigma2) {
-    return exp(-x * x / two_sigma2);
-}
-
 void main() {
     vec2 texel = params.direction / vec2(textureSize(source, 0));
-    float two_sigma2 = 2.0 * params.sigma * params.sigma;
-    vec3 sum = texture(source, uv).rgb;
-    float total = 1.0;
-    for (int i = 1; i <= params.radius; i += 2) {
-        float x1 = float(i);
-        float w1 = weight(x1, two_sigma2);
-        float w2 = i + 1 <= params.radius ? weight(x1 + 1.0, two_sigma2) : 0.0;
-        float w = w1 + w2;
-        float offset = (x1 * w1 + (x1 + 1.0) * w2) / w;
-        sum += w * texture(source, uv + offset * texel).rgb;
-        sum += w * texture(source, uv - offset * texel).rgb;
-        total += 2.0 * w;
+    vec3 sum = params.gauss_weights[0] * texture(source, uv).rgb;
+    for (int i = 1; i < params.gauss_taps; ++i) {
+        vec2 offset = params.gauss_offsets[i] * texel;
+        sum += params.gauss_weights[i] * (texture(source, uv + offset).rgb + texture(source, uv - offset).rgb);
     }
-    color = vec4(sum / total, 1.0);
+    color = vec4(sum, 1.0);
 }

@@ -1,10 +1,11 @@
 #version 450
-// Bloom bright pass: what each channel has above `threshold`, scaled by
-// `emissive_boost`, written at the bloom resolution.
+// Bloom bright pass, at the bloom resolution: keeps the pixels whose brightest
+// channel exceeds `threshold`, scaled by how far it does, (peak - threshold) /
+// peak, so the hue is kept and nothing pops at the threshold. A pixel at or
+// below the threshold contributes exactly zero.
 layout(set = 0, binding = 0) uniform sampler2D hdr;
 layout(push_constant) uniform Params {
     float threshold;
-    float emissive_boost;
 } params;
 
 layout(location = 0) in vec2 uv;
@@ -12,5 +13,7 @@ layout(location = 0) out vec4 color;
 
 void main() {
     vec3 c = texture(hdr, uv).rgb;
-    color = vec4(max(c - vec3(params.threshold), vec3(0.0)) * params.emissive_boost, 1.0);
+    float peak = max(c.r, max(c.g, c.b));
+    float keep = peak > params.threshold ? (peak - params.threshold) / peak : 0.0;
+    color = vec4(c * keep, 1.0);
 }

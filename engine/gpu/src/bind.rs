@@ -3,6 +3,7 @@
 //! outputs match the colour attachments; and packs graph parameters into the
 //! push-constant block by member name.
 
+use crate::gaussian::GaussianTaps;
 use crate::reflect::{DescriptorKind, PipelineInterface, PushBlock, ScalarKind, ShaderBinding};
 use std::collections::BTreeMap;
 use weft_graph::plan::{Binding, BindingKind, Plan, PlanPass, ResourceDesc};
@@ -179,7 +180,9 @@ pub struct FrameValues {
 }
 
 /// Packs parameters into the push-constant block; every member must be a
-/// graph parameter of the pass or one of `time`, `frame`, `extent`.
+/// graph parameter of the pass, one of `time`, `frame`, `extent`, or one of the
+/// values the engine derives from the pass's parameters (`gauss_*`, see
+/// [`derived_value`]).
 pub fn pack_push(
     block: &PushBlock,
     params: &BTreeMap<String, ParamValue>,
@@ -188,6 +191,7 @@ pub fn pack_push(
     let mut bytes = vec![0u8; block.size as usize];
     let mut problems = Vec::new();
     for m in &block.members {
+        let capacity = (m.components * m.count) as usize;
         let values: Vec<f64> = match params.get(&m.name) {
             Some(ParamValue::Number(n)) => vec![*n],
             Some(ParamValue::Vector(v)) => v.clone(),
@@ -203,21 +207,37 @@ pub fn pack_push(
                 "time" => vec![f64::from(frame.time)],
                 "frame" => vec![f64::from(frame.frame)],
                 "extent" => frame.extent.iter().map(|&v| f64::from(v)).collect(),
-                _ => {
-                    problems.push(format!(
-                        "push-constant member `{}` has no graph parameter of that name",
-                        m.name
-                    ));
-                    continue;
-                }
+                name => match derived_value(name, params) {
+                    Some(Ok(values)) if values.len() > capacity => {
+                        problems.push(format!(
+                            "push-constant member `{name}` holds {capacity} value(s) but the pass's `sigma` and `radius` need {}",
+                            values.len()
+                        ));
+                        continue;
+                    }
+                    Some(Ok(mut values)) => {
+                        values.resize(capacity, 0.0);
+                        values
+                    }
+                    Some(Err(problem)) => {
+                        problems.push(format!("push-constant member `{name}`: {problem}"));
+                        continue;
+                    }
+                    None => {
+                        problems.push(format!(
+                            "push-constant member `{name}` has no graph parameter of that name"
+                        ));
+                        continue;
+                    }
+                },
             },
         };
-        if values.len() != m.components as usize {
+        if values.len() != capacity {
             problems.push(format!(
                 "parameter `{}` has {} component(s) but the shader member has {}",
                 m.name,
                 values.len(),
-                m.components
+                capacity
             ));
             continue;
         }
@@ -227,7 +247,9 @@ pub fn pack_push(
                 ScalarKind::Int => (*v as i32).to_ne_bytes(),
                 ScalarKind::Uint => (*v as u32).to_ne_bytes(),
             };
-            let at = m.offset as usize + 4 * i;
+            let element = i / m.components as usize;
+            let component = i % m.components as usize;
+            let at = m.offset as usize + element * m.stride as usize + 4 * component;
             match bytes.get_mut(at..at + 4) {
                 Some(slot) => slot.copy_from_slice(&word),
                 None => problems.push(format!(
@@ -244,6 +266,42 @@ pub fn pack_push(
     }
 }
 
+/// Values the engine computes from a pass's parameters rather than taking
+/// them literally: a Gaussian blur's taps from `sigma` and `radius`
+/// (`gauss_weights`, `gauss_offsets` and the tap count `gauss_taps`, centre
+/// included). With `linear_taps: false` the taps are one per texel (offsets
+/// 0, 1, 2, ...), otherwise neighbours are paired into linear-filtered fetches.
+/// `None` for a name that is not derived.
+pub fn derived_value(
+    name: &str,
+    params: &BTreeMap<String, ParamValue>,
+) -> Option<Result<Vec<f64>, String>> {
+    if !matches!(name, "gauss_weights" | "gauss_offsets" | "gauss_taps") {
+        return None;
+    }
+    let number = |key: &str| match params.get(key) {
+        Some(ParamValue::Number(n)) => Ok(*n),
+        _ => Err(format!("the pass needs a numeric parameter `{key}`")),
+    };
+    let linear = !matches!(params.get("linear_taps"), Some(ParamValue::Bool(false)));
+    Some(number("sigma").and_then(|sigma| {
+        let radius = number("radius")?;
+        if radius.fract() != 0.0 || radius < 0.0 {
+            return Err(format!("`radius` must be a whole number, got {radius}"));
+        }
+        let taps = if linear {
+            GaussianTaps::linear(sigma, radius as u32)?
+        } else {
+            GaussianTaps::discrete(sigma, radius as u32)?
+        };
+        Ok(match name {
+            "gauss_weights" => taps.weights,
+            "gauss_offsets" => taps.offsets,
+            _ => vec![taps.len() as f64],
+        })
+    }))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -255,6 +313,8 @@ mod tests {
             offset,
             scalar,
             components,
+            count: 1,
+            stride: 0,
         }
     }
 
@@ -306,6 +366,87 @@ mod tests {
             vec![
                 "parameter `direction` has 1 component(s) but the shader member has 2".to_string(),
                 "push-constant member `sigma` has no graph parameter of that name".to_string(),
+            ]
+        );
+    }
+
+    fn array(name: &str, offset: u32, scalar: ScalarKind, count: u32) -> PushMember {
+        PushMember {
+            count,
+            stride: 4,
+            ..member(name, offset, scalar, 1)
+        }
+    }
+
+    #[test]
+    fn derives_gaussian_taps_from_sigma_and_radius() {
+        let block = PushBlock {
+            size: 108,
+            members: vec![
+                member("direction", 0, ScalarKind::Float, 2),
+                member("gauss_taps", 8, ScalarKind::Int, 1),
+                array("gauss_weights", 12, ScalarKind::Float, 12),
+                array("gauss_offsets", 60, ScalarKind::Float, 12),
+            ],
+        };
+        let params = BTreeMap::from([
+            ("direction".to_string(), ParamValue::Vector(vec![1.0, 0.0])),
+            ("sigma".to_string(), ParamValue::Number(9.0)),
+            ("radius".to_string(), ParamValue::Number(21.0)),
+        ]);
+        let bytes = pack_push(&block, &params, &FrameValues::default()).expect("packs");
+        let float = |i: usize| f32::from_ne_bytes(bytes[i..i + 4].try_into().unwrap());
+        let taps = GaussianTaps::linear(9.0, 21).unwrap();
+        assert_eq!(i32::from_ne_bytes(bytes[8..12].try_into().unwrap()), 12);
+        for k in 0..12 {
+            assert_eq!(float(12 + 4 * k), taps.weights[k] as f32);
+            assert_eq!(float(60 + 4 * k), taps.offsets[k] as f32);
+        }
+    }
+
+    #[test]
+    fn one_tap_per_texel_when_linear_taps_is_off_and_padding_is_zero() {
+        let block = PushBlock {
+            size: 4 * 24,
+            members: vec![array("gauss_weights", 0, ScalarKind::Float, 24)],
+        };
+        let params = BTreeMap::from([
+            ("sigma".to_string(), ParamValue::Number(9.0)),
+            ("radius".to_string(), ParamValue::Number(21.0)),
+            ("linear_taps".to_string(), ParamValue::Bool(false)),
+        ]);
+        let bytes = pack_push(&block, &params, &FrameValues::default()).expect("packs");
+        let float = |k: usize| f32::from_ne_bytes(bytes[4 * k..4 * k + 4].try_into().unwrap());
+        let taps = GaussianTaps::discrete(9.0, 21).unwrap();
+        for k in 0..22 {
+            assert_eq!(float(k), taps.weights[k] as f32);
+        }
+        assert_eq!((float(22), float(23)), (0.0, 0.0));
+    }
+
+    #[test]
+    fn reports_a_kernel_that_does_not_fit_and_missing_sigma() {
+        let block = PushBlock {
+            size: 48,
+            members: vec![array("gauss_weights", 0, ScalarKind::Float, 12)],
+        };
+        let wide = BTreeMap::from([
+            ("sigma".to_string(), ParamValue::Number(12.0)),
+            ("radius".to_string(), ParamValue::Number(30.0)),
+        ]);
+        assert_eq!(
+            pack_push(&block, &wide, &FrameValues::default()).unwrap_err(),
+            vec![
+                "push-constant member `gauss_weights` holds 12 value(s) but the pass's `sigma` and `radius` need 16"
+                    .to_string()
+            ]
+        );
+        let missing = BTreeMap::from([("radius".to_string(), ParamValue::Number(21.0))]);
+        assert_eq!(
+            pack_push(&block, &missing, &FrameValues::default()).unwrap_err(),
+            vec![
+                "push-constant member `gauss_weights`: the pass needs a numeric parameter `sigma`"
+                    .to_string()
             ]
         );
     }

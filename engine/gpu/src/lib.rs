@@ -12,6 +12,7 @@ pub mod draw;
 pub mod error;
 pub mod executor;
 mod frame;
+pub mod gaussian;
 pub mod golden;
 pub mod layouts;
 pub mod pipeline;

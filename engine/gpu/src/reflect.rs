@@ -71,6 +71,10 @@ pub struct PushMember {
     pub scalar: ScalarKind,
     /// 1 for scalars, 2 to 4 for vectors.
     pub components: u32,
+    /// Array length; 1 for a member that is not an array.
+    pub count: u32,
+    /// Bytes between array elements (0 when not an array).
+    pub stride: u32,
 }
 
 /// The push-constant block of a shader.
@@ -224,8 +228,21 @@ fn push_block(ty: &Type) -> Result<PushBlock, String> {
     let mut members = Vec::new();
     for m in &s.members {
         let name = m.name.clone().unwrap_or_default();
-        let (scalar, components) = scalar_shape(&m.ty).ok_or_else(|| {
-            format!("push-constant member `{name}` must be a 32-bit scalar or vector")
+        let (element, count, stride) = match &m.ty {
+            Type::Array(a) => match (a.nelement, a.stride) {
+                (Some(n), Some(stride)) => (a.element_ty.as_ref(), n, stride as u32),
+                _ => {
+                    return Err(format!(
+                        "push-constant member `{name}` must be an array of fixed length"
+                    ))
+                }
+            },
+            other => (other, 1, 0),
+        };
+        let (scalar, components) = scalar_shape(element).ok_or_else(|| {
+            format!(
+                "push-constant member `{name}` must be a 32-bit scalar or vector, or an array of them"
+            )
         })?;
         let offset = m.offset.ok_or("push-constant member without an offset")? as u32;
         members.push(PushMember {
@@ -233,6 +250,8 @@ fn push_block(ty: &Type) -> Result<PushBlock, String> {
             offset,
             scalar,
             components,
+            count,
+            stride,
         });
     }
     Ok(PushBlock { size, members })

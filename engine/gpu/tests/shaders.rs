@@ -111,19 +111,25 @@ fn reflects_samplers_and_push_constants() {
                 name: "color".into(),
                 offset: 0,
                 scalar: ScalarKind::Float,
-                components: 4
+                components: 4,
+                count: 1,
+                stride: 0,
             },
             PushMember {
                 name: "strength".into(),
                 offset: 16,
                 scalar: ScalarKind::Float,
-                components: 1
+                components: 1,
+                count: 1,
+                stride: 0,
             },
             PushMember {
                 name: "mode".into(),
                 offset: 20,
                 scalar: ScalarKind::Int,
-                components: 1
+                components: 1,
+                count: 1,
+                stride: 0,
             },
         ]
     );

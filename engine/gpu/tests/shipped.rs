@@ -169,9 +169,12 @@ fn forward_with_bloom_tonemaps_the_painted_colour() {
             "tonemap"
         ]
     );
-    // Bloom adds what lies above the threshold (1.0): green 3.0 becomes 5.0.
-    assert_close(pixel, tonemapped([1.0, 5.0, 0.0]));
-    assert_eq!(tonemapped([1.0, 5.0, 0.0]), [188, 235, 0, 255]);
+    // The brightest channel, 3.0, is above the threshold (1.0): the bright pass
+    // keeps the colour scaled by (3 - 1) / 3, and blurring a uniform image
+    // leaves it as it is, so bloom adds (2/3, 2, 0).
+    let bloomed = [1.0 + 2.0 / 3.0, 5.0, 0.0];
+    assert_close(pixel, tonemapped(bloomed));
+    assert_eq!(tonemapped(bloomed), [207, 235, 0, 255]);
 }
 
 #[test]

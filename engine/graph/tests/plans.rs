@@ -152,6 +152,8 @@ fn scene_features_cull_passes_and_variants() {
         culled,
         [
             ("shadow_sun", "enabled_if [shadow_casters] is false"),
+            ("bloom_naive_h", "enabled_if [bloom_naive] is false"),
+            ("bloom_naive_v", "enabled_if [bloom_naive] is false"),
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
             ("transparent", "enabled_if [transparent] is false"),
