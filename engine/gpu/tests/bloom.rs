@@ -110,7 +110,7 @@ fn render(
     (report.output.expect("output"), report.readbacks)
 }
 
-fn named<'a>(readbacks: &'a [(String, Readback)], name: &str) -> Rgb {
+fn named(readbacks: &[(String, Readback)], name: &str) -> Rgb {
     Rgb::from(
         &readbacks
             .iter()
