@@ -5,6 +5,9 @@ layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
 layout(set = 0, binding = 3) uniform sampler2D depth;
+#ifdef HAS_SHADOW_MAP
+layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
+#endif
 #include "include/deferred.glsl"
 
 layout(location = 0) flat in uint light_index;

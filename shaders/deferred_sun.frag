@@ -6,7 +6,7 @@ layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
 layout(set = 0, binding = 3) uniform sampler2D depth;
 #ifdef HAS_SHADOW_MAP
-layout(set = 0, binding = 4) uniform sampler2D shadow_map;
+layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
 #endif
 #include "include/deferred.glsl"
 

@@ -3,7 +3,7 @@
 // code (include/lighting.glsl), plus ambient and emission, into linear HDR;
 // alpha is the material's opacity, which transparent meshes blend with.
 #ifdef HAS_SHADOW_MAP
-layout(set = 0, binding = 0) uniform sampler2D shadow_map;
+layout(set = 0, binding = 0) uniform sampler2DShadow shadow_map;
 #endif
 #include "include/lighting.glsl"
 

@@ -1,10 +1,17 @@
 #version 450
-// Sun shadow map: meshes seen from the first sun through its orthographic
-// matrix (forward Z; the graph clears the map to 1). Depth bias is pipeline state.
+// Shadow views (include/shadows.glsl): meshes seen through view `shadow_view`'s
+// matrix (forward Z; the graph clears the map to 1). weft-render draws the pass
+// once per view into the view's atlas tile, setting `shadow_view` each time.
+// Depth bias is pipeline state (the pass's depth_bias and slope_bias).
 #include "include/transform.glsl"
+#include "include/shadows.glsl"
+
+layout(push_constant) uniform Push {
+    uint shadow_view;
+};
 
 layout(location = 0) in vec3 position;
 
 void main() {
-    gl_Position = frame.sun_shadow * world_position(gl_InstanceIndex, position);
+    gl_Position = shadow_views[shadow_view].clip * world_position(gl_InstanceIndex, position);
 }

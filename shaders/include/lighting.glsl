@@ -3,7 +3,8 @@
 // use. Both paths call `shade_light` and `shade_ambient_emissive` with the same
 // inputs (the surface and its material, loaded once per pixel), so they cannot
 // drift apart. An includer that defines HAS_SHADOW_MAP must declare
-// `uniform sampler2D shadow_map` before including this file.
+// `uniform sampler2DShadow shadow_map` before including this file
+// (include/shadows.glsl holds the lookups).
 #ifndef WEFT_LIGHTING_GLSL
 #define WEFT_LIGHTING_GLSL
 #include "scene.glsl"
@@ -40,28 +41,7 @@ float attenuate(uint index, float d) {
 }
 
 #ifdef HAS_SHADOW_MAP
-// Fraction of the first sun's light reaching `p`: 3x3 percentage-closer filtering of
-// the forward-Z shadow map, with the lookup pushed out along the normal by 1.5 texels.
-float sun_visibility(vec3 p, vec3 n) {
-    vec2 size = vec2(textureSize(shadow_map, 0));
-    // The orthographic x scale is 1 / half-width, so one texel spans 2 / (size * scale).
-    float scale = length(vec3(frame.sun_shadow[0][0], frame.sun_shadow[1][0], frame.sun_shadow[2][0]));
-    vec4 c = frame.sun_shadow * vec4(p + n * (3.0 / (size.x * scale)), 1.0);
-    vec3 ndc = c.xyz / c.w;
-    vec2 uv = ndc.xy * 0.5 + 0.5;
-    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || ndc.z > 1.0) {
-        return 1.0;
-    }
-    ivec2 centre = ivec2(uv * size);
-    float lit = 0.0;
-    for (int y = -1; y <= 1; ++y) {
-        for (int x = -1; x <= 1; ++x) {
-            ivec2 t = clamp(centre + ivec2(x, y), ivec2(0), ivec2(size) - 1);
-            lit += ndc.z <= texelFetch(shadow_map, t, 0).r ? 1.0 : 0.0;
-        }
-    }
-    return lit / 9.0;
-}
+#include "shadows.glsl"
 #endif
 
 // Radiance arriving at the surface from light `index` and the unit direction
@@ -99,6 +79,11 @@ vec3 incoming(uint index, Surface s, out vec3 l) {
         return vec3(0.0);
     }
     float spot = lights[index].color_exponent.w > 0.0 ? pow(max(cosine, 0.0), lights[index].color_exponent.w) : 1.0;
+#ifdef HAS_SHADOW_MAP
+    if (type == LIGHT_SPOT_CONE && dot(s.normal, l) > 0.0) {
+        spot *= spot_visibility(index, s.position, s.normal, d);
+    }
+#endif
     return lights[index].color_exponent.rgb * spot * attenuate(index, d);
 }
 

@@ -33,7 +33,6 @@ struct Draw {
 layout(set = 1, binding = 0) uniform Frame {
     mat4 view_proj;
     mat4 inv_view_proj;
-    mat4 sun_shadow;       // world to the first sun's shadow-map clip space
     vec4 camera_position;
     vec4 ambient;          // sum of the suns' ambient terms
     uvec4 counts;          // suns, point lights, spots, all lights

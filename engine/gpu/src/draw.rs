@@ -31,6 +31,8 @@ pub struct RasterContext<'a> {
     /// The nearest clamp sampler, for formats without linear filtering
     /// (`Gpu::linear_filter`), such as depth formats on lavapipe.
     pub nearest_sampler: vk::Sampler,
+    /// The depth-compare sampler for `sampler2DShadow` bindings (shadow maps).
+    pub compare_sampler: vk::Sampler,
 }
 
 impl RasterContext<'_> {

@@ -406,7 +406,11 @@ impl<'g> Renderer<'g> {
                     Some(GpuResource::Image(img)) => image_infos.push((
                         rb,
                         [vk::DescriptorImageInfo {
-                            sampler: self.samplers.for_format(self.gpu, img.desc.format_raw),
+                            sampler: self.samplers.for_binding(
+                                self.gpu,
+                                rb.shader.depth_compare,
+                                img.desc.format_raw,
+                            ),
                             image_view: img.shader_view,
                             image_layout: crate::convert::layout(layouts[rb.graph.resource]),
                         }],
@@ -514,6 +518,7 @@ impl<'g> Renderer<'g> {
                     resources,
                     sampler: self.samplers.linear,
                     nearest_sampler: self.samplers.nearest,
+                    compare_sampler: self.samplers.compare,
                 };
                 let drawn = match &prep.pipeline {
                     Some(p) => {

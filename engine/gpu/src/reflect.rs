@@ -47,6 +47,9 @@ pub struct ShaderBinding {
     pub kind: DescriptorKind,
     /// Array size (1 for a single descriptor).
     pub count: u32,
+    /// A depth-comparison sampler (`sampler2DShadow`): bound with the compare
+    /// sampler, so `texture`/`textureProj` return filtered visibility.
+    pub depth_compare: bool,
 }
 
 /// Scalar type of a push-constant member.
@@ -163,6 +166,7 @@ impl ShaderInterface {
                         name,
                         kind,
                         count: nbind.max(1),
+                        depth_compare: is_depth_sampler(&ty),
                     });
                 }
                 Variable::PushConstant { ty, .. } => {
@@ -189,6 +193,13 @@ impl ShaderInterface {
             push,
             outputs,
         })
+    }
+}
+
+fn is_depth_sampler(ty: &Type) -> bool {
+    match ty {
+        Type::CombinedImageSampler(t) => t.sampled_image_ty.is_depth == Some(true),
+        _ => false,
     }
 }
 

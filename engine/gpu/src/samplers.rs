@@ -1,16 +1,41 @@
-//! The samplers graph images are read through: linear clamp-to-edge, and
-//! nearest for formats the device cannot filter linearly (depth on lavapipe).
+//! The samplers graph images are read through: linear clamp-to-edge, nearest
+//! for formats the device cannot filter linearly (depth on lavapipe), and a
+//! depth-compare sampler for `sampler2DShadow` bindings (shadow maps).
 
 use crate::context::Gpu;
 use crate::error::{GpuError, VkCall};
 use ash::vk;
 
-/// Linear and nearest clamp-to-edge samplers.
+/// Linear and nearest clamp-to-edge samplers, and the shadow-map compare sampler.
 pub struct Samplers {
     /// Linear filtering, linear mips.
     pub linear: vk::Sampler,
     /// Nearest filtering, for formats without linear filtering.
     pub nearest: vk::Sampler,
+    /// Depth comparison `reference <= stored` (forward-Z shadow maps cleared to 1)
+    /// with linear filtering, so one lookup is the hardware's 2x2 percentage-closer
+    /// filter; clamp to an opaque white border, so lookups outside the map are lit.
+    pub compare: vk::Sampler,
+}
+
+/// The shadow-map sampler: compare-enabled, bilinear, white border. Linear
+/// filtering of a compare sampler filters the comparison results, which Vulkan
+/// allows for depth formats without `SAMPLED_IMAGE_FILTER_LINEAR` (VUID-04553
+/// concerns samplers with comparison off).
+fn create_compare(gpu: &Gpu) -> Result<vk::Sampler, GpuError> {
+    let border = vk::SamplerAddressMode::CLAMP_TO_BORDER;
+    let info = vk::SamplerCreateInfo::default()
+        .mag_filter(vk::Filter::LINEAR)
+        .min_filter(vk::Filter::LINEAR)
+        .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+        .address_mode_u(border)
+        .address_mode_v(border)
+        .address_mode_w(border)
+        .border_color(vk::BorderColor::FLOAT_OPAQUE_WHITE)
+        .compare_enable(true)
+        .compare_op(vk::CompareOp::LESS_OR_EQUAL)
+        .max_lod(0.0);
+    unsafe { gpu.device().create_sampler(&info, None) }.call("vkCreateSampler")
 }
 
 fn create(
@@ -30,15 +55,39 @@ fn create(
 }
 
 impl Samplers {
-    /// Creates both samplers.
+    /// Creates the three samplers.
     pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
         let linear = create(gpu, vk::Filter::LINEAR, vk::SamplerMipmapMode::LINEAR)?;
-        match create(gpu, vk::Filter::NEAREST, vk::SamplerMipmapMode::NEAREST) {
-            Ok(nearest) => Ok(Self { linear, nearest }),
+        let nearest = match create(gpu, vk::Filter::NEAREST, vk::SamplerMipmapMode::NEAREST) {
+            Ok(n) => n,
             Err(e) => {
                 unsafe { gpu.device().destroy_sampler(linear, None) };
+                return Err(e);
+            }
+        };
+        match create_compare(gpu) {
+            Ok(compare) => Ok(Self {
+                linear,
+                nearest,
+                compare,
+            }),
+            Err(e) => {
+                unsafe {
+                    gpu.device().destroy_sampler(linear, None);
+                    gpu.device().destroy_sampler(nearest, None);
+                }
                 Err(e)
             }
+        }
+    }
+
+    /// The sampler for a shader binding reading an image of `format_raw`: the
+    /// compare sampler for `sampler2DShadow`, else by the format's filtering.
+    pub fn for_binding(&self, gpu: &Gpu, depth_compare: bool, format_raw: i32) -> vk::Sampler {
+        if depth_compare {
+            self.compare
+        } else {
+            self.for_format(gpu, format_raw)
         }
     }
 
@@ -51,11 +100,12 @@ impl Samplers {
         }
     }
 
-    /// Destroys both samplers.
+    /// Destroys the samplers.
     pub fn destroy(&self, gpu: &Gpu) {
         unsafe {
             gpu.device().destroy_sampler(self.linear, None);
             gpu.device().destroy_sampler(self.nearest, None);
+            gpu.device().destroy_sampler(self.compare, None);
         }
     }
 }

@@ -23,6 +23,7 @@ pub mod pipelines;
 pub mod recorder;
 pub mod reload;
 pub mod scene_gpu;
+pub mod shadows;
 pub mod sources;
 pub mod state;
 pub mod texture;

@@ -6,6 +6,7 @@
 use crate::geometry::DrawItem;
 use crate::pipelines::{ScenePipeline, ScenePipelineKey, ScenePipelines, MATERIAL_SET};
 use crate::scene_gpu::GpuScene;
+use crate::shadows::ShadowSettings;
 use crate::state::{pass_state, DepthTest, PassState};
 use ash::vk;
 use glam::Vec3;
@@ -13,10 +14,13 @@ use weft_gpu::bind::{pack_push, resolve_bindings, FrameValues};
 use weft_gpu::pipeline::{BlendCode, Pipeline, ShaderKey};
 use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, ShaderStage, SCENE_SET};
-use weft_graph::schema::{Draw, LightKind, MaterialFilter};
+use weft_graph::schema::{Draw, LightKind, MaterialFilter, ParamValue};
 
 /// Descriptor sets for graph resources one frame may need.
 const FRAME_SETS: u32 = 64;
+/// The push-constant member that makes a pass a shadow pass: drawn once per
+/// shadow view (`shaders/shadow.vert`), into the view's atlas tile.
+const SHADOW_VIEW_MEMBER: &str = "shadow_view";
 
 fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
     move |result| GpuError::Vulkan { call, result }
@@ -263,7 +267,9 @@ impl<'g> SceneRecorder<'g> {
                 Some(weft_gpu::resources::GpuResource::Image(img)) => images.push((
                     rb,
                     [vk::DescriptorImageInfo {
-                        sampler: if ctx.gpu.linear_filter(img.desc.format_raw) {
+                        sampler: if rb.shader.depth_compare {
+                            ctx.compare_sampler
+                        } else if ctx.gpu.linear_filter(img.desc.format_raw) {
                             ctx.sampler
                         } else {
                             ctx.nearest_sampler
@@ -304,6 +310,76 @@ impl<'g> SceneRecorder<'g> {
         }
         unsafe { self.gpu.device().update_descriptor_sets(&writes, &[]) };
         Ok(Some(set))
+    }
+}
+
+/// Whether the pipeline's vertex shader picks a shadow view by push constant.
+fn is_shadow_pass(p: &ScenePipeline) -> bool {
+    p.interface
+        .push
+        .as_ref()
+        .is_some_and(|(block, _)| block.members.iter().any(|m| m.name == SHADOW_VIEW_MEMBER))
+}
+
+impl SceneRecorder<'_> {
+    /// A shadow pass: fits this frame's views to the attachment's size with the
+    /// pass's parameters, then draws the casters once per view into its tile.
+    fn draw_shadow_views(
+        &mut self,
+        ctx: &RasterContext<'_>,
+        p: &ScenePipeline,
+        filter: MaterialFilter,
+    ) -> Result<u64, GpuError> {
+        let pass = ctx.pass();
+        let settings = ShadowSettings::from_params(&pass.params);
+        let views = self.scene.prepare_shadows(&settings, ctx.extent.width)?;
+        let (block, stages) = p.interface.push.as_ref().ok_or_else(|| GpuError::Pass {
+            pass: pass.name.clone(),
+            message: "shadow pass without push constants".into(),
+        })?;
+        let device = self.gpu.device();
+        let mut calls = 0;
+        for (i, view) in views.iter().enumerate() {
+            let mut params = pass.params.clone();
+            params.insert(SHADOW_VIEW_MEMBER.to_string(), ParamValue::Number(i as f64));
+            let bytes =
+                pack_push(block, &params, &self.frame).map_err(|problems| GpuError::Pass {
+                    pass: pass.name.clone(),
+                    message: problems.join("; "),
+                })?;
+            let [x, y, side] = view.viewport;
+            unsafe {
+                device.cmd_set_viewport(
+                    ctx.cmd,
+                    0,
+                    &[vk::Viewport {
+                        x: x as f32,
+                        y: y as f32,
+                        width: side as f32,
+                        height: side as f32,
+                        min_depth: 0.0,
+                        max_depth: 1.0,
+                    }],
+                );
+                device.cmd_set_scissor(
+                    ctx.cmd,
+                    0,
+                    &[vk::Rect2D {
+                        offset: vk::Offset2D {
+                            x: x as i32,
+                            y: y as i32,
+                        },
+                        extent: vk::Extent2D {
+                            width: side,
+                            height: side,
+                        },
+                    }],
+                );
+                device.cmd_push_constants(ctx.cmd, p.layout, *stages, 0, &bytes);
+            }
+            calls += self.draw_meshes(ctx.cmd, p, self.scene.geometry.filtered(filter));
+        }
+        Ok(calls)
     }
 }
 
@@ -348,13 +424,17 @@ impl DrawRecorder for SceneRecorder<'_> {
             self.scene.material_layout,
         )?;
         let graph_set = self.graph_set(ctx, p.graph_layout, &p.interface)?;
+        let mut params = pass.params.clone();
+        if is_shadow_pass(&p) {
+            params.insert(SHADOW_VIEW_MEMBER.to_string(), ParamValue::Number(0.0));
+        }
         let push = match &p.interface.push {
             Some((block, stages)) => {
                 let frame = FrameValues {
                     extent: [ctx.extent.width, ctx.extent.height],
                     ..self.frame
                 };
-                let bytes = pack_push(block, &pass.params, &frame)
+                let bytes = pack_push(block, &params, &frame)
                     .map_err(|problems| fail(problems.join("; ")))?;
                 Some((*stages, bytes))
             }
@@ -383,6 +463,9 @@ impl DrawRecorder for SceneRecorder<'_> {
                     self.bind(ctx.cmd, &q, &bindings);
                     calls += self.draw_meshes(ctx.cmd, &q, transparent.iter());
                 }
+            }
+            Draw::Meshes(filter) if is_shadow_pass(&p) => {
+                calls += self.draw_shadow_views(ctx, &p, filter)?;
             }
             Draw::Meshes(filter) => {
                 calls += self.draw_meshes(ctx.cmd, &p, g.filtered(filter));

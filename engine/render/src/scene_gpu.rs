@@ -9,9 +9,9 @@ use crate::geometry::SceneGeometry;
 use crate::lights::{pack_lights, LightSet, LIGHT_BYTES};
 use crate::materials::pack_material;
 use crate::packing::Words;
+use crate::shadows::{self, ShadowSettings, ShadowView, ViewVolume};
 use crate::texture::{self, Pixels, Texture};
 use ash::vk;
-use glam::Mat4;
 use std::collections::HashMap;
 use std::path::PathBuf;
 use weft_gpu::{Gpu, GpuError};
@@ -26,8 +26,10 @@ pub const LIGHTS_BINDING: u32 = 1;
 pub const DRAWS_BINDING: u32 = 2;
 /// Binding of the material records.
 pub const MATERIALS_BINDING: u32 = 3;
+/// Binding of the shadow views (`Shadows` in `shaders/include/shadows.glsl`).
+pub const SHADOWS_BINDING: u32 = 4;
 /// Bytes of the `Frame` uniform block.
-pub const FRAME_BYTES: usize = 3 * 64 + 4 * 16;
+pub const FRAME_BYTES: usize = 2 * 64 + 4 * 16;
 /// Scene sets that fullscreen pipelines built by the executor may ask for.
 const FOREIGN_SETS: u32 = 32;
 
@@ -48,6 +50,7 @@ pub struct GpuScene<'g> {
     materials: Buffer<'g>,
     frame: Buffer<'g>,
     lights: Buffer<'g>,
+    shadows: Buffer<'g>,
     textures: Vec<Texture<'g>>,
     sampler: vk::Sampler,
     pool: vk::DescriptorPool,
@@ -63,6 +66,8 @@ pub struct GpuScene<'g> {
     foreign_sets: HashMap<vk::DescriptorSetLayout, vk::DescriptorSet>,
     source_lights: Vec<weft_scene::Light>,
     bounds: weft_scene::Aabb,
+    /// The camera's view volume at the last update, what sun cascades are fitted to.
+    pub view_volume: ViewVolume,
     /// Camera position at the last update, for sorting transparent meshes.
     pub camera_position: glam::Vec3,
     /// Light counts by kind (stable over time; animation moves lights only).
@@ -156,6 +161,8 @@ impl<'g> GpuScene<'g> {
             (light_set.len() as usize * LIGHT_BYTES) as u64,
             storage,
         )?;
+        let mut shadows = Buffer::host(gpu, "shadows", shadows::SHADOWS_BYTES as u64, storage)?;
+        shadows.write(&vec![0u8; shadows::SHADOWS_BYTES])?;
         let device = gpu.device();
         let sampler_info = vk::SamplerCreateInfo::default()
             .mag_filter(vk::Filter::LINEAR)
@@ -176,6 +183,7 @@ impl<'g> GpuScene<'g> {
             materials,
             frame,
             lights,
+            shadows,
             textures,
             sampler,
             pool: vk::DescriptorPool::null(),
@@ -186,6 +194,14 @@ impl<'g> GpuScene<'g> {
             foreign_sets: HashMap::new(),
             source_lights: scene.lights.clone(),
             bounds,
+            view_volume: ViewVolume::new(
+                glam::Vec3::ZERO,
+                glam::Quat::IDENTITY,
+                1.0,
+                1.0,
+                0.1,
+                100.0,
+            ),
             camera_position: glam::Vec3::ZERO,
             light_set,
             warnings,
@@ -202,6 +218,7 @@ impl<'g> GpuScene<'g> {
             (LIGHTS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
             (DRAWS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
             (MATERIALS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
+            (SHADOWS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
         ]
         .iter()
         .map(|&(b, ty)| {
@@ -240,7 +257,7 @@ impl<'g> GpuScene<'g> {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: 3 * scene_sets,
+                descriptor_count: 4 * scene_sets,
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
@@ -264,6 +281,7 @@ impl<'g> GpuScene<'g> {
                 LIGHTS_BINDING,
                 DRAWS_BINDING,
                 MATERIALS_BINDING,
+                SHADOWS_BINDING,
             ],
         );
         for &slot in material_texture {
@@ -307,6 +325,7 @@ impl<'g> GpuScene<'g> {
                     LIGHTS_BINDING => (&self.lights, vk::DescriptorType::STORAGE_BUFFER),
                     DRAWS_BINDING => (&self.draws, vk::DescriptorType::STORAGE_BUFFER),
                     MATERIALS_BINDING => (&self.materials, vk::DescriptorType::STORAGE_BUFFER),
+                    SHADOWS_BINDING => (&self.shadows, vk::DescriptorType::STORAGE_BUFFER),
                     _ => return None,
                 };
                 Some((
@@ -356,19 +375,17 @@ impl<'g> GpuScene<'g> {
         let view_proj = camera::view_projection(camera, time, w / h);
         let eye = camera::camera_position(camera, time);
         self.camera_position = eye;
+        let (_, rotation) = camera.pose_at(time);
+        self.view_volume =
+            ViewVolume::new(eye, rotation, camera.fov_y, w / h, camera.near, camera.far);
         let lights = pack_lights(
             &weft_scene::animation::lights_at(&self.source_lights, time, 0),
             &self.bounds,
         );
-        let shadow = lights
-            .sun_direction
-            .map(|d| camera::sun_shadow_matrix(d, &self.bounds))
-            .unwrap_or(Mat4::IDENTITY);
         let mut words = Words::default();
         words
             .mat4(&view_proj)
             .mat4(&view_proj.inverse())
-            .mat4(&shadow)
             .vec3w(eye, 1.0)
             .vec3w(lights.ambient, 0.0)
             .u32(lights.suns)
@@ -385,6 +402,28 @@ impl<'g> GpuScene<'g> {
         }
         self.light_set = lights;
         Ok(())
+    }
+}
+
+impl GpuScene<'_> {
+    /// Fits this frame's shadow views for a `atlas_size` squared shadow map with
+    /// `settings` (after [`GpuScene::update`]) and writes the record the shaders
+    /// read; returns the views, to draw one by one. The device must not be
+    /// reading the record (the previous frame has finished).
+    pub fn prepare_shadows(
+        &mut self,
+        settings: &ShadowSettings,
+        atlas_size: u32,
+    ) -> Result<Vec<ShadowView>, GpuError> {
+        let frame = shadows::shadow_frame(
+            settings,
+            atlas_size,
+            &self.view_volume,
+            &self.light_set,
+            &self.bounds,
+        );
+        self.shadows.write(&frame.pack(settings).bytes())?;
+        Ok(frame.views)
     }
 }
 

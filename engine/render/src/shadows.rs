@@ -1,0 +1,632 @@
+//! Shadow views, pure math: the sun's cascades fitted each frame to slices of
+//! the camera's view volume (orthographic, forward Z), one perspective view per
+//! shadow-casting spot cone, their tiles in the shadow-map atlas, and the record
+//! the shaders read (`Shadows` in `shaders/include/shadows.glsl`).
+//!
+//! Atlas: the graph's `shadow_map` (`resolution` squared) is cut into a
+//! `grid` x `grid` array of square tiles, `grid = ceil(sqrt(views))`; views are
+//! the cascades, then the spots. One cascade and no spot uses the whole map.
+
+use crate::lights::{LightSet, LIGHT_BYTES};
+use crate::packing::Words;
+use glam::{Mat4, Vec3, Vec4};
+use std::collections::BTreeMap;
+use weft_graph::schema::ParamValue;
+use weft_scene::Aabb;
+
+/// Most sun cascades (`cascades` is clamped to 1..=this).
+pub const MAX_CASCADES: u32 = 4;
+/// Most spot cones given a shadow view; later spots are unshadowed.
+pub const MAX_SPOT_SHADOWS: u32 = 8;
+/// Largest manual PCF radius honoured (a 15x15 kernel of 2x2 filtered taps).
+pub const MAX_PCF_RADIUS: u32 = 7;
+/// Bytes before the first view record: counts, splits, camera forward + normal bias.
+pub const HEADER_BYTES: usize = 48;
+/// Bytes of one view record: clip matrix, lookup matrix, tile bounds, texel size.
+pub const VIEW_BYTES: usize = 160;
+/// Bytes of the whole record with room for every view.
+pub const SHADOWS_BYTES: usize =
+    HEADER_BYTES + VIEW_BYTES * (MAX_CASCADES + MAX_SPOT_SHADOWS) as usize;
+
+/// The shadow pass's parameters (`graphs/shadows.ron` documents the defaults).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowSettings {
+    /// Sun cascades, 1..=[`MAX_CASCADES`].
+    pub cascades: u32,
+    /// Manual PCF kernel radius r: (2r+1)^2 taps, each a hardware 2x2 compare.
+    pub pcf_radius: u32,
+    /// Lookup offset along the surface normal, in shadow texels per kernel ring
+    /// (the offset is `normal_bias * (pcf_radius + 1)` texels).
+    pub normal_bias: f32,
+    /// Split blend: 0 uniform, 1 logarithmic (practical split scheme).
+    pub split_lambda: f32,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        Self {
+            cascades: 1,
+            pcf_radius: 1,
+            normal_bias: 1.0,
+            split_lambda: 0.75,
+        }
+    }
+}
+
+impl ShadowSettings {
+    /// Settings from a pass's parameters; missing or non-numeric ones keep their
+    /// defaults, out-of-range ones are clamped.
+    pub fn from_params(params: &BTreeMap<String, ParamValue>) -> Self {
+        let d = Self::default();
+        let number = |name: &str| match params.get(name) {
+            Some(ParamValue::Number(n)) if n.is_finite() => Some(*n),
+            _ => None,
+        };
+        Self {
+            cascades: number("cascades").map_or(d.cascades, |n| {
+                (n.round() as i64).clamp(1, i64::from(MAX_CASCADES)) as u32
+            }),
+            pcf_radius: number("pcf_radius").map_or(d.pcf_radius, |n| {
+                (n.round() as i64).clamp(0, i64::from(MAX_PCF_RADIUS)) as u32
+            }),
+            normal_bias: number("normal_bias").map_or(d.normal_bias, |n| n.max(0.0) as f32),
+            split_lambda: number("split_lambda")
+                .map_or(d.split_lambda, |n| n.clamp(0.0, 1.0) as f32),
+        }
+    }
+
+    /// Texels kept free at a tile's edge so a kernel never reads a neighbour tile.
+    fn margin(&self) -> f32 {
+        self.pcf_radius as f32 + 2.0
+    }
+}
+
+/// The camera's view volume at this frame, what the sun's cascades are fitted to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewVolume {
+    /// Camera position.
+    pub eye: Vec3,
+    /// Unit view direction.
+    pub forward: Vec3,
+    /// Unit right and up vectors.
+    pub right: Vec3,
+    /// Unit up vector.
+    pub up: Vec3,
+    /// tan(fov_y / 2).
+    pub tan_half_y: f32,
+    /// Width / height.
+    pub aspect: f32,
+    /// Near and far clip distances.
+    pub near: f32,
+    /// Far clip distance.
+    pub far: f32,
+}
+
+impl ViewVolume {
+    /// The volume of a camera posed at `eye` with `rotation` (looking down -Z).
+    pub fn new(
+        eye: Vec3,
+        rotation: glam::Quat,
+        fov_y: f32,
+        aspect: f32,
+        near: f32,
+        far: f32,
+    ) -> Self {
+        Self {
+            eye,
+            forward: rotation * Vec3::NEG_Z,
+            right: rotation * Vec3::X,
+            up: rotation * Vec3::Y,
+            tan_half_y: (fov_y * 0.5).tan(),
+            aspect,
+            near,
+            far,
+        }
+    }
+
+    /// The eight corners of the slice between view depths `near` and `far`.
+    pub fn corners(&self, near: f32, far: f32) -> [Vec3; 8] {
+        let mut out = [Vec3::ZERO; 8];
+        for (i, c) in out.iter_mut().enumerate() {
+            let d = if i & 4 == 0 { near } else { far };
+            let y = d * self.tan_half_y * if i & 2 == 0 { -1.0 } else { 1.0 };
+            let x = d * self.tan_half_y * self.aspect * if i & 1 == 0 { -1.0 } else { 1.0 };
+            *c = self.eye + self.forward * d + self.right * x + self.up * y;
+        }
+        out
+    }
+
+    /// The far distance worth covering: the camera's far plane, or the farthest
+    /// corner of `bounds` along the view direction if nearer.
+    pub fn shadow_far(&self, bounds: &Aabb) -> f32 {
+        if bounds.is_empty() {
+            return self.far;
+        }
+        let deepest = aabb_corners(bounds)
+            .iter()
+            .map(|c| (*c - self.eye).dot(self.forward))
+            .fold(f32::MIN, f32::max);
+        deepest.min(self.far).max(self.near * 2.0)
+    }
+}
+
+fn aabb_corners(b: &Aabb) -> [Vec3; 8] {
+    std::array::from_fn(|i| {
+        Vec3::new(
+            if i & 1 == 0 { b.min.x } else { b.max.x },
+            if i & 2 == 0 { b.min.y } else { b.max.y },
+            if i & 4 == 0 { b.min.z } else { b.max.z },
+        )
+    })
+}
+
+/// Far view depth of each of `count` cascades between `near` and `far`: the
+/// practical split scheme, `lambda` of the logarithmic split plus `1 - lambda`
+/// of the uniform one, so near cascades stay small without starving far ones.
+pub fn cascade_splits(near: f32, far: f32, count: u32, lambda: f32) -> Vec<f32> {
+    let near = near.max(1e-4);
+    let far = far.max(near * 1.0001);
+    (1..=count.max(1))
+        .map(|i| {
+            let f = i as f32 / count.max(1) as f32;
+            let log = near * (far / near).powf(f);
+            let uniform = near + (far - near) * f;
+            lambda * log + (1.0 - lambda) * uniform
+        })
+        .collect()
+}
+
+/// Square tiles of the shadow-map atlas.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Atlas {
+    /// Texels per side of the whole map.
+    pub size: u32,
+    /// Tiles per side.
+    pub grid: u32,
+    /// Texels per side of one tile.
+    pub tile: u32,
+}
+
+impl Atlas {
+    /// The layout for `views` tiles in a `size` squared map.
+    pub fn new(size: u32, views: u32) -> Self {
+        let mut grid = 1;
+        while grid * grid < views.max(1) {
+            grid += 1;
+        }
+        Self {
+            size,
+            grid,
+            tile: (size / grid).max(1),
+        }
+    }
+
+    /// Texel x, y of tile `i`'s corner and its side, for the viewport.
+    pub fn viewport(&self, i: u32) -> [u32; 3] {
+        [
+            (i % self.grid) * self.tile,
+            (i / self.grid) * self.tile,
+            self.tile,
+        ]
+    }
+
+    /// Clip space of tile `i`'s view to atlas texture coordinates (xy), keeping z and w,
+    /// so `lookup = to_uv * clip` and `textureProj` divides by w.
+    pub fn to_uv(&self, i: u32) -> Mat4 {
+        let [x, y, side] = self.viewport(i);
+        let scale = side as f32 / self.size as f32;
+        let (ox, oy) = (x as f32 / self.size as f32, y as f32 / self.size as f32);
+        Mat4::from_cols(
+            Vec4::new(0.5 * scale, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, 0.5 * scale, 0.0, 0.0),
+            Vec4::new(0.0, 0.0, 1.0, 0.0),
+            Vec4::new(ox + 0.5 * scale, oy + 0.5 * scale, 0.0, 1.0),
+        )
+    }
+
+    /// Tile `i`'s texture-coordinate bounds (min xy, max xy) shrunk by `margin`
+    /// texels: a lookup inside them reads only this tile.
+    pub fn inner_rect(&self, i: u32, margin: f32) -> Vec4 {
+        let [x, y, side] = self.viewport(i);
+        let s = self.size as f32;
+        Vec4::new(
+            (x as f32 + margin) / s,
+            (y as f32 + margin) / s,
+            ((x + side) as f32 - margin) / s,
+            ((y + side) as f32 - margin) / s,
+        )
+    }
+}
+
+/// One rendered shadow view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowView {
+    /// World to clip space, for drawing casters into the tile (forward Z, Y flipped).
+    pub clip: Mat4,
+    /// World to atlas coordinates for `textureProj` (xy / w texture coordinates, z / w depth).
+    pub lookup: Mat4,
+    /// Tile corner and side in texels.
+    pub viewport: [u32; 3],
+    /// Texture-coordinate bounds inside which a kernel stays in the tile.
+    pub rect: Vec4,
+    /// World size of one texel: constant for the sun, per unit distance for spots.
+    pub texel: f32,
+    /// Whether `texel` scales with distance from the light (spots).
+    pub perspective: bool,
+}
+
+/// An orthographic world-to-clip matrix for the sun travelling along `direction`:
+/// x/y cover the part of `slice` (points of a view-volume slice) that lies inside
+/// `bounds`, squared, widened by `margin` texels and snapped to whole texels of a
+/// `tile`-texel map (so moving the camera does not make edges shimmer); z covers
+/// all of `bounds`, so casters outside the view still cast. Returns the matrix and
+/// the world size of one texel.
+pub fn fit_sun(
+    direction: Vec3,
+    slice: &[Vec3; 8],
+    bounds: &Aabb,
+    tile: u32,
+    margin: f32,
+) -> (Mat4, f32) {
+    let dir = direction.try_normalize().unwrap_or(Vec3::NEG_Y);
+    let up = if dir.cross(Vec3::Y).length_squared() < 1e-6 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
+    let (center, radius) = if bounds.is_empty() {
+        (Vec3::ZERO, 1.0)
+    } else {
+        (bounds.center(), (bounds.diagonal() * 0.5).max(1e-3))
+    };
+    // A fixed light-space origin (the scene's centre), so snapping to texels in
+    // light space is stable from frame to frame.
+    let view = Mat4::look_at_rh(center - dir * radius * 2.0, center, up);
+    let to_light = |p: &Vec3| view.transform_point3(*p);
+    let scene_pts: Vec<Vec3> = if bounds.is_empty() {
+        aabb_corners(&Aabb {
+            min: Vec3::splat(-1.0),
+            max: Vec3::splat(1.0),
+        })
+        .iter()
+        .map(to_light)
+        .collect()
+    } else {
+        aabb_corners(bounds).iter().map(to_light).collect()
+    };
+    let lo = |pts: &[Vec3]| pts.iter().fold(Vec3::splat(f32::MAX), |a, p| a.min(*p));
+    let hi = |pts: &[Vec3]| pts.iter().fold(Vec3::splat(f32::MIN), |a, p| a.max(*p));
+    let (s_lo, s_hi) = (lo(&scene_pts), hi(&scene_pts));
+    let view_pts: Vec<Vec3> = slice.iter().map(to_light).collect();
+    let (v_lo, v_hi) = (lo(&view_pts), hi(&view_pts));
+    let (mut min, mut max) = (v_lo.max(s_lo), v_hi.min(s_hi));
+    if min.x >= max.x || min.y >= max.y {
+        (min, max) = (s_lo, s_hi);
+    }
+    let scene_side = (s_hi.x - s_lo.x).max(s_hi.y - s_lo.y).max(1e-4);
+    let wanted = (max.x - min.x).max(max.y - min.y).max(scene_side * 1e-3);
+    // Quarter-octave steps of the scene's extent: the texel size changes only when
+    // the view's footprint crosses a step, not every frame.
+    let steps = ((wanted / scene_side).log2() * 4.0).ceil() / 4.0;
+    let tile = tile.max(1) as f32;
+    let usable = (tile - 2.0 * margin).max(1.0);
+    let side = scene_side * steps.exp2() * tile / usable;
+    let texel = side / tile;
+    let half = side * 0.5;
+    let snap = |v: f32| (v / texel).round() * texel;
+    let cx = snap((min.x + max.x) * 0.5);
+    let cy = snap((min.y + max.y) * 0.5);
+    // Light-space z is negative in front of the light; pad by 1% so bounds-hugging
+    // casters are not clipped.
+    let pad = (s_hi.z - s_lo.z).abs() * 0.01 + 1e-4;
+    let (near, far) = (-s_hi.z - pad, -s_lo.z + pad);
+    let mut proj = Mat4::orthographic_rh(cx - half, cx + half, cy - half, cy + half, near, far);
+    proj.y_axis.y = -proj.y_axis.y;
+    (proj * view, texel)
+}
+
+/// Perspective world-to-clip for a spot at `position` shining along `direction`
+/// with half-angle `acos(cos_cutoff)` and reach `range` (forward Z, Y flipped),
+/// widened so the cone fits inside `margin` texels from a `tile`-texel map's edge.
+/// Returns the matrix and the world size of a texel one unit from the light.
+pub fn spot_clip(
+    position: Vec3,
+    direction: Vec3,
+    cos_cutoff: f32,
+    range: f32,
+    tile: u32,
+    margin: f32,
+) -> (Mat4, f32) {
+    let dir = direction.try_normalize().unwrap_or(Vec3::NEG_Y);
+    let up = if dir.cross(Vec3::Y).length_squared() < 1e-6 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
+    let half = cos_cutoff
+        .clamp(-1.0, 1.0)
+        .acos()
+        .clamp(1e-3, 80f32.to_radians());
+    let tile = tile.max(1) as f32;
+    let tan = half.tan() * tile / (tile - 2.0 * margin).max(1.0);
+    let far = range.max(1e-3);
+    let near = (far * 1e-3).max(1e-3).min(far * 0.5);
+    let view = Mat4::look_at_rh(position, position + dir, up);
+    let mut proj = Mat4::perspective_rh(2.0 * tan.atan(), 1.0, near, far);
+    proj.y_axis.y = -proj.y_axis.y;
+    (proj * view, 2.0 * tan / tile)
+}
+
+/// Everything about this frame's shadows: the views and the record shaders read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShadowFrame {
+    /// Cascades first, then spots.
+    pub views: Vec<ShadowView>,
+    /// Cascades rendered (0 without a sun).
+    pub cascades: u32,
+    /// Spot views rendered.
+    pub spots: u32,
+    /// Light index of the first spot cone (spot view k belongs to light `first_spot + k`).
+    pub first_spot: u32,
+    /// Far view depth of each cascade.
+    pub splits: [f32; 4],
+    /// The camera's view direction, for picking a cascade by view depth.
+    pub forward: Vec3,
+}
+
+fn word_f32(words: &Words, at: usize) -> f32 {
+    words.0.get(at).map_or(0.0, |w| f32::from_bits(*w))
+}
+
+fn word_vec3(words: &Words, at: usize) -> Vec3 {
+    Vec3::new(
+        word_f32(words, at),
+        word_f32(words, at + 1),
+        word_f32(words, at + 2),
+    )
+}
+
+/// Lays out and fits this frame's views for a `atlas_size` squared shadow map.
+pub fn shadow_frame(
+    settings: &ShadowSettings,
+    atlas_size: u32,
+    volume: &ViewVolume,
+    lights: &LightSet,
+    bounds: &Aabb,
+) -> ShadowFrame {
+    let cascades = if lights.sun_direction.is_some() {
+        settings.cascades.clamp(1, MAX_CASCADES)
+    } else {
+        0
+    };
+    let spots = lights.spot_cones.min(MAX_SPOT_SHADOWS);
+    let atlas = Atlas::new(atlas_size, cascades + spots);
+    let margin = settings.margin();
+    let far = volume.shadow_far(bounds);
+    let near = volume.near.min(far * 0.5);
+    let ends = cascade_splits(near, far, cascades.max(1), settings.split_lambda);
+    let mut splits = [0.0; 4];
+    let mut views = Vec::new();
+    let mut start = near;
+    for (i, &end) in ends.iter().enumerate().take(cascades as usize) {
+        let dir = lights.sun_direction.unwrap_or(Vec3::NEG_Y);
+        let (clip, texel) = fit_sun(dir, &volume.corners(start, end), bounds, atlas.tile, margin);
+        views.push(view(&atlas, i as u32, clip, texel, false, margin));
+        splits[i] = end;
+        start = end;
+    }
+    let words_per_light = LIGHT_BYTES / 4;
+    let first_spot = lights.first_spot_cone();
+    for k in 0..spots {
+        let at = (first_spot + k) as usize * words_per_light;
+        let position = word_vec3(&lights.words, at);
+        let range = word_f32(&lights.words, at + 3);
+        let direction = word_vec3(&lights.words, at + 4);
+        let cos_cutoff = word_f32(&lights.words, at + 15);
+        let (clip, texel) = spot_clip(position, direction, cos_cutoff, range, atlas.tile, margin);
+        views.push(view(&atlas, cascades + k, clip, texel, true, margin));
+    }
+    ShadowFrame {
+        views,
+        cascades,
+        spots,
+        first_spot,
+        splits,
+        forward: volume.forward,
+    }
+}
+
+fn view(
+    atlas: &Atlas,
+    i: u32,
+    clip: Mat4,
+    texel: f32,
+    perspective: bool,
+    margin: f32,
+) -> ShadowView {
+    ShadowView {
+        clip,
+        lookup: atlas.to_uv(i) * clip,
+        viewport: atlas.viewport(i),
+        rect: atlas.inner_rect(i, margin - 1.0),
+        texel,
+        perspective,
+    }
+}
+
+impl ShadowFrame {
+    /// The `Shadows` record: counts (cascades, spot views, first spot light, PCF
+    /// radius), cascade splits, camera forward and normal bias, then the views.
+    pub fn pack(&self, settings: &ShadowSettings) -> Words {
+        let mut w = Words::default();
+        w.u32(self.cascades)
+            .u32(self.spots)
+            .u32(self.first_spot)
+            .u32(settings.pcf_radius)
+            .vec4(Vec4::from_array(self.splits))
+            .vec3w(
+                self.forward,
+                settings.normal_bias * (settings.pcf_radius as f32 + 1.0),
+            );
+        for v in &self.views {
+            w.mat4(&v.clip)
+                .mat4(&v.lookup)
+                .vec4(v.rect)
+                .f32(v.texel)
+                .f32(if v.perspective { 1.0 } else { 0.0 })
+                .f32(0.0)
+                .f32(0.0);
+        }
+        w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Vec3Swizzles, Vec4Swizzles};
+
+    fn cube(h: f32) -> Aabb {
+        Aabb {
+            min: Vec3::splat(-h),
+            max: Vec3::splat(h),
+        }
+    }
+
+    fn volume() -> ViewVolume {
+        let rot = glam::Quat::from_rotation_y(0.3);
+        ViewVolume::new(Vec3::new(0.0, 1.0, 8.0), rot, 1.0, 16.0 / 9.0, 0.1, 100.0)
+    }
+
+    #[test]
+    fn splits_blend_logarithmic_and_uniform() {
+        let s = cascade_splits(1.0, 100.0, 2, 1.0);
+        assert!(
+            (s[0] - 10.0).abs() < 1e-4 && (s[1] - 100.0).abs() < 1e-3,
+            "{s:?}"
+        );
+        let u = cascade_splits(1.0, 101.0, 4, 0.0);
+        assert_eq!(
+            u.iter().map(|v| v.round() as i32).collect::<Vec<_>>(),
+            [26, 51, 76, 101]
+        );
+        let p = cascade_splits(1.0, 100.0, 2, 0.5);
+        assert!((p[0] - 0.5 * (10.0 + 50.5)).abs() < 1e-3, "{p:?}");
+    }
+
+    #[test]
+    fn atlas_tiles_cover_the_map_without_overlap() {
+        let a = Atlas::new(2048, 3);
+        assert_eq!((a.grid, a.tile), (2, 1024));
+        assert_eq!(a.viewport(0), [0, 0, 1024]);
+        assert_eq!(a.viewport(1), [1024, 0, 1024]);
+        assert_eq!(a.viewport(2), [0, 1024, 1024]);
+        assert_eq!(
+            Atlas::new(512, 1),
+            Atlas {
+                size: 512,
+                grid: 1,
+                tile: 512
+            }
+        );
+        // Clip corners land on the tile's corners in texture coordinates.
+        let m = a.to_uv(1);
+        assert_eq!(
+            m * Vec4::new(-1.0, -1.0, 0.3, 1.0),
+            Vec4::new(0.5, 0.0, 0.3, 1.0)
+        );
+        assert_eq!(
+            m * Vec4::new(1.0, 1.0, 0.3, 1.0),
+            Vec4::new(1.0, 0.5, 0.3, 1.0)
+        );
+        let r = a.inner_rect(2, 4.0);
+        assert_eq!(
+            r,
+            Vec4::new(
+                4.0 / 2048.0,
+                0.5 + 4.0 / 2048.0,
+                0.5 - 4.0 / 2048.0,
+                1.0 - 4.0 / 2048.0
+            )
+        );
+    }
+
+    #[test]
+    fn settings_come_from_params_clamped() {
+        let mut p = BTreeMap::new();
+        p.insert("cascades".to_string(), ParamValue::Number(9.0));
+        p.insert("pcf_radius".to_string(), ParamValue::Number(2.0));
+        p.insert("normal_bias".to_string(), ParamValue::Bool(true));
+        let s = ShadowSettings::from_params(&p);
+        assert_eq!((s.cascades, s.pcf_radius, s.normal_bias), (4, 2, 1.0));
+        assert_eq!(
+            ShadowSettings::from_params(&BTreeMap::new()),
+            ShadowSettings::default()
+        );
+    }
+
+    #[test]
+    fn the_sun_view_holds_the_visible_slice_and_every_caster_in_depth() {
+        let v = volume();
+        let bounds = cube(3.0);
+        let slice = v.corners(0.1, 12.0);
+        let (m, texel) = fit_sun(Vec3::new(-0.3, -1.0, -0.2), &slice, &bounds, 1024, 3.0);
+        // Every point of the slice inside the bounds projects inside x/y.
+        for i in 0..=20 {
+            for j in 0..=20 {
+                let p =
+                    slice[0].lerp(slice[7], i as f32 / 20.0) + Vec3::Y * (j as f32 / 10.0 - 1.0);
+                if (p.abs().max_element()) > 3.0 {
+                    continue;
+                }
+                let c = m * p.extend(1.0);
+                assert!(c.xy().abs().max_element() <= 1.0, "{p} -> {c}");
+            }
+        }
+        // Every corner of the bounds lies within the depth range.
+        for c in aabb_corners(&bounds) {
+            let z = (m * c.extend(1.0)).z;
+            assert!((0.0..=1.0).contains(&z), "{c}: {z}");
+        }
+        // Texel world size matches the ortho width over the tile.
+        let width = 2.0 / m.row(0).xyz().length();
+        assert!((width / 1024.0 - texel).abs() < 1e-5 * width);
+    }
+
+    #[test]
+    fn moving_the_camera_moves_the_sun_view_by_whole_texels() {
+        let bounds = cube(50.0);
+        let dir = Vec3::new(-0.3, -1.0, -0.2);
+        let a = volume();
+        let mut b = a;
+        b.eye += Vec3::new(0.0137, 0.0, -0.0071);
+        let (ma, ta) = fit_sun(dir, &a.corners(0.1, 10.0), &bounds, 1024, 3.0);
+        let (mb, tb) = fit_sun(dir, &b.corners(0.1, 10.0), &bounds, 1024, 3.0);
+        assert_eq!(ta, tb, "same footprint step, same texel size");
+        // A fixed world point shifts by a whole number of texels (2 / tile in clip units).
+        let p = Vec3::new(1.0, 0.5, -2.0).extend(1.0);
+        let shift = ((mb * p).xy() - (ma * p).xy()) * 1024.0 / 2.0;
+        assert!(
+            (shift - shift.round()).abs().max_element() < 1e-2,
+            "{shift}"
+        );
+    }
+
+    #[test]
+    fn a_spot_view_holds_its_cone_inside_the_margin() {
+        let pos = Vec3::new(0.0, 5.0, 0.0);
+        let dir = Vec3::new(0.2, -1.0, 0.1).normalize();
+        let cos = 30f32.to_radians().cos();
+        let (m, texel) = spot_clip(pos, dir, cos, 10.0, 256, 3.0);
+        // A point on the cone's edge 5 units out lies 3 texels inside the tile.
+        let side = dir.cross(Vec3::X).normalize();
+        let q = glam::Quat::from_axis_angle(side, 30f32.to_radians());
+        let edge = pos + q * dir * 5.0;
+        let c = m * edge.extend(1.0);
+        let ndc = c.xyz() / c.w;
+        let inside = (1.0 - ndc.xy().abs().max_element()) * 128.0;
+        assert!(inside > 2.9, "{inside}");
+        assert!(ndc.z > 0.0 && ndc.z < 1.0);
+        assert!((texel - 2.0 * 30f32.to_radians().tan() * 256.0 / 250.0 / 256.0).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,306 @@
+//! Shadow maps against geometry, with validation and synchronization validation
+//! on (zero messages): a floating box's shadow on a plane lands where the sun's
+//! direction predicts; a lit plane shows no acne at the default bias; widening
+//! PCF never narrows the penumbra; every configuration (forward or deferred,
+//! shadows and bloom on or off) runs cleanly.
+
+mod common;
+
+use glam::{Vec3, Vec4Swizzles};
+use std::path::{Path, PathBuf};
+use weft_gpu::{Gpu, GpuOptions, Pixels};
+use weft_graph::plan::Extent;
+use weft_render::{render, RenderSettings};
+
+const SIZE: u32 = 256;
+
+/// A 16x16 plane at y = 0 and, when `box_on`, a unit box floating at y 1..2.
+fn write_scene(dir: &Path, sun: Vec3, camera: (Vec3, Vec3), box_on: bool) -> PathBuf {
+    std::fs::create_dir_all(dir).expect("temp dir");
+    let mut obj = String::from("mtllib white.mtl\nusemtl white\nv -8 0 -8\nv 8 0 -8\nv 8 0 8\nv -8 0 8\nf 1 4 3\nf 1 3 2\n");
+    if box_on {
+        for i in 0..8 {
+            let x = if i & 1 == 0 { -0.5 } else { 0.5 };
+            let y = if i & 2 == 0 { 1.0 } else { 2.0 };
+            let z = if i & 4 == 0 { -0.5 } else { 0.5 };
+            obj.push_str(&format!("v {x} {y} {z}\n"));
+        }
+        for [a, b, c, d] in [
+            [1, 3, 7, 5],
+            [2, 6, 8, 4],
+            [1, 5, 6, 2],
+            [3, 4, 8, 7],
+            [1, 2, 4, 3],
+            [5, 7, 8, 6],
+        ] {
+            let (a, b, c, d) = (a + 4, b + 4, c + 4, d + 4);
+            obj.push_str(&format!("f {a} {b} {c}\nf {a} {c} {d}\n"));
+        }
+    }
+    std::fs::write(dir.join("plane.obj"), obj).expect("obj");
+    std::fs::write(dir.join("white.mtl"), "newmtl white\nKd 1 1 1\nKs 0 0 0\n").expect("mtl");
+    let (eye, target) = camera;
+    let scene = format!(
+        "model\n{{\n\tfile \"plane.obj\"\n}}\nsunlight\n{{\n\tdirection {} {} {}\n\tcolor 1 1 1\n\tambient 0\n}}\ncamera \"top\"\n{{\n\tposition {} {} {}\n\ttarget {} {} {}\n\tfov_deg 40\n}}\n",
+        sun.x, sun.y, sun.z, eye.x, eye.y, eye.z, target.x, target.y, target.z
+    );
+    let path = dir.join("plane.scene");
+    std::fs::write(&path, scene).expect("scene");
+    path
+}
+
+/// `graphs/<graph>` rewritten into `dir` with shadow parameters overridden.
+fn graph_with(dir: &Path, graph: &str, shadow_params: &str) -> PathBuf {
+    let root = common::root().join("graphs");
+    let text = std::fs::read_to_string(root.join(graph)).expect("graph");
+    let include = format!(
+        "(file: \"{}\", params: {{ {shadow_params} }})",
+        root.join("shadows.ron").display()
+    );
+    let text = text
+        .replace(
+            "(file: \"shadows.ron\", params: { \"resolution\": 2048 })",
+            "(file: \"shadows.ron\")",
+        )
+        .replace("(file: \"shadows.ron\")", &include)
+        .replace(
+            "(file: \"bloom.ron\"",
+            &format!("(file: \"{}\"", root.join("bloom.ron").display()),
+        )
+        .replace(
+            "\"../shaders/",
+            &format!("\"{}/", common::root().join("shaders").display()),
+        );
+    let path = dir.join(graph);
+    std::fs::write(&path, text).expect("graph");
+    path
+}
+
+/// Renders `scene` through `graph` and returns the HDR image's red channel, row by row.
+fn render_hdr(scene: &Path, graph: &Path) -> Vec<f32> {
+    let scene = weft_scene::load_scene(scene).expect("scene loads");
+    let gpu = Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("device");
+    let log = gpu.validation();
+    let settings = RenderSettings {
+        graph: graph.to_path_buf(),
+        extent: Extent {
+            width: SIZE,
+            height: SIZE,
+        },
+        features: vec!["!bloom".into()],
+        extra_readback: vec!["hdr".into()],
+        ..RenderSettings::default()
+    };
+    let rendered = render(&gpu, &scene, &settings).expect("renders");
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+    assert_eq!(rendered.plan.passes[0].name, "shadow_sun");
+    let (_, hdr) = &rendered.report.readbacks[0];
+    let Pixels::RgbaF32(values) = &hdr.pixels else {
+        panic!("hdr is float");
+    };
+    values.chunks(4).map(|p| p[0]).collect()
+}
+
+/// Pixel coordinates (x right, y down, pixel centres at +0.5) of a world point.
+fn project(scene: &Path, p: Vec3) -> glam::Vec2 {
+    let scene = weft_scene::load_scene(scene).expect("scene loads");
+    let m = weft_render::camera::view_projection(&scene.cameras[0], 0.0, 1.0);
+    let c = m * p.extend(1.0);
+    (c.xy() / c.w * 0.5 + 0.5) * SIZE as f32
+}
+
+/// Where pixel (x, y)'s centre ray meets the plane y = 0, if it does.
+fn plane_hit(inv: &glam::Mat4, x: u32, y: u32) -> Option<Vec3> {
+    let ndc = (glam::Vec2::new(x as f32, y as f32) + 0.5) / SIZE as f32 * 2.0 - 1.0;
+    let a = inv.project_point3(ndc.extend(1.0));
+    let b = inv.project_point3(ndc.extend(0.5));
+    let t = a.y / (a.y - b.y);
+    (t > 0.0).then(|| a + (b - a) * t)
+}
+
+/// Where a line of samples first crosses `level` going from index `from` in
+/// direction `step`, interpolated between samples, as a sample index.
+fn crossing(samples: &[f32], from: usize, step: isize, level: f32) -> f32 {
+    let mut i = from as isize;
+    loop {
+        let j = i + step;
+        assert!(
+            j >= 0 && (j as usize) < samples.len(),
+            "no crossing of {level}"
+        );
+        let (a, b) = (samples[i as usize], samples[j as usize]);
+        if (a - level) * (b - level) <= 0.0 && a != b {
+            return i as f32 + step as f32 * (a - level) / (a - b);
+        }
+        i = j;
+    }
+}
+
+fn row(image: &[f32], y: usize) -> Vec<f32> {
+    image[y * SIZE as usize..(y + 1) * SIZE as usize].to_vec()
+}
+
+fn column(image: &[f32], x: usize) -> Vec<f32> {
+    (0..SIZE as usize)
+        .map(|y| image[y * SIZE as usize + x])
+        .collect()
+}
+
+/// The sun travels along (-2, -1, 0): the box (x, z in -0.5..0.5, y in 1..2)
+/// shadows x in -4.5..-1.5, z in -0.5..0.5 on the plane.
+const SUN: Vec3 = Vec3::new(-2.0, -1.0, 0.0);
+const TOP: (Vec3, Vec3) = (Vec3::new(-3.0, 10.0, 0.0), Vec3::new(-3.0, 0.0, 0.0));
+
+#[test]
+fn a_box_shadow_lands_where_the_sun_direction_predicts() {
+    let dir = std::env::temp_dir().join("weft-shadows-analytic");
+    let scene = write_scene(&dir, SUN, TOP, true);
+    for graph in ["forward.ron", "deferred.ron"] {
+        let g = graph_with(&dir, graph, "");
+        let image = render_hdr(&scene, &g);
+        let lit = 1.0 / 5f32.sqrt();
+        let centre = project(&scene, Vec3::new(-3.0, 0.0, 0.0));
+        let (cx, cy) = (centre.x as usize, centre.y as usize);
+        assert!(
+            image[cy * SIZE as usize + cx] < 0.01,
+            "{graph}: the centre is in shadow"
+        );
+        // Edges along the row and the column through the shadow's centre.
+        let edges = [
+            (Vec3::new(-4.5, 0.0, 0.0), true),
+            (Vec3::new(-1.5, 0.0, 0.0), true),
+            (Vec3::new(-3.0, 0.0, -0.5), false),
+            (Vec3::new(-3.0, 0.0, 0.5), false),
+        ];
+        for (edge, along_row) in edges {
+            let p = project(&scene, edge);
+            let (line, from, predicted) = if along_row {
+                (row(&image, cy), cx, p.x - 0.5)
+            } else {
+                (column(&image, cx), cy, p.y - 0.5)
+            };
+            let step = if predicted > from as f32 { 1 } else { -1 };
+            let measured = crossing(&line, from, step, lit * 0.5);
+            eprintln!(
+                "{graph}: edge {edge}: measured {measured:.2} px, predicted {predicted:.2} px"
+            );
+            assert!(
+                (measured - predicted).abs() <= 1.5,
+                "{graph}: edge at {edge} measured at pixel {measured:.2}, predicted {predicted:.2}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_lit_plane_shows_no_acne_at_the_default_bias() {
+    let dir = std::env::temp_dir().join("weft-shadows-acne");
+    let camera = (Vec3::new(0.0, 4.0, 9.0), Vec3::new(0.0, 0.0, 0.0));
+    for (i, degrees) in [10.0f32, 45.0, 70.0].into_iter().enumerate() {
+        let d = dir.join(format!("{i}"));
+        let angle = degrees.to_radians();
+        let sun = Vec3::new(angle.sin() * 0.6, -angle.cos(), angle.sin() * 0.8);
+        let scene = write_scene(&d, sun, camera, false);
+        // Pixels whose centre sees the plane at least 0.25 from its edges.
+        let loaded = weft_scene::load_scene(&scene).expect("scene loads");
+        let inv = weft_render::camera::view_projection(&loaded.cameras[0], 0.0, 1.0).inverse();
+        let inside: Vec<usize> = (0..SIZE * SIZE)
+            .filter(|i| {
+                plane_hit(&inv, i % SIZE, i / SIZE)
+                    .is_some_and(|p| p.x.abs() < 7.75 && p.z.abs() < 7.75)
+            })
+            .map(|i| i as usize)
+            .collect();
+        for graph in ["forward.ron", "deferred.ron"] {
+            let g = graph_with(&d, graph, "");
+            let image = render_hdr(&scene, &g);
+            let lit = angle.cos();
+            let plane: Vec<f32> = inside.iter().map(|&i| image[i]).collect();
+            let darkened = plane.iter().filter(|v| **v < lit * 0.99).count();
+            let share = darkened as f64 / plane.len() as f64;
+            eprintln!(
+                "{graph}, sun {degrees} degrees: {darkened} of {} plane pixels darkened",
+                plane.len()
+            );
+            assert!(plane.len() > 20_000, "the plane fills most of the view");
+            assert!(
+                share < 0.001,
+                "{graph}, sun {degrees} degrees from the normal: {darkened} of {} lit pixels darkened",
+                plane.len()
+            );
+        }
+    }
+}
+
+/// Width in pixels of the transition from 10% to 90% of the lit value across
+/// the shadow's right edge (x = -1.5), on the row through its centre.
+fn penumbra(scene: &Path, image: &[f32]) -> f32 {
+    let lit = 1.0 / 5f32.sqrt();
+    let centre = project(scene, Vec3::new(-3.0, 0.0, 0.0));
+    let line = row(image, centre.y as usize);
+    let from = centre.x as usize;
+    let step = if project(scene, Vec3::new(-1.5, 0.0, 0.0)).x > centre.x {
+        1
+    } else {
+        -1
+    };
+    (crossing(&line, from, step, lit * 0.9) - crossing(&line, from, step, lit * 0.1)).abs()
+}
+
+#[test]
+fn widening_pcf_never_narrows_the_penumbra() {
+    let dir = std::env::temp_dir().join("weft-shadows-penumbra");
+    let scene = write_scene(&dir, SUN, TOP, true);
+    let mut widths = Vec::new();
+    for r in 0..=3 {
+        let g = graph_with(
+            &dir,
+            "forward.ron",
+            &format!("\"resolution\": 512, \"pcf_radius\": {r}"),
+        );
+        widths.push(penumbra(&scene, &render_hdr(&scene, &g)));
+    }
+    eprintln!("penumbra widths (pixels) for pcf_radius 0..3 at 512 texels: {widths:?}");
+    for w in widths.windows(2) {
+        assert!(w[1] >= w[0], "penumbra widths by radius 0..3: {widths:?}");
+    }
+    assert!(
+        widths[3] > widths[0] + 1.0,
+        "a 7x7 kernel widens the edge: {widths:?}"
+    );
+}
+
+#[test]
+fn every_configuration_runs_without_validation_messages() {
+    for graph in ["forward.ron", "deferred.ron"] {
+        for shadows in ["shadow_casters", "!shadow_casters"] {
+            for bloom in ["bloom", "!bloom"] {
+                let out = common::render_validated(
+                    &common::demo_scene(),
+                    &common::graph(graph),
+                    96,
+                    54,
+                    &[shadows, bloom],
+                );
+                assert_eq!(out.messages, Vec::new(), "{graph} {shadows} {bloom}");
+                assert_eq!(
+                    out.passes.contains(&"shadow_sun".to_string()),
+                    shadows == "shadow_casters",
+                    "{graph} {shadows} {bloom}: {:?}",
+                    out.passes
+                );
+                assert_eq!(
+                    out.passes.contains(&"bloom_bright".to_string()),
+                    bloom == "bloom",
+                    "{graph} {shadows} {bloom}: {:?}",
+                    out.passes
+                );
+            }
+        }
+    }
+}
