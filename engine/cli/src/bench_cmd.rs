@@ -11,11 +11,14 @@ use std::process::ExitCode;
 pub enum BenchCommand {
     /// Frame time against the number of point lights, one line per graph.
     Lights(crate::bench_lights::LightsArgs),
+    /// Bloom blur time and error: paired linear-filtered taps against one fetch per texel.
+    Bloom(crate::bench_bloom::BloomArgs),
 }
 
 /// Runs `weft bench ...`.
 pub fn run(cmd: BenchCommand) -> Result<ExitCode> {
     match cmd {
         BenchCommand::Lights(args) => crate::bench_lights::run(args),
+        BenchCommand::Bloom(args) => crate::bench_bloom::run(args),
     }
 }

@@ -1,5 +1,6 @@
 //! The `weft` command.
 
+mod bench_bloom;
 mod bench_cmd;
 mod bench_lights;
 mod graph_cmd;

@@ -1,6 +1,7 @@
 #version 450
-// A deterministic HDR test image: a coloured ramp up to `level`, with dots of
-// `peak` on a sparse lattice (one texel each) and one 3x3 block.
+// A deterministic HDR test image for the bloom tests and `weft bench bloom`:
+// a coloured ramp up to `level`, with dots of `peak` on a sparse lattice (one
+// texel each) and one 3x3 block.
 layout(push_constant) uniform Params {
     float peak;
     float level;
