@@ -7,6 +7,7 @@ mod graph_cmd;
 mod plot;
 mod render_cmd;
 mod scene_cmd;
+mod view;
 mod watch_cmd;
 
 use clap::{Parser, Subcommand};
@@ -33,6 +34,8 @@ enum Command {
     /// Benchmarks that write figures and plots (into docs/ by default).
     #[command(subcommand)]
     Bench(bench_cmd::BenchCommand),
+    /// Show a scene in a window: fly around, switch graphs and features, hot reload.
+    View(view::ViewArgs),
 }
 
 fn main() -> ExitCode {
@@ -42,6 +45,7 @@ fn main() -> ExitCode {
         Command::Scene(cmd) => scene_cmd::run(cmd),
         Command::Render(args) => render_cmd::run(args),
         Command::Bench(cmd) => bench_cmd::run(cmd),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(code) => code,

@@ -67,6 +67,7 @@ pub struct RenderArgs {
     watch: bool,
 }
 
+/// Parses `WIDTHxHEIGHT` (each 1..=16384), as `--size` takes it.
 pub(crate) fn parse_size(text: &str) -> Result<Extent, String> {
     let (w, h) = text
         .split_once(['x', 'X'])

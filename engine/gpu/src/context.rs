@@ -7,7 +7,7 @@ use crate::validation::{self, ValidationCounts, ValidationLog};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use gpu_allocator::{AllocationSizes, AllocatorDebugSettings};
-use std::ffi::{c_void, CStr};
+use std::ffi::{c_char, c_void, CStr};
 use std::mem::ManuallyDrop;
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -78,15 +78,41 @@ pub struct Gpu {
     allocator: ManuallyDrop<Mutex<Allocator>>,
     info: DeviceInfo,
     log: Arc<ValidationLog>,
+    presenting: bool,
 }
 
 impl Gpu {
     /// Creates the instance, picks a device and creates everything on it.
     pub fn new(options: &GpuOptions) -> Result<Self, GpuError> {
+        Self::create(options, None)
+    }
+
+    /// Like [`Gpu::new`], with the surface extensions of `display` and the
+    /// swapchain extension enabled, so windows on that display can be presented
+    /// to; headless contexts leave them off.
+    pub fn for_display(
+        options: &GpuOptions,
+        display: raw_window_handle::RawDisplayHandle,
+    ) -> Result<Self, GpuError> {
+        let extensions = ash_window::enumerate_required_extensions(display)
+            .call("vkEnumerateInstanceExtensionProperties")?;
+        Self::create(options, Some(extensions))
+    }
+
+    fn create(
+        options: &GpuOptions,
+        surface_extensions: Option<&[*const c_char]>,
+    ) -> Result<Self, GpuError> {
         let entry = unsafe { ash::Entry::load() }.map_err(|e| GpuError::Loader(e.to_string()))?;
         let log = ValidationLog::new();
+        let presenting = surface_extensions.is_some();
         let mut guard = InstanceGuard {
-            instance: Some(create_instance(&entry, options.validation, &log)?),
+            instance: Some(create_instance(
+                &entry,
+                options.validation,
+                &log,
+                surface_extensions.unwrap_or_default(),
+            )?),
             debug: None,
         };
         if options.validation {
@@ -97,12 +123,13 @@ impl Gpu {
             guard.debug = Some((loader, messenger));
         }
         let (physical, info, queue_family) =
-            choose_device(guard.instance()?, options.device.as_deref())?;
+            choose_device(guard.instance()?, options.device.as_deref(), presenting)?;
         let device = create_device(
             guard.instance()?,
             physical,
             queue_family,
             info.pipeline_statistics,
+            presenting,
         )?;
         let (instance, debug) = guard.release()?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
@@ -154,7 +181,13 @@ impl Gpu {
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             info,
             log,
+            presenting,
         })
+    }
+
+    /// Whether the swapchain extension is on (made by [`Gpu::for_display`]).
+    pub fn can_present(&self) -> bool {
+        self.presenting
     }
 
     /// The logical device, for recording commands.
@@ -408,13 +441,14 @@ fn create_instance(
     entry: &ash::Entry,
     validate: bool,
     log: &Arc<ValidationLog>,
+    surface_extensions: &[*const c_char],
 ) -> Result<ash::Instance, GpuError> {
     let app = vk::ApplicationInfo::default()
         .application_name(c"weft")
         .engine_name(c"weft")
         .api_version(vk::API_VERSION_1_3);
     let mut layers = Vec::new();
-    let mut extensions = Vec::new();
+    let mut extensions = surface_extensions.to_vec();
     if validate {
         let available = unsafe { entry.enumerate_instance_layer_properties() }
             .call("vkEnumerateInstanceLayerProperties")?;
@@ -443,6 +477,7 @@ fn create_instance(
 fn choose_device(
     instance: &ash::Instance,
     wanted: Option<&str>,
+    presenting: bool,
 ) -> Result<(vk::PhysicalDevice, DeviceInfo, u32), GpuError> {
     let devices =
         unsafe { instance.enumerate_physical_devices() }.call("vkEnumeratePhysicalDevices")?;
@@ -479,6 +514,9 @@ fn choose_device(
         if f13.synchronization2 == vk::FALSE || f13.maintenance4 == vk::FALSE {
             continue;
         }
+        if presenting && !has_swapchain(instance, physical) {
+            continue;
+        }
         let info = DeviceInfo {
             name,
             kind: DeviceKind::from_vk(props.device_type),
@@ -507,6 +545,7 @@ fn create_device(
     physical: vk::PhysicalDevice,
     family: u32,
     pipeline_statistics: bool,
+    presenting: bool,
 ) -> Result<ash::Device, GpuError> {
     let priorities = [1.0];
     let queues = [vk::DeviceQueueCreateInfo::default()
@@ -519,8 +558,24 @@ fn create_device(
     let mut features = vk::PhysicalDeviceFeatures2::default()
         .features(core)
         .push_next(&mut f13);
+    let extensions = if presenting {
+        vec![ash::khr::swapchain::NAME.as_ptr()]
+    } else {
+        Vec::new()
+    };
     let info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)
+        .enabled_extension_names(&extensions)
         .push_next(&mut features);
     unsafe { instance.create_device(physical, &info, None) }.call("vkCreateDevice")
+}
+
+/// Whether the device offers `VK_KHR_swapchain`.
+fn has_swapchain(instance: &ash::Instance, physical: vk::PhysicalDevice) -> bool {
+    unsafe { instance.enumerate_device_extension_properties(physical) }
+        .map(|all| {
+            all.iter()
+                .any(|e| e.extension_name_as_c_str() == Ok(ash::khr::swapchain::NAME))
+        })
+        .unwrap_or(false)
 }

@@ -15,6 +15,7 @@ use std::collections::BTreeSet;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use weft_gpu::pipeline::PipelineCache;
+use weft_gpu::resources::GpuImage;
 use weft_gpu::{FrameOptions, FrameReport, FrameResources, Gpu, GpuError, Renderer, ShaderError};
 use weft_graph::plan::Plan;
 use weft_scene::{Camera, Scene, SceneError};
@@ -211,19 +212,47 @@ impl<'g> LiveRender<'g> {
         &self.scene
     }
 
+    /// The settings the live version was built with.
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// The camera the settings name (or the scene's first).
+    pub fn camera(&self) -> Result<&Camera, RenderError> {
+        pick_camera(&self.scene, &self.settings)
+    }
+
+    /// The live plan's output image; after a frame it is in
+    /// `TRANSFER_SRC_OPTIMAL`, ready to be presented or copied.
+    pub fn output(&self) -> Result<&GpuImage, GpuError> {
+        self.resources.image(self.plan.output)
+    }
+
     /// Renders one frame of the live version at the settings' time, reading the
     /// output (and the settings' extra images) back.
     pub fn frame(&mut self) -> Result<FrameReport, RenderError> {
         let camera = pick_camera(&self.scene, &self.settings)?.clone();
-        let time = self.settings.time;
+        self.draw(&camera, self.settings.time, 0, true)
+    }
+
+    /// Renders frame number `frame` of the live version seen from `camera` at
+    /// `time` seconds (a viewer's own camera), reading the output back only
+    /// when asked.
+    pub fn draw(
+        &mut self,
+        camera: &Camera,
+        time: f32,
+        frame: u32,
+        readback: bool,
+    ) -> Result<FrameReport, RenderError> {
         let extent = [self.settings.extent.width, self.settings.extent.height];
-        self.recorder.scene.update(&camera, time, extent)?;
-        self.recorder.set_frame(time, 0);
+        self.recorder.scene.update(camera, time, extent)?;
+        self.recorder.set_frame(time, frame);
         let options = FrameOptions {
             timing: self.settings.timing,
-            readback: true,
+            readback,
             time,
-            frame: 0,
+            frame,
         };
         Ok(self.renderer.execute(
             &self.plan,
@@ -231,6 +260,41 @@ impl<'g> LiveRender<'g> {
             &mut self.recorder,
             &options,
         )?)
+    }
+
+    /// Switches to other settings (another graph, feature set or size) all-or-nothing:
+    /// the new plan and its shaders are built and checked first, and on failure the
+    /// live version keeps rendering unchanged. Shader files the live version did not
+    /// use are compiled afresh from disk, since no watcher saw their edits.
+    pub fn reconfigure(&mut self, settings: RenderSettings) -> Result<(), ReloadError> {
+        let graph = settings.graph.clone();
+        pick_camera(&self.scene, &settings).map_err(|e| ReloadError::render(e, &self.scene_path))?;
+        let plan = compile_for_scene(self.gpu, &self.scene, &settings)
+            .map_err(|e| ReloadError::render(e, &graph))?;
+        let fail = |e: GpuError| ReloadError::gpu(e, &graph);
+        let mut checker = PipelineCache::new().map_err(fail)?;
+        check_shaders(&mut checker, &plan, &graph)?;
+        let shaders = shader_files(&mut checker, &plan).map_err(fail)?;
+        let resources = self.renderer.create_resources(&plan).map_err(fail)?;
+        let unwatched: Vec<&PathBuf> = shaders
+            .iter()
+            .filter(|(file, _)| !self.sources.shaders.contains_key(*file))
+            .flat_map(|(_, raw)| raw)
+            .collect();
+        for raw in unwatched {
+            self.renderer.reload(raw).map_err(fail)?;
+            self.recorder.reload(raw).map_err(fail)?;
+        }
+        self.sources = Sources {
+            graph: graph_files(&graph),
+            shaders,
+            scene: self.sources.scene.clone(),
+        };
+        self.checker = checker;
+        self.resources = resources;
+        self.plan = plan;
+        self.settings = settings;
+        Ok(())
     }
 
     /// Applies edits to `changed` files (normalized paths; files this render does not

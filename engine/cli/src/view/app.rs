@@ -1,0 +1,526 @@
+//! The viewer's event loop: winit events drive the fly camera, graph and
+//! feature switches and screenshots; each redraw applies pending file edits
+//! (all-or-nothing, at the frame boundary), renders the live graph from the fly
+//! camera and presents it.
+
+use super::controls::{self, Status};
+use super::fly::{self, FlyCamera, FlyInput};
+use super::ViewArgs;
+use anyhow::{anyhow, Context, Result};
+use ash::vk;
+use glam::Vec2;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+use weft_gpu::{Gpu, PresentSource, Presented, Presenter, Readback, Swapchain};
+use weft_graph::plan::Extent;
+use weft_render::watch::{FileWatcher, QUIET};
+use weft_render::{LiveRender, RenderSettings};
+use weft_scene::Camera;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::ActiveEventLoop;
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use winit::window::{Window, WindowId};
+
+/// How often the title's times are refreshed.
+const TITLE_EVERY: Duration = Duration::from_millis(500);
+/// Pixels of scrolling that count as one wheel notch (touchpads).
+const PIXELS_PER_NOTCH: f64 = 40.0;
+
+/// The number keys that toggle features, in order.
+const FEATURE_KEYS: [KeyCode; 9] = [
+    KeyCode::Digit1,
+    KeyCode::Digit2,
+    KeyCode::Digit3,
+    KeyCode::Digit4,
+    KeyCode::Digit5,
+    KeyCode::Digit6,
+    KeyCode::Digit7,
+    KeyCode::Digit8,
+    KeyCode::Digit9,
+];
+
+/// Frame times gathered between title updates.
+#[derive(Default)]
+struct Stats {
+    total_ms: f64,
+    frames: u32,
+    mean_ms: f64,
+    since: Option<Instant>,
+}
+
+/// The viewer's state; the presenter is declared before the window so it is
+/// dropped first (the surface must go before its window).
+pub struct Viewer<'g> {
+    gpu: &'g Gpu,
+    live: LiveRender<'g>,
+    watcher: FileWatcher,
+    presenter: Option<Presenter<'g>>,
+    window: Option<Window>,
+    start: FlyCamera,
+    camera: FlyCamera,
+    lens: Camera,
+    held: HashSet<KeyCode>,
+    shift: bool,
+    dragging: bool,
+    cursor: Option<(f64, f64)>,
+    drag: Vec2,
+    time: f32,
+    paused: bool,
+    last_frame: Option<Instant>,
+    frames: u32,
+    frame_limit: Option<u32>,
+    resize_to: Option<Extent>,
+    pending_size: Option<[u32; 2]>,
+    screenshot_on_exit: Option<PathBuf>,
+    screenshot_now: bool,
+    screenshots: u32,
+    graphs: Vec<PathBuf>,
+    features: Vec<String>,
+    error: Option<String>,
+    stats: Stats,
+    timings: Vec<weft_gpu::PassTiming>,
+    failure: Option<anyhow::Error>,
+}
+
+impl<'g> Viewer<'g> {
+    /// Loads the scene and graph and starts watching their files; the window
+    /// comes when the event loop resumes.
+    pub fn new(gpu: &'g Gpu, args: &ViewArgs, settings: RenderSettings) -> Result<Self> {
+        let live = LiveRender::new(gpu, &args.scene, settings).map_err(|e| anyhow!("{e}"))?;
+        let lens = live.camera()?.clone();
+        let (position, orientation) = lens.pose_at(args.time);
+        let start = FlyCamera {
+            position,
+            orientation,
+            speed: fly::speed_for(live.scene().effective_bounds().diagonal()),
+        };
+        let mut watcher = FileWatcher::new(QUIET)?;
+        watcher.watch(&live.sources().all())?;
+        let graph = live.settings().graph.clone();
+        let viewer = Self {
+            gpu,
+            watcher,
+            presenter: None,
+            window: None,
+            start,
+            camera: start,
+            lens,
+            held: HashSet::new(),
+            shift: false,
+            dragging: false,
+            cursor: None,
+            drag: Vec2::ZERO,
+            time: args.time,
+            paused: args.paused,
+            last_frame: None,
+            frames: 0,
+            frame_limit: args.frames,
+            resize_to: args.resize_to,
+            pending_size: None,
+            screenshot_on_exit: args.screenshot_on_exit.clone(),
+            screenshot_now: false,
+            screenshots: 0,
+            graphs: controls::sibling_graphs(&graph),
+            features: controls::graph_features(&graph),
+            error: None,
+            stats: Stats::default(),
+            timings: Vec::new(),
+            failure: None,
+            live,
+        };
+        viewer.print_features();
+        Ok(viewer)
+    }
+
+    /// Releases the window and reports a failure that stopped the loop.
+    pub fn finish(mut self) -> Result<()> {
+        self.presenter = None;
+        self.window = None;
+        match self.failure.take() {
+            Some(err) => Err(err),
+            None => Ok(()),
+        }
+    }
+
+    fn print_features(&self) {
+        let on = &self.live.plan().features;
+        let list: Vec<String> = self
+            .features
+            .iter()
+            .take(FEATURE_KEYS.len())
+            .enumerate()
+            .map(|(i, f)| {
+                let state = if on.contains(f) { "on" } else { "off" };
+                format!("{} {f} [{state}]", i + 1)
+            })
+            .collect();
+        println!(
+            "graph {}: features {}",
+            self.live.settings().graph.display(),
+            if list.is_empty() {
+                "none".to_string()
+            } else {
+                list.join(", ")
+            }
+        );
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, err: anyhow::Error) {
+        self.failure.get_or_insert(err);
+        event_loop.exit();
+    }
+
+    /// Creates the window, its swapchain and the presenter.
+    fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let extent = self.live.settings().extent;
+        let attributes = Window::default_attributes()
+            .with_title("weft view")
+            .with_inner_size(PhysicalSize::new(extent.width, extent.height));
+        let window = event_loop
+            .create_window(attributes)
+            .context("creating the window")?;
+        let size = window.inner_size();
+        let display = window.display_handle()?.as_raw();
+        let handle = window.window_handle()?.as_raw();
+        // The presenter is dropped before the window (see `finish` and field order).
+        let swapchain =
+            unsafe { Swapchain::new(self.gpu, display, handle, [size.width, size.height]) }?;
+        self.presenter = Some(Presenter::new(self.gpu, swapchain)?);
+        self.window = Some(window);
+        self.pending_size = Some([size.width, size.height]);
+        Ok(())
+    }
+
+    fn key(&mut self, event_loop: &ActiveEventLoop, event: &KeyEvent) {
+        let PhysicalKey::Code(code) = event.physical_key else {
+            return;
+        };
+        if event.state == ElementState::Released {
+            self.held.remove(&code);
+            return;
+        }
+        self.held.insert(code);
+        if event.repeat {
+            return;
+        }
+        match code {
+            KeyCode::Escape => event_loop.exit(),
+            KeyCode::F12 => self.screenshot_now = true,
+            KeyCode::Space => self.paused = !self.paused,
+            KeyCode::KeyR => self.camera = FlyCamera {
+                speed: self.camera.speed,
+                ..self.start
+            },
+            KeyCode::KeyG => {
+                let step = if self.shift { -1 } else { 1 };
+                let current = self.live.settings().graph.clone();
+                if let Some(next) = controls::cycle(&self.graphs, &current, step) {
+                    let settings = RenderSettings {
+                        graph: next,
+                        ..self.live.settings().clone()
+                    };
+                    self.reconfigure(settings);
+                }
+            }
+            _ => {
+                if let Some(i) = FEATURE_KEYS.iter().position(|&k| k == code) {
+                    self.toggle_feature(i);
+                }
+            }
+        }
+    }
+
+    fn toggle_feature(&mut self, index: usize) {
+        let Some(name) = self.features.get(index).cloned() else {
+            return;
+        };
+        let on = self.live.plan().features.contains(&name);
+        let settings = RenderSettings {
+            features: controls::toggle(&self.live.settings().features, &name, on),
+            ..self.live.settings().clone()
+        };
+        self.reconfigure(settings);
+    }
+
+    /// Switches the live render to `settings`; a refusal keeps the last good version.
+    fn reconfigure(&mut self, settings: RenderSettings) -> bool {
+        let graph_changed = settings.graph != self.live.settings().graph;
+        let features_changed = settings.features != self.live.settings().features;
+        match self.live.reconfigure(settings) {
+            Ok(()) => {
+                if graph_changed {
+                    self.features = controls::graph_features(&self.live.settings().graph);
+                }
+                if graph_changed || features_changed {
+                    self.print_features();
+                }
+                self.watch();
+                self.error = None;
+                true
+            }
+            Err(err) => {
+                self.report_error(err.to_string());
+                false
+            }
+        }
+    }
+
+    fn report_error(&mut self, error: String) {
+        eprintln!("error: {error} (kept last good)");
+        self.error = Some(error);
+        self.update_title(true);
+    }
+
+    fn watch(&mut self) {
+        if let Err(err) = self.watcher.watch(&self.live.sources().all()) {
+            eprintln!("error: {err} (still watching the other files)");
+        }
+    }
+
+    /// Applies edited files, if any, all-or-nothing.
+    fn hot_reload(&mut self) -> Result<()> {
+        let changed = self.watcher.next_batch(Duration::ZERO)?;
+        if changed.is_empty() {
+            return Ok(());
+        }
+        let started = Instant::now();
+        match self.live.apply(&changed) {
+            Ok(paths) => {
+                self.watch();
+                self.error = None;
+                if !paths.is_empty() {
+                    println!(
+                        "reloaded {} in {:.1} ms",
+                        paths
+                            .iter()
+                            .map(|p| p.display().to_string())
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                        started.elapsed().as_secs_f64() * 1e3
+                    );
+                }
+            }
+            Err(err) => self.report_error(err.to_string()),
+        }
+        Ok(())
+    }
+
+    /// What the held keys, drag and wheel ask for since the last frame.
+    fn input(&mut self, dt: f32) -> FlyInput {
+        let axis = |plus: KeyCode, minus: KeyCode| {
+            f32::from(u8::from(self.held.contains(&plus)))
+                - f32::from(u8::from(self.held.contains(&minus)))
+        };
+        let keys = Vec2::new(
+            axis(KeyCode::ArrowRight, KeyCode::ArrowLeft),
+            axis(KeyCode::ArrowUp, KeyCode::ArrowDown),
+        );
+        let look = keys * fly::KEY_LOOK * dt + self.drag * fly::DRAG_LOOK;
+        self.drag = Vec2::ZERO;
+        FlyInput {
+            forward: axis(KeyCode::KeyW, KeyCode::KeyS),
+            right: axis(KeyCode::KeyD, KeyCode::KeyA),
+            up: axis(KeyCode::KeyE, KeyCode::KeyQ),
+            fast: self.shift,
+            look,
+        }
+    }
+
+    /// One frame: reload, resize, move, render, present, screenshot.
+    fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        self.hot_reload()?;
+        let Some(window) = &self.window else {
+            return Ok(());
+        };
+        let size = window.inner_size();
+        if size.width == 0 || size.height == 0 {
+            return Ok(());
+        }
+        let size = [size.width, size.height];
+        if let Some(wanted) = self.pending_size.take() {
+            self.resize(wanted)?;
+        }
+        let now = Instant::now();
+        let dt = self
+            .last_frame
+            .map_or(0.0, |t| now.duration_since(t).as_secs_f32());
+        self.last_frame = Some(now);
+        let input = self.input(dt);
+        self.camera.update(&input, dt);
+        if !self.paused {
+            self.time += dt;
+        }
+        let camera = Camera {
+            name: "fly".into(),
+            position: self.camera.position,
+            orientation: self.camera.orientation,
+            path: Vec::new(),
+            ..self.lens.clone()
+        };
+        let report = self.live.draw(&camera, self.time, self.frames, false)?;
+        let output = self.live.output()?;
+        let source = PresentSource {
+            image: output.image,
+            extent: vk::Extent2D {
+                width: output.desc.extent.width,
+                height: output.desc.extent.height,
+            },
+            format: vk::Format::from_raw(output.desc.format_raw),
+        };
+        let last = self.frame_limit.is_some_and(|n| self.frames + 1 >= n);
+        let on_exit = last && self.screenshot_on_exit.is_some();
+        let capture = self.screenshot_now || on_exit;
+        let presenter = self
+            .presenter
+            .as_mut()
+            .context("no presenter for the window")?;
+        let shown = match presenter.present(source, capture, size)? {
+            Presented::Shown(pixels) => pixels,
+            Presented::Recreated => return Ok(()),
+        };
+        self.frames += 1;
+        self.timings = report.timings;
+        self.stats.total_ms += now.elapsed().as_secs_f64() * 1e3;
+        self.stats.frames += 1;
+        if let Some(pixels) = shown {
+            self.save_screenshots(&pixels, on_exit)?;
+        }
+        self.update_title(false);
+        if let (Some(limit), Some(to)) = (self.frame_limit, self.resize_to) {
+            if self.frames == limit / 2 {
+                if let Some(window) = &self.window {
+                    let _ = window.request_inner_size(PhysicalSize::new(to.width, to.height));
+                }
+            }
+        }
+        if last {
+            event_loop.exit();
+        }
+        Ok(())
+    }
+
+    /// Rebuilds the swapchain and the plan for a window of `size` pixels.
+    fn resize(&mut self, size: [u32; 2]) -> Result<()> {
+        if let Some(presenter) = self.presenter.as_mut() {
+            presenter.resize(size)?;
+        }
+        let extent = Extent {
+            width: size[0],
+            height: size[1],
+        };
+        if self.live.settings().extent != extent {
+            let settings = RenderSettings {
+                extent,
+                ..self.live.settings().clone()
+            };
+            self.reconfigure(settings);
+        }
+        Ok(())
+    }
+
+    fn save_screenshots(&mut self, pixels: &Readback, on_exit: bool) -> Result<()> {
+        if self.screenshot_now {
+            self.screenshot_now = false;
+            self.screenshots += 1;
+            let stamp = std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs());
+            let path = PathBuf::from(format!("weft-{stamp}-{}.png", self.screenshots));
+            save(pixels, &path)?;
+        }
+        if on_exit {
+            if let Some(path) = self.screenshot_on_exit.clone() {
+                save(pixels, &path)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn update_title(&mut self, now: bool) {
+        let since = *self.stats.since.get_or_insert_with(Instant::now);
+        if !now && since.elapsed() < TITLE_EVERY {
+            return;
+        }
+        if self.stats.frames > 0 {
+            self.stats.mean_ms = self.stats.total_ms / f64::from(self.stats.frames);
+        }
+        self.stats.total_ms = 0.0;
+        self.stats.frames = 0;
+        self.stats.since = Some(Instant::now());
+        let title = controls::title(&Status {
+            graph: &self.live.settings().graph,
+            features: &self.live.plan().features,
+            frame_ms: self.stats.mean_ms,
+            timings: &self.timings,
+            error: self.error.as_deref(),
+        });
+        if let Some(window) = &self.window {
+            window.set_title(&title);
+        }
+    }
+}
+
+/// Writes a screenshot and says where.
+fn save(pixels: &Readback, path: &Path) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    pixels.save(path)?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
+impl ApplicationHandler for Viewer<'_> {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_none() {
+            if let Err(err) = self.open(event_loop) {
+                self.fail(event_loop, err);
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => self.pending_size = Some([size.width, size.height]),
+            WindowEvent::ModifiersChanged(modifiers) => {
+                self.shift = modifiers.state().shift_key();
+            }
+            WindowEvent::KeyboardInput { event, .. } => self.key(event_loop, &event),
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => self.dragging = state == ElementState::Pressed,
+            WindowEvent::CursorMoved { position, .. } => {
+                if let (true, Some((x, y))) = (self.dragging, self.cursor) {
+                    self.drag += Vec2::new((position.x - x) as f32, (y - position.y) as f32);
+                }
+                self.cursor = Some((position.x, position.y));
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let notches = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => (p.y / PIXELS_PER_NOTCH) as f32,
+                };
+                self.camera.scroll(notches, self.start.speed);
+            }
+            WindowEvent::RedrawRequested => {
+                if let Err(err) = self.frame(event_loop) {
+                    self.fail(event_loop, err);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Some(window) = &self.window {
+            window.request_redraw();
+        }
+    }
+}

@@ -1,0 +1,204 @@
+//! What the viewer's keys switch between, apart from the window: the graphs
+//! beside the one being viewed, the features a graph can toggle, and the title
+//! line that reports them with frame and pass times or the last reload error.
+
+use std::path::{Path, PathBuf};
+use weft_gpu::PassTiming;
+
+/// The features `graph` can switch (names in its conditions and its defaults),
+/// sorted; number keys 1 to 9 toggle them in this order. Empty when the graph
+/// does not load.
+pub fn graph_features(graph: &Path) -> Vec<String> {
+    let loaded = weft_graph::load(graph);
+    let mut names = match weft_graph::Prepared::new(&loaded) {
+        Ok(prepared) => weft_graph::compile::feature_names(prepared.ir()),
+        Err(_) => return Vec::new(),
+    };
+    names.extend(loaded.default_features.iter().cloned());
+    names.into_iter().collect()
+}
+
+/// The requested toggles with `name` flipped: any earlier toggle of it is
+/// dropped and `!name` or `name` added, so it holds over scene and graph defaults.
+pub fn toggle(requested: &[String], name: &str, on_now: bool) -> Vec<String> {
+    let mut next: Vec<String> = requested
+        .iter()
+        .filter(|f| f.trim_start_matches('!') != name)
+        .cloned()
+        .collect();
+    next.push(if on_now {
+        format!("!{name}")
+    } else {
+        name.to_string()
+    });
+    next
+}
+
+/// The graphs to cycle through: the `.ron` files in `graph`'s folder that
+/// compile on their own (not fragments), sorted, always including `graph`.
+pub fn sibling_graphs(graph: &Path) -> Vec<PathBuf> {
+    let dir = graph
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let mut graphs: Vec<PathBuf> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .filter(|p| weft_graph::Prepared::new(&weft_graph::load(p)).is_ok())
+        .collect();
+    if !graphs.iter().any(|g| same_file(g, graph)) {
+        graphs.push(graph.to_path_buf());
+    }
+    graphs.sort();
+    graphs
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    }
+}
+
+/// The graph `step` places after `current` in `graphs`, wrapping around.
+pub fn cycle(graphs: &[PathBuf], current: &Path, step: isize) -> Option<PathBuf> {
+    let n = graphs.len() as isize;
+    if n == 0 {
+        return None;
+    }
+    let at = graphs
+        .iter()
+        .position(|g| same_file(g, current))
+        .unwrap_or(0) as isize;
+    graphs.get((at + step).rem_euclid(n) as usize).cloned()
+}
+
+/// What the title shows.
+pub struct Status<'a> {
+    /// The graph file.
+    pub graph: &'a Path,
+    /// Features on in the live plan.
+    pub features: &'a [String],
+    /// Mean wall milliseconds per frame (render and present).
+    pub frame_ms: f64,
+    /// The last frame's per-pass times.
+    pub timings: &'a [PassTiming],
+    /// The last refused reload, shown until one succeeds.
+    pub error: Option<&'a str>,
+}
+
+/// The window title: graph, features, frame time and per-pass times, or the
+/// reload error in front of them.
+pub fn title(status: &Status) -> String {
+    let graph = status
+        .graph
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let fps = if status.frame_ms > 0.0 {
+        1000.0 / status.frame_ms
+    } else {
+        0.0
+    };
+    let mut line = format!(
+        "weft view: {graph} [{}] {:.1} ms ({fps:.0} fps)",
+        status.features.join(" "),
+        status.frame_ms
+    );
+    if !status.timings.is_empty() {
+        let passes: Vec<String> = status
+            .timings
+            .iter()
+            .map(|t| format!("{} {:.2}", t.pass, t.ms))
+            .collect();
+        line.push_str(&format!(" | {}", passes.join(", ")));
+    }
+    match status.error {
+        Some(error) => format!("ERROR {error} (kept last good) | {line}"),
+        None => line,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use weft_gpu::TimingSource;
+    use weft_graph::schema::PassKind;
+
+    fn graphs_dir() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs")
+    }
+
+    #[test]
+    fn toggling_replaces_earlier_toggles_of_the_same_feature() {
+        let requested = vec!["bloom".to_string(), "!shadow_casters".to_string()];
+        assert_eq!(
+            toggle(&requested, "shadow_casters", false),
+            vec!["bloom".to_string(), "shadow_casters".to_string()]
+        );
+        assert_eq!(
+            toggle(&requested, "bloom", true),
+            vec!["!shadow_casters".to_string(), "!bloom".to_string()]
+        );
+        assert_eq!(toggle(&[], "x", false), vec!["x".to_string()]);
+    }
+
+    #[test]
+    fn features_of_the_shipped_forward_graph() {
+        let names = graph_features(&graphs_dir().join("forward.ron"));
+        for expected in ["bloom", "depth_prepass", "shadow_casters"] {
+            assert!(names.iter().any(|n| n == expected), "{expected} in {names:?}");
+        }
+        let mut sorted = names.clone();
+        sorted.sort();
+        assert_eq!(names, sorted);
+        assert!(graph_features(Path::new("no/such/graph.ron")).is_empty());
+    }
+
+    #[test]
+    fn graphs_cycle_in_name_order_and_wrap() {
+        let forward = graphs_dir().join("forward.ron");
+        let graphs = sibling_graphs(&forward);
+        let names: Vec<String> = graphs
+            .iter()
+            .map(|g| g.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        for expected in ["deferred.ron", "forward.ron"] {
+            assert!(names.iter().any(|n| n == expected), "{expected} in {names:?}");
+        }
+        let next = cycle(&graphs, &forward, 1).unwrap();
+        let at = graphs.iter().position(|g| *g == forward).unwrap();
+        assert_eq!(next, graphs[(at + 1) % graphs.len()]);
+        assert_eq!(cycle(&graphs, &next, -1).unwrap(), forward);
+        assert_eq!(cycle(&graphs, &forward, graphs.len() as isize).unwrap(), forward);
+        assert_eq!(cycle(&[], &forward, 1), None);
+    }
+
+    #[test]
+    fn title_shows_graph_features_times_and_errors() {
+        let timings = [PassTiming {
+            pass: "forward".into(),
+            kind: PassKind::Raster,
+            source: TimingSource::GpuTimestamp,
+            ms: 1.234,
+        }];
+        let features = ["bloom".to_string(), "shadow_casters".to_string()];
+        let mut status = Status {
+            graph: Path::new("graphs/forward.ron"),
+            features: &features,
+            frame_ms: 20.0,
+            timings: &timings,
+            error: None,
+        };
+        assert_eq!(
+            title(&status),
+            "weft view: forward.ron [bloom shadow_casters] 20.0 ms (50 fps) | forward 1.23"
+        );
+        status.error = Some("graphs/forward.ron:3: unknown pass kind");
+        assert!(title(&status)
+            .starts_with("ERROR graphs/forward.ron:3: unknown pass kind (kept last good) | weft view: forward.ron"));
+    }
+}

@@ -1,0 +1,123 @@
+//! `weft view`: a window showing a scene through a graph, flown with keyboard
+//! and mouse, switching graphs and features, with per-pass times in the title,
+//! screenshots, and hot reload of the graph, its shaders and the scene.
+
+mod app;
+mod controls;
+mod fly;
+
+use crate::render_cmd::parse_size;
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use weft_gpu::{Gpu, GpuOptions, TimingMode};
+use weft_graph::plan::Extent;
+use weft_render::RenderSettings;
+use winit::event_loop::EventLoop;
+use winit::raw_window_handle::HasDisplayHandle;
+
+/// The controls, for `--help` and the README.
+pub const CONTROLS: &str = "\
+Controls:
+  W A S D        move forward, left, back, right      Q / E   down / up
+  mouse drag     look (left button)                   arrows  look
+  Shift          move 4x faster                       wheel   change speed (x1.25 a notch)
+  G / Shift+G    next / previous graph in the graph's folder
+  1-9            toggle the graph's features (listed on stdout when a graph loads)
+  Space          pause / resume scene time            R       back to the scene camera
+  F12            save a screenshot (weft-<time>-<n>.png, name printed)
+  Esc            quit
+The title shows the graph, its features, frame time and per-pass GPU times, or the
+last refused reload as file:line (also on stderr); edits to the graph, its includes,
+its shaders or the scene reload all-or-nothing.";
+
+/// Arguments of `weft view`.
+#[derive(Args)]
+#[command(after_help = CONTROLS)]
+pub struct ViewArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// The render graph.
+    #[arg(long, default_value = "graphs/forward.ron")]
+    graph: PathBuf,
+    /// Window size, WIDTHxHEIGHT (the graph renders at the window's size).
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    size: Extent,
+    /// Camera to start from; the scene's first by default.
+    #[arg(long)]
+    camera: Option<String>,
+    /// Scene time in seconds at the start.
+    #[arg(long, default_value_t = 0.0)]
+    time: f32,
+    /// Start with scene time stopped (Space resumes).
+    #[arg(long)]
+    paused: bool,
+    /// Feature toggles added after the scene's features (`name` on, `!name` off).
+    #[arg(long, value_delimiter = ',')]
+    features: Vec<String>,
+    /// Enable the validation layer with synchronization validation; any message
+    /// makes the command fail when it exits.
+    #[arg(long)]
+    validate: bool,
+    /// Use the first device whose name contains this.
+    #[arg(long)]
+    device: Option<String>,
+    /// Quit after presenting this many frames (for scripts and tests).
+    #[arg(long)]
+    frames: Option<u32>,
+    /// Ask the window to become WIDTHxHEIGHT after half of --frames (tests resizing).
+    #[arg(long, value_parser = parse_size, requires = "frames")]
+    resize_to: Option<Extent>,
+    /// Save the last presented frame, as shown in the window, to this PNG on exit.
+    #[arg(long)]
+    screenshot_on_exit: Option<PathBuf>,
+}
+
+/// Runs `weft view`.
+pub fn run(args: ViewArgs) -> Result<ExitCode> {
+    let event_loop = EventLoop::new().context("opening the display (is DISPLAY or WAYLAND_DISPLAY set?)")?;
+    let display = event_loop
+        .display_handle()
+        .context("the display has no handle")?
+        .as_raw();
+    let gpu = Gpu::for_display(
+        &GpuOptions {
+            validation: args.validate,
+            device: args.device.clone(),
+        },
+        display,
+    )?;
+    let log = gpu.validation();
+    let settings = RenderSettings {
+        graph: args.graph.clone(),
+        extent: args.size,
+        camera: args.camera.clone(),
+        time: args.time,
+        features: args.features.clone(),
+        timing: if gpu.info().timestamps {
+            TimingMode::GpuTimestamps
+        } else {
+            TimingMode::Off
+        },
+        readback: false,
+        ..RenderSettings::default()
+    };
+    let mut app = app::Viewer::new(&gpu, &args, settings)?;
+    event_loop.run_app(&mut app)?;
+    let outcome = app.finish();
+    drop(gpu);
+    let messages = log.messages();
+    for m in &messages {
+        eprintln!("validation {:?}: {}: {}", m.severity, m.id, m.text);
+    }
+    if args.validate {
+        println!("validation: {}", log.counts());
+    }
+    outcome?;
+    Ok(if messages.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}

@@ -1,0 +1,467 @@
+//! Putting a rendered image on screen: acquire a swapchain image, blit the
+//! graph's output into it (scaled when the sizes differ), optionally copy the
+//! result back (screenshots of exactly what was shown), and present it.
+//!
+//! Synchronization: acquire signals a semaphore that the blit waits for at the
+//! blit stage; the blit signals a per-swapchain-image semaphore that presenting
+//! waits for (a per-image semaphore is never signalled again while a present
+//! may still wait on it); a fence per frame slot bounds the frames in flight.
+//! Before returning, the submission is waited for, because the executor writes
+//! the output image again next frame and runs one frame at a time itself.
+
+use crate::context::Gpu;
+use crate::error::{GpuError, VkCall};
+use crate::readback::{self, Readback};
+use crate::swapchain::Swapchain;
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+
+/// Frame slots: acquire semaphores, fences and command buffers cycle through them.
+const FRAMES_IN_FLIGHT: usize = 2;
+
+/// The image to show: the graph's output, in `TRANSFER_SRC_OPTIMAL` with blit
+/// reads made visible (what the plan's epilogue leaves it in).
+#[derive(Debug, Clone, Copy)]
+pub struct PresentSource {
+    /// The image.
+    pub image: vk::Image,
+    /// Its size in pixels.
+    pub extent: vk::Extent2D,
+    /// Its format, to know whether it can be filtered when scaled.
+    pub format: vk::Format,
+}
+
+/// What presenting a frame did.
+#[derive(Debug)]
+pub enum Presented {
+    /// Shown; with the swapchain image's pixels when a capture was asked for.
+    Shown(Option<Readback>),
+    /// The swapchain no longer matched the window; it was recreated at the
+    /// window's size and nothing was shown (render again).
+    Recreated,
+}
+
+/// Presents images to one window.
+pub struct Presenter<'g> {
+    gpu: &'g Gpu,
+    swapchain: Swapchain<'g>,
+    acquired: Vec<vk::Semaphore>,
+    rendered: Vec<vk::Semaphore>,
+    fences: Vec<vk::Fence>,
+    commands: Vec<vk::CommandBuffer>,
+    slot: usize,
+}
+
+impl<'g> Presenter<'g> {
+    /// Takes over a swapchain and creates the per-frame objects.
+    pub fn new(gpu: &'g Gpu, swapchain: Swapchain<'g>) -> Result<Self, GpuError> {
+        let mut this = Self {
+            gpu,
+            swapchain,
+            acquired: Vec::new(),
+            rendered: Vec::new(),
+            fences: Vec::new(),
+            commands: Vec::new(),
+            slot: 0,
+        };
+        for _ in 0..FRAMES_IN_FLIGHT {
+            this.acquired.push(semaphore(gpu)?);
+            let signalled = vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
+            this.fences
+                .push(unsafe { gpu.device().create_fence(&signalled, None) }.call("vkCreateFence")?);
+            this.commands.push(gpu.allocate_command_buffer()?);
+        }
+        this.make_image_semaphores()?;
+        Ok(this)
+    }
+
+    /// The swapchain's current size.
+    pub fn extent(&self) -> vk::Extent2D {
+        self.swapchain.extent()
+    }
+
+    /// The swapchain's image format.
+    pub fn format(&self) -> vk::Format {
+        self.swapchain.format().format
+    }
+
+    /// Rebuilds the swapchain for a window of `size` pixels (after a resize).
+    pub fn resize(&mut self, size: [u32; 2]) -> Result<(), GpuError> {
+        self.swapchain.recreate(size)?;
+        self.make_image_semaphores()
+    }
+
+    /// One semaphore per swapchain image, made afresh (the device is idle
+    /// whenever this runs, so none is in use).
+    fn make_image_semaphores(&mut self) -> Result<(), GpuError> {
+        self.gpu.wait_idle()?;
+        for s in self.rendered.drain(..) {
+            unsafe { self.gpu.device().destroy_semaphore(s, None) };
+        }
+        for _ in self.swapchain.images() {
+            self.rendered.push(semaphore(self.gpu)?);
+        }
+        Ok(())
+    }
+
+    /// Shows `source` in the window (scaled to the swapchain's size). With
+    /// `capture`, the swapchain image is also copied back. `size` is the
+    /// window's size, used if the swapchain must be recreated.
+    pub fn present(
+        &mut self,
+        source: PresentSource,
+        capture: bool,
+        size: [u32; 2],
+    ) -> Result<Presented, GpuError> {
+        let device = self.gpu.device();
+        let slot = self.slot;
+        let fence = self.fences[slot];
+        unsafe { device.wait_for_fences(&[fence], true, u64::MAX) }.call("vkWaitForFences")?;
+        let acquired = unsafe {
+            self.swapchain.fns().acquire_next_image(
+                self.swapchain.handle(),
+                u64::MAX,
+                self.acquired[slot],
+                vk::Fence::null(),
+            )
+        };
+        let index = match acquired {
+            Ok((index, _suboptimal)) => index,
+            Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => {
+                self.resize(size)?;
+                return Ok(Presented::Recreated);
+            }
+            Err(result) => {
+                return Err(GpuError::Vulkan {
+                    call: "vkAcquireNextImageKHR",
+                    result,
+                })
+            }
+        };
+        let target = self.swapchain.images()[index as usize];
+        let extent = self.swapchain.extent();
+        let capture_buffer = if capture {
+            Some(CaptureBuffer::new(self.gpu, extent)?)
+        } else {
+            None
+        };
+        let cmd = self.commands[slot];
+        unsafe {
+            device.reset_fences(&[fence]).call("vkResetFences")?;
+            device
+                .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
+                .call("vkResetCommandBuffer")?;
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            device
+                .begin_command_buffer(cmd, &begin)
+                .call("vkBeginCommandBuffer")?;
+        }
+        let filter = if source.extent == extent || !self.gpu.linear_filter(source.format.as_raw())
+        {
+            vk::Filter::NEAREST
+        } else {
+            vk::Filter::LINEAR
+        };
+        self.record_blit(cmd, source, target, extent, filter, capture_buffer.as_ref());
+        unsafe { device.end_command_buffer(cmd) }.call("vkEndCommandBuffer")?;
+        let waits = [vk::SemaphoreSubmitInfo::default()
+            .semaphore(self.acquired[slot])
+            .stage_mask(vk::PipelineStageFlags2::BLIT)];
+        let signals = [vk::SemaphoreSubmitInfo::default()
+            .semaphore(self.rendered[index as usize])
+            .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
+        let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        let submit = vk::SubmitInfo2::default()
+            .wait_semaphore_infos(&waits)
+            .command_buffer_infos(&buffers)
+            .signal_semaphore_infos(&signals);
+        unsafe { device.queue_submit2(self.gpu.queue(), &[submit], fence) }
+            .call("vkQueueSubmit2")?;
+        let wait = [self.rendered[index as usize]];
+        let swapchains = [self.swapchain.handle()];
+        let indices = [index];
+        let info = vk::PresentInfoKHR::default()
+            .wait_semaphores(&wait)
+            .swapchains(&swapchains)
+            .image_indices(&indices);
+        let shown = unsafe { self.swapchain.fns().queue_present(self.gpu.queue(), &info) };
+        self.slot = (slot + 1) % FRAMES_IN_FLIGHT;
+        unsafe { device.wait_for_fences(&[fence], true, u64::MAX) }.call("vkWaitForFences")?;
+        let pixels = match capture_buffer {
+            Some(buffer) => Some(buffer.read(self.swapchain.format().format)?),
+            None => None,
+        };
+        match shown {
+            Ok(false) => Ok(Presented::Shown(pixels)),
+            Ok(true) | Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => {
+                self.resize(size)?;
+                Ok(Presented::Shown(pixels))
+            }
+            Err(result) => Err(GpuError::Vulkan {
+                call: "vkQueuePresentKHR",
+                result,
+            }),
+        }
+    }
+
+    fn record_blit(
+        &self,
+        cmd: vk::CommandBuffer,
+        source: PresentSource,
+        target: vk::Image,
+        extent: vk::Extent2D,
+        filter: vk::Filter,
+        capture: Option<&CaptureBuffer<'_>>,
+    ) {
+        let device = self.gpu.device();
+        let to_dst = image_barrier(target)
+            .src_stage_mask(vk::PipelineStageFlags2::BLIT)
+            .dst_stage_mask(vk::PipelineStageFlags2::BLIT)
+            .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .old_layout(vk::ImageLayout::UNDEFINED)
+            .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+        let region = vk::ImageBlit2::default()
+            .src_subresource(color_layers())
+            .src_offsets([vk::Offset3D::default(), corner(source.extent)])
+            .dst_subresource(color_layers())
+            .dst_offsets([vk::Offset3D::default(), corner(extent)]);
+        let regions = [region];
+        let blit = vk::BlitImageInfo2::default()
+            .src_image(source.image)
+            .src_image_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+            .dst_image(target)
+            .dst_image_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+            .regions(&regions)
+            .filter(filter);
+        unsafe {
+            device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&[to_dst]),
+            );
+            device.cmd_blit_image2(cmd, &blit);
+        }
+        let (last_stage, last_access, last_layout) = match capture {
+            Some(buffer) => {
+                let to_src = image_barrier(target)
+                    .src_stage_mask(vk::PipelineStageFlags2::BLIT)
+                    .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                    .dst_stage_mask(vk::PipelineStageFlags2::COPY)
+                    .dst_access_mask(vk::AccessFlags2::TRANSFER_READ)
+                    .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+                    .new_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+                unsafe {
+                    device.cmd_pipeline_barrier2(
+                        cmd,
+                        &vk::DependencyInfo::default().image_memory_barriers(&[to_src]),
+                    );
+                }
+                buffer.record(cmd, target, extent);
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::NONE,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                )
+            }
+            None => (
+                vk::PipelineStageFlags2::BLIT,
+                vk::AccessFlags2::TRANSFER_WRITE,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            ),
+        };
+        let to_present = image_barrier(target)
+            .src_stage_mask(last_stage)
+            .src_access_mask(last_access)
+            .dst_stage_mask(vk::PipelineStageFlags2::NONE)
+            .dst_access_mask(vk::AccessFlags2::NONE)
+            .old_layout(last_layout)
+            .new_layout(vk::ImageLayout::PRESENT_SRC_KHR);
+        unsafe {
+            device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&[to_present]),
+            );
+        }
+    }
+}
+
+impl Drop for Presenter<'_> {
+    fn drop(&mut self) {
+        let device = self.gpu.device();
+        unsafe {
+            let _ = device.device_wait_idle();
+            for &s in self.acquired.iter().chain(&self.rendered) {
+                device.destroy_semaphore(s, None);
+            }
+            for &f in &self.fences {
+                device.destroy_fence(f, None);
+            }
+            device.free_command_buffers(self.gpu.command_pool(), &self.commands);
+        }
+    }
+}
+
+fn semaphore(gpu: &Gpu) -> Result<vk::Semaphore, GpuError> {
+    unsafe {
+        gpu.device()
+            .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
+    }
+    .call("vkCreateSemaphore")
+}
+
+fn color_layers() -> vk::ImageSubresourceLayers {
+    vk::ImageSubresourceLayers {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        mip_level: 0,
+        base_array_layer: 0,
+        layer_count: 1,
+    }
+}
+
+fn corner(extent: vk::Extent2D) -> vk::Offset3D {
+    vk::Offset3D {
+        x: extent.width as i32,
+        y: extent.height as i32,
+        z: 1,
+    }
+}
+
+fn image_barrier(image: vk::Image) -> vk::ImageMemoryBarrier2<'static> {
+    vk::ImageMemoryBarrier2::default()
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(vk::ImageSubresourceRange {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        })
+}
+
+/// The name `readback::decode` knows a swapchain format by.
+fn format_name(format: vk::Format) -> Option<&'static str> {
+    match format {
+        vk::Format::B8G8R8A8_SRGB => Some("B8G8R8A8_SRGB"),
+        vk::Format::B8G8R8A8_UNORM => Some("B8G8R8A8_UNORM"),
+        vk::Format::R8G8B8A8_SRGB => Some("R8G8B8A8_SRGB"),
+        vk::Format::R8G8B8A8_UNORM => Some("R8G8B8A8_UNORM"),
+        _ => None,
+    }
+}
+
+/// A host-visible buffer a presented image is copied into.
+struct CaptureBuffer<'g> {
+    gpu: &'g Gpu,
+    buffer: vk::Buffer,
+    allocation: Option<Allocation>,
+    extent: vk::Extent2D,
+}
+
+impl<'g> CaptureBuffer<'g> {
+    fn new(gpu: &'g Gpu, extent: vk::Extent2D) -> Result<Self, GpuError> {
+        let size = u64::from(extent.width) * u64::from(extent.height) * 4;
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(vk::BufferUsageFlags::TRANSFER_DST)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let buffer = unsafe { gpu.device().create_buffer(&info, None) }.call("vkCreateBuffer")?;
+        let mut this = Self {
+            gpu,
+            buffer,
+            allocation: None,
+            extent,
+        };
+        let requirements = unsafe { gpu.device().get_buffer_memory_requirements(buffer) };
+        let allocation = gpu
+            .allocator()
+            .allocate(&AllocationCreateDesc {
+                name: "screenshot",
+                requirements,
+                location: MemoryLocation::GpuToCpu,
+                linear: true,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .map_err(|e| GpuError::Allocation {
+                what: "the screenshot buffer".into(),
+                message: e.to_string(),
+            })?;
+        unsafe {
+            gpu.device()
+                .bind_buffer_memory(buffer, allocation.memory(), allocation.offset())
+        }
+        .call("vkBindBufferMemory")?;
+        this.allocation = Some(allocation);
+        Ok(this)
+    }
+
+    /// Copies `image` (in `TRANSFER_SRC_OPTIMAL`) and makes it visible to the host.
+    fn record(&self, cmd: vk::CommandBuffer, image: vk::Image, extent: vk::Extent2D) {
+        let regions = [vk::BufferImageCopy2::default()
+            .image_subresource(color_layers())
+            .image_extent(vk::Extent3D {
+                width: extent.width,
+                height: extent.height,
+                depth: 1,
+            })];
+        let copy = vk::CopyImageToBufferInfo2::default()
+            .src_image(image)
+            .src_image_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+            .dst_buffer(self.buffer)
+            .regions(&regions);
+        let host = [vk::BufferMemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::COPY)
+            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+            .dst_access_mask(vk::AccessFlags2::HOST_READ)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .buffer(self.buffer)
+            .offset(0)
+            .size(vk::WHOLE_SIZE)];
+        let device = self.gpu.device();
+        unsafe {
+            device.cmd_copy_image_to_buffer2(cmd, &copy);
+            device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().buffer_memory_barriers(&host),
+            );
+        }
+    }
+
+    /// The copied pixels as RGBA (after the submission finished).
+    fn read(&self, format: vk::Format) -> Result<Readback, GpuError> {
+        let name = format_name(format).ok_or_else(|| {
+            GpuError::Plan(format!("cannot read back swapchain format {format:?}"))
+        })?;
+        let size = self.extent.width as usize * self.extent.height as usize * 4;
+        let bytes = self
+            .allocation
+            .as_ref()
+            .and_then(|a| a.mapped_slice())
+            .and_then(|s| s.get(..size))
+            .ok_or_else(|| GpuError::Allocation {
+                what: "the screenshot buffer".into(),
+                message: "memory is not host-mapped".into(),
+            })?;
+        let pixels = readback::decode(name, bytes).map_err(|e| GpuError::Plan(e.to_string()))?;
+        Ok(Readback {
+            width: self.extent.width,
+            height: self.extent.height,
+            format: name.to_string(),
+            pixels,
+        })
+    }
+}
+
+impl Drop for CaptureBuffer<'_> {
+    fn drop(&mut self) {
+        unsafe { self.gpu.device().destroy_buffer(self.buffer, None) };
+        if let Some(a) = self.allocation.take() {
+            // Freeing only fails for allocations this allocator did not make.
+            let _ = self.gpu.allocator().free(a);
+        }
+    }
+}
