@@ -1,12 +1,15 @@
 //! `weft view` under a private Xvfb: the window opens, renders and presents
-//! with validation (synchronization included) silent, resizes, and what it
-//! shows matches the headless render of the same camera. Every test starts its
+//! with validation (synchronization included) silent, resizes, what it shows
+//! matches the headless render of the same camera, and shader edits are hot
+//! reloaded (a broken one keeps the last good version). Every test starts its
 //! own X server on a display number the server picks (`-displayfd`) and stops
 //! it when the test ends, passed or failed.
 
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
+use std::sync::mpsc::{channel, Receiver};
+use std::time::{Duration, Instant};
 
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -50,15 +53,20 @@ impl Xvfb {
         server
     }
 
-    /// Runs `weft` with `args` on this display.
-    fn weft(&self, args: &[&str]) -> Output {
-        Command::new(env!("CARGO_BIN_EXE_weft"))
+    /// `weft` with `args` on this display, run in `dir`.
+    fn command(&self, args: &[&str], dir: &Path) -> Command {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_weft"));
+        command
             .args(args)
-            .current_dir(repo())
+            .current_dir(dir)
             .env("DISPLAY", &self.display)
-            .env_remove("WAYLAND_DISPLAY")
-            .output()
-            .expect("weft runs")
+            .env_remove("WAYLAND_DISPLAY");
+        command
+    }
+
+    /// Runs `weft` with `args` on this display in the repository.
+    fn weft(&self, args: &[&str]) -> Output {
+        self.command(args, &repo()).output().expect("weft runs")
     }
 }
 
@@ -113,10 +121,16 @@ fn opens_renders_presents_and_exits_cleanly() {
     ]);
     assert_clean(&out);
     let stdout = text(&out.stdout);
-    assert!(stdout.contains("graph graphs/forward.ron: features 1 "), "{stdout}");
+    assert!(
+        stdout.contains("graph graphs/forward.ron: features 1 "),
+        "{stdout}"
+    );
     let image = load(&shot);
     assert_eq!(image.dimensions(), (160, 90));
-    let lit = image.pixels().filter(|p| p[0] > 8 || p[1] > 8 || p[2] > 8).count();
+    let lit = image
+        .pixels()
+        .filter(|p| p[0] > 8 || p[1] > 8 || p[2] > 8)
+        .count();
     assert!(lit > 160 * 90 / 4, "only {lit} pixels are not black");
 }
 
@@ -188,7 +202,10 @@ fn screenshot_matches_the_headless_render() {
     let p99 = diffs[diffs.len() * 99 / 100];
     let max = diffs[diffs.len() - 1];
     eprintln!("screenshot vs headless: mean {mean:.4}, p99 {p99}, max {max}");
-    assert!(mean <= 0.05 && p99 <= 1 && max <= 1, "mean {mean}, p99 {p99}, max {max}");
+    assert!(
+        mean <= 0.05 && p99 <= 1 && max <= 1,
+        "mean {mean}, p99 {p99}, max {max}"
+    );
 }
 
 #[test]
@@ -209,5 +226,138 @@ fn a_graph_that_does_not_load_is_reported_at_its_line() {
     assert!(
         stderr.contains(&format!("{}:3", graph.display())),
         "{stderr}"
+    );
+}
+
+/// How long a reload may take before the test gives up (lavapipe under load).
+const REPLY: Duration = Duration::from_secs(60);
+
+/// A copy of the graphs and shaders, so edits never touch the repository.
+struct Copy(PathBuf);
+
+impl Copy {
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("weft-view-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        for folder in ["graphs", "shaders"] {
+            copy_dir(&repo().join(folder), &dir.join(folder));
+        }
+        Self(dir)
+    }
+}
+
+impl Drop for Copy {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("create copy folder");
+    for entry in std::fs::read_dir(from).expect("read folder") {
+        let entry = entry.expect("folder entry");
+        let target = to.join(entry.file_name());
+        if entry.path().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).expect("copy file");
+        }
+    }
+}
+
+/// Waits for a line of `lines` that satisfies `wanted`.
+fn wait_for(lines: &Receiver<String>, wanted: impl Fn(&str) -> bool, what: &str) -> String {
+    let deadline = Instant::now() + REPLY;
+    loop {
+        let left = deadline.saturating_duration_since(Instant::now());
+        match lines.recv_timeout(left) {
+            Ok(line) if wanted(&line) => return line,
+            Ok(_) => {}
+            Err(_) => panic!("no {what} within {REPLY:?}"),
+        }
+    }
+}
+
+/// Lines a pipe carries, read on a thread.
+fn lines(pipe: impl Read + Send + 'static) -> Receiver<String> {
+    let (send, receive) = channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(pipe).lines().map_while(Result::ok) {
+            if send.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    receive
+}
+
+#[test]
+fn shader_edits_reload_while_viewing_and_a_broken_one_keeps_the_last_good() {
+    const TONEMAP: &str = "shaders/tonemap.frag";
+    const OUT: &str = "color = vec4(c / (1.0 + c), 1.0);";
+    let x = Xvfb::start();
+    let copy = Copy::new("reload");
+    let shot = copy.0.join("last.png");
+    let scene = repo().join("scenes/demo.scene");
+    let mut child = x
+        .command(
+            &[
+                "view",
+                scene.to_str().expect("utf-8 path"),
+                "--size",
+                "64x36",
+                "--validate",
+                "--screenshot-on-exit",
+                shot.to_str().expect("utf-8 path"),
+            ],
+            &copy.0,
+        )
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("weft starts");
+    let stdout = lines(child.stdout.take().expect("stdout"));
+    let stderr = lines(child.stderr.take().expect("stderr"));
+    wait_for(&stdout, |l| l.starts_with("graph "), "features line");
+    let tonemap = copy.0.join(TONEMAP);
+    let original = std::fs::read_to_string(&tonemap).expect("read shader");
+    assert!(original.contains(OUT));
+
+    let saved = Instant::now();
+    std::fs::write(
+        &tonemap,
+        original.replace(OUT, "color = vec4(1.0, 0.0, 0.0, 1.0);"),
+    )
+    .expect("edit shader");
+    let line = wait_for(&stdout, |l| l.starts_with("reloaded "), "reload line");
+    eprintln!(
+        "edit to shown: {:.1} ms ({line})",
+        saved.elapsed().as_secs_f64() * 1e3
+    );
+    assert!(line.contains("tonemap.frag"), "{line}");
+
+    let broken_line = original.lines().count() + 1;
+    std::fs::write(&tonemap, format!("{original}this is not glsl\n")).expect("break shader");
+    let error = wait_for(&stderr, |l| l.starts_with("error: "), "error line");
+    assert!(
+        error.contains(&format!("tonemap.frag:{broken_line}: "))
+            && error.ends_with("(kept last good)"),
+        "{error}"
+    );
+
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(killed.success());
+    let status = child.wait().expect("weft exits");
+    let rest: Vec<String> = stderr.try_iter().collect();
+    assert!(status.success(), "{status:?}; stderr: {rest:?}");
+    assert!(rest.iter().all(|l| !l.contains("validation")), "{rest:?}");
+    let image = load(&shot);
+    assert_eq!(image.dimensions(), (64, 36));
+    assert!(
+        image.pixels().all(|p| p.0 == [255, 0, 0, 255]),
+        "the red version is still shown after the broken edit"
     );
 }

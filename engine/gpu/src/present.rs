@@ -68,8 +68,9 @@ impl<'g> Presenter<'g> {
         for _ in 0..FRAMES_IN_FLIGHT {
             this.acquired.push(semaphore(gpu)?);
             let signalled = vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
-            this.fences
-                .push(unsafe { gpu.device().create_fence(&signalled, None) }.call("vkCreateFence")?);
+            this.fences.push(
+                unsafe { gpu.device().create_fence(&signalled, None) }.call("vkCreateFence")?,
+            );
             this.commands.push(gpu.allocate_command_buffer()?);
         }
         this.make_image_semaphores()?;
@@ -158,8 +159,7 @@ impl<'g> Presenter<'g> {
                 .begin_command_buffer(cmd, &begin)
                 .call("vkBeginCommandBuffer")?;
         }
-        let filter = if source.extent == extent || !self.gpu.linear_filter(source.format.as_raw())
-        {
+        let filter = if source.extent == extent || !self.gpu.linear_filter(source.format.as_raw()) {
             vk::Filter::NEAREST
         } else {
             vk::Filter::LINEAR

@@ -38,9 +38,10 @@ impl<'g> Swapchain<'g> {
                 "this context was made without presentation (use Gpu::for_display)".into(),
             ));
         }
-        let surface =
-            unsafe { ash_window::create_surface(gpu.entry(), gpu.instance(), display, window, None) }
-                .call("vkCreateSurfaceKHR")?;
+        let surface = unsafe {
+            ash_window::create_surface(gpu.entry(), gpu.instance(), display, window, None)
+        }
+        .call("vkCreateSurfaceKHR")?;
         let surface_fns = ash::khr::surface::Instance::new(gpu.entry(), gpu.instance());
         let fns = ash::khr::swapchain::Device::new(gpu.instance(), gpu.device());
         let mut this = Self {
@@ -90,9 +91,8 @@ impl<'g> Swapchain<'g> {
                 .get_physical_device_surface_present_modes(physical, self.surface)
         }
         .call("vkGetPhysicalDeviceSurfacePresentModesKHR")?;
-        let format = choose_format(&formats).ok_or(GpuError::Plan(
-            "the surface offers no image format".into(),
-        ))?;
+        let format = choose_format(&formats)
+            .ok_or(GpuError::Plan("the surface offers no image format".into()))?;
         let extent = choose_extent(&caps, size);
         let usage = vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC;
         if !caps.supported_usage_flags.contains(usage) {
@@ -122,8 +122,8 @@ impl<'g> Swapchain<'g> {
             unsafe { self.fns.destroy_swapchain(old, None) };
         }
         self.swapchain = swapchain;
-        self.images = unsafe { self.fns.get_swapchain_images(swapchain) }
-            .call("vkGetSwapchainImagesKHR")?;
+        self.images =
+            unsafe { self.fns.get_swapchain_images(swapchain) }.call("vkGetSwapchainImagesKHR")?;
         self.format = format;
         self.extent = extent;
         for (i, &image) in self.images.iter().enumerate() {
@@ -182,9 +182,10 @@ pub fn choose_format(formats: &[vk::SurfaceFormatKHR]) -> Option<vk::SurfaceForm
     preferred
         .iter()
         .find_map(|&want| {
-            formats.iter().copied().find(|f| {
-                f.format == want && f.color_space == vk::ColorSpaceKHR::SRGB_NONLINEAR
-            })
+            formats
+                .iter()
+                .copied()
+                .find(|f| f.format == want && f.color_space == vk::ColorSpaceKHR::SRGB_NONLINEAR)
         })
         .or_else(|| formats.first().copied())
 }
@@ -207,7 +208,11 @@ pub fn choose_extent(caps: &vk::SurfaceCapabilitiesKHR, size: [u32; 2]) -> vk::E
     }
     let clamp = |v: u32, lo: u32, hi: u32| v.clamp(lo.max(1), hi.max(lo).max(1));
     vk::Extent2D {
-        width: clamp(size[0], caps.min_image_extent.width, caps.max_image_extent.width),
+        width: clamp(
+            size[0],
+            caps.min_image_extent.width,
+            caps.max_image_extent.width,
+        ),
         height: clamp(
             size[1],
             caps.min_image_extent.height,

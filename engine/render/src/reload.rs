@@ -268,7 +268,8 @@ impl<'g> LiveRender<'g> {
     /// use are compiled afresh from disk, since no watcher saw their edits.
     pub fn reconfigure(&mut self, settings: RenderSettings) -> Result<(), ReloadError> {
         let graph = settings.graph.clone();
-        pick_camera(&self.scene, &settings).map_err(|e| ReloadError::render(e, &self.scene_path))?;
+        pick_camera(&self.scene, &settings)
+            .map_err(|e| ReloadError::render(e, &self.scene_path))?;
         let plan = compile_for_scene(self.gpu, &self.scene, &settings)
             .map_err(|e| ReloadError::render(e, &graph))?;
         let fail = |e: GpuError| ReloadError::gpu(e, &graph);

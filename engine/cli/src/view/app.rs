@@ -11,6 +11,8 @@ use ash::vk;
 use glam::Vec2;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 use weft_gpu::{Gpu, PresentSource, Presented, Presenter, Readback, Swapchain};
 use weft_graph::plan::Extent;
@@ -84,12 +86,21 @@ pub struct Viewer<'g> {
     stats: Stats,
     timings: Vec<weft_gpu::PassTiming>,
     failure: Option<anyhow::Error>,
+    /// Set by SIGINT/SIGTERM (and Esc, closing): the next frame is the last.
+    stop: Arc<AtomicBool>,
+    /// A reload applied, with when its batch was taken, until its frame is shown.
+    reloaded: Option<(String, Instant)>,
 }
 
 impl<'g> Viewer<'g> {
     /// Loads the scene and graph and starts watching their files; the window
     /// comes when the event loop resumes.
-    pub fn new(gpu: &'g Gpu, args: &ViewArgs, settings: RenderSettings) -> Result<Self> {
+    pub fn new(
+        gpu: &'g Gpu,
+        args: &ViewArgs,
+        settings: RenderSettings,
+        stop: Arc<AtomicBool>,
+    ) -> Result<Self> {
         let live = LiveRender::new(gpu, &args.scene, settings).map_err(|e| anyhow!("{e}"))?;
         let lens = live.camera()?.clone();
         let (position, orientation) = lens.pose_at(args.time);
@@ -130,6 +141,8 @@ impl<'g> Viewer<'g> {
             stats: Stats::default(),
             timings: Vec::new(),
             failure: None,
+            stop,
+            reloaded: None,
             live,
         };
         viewer.print_features();
@@ -195,7 +208,7 @@ impl<'g> Viewer<'g> {
         Ok(())
     }
 
-    fn key(&mut self, event_loop: &ActiveEventLoop, event: &KeyEvent) {
+    fn key(&mut self, event: &KeyEvent) {
         let PhysicalKey::Code(code) = event.physical_key else {
             return;
         };
@@ -208,13 +221,15 @@ impl<'g> Viewer<'g> {
             return;
         }
         match code {
-            KeyCode::Escape => event_loop.exit(),
+            KeyCode::Escape => self.stop.store(true, Ordering::SeqCst),
             KeyCode::F12 => self.screenshot_now = true,
             KeyCode::Space => self.paused = !self.paused,
-            KeyCode::KeyR => self.camera = FlyCamera {
-                speed: self.camera.speed,
-                ..self.start
-            },
+            KeyCode::KeyR => {
+                self.camera = FlyCamera {
+                    speed: self.camera.speed,
+                    ..self.start
+                }
+            }
             KeyCode::KeyG => {
                 let step = if self.shift { -1 } else { 1 };
                 let current = self.live.settings().graph.clone();
@@ -293,15 +308,9 @@ impl<'g> Viewer<'g> {
                 self.watch();
                 self.error = None;
                 if !paths.is_empty() {
-                    println!(
-                        "reloaded {} in {:.1} ms",
-                        paths
-                            .iter()
-                            .map(|p| p.display().to_string())
-                            .collect::<Vec<_>>()
-                            .join(", "),
-                        started.elapsed().as_secs_f64() * 1e3
-                    );
+                    let files: Vec<String> =
+                        paths.iter().map(|p| p.display().to_string()).collect();
+                    self.reloaded = Some((files.join(", "), started));
                 }
             }
             Err(err) => self.report_error(err.to_string()),
@@ -371,7 +380,8 @@ impl<'g> Viewer<'g> {
             },
             format: vk::Format::from_raw(output.desc.format_raw),
         };
-        let last = self.frame_limit.is_some_and(|n| self.frames + 1 >= n);
+        let last = self.frame_limit.is_some_and(|n| self.frames + 1 >= n)
+            || self.stop.load(Ordering::SeqCst);
         let on_exit = last && self.screenshot_on_exit.is_some();
         let capture = self.screenshot_now || on_exit;
         let presenter = self
@@ -386,6 +396,12 @@ impl<'g> Viewer<'g> {
         self.timings = report.timings;
         self.stats.total_ms += now.elapsed().as_secs_f64() * 1e3;
         self.stats.frames += 1;
+        if let Some((files, started)) = self.reloaded.take() {
+            println!(
+                "reloaded {files}: shown {:.1} ms after the change was taken",
+                started.elapsed().as_secs_f64() * 1e3
+            );
+        }
         if let Some(pixels) = shown {
             self.save_screenshots(&pixels, on_exit)?;
         }
@@ -485,12 +501,12 @@ impl ApplicationHandler for Viewer<'_> {
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         match event {
-            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::CloseRequested => self.stop.store(true, Ordering::SeqCst),
             WindowEvent::Resized(size) => self.pending_size = Some([size.width, size.height]),
             WindowEvent::ModifiersChanged(modifiers) => {
                 self.shift = modifiers.state().shift_key();
             }
-            WindowEvent::KeyboardInput { event, .. } => self.key(event_loop, &event),
+            WindowEvent::KeyboardInput { event, .. } => self.key(&event),
             WindowEvent::MouseInput {
                 state,
                 button: MouseButton::Left,
@@ -518,9 +534,15 @@ impl ApplicationHandler for Viewer<'_> {
         }
     }
 
-    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
-        if let Some(window) = &self.window {
-            window.request_redraw();
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        let drawable = self
+            .window
+            .as_ref()
+            .is_some_and(|w| w.inner_size().width > 0 && w.inner_size().height > 0);
+        match &self.window {
+            Some(window) if drawable => window.request_redraw(),
+            _ if self.stop.load(Ordering::SeqCst) => event_loop.exit(),
+            _ => {}
         }
     }
 }

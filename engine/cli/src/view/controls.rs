@@ -150,7 +150,10 @@ mod tests {
     fn features_of_the_shipped_forward_graph() {
         let names = graph_features(&graphs_dir().join("forward.ron"));
         for expected in ["bloom", "depth_prepass", "shadow_casters"] {
-            assert!(names.iter().any(|n| n == expected), "{expected} in {names:?}");
+            assert!(
+                names.iter().any(|n| n == expected),
+                "{expected} in {names:?}"
+            );
         }
         let mut sorted = names.clone();
         sorted.sort();
@@ -167,13 +170,19 @@ mod tests {
             .map(|g| g.file_name().unwrap().to_string_lossy().into_owned())
             .collect();
         for expected in ["deferred.ron", "forward.ron"] {
-            assert!(names.iter().any(|n| n == expected), "{expected} in {names:?}");
+            assert!(
+                names.iter().any(|n| n == expected),
+                "{expected} in {names:?}"
+            );
         }
         let next = cycle(&graphs, &forward, 1).unwrap();
         let at = graphs.iter().position(|g| *g == forward).unwrap();
         assert_eq!(next, graphs[(at + 1) % graphs.len()]);
         assert_eq!(cycle(&graphs, &next, -1).unwrap(), forward);
-        assert_eq!(cycle(&graphs, &forward, graphs.len() as isize).unwrap(), forward);
+        assert_eq!(
+            cycle(&graphs, &forward, graphs.len() as isize).unwrap(),
+            forward
+        );
         assert_eq!(cycle(&[], &forward, 1), None);
     }
 

@@ -62,18 +62,16 @@ impl FlyCamera {
     }
 
     /// Turns right by `look.x` radians about world up and up by `look.y` radians
-    /// about its right axis; a tilt that would pass the vertical is left out.
+    /// about its right axis; a tilt that would reach or pass the vertical (turning
+    /// the view upside down) is left out.
     pub fn turn(&mut self, look: Vec2) {
         if look == Vec2::ZERO {
             return;
         }
         let yawed = Quat::from_rotation_y(-look.x) * self.orientation;
         let tilted = (yawed * Quat::from_rotation_x(look.y)).normalize();
-        self.orientation = if (tilted * Vec3::NEG_Z).y.abs() <= MAX_TILT {
-            tilted
-        } else {
-            yawed.normalize()
-        };
+        let upright = (tilted * Vec3::Y).y > 0.0 && (tilted * Vec3::NEG_Z).y.abs() <= MAX_TILT;
+        self.orientation = if upright { tilted } else { yawed.normalize() };
     }
 
     /// Changes speed by [`SCROLL_STEP`] per notch (negative slows down), within
@@ -117,7 +115,11 @@ mod tests {
             ..FlyInput::default()
         };
         c.update(&input, 0.5);
-        assert!(close(c.position, Vec3::new(0.0, 0.0, -1.0)), "{}", c.position);
+        assert!(
+            close(c.position, Vec3::new(0.0, 0.0, -1.0)),
+            "{}",
+            c.position
+        );
         c.update(
             &FlyInput {
                 right: 1.0,
@@ -127,7 +129,11 @@ mod tests {
             },
             0.25,
         );
-        assert!(close(c.position, Vec3::new(2.0, -2.0, -1.0)), "{}", c.position);
+        assert!(
+            close(c.position, Vec3::new(2.0, -2.0, -1.0)),
+            "{}",
+            c.position
+        );
     }
 
     #[test]
@@ -142,7 +148,11 @@ mod tests {
             },
             1.0,
         );
-        assert!(close(c.position, Vec3::new(0.0, 2.0, 0.0)), "{}", c.position);
+        assert!(
+            close(c.position, Vec3::new(0.0, 2.0, 0.0)),
+            "{}",
+            c.position
+        );
     }
 
     #[test]
@@ -154,7 +164,10 @@ mod tests {
         assert!((c.forward().y - 0.5f32.sin()).abs() < 1e-5);
         assert!(close(c.right(), Vec3::Z), "{}", c.right());
         c.turn(Vec2::new(0.0, 2.0));
-        assert!((c.forward().y - 0.5f32.sin()).abs() < 1e-5, "a tilt past vertical is refused");
+        assert!(
+            (c.forward().y - 0.5f32.sin()).abs() < 1e-5,
+            "a tilt past vertical is refused"
+        );
         assert!(c.right().y.abs() < 1e-5, "no roll creeps in");
     }
 

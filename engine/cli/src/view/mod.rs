@@ -11,6 +11,8 @@ use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 use weft_gpu::{Gpu, GpuOptions, TimingMode};
 use weft_graph::plan::Extent;
 use weft_render::RenderSettings;
@@ -69,14 +71,20 @@ pub struct ViewArgs {
     /// Ask the window to become WIDTHxHEIGHT after half of --frames (tests resizing).
     #[arg(long, value_parser = parse_size, requires = "frames")]
     resize_to: Option<Extent>,
-    /// Save the last presented frame, as shown in the window, to this PNG on exit.
+    /// Save the last presented frame, as shown in the window, to this PNG on exit
+    /// (after --frames, Esc, closing the window, SIGINT or SIGTERM).
     #[arg(long)]
     screenshot_on_exit: Option<PathBuf>,
 }
 
 /// Runs `weft view`.
 pub fn run(args: ViewArgs) -> Result<ExitCode> {
-    let event_loop = EventLoop::new().context("opening the display (is DISPLAY or WAYLAND_DISPLAY set?)")?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::SeqCst))
+        .context("installing the SIGINT/SIGTERM handler")?;
+    let event_loop =
+        EventLoop::new().context("opening the display (is DISPLAY or WAYLAND_DISPLAY set?)")?;
     let display = event_loop
         .display_handle()
         .context("the display has no handle")?
@@ -103,7 +111,7 @@ pub fn run(args: ViewArgs) -> Result<ExitCode> {
         readback: false,
         ..RenderSettings::default()
     };
-    let mut app = app::Viewer::new(&gpu, &args, settings)?;
+    let mut app = app::Viewer::new(&gpu, &args, settings, stop)?;
     event_loop.run_app(&mut app)?;
     let outcome = app.finish();
     drop(gpu);
