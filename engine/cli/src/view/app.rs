@@ -45,13 +45,14 @@ const FEATURE_KEYS: [KeyCode; 9] = [
     KeyCode::Digit9,
 ];
 
-/// Frame times gathered between title updates.
+/// Frame times gathered between title updates, and over the whole run.
 #[derive(Default)]
 struct Stats {
     total_ms: f64,
     frames: u32,
     mean_ms: f64,
     since: Option<Instant>,
+    all_ms: Vec<f64>,
 }
 
 /// The viewer's state; the presenter is declared before the window so it is
@@ -149,10 +150,25 @@ impl<'g> Viewer<'g> {
         Ok(viewer)
     }
 
-    /// Releases the window and reports a failure that stopped the loop.
+    /// Releases the window, prints how many frames were shown and how long
+    /// they took, and reports a failure that stopped the loop.
     pub fn finish(mut self) -> Result<()> {
         self.presenter = None;
         self.window = None;
+        let mut times = std::mem::take(&mut self.stats.all_ms);
+        if let Some(first) = times.first().copied() {
+            let steady = if times.len() > 1 {
+                &mut times[1..]
+            } else {
+                &mut times[..]
+            };
+            steady.sort_by(f64::total_cmp);
+            println!(
+                "presented {} frames: first {first:.1} ms, then median {:.1} ms",
+                self.frames,
+                steady[steady.len() / 2]
+            );
+        }
         match self.failure.take() {
             Some(err) => Err(err),
             None => Ok(()),
@@ -394,7 +410,9 @@ impl<'g> Viewer<'g> {
         };
         self.frames += 1;
         self.timings = report.timings;
-        self.stats.total_ms += now.elapsed().as_secs_f64() * 1e3;
+        let frame_ms = now.elapsed().as_secs_f64() * 1e3;
+        self.stats.total_ms += frame_ms;
+        self.stats.all_ms.push(frame_ms);
         self.stats.frames += 1;
         if let Some((files, started)) = self.reloaded.take() {
             println!(
