@@ -134,3 +134,75 @@ fn sources_cover_graph_includes_shader_includes_and_the_scene_model() {
     drop(live);
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+#[test]
+fn reconfigure_switches_graph_features_and_size_all_or_nothing() {
+    let dir = fixture("reconfigure");
+    let gpu = Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("gpu");
+    let forward = settings(&dir);
+    let mut live =
+        LiveRender::new(&gpu, &dir.join("scenes/tiny.scene"), forward.clone()).expect("live");
+    let first = pixels(&mut live);
+    let has_pass =
+        |live: &LiveRender<'_>, name: &str| live.plan().passes.iter().any(|p| p.name == name);
+
+    let deferred = RenderSettings {
+        graph: dir.join("graphs/deferred.ron"),
+        ..forward.clone()
+    };
+    live.reconfigure(deferred.clone()).expect("to deferred");
+    assert!(has_pass(&live, "gbuffer"));
+    assert!(live
+        .sources()
+        .graph
+        .contains(&normalize(&dir.join("graphs/deferred.ron"))));
+    assert_eq!(pixels(&mut live).len(), 64 * 36 * 4);
+
+    live.reconfigure(RenderSettings {
+        features: vec!["!bloom".into()],
+        extent: Extent {
+            width: 32,
+            height: 20,
+        },
+        ..forward.clone()
+    })
+    .expect("forward without bloom, smaller");
+    assert!(!live.plan().features.iter().any(|f| f == "bloom"));
+    assert!(!has_pass(&live, "bloom_bright"));
+    let report = live.frame().expect("frame");
+    let output = report.output.expect("output");
+    assert_eq!((output.width, output.height), (32, 20));
+
+    live.reconfigure(forward.clone()).expect("back to forward");
+    assert_eq!(
+        pixels(&mut live),
+        first,
+        "the same settings give the same image"
+    );
+
+    // A shader the live graph does not use is edited (no watcher sees it): switching
+    // to the graph that uses it compiles it from disk, finds the error, and keeps
+    // the forward version rendering unchanged.
+    let gbuffer = dir.join("shaders/gbuffer.frag");
+    let text = std::fs::read_to_string(&gbuffer).expect("read");
+    let broken_line = text.lines().count() + 1;
+    std::fs::write(&gbuffer, format!("{text}this is not glsl\n")).expect("break");
+    let err = live
+        .reconfigure(deferred)
+        .expect_err("broken gbuffer shader");
+    assert_eq!(normalize(&err.file), normalize(&gbuffer), "{err}");
+    assert_eq!(err.line, Some(broken_line as u32), "{err}");
+    assert_eq!(live.settings().graph, forward.graph);
+    assert_eq!(
+        pixels(&mut live),
+        first,
+        "the forward version still renders"
+    );
+    drop(live);
+    assert!(gpu.validation().messages().is_empty());
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}

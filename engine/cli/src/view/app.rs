@@ -440,7 +440,10 @@ impl<'g> Viewer<'g> {
     /// Rebuilds the swapchain and the plan for a window of `size` pixels.
     fn resize(&mut self, size: [u32; 2]) -> Result<()> {
         if let Some(presenter) = self.presenter.as_mut() {
-            presenter.resize(size)?;
+            let current = presenter.extent();
+            if [current.width, current.height] != size {
+                presenter.resize(size)?;
+            }
         }
         let extent = Extent {
             width: size[0],
