@@ -361,3 +361,58 @@ fn shader_edits_reload_while_viewing_and_a_broken_one_keeps_the_last_good() {
         "the red version is still shown after the broken edit"
     );
 }
+
+/// Keys pressed by script: G switches to the next graph in `graphs/`, 1 flips the
+/// first feature, F12 saves what the window shows; validation stays silent.
+#[test]
+fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
+    let x = Xvfb::start();
+    let dir = temp("keys");
+    std::fs::create_dir_all(&dir).expect("screenshot folder");
+    let scene = repo().join("scenes/demo.scene");
+    let graph = repo().join("graphs/forward.ron");
+    let out = x
+        .command(
+            &[
+                "view",
+                scene.to_str().expect("utf-8 path"),
+                "--graph",
+                graph.to_str().expect("utf-8 path"),
+                "--size",
+                "96x54",
+                "--frames",
+                "5",
+                "--press",
+                "1:g,2:1,3:f12",
+                "--validate",
+            ],
+            &dir,
+        )
+        .output()
+        .expect("weft runs");
+    assert_clean(&out);
+    let stdout = text(&out.stdout);
+    let graphs: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
+    assert_eq!(graphs.len(), 3, "{stdout}");
+    assert!(graphs[0].contains("forward.ron: features"), "{stdout}");
+    assert!(!graphs[1].contains("forward.ron"), "G moved on: {stdout}");
+    let first_feature = |line: &str| {
+        let list = line.split(": features ").nth(1).expect("feature list");
+        list.split(", ").next().expect("first feature").to_string()
+    };
+    let (before, after) = (first_feature(graphs[1]), first_feature(graphs[2]));
+    assert_ne!(before, after, "key 1 flips the first feature");
+    assert_eq!(
+        before.replace("[on]", "[off]").replace("[off]", ""),
+        after.replace("[on]", "[off]").replace("[off]", ""),
+        "the same feature"
+    );
+    let saved = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("wrote weft-"))
+        .unwrap_or_else(|| panic!("no screenshot line: {stdout}"));
+    assert_eq!(
+        load(&dir.join(format!("weft-{saved}"))).dimensions(),
+        (96, 54)
+    );
+}

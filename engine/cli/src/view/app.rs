@@ -3,7 +3,7 @@
 //! (all-or-nothing, at the frame boundary), renders the live graph from the fly
 //! camera and presents it.
 
-use super::controls::{self, Status};
+use super::controls::{self, Action, Status};
 use super::fly::{self, FlyCamera, FlyInput};
 use super::ViewArgs;
 use anyhow::{anyhow, Context, Result};
@@ -31,19 +31,6 @@ use winit::window::{Window, WindowId};
 const TITLE_EVERY: Duration = Duration::from_millis(500);
 /// Pixels of scrolling that count as one wheel notch (touchpads).
 const PIXELS_PER_NOTCH: f64 = 40.0;
-
-/// The number keys that toggle features, in order.
-const FEATURE_KEYS: [KeyCode; 9] = [
-    KeyCode::Digit1,
-    KeyCode::Digit2,
-    KeyCode::Digit3,
-    KeyCode::Digit4,
-    KeyCode::Digit5,
-    KeyCode::Digit6,
-    KeyCode::Digit7,
-    KeyCode::Digit8,
-    KeyCode::Digit9,
-];
 
 /// Frame times gathered between title updates, and over the whole run.
 #[derive(Default)]
@@ -87,6 +74,8 @@ pub struct Viewer<'g> {
     stats: Stats,
     timings: Vec<weft_gpu::PassTiming>,
     failure: Option<anyhow::Error>,
+    /// Scripted key presses (`--press`): before the frame numbered first, the action.
+    presses: Vec<(u32, Action)>,
     /// Set by SIGINT/SIGTERM (and Esc, closing): the next frame is the last.
     stop: Arc<AtomicBool>,
     /// A reload applied, with when its batch was taken, until its frame is shown.
@@ -143,6 +132,7 @@ impl<'g> Viewer<'g> {
             timings: Vec::new(),
             failure: None,
             stop,
+            presses: args.press.clone(),
             reloaded: None,
             live,
         };
@@ -180,7 +170,7 @@ impl<'g> Viewer<'g> {
         let list: Vec<String> = self
             .features
             .iter()
-            .take(FEATURE_KEYS.len())
+            .take(controls::FEATURE_KEYS.len())
             .enumerate()
             .map(|(i, f)| {
                 let state = if on.contains(f) { "on" } else { "off" };
@@ -236,18 +226,23 @@ impl<'g> Viewer<'g> {
         if event.repeat {
             return;
         }
-        match code {
-            KeyCode::Escape => self.stop.store(true, Ordering::SeqCst),
-            KeyCode::F12 => self.screenshot_now = true,
-            KeyCode::Space => self.paused = !self.paused,
-            KeyCode::KeyR => {
+        if let Some(action) = controls::action(code, self.shift) {
+            self.act(action);
+        }
+    }
+
+    fn act(&mut self, action: Action) {
+        match action {
+            Action::Quit => self.stop.store(true, Ordering::SeqCst),
+            Action::Screenshot => self.screenshot_now = true,
+            Action::Pause => self.paused = !self.paused,
+            Action::ResetCamera => {
                 self.camera = FlyCamera {
                     speed: self.camera.speed,
                     ..self.start
                 }
             }
-            KeyCode::KeyG => {
-                let step = if self.shift { -1 } else { 1 };
+            Action::Graph(step) => {
                 let current = self.live.settings().graph.clone();
                 if let Some(next) = controls::cycle(&self.graphs, &current, step) {
                     let settings = RenderSettings {
@@ -257,11 +252,7 @@ impl<'g> Viewer<'g> {
                     self.reconfigure(settings);
                 }
             }
-            _ => {
-                if let Some(i) = FEATURE_KEYS.iter().position(|&k| k == code) {
-                    self.toggle_feature(i);
-                }
-            }
+            Action::Feature(index) => self.toggle_feature(index),
         }
     }
 
@@ -358,6 +349,16 @@ impl<'g> Viewer<'g> {
     /// One frame: reload, resize, move, render, present, screenshot.
     fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         self.hot_reload()?;
+        let due: Vec<Action> = self
+            .presses
+            .iter()
+            .filter(|(frame, _)| *frame == self.frames)
+            .map(|&(_, action)| action)
+            .collect();
+        self.presses.retain(|(frame, _)| *frame != self.frames);
+        for action in due {
+            self.act(action);
+        }
         let Some(window) = &self.window else {
             return Ok(());
         };

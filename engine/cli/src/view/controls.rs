@@ -4,6 +4,83 @@
 
 use std::path::{Path, PathBuf};
 use weft_gpu::PassTiming;
+use winit::keyboard::KeyCode;
+
+/// The number keys that toggle features, in order.
+pub const FEATURE_KEYS: [KeyCode; 9] = [
+    KeyCode::Digit1,
+    KeyCode::Digit2,
+    KeyCode::Digit3,
+    KeyCode::Digit4,
+    KeyCode::Digit5,
+    KeyCode::Digit6,
+    KeyCode::Digit7,
+    KeyCode::Digit8,
+    KeyCode::Digit9,
+];
+
+/// What a key press asks for (movement and look keys are read while held instead).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    /// Esc: end after this frame.
+    Quit,
+    /// F12: save what the window shows.
+    Screenshot,
+    /// Space: stop or resume scene time.
+    Pause,
+    /// R: back to the scene camera.
+    ResetCamera,
+    /// G (+1) or Shift+G (-1): another graph from the graph's folder.
+    Graph(isize),
+    /// 1-9: toggle the graph's feature with this index.
+    Feature(usize),
+}
+
+/// The action of a key pressed with or without Shift.
+pub fn action(code: KeyCode, shift: bool) -> Option<Action> {
+    match code {
+        KeyCode::Escape => Some(Action::Quit),
+        KeyCode::F12 => Some(Action::Screenshot),
+        KeyCode::Space => Some(Action::Pause),
+        KeyCode::KeyR => Some(Action::ResetCamera),
+        KeyCode::KeyG => Some(Action::Graph(if shift { -1 } else { 1 })),
+        _ => FEATURE_KEYS
+            .iter()
+            .position(|&k| k == code)
+            .map(Action::Feature),
+    }
+}
+
+/// Parses one `--press` entry, `FRAME:KEY`: the key is pressed before frame
+/// FRAME (counted from 0) renders. KEY is `g`, `G` (Shift+G), `1`-`9`, `f12`,
+/// `space`, `r` or `esc`.
+pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
+    let (frame, key) = text
+        .split_once(':')
+        .ok_or_else(|| format!("expected FRAME:KEY, found \"{text}\""))?;
+    let frame = frame
+        .trim()
+        .parse::<u32>()
+        .map_err(|_| format!("\"{frame}\" is not a frame number"))?;
+    let (code, shift) = match key.trim() {
+        "g" => (KeyCode::KeyG, false),
+        "G" => (KeyCode::KeyG, true),
+        "f12" | "F12" => (KeyCode::F12, false),
+        "space" => (KeyCode::Space, false),
+        "r" => (KeyCode::KeyR, false),
+        "esc" => (KeyCode::Escape, false),
+        digit => match digit.parse::<usize>() {
+            Ok(n @ 1..=9) => (FEATURE_KEYS[n - 1], false),
+            _ => {
+                return Err(format!(
+                    "unknown key \"{digit}\" (use g, G, 1-9, f12, space, r or esc)"
+                ))
+            }
+        },
+    };
+    let action = action(code, shift).ok_or_else(|| format!("no action for \"{key}\""))?;
+    Ok((frame, action))
+}
 
 /// The features `graph` can switch (names in its conditions and its defaults),
 /// sorted; number keys 1 to 9 toggle them in this order. Empty when the graph
@@ -130,6 +207,23 @@ mod tests {
 
     fn graphs_dir() -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs")
+    }
+
+    #[test]
+    fn keys_map_to_actions_and_press_scripts_parse() {
+        assert_eq!(action(KeyCode::KeyG, false), Some(Action::Graph(1)));
+        assert_eq!(action(KeyCode::KeyG, true), Some(Action::Graph(-1)));
+        assert_eq!(action(KeyCode::Digit1, false), Some(Action::Feature(0)));
+        assert_eq!(action(KeyCode::Digit9, true), Some(Action::Feature(8)));
+        assert_eq!(action(KeyCode::F12, false), Some(Action::Screenshot));
+        assert_eq!(action(KeyCode::KeyW, false), None);
+        assert_eq!(parse_press("3:G"), Ok((3, Action::Graph(-1))));
+        assert_eq!(parse_press("0:2"), Ok((0, Action::Feature(1))));
+        assert_eq!(parse_press(" 7 : f12 "), Ok((7, Action::Screenshot)));
+        assert_eq!(parse_press("1:esc"), Ok((1, Action::Quit)));
+        assert!(parse_press("1:0").is_err());
+        assert!(parse_press("x:g").is_err());
+        assert!(parse_press("g").is_err());
     }
 
     #[test]

@@ -71,6 +71,10 @@ pub struct ViewArgs {
     /// Ask the window to become WIDTHxHEIGHT after half of --frames (tests resizing).
     #[arg(long, value_parser = parse_size, requires = "frames")]
     resize_to: Option<Extent>,
+    /// Press keys without a keyboard (for scripts and tests): FRAME:KEY,... where KEY
+    /// is g, G (Shift+G), 1-9, f12, space, r or esc, pressed before frame FRAME.
+    #[arg(long, value_delimiter = ',', value_parser = controls::parse_press)]
+    press: Vec<(u32, controls::Action)>,
     /// Save the last presented frame, as shown in the window, to this PNG on exit
     /// (after --frames, Esc, closing the window, SIGINT or SIGTERM).
     #[arg(long)]
