@@ -10,7 +10,7 @@ use weft_scene::{load_scene, load_scene_with, LoadOptions};
 fn cached_loads_equal_fresh_loads() {
     let cache = temp_dir("cache-equal");
     let options = LoadOptions {
-        cache_dir: Some(cache.clone()),
+        cache_dir: Some(cache.to_path_buf()),
     };
     for file in [
         repo_scene("demo.scene"),

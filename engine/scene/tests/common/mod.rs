@@ -36,12 +36,36 @@ pub fn short_warnings(warnings: &[weft_scene::Warning]) -> Vec<String> {
         .collect()
 }
 
-/// A fresh empty folder under the system temp folder, unique to this test.
-pub fn temp_dir(name: &str) -> PathBuf {
+/// A fresh empty folder under the system temp folder, unique to this test,
+/// removed with everything in it when dropped (the large-model tests copy
+/// tens of megabytes into theirs).
+pub struct TempDir(PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for TempDir {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Creates the test's `TempDir`.
+pub fn temp_dir(name: &str) -> TempDir {
     let dir = std::env::temp_dir().join(format!("weft-scene-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("create temp dir");
-    dir
+    TempDir(dir)
 }
 
 /// The bytes of `member` inside the zip archive `zip` (stored or deflated), read through the
