@@ -77,10 +77,26 @@ impl Drop for Xvfb {
     }
 }
 
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("weft-view-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
+/// A test's own temporary folder, removed when the test ends.
+struct Temp(PathBuf);
+
+impl Temp {
+    fn new(test: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("weft-view-cli-{test}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        Self(dir)
+    }
+
+    fn file(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+}
+
+impl Drop for Temp {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }
 
 fn text(bytes: &[u8]) -> String {
@@ -107,7 +123,8 @@ fn load(path: &Path) -> image::RgbaImage {
 #[test]
 fn opens_renders_presents_and_exits_cleanly() {
     let x = Xvfb::start();
-    let shot = temp("open.png");
+    let tmp = Temp::new("open");
+    let shot = tmp.file("open.png");
     let out = x.weft(&[
         "view",
         "scenes/demo.scene",
@@ -137,7 +154,8 @@ fn opens_renders_presents_and_exits_cleanly() {
 #[test]
 fn resizing_rebuilds_the_swapchain_and_the_plan() {
     let x = Xvfb::start();
-    let shot = temp("resized.png");
+    let tmp = Temp::new("resize");
+    let shot = tmp.file("resized.png");
     let out = x.weft(&[
         "view",
         "scenes/demo.scene",
@@ -163,8 +181,9 @@ fn resizing_rebuilds_the_swapchain_and_the_plan() {
 #[test]
 fn screenshot_matches_the_headless_render() {
     let x = Xvfb::start();
-    let shown = temp("shown.png");
-    let headless = temp("headless.png");
+    let tmp = Temp::new("match");
+    let shown = tmp.file("shown.png");
+    let headless = tmp.file("headless.png");
     let out = x.weft(&[
         "view",
         "scenes/demo.scene",
@@ -211,7 +230,8 @@ fn screenshot_matches_the_headless_render() {
 #[test]
 fn a_graph_that_does_not_load_is_reported_at_its_line() {
     let x = Xvfb::start();
-    let graph = temp("broken.ron");
+    let tmp = Temp::new("broken");
+    let graph = tmp.file("broken.ron");
     std::fs::write(&graph, "(\n  name: \"broken\",\n  passes: [,\n").expect("write graph");
     let out = x.weft(&[
         "view",
@@ -367,8 +387,8 @@ fn shader_edits_reload_while_viewing_and_a_broken_one_keeps_the_last_good() {
 #[test]
 fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
     let x = Xvfb::start();
-    let dir = temp("keys");
-    std::fs::create_dir_all(&dir).expect("screenshot folder");
+    let tmp = Temp::new("keys");
+    let dir = tmp.0.clone();
     let scene = repo().join("scenes/demo.scene");
     let graph = repo().join("graphs/forward.ron");
     let out = x
