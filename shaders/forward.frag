@@ -8,6 +8,7 @@ layout(set = 0, binding = 0) uniform sampler2DShadow shadow_map;
 #include "include/lighting.glsl"
 
 layout(set = 2, binding = 0) uniform sampler2D base_color;
+layout(set = 2, binding = 1) uniform sampler2D metallic_roughness;
 
 layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 world_normal;
@@ -19,8 +20,9 @@ layout(location = 0) out vec4 color;
 void main() {
     vec3 n = normalize(world_normal);
     vec4 texel = texture(base_color, texcoord);
-    Surface s = Surface(world, gl_FrontFacing ? n : -n, texel.rgb, material);
     Material m = materials[material];
+    vec2 mr = metal_rough(m, texture(metallic_roughness, texcoord));
+    Surface s = Surface(world, gl_FrontFacing ? n : -n, texel.rgb, material, mr);
     vec3 c = shade_ambient_emissive(s, m);
     for (uint i = 0u; i < frame.counts.w; ++i) {
         c += shade_light(i, s, m);

@@ -4,6 +4,7 @@
 #include "include/gbuffer.glsl"
 
 layout(set = 2, binding = 0) uniform sampler2D base_color;
+layout(set = 2, binding = 1) uniform sampler2D metallic_roughness;
 
 layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 world_normal;
@@ -18,5 +19,6 @@ void main() {
     vec3 n = normalize(world_normal);
     albedo = vec4(texture(base_color, texcoord).rgb, 1.0);
     normal = octahedral_encode_half(gl_FrontFacing ? n : -n);
-    material_out = encode_material(material);
+    vec2 mr = metal_rough(materials[material], texture(metallic_roughness, texcoord));
+    material_out = encode_material(material, mr);
 }

@@ -15,7 +15,9 @@ bool read_surface(out Surface s) {
     s.position = position_from_depth(gl_FragCoord.xy, d);
     s.normal = octahedral_decode(texelFetch(gbuffer_normal, p, 0).rg);
     s.texel = texelFetch(gbuffer_albedo, p, 0).rgb;
-    s.material = decode_material(texelFetch(gbuffer_material, p, 0));
+    vec4 material = texelFetch(gbuffer_material, p, 0);
+    s.material = decode_material(material);
+    s.metal_rough = material.ba;
     return true;
 }
 

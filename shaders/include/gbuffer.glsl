@@ -1,8 +1,8 @@
 // The deferred G-buffer encoding (graphs/deferred.ron): albedo = base-colour
 // texture sample (sRGB 8-bit), normal = octahedral in two 16-bit floats (the
 // closest half-float pair), material = material index in r (low byte) and g
-// (high byte); position comes from reverse-Z depth. Shared by gbuffer.frag and
-// the lighting passes.
+// (high byte), metallic in b, roughness in a; position comes from reverse-Z
+// depth. Shared by gbuffer.frag and the lighting passes.
 #ifndef WEFT_GBUFFER_GLSL
 #define WEFT_GBUFFER_GLSL
 #include "lighting.glsl"
@@ -50,8 +50,9 @@ vec2 octahedral_encode_half(vec3 n) {
     return best;
 }
 
-vec4 encode_material(uint index) {
-    return vec4(float(index & 255u), float((index >> 8) & 255u), 0.0, 255.0) / 255.0;
+// `metal_rough` is already rounded to 8 bits (lighting.glsl metal_rough).
+vec4 encode_material(uint index, vec2 metal_rough) {
+    return vec4(vec2(float(index & 255u), float((index >> 8) & 255u)) / 255.0, metal_rough);
 }
 
 uint decode_material(vec4 m) {

@@ -1,21 +1,64 @@
-// Shading shared by forward and deferred: material decoding, Blinn-Phong, and
-// sun / point / spot light evaluation with the same cutoffs the light volumes
-// use. Both paths call `shade_light` and `shade_ambient_emissive` with the same
+// Shading shared by forward and deferred: material decoding, Blinn-Phong for
+// MTL materials, metallic-roughness GGX for glTF materials, and sun / point /
+// spot / area light evaluation with the same cutoffs the light volumes use.
+// Both paths call `shade_light` and `shade_ambient_emissive` with the same
 // inputs (the surface and its material, loaded once per pixel), so they cannot
-// drift apart. An includer that defines HAS_SHADOW_MAP must declare
+// drift apart. engine/render/src/brdf.rs mirrors the BRDFs on the CPU for
+// tests. An includer that defines HAS_SHADOW_MAP must declare
 // `uniform sampler2DShadow shadow_map` before including this file
 // (include/shadows.glsl holds the lookups).
 #ifndef WEFT_LIGHTING_GLSL
 #define WEFT_LIGHTING_GLSL
 #include "scene.glsl"
 
+const float PI = 3.14159265358979;
+// Roughness is raised to at least this (brdf.rs MIN_ROUGHNESS): a smoother GGX
+// lobe turns point-light highlights into single-pixel sparkles.
+const float MIN_ROUGHNESS = 0.045;
+// Reflectance at normal incidence of every non-metal (brdf.rs DIELECTRIC_F0).
+const float DIELECTRIC_F0 = 0.04;
+// Area lights are integrated over AREA_SAMPLES x AREA_SAMPLES equal-area cells
+// (brdf.rs AREA_SAMPLES).
+const int AREA_SAMPLES = 8;
+
 // What shading needs about a surface point.
 struct Surface {
-    vec3 position;   // world
-    vec3 normal;     // unit, facing the viewer
-    vec3 texel;      // base-colour texture sample (white without a texture)
+    vec3 position;     // world
+    vec3 normal;       // unit, facing the viewer
+    vec3 texel;        // base-colour texture sample (white without a texture)
     uint material;
+    vec2 metal_rough;  // metallic-roughness materials: metallic, roughness
 };
+
+// Metallic and roughness at a pixel: the material's factors times the
+// metallicRoughness texture's B and G, rounded to the 8 bits the G-buffer keeps,
+// so forward and deferred shade identical inputs.
+vec2 metal_rough(Material m, vec4 texel) {
+    return round(clamp(m.specular.xy * texel.bg, 0.0, 1.0) * 255.0) / 255.0;
+}
+
+// Cook-Torrance times N.L: GGX distribution, Smith height-correlated visibility,
+// Schlick Fresnel with F0 = mix(0.04, base, metallic), and Lambert diffuse
+// weighted by (1 - F)(1 - metallic); alpha = roughness^2.
+vec3 cook_torrance(vec3 base, vec2 mr, vec3 n, vec3 v, vec3 l) {
+    float ndl = dot(n, l);
+    if (ndl <= 0.0) {
+        return vec3(0.0);
+    }
+    float ndv = max(dot(n, v), 1e-4);
+    vec3 h = normalize(l + v);
+    float ndh = max(dot(n, h), 0.0);
+    float vdh = max(dot(v, h), 0.0);
+    float r = max(mr.y, MIN_ROUGHNESS);
+    float a2 = r * r * r * r;
+    float q = ndh * ndh * (a2 - 1.0) + 1.0;
+    float distribution = a2 / (PI * q * q);
+    float visibility = 0.5 / (ndl * sqrt(ndv * ndv * (1.0 - a2) + a2) + ndv * sqrt(ndl * ndl * (1.0 - a2) + a2));
+    vec3 f0 = mix(vec3(DIELECTRIC_F0), base, mr.x);
+    vec3 fresnel = f0 + (1.0 - f0) * pow(1.0 - vdh, 5.0);
+    vec3 diffuse = (1.0 - fresnel) * (1.0 - mr.x) * base / PI;
+    return (diffuse + distribution * visibility * fresnel) * ndl;
+}
 
 // Blinn-Phong: Kd * texture * (N.L) + Ks * (N.H)^Ns, times the light's radiance.
 vec3 blinn_phong(Material m, Surface s, vec3 l, vec3 radiance) {
@@ -87,20 +130,84 @@ vec3 incoming(uint index, Surface s, out vec3 l) {
     return lights[index].color_exponent.rgb * spot * attenuate(index, d);
 }
 
+// Light reflected to the camera from `radiance` arriving along `l`, by the
+// material's shading model.
+vec3 reflected(Material m, Surface s, vec3 l, vec3 radiance) {
+    if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
+        vec3 v = normalize(frame.camera_position.xyz - s.position);
+        return radiance * cook_torrance(m.diffuse.rgb * s.texel, s.metal_rough, s.normal, v, l);
+    }
+    return blinn_phong(m, s, l, radiance);
+}
+
+// Shirley-Chiu concentric map of [-1, 1]^2 onto the unit disc; it preserves
+// area, so equal cells of the square stay equal on the disc.
+vec2 concentric(vec2 p) {
+    if (p.x == 0.0 && p.y == 0.0) {
+        return vec2(0.0);
+    }
+    float r = abs(p.x) > abs(p.y) ? p.x : p.y;
+    float phi = abs(p.x) > abs(p.y) ? PI / 4.0 * p.y / p.x : PI / 2.0 - PI / 4.0 * p.x / p.y;
+    return r * vec2(cos(phi), sin(phi));
+}
+
+// Area light `index`: the rectangle or disc split into AREA_SAMPLES^2 cells of
+// equal area A, each lighting the surface from its centre with irradiance
+// L cos(theta_light) A / (d^2 + A / pi) (a disc of area A seen head-on gives
+// exactly that, so the sum stays finite next to the light). No shadowing.
+vec3 shade_area(uint index, Surface s, Material m) {
+    vec3 centre = lights[index].position_range.xyz;
+    vec3 x = lights[index].direction_type.xyz;
+    vec3 y = lights[index].attenuation_cos.xyz;
+    bool disc = lights[index].direction_type.w == LIGHT_AREA_DISC;
+    bool two_sided = lights[index].color_exponent.w > 0.5;
+    vec3 facing = -normalize(cross(x, y));
+    float cell = (disc ? PI : 4.0) * length(x) * length(y) / float(AREA_SAMPLES * AREA_SAMPLES);
+    vec3 sum = vec3(0.0);
+    for (int j = 0; j < AREA_SAMPLES; ++j) {
+        for (int i = 0; i < AREA_SAMPLES; ++i) {
+            vec2 uv = (vec2(i, j) + 0.5) * (2.0 / float(AREA_SAMPLES)) - 1.0;
+            if (disc) {
+                uv = concentric(uv);
+            }
+            vec3 to_light = centre + uv.x * x + uv.y * y - s.position;
+            float d2 = dot(to_light, to_light);
+            vec3 l = to_light * inversesqrt(max(d2, 1e-12));
+            float cos_light = -dot(l, facing);
+            cos_light = two_sided ? abs(cos_light) : cos_light;
+            if (cos_light > 0.0) {
+                sum += reflected(m, s, l, vec3(cos_light * cell / (d2 + cell / PI)));
+            }
+        }
+    }
+    return sum * lights[index].color_exponent.rgb;
+}
+
 // One light's contribution to the surface.
 vec3 shade_light(uint index, Surface s, Material m) {
+    if (lights[index].direction_type.w >= LIGHT_AREA_RECT) {
+        return shade_area(index, s, m);
+    }
     vec3 l;
     vec3 radiance = incoming(index, s, l);
     if (all(equal(radiance, vec3(0.0)))) {
         return vec3(0.0);
     }
-    return blinn_phong(m, s, l, radiance);
+    return reflected(m, s, l, radiance);
 }
 
 // What the surface shows without any direct light: the suns' ambient on its
-// ambient reflectance (modulated by the texture), plus its emission.
+// ambient reflectance, plus its emission. Blinn-Phong: Ka (or Kd) times the
+// texture; metallic-roughness: the diffuse colour plus F0, the response to
+// uniform surroundings without the GGX terms' angular detail.
 vec3 shade_ambient_emissive(Surface s, Material m) {
-    return frame.ambient.rgb * m.ambient.rgb * s.texel + m.emissive.rgb;
+    vec3 reflectance = m.ambient.rgb * s.texel;
+    if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
+        vec3 base = m.diffuse.rgb * s.texel;
+        float metallic = s.metal_rough.x;
+        reflectance = base * (1.0 - metallic) + mix(vec3(DIELECTRIC_F0), base, metallic);
+    }
+    return frame.ambient.rgb * reflectance + m.emissive.rgb;
 }
 
 #endif

@@ -9,7 +9,17 @@
 #define LIGHT_POINT 1.0
 #define LIGHT_SPOT_CONE 2.0
 #define LIGHT_SPOT_SPHERE 3.0
+#define LIGHT_AREA_RECT 4.0
+#define LIGHT_AREA_DISC 5.0
 
+// Shading models (engine/render/src/materials.rs), in Material.emissive.w.
+#define SHADING_BLINN_PHONG 0.0
+#define SHADING_METALLIC_ROUGHNESS 1.0
+
+// Area lights reuse the fields: position_range = centre, 0; direction_type =
+// local X times the half width (or the disc radius), type; color_exponent =
+// emitted radiance, 1 when two-sided; attenuation_cos = local Y times the half
+// height (or the radius), 0. They face -normalize(cross(X, Y)) (local -Z).
 struct Light {
     vec4 position_range;   // xyz world position, w cutoff range
     vec4 direction_type;   // xyz unit direction the light travels, w type
@@ -17,11 +27,14 @@ struct Light {
     vec4 attenuation_cos;  // constant, linear, quadratic, cos(spot half-angle)
 };
 
+// Blinn-Phong materials use every field; metallic-roughness materials use
+// diffuse (base colour factor, alpha), specular.xy (metallic and roughness
+// factors) and emissive.
 struct Material {
-    vec4 diffuse;   // Kd, alpha
-    vec4 specular;  // Ks, Ns
+    vec4 diffuse;   // Kd or base colour, alpha
+    vec4 specular;  // Ks, Ns (metallic-roughness: metallic, roughness, 0, 0)
     vec4 ambient;   // ambient reflectance (Ka, or Kd where Ka is black), textured flag
-    vec4 emissive;  // Ke
+    vec4 emissive;  // Ke, shading model
 };
 
 struct Draw {

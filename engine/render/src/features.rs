@@ -7,7 +7,8 @@ use weft_scene::{Light, Scene};
 
 /// The features `scene` switches on: `shadow_casters` when a placed mesh casts,
 /// `point_lights` / `spot_lights` when there are such lights, `emissive` when a
-/// placed mesh glows, `transparent` when a placed mesh blends.
+/// placed mesh glows, `transparent` when a placed mesh blends, `area_lights` when
+/// there are area lights.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
     let placed = || {
         scene
@@ -38,6 +39,9 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     }
     if scene.lights.iter().any(|l| matches!(l, Light::Spot(_))) {
         features.push("spot_lights".to_string());
+    }
+    if scene.lights.iter().any(|l| matches!(l, Light::Area(_))) {
+        features.push("area_lights".to_string());
     }
     features
 }

@@ -9,6 +9,7 @@
 
 #![warn(missing_docs)]
 
+pub mod brdf;
 pub mod buffer;
 pub mod camera;
 pub mod error;

@@ -1,11 +1,12 @@
 //! Light records for the GPU: suns, then point lights, then spots, each with the
 //! cutoff range both forward and deferred shading apply, so the light volumes
-//! and the per-pixel loop cut light off at the same distance.
+//! and the per-pixel loop cut light off at the same distance; area lights last.
 
+use crate::brdf::AreaGeometry;
 use crate::packing::Words;
 use glam::Vec3;
 use weft_scene::light::{derive_radius, DEFAULT_LUMINANCE_THRESHOLD};
-use weft_scene::{Aabb, Attenuation, Light};
+use weft_scene::{Aabb, AreaLight, AreaShape, Attenuation, Light};
 
 /// Bytes of one light record (`struct Light` in `shaders/include/scene.glsl`).
 pub const LIGHT_BYTES: usize = 64;
@@ -17,11 +18,14 @@ pub const POINT: f32 = 1.0;
 pub const SPOT_CONE: f32 = 2.0;
 /// Type code of a spot too wide for a cone, drawn with a sphere volume.
 pub const SPOT_SPHERE: f32 = 3.0;
+/// Type code of a rectangular area light.
+pub const AREA_RECT: f32 = 4.0;
+/// Type code of a disc area light.
+pub const AREA_DISC: f32 = 5.0;
 /// Widest half-angle (degrees) drawn as a cone; wider cones would be huge or inverted.
 pub const CONE_MAX_ANGLE: f32 = 70.0;
 
-/// The scene's sun, point and spot lights packed for the shaders (area lights are
-/// left out: real-time shading does not approximate them yet).
+/// The scene's lights packed for the shaders.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LightSet {
     /// Records in order: suns, points, spot cones, spot spheres.
@@ -34,6 +38,8 @@ pub struct LightSet {
     pub spot_cones: u32,
     /// Number of spots too wide for a cone, drawn with sphere volumes.
     pub spot_spheres: u32,
+    /// Number of area lights (the last records).
+    pub areas: u32,
     /// Sum of the suns' ambient terms.
     pub ambient: Vec3,
     /// Direction of the first sun, for its shadow map.
@@ -43,7 +49,7 @@ pub struct LightSet {
 impl LightSet {
     /// Number of records.
     pub fn len(&self) -> u32 {
-        self.suns + self.points + self.spot_cones + self.spot_spheres
+        self.suns + self.points + self.spot_cones + self.spot_spheres + self.areas
     }
 
     /// Whether there is no light at all.
@@ -64,6 +70,11 @@ impl LightSet {
     /// Index of the first spot record drawn as a sphere.
     pub fn first_spot_sphere(&self) -> u32 {
         self.suns + self.points + self.spot_cones
+    }
+
+    /// Index of the first area light record.
+    pub fn first_area(&self) -> u32 {
+        self.first_spot_sphere() + self.spot_spheres
     }
 }
 
@@ -180,7 +191,50 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
             }
         }
     }
+    for light in lights {
+        if let Light::Area(a) = light {
+            if pack_area(a, &mut set.words) {
+                set.areas += 1;
+            }
+        }
+    }
     set
+}
+
+/// An area light as the shaders see it (centre, half-extent axes: local X and Y
+/// scaled by the half size or the radius), or `None` when it has no area or a
+/// field is not finite.
+pub fn area_shape(a: &AreaLight) -> Option<AreaGeometry> {
+    let (disc, half_x, half_y) = match a.shape {
+        AreaShape::Rect { width, height } => (false, width * 0.5, height * 0.5),
+        AreaShape::Disc { radius } => (true, radius, radius),
+    };
+    let rotation = a.orientation.normalize();
+    let shape = AreaGeometry {
+        centre: a.position,
+        x: rotation * Vec3::X * half_x,
+        y: rotation * Vec3::Y * half_y,
+        disc,
+        two_sided: a.two_sided,
+    };
+    let finite = [shape.centre, shape.x, shape.y, a.emission]
+        .iter()
+        .all(|v| v.is_finite());
+    (half_x > 0.0 && half_y > 0.0 && finite).then_some(shape)
+}
+
+/// Appends an area light's record (layout in `scene.glsl`); lights without a
+/// usable shape are left out: false.
+fn pack_area(a: &AreaLight, words: &mut Words) -> bool {
+    let Some(shape) = area_shape(a) else {
+        return false;
+    };
+    words
+        .vec3w(shape.centre, 0.0)
+        .vec3w(shape.x, if shape.disc { AREA_DISC } else { AREA_RECT })
+        .vec3w(a.emission, if shape.two_sided { 1.0 } else { 0.0 })
+        .vec3w(shape.y, 0.0);
+    true
 }
 
 #[cfg(test)]
@@ -245,5 +299,77 @@ mod tests {
         assert_eq!(word(3, 3), 5.0, "spot length");
         assert_eq!(word(3, 7), SPOT_SPHERE);
         assert_eq!(set.ambient, Vec3::splat(0.1));
+    }
+
+    #[test]
+    fn area_lights_come_last_with_their_half_axes() {
+        let panel = |shape, width: f32| {
+            Light::Area(AreaLight {
+                shape,
+                position: Vec3::new(0.0, 2.0, 0.0),
+                // Facing down: local -Z turned onto -Y.
+                orientation: glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+                emission: Vec3::new(17.0, 12.0, width),
+                two_sided: width > 0.0,
+            })
+        };
+        let lights = vec![
+            panel(
+                AreaShape::Rect {
+                    width: 0.5,
+                    height: 0.25,
+                },
+                0.5,
+            ),
+            panel(AreaShape::Disc { radius: 0.3 }, 0.0),
+            panel(
+                AreaShape::Rect {
+                    width: 0.0,
+                    height: 1.0,
+                },
+                0.0,
+            ),
+            spot(30.0, None),
+        ];
+        let set = pack_lights(&lights, &Aabb::EMPTY);
+        assert_eq!(
+            (set.spot_cones, set.areas, set.len()),
+            (1, 2, 3),
+            "the empty rectangle is left out"
+        );
+        assert_eq!(set.first_area(), 1);
+        let record = |r: usize| -> Vec<f32> {
+            set.words.0[r * 16..(r + 1) * 16]
+                .iter()
+                .map(|&w| f32::from_bits(w))
+                .collect()
+        };
+        let close = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-6);
+        let rect = record(1);
+        assert!(
+            close(
+                &rect,
+                &[
+                    0.0, 2.0, 0.0, 0.0, 0.25, 0.0, 0.0, AREA_RECT, 17.0, 12.0, 0.5, 1.0, 0.0, 0.0,
+                    -0.125, 0.0
+                ]
+            ),
+            "{rect:?}"
+        );
+        let disc = record(2);
+        assert!(
+            close(
+                &disc,
+                &[
+                    0.0, 2.0, 0.0, 0.0, 0.3, 0.0, 0.0, AREA_DISC, 17.0, 12.0, 0.0, 0.0, 0.0, 0.0,
+                    -0.3, 0.0
+                ]
+            ),
+            "{disc:?}"
+        );
+        // The shaders' facing direction -normalize(cross(x, y)) is the light's normal.
+        let x = Vec3::new(rect[4], rect[5], rect[6]);
+        let y = Vec3::new(rect[12], rect[13], rect[14]);
+        assert!((-x.cross(y).normalize() - Vec3::NEG_Y).length() < 1e-6);
     }
 }

@@ -1,14 +1,19 @@
 //! Material records for the GPU and the material filters passes draw by: MTL
-//! Blinn-Phong parameters as given, glTF metallic-roughness mapped onto them.
+//! Blinn-Phong parameters as given, glTF metallic-roughness factors for the GGX
+//! shading in `shaders/include/lighting.glsl`.
 
 use crate::packing::Words;
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::material::{AlphaMode, ShadingModel};
 use weft_scene::Material;
 
 /// Bytes of one material record (`struct Material` in `shaders/include/scene.glsl`).
 pub const MATERIAL_BYTES: usize = 64;
+/// Shading-model code of MTL materials (`SHADING_BLINN_PHONG`).
+pub const BLINN_PHONG: f32 = 0.0;
+/// Shading-model code of glTF materials (`SHADING_METALLIC_ROUGHNESS`).
+pub const METALLIC_ROUGHNESS: f32 = 1.0;
 
 /// Whether a mesh with this material is drawn by a pass with `filter`.
 pub fn matches(filter: MaterialFilter, m: &Material) -> bool {
@@ -21,45 +26,61 @@ pub fn matches(filter: MaterialFilter, m: &Material) -> bool {
     }
 }
 
-/// Blinn-Phong parameters: (diffuse, specular, shininess, ambient reflectance).
-/// The ambient reflectance is `Ka`, or `Kd` where `Ka` is black, as most exporters
-/// leave it; glTF materials map metallic-roughness onto the same terms.
+/// Blinn-Phong parameters of an MTL material: (diffuse, specular, shininess,
+/// ambient reflectance). The ambient reflectance is `Ka`, or `Kd` where `Ka` is
+/// black, as most exporters leave it.
 pub fn blinn_phong(m: &Material) -> (Vec3, Vec3, f32, Vec3) {
     let base = m.base_color.truncate();
+    let ambient = if m.ambient.max_element() > 0.0 {
+        m.ambient
+    } else {
+        base
+    };
+    (base, m.specular, m.shininess.max(0.0), ambient)
+}
+
+/// Appends one material record; `textured` says whether it samples a base-colour
+/// texture. glTF materials keep their metallic and roughness factors (which the
+/// shaders multiply by the metallicRoughness texture) in the specular slot.
+pub fn pack_material(words: &mut Words, m: &Material, textured: bool) {
+    let textured = if textured { 1.0 } else { 0.0 };
     match m.shading {
         ShadingModel::BlinnPhong => {
-            let ambient = if m.ambient.max_element() > 0.0 {
-                m.ambient
-            } else {
-                base
-            };
-            (base, m.specular, m.shininess.max(0.0), ambient)
+            let (diffuse, specular, shininess, ambient) = blinn_phong(m);
+            words
+                .vec3w(diffuse, m.base_color.w)
+                .vec3w(specular, shininess)
+                .vec3w(ambient, textured)
+                .vec3w(m.emissive, BLINN_PHONG);
         }
         ShadingModel::MetallicRoughness => {
-            let metallic = m.metallic.clamp(0.0, 1.0);
-            let diffuse = base * (1.0 - metallic);
-            let specular = Vec3::splat(0.04).lerp(base, metallic);
-            let alpha = (m.roughness.clamp(0.0, 1.0)).powi(2).max(1e-3);
-            let shininess = (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0);
-            (diffuse, specular, shininess, diffuse)
+            let factors = Vec4::new(
+                finite_unit(m.metallic, 0.0),
+                finite_unit(m.roughness, 1.0),
+                0.0,
+                0.0,
+            );
+            words
+                .vec4(m.base_color)
+                .vec4(factors)
+                .vec3w(Vec3::ZERO, textured)
+                .vec3w(m.emissive, METALLIC_ROUGHNESS);
         }
     }
 }
 
-/// Appends one material record; `textured` says whether it samples a base-colour texture.
-pub fn pack_material(words: &mut Words, m: &Material, textured: bool) {
-    let (diffuse, specular, shininess, ambient) = blinn_phong(m);
-    words
-        .vec3w(diffuse, m.base_color.w)
-        .vec3w(specular, shininess)
-        .vec3w(ambient, if textured { 1.0 } else { 0.0 })
-        .vec3w(m.emissive, 0.0);
+/// `v` clamped to [0, 1], or `fallback` when it is not a number.
+fn finite_unit(v: f32, fallback: f32) -> f32 {
+    if v.is_nan() {
+        fallback
+    } else {
+        v.clamp(0.0, 1.0)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec4;
 
     #[test]
     fn filters_follow_alpha_and_emission() {
@@ -82,7 +103,7 @@ mod tests {
     }
 
     #[test]
-    fn ambient_falls_back_to_diffuse_and_gltf_maps_to_phong() {
+    fn ambient_falls_back_to_diffuse_and_gltf_keeps_its_factors() {
         let mut m = Material {
             base_color: Vec4::new(0.5, 0.25, 1.0, 1.0),
             specular: Vec3::splat(0.3),
@@ -100,16 +121,65 @@ mod tests {
         );
         m.ambient = Vec3::splat(0.2);
         assert_eq!(blinn_phong(&m).3, Vec3::splat(0.2));
+        let mut w = Words::default();
+        pack_material(&mut w, &m, false);
+        let floats = |w: &Words| w.0.iter().map(|&b| f32::from_bits(b)).collect::<Vec<_>>();
+        assert_eq!(
+            floats(&w),
+            [
+                0.5,
+                0.25,
+                1.0,
+                1.0,
+                0.3,
+                0.3,
+                0.3,
+                9.0,
+                0.2,
+                0.2,
+                0.2,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                BLINN_PHONG
+            ]
+        );
         m.shading = ShadingModel::MetallicRoughness;
-        m.metallic = 1.0;
-        m.roughness = 0.5;
-        let (d, s, n, _) = blinn_phong(&m);
-        assert_eq!(d, Vec3::ZERO);
-        assert_eq!(s, Vec3::new(0.5, 0.25, 1.0));
-        assert_eq!(n, 30.0);
+        m.metallic = 1.5;
+        m.roughness = 0.25;
+        m.emissive = Vec3::new(2.0, 3.0, 4.0);
         let mut w = Words::default();
         pack_material(&mut w, &m, true);
         assert_eq!(w.byte_len(), MATERIAL_BYTES);
-        assert_eq!(f32::from_bits(w.0[11]), 1.0);
+        assert_eq!(
+            floats(&w),
+            [
+                0.5,
+                0.25,
+                1.0,
+                1.0,
+                1.0,
+                0.25,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                1.0,
+                2.0,
+                3.0,
+                4.0,
+                METALLIC_ROUGHNESS
+            ]
+        );
+        m.roughness = f32::NAN;
+        let mut w = Words::default();
+        pack_material(&mut w, &m, true);
+        assert_eq!(
+            f32::from_bits(w.0[5]),
+            1.0,
+            "NaN roughness falls back to rough"
+        );
     }
 }

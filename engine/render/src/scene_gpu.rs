@@ -1,6 +1,6 @@
 //! The scene on the device: geometry, draw records and materials uploaded once,
 //! textures, and the per-frame camera and light buffers; descriptor set 1 (scene
-//! data) and set 2 (a material's texture) that every scene shader binds.
+//! data) and set 2 (a material's textures) that every scene shader binds.
 
 use crate::buffer::Buffer;
 use crate::camera;
@@ -15,7 +15,7 @@ use ash::vk;
 use std::collections::HashMap;
 use std::path::PathBuf;
 use weft_gpu::{Gpu, GpuError};
-use weft_scene::material::TextureSource;
+use weft_scene::material::{TextureRef, TextureSource};
 use weft_scene::{Camera, Scene};
 
 /// Binding of the per-frame uniform block (`Frame` in `scene.glsl`).
@@ -28,6 +28,10 @@ pub const DRAWS_BINDING: u32 = 2;
 pub const MATERIALS_BINDING: u32 = 3;
 /// Binding of the shadow views (`Shadows` in `shaders/include/shadows.glsl`).
 pub const SHADOWS_BINDING: u32 = 4;
+/// Set 2 binding of a material's base-colour texture (sRGB).
+pub const BASE_COLOR_BINDING: u32 = 0;
+/// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
+pub const METALLIC_ROUGHNESS_BINDING: u32 = 1;
 /// Bytes of the `Frame` uniform block.
 pub const FRAME_BYTES: usize = 2 * 64 + 4 * 16;
 /// Scene sets that fullscreen pipelines built by the executor may ask for.
@@ -56,7 +60,7 @@ pub struct GpuScene<'g> {
     pool: vk::DescriptorPool,
     /// Layout of set 1 (scene data) in pipelines built here.
     pub scene_layout: vk::DescriptorSetLayout,
-    /// Layout of set 2 (one material's texture).
+    /// Layout of set 2 (one material's textures).
     pub material_layout: vk::DescriptorSetLayout,
     /// Set 1 for `scene_layout`.
     pub scene_set: vk::DescriptorSet,
@@ -111,36 +115,34 @@ impl<'g> GpuScene<'g> {
         )?;
         let draws =
             Buffer::device_local(gpu, "scene draws", &geometry.draw_records.bytes(), storage)?;
-        let mut textures = vec![Texture::upload(gpu, "white", &Pixels::white())?];
-        let mut by_source: HashMap<String, usize> = HashMap::new();
+        let mut textures = vec![Texture::upload(gpu, "white", &Pixels::white(), true)?];
+        let mut by_source: HashMap<(String, bool), usize> = HashMap::new();
         let mut material_texture = Vec::with_capacity(geometry.materials.len());
         let mut material_words = Words::default();
-        for m in &geometry.materials {
-            let slot = match &m.textures.base_color {
-                None => 0,
-                Some(t) => {
-                    let key = source_key(&t.source);
-                    match by_source.get(&key) {
-                        Some(&i) => i,
-                        None => {
-                            let i = match texture::decode(&t.source) {
-                                Ok(pixels) => {
-                                    textures.push(Texture::upload(gpu, &key, &pixels)?);
-                                    textures.len() - 1
-                                }
-                                Err(e) => {
-                                    warnings.push(format!("texture left white: {e}"));
-                                    0
-                                }
-                            };
-                            by_source.insert(key, i);
-                            i
-                        }
-                    }
+        let mut slot = |t: Option<&TextureRef>, srgb: bool| -> Result<usize, GpuError> {
+            let Some(t) = t else { return Ok(0) };
+            let key = (source_key(&t.source), srgb);
+            if let Some(&i) = by_source.get(&key) {
+                return Ok(i);
+            }
+            let i = match texture::decode(&t.source) {
+                Ok(pixels) => {
+                    textures.push(Texture::upload(gpu, &key.0, &pixels, srgb)?);
+                    textures.len() - 1
+                }
+                Err(e) => {
+                    warnings.push(format!("texture left white: {e}"));
+                    0
                 }
             };
-            pack_material(&mut material_words, m, slot != 0);
-            material_texture.push(slot);
+            by_source.insert(key, i);
+            Ok(i)
+        };
+        for m in &geometry.materials {
+            let base = slot(m.textures.base_color.as_ref(), true)?;
+            let metal_rough = slot(m.textures.metallic_roughness.as_ref(), false)?;
+            pack_material(&mut material_words, m, base != 0);
+            material_texture.push([base, metal_rough]);
         }
         let materials =
             Buffer::device_local(gpu, "scene materials", &material_words.bytes(), storage)?;
@@ -210,7 +212,7 @@ impl<'g> GpuScene<'g> {
         Ok(this)
     }
 
-    fn create_sets(&mut self, material_texture: &[usize]) -> Result<(), GpuError> {
+    fn create_sets(&mut self, material_texture: &[[usize; 2]]) -> Result<(), GpuError> {
         let device = self.gpu.device();
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let scene_bindings: Vec<_> = [
@@ -236,11 +238,13 @@ impl<'g> GpuScene<'g> {
             )
         }
         .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
-        let material_bindings = [vk::DescriptorSetLayoutBinding::default()
-            .binding(0)
-            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-            .descriptor_count(1)
-            .stage_flags(vk::ShaderStageFlags::FRAGMENT)];
+        let material_bindings = [BASE_COLOR_BINDING, METALLIC_ROUGHNESS_BINDING].map(|b| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(b)
+                .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                .descriptor_count(1)
+                .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+        });
         self.material_layout = unsafe {
             device.create_descriptor_set_layout(
                 &vk::DescriptorSetLayoutCreateInfo::default().bindings(&material_bindings),
@@ -261,7 +265,7 @@ impl<'g> GpuScene<'g> {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                descriptor_count: materials.max(1),
+                descriptor_count: 2 * materials.max(1),
             },
         ];
         self.pool = unsafe {
@@ -284,19 +288,27 @@ impl<'g> GpuScene<'g> {
                 SHADOWS_BINDING,
             ],
         );
-        for &slot in material_texture {
+        for slots in material_texture {
             let set = self.allocate(self.material_layout)?;
-            let info = [vk::DescriptorImageInfo {
-                sampler: self.sampler,
-                image_view: self.textures[slot].view,
-                image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            }];
-            let write = vk::WriteDescriptorSet::default()
-                .dst_set(set)
-                .dst_binding(0)
-                .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                .image_info(&info);
-            unsafe { device.update_descriptor_sets(&[write], &[]) };
+            let infos = slots.map(|slot| {
+                [vk::DescriptorImageInfo {
+                    sampler: self.sampler,
+                    image_view: self.textures[slot].view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                }]
+            });
+            let writes: Vec<_> = [BASE_COLOR_BINDING, METALLIC_ROUGHNESS_BINDING]
+                .iter()
+                .zip(&infos)
+                .map(|(&binding, info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(binding)
+                        .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                        .image_info(info)
+                })
+                .collect();
+            unsafe { device.update_descriptor_sets(&writes, &[]) };
             self.material_sets.push(set);
         }
         Ok(())

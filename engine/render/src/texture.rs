@@ -1,6 +1,7 @@
-//! Material textures: decoded on the CPU, uploaded once to sRGB images through a
-//! staging buffer and left in `SHADER_READ_ONLY_OPTIMAL`; a 1x1 white texture
-//! stands in for materials without one (and for files that cannot be read).
+//! Material textures: decoded on the CPU, uploaded once through a staging buffer
+//! (colour as sRGB, data such as metallic-roughness as UNORM) and left in
+//! `SHADER_READ_ONLY_OPTIMAL`; a 1x1 white texture stands in for materials
+//! without one (and for files that cannot be read).
 
 use crate::buffer::Buffer;
 use crate::error::RenderError;
@@ -66,11 +67,16 @@ fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
 }
 
 impl<'g> Texture<'g> {
-    /// Uploads `pixels` as an `R8G8B8A8_SRGB` image with a full mip chain (made by
-    /// linear blits, where the format can be filtered) ready for sampling in fragment shaders.
-    pub fn upload(gpu: &'g Gpu, name: &str, pixels: &Pixels) -> Result<Self, GpuError> {
+    /// Uploads `pixels` as an `R8G8B8A8_SRGB` image (colour, `srgb`) or
+    /// `R8G8B8A8_UNORM` (data) with a full mip chain (made by linear blits, where
+    /// the format can be filtered) ready for sampling in fragment shaders.
+    pub fn upload(gpu: &'g Gpu, name: &str, pixels: &Pixels, srgb: bool) -> Result<Self, GpuError> {
         let device = gpu.device();
-        let format = vk::Format::R8G8B8A8_SRGB;
+        let format = if srgb {
+            vk::Format::R8G8B8A8_SRGB
+        } else {
+            vk::Format::R8G8B8A8_UNORM
+        };
         let extent = vk::Extent3D {
             width: pixels.width.max(1),
             height: pixels.height.max(1),

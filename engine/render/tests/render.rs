@@ -62,6 +62,7 @@ fn deferred_renders_the_demo_scene_cleanly_and_matches_its_golden() {
             "sun",
             "point_lights",
             "spot_lights",
+            "area_lights",
             "bloom_bright",
             "bloom_blur_h",
             "bloom_blur_v",
