@@ -91,7 +91,7 @@ fn plan_json_has_stats() {
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     let stats = &json["stats"];
     assert_eq!(stats["passes"], 8);
-    assert_eq!(stats["culled"], 4);
+    assert_eq!(stats["culled"], 5);
     assert!(stats["barriers"].as_u64().expect("barriers") > 10);
     let aliased = stats["transient_bytes"].as_u64().expect("bytes");
     let unaliased = stats["transient_bytes_unaliased"].as_u64().expect("bytes");

@@ -18,6 +18,7 @@ const FEATURE_SETS: &[(&str, &[&str])] = &[
             "shadow_casters",
             "point_lights",
             "spot_lights",
+            "area_lights",
             "depth_prepass",
             "transparent",
         ],
@@ -105,6 +106,7 @@ fn removing_any_barrier_makes_the_checker_fail() {
             "shadow_casters",
             "point_lights",
             "spot_lights",
+            "area_lights",
             "transparent",
         ]),
         ..CompileOptions::default()
@@ -156,6 +158,7 @@ fn scene_features_cull_passes_and_variants() {
             ("bloom_naive_v", "enabled_if [bloom_naive] is false"),
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
+            ("area_lights", "enabled_if [area_lights] is false"),
             ("transparent", "enabled_if [transparent] is false"),
         ]
     );

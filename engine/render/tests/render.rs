@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{agreement, cube_scene, demo_scene, graph, render_validated};
+use common::{agreement, cube_scene, demo_scene, gltf_scene, graph, render_validated};
 use std::path::Path;
 use weft_gpu::{check_golden, Tolerance};
 
@@ -117,6 +117,24 @@ fn forward_and_deferred_agree_on_the_15_462_cube_scene() {
     let a = agreement(&f.image, &d.image);
     eprintln!("forward vs deferred: {a:?}");
     assert!(a.mean <= 0.25 && a.p99 <= 1, "{a:?}");
+}
+
+#[test]
+fn forward_and_deferred_agree_on_a_gltf_scene_and_match_their_goldens() {
+    let f = render_validated(&gltf_scene(), &graph("forward.ron"), 320, 180, &[]);
+    let d = render_validated(&gltf_scene(), &graph("deferred.ron"), 320, 180, &[]);
+    assert_eq!(f.messages, Vec::new());
+    assert_eq!(d.messages, Vec::new());
+    assert!(
+        d.passes.contains(&"area_lights".to_string()),
+        "{:?}",
+        d.passes
+    );
+    let a = agreement(&f.image, &d.image);
+    eprintln!("forward vs deferred: {a:?}");
+    assert!(a.mean <= 0.25 && a.p99 <= 1, "{a:?}");
+    assert_golden(&f.image, "flight_helmet_forward_320x180.png");
+    assert_golden(&d.image, "flight_helmet_deferred_320x180.png");
 }
 
 #[test]

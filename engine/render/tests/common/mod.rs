@@ -24,6 +24,11 @@ pub fn cube_scene() -> PathBuf {
     root().join("../shared/assets/462/scenes/cube.scene")
 }
 
+/// A glTF model (FlightHelmet: metallic-roughness textures) under every light type.
+pub fn gltf_scene() -> PathBuf {
+    root().join("scenes/flight_helmet.scene")
+}
+
 /// A shipped graph.
 pub fn graph(name: &str) -> PathBuf {
     root().join("graphs").join(name)
