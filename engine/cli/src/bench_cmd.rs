@@ -13,6 +13,8 @@ pub enum BenchCommand {
     Lights(crate::bench_lights::LightsArgs),
     /// Bloom blur time and error: paired linear-filtered taps against one fetch per texel.
     Bloom(crate::bench_bloom::BloomArgs),
+    /// Shadow-map resolution and PCF radius against error (vs ray-traced visibility) and time.
+    Shadows(crate::bench_shadows::ShadowsArgs),
 }
 
 /// Runs `weft bench ...`.
@@ -20,5 +22,6 @@ pub fn run(cmd: BenchCommand) -> Result<ExitCode> {
     match cmd {
         BenchCommand::Lights(args) => crate::bench_lights::run(args),
         BenchCommand::Bloom(args) => crate::bench_bloom::run(args),
+        BenchCommand::Shadows(args) => crate::bench_shadows::run(args),
     }
 }

@@ -3,6 +3,7 @@
 mod bench_bloom;
 mod bench_cmd;
 mod bench_lights;
+mod bench_shadows;
 mod graph_cmd;
 mod plot;
 mod render_cmd;

@@ -14,8 +14,17 @@ use weft_render::{render, RenderSettings};
 
 const SIZE: u32 = 256;
 
-/// A 16x16 plane at y = 0 and, when `box_on`, a unit box floating at y 1..2.
-fn write_scene(dir: &Path, sun: Vec3, camera: (Vec3, Vec3), box_on: bool) -> PathBuf {
+/// A scene block for a white sun travelling along `d`, without ambient light.
+fn sun_block(d: Vec3) -> String {
+    format!(
+        "sunlight\n{{\n\tdirection {} {} {}\n\tcolor 1 1 1\n\tambient 0\n}}\n",
+        d.x, d.y, d.z
+    )
+}
+
+/// A 16x16 plane at y = 0 and, when `box_on`, a unit box floating at y 1..2,
+/// lit by `lights` (scene blocks).
+fn write_scene(dir: &Path, lights: &str, camera: (Vec3, Vec3), box_on: bool) -> PathBuf {
     std::fs::create_dir_all(dir).expect("temp dir");
     let mut obj = String::from("mtllib white.mtl\nusemtl white\nv -8 0 -8\nv 8 0 -8\nv 8 0 8\nv -8 0 8\nf 1 4 3\nf 1 3 2\n");
     if box_on {
@@ -41,8 +50,8 @@ fn write_scene(dir: &Path, sun: Vec3, camera: (Vec3, Vec3), box_on: bool) -> Pat
     std::fs::write(dir.join("white.mtl"), "newmtl white\nKd 1 1 1\nKs 0 0 0\n").expect("mtl");
     let (eye, target) = camera;
     let scene = format!(
-        "model\n{{\n\tfile \"plane.obj\"\n}}\nsunlight\n{{\n\tdirection {} {} {}\n\tcolor 1 1 1\n\tambient 0\n}}\ncamera \"top\"\n{{\n\tposition {} {} {}\n\ttarget {} {} {}\n\tfov_deg 40\n}}\n",
-        sun.x, sun.y, sun.z, eye.x, eye.y, eye.z, target.x, target.y, target.z
+        "model\n{{\n\tfile \"plane.obj\"\n}}\n{lights}camera \"top\"\n{{\n\tposition {} {} {}\n\ttarget {} {} {}\n\tfov_deg 40\n}}\n",
+        eye.x, eye.y, eye.z, target.x, target.y, target.z
     );
     let path = dir.join("plane.scene");
     std::fs::write(&path, scene).expect("scene");
@@ -159,16 +168,16 @@ const TOP: (Vec3, Vec3) = (Vec3::new(-3.0, 10.0, 0.0), Vec3::new(-3.0, 0.0, 0.0)
 #[test]
 fn a_box_shadow_lands_where_the_sun_direction_predicts() {
     let dir = std::env::temp_dir().join("weft-shadows-analytic");
-    let scene = write_scene(&dir, SUN, TOP, true);
-    for graph in ["forward.ron", "deferred.ron"] {
-        let g = graph_with(&dir, graph, "");
+    let scene = write_scene(&dir, &sun_block(SUN), TOP, true);
+    for (graph, cascades) in [("forward.ron", 1), ("deferred.ron", 1), ("forward.ron", 3)] {
+        let g = graph_with(&dir, graph, &format!("\"cascades\": {cascades}"));
         let image = render_hdr(&scene, &g);
         let lit = 1.0 / 5f32.sqrt();
         let centre = project(&scene, Vec3::new(-3.0, 0.0, 0.0));
         let (cx, cy) = (centre.x as usize, centre.y as usize);
         assert!(
             image[cy * SIZE as usize + cx] < 0.01,
-            "{graph}: the centre is in shadow"
+            "{graph}, {cascades} cascade(s): the centre is in shadow"
         );
         // Edges along the row and the column through the shadow's centre.
         let edges = [
@@ -187,11 +196,43 @@ fn a_box_shadow_lands_where_the_sun_direction_predicts() {
             let step = if predicted > from as f32 { 1 } else { -1 };
             let measured = crossing(&line, from, step, lit * 0.5);
             eprintln!(
-                "{graph}: edge {edge}: measured {measured:.2} px, predicted {predicted:.2} px"
+                "{graph}, {cascades} cascade(s): edge {edge}: measured {measured:.2} px, predicted {predicted:.2} px"
             );
             assert!(
                 (measured - predicted).abs() <= 1.5,
-                "{graph}: edge at {edge} measured at pixel {measured:.2}, predicted {predicted:.2}"
+                "{graph}, {cascades} cascade(s): edge at {edge} measured at pixel {measured:.2}, predicted {predicted:.2}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_spot_light_shadow_lands_where_its_position_predicts() {
+    // A spot 6 above the plane pointing down: the box's top corners (y = 2,
+    // x = +-0.5) cast the shadow's edges at x = +-0.5 * 6 / 4 = +-0.75.
+    let dir = std::env::temp_dir().join("weft-shadows-spot");
+    let spot = "spotlight\n{\n\tposition 0 6 0\n\tdirection 0 -1 0\n\tcolor 1 1 1\n\texponent 0\n\tangle 40\n\tattenuation 1 0 0\n}\n";
+    let camera = (Vec3::new(0.0, 8.0, 6.0), Vec3::ZERO);
+    let scene = write_scene(&dir, spot, camera, true);
+    for graph in ["forward.ron", "deferred.ron"] {
+        let g = graph_with(&dir, graph, "");
+        let image = render_hdr(&scene, &g);
+        let centre = project(&scene, Vec3::ZERO);
+        let (cx, cy) = (centre.x as usize, centre.y as usize);
+        assert!(
+            image[cy * SIZE as usize + cx] < 0.01,
+            "{graph}: the centre is in shadow"
+        );
+        let line = row(&image, cy);
+        for x in [-0.75f32, 0.75] {
+            let predicted = project(&scene, Vec3::new(x, 0.0, 0.0)).x - 0.5;
+            let lit = 6.0 / (36.0 + x * x).sqrt();
+            let step = if predicted > cx as f32 { 1 } else { -1 };
+            let measured = crossing(&line, cx, step, lit * 0.5);
+            eprintln!("{graph}, spot: edge x = {x}: measured {measured:.2} px, predicted {predicted:.2} px");
+            assert!(
+                (measured - predicted).abs() <= 1.5,
+                "{graph}: spot shadow edge x = {x} measured at pixel {measured:.2}, predicted {predicted:.2}"
             );
         }
     }
@@ -205,7 +246,7 @@ fn a_lit_plane_shows_no_acne_at_the_default_bias() {
         let d = dir.join(format!("{i}"));
         let angle = degrees.to_radians();
         let sun = Vec3::new(angle.sin() * 0.6, -angle.cos(), angle.sin() * 0.8);
-        let scene = write_scene(&d, sun, camera, false);
+        let scene = write_scene(&d, &sun_block(sun), camera, false);
         // Pixels whose centre sees the plane at least 0.25 from its edges.
         let loaded = weft_scene::load_scene(&scene).expect("scene loads");
         let inv = weft_render::camera::view_projection(&loaded.cameras[0], 0.0, 1.0).inverse();
@@ -255,7 +296,7 @@ fn penumbra(scene: &Path, image: &[f32]) -> f32 {
 #[test]
 fn widening_pcf_never_narrows_the_penumbra() {
     let dir = std::env::temp_dir().join("weft-shadows-penumbra");
-    let scene = write_scene(&dir, SUN, TOP, true);
+    let scene = write_scene(&dir, &sun_block(SUN), TOP, true);
     let mut widths = Vec::new();
     for r in 0..=3 {
         let g = graph_with(
