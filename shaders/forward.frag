@@ -9,6 +9,7 @@ layout(set = 0, binding = 0) uniform sampler2DShadow shadow_map;
 
 layout(set = 2, binding = 0) uniform sampler2D base_color;
 layout(set = 2, binding = 1) uniform sampler2D metallic_roughness;
+layout(set = 2, binding = 2) uniform sampler2D normal_map;
 
 layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 world_normal;
@@ -22,7 +23,9 @@ void main() {
     vec4 texel = texture(base_color, texcoord);
     Material m = materials[material];
     vec2 mr = metal_rough(m, texture(metallic_roughness, texcoord));
-    Surface s = Surface(world, gl_FrontFacing ? n : -n, texel.rgb, material, mr);
+    vec3 bent = texture(normal_map, texcoord).rgb;
+    n = mapped_normal(gl_FrontFacing ? n : -n, world, texcoord, bent, m.ambient.w);
+    Surface s = Surface(world, n, texel.rgb, material, mr);
     vec3 c = shade_ambient_emissive(s, m);
     for (uint i = 0u; i < frame.counts.w; ++i) {
         c += shade_light(i, s, m);

@@ -5,6 +5,7 @@
 
 layout(set = 2, binding = 0) uniform sampler2D base_color;
 layout(set = 2, binding = 1) uniform sampler2D metallic_roughness;
+layout(set = 2, binding = 2) uniform sampler2D normal_map;
 
 layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 world_normal;
@@ -18,7 +19,9 @@ layout(location = 2) out vec4 material_out;
 void main() {
     vec3 n = normalize(world_normal);
     albedo = vec4(texture(base_color, texcoord).rgb, 1.0);
-    normal = octahedral_encode_half(gl_FrontFacing ? n : -n);
-    vec2 mr = metal_rough(materials[material], texture(metallic_roughness, texcoord));
+    Material m = materials[material];
+    vec3 bent = texture(normal_map, texcoord).rgb;
+    normal = octahedral_encode_half(mapped_normal(gl_FrontFacing ? n : -n, world, texcoord, bent, m.ambient.w));
+    vec2 mr = metal_rough(m, texture(metallic_roughness, texcoord));
     material_out = encode_material(material, mr);
 }

@@ -37,6 +37,28 @@ vec2 metal_rough(Material m, vec4 texel) {
     return round(clamp(m.specular.xy * texel.bg, 0.0, 1.0) * 255.0) / 255.0;
 }
 
+// The normal `n` bent by a tangent-space normal-map texel (glTF convention:
+// +X along increasing u, +Y up in the image) with strength `scale`; 0 leaves
+// `n` as it is. The tangent frame comes from screen-space derivatives of the
+// position and UV (dP/du, made orthogonal to n), so meshes need no tangents;
+// it is constant across a triangle and assumes UVs are not mirrored.
+vec3 mapped_normal(vec3 n, vec3 p, vec2 uv, vec3 texel, float scale) {
+    vec3 dpx = dFdx(p);
+    vec3 dpy = dFdy(p);
+    vec2 dux = dFdx(uv);
+    vec2 duy = dFdy(uv);
+    float det = dux.x * duy.y - duy.x * dux.y;
+    vec3 t = (duy.y * dpx - dux.y * dpy) * sign(det);
+    t -= n * dot(n, t);
+    if (scale == 0.0 || det == 0.0 || dot(t, t) <= 1e-20) {
+        return n;
+    }
+    t = normalize(t);
+    vec3 bent = texel * 2.0 - 1.0;
+    bent.xy *= scale;
+    return normalize(mat3(t, cross(n, t), n) * bent);
+}
+
 // Cook-Torrance times N.L: GGX distribution, Smith height-correlated visibility,
 // Schlick Fresnel with F0 = mix(0.04, base, metallic), and Lambert diffuse
 // weighted by (1 - F)(1 - metallic); alpha = roughness^2.

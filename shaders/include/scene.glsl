@@ -33,7 +33,7 @@ struct Light {
 struct Material {
     vec4 diffuse;   // Kd or base colour, alpha
     vec4 specular;  // Ks, Ns (metallic-roughness: metallic, roughness, 0, 0)
-    vec4 ambient;   // ambient reflectance (Ka, or Kd where Ka is black), textured flag
+    vec4 ambient;   // ambient reflectance (Ka, or Kd where Ka is black), normal-map scale (0: none)
     vec4 emissive;  // Ke, shading model
 };
 

@@ -39,18 +39,23 @@ pub fn blinn_phong(m: &Material) -> (Vec3, Vec3, f32, Vec3) {
     (base, m.specular, m.shininess.max(0.0), ambient)
 }
 
-/// Appends one material record; `textured` says whether it samples a base-colour
-/// texture. glTF materials keep their metallic and roughness factors (which the
-/// shaders multiply by the metallicRoughness texture) in the specular slot.
-pub fn pack_material(words: &mut Words, m: &Material, textured: bool) {
-    let textured = if textured { 1.0 } else { 0.0 };
+/// Appends one material record; `normal_mapped` says whether a normal map is
+/// bound, whose strength (`normal_scale`) goes in the ambient slot's w (0: none).
+/// glTF materials keep their metallic and roughness factors (which the shaders
+/// multiply by the metallicRoughness texture) in the specular slot.
+pub fn pack_material(words: &mut Words, m: &Material, normal_mapped: bool) {
+    let normal_scale = if normal_mapped && m.normal_scale.is_finite() {
+        m.normal_scale
+    } else {
+        0.0
+    };
     match m.shading {
         ShadingModel::BlinnPhong => {
             let (diffuse, specular, shininess, ambient) = blinn_phong(m);
             words
                 .vec3w(diffuse, m.base_color.w)
                 .vec3w(specular, shininess)
-                .vec3w(ambient, textured)
+                .vec3w(ambient, normal_scale)
                 .vec3w(m.emissive, BLINN_PHONG);
         }
         ShadingModel::MetallicRoughness => {
@@ -63,7 +68,7 @@ pub fn pack_material(words: &mut Words, m: &Material, textured: bool) {
             words
                 .vec4(m.base_color)
                 .vec4(factors)
-                .vec3w(Vec3::ZERO, textured)
+                .vec3w(Vec3::ZERO, normal_scale)
                 .vec3w(m.emissive, METALLIC_ROUGHNESS);
         }
     }
@@ -149,6 +154,7 @@ mod tests {
         m.metallic = 1.5;
         m.roughness = 0.25;
         m.emissive = Vec3::new(2.0, 3.0, 4.0);
+        m.normal_scale = 0.5;
         let mut w = Words::default();
         pack_material(&mut w, &m, true);
         assert_eq!(w.byte_len(), MATERIAL_BYTES);
@@ -166,7 +172,7 @@ mod tests {
                 0.0,
                 0.0,
                 0.0,
-                1.0,
+                0.5,
                 2.0,
                 3.0,
                 4.0,

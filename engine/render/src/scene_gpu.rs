@@ -32,6 +32,14 @@ pub const SHADOWS_BINDING: u32 = 4;
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
 pub const METALLIC_ROUGHNESS_BINDING: u32 = 1;
+/// Set 2 binding of a material's tangent-space normal map (UNORM).
+pub const NORMAL_BINDING: u32 = 2;
+/// The set 2 bindings, in the order of a material's texture slots.
+const MATERIAL_BINDINGS: [u32; 3] = [
+    BASE_COLOR_BINDING,
+    METALLIC_ROUGHNESS_BINDING,
+    NORMAL_BINDING,
+];
 /// Bytes of the `Frame` uniform block.
 pub const FRAME_BYTES: usize = 2 * 64 + 4 * 16;
 /// Scene sets that fullscreen pipelines built by the executor may ask for.
@@ -141,8 +149,9 @@ impl<'g> GpuScene<'g> {
         for m in &geometry.materials {
             let base = slot(m.textures.base_color.as_ref(), true)?;
             let metal_rough = slot(m.textures.metallic_roughness.as_ref(), false)?;
-            pack_material(&mut material_words, m, base != 0);
-            material_texture.push([base, metal_rough]);
+            let normal = slot(m.textures.normal.as_ref(), false)?;
+            pack_material(&mut material_words, m, normal != 0);
+            material_texture.push([base, metal_rough, normal]);
         }
         let materials =
             Buffer::device_local(gpu, "scene materials", &material_words.bytes(), storage)?;
@@ -212,7 +221,7 @@ impl<'g> GpuScene<'g> {
         Ok(this)
     }
 
-    fn create_sets(&mut self, material_texture: &[[usize; 2]]) -> Result<(), GpuError> {
+    fn create_sets(&mut self, material_texture: &[[usize; 3]]) -> Result<(), GpuError> {
         let device = self.gpu.device();
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let scene_bindings: Vec<_> = [
@@ -238,7 +247,7 @@ impl<'g> GpuScene<'g> {
             )
         }
         .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
-        let material_bindings = [BASE_COLOR_BINDING, METALLIC_ROUGHNESS_BINDING].map(|b| {
+        let material_bindings = MATERIAL_BINDINGS.map(|b| {
             vk::DescriptorSetLayoutBinding::default()
                 .binding(b)
                 .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
@@ -265,7 +274,7 @@ impl<'g> GpuScene<'g> {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                descriptor_count: 2 * materials.max(1),
+                descriptor_count: MATERIAL_BINDINGS.len() as u32 * materials.max(1),
             },
         ];
         self.pool = unsafe {
@@ -297,7 +306,7 @@ impl<'g> GpuScene<'g> {
                     image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
                 }]
             });
-            let writes: Vec<_> = [BASE_COLOR_BINDING, METALLIC_ROUGHNESS_BINDING]
+            let writes: Vec<_> = MATERIAL_BINDINGS
                 .iter()
                 .zip(&infos)
                 .map(|(&binding, info)| {

@@ -1,7 +1,8 @@
 //! Shading measured in linear HDR against the CPU reference: a glTF
-//! metallic-roughness quad under a sun (factors, and a metallicRoughness texture
-//! read as B = metallic, G = roughness) equals `weft_render::brdf::cook_torrance`
-//! within 0.2% (measured at most 0.053%: half-float storage), and a diffuse quad
+//! metallic-roughness quad under a sun (factors, a metallicRoughness texture read
+//! as B = metallic, G = roughness, a normal map with a scale) equals
+//! `weft_render::brdf::cook_torrance`
+//! within 0.2% (measured at most 0.086%: half-float storage), and a diffuse quad
 //! under a rectangle and a two-sided disc area light equals a brute-force integral
 //! within 1% (measured at most 0.33%) and the CPU copy of the shaders' 8 x 8
 //! quadrature within 0.2% (measured at most 0.041%), through forward and deferred,
@@ -88,10 +89,17 @@ fn assert_relative(got: Vec3, want: Vec3, tolerance: f32, what: &str) {
     );
 }
 
-/// Writes a glTF file with one 2 x 2 quad in z = 0 facing +Z and one
-/// metallic-roughness material (`material` is its pbrMetallicRoughness JSON);
-/// `texture` adds a 1x1 metallicRoughness PNG with that RGB.
-fn write_gltf_quad(dir: &Path, material: &str, texture: Option<[u8; 3]>) {
+/// A 1x1 texture of one colour for a test glTF file.
+struct Texel {
+    rgb: [u8; 3],
+    /// A normal map's `scale`, or `None` for the metallicRoughness texture.
+    normal_scale: Option<f32>,
+}
+
+/// Writes a glTF file with one 2 x 2 quad in z = 0 facing +Z (u along +X, v
+/// along -Y) and one metallic-roughness material (`material` is its
+/// pbrMetallicRoughness JSON) with `textures` as 1x1 PNGs.
+fn write_gltf_quad(dir: &Path, material: &str, textures: &[Texel]) {
     let mut bin: Vec<u8> = Vec::new();
     let positions = [
         [-1.0f32, -1.0, 0.0],
@@ -112,19 +120,31 @@ fn write_gltf_quad(dir: &Path, material: &str, texture: Option<[u8; 3]>) {
         bin.extend(i.to_le_bytes());
     }
     std::fs::write(dir.join("quad.bin"), &bin).expect("bin");
-    let texture_json = match texture {
-        Some(rgb) => {
-            image::RgbaImage::from_pixel(1, 1, image::Rgba([rgb[0], rgb[1], rgb[2], 255]))
-                .save(dir.join("mr.png"))
-                .expect("png");
-            r#", "metallicRoughnessTexture": { "index": 0 }"#
+    let (mut pbr, mut normal, mut images) = (String::new(), String::new(), Vec::new());
+    for (i, t) in textures.iter().enumerate() {
+        let [r, g, b] = t.rgb;
+        image::RgbaImage::from_pixel(1, 1, image::Rgba([r, g, b, 255]))
+            .save(dir.join(format!("t{i}.png")))
+            .expect("png");
+        images.push(format!(r#"{{ "uri": "t{i}.png" }}"#));
+        match t.normal_scale {
+            Some(scale) => {
+                normal = format!(r#", "normalTexture": {{ "index": {i}, "scale": {scale} }}"#)
+            }
+            None => pbr = format!(r#", "metallicRoughnessTexture": {{ "index": {i} }}"#),
         }
-        None => "",
-    };
-    let textures = if texture.is_some() {
-        r#""images": [{ "uri": "mr.png" }], "textures": [{ "source": 0 }],"#
+    }
+    let sources: Vec<String> = (0..images.len())
+        .map(|i| format!(r#"{{ "source": {i} }}"#))
+        .collect();
+    let textures = if images.is_empty() {
+        String::new()
     } else {
-        ""
+        format!(
+            r#""images": [{}], "textures": [{}],"#,
+            images.join(", "),
+            sources.join(", ")
+        )
     };
     let json = format!(
         r#"{{
@@ -133,7 +153,7 @@ fn write_gltf_quad(dir: &Path, material: &str, texture: Option<[u8; 3]>) {
   "scenes": [{{ "nodes": [0] }}],
   "nodes": [{{ "mesh": 0 }}],
   "meshes": [{{ "primitives": [{{ "attributes": {{ "POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2 }}, "indices": 3, "material": 0 }}] }}],
-  "materials": [{{ "pbrMetallicRoughness": {{ {material}{texture_json} }} }}],
+  "materials": [{{ "pbrMetallicRoughness": {{ {material}{pbr} }}{normal} }}],
   {textures}
   "buffers": [{{ "uri": "quad.bin", "byteLength": {len} }}],
   "bufferViews": [
@@ -161,35 +181,58 @@ fn unorm8(v: f32) -> f32 {
 
 #[test]
 fn gltf_metallic_roughness_matches_the_cpu_brdf_in_both_paths() {
-    let sun = Vec3::new(-0.6, 0.0, -0.8); // travels down-left: L = (0.6, 0, 0.8)
+    let sun = Vec3::new(-0.6, -0.4, -0.7); // L = (0.6, 0.4, 0.7), normalised
     let base = Vec3::new(0.8, 0.5, 0.2);
-    // (name, pbrMetallicRoughness factors, texture RGB, metallic, roughness).
+    let mr = |rgb| Texel {
+        rgb,
+        normal_scale: None,
+    };
+    // A normal-map texel bending the normal towards +X (u) and +Y (up in the image),
+    // at half strength: the expected normal in world space (tangent +X, bitangent +Y).
+    let bent = Texel {
+        rgb: [204, 160, 230],
+        normal_scale: Some(0.5),
+    };
+    let decode = |c: u8| f32::from(c) / 255.0 * 2.0 - 1.0;
+    let bent_normal = Vec3::new(0.5 * decode(204), 0.5 * decode(160), decode(230)).normalize();
+    // (name, pbrMetallicRoughness factors, textures, metallic, roughness, normal).
     let cases = [
         (
             "factors",
             r#""baseColorFactor": [0.8, 0.5, 0.2, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.6"#,
-            None,
+            vec![],
             0.0,
             unorm8(0.6),
+            Vec3::Z,
         ),
         (
             "textured",
             r#""baseColorFactor": [0.8, 0.5, 0.2, 1.0], "metallicFactor": 1.0, "roughnessFactor": 1.0"#,
-            Some([0u8, 100, 255]),
+            vec![mr([0u8, 100, 255])],
             1.0,
             100.0 / 255.0,
+            Vec3::Z,
         ),
         (
             "textured_scaled",
             r#""baseColorFactor": [0.8, 0.5, 0.2, 1.0], "metallicFactor": 0.5, "roughnessFactor": 0.5"#,
-            Some([0u8, 200, 102]),
+            vec![mr([0u8, 200, 102])],
             unorm8(0.5 * 0.4),
             unorm8(0.5 * 200.0 / 255.0),
+            Vec3::Z,
+        ),
+        (
+            "normal_mapped",
+            r#""baseColorFactor": [0.8, 0.5, 0.2, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.6"#,
+            vec![bent],
+            0.0,
+            unorm8(0.6),
+            bent_normal,
         ),
     ];
-    for (name, factors, texture, metallic, roughness) in cases {
+    for (name, factors, textures, metallic, roughness, normal) in cases {
         let dir = temp_dir(name);
-        write_gltf_quad(&dir, factors, texture);
+        write_gltf_quad(&dir, factors, &textures);
         std::fs::write(
             dir.join("quad.scene"),
             format!(
@@ -207,7 +250,7 @@ fn gltf_metallic_roughness_matches_the_cpu_brdf_in_both_paths() {
             for x in [4, 16, 28] {
                 let p = on_plane(x);
                 let v = (Vec3::Z * CAMERA_Z - p).normalize();
-                let want = 2.0 * cook_torrance(base, metallic, roughness, Vec3::Z, v, l);
+                let want = 2.0 * cook_torrance(base, metallic, roughness, normal, v, l);
                 let got = pixel(&hdr, x, SIZE / 2);
                 assert_relative(got, want, 0.002, &format!("{name} {graph} pixel {x}"));
             }
