@@ -20,7 +20,8 @@ pub struct RasterContext<'a> {
     pub plan: &'a Plan,
     /// Index of the pass in `plan.passes`.
     pub pass_index: usize,
-    /// The render pass the recorder's pipelines must be compatible with (subpass 0).
+    /// The render pass the recorder's pipelines must be compatible with (subpass 0);
+    /// null for a compute pass, which only gets `bind_scene` calls.
     pub render_pass: vk::RenderPass,
     /// The render area, also set as viewport and scissor.
     pub extent: vk::Extent2D,
@@ -54,7 +55,8 @@ impl RasterContext<'_> {
 
 /// The descriptor set number reserved for scene data (camera, lights): graph
 /// resources are bound in set 0, and a fullscreen pass whose shaders declare
-/// set 1 gets it from the draw recorder, so deferred lighting can read the scene.
+/// set 1 gets it from the draw recorder, so deferred lighting can read the scene
+/// (and so can a compute pass, such as tiled light culling).
 pub const SCENE_SET: u32 = 1;
 
 /// Records the draws of raster passes whose content comes from outside the

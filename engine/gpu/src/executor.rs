@@ -478,8 +478,32 @@ impl<'g> Renderer<'g> {
                     message: "compute pass without a dispatch size".into(),
                 })?;
                 self.bind(cmd, prep);
-                unsafe { device.cmd_dispatch(cmd, dispatch[0], dispatch[1], dispatch[2]) };
-                Ok(())
+                // A compute pass that reads scene data (tiled light culling reads the
+                // camera and the lights) gets set 1 from the draw recorder, as a
+                // fullscreen pass does; there is no render pass around it.
+                let scene = prep.pipeline.as_ref().filter(|p| {
+                    p.interface.bindings.keys().any(|(s, _)| *s == SCENE_SET)
+                });
+                let bound = match scene {
+                    Some(p) => draws.bind_scene(
+                        &RasterContext {
+                            gpu: self.gpu,
+                            cmd,
+                            plan,
+                            pass_index: index,
+                            render_pass: vk::RenderPass::null(),
+                            extent: prep.extent,
+                            resources,
+                            sampler: self.samplers.linear,
+                            nearest_sampler: self.samplers.nearest,
+                        },
+                        p,
+                    ),
+                    None => Ok(()),
+                };
+                bound.map(|()| unsafe {
+                    device.cmd_dispatch(cmd, dispatch[0], dispatch[1], dispatch[2])
+                })
             }
             PassKind::Fullscreen | PassKind::Raster => {
                 let area = vk::Rect2D {
