@@ -481,9 +481,10 @@ impl<'g> Renderer<'g> {
                 // A compute pass that reads scene data (tiled light culling reads the
                 // camera and the lights) gets set 1 from the draw recorder, as a
                 // fullscreen pass does; there is no render pass around it.
-                let scene = prep.pipeline.as_ref().filter(|p| {
-                    p.interface.bindings.keys().any(|(s, _)| *s == SCENE_SET)
-                });
+                let scene = prep
+                    .pipeline
+                    .as_ref()
+                    .filter(|p| p.interface.bindings.keys().any(|(s, _)| *s == SCENE_SET));
                 let bound = match scene {
                     Some(p) => draws.bind_scene(
                         &RasterContext {

@@ -10,7 +10,11 @@
 mod common;
 
 use common::{agreement, graph, render_validated};
+use glam::{Mat4, Vec2, Vec3};
 use std::path::{Path, PathBuf};
+use weft_gpu::{Gpu, GpuOptions};
+use weft_graph::plan::Extent;
+use weft_render::{camera, render, tiles, RenderSettings};
 
 /// A fresh folder under the system temp folder for this test's scene files.
 fn scratch(name: &str) -> PathBuf {
@@ -43,7 +47,10 @@ fn a_thousand_lights_agree_across_forward_deferred_and_tiled() {
     let fd = agreement(&forward.image, &deferred.image);
     let td = agreement(&tiled.image, &deferred.image);
     eprintln!("forward vs deferred {fd:?}; tiled vs deferred {td:?}");
-    assert!(fd.mean <= 0.25 && fd.p99 <= 1, "forward vs deferred: {fd:?}");
+    assert!(
+        fd.mean <= 0.25 && fd.p99 <= 1,
+        "forward vs deferred: {fd:?}"
+    );
     assert!(td.mean <= 0.25 && td.p99 <= 1, "tiled vs deferred: {td:?}");
     // The lights light the scene: not a comparison of two black images.
     let lit = tiled.image.pixels().filter(|p| p.0[0] > 32).count();
@@ -57,5 +64,186 @@ fn a_thousand_lights_agree_across_forward_deferred_and_tiled() {
         },
     ) {
         panic!("{e}");
+    }
+}
+
+/// Eight point lights of known position and cutoff radius over a floor that
+/// fills the view of a camera looking steeply down.
+const KNOWN_LIGHTS: [([f32; 3], f32); 8] = [
+    ([0.0, 0.5, 0.0], 2.0),
+    ([0.5, 1.0, 0.5], 1.5),
+    ([-3.0, 0.3, -1.0], 1.0),
+    ([3.0, 0.2, 1.5], 2.5),
+    ([-1.5, 2.5, 2.0], 3.0),
+    ([2.0, 0.8, -2.0], 1.2),
+    ([-4.0, 0.5, 2.5], 0.8),
+    ([0.0, 3.0, -3.0], 2.0),
+];
+
+fn known_scene(dir: &Path) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(
+        dir.join("plane.obj"),
+        "v -50 0 50\nv 50 0 50\nv 50 0 -50\nv -50 0 -50\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let mut text = String::from("model\n{\n\tfile \"plane.obj\"\n}\n");
+    for ([x, y, z], r) in KNOWN_LIGHTS {
+        text.push_str(&format!(
+            "pointlight\n{{\n\tposition {x} {y} {z}\n\tcolor 0.5 0.5 0.5\n\tattenuation 1 0 1\n\tradius {r}\n}}\n"
+        ));
+    }
+    text.push_str("camera \"top\"\n{\n\tposition 0 9 4\n\ttarget 0 0 0\n\tfov_deg 60\n}\n");
+    let path = dir.join("known.scene");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// The reverse-Z depth of the floor (y = 0) seen through pixel centre `centre`.
+fn floor_depth(view_proj: Mat4, inv: Mat4, viewport: Vec2, centre: Vec2) -> f32 {
+    let near = tiles::unproject(inv, viewport, centre, 1.0);
+    let far = tiles::unproject(inv, viewport, centre, 0.5);
+    let dir = far - near;
+    let hit = near + dir * (-near.y / dir.y);
+    let clip = view_proj * hit.extend(1.0);
+    clip.z / clip.w
+}
+
+/// Rows of the 3x5 digits the heat-map legend draws, top first.
+const FONT: [[&str; 5]; 10] = [
+    ["###", "#.#", "#.#", "#.#", "###"],
+    [".#.", "##.", ".#.", ".#.", "###"],
+    ["###", "..#", "###", "#..", "###"],
+    ["###", "..#", "###", "..#", "###"],
+    ["#.#", "#.#", "###", "..#", "..#"],
+    ["###", "#..", "###", "..#", "###"],
+    ["###", "#..", "###", "#.#", "###"],
+    ["###", "..#", "..#", "..#", "..#"],
+    ["###", "#.#", "###", "#.#", "###"],
+    ["###", "#.#", "###", "..#", "###"],
+];
+
+#[test]
+fn the_heat_map_counts_known_lights_per_tile_and_draws_its_legend() {
+    let (w, h) = (320u32, 180u32);
+    let dir = scratch("heatmap");
+    let path = known_scene(&dir);
+    let scene = weft_scene::load_scene(&path).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let gpu = Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("a Vulkan 1.3 device with the validation layer (run tools/setup)");
+    let log = gpu.validation();
+    let settings = RenderSettings {
+        graph: graph("tiled.ron"),
+        extent: Extent {
+            width: w,
+            height: h,
+        },
+        features: vec!["light_heatmap".into(), "!bloom".into()],
+        extra_readback: vec!["light_counts".into()],
+        ..RenderSettings::default()
+    };
+    let rendered = render(&gpu, &scene, &settings).unwrap();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+    let counts = &rendered.report.readbacks[0];
+    assert_eq!(counts.0, "light_counts");
+    let count_at = |x: u32, y: u32| {
+        let [r, g, b, _] = counts.1.rgba8_at(x, y);
+        u32::from(r) + 256 * u32::from(g) + 65536 * u32::from(b)
+    };
+
+    // The CPU mirror of the culling test, with the floor's depth at the tile's
+    // corner pixel centres as its bounds (depth on a plane is affine on screen).
+    let camera = &scene.cameras[0];
+    let view_proj = camera::view_projection(camera, 0.0, w as f32 / h as f32);
+    let inv = view_proj.inverse();
+    let eye = camera::camera_position(camera, 0.0);
+    let viewport = Vec2::new(w as f32, h as f32);
+    let (tiles_x, tiles_y) = tiles::tile_grid(w, h);
+    let (mut ambiguous, mut most, mut zero) = (0, 0, 0);
+    for ty in 0..tiles_y {
+        for tx in 0..tiles_x {
+            let (x0, y0) = (tx * 16, ty * 16);
+            let (x1, y1) = ((x0 + 15).min(w - 1), (y0 + 15).min(h - 1));
+            let depths = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| {
+                floor_depth(
+                    view_proj,
+                    inv,
+                    viewport,
+                    Vec2::new(x as f32 + 0.5, y as f32 + 0.5),
+                )
+            });
+            let nearest = depths.iter().copied().fold(f32::MIN, f32::max);
+            let farthest = depths.iter().copied().fold(f32::MAX, f32::min);
+            let slab = tiles::TileSlab::new(inv, eye, viewport, (tx, ty), nearest, farthest);
+            let margins: Vec<f32> = KNOWN_LIGHTS
+                .iter()
+                .map(|(p, r)| slab.margin(Vec3::from(*p), *r))
+                .collect();
+            let sure = margins.iter().filter(|m| **m < -1e-3).count() as u32;
+            let maybe = margins.iter().filter(|m| **m <= 1e-3).count() as u32;
+            ambiguous += u32::from(sure != maybe);
+            // Every pixel of the tile holds the tile's count.
+            let gpu_count = count_at(x0, y0);
+            assert_eq!(count_at(x1, y1), gpu_count, "tile ({tx}, {ty})");
+            assert!(
+                (sure..=maybe).contains(&gpu_count),
+                "tile ({tx}, {ty}): GPU {gpu_count}, CPU {sure}..={maybe} (margins {margins:?})"
+            );
+            most = most.max(gpu_count);
+            zero += u32::from(gpu_count == 0);
+        }
+    }
+    eprintln!("{ambiguous} ambiguous tiles, most lights {most}, {zero} empty tiles");
+    assert!(
+        ambiguous * 50 <= tiles_x * tiles_y,
+        "{ambiguous} ambiguous tiles"
+    );
+    assert!(
+        most >= 3,
+        "overlapping lights give tiles with several lights"
+    );
+    assert!(zero > 0, "tiles far from every light list none");
+
+    // The legend, bottom-left: a black box, the colour bar, labels 0, 32, 64.
+    let image = rendered.report.output.expect("readback");
+    let at = |x: i32, y: i32| image.rgba8_at(x as u32, h - 1 - y as u32);
+    let bar = 80; // clamp(width / 4, 64, 256)
+    assert_eq!(at(12, 44), [0, 0, 0, 255], "legend box");
+    // heat(0) = (0, 0, 0.5) and heat(1) = (1, 0, 0), linear, stored as sRGB.
+    let start = at(16, 34);
+    assert!(
+        start[0] == 0 && start[1] == 0 && start[2].abs_diff(188) <= 1,
+        "{start:?}"
+    );
+    assert_eq!(at(16 + bar - 1, 34), [255, 0, 0, 255], "bar end");
+    for (i, label) in [0u32, 32, 64].into_iter().enumerate() {
+        let text = label.to_string();
+        let width = text.len() as i32 * 8 - 2;
+        let centre = 16 + (bar - 1) * i as i32 / 2;
+        let left = (centre - width / 2).clamp(10, 22 + bar - width);
+        for (k, digit) in text.bytes().enumerate() {
+            let glyph = FONT[usize::from(digit - b'0')];
+            for row in 0..10 {
+                for col in 0..8 {
+                    let lit =
+                        col < 6 && glyph[row as usize / 2].as_bytes()[col as usize / 2] == b'#';
+                    let pixel = at(left + k as i32 * 8 + col, 24 - row);
+                    let expected = if lit {
+                        [255, 255, 255, 255]
+                    } else {
+                        [0, 0, 0, 255]
+                    };
+                    assert_eq!(
+                        pixel, expected,
+                        "label {label} digit {k} row {row} col {col}"
+                    );
+                }
+            }
+        }
     }
 }
