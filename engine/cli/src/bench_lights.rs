@@ -40,6 +40,10 @@ pub struct LightsArgs {
     /// Where the CSV and the plot go (`lights_bench.csv`, `lights_bench.png`).
     #[arg(long, default_value = "docs")]
     out_dir: PathBuf,
+    /// Keep the generated scenes (`floor.obj`, `lights_<N>.scene`) in this folder
+    /// instead of a temporary one that is removed afterwards.
+    #[arg(long)]
+    scenes: Option<PathBuf>,
     /// Use the first device whose name contains this.
     #[arg(long)]
     device: Option<String>,
@@ -195,7 +199,9 @@ pub fn run(args: LightsArgs) -> Result<ExitCode> {
         args.frames,
         args.features.join(",")
     );
-    let scenes = std::env::temp_dir().join(format!("weft-bench-lights-{}", std::process::id()));
+    let scenes = args.scenes.clone().unwrap_or_else(|| {
+        std::env::temp_dir().join(format!("weft-bench-lights-{}", std::process::id()))
+    });
     let names: Vec<String> = args.graphs.iter().map(|g| graph_name(g)).collect();
     let mut samples = Vec::new();
     for &n in &args.counts {
@@ -236,7 +242,9 @@ pub fn run(args: LightsArgs) -> Result<ExitCode> {
             println!("{name:>10} {n:>6} lights: {frame_ms:.1} ms");
         }
     }
-    let _ = std::fs::remove_dir_all(&scenes);
+    if args.scenes.is_none() {
+        let _ = std::fs::remove_dir_all(&scenes);
+    }
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("creating {}", args.out_dir.display()))?;
     let csv_path = args.out_dir.join("lights_bench.csv");

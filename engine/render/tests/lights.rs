@@ -42,7 +42,7 @@ fn a_thousand_lights_agree_across_forward_deferred_and_tiled() {
     }
     assert_eq!(
         tiled.passes,
-        ["gbuffer", "shadow_sun", "cull_lights", "shade", "tonemap"]
+        ["shadow_sun", "gbuffer", "cull_lights", "shade", "tonemap"]
     );
     let fd = agreement(&forward.image, &deferred.image);
     let td = agreement(&tiled.image, &deferred.image);
