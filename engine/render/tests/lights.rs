@@ -1,5 +1,5 @@
-//! Many lights: a generated 1,000-light scene (`weft_render::light_scene`, seed
-//! 1) rendered at 320x180 through forward, deferred (light volumes) and tiled
+//! Many lights: a generated 1,000-light scene (`weft_render::light_scene`,
+//! seed 1) rendered at 320x180 through forward, deferred (light volumes) and tiled
 //! shading under validation and synchronization validation (zero messages).
 //! RGB channel differences in 8-bit units: forward vs deferred and tiled vs
 //! deferred each within mean <= 0.25 and 99th percentile <= 1; tiled also
