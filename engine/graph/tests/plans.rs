@@ -90,7 +90,7 @@ fn plans_match_snapshots_and_pass_the_checker() {
             }
         }
     }
-    assert_eq!(compared, 6);
+    assert_eq!(compared, 9);
     assert!(
         mismatches.is_empty(),
         "plans differ from snapshots (review, then WEFT_BLESS=1 to accept):\n{}",
