@@ -8,7 +8,7 @@ layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
 layout(set = 0, binding = 3) uniform sampler2D depth;
 #ifdef HAS_SHADOW_MAP
-layout(set = 0, binding = 4) uniform sampler2D shadow_map;
+layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
 #endif
 layout(std430, set = 0, binding = 5) readonly buffer TileLights { uint words[]; } tile_lights;
 layout(push_constant) uniform Push { uint max_per_tile; } pc;

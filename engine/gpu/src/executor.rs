@@ -497,6 +497,7 @@ impl<'g> Renderer<'g> {
                             resources,
                             sampler: self.samplers.linear,
                             nearest_sampler: self.samplers.nearest,
+                            compare_sampler: self.samplers.compare,
                         },
                         p,
                     ),
