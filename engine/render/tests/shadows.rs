@@ -77,6 +77,10 @@ fn graph_with(dir: &Path, graph: &str, shadow_params: &str) -> PathBuf {
             &format!("(file: \"{}\"", root.join("bloom.ron").display()),
         )
         .replace(
+            "(file: \"gbuffer.ron\"",
+            &format!("(file: \"{}\"", root.join("gbuffer.ron").display()),
+        )
+        .replace(
             "\"../shaders/",
             &format!("\"{}/", common::root().join("shaders").display()),
         );
