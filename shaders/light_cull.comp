@@ -85,7 +85,10 @@ void main() {
     uint tile = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
     uint record = tile_record(tile, pc.max_per_tile);
     if (!empty) {
-        for (uint i = frame.counts.x + local; i < frame.counts.w; i += 256u) {
+        // Point and spot records follow the suns; area lights (the last records)
+        // are shaded by their own pass.
+        uint end = frame.counts.x + frame.counts.y + frame.counts.z;
+        for (uint i = frame.counts.x + local; i < end; i += 256u) {
             vec4 sphere = lights[i].position_range;
             bool touches = true;
             for (int k = 0; k < 6; ++k) {
