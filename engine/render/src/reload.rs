@@ -1,11 +1,17 @@
 //! Hot reload: a render that stays alive across edits. [`LiveRender`] keeps the
 //! GPU context, the renderer's caches, the uploaded scene and the plan's images,
-//! and applies changed files all-or-nothing: the new scene, plan and shaders are
-//! loaded and checked before anything live is touched, and only then swapped in.
-//! A failure leaves the last good version rendering and is reported at file:line.
+//! and applies changed files all-or-nothing in two steps: a [`ReloadJob`] is
+//! prepared (loaded and checked, on any thread; see [`crate::prepare`]) without
+//! touching anything live, and [`LiveRender::commit`] swaps it in at a frame
+//! boundary with only the device work left. A failure leaves the last good
+//! version rendering and is reported at file:line.
 
 use crate::error::RenderError;
 use crate::frame::{compile_for_scene, RenderSettings};
+use crate::prepare::{
+    check_shaders, graph_files, pick_camera, PreparedReload, ReloadBase, ReloadChange, ReloadJob,
+    ShaderChecker,
+};
 use crate::recorder::SceneRecorder;
 use crate::scene_gpu::GpuScene;
 use crate::sources::{
@@ -14,6 +20,7 @@ use crate::sources::{
 use std::collections::BTreeSet;
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use weft_gpu::pipeline::PipelineCache;
 use weft_gpu::resources::GpuImage;
 use weft_gpu::{FrameOptions, FrameReport, FrameResources, Gpu, GpuError, Renderer, ShaderError};
@@ -41,7 +48,7 @@ impl fmt::Display for ReloadError {
 }
 
 impl ReloadError {
-    fn new(file: &Path, line: Option<u32>, message: &str) -> Self {
+    pub(crate) fn new(file: &Path, line: Option<u32>, message: &str) -> Self {
         Self {
             file: file.to_path_buf(),
             line,
@@ -54,14 +61,14 @@ impl ReloadError {
         }
     }
 
-    fn scene(err: &SceneError) -> Self {
+    pub(crate) fn scene(err: &SceneError) -> Self {
         let at = err.location();
         let line = at.line.and_then(|l| u32::try_from(l).ok());
         Self::new(&at.file, line, &err.message())
     }
 
     /// Locates a render error; errors that name no file are put on `fallback`.
-    fn render(err: RenderError, fallback: &Path) -> Self {
+    pub(crate) fn render(err: RenderError, fallback: &Path) -> Self {
         match err {
             RenderError::Graph(diagnostics) => diagnostics
                 .iter()
@@ -74,7 +81,7 @@ impl ReloadError {
         }
     }
 
-    fn gpu(err: GpuError, fallback: &Path) -> Self {
+    pub(crate) fn gpu(err: GpuError, fallback: &Path) -> Self {
         match err {
             GpuError::Shader(ShaderError::Compile(diagnostics)) => diagnostics
                 .iter()
@@ -92,69 +99,29 @@ pub struct LiveRender<'g> {
     resources: FrameResources<'g>,
     recorder: SceneRecorder<'g>,
     renderer: Renderer<'g>,
-    /// Shaders compiled from disk to check a candidate before it goes live; it
-    /// builds no pipelines, so invalidating it never touches the device.
-    checker: PipelineCache,
+    /// Checks reloads prepared on this thread ([`LiveRender::apply`]).
+    checker: ShaderChecker,
     gpu: &'g Gpu,
     settings: RenderSettings,
     scene_path: PathBuf,
-    scene: Scene,
-    plan: Plan,
+    scene: Arc<Scene>,
+    plan: Arc<Plan>,
     sources: Sources,
     /// Files changed since the last successful reload; a refused reload keeps
     /// them, so the next attempt still reloads everything that changed.
     pending: BTreeSet<PathBuf>,
+    /// Counts commits, so a reload prepared from an older version is refused.
+    version: u64,
 }
 
-/// The camera the settings name, or the scene's first.
-fn pick_camera<'s>(scene: &'s Scene, settings: &RenderSettings) -> Result<&'s Camera, RenderError> {
-    match &settings.camera {
-        Some(name) => scene.camera(name).ok_or_else(|| RenderError::Camera {
-            name: name.clone(),
-            available: scene
-                .cameras
-                .iter()
-                .map(|c| c.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", "),
-        }),
-        None => scene.cameras.first().ok_or_else(|| RenderError::Camera {
-            name: "(first)".into(),
-            available: "none".into(),
-        }),
-    }
-}
-
-/// Compiles and checks every shader the plan runs (and its agreement with the
-/// graph) through `checker`, without building pipelines.
-fn check_shaders(
-    checker: &mut PipelineCache,
-    plan: &Plan,
-    graph: &Path,
-) -> Result<(), ReloadError> {
-    let keys = plan_shader_keys(plan).map_err(|e| ReloadError::gpu(e, graph))?;
-    for key in &keys {
-        checker
-            .shader(key)
-            .map_err(|e| ReloadError::gpu(e, &key.path))?;
-    }
-    let problems = weft_gpu::check::check_with(checker, plan);
-    match problems.first() {
-        None => Ok(()),
-        Some(problem) => {
-            let at = plan
-                .passes
-                .iter()
-                .find(|p| p.name == problem.pass)
-                .map(|p| (p.declared_at.file.clone(), Some(p.declared_at.pos.line)))
-                .unwrap_or_else(|| (graph.to_path_buf(), None));
-            Err(ReloadError::new(
-                &at.0,
-                at.1,
-                &format!("pass `{}`: {}", problem.pass, problem.message),
-            ))
-        }
-    }
+/// What [`LiveRender::commit`] did.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Committed {
+    /// The new version is live; these edited files were applied.
+    Applied(Vec<PathBuf>),
+    /// Nothing: the reload was prepared from a version that is no longer live
+    /// (another reload committed meanwhile); prepare it again.
+    Stale,
 }
 
 impl<'g> LiveRender<'g> {
@@ -169,9 +136,9 @@ impl<'g> LiveRender<'g> {
         pick_camera(&scene, &settings).map_err(|e| ReloadError::render(e, scene_path))?;
         let plan = compile_for_scene(gpu, &scene, &settings)
             .map_err(|e| ReloadError::render(e, &settings.graph))?;
-        let mut checker = PipelineCache::new().map_err(|e| ReloadError::gpu(e, &settings.graph))?;
-        check_shaders(&mut checker, &plan, &settings.graph)?;
         let fail = |e: GpuError| ReloadError::gpu(e, &settings.graph);
+        let mut cache = PipelineCache::new().map_err(fail)?;
+        check_shaders(&mut cache, &plan, &settings.graph)?;
         let renderer = Renderer::new(gpu).map_err(fail)?;
         let uploaded =
             GpuScene::new(gpu, &scene).map_err(|e| ReloadError::render(e, scene_path))?;
@@ -179,21 +146,22 @@ impl<'g> LiveRender<'g> {
         let resources = renderer.create_resources(&plan).map_err(fail)?;
         let sources = Sources {
             graph: graph_files(&settings.graph),
-            shaders: shader_files(&mut checker, &plan).map_err(fail)?,
+            shaders: shader_files(&mut cache, &plan).map_err(fail)?,
             scene: scene_files(&scene),
         };
         Ok(Self {
             resources,
             recorder,
             renderer,
-            checker,
+            checker: ShaderChecker::new().map_err(fail)?,
             gpu,
             settings,
             scene_path: scene_path.to_path_buf(),
-            scene,
-            plan,
+            scene: Arc::new(scene),
+            plan: Arc::new(plan),
             sources,
             pending: BTreeSet::new(),
+            version: 0,
         })
     }
 
@@ -262,95 +230,50 @@ impl<'g> LiveRender<'g> {
         )?)
     }
 
-    /// Switches to other settings (another graph, feature set or size) all-or-nothing:
-    /// the new plan and its shaders are built and checked first, and on failure the
-    /// live version keeps rendering unchanged. Shader files the live version did not
-    /// use are compiled afresh from disk, since no watcher saw their edits.
-    pub fn reconfigure(&mut self, settings: RenderSettings) -> Result<(), ReloadError> {
-        let graph = settings.graph.clone();
-        pick_camera(&self.scene, &settings)
-            .map_err(|e| ReloadError::render(e, &self.scene_path))?;
-        let plan = compile_for_scene(self.gpu, &self.scene, &settings)
-            .map_err(|e| ReloadError::render(e, &graph))?;
-        let fail = |e: GpuError| ReloadError::gpu(e, &graph);
-        let mut checker = PipelineCache::new().map_err(fail)?;
-        check_shaders(&mut checker, &plan, &graph)?;
-        let shaders = shader_files(&mut checker, &plan).map_err(fail)?;
-        let resources = self.renderer.create_resources(&plan).map_err(fail)?;
-        let unwatched: Vec<&PathBuf> = shaders
-            .iter()
-            .filter(|(file, _)| !self.sources.shaders.contains_key(*file))
-            .flat_map(|(_, raw)| raw)
-            .collect();
-        for raw in unwatched {
-            self.renderer.reload(raw).map_err(fail)?;
-            self.recorder.reload(raw).map_err(fail)?;
+    fn base(&self) -> ReloadBase {
+        ReloadBase {
+            version: self.version,
+            scene_path: self.scene_path.clone(),
+            settings: self.settings.clone(),
+            scene: Arc::clone(&self.scene),
+            plan: Arc::clone(&self.plan),
+            sources: self.sources.clone(),
         }
-        self.sources = Sources {
-            graph: graph_files(&graph),
-            shaders,
-            scene: self.sources.scene.clone(),
-        };
-        self.checker = checker;
-        self.resources = resources;
-        self.plan = plan;
-        self.settings = settings;
-        Ok(())
     }
 
-    /// Applies edits to `changed` files (normalized paths; files this render does not
-    /// use are ignored). Everything that changed since the last good version is
-    /// reloaded and checked first; only if all of it succeeds is it swapped in.
-    /// Returns the files reloaded, or why the last good version was kept.
-    pub fn apply(&mut self, changed: &BTreeSet<PathBuf>) -> Result<Vec<PathBuf>, ReloadError> {
+    /// Records edits to `changed` files (normalized paths; files this render does
+    /// not use are ignored) and returns the reload of everything changed since
+    /// the last good version, to prepare on any thread and [`commit`](Self::commit).
+    pub fn files_job(&mut self, changed: &BTreeSet<PathBuf>) -> ReloadJob {
         let all = self.sources.all();
         self.pending
             .extend(changed.iter().filter(|p| all.contains(*p)).cloned());
-        let pending = self.pending.clone();
-        let scene_changed = pending.iter().any(|p| self.sources.scene.contains(p));
-        let graph_changed = pending.iter().any(|p| self.sources.graph.contains(p));
-        let shaders: BTreeSet<PathBuf> = pending
-            .iter()
-            .filter_map(|p| self.sources.shaders.get(p))
-            .flatten()
-            .cloned()
-            .collect();
-        let graph = self.settings.graph.clone();
-        let device = self.gpu.device();
-        for raw in &shaders {
-            self.checker.invalidate(device, raw);
+        ReloadJob {
+            base: self.base(),
+            change: ReloadChange::Files(self.pending.clone()),
         }
-        let new_scene = if scene_changed {
-            Some(weft_scene::load_scene(&self.scene_path).map_err(|e| ReloadError::scene(&e))?)
-        } else {
-            None
-        };
-        let scene = new_scene.as_ref().unwrap_or(&self.scene);
-        pick_camera(scene, &self.settings).map_err(|e| ReloadError::render(e, &self.scene_path))?;
-        let new_plan = if scene_changed || graph_changed {
-            Some(
-                compile_for_scene(self.gpu, scene, &self.settings)
-                    .map_err(|e| ReloadError::render(e, &graph))?,
-            )
-        } else {
-            None
-        };
-        let plan = new_plan.as_ref().unwrap_or(&self.plan);
-        check_shaders(&mut self.checker, plan, &graph)?;
+    }
+
+    /// The reload that switches to other settings (another graph, feature set or size).
+    pub fn settings_job(&self, settings: RenderSettings) -> ReloadJob {
+        ReloadJob {
+            base: self.base(),
+            change: ReloadChange::Settings(settings),
+        }
+    }
+
+    /// Swaps a prepared reload in at a frame boundary: uploads a changed scene,
+    /// creates a changed plan's images and drops the pipelines of changed shaders
+    /// (rebuilt by the next frame). Everything that can be wrong with the edited
+    /// files was refused by the prepare step; this fails only on device errors,
+    /// and then leaves the live version as it was.
+    pub fn commit(&mut self, prepared: PreparedReload) -> Result<Committed, ReloadError> {
+        if prepared.version != self.version {
+            return Ok(Committed::Stale);
+        }
+        let graph = prepared.settings.graph.clone();
         let fail = |e: GpuError| ReloadError::gpu(e, &graph);
-        let sources = Sources {
-            graph: if graph_changed {
-                graph_files(&graph)
-            } else {
-                self.sources.graph.clone()
-            },
-            shaders: shader_files(&mut self.checker, plan).map_err(fail)?,
-            scene: match &new_scene {
-                Some(s) => scene_files(s),
-                None => self.sources.scene.clone(),
-            },
-        };
-        let new_recorder = match &new_scene {
+        let new_recorder = match &prepared.scene {
             Some(s) => {
                 let uploaded = GpuScene::new(self.gpu, s)
                     .map_err(|e| ReloadError::render(e, &self.scene_path))?;
@@ -358,27 +281,70 @@ impl<'g> LiveRender<'g> {
             }
             None => None,
         };
-        let new_resources = match &new_plan {
+        let new_resources = match &prepared.plan {
             Some(p) => Some(self.renderer.create_resources(p).map_err(fail)?),
             None => None,
         };
-        for raw in &shaders {
-            self.renderer.reload(raw).map_err(fail)?;
-            self.recorder.reload(raw).map_err(fail)?;
-        }
+        let unwatched = prepared
+            .sources
+            .shaders
+            .iter()
+            .filter(|(file, _)| !self.sources.shaders.contains_key(*file))
+            .flat_map(|(_, raw)| raw);
+        let rebuild: BTreeSet<PathBuf> =
+            prepared.shaders.iter().chain(unwatched).cloned().collect();
         if let Some(recorder) = new_recorder {
             self.recorder = recorder;
         }
-        if let (Some(plan), Some(resources)) = (new_plan, new_resources) {
+        for raw in &rebuild {
+            self.renderer.reload(raw).map_err(fail)?;
+            self.recorder.reload(raw).map_err(fail)?;
+        }
+        if let (Some(plan), Some(resources)) = (prepared.plan, new_resources) {
             self.resources = resources;
             self.plan = plan;
         }
-        if let Some(scene) = new_scene {
+        if let Some(scene) = prepared.scene {
             self.scene = scene;
         }
-        self.sources = sources;
-        self.pending.clear();
-        Ok(pending.into_iter().collect())
+        self.sources = prepared.sources;
+        self.settings = prepared.settings;
+        for file in &prepared.files {
+            self.pending.remove(file);
+        }
+        self.version += 1;
+        Ok(Committed::Applied(prepared.files))
+    }
+
+    /// Prepares and commits a job on this thread.
+    fn prepare_and_commit(&mut self, job: &ReloadJob) -> Result<Vec<PathBuf>, ReloadError> {
+        let prepared = job.prepare(self.gpu, &mut self.checker)?;
+        match self.commit(prepared)? {
+            Committed::Applied(files) => Ok(files),
+            Committed::Stale => Err(ReloadError::new(
+                &self.scene_path,
+                None,
+                "the live version changed while the reload was prepared",
+            )),
+        }
+    }
+
+    /// Switches to other settings (another graph, feature set or size) all-or-nothing:
+    /// the new plan and its shaders are built and checked first, and on failure the
+    /// live version keeps rendering unchanged. Shader files the live version did not
+    /// use are compiled afresh from disk, since no watcher saw their edits.
+    pub fn reconfigure(&mut self, settings: RenderSettings) -> Result<(), ReloadError> {
+        let job = self.settings_job(settings);
+        self.prepare_and_commit(&job).map(|_| ())
+    }
+
+    /// Applies edits to `changed` files (normalized paths; files this render does not
+    /// use are ignored) on this thread: everything that changed since the last good
+    /// version is prepared and checked first; only if all of it succeeds is it
+    /// committed. Returns the files reloaded, or why the last good version was kept.
+    pub fn apply(&mut self, changed: &BTreeSet<PathBuf>) -> Result<Vec<PathBuf>, ReloadError> {
+        let job = self.files_job(changed);
+        self.prepare_and_commit(&job)
     }
 }
 
@@ -409,16 +375,5 @@ pub fn startup_files(
                 .map(|k| normalize(&k.path)),
         );
     }
-    files
-}
-
-/// The graph file and its includes, normalized.
-fn graph_files(graph: &Path) -> BTreeSet<PathBuf> {
-    let mut files: BTreeSet<PathBuf> = weft_graph::load(graph)
-        .files()
-        .iter()
-        .map(|p| normalize(p))
-        .collect();
-    files.insert(normalize(graph));
     files
 }

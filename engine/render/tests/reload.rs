@@ -1,16 +1,20 @@
 //! `LiveRender` hot reload on a private copy of the forward graph, the shaders and
 //! a tiny scene: a refused reload changes nothing that renders, files changed
 //! meanwhile are reloaded with the next good version, and the watched sources
-//! cover graph includes, shader includes and the scene's model.
+//! cover graph includes, shader includes and the scene's model. Reloads prepared on
+//! a `ReloadWorker` thread leave frames coming and the live version untouched
+//! until committed; a newer request supersedes an older one.
 
 mod common;
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 use weft_gpu::{Gpu, GpuOptions};
 use weft_graph::plan::Extent;
+use weft_render::reload_worker::Prepared;
 use weft_render::sources::normalize;
-use weft_render::{LiveRender, RenderSettings};
+use weft_render::{Committed, LiveRender, ReloadWorker, RenderSettings};
 
 const QUAD_OBJ: &str =
     "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nvn 0 1 0\nf 1//1 3//1 2//1\nf 1//1 4//1 3//1\n";
@@ -202,6 +206,153 @@ fn reconfigure_switches_graph_features_and_size_all_or_nothing() {
         first,
         "the forward version still renders"
     );
+    drop(live);
+    assert!(gpu.validation().messages().is_empty());
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
+const RED: &str = "color = vec4(1.0, 0.0, 0.0, 1.0);";
+
+fn gpu() -> Gpu {
+    Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("gpu")
+}
+
+/// Renders frames of the live version until the worker answers; returns the
+/// answer and how many frames were rendered meanwhile, each checked to be `shown`.
+fn frames_until_prepared(
+    worker: &mut ReloadWorker,
+    live: &mut LiveRender<'_>,
+    shown: &[u8],
+) -> (Prepared, u32) {
+    let started = Instant::now();
+    let mut frames = 0;
+    loop {
+        if let Some(prepared) = worker.poll() {
+            return (prepared, frames);
+        }
+        assert!(started.elapsed() < Duration::from_secs(120), "no answer");
+        assert_eq!(pixels(live), shown, "frame {frames} shows the live version");
+        frames += 1;
+    }
+}
+
+#[test]
+fn a_slow_prepare_runs_on_the_worker_while_frames_keep_coming() {
+    let dir = fixture("worker");
+    let gpu = gpu();
+    let mut live =
+        LiveRender::new(&gpu, &dir.join("scenes/tiny.scene"), settings(&dir)).expect("live");
+    let first = pixels(&mut live);
+    let tonemap = dir.join("shaders/tonemap.frag");
+    edit(&tonemap, TONEMAP_OUT, RED);
+    let delay = Duration::from_millis(500);
+    std::thread::scope(|scope| {
+        let mut worker = ReloadWorker::spawn(scope, &gpu, delay);
+        worker.submit(live.files_job(&BTreeSet::from([normalize(&tonemap)])));
+        assert!(worker.waiting());
+        let (prepared, frames) = frames_until_prepared(&mut worker, &mut live, &first);
+        assert!(frames > 0, "no frame was rendered during the prepare");
+        assert_ne!(prepared.thread, std::thread::current().id());
+        assert!(prepared.elapsed >= delay, "{:?}", prepared.elapsed);
+        assert!(!worker.waiting());
+        let reload = prepared.result.expect("prepared");
+        assert_eq!(reload.files(), [normalize(&tonemap)]);
+        assert_eq!(
+            live.commit(reload).expect("committed"),
+            Committed::Applied(vec![normalize(&tonemap)])
+        );
+    });
+    assert!(
+        pixels(&mut live)
+            .chunks_exact(4)
+            .all(|p| p == [255, 0, 0, 255]),
+        "the committed shader edit is live"
+    );
+    drop(live);
+    assert!(gpu.validation().messages().is_empty());
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
+#[test]
+fn a_refused_prepare_never_touches_the_live_version_and_a_newer_edit_supersedes_it() {
+    let dir = fixture("superseded");
+    let gpu = gpu();
+    let mut live =
+        LiveRender::new(&gpu, &dir.join("scenes/tiny.scene"), settings(&dir)).expect("live");
+    let first = pixels(&mut live);
+    let plan = live.plan() as *const _;
+    let sources = live.sources().clone();
+    let tonemap = dir.join("shaders/tonemap.frag");
+    let changed = BTreeSet::from([normalize(&tonemap)]);
+    std::thread::scope(|scope| {
+        let mut worker = ReloadWorker::spawn(scope, &gpu, Duration::from_millis(200));
+        edit(&tonemap, TONEMAP_OUT, "color = vec4(c / (1.0 + c), 1.0) +;");
+        worker.submit(live.files_job(&changed));
+        let (prepared, frames) = frames_until_prepared(&mut worker, &mut live, &first);
+        assert!(frames > 0);
+        let err = prepared.result.expect_err("syntax error");
+        assert_eq!(normalize(&err.file), normalize(&tonemap));
+        assert!(err.line.is_some(), "{err}");
+        assert!(std::ptr::eq(live.plan(), plan), "the live plan was kept");
+        assert_eq!(live.sources(), &sources);
+        assert_eq!(pixels(&mut live), first, "the broken shader is not live");
+
+        // A broken edit and, before it is answered, its fix: only the fix counts.
+        let broken = worker.submit(live.files_job(&changed));
+        edit(&tonemap, "color = vec4(c / (1.0 + c), 1.0) +;", RED);
+        let fixed = worker.submit(live.files_job(&changed));
+        assert_eq!(fixed, broken + 1);
+        let (prepared, _) = frames_until_prepared(&mut worker, &mut live, &first);
+        assert_eq!(prepared.generation, fixed);
+        let reload = prepared.result.expect("the fix prepares");
+        assert_eq!(
+            live.commit(reload).expect("committed"),
+            Committed::Applied(vec![normalize(&tonemap)])
+        );
+        drop(worker);
+    });
+    assert!(pixels(&mut live)
+        .chunks_exact(4)
+        .all(|p| p == [255, 0, 0, 255]));
+    drop(live);
+    assert!(gpu.validation().messages().is_empty());
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
+#[test]
+fn a_reload_prepared_from_an_older_version_is_not_committed() {
+    let dir = fixture("stale");
+    let gpu = gpu();
+    let mut live =
+        LiveRender::new(&gpu, &dir.join("scenes/tiny.scene"), settings(&dir)).expect("live");
+    let tonemap = dir.join("shaders/tonemap.frag");
+    edit(&tonemap, TONEMAP_OUT, RED);
+    let job = live.files_job(&BTreeSet::from([normalize(&tonemap)]));
+    let mut small = live.settings().clone();
+    small.extent = Extent {
+        width: 32,
+        height: 18,
+    };
+    live.reconfigure(small).expect("reconfigured");
+    let plan = live.plan() as *const _;
+    let mut checker = weft_render::prepare::ShaderChecker::new().expect("checker");
+    let prepared = job.prepare(&gpu, &mut checker).expect("prepared");
+    assert_eq!(live.commit(prepared).expect("commit"), Committed::Stale);
+    assert!(std::ptr::eq(live.plan(), plan));
+    assert_eq!(pixels(&mut live).len(), 32 * 18 * 4, "the new size is live");
+    assert!(
+        live.sources().shaders.contains_key(&normalize(&tonemap)),
+        "still watched"
+    );
+    let reloaded = live.apply(&BTreeSet::new()).expect("pending edit applies");
+    assert_eq!(reloaded, vec![normalize(&tonemap)]);
+    assert!(pixels(&mut live)
+        .chunks_exact(4)
+        .all(|p| p == [255, 0, 0, 255]));
     drop(live);
     assert!(gpu.validation().messages().is_empty());
     std::fs::remove_dir_all(&dir).expect("clean up");

@@ -1,5 +1,6 @@
 //! The viewer's event loop: winit events drive the fly camera, graph and
-//! feature switches and screenshots; each redraw applies pending file edits
+//! feature switches and screenshots; file edits are prepared on a worker thread
+//! while frames keep coming, and each redraw commits a prepared one
 //! (all-or-nothing, at the frame boundary), renders the live graph from the fly
 //! camera and presents it.
 
@@ -17,7 +18,7 @@ use std::time::{Duration, Instant};
 use weft_gpu::{Gpu, PresentSource, Presented, Presenter, Readback, Swapchain};
 use weft_graph::plan::Extent;
 use weft_render::watch::{FileWatcher, QUIET};
-use weft_render::{LiveRender, RenderSettings};
+use weft_render::{Committed, LiveRender, ReloadWorker, RenderSettings};
 use weft_scene::Camera;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
@@ -78,8 +79,25 @@ pub struct Viewer<'g> {
     presses: Vec<(u32, Action)>,
     /// Set by SIGINT/SIGTERM (and Esc, closing): the next frame is the last.
     stop: Arc<AtomicBool>,
-    /// A reload applied, with when its batch was taken, until its frame is shown.
-    reloaded: Option<(String, Instant)>,
+    /// Prepares file edits off the frame loop.
+    worker: ReloadWorker,
+    /// The reload in progress, from when its first batch was taken to the frame
+    /// that shows it.
+    reload: Option<ReloadProgress>,
+    /// A reload committed, until its frame is shown.
+    reloaded: Option<(String, ReloadProgress, f64)>,
+}
+
+/// What the frame loop did while a reload was on its way.
+#[derive(Debug, Clone, Copy)]
+struct ReloadProgress {
+    /// When the first edited batch was taken.
+    taken: Instant,
+    /// Frames presented since.
+    frames: u32,
+    /// The longest frame since, from the start of one redraw (committing
+    /// included) to its present, in milliseconds.
+    longest_ms: f64,
 }
 
 impl<'g> Viewer<'g> {
@@ -90,6 +108,7 @@ impl<'g> Viewer<'g> {
         args: &ViewArgs,
         settings: RenderSettings,
         stop: Arc<AtomicBool>,
+        scope: &'g std::thread::Scope<'g, '_>,
     ) -> Result<Self> {
         let live = LiveRender::new(gpu, &args.scene, settings).map_err(|e| anyhow!("{e}"))?;
         let lens = live.camera()?.clone();
@@ -102,7 +121,7 @@ impl<'g> Viewer<'g> {
         let mut watcher = FileWatcher::new(QUIET)?;
         watcher.watch(&live.sources().all())?;
         let graph = live.settings().graph.clone();
-        let viewer = Self {
+        let mut viewer = Self {
             gpu,
             watcher,
             presenter: None,
@@ -133,10 +152,16 @@ impl<'g> Viewer<'g> {
             failure: None,
             stop,
             presses: args.press.clone(),
+            worker: ReloadWorker::spawn(scope, gpu, Duration::from_millis(args.prepare_delay_ms)),
+            reload: None,
             reloaded: None,
             live,
         };
         viewer.print_features();
+        // A first check of the live version compiles every shader on the
+        // worker, so the first edit finds its checker warm.
+        let job = viewer.live.files_job(&Default::default());
+        viewer.worker.submit(job);
         Ok(viewer)
     }
 
@@ -303,24 +328,43 @@ impl<'g> Viewer<'g> {
         }
     }
 
-    /// Applies edited files, if any, all-or-nothing.
+    /// Hands edited files, if any, to the worker (superseding a reload still
+    /// being prepared), and commits the newest prepared reload, if one is ready.
     fn hot_reload(&mut self) -> Result<()> {
         let changed = self.watcher.next_batch(Duration::ZERO)?;
-        if changed.is_empty() {
-            return Ok(());
+        if !changed.is_empty() {
+            self.reload.get_or_insert(ReloadProgress {
+                taken: Instant::now(),
+                frames: 0,
+                longest_ms: 0.0,
+            });
+            let job = self.live.files_job(&changed);
+            self.worker.submit(job);
         }
-        let started = Instant::now();
-        match self.live.apply(&changed) {
-            Ok(paths) => {
+        let Some(prepared) = self.worker.poll() else {
+            return Ok(());
+        };
+        let prepare_ms = prepared.elapsed.as_secs_f64() * 1e3;
+        let committed = prepared.result.and_then(|reload| self.live.commit(reload));
+        match committed {
+            Ok(Committed::Applied(paths)) => {
                 self.watch();
                 self.error = None;
-                if !paths.is_empty() {
+                let progress = self.reload.take();
+                if let (false, Some(progress)) = (paths.is_empty(), progress) {
                     let files: Vec<String> =
                         paths.iter().map(|p| p.display().to_string()).collect();
-                    self.reloaded = Some((files.join(", "), started));
+                    self.reloaded = Some((files.join(", "), progress, prepare_ms));
                 }
             }
-            Err(err) => self.report_error(err.to_string()),
+            Ok(Committed::Stale) => {
+                let job = self.live.files_job(&Default::default());
+                self.worker.submit(job);
+            }
+            Err(err) => {
+                self.reload = None;
+                self.report_error(err.to_string());
+            }
         }
         Ok(())
     }
@@ -348,6 +392,7 @@ impl<'g> Viewer<'g> {
 
     /// One frame: reload, resize, move, render, present, screenshot.
     fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let began = Instant::now();
         self.hot_reload()?;
         let due: Vec<Action> = self
             .presses
@@ -415,10 +460,19 @@ impl<'g> Viewer<'g> {
         self.stats.total_ms += frame_ms;
         self.stats.all_ms.push(frame_ms);
         self.stats.frames += 1;
-        if let Some((files, started)) = self.reloaded.take() {
+        let loop_ms = began.elapsed().as_secs_f64() * 1e3;
+        if let Some(progress) = self.reload.as_mut() {
+            progress.frames += 1;
+            progress.longest_ms = progress.longest_ms.max(loop_ms);
+        }
+        if let Some((files, progress, prepare_ms)) = self.reloaded.take() {
             println!(
-                "reloaded {files}: shown {:.1} ms after the change was taken",
-                started.elapsed().as_secs_f64() * 1e3
+                "reloaded {files}: shown {:.1} ms after the change was taken \
+                 (prepared off the frame loop in {prepare_ms:.1} ms; {} frames presented \
+                 meanwhile, the longest {:.1} ms; this frame {loop_ms:.1} ms)",
+                progress.taken.elapsed().as_secs_f64() * 1e3,
+                progress.frames,
+                progress.longest_ms,
             );
         }
         if let Some(pixels) = shown {

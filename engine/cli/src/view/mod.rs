@@ -79,6 +79,10 @@ pub struct ViewArgs {
     /// (after --frames, Esc, closing the window, SIGINT or SIGTERM).
     #[arg(long)]
     screenshot_on_exit: Option<PathBuf>,
+    /// Make every reload's preparation (on the worker thread) sleep this long
+    /// first, to see the frame loop keep going during a slow one (tests).
+    #[arg(long, hide = true, default_value_t = 0)]
+    prepare_delay_ms: u64,
 }
 
 /// Runs `weft view`.
@@ -115,9 +119,11 @@ pub fn run(args: ViewArgs) -> Result<ExitCode> {
         readback: false,
         ..RenderSettings::default()
     };
-    let mut app = app::Viewer::new(&gpu, &args, settings, stop)?;
-    event_loop.run_app(&mut app)?;
-    let outcome = app.finish();
+    let outcome = std::thread::scope(|scope| -> Result<Result<()>> {
+        let mut app = app::Viewer::new(&gpu, &args, settings, stop, scope)?;
+        event_loop.run_app(&mut app)?;
+        Ok(app.finish())
+    })?;
     drop(gpu);
     let messages = log.messages();
     for m in &messages {
