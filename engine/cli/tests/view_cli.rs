@@ -382,6 +382,94 @@ fn shader_edits_reload_while_viewing_and_a_broken_one_keeps_the_last_good() {
     );
 }
 
+/// A reload whose preparation takes 1.5 s (the hidden `--prepare-delay-ms`) is
+/// prepared on the worker: frames keep being presented meanwhile, none of them
+/// as long as the delay, and the edit still goes live.
+#[test]
+fn a_slow_reload_is_prepared_while_frames_keep_being_presented() {
+    const TONEMAP: &str = "shaders/tonemap.frag";
+    const OUT: &str = "color = vec4(c / (1.0 + c), 1.0);";
+    const DELAY_MS: f64 = 1500.0;
+    let x = Xvfb::start();
+    let copy = Copy::new("slow");
+    std::fs::create_dir_all(copy.0.join("scenes")).expect("scenes folder");
+    std::fs::write(
+        copy.0.join("scenes/quad.obj"),
+        "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nvn 0 1 0\nf 1//1 3//1 2//1\nf 1//1 4//1 3//1\n",
+    )
+    .expect("write model");
+    std::fs::write(
+        copy.0.join("scenes/tiny.scene"),
+        "model\n{\n\tfile \"quad.obj\"\n}\ncamera\n{\n\tposition 0 3 5\n\ttarget 0 0 0\n}\n\
+         sunlight\n{\n\tdirection -0.3 -1 -0.4\n\tcolor 0.3 0.3 0.3\n}\n",
+    )
+    .expect("write scene");
+    let shot = copy.0.join("last.png");
+    let mut child = x
+        .command(
+            &[
+                "view",
+                "scenes/tiny.scene",
+                "--size",
+                "64x36",
+                "--validate",
+                "--prepare-delay-ms",
+                "1500",
+                "--screenshot-on-exit",
+                shot.to_str().expect("utf-8 path"),
+            ],
+            &copy.0,
+        )
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("weft starts");
+    let stdout = lines(child.stdout.take().expect("stdout"));
+    let stderr = lines(child.stderr.take().expect("stderr"));
+    wait_for(&stdout, |l| l.starts_with("graph "), "features line");
+    let tonemap = copy.0.join(TONEMAP);
+    let original = std::fs::read_to_string(&tonemap).expect("read shader");
+    std::fs::write(
+        &tonemap,
+        original.replace(OUT, "color = vec4(1.0, 0.0, 0.0, 1.0);"),
+    )
+    .expect("edit shader");
+    let line = wait_for(&stdout, |l| l.starts_with("reloaded "), "reload line");
+    let number_before = |marker: &str| -> f64 {
+        let head = &line[..line
+            .find(marker)
+            .unwrap_or_else(|| panic!("{marker}: {line}"))];
+        let word = head.split_whitespace().last().expect("a number");
+        word.parse().unwrap_or_else(|_| panic!("{word}: {line}"))
+    };
+    let prepare_ms = number_before(" ms; ");
+    let frames = number_before(" frames presented");
+    let longest = line
+        .split("the longest ")
+        .nth(1)
+        .and_then(|rest| rest.split(" ms").next())
+        .and_then(|n| n.parse::<f64>().ok())
+        .unwrap_or_else(|| panic!("longest: {line}"));
+    eprintln!("{line}");
+    assert!(prepare_ms >= DELAY_MS, "{line}");
+    assert!(frames > 0.0, "{line}");
+    assert!(longest < DELAY_MS, "{line}");
+
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(killed.success());
+    let status = child.wait().expect("weft exits");
+    let rest: Vec<String> = stderr.try_iter().collect();
+    assert!(status.success(), "{status:?}; stderr: {rest:?}");
+    assert!(rest.iter().all(|l| !l.contains("validation")), "{rest:?}");
+    assert!(
+        load(&shot).pixels().all(|p| p.0 == [255, 0, 0, 255]),
+        "the edit is live"
+    );
+}
+
 /// Keys pressed by script: G switches to the next graph in `graphs/`, 1 flips the
 /// first feature, F12 saves what the window shows; validation stays silent.
 #[test]
