@@ -153,6 +153,13 @@ impl PipelineCache {
         Ok(module)
     }
 
+    /// Takes a shader variant compiled elsewhere (a hot reload's check, on
+    /// another thread) so it is not compiled again here; a variant already
+    /// cached is kept, since pipelines may have been built from it.
+    pub fn adopt(&mut self, key: ShaderKey, module: Arc<ShaderModule>) {
+        self.shaders.entry(key).or_insert(module);
+    }
+
     /// The merged interface of shader stages, compiling and reflecting them
     /// if needed but creating no Vulkan objects.
     pub fn interface(&mut self, keys: &[&ShaderKey]) -> Result<PipelineInterface, GpuError> {

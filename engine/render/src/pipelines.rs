@@ -117,6 +117,11 @@ impl ScenePipelines {
         Ok(pipeline)
     }
 
+    /// Takes a shader variant compiled elsewhere (see `PipelineCache::adopt`).
+    pub fn adopt(&mut self, key: ShaderKey, module: Arc<ShaderModule>) {
+        self.shaders.adopt(key, module);
+    }
+
     /// Forgets every shader and pipeline built from `file` (hot reload) so the next
     /// frame rebuilds them; the caller must make sure the device no longer uses them.
     /// Returns how many pipelines were dropped.

@@ -10,7 +10,7 @@ use crate::sources::{normalize, plan_shader_keys, scene_files, shader_files, Sou
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use weft_gpu::pipeline::PipelineCache;
+use weft_gpu::pipeline::{PipelineCache, ShaderKey, ShaderModule};
 use weft_gpu::{Gpu, GpuError};
 use weft_graph::plan::Plan;
 use weft_scene::{Camera, Scene};
@@ -61,6 +61,9 @@ pub struct PreparedReload {
     pub(crate) shaders: BTreeSet<PathBuf>,
     /// The edited files this reload applies.
     pub(crate) files: Vec<PathBuf>,
+    /// Every shader variant the new version runs, compiled and checked, for
+    /// the live caches to adopt instead of compiling them again.
+    pub(crate) modules: Vec<(ShaderKey, Arc<ShaderModule>)>,
 }
 
 impl PreparedReload {
@@ -156,6 +159,24 @@ pub(crate) fn check_shaders(
     }
 }
 
+/// The checked modules of every shader variant `plan` runs (cached by
+/// `check_shaders`, so nothing is compiled again).
+fn plan_modules(
+    cache: &mut PipelineCache,
+    plan: &Plan,
+    graph: &Path,
+) -> Result<Vec<(ShaderKey, Arc<ShaderModule>)>, ReloadError> {
+    let keys = plan_shader_keys(plan).map_err(|e| ReloadError::gpu(e, graph))?;
+    keys.into_iter()
+        .map(|key| {
+            let module = cache
+                .shader(&key)
+                .map_err(|e| ReloadError::gpu(e, &key.path))?;
+            Ok((key, module))
+        })
+        .collect()
+}
+
 /// The graph file and its includes, normalized.
 pub(crate) fn graph_files(graph: &Path) -> BTreeSet<PathBuf> {
     let mut files: BTreeSet<PathBuf> = weft_graph::load(graph)
@@ -235,6 +256,7 @@ fn prepare_files(
         },
     };
     checker.watched = sources.shaders.clone();
+    let modules = plan_modules(&mut checker.cache, plan, graph)?;
     Ok(PreparedReload {
         version: base.version,
         settings: base.settings.clone(),
@@ -243,6 +265,7 @@ fn prepare_files(
         sources,
         shaders,
         files: changed.iter().cloned().collect(),
+        modules,
     })
 }
 
@@ -265,6 +288,7 @@ fn prepare_settings(
         shaders: shader_files(&mut cache, &plan).map_err(fail)?,
         scene: base.sources.scene.clone(),
     };
+    let modules = plan_modules(&mut cache, &plan, graph)?;
     Ok(PreparedReload {
         version: base.version,
         settings: settings.clone(),
@@ -273,5 +297,6 @@ fn prepare_settings(
         sources,
         shaders: BTreeSet::new(),
         files: Vec::new(),
+        modules,
     })
 }

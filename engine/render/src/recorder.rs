@@ -10,8 +10,9 @@ use crate::shadows::ShadowSettings;
 use crate::state::{pass_state, DepthTest, PassState};
 use ash::vk;
 use glam::Vec3;
+use std::sync::Arc;
 use weft_gpu::bind::{pack_push, resolve_bindings, FrameValues};
-use weft_gpu::pipeline::{BlendCode, Pipeline, ShaderKey};
+use weft_gpu::pipeline::{BlendCode, Pipeline, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, ShaderStage, SCENE_SET};
 use weft_graph::schema::{Draw, LightKind, MaterialFilter, ParamValue};
@@ -118,6 +119,12 @@ impl<'g> SceneRecorder<'g> {
     pub fn reload(&mut self, changed: &std::path::Path) -> Result<usize, GpuError> {
         self.gpu.wait_idle()?;
         Ok(self.pipelines.invalidate(self.gpu.device(), changed))
+    }
+
+    /// Takes a shader variant a hot reload already compiled and checked, so the
+    /// next frame only builds its pipeline.
+    pub fn adopt(&mut self, key: ShaderKey, module: Arc<ShaderModule>) {
+        self.pipelines.adopt(key, module);
     }
 
     /// Passes come in increasing order within a frame, so a pass index not above the

@@ -263,8 +263,9 @@ impl<'g> LiveRender<'g> {
     }
 
     /// Swaps a prepared reload in at a frame boundary: uploads a changed scene,
-    /// creates a changed plan's images and drops the pipelines of changed shaders
-    /// (rebuilt by the next frame). Everything that can be wrong with the edited
+    /// creates a changed plan's images, drops the pipelines of changed shaders and
+    /// hands the caches the shader modules the prepare step compiled, so the next
+    /// frame only builds pipelines. Everything that can be wrong with the edited
     /// files was refused by the prepare step; this fails only on device errors,
     /// and then leaves the live version as it was.
     pub fn commit(&mut self, prepared: PreparedReload) -> Result<Committed, ReloadError> {
@@ -299,6 +300,10 @@ impl<'g> LiveRender<'g> {
         for raw in &rebuild {
             self.renderer.reload(raw).map_err(fail)?;
             self.recorder.reload(raw).map_err(fail)?;
+        }
+        for (key, module) in prepared.modules {
+            self.recorder.adopt(key.clone(), Arc::clone(&module));
+            self.renderer.pipelines().adopt(key, module);
         }
         if let (Some(plan), Some(resources)) = (prepared.plan, new_resources) {
             self.resources = resources;

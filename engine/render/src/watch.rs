@@ -6,7 +6,7 @@
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::{channel, Receiver, RecvTimeoutError};
+use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, TryRecvError};
 use std::time::{Duration, Instant};
 
 use notify::event::{AccessKind, AccessMode, EventKind};
@@ -41,6 +41,10 @@ pub struct FileWatcher {
     files: BTreeSet<PathBuf>,
     dirs: BTreeSet<PathBuf>,
     quiet: Duration,
+    /// Files `poll_batch` has seen change, with when the last one did, until
+    /// they have been quiet long enough to hand out.
+    gathering: BTreeSet<PathBuf>,
+    last_change: Option<Instant>,
 }
 
 /// Whether an event can mean new contents (opening or reading a file cannot).
@@ -69,6 +73,8 @@ impl FileWatcher {
             files: BTreeSet::new(),
             dirs: BTreeSet::new(),
             quiet,
+            gathering: BTreeSet::new(),
+            last_change: None,
         })
     }
 
@@ -115,7 +121,8 @@ impl FileWatcher {
     /// changed for the quiet period; returns the changed files, or an empty set
     /// when nothing changed in time.
     pub fn next_batch(&mut self, timeout: Duration) -> Result<BTreeSet<PathBuf>, WatchError> {
-        let mut changed = BTreeSet::new();
+        let mut changed = std::mem::take(&mut self.gathering);
+        self.last_change = None;
         let deadline = Instant::now() + timeout;
         while changed.is_empty() {
             let left = deadline.saturating_duration_since(Instant::now());
@@ -139,6 +146,32 @@ impl FileWatcher {
                 Err(RecvTimeoutError::Timeout) => return Ok(changed),
                 Err(RecvTimeoutError::Disconnected) => return Err(WatchError::Stopped),
             }
+        }
+    }
+
+    /// Never waits: gathers the changes reported so far and hands them out once
+    /// none has come for the quiet period (an empty set before that), so a frame
+    /// loop can poll it every frame without the debounce stalling a frame.
+    pub fn poll_batch(&mut self) -> Result<BTreeSet<PathBuf>, WatchError> {
+        loop {
+            match self.events.try_recv() {
+                Ok(event) => {
+                    let paths = self.relevant(event);
+                    if !paths.is_empty() {
+                        self.last_change = Some(Instant::now());
+                        self.gathering.extend(paths);
+                    }
+                }
+                Err(TryRecvError::Empty) => break,
+                Err(TryRecvError::Disconnected) => return Err(WatchError::Stopped),
+            }
+        }
+        match self.last_change {
+            Some(at) if at.elapsed() >= self.quiet => {
+                self.last_change = None;
+                Ok(std::mem::take(&mut self.gathering))
+            }
+            _ => Ok(BTreeSet::new()),
         }
     }
 }

@@ -74,3 +74,43 @@ fn a_burst_of_writes_is_one_batch_after_the_quiet_period() {
         .is_empty());
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+#[test]
+fn polling_never_waits_and_hands_a_burst_out_once_it_is_quiet() {
+    let dir = temp_dir("poll");
+    let a = dir.join("a.frag");
+    let b = dir.join("b.ron");
+    std::fs::write(&a, "one").expect("write");
+    std::fs::write(&b, "one").expect("write");
+    let mut watcher = watching(&[&a, &b]);
+    std::fs::write(&a, "two").expect("write a");
+    std::fs::write(&b, "two").expect("write b");
+    let started = Instant::now();
+    let mut polls = 0;
+    let batch = loop {
+        let before = Instant::now();
+        let batch = watcher.poll_batch().expect("poll");
+        assert!(
+            before.elapsed() < QUIET,
+            "a poll waited {:?}",
+            before.elapsed()
+        );
+        polls += 1;
+        if !batch.is_empty() {
+            break batch;
+        }
+        assert!(started.elapsed() < Duration::from_secs(10), "no batch");
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    assert!(
+        started.elapsed() >= QUIET,
+        "handed out before the quiet period"
+    );
+    assert!(
+        polls > 1,
+        "the first poll came before the quiet period ended"
+    );
+    assert_eq!(batch, BTreeSet::from([normalize(&a), normalize(&b)]));
+    assert!(watcher.poll_batch().expect("poll").is_empty());
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}

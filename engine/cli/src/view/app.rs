@@ -331,7 +331,7 @@ impl<'g> Viewer<'g> {
     /// Hands edited files, if any, to the worker (superseding a reload still
     /// being prepared), and commits the newest prepared reload, if one is ready.
     fn hot_reload(&mut self) -> Result<()> {
-        let changed = self.watcher.next_batch(Duration::ZERO)?;
+        let changed = self.watcher.poll_batch()?;
         if !changed.is_empty() {
             self.reload.get_or_insert(ReloadProgress {
                 taken: Instant::now(),
