@@ -22,6 +22,6 @@ pub mod vk;
 pub use check::check;
 pub use compile::{compile, CompileOptions, Prepared};
 pub use diagnostic::{Diagnostic, Severity};
-pub use load::{load, load_with, LoadedGraph};
+pub use load::{load, load_with, load_with_params, LoadedGraph};
 pub use memory::{estimate_requirements, MemoryRequirements};
 pub use plan::{Extent, Plan};

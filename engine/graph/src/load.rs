@@ -98,9 +98,24 @@ pub fn load(path: &Path) -> LoadedGraph {
 
 /// Loads a graph with a custom file reader.
 pub fn load_with(path: &Path, read: ReadFile) -> LoadedGraph {
+    load_overridden(path, read, BTreeMap::new())
+}
+
+/// Loads a graph from disk with some of its top-level parameters set, as an
+/// include site would set a fragment's (`weft render --param exposure=2`); a
+/// name the graph does not declare is an error located at its `params`.
+pub fn load_with_params(path: &Path, overrides: BTreeMap<String, ParamValue>) -> LoadedGraph {
+    load_overridden(path, &|p: &Path| std::fs::read_to_string(p), overrides)
+}
+
+fn load_overridden(
+    path: &Path,
+    read: ReadFile,
+    overrides: BTreeMap<String, ParamValue>,
+) -> LoadedGraph {
     let mut graph = LoadedGraph::default();
     let mut stack = Vec::new();
-    load_file(&mut graph, read, path, BTreeMap::new(), None, &mut stack);
+    load_file(&mut graph, read, path, overrides, None, &mut stack);
     if let Some(root) = graph.sources.first() {
         if graph.name.is_empty() {
             graph.name = root
@@ -302,6 +317,18 @@ fn resolve_params(
     for (name, value) in overrides {
         if let Some(slot) = params.get_mut(&name) {
             *slot = value;
+        } else if site.is_none() {
+            let (file, pos) = graph.locate(source, &[Seg::Field("params")]);
+            let names: Vec<&str> = declared.keys().map(String::as_str).collect();
+            let graph_file = file_name(&graph.sources[source].file);
+            graph.diagnostics.push(
+                Diagnostic::error(
+                    file,
+                    pos,
+                    format!("unknown parameter \"{name}\" for \"{graph_file}\""),
+                )
+                .suggest(&name, names),
+            );
         } else if let Some(site) = site {
             let (file, pos) = graph.locate(
                 site.source,

@@ -232,3 +232,41 @@ fn images_read_back_after_the_frame_are_kept_and_left_readable() {
     );
     assert_eq!(errors[0].hint.as_deref(), Some("did you mean \"hdr\"?"));
 }
+
+#[test]
+fn top_level_parameters_can_be_set_when_loading() {
+    use std::collections::BTreeMap;
+    use weft_graph::schema::ParamValue;
+    let path = repo_root().join("graphs/forward.ron");
+    let set =
+        |name: &str, value: f64| BTreeMap::from([(name.to_string(), ParamValue::Number(value))]);
+    let graph = weft_graph::load_with_params(&path, set("exposure", 2.5));
+    let options = CompileOptions {
+        features: graph.features::<&str>(&[]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let tonemap = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "tonemap")
+        .expect("tonemap pass");
+    assert_eq!(tonemap.params["exposure"], ParamValue::Number(2.5));
+
+    let misspelt = weft_graph::load_with_params(&path, set("exposur", 2.5));
+    let errors: Vec<_> = misspelt
+        .diagnostics
+        .iter()
+        .filter(|d| d.is_error())
+        .collect();
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert_eq!(
+        errors[0].message,
+        "unknown parameter \"exposur\" for \"forward.ron\""
+    );
+    assert_eq!(
+        errors[0].hint.as_deref(),
+        Some("did you mean \"exposure\"?")
+    );
+    assert!(errors[0].file.ends_with("forward.ron"));
+}
