@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_gpu::{format_timings, Gpu, GpuOptions, TimingMode};
 use weft_graph::plan::Extent;
-use weft_graph::schema::ResourceDecl;
+use weft_graph::schema::{ParamValue, ResourceDecl};
 use weft_render::{render, RenderSettings, Rendered};
 
 /// Which per-pass times `--timings` measures.
@@ -57,6 +57,10 @@ pub struct RenderArgs {
     /// Feature toggles added after the scene's features (`name` on, `!name` off).
     #[arg(long, value_delimiter = ',')]
     features: Vec<String>,
+    /// Set a top-level graph parameter, NAME=VALUE (a number, true/false, or a
+    /// comma-separated vector); repeatable.
+    #[arg(long = "param", value_parser = parse_param)]
+    params: Vec<(String, ParamValue)>,
     /// Use the first device whose name contains this.
     #[arg(long)]
     device: Option<String>,
@@ -80,6 +84,29 @@ pub(crate) fn parse_size(text: &str) -> Result<Extent, String> {
         width: parse(w)?,
         height: parse(h)?,
     })
+}
+
+/// Parses `NAME=VALUE` as `--param` takes it.
+pub(crate) fn parse_param(text: &str) -> Result<(String, ParamValue), String> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("a parameter must look like name=value, found \"{text}\""))?;
+    let number = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|n| n.is_finite())
+            .ok_or_else(|| format!("\"{v}\" in --param {name} is not a number"))
+    };
+    let value = match value.trim() {
+        "true" => ParamValue::Bool(true),
+        "false" => ParamValue::Bool(false),
+        v if v.contains(',') => {
+            ParamValue::Vector(v.split(',').map(number).collect::<Result<_, _>>()?)
+        }
+        v => ParamValue::Number(number(v)?),
+    };
+    Ok((name.trim().to_string(), value))
 }
 
 /// Whether the graph declares an image called `name` (EXR output reads it back).
@@ -114,6 +141,7 @@ fn settings(args: &RenderArgs, extra_readback: Vec<String>) -> RenderSettings {
         },
         readback: true,
         extra_readback,
+        params: args.params.iter().cloned().collect(),
         ..RenderSettings::default()
     }
 }
@@ -255,4 +283,33 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     } else {
         ExitCode::FAILURE
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn params_parse_as_numbers_bools_and_vectors() {
+        assert_eq!(
+            parse_param("exposure=2.5"),
+            Ok(("exposure".into(), ParamValue::Number(2.5)))
+        );
+        assert_eq!(
+            parse_param("linear_taps=false"),
+            Ok(("linear_taps".into(), ParamValue::Bool(false)))
+        );
+        assert_eq!(
+            parse_param("direction=1,0"),
+            Ok(("direction".into(), ParamValue::Vector(vec![1.0, 0.0])))
+        );
+        assert_eq!(
+            parse_param("exposure"),
+            Err("a parameter must look like name=value, found \"exposure\"".into())
+        );
+        assert_eq!(
+            parse_param("exposure=bright"),
+            Err("\"bright\" in --param exposure is not a number".into())
+        );
+    }
 }

@@ -6,9 +6,11 @@ use crate::error::RenderError;
 use crate::features::scene_features;
 use crate::recorder::SceneRecorder;
 use crate::scene_gpu::GpuScene;
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use weft_gpu::{memory_requirements, FrameOptions, FrameReport, Gpu, Renderer, TimingMode};
 use weft_graph::plan::{Extent, Plan};
+use weft_graph::schema::ParamValue;
 use weft_graph::CompileOptions;
 use weft_scene::Scene;
 
@@ -35,6 +37,9 @@ pub struct RenderSettings {
     pub readback: bool,
     /// Other images to copy back with the output (e.g. `hdr` for EXR files).
     pub extra_readback: Vec<String>,
+    /// Values for the graph's top-level parameters, replacing those in the file
+    /// (`--param exposure=2`), so a sweep needs no edited copies of the graph.
+    pub params: BTreeMap<String, ParamValue>,
 }
 
 impl Default for RenderSettings {
@@ -53,6 +58,7 @@ impl Default for RenderSettings {
             timing: TimingMode::Off,
             readback: true,
             extra_readback: Vec::new(),
+            params: BTreeMap::new(),
         }
     }
 }
@@ -96,7 +102,7 @@ pub fn compile_for_scene(
     scene: &Scene,
     settings: &RenderSettings,
 ) -> Result<Plan, RenderError> {
-    let loaded = weft_graph::load(&settings.graph);
+    let loaded = weft_graph::load_with_params(&settings.graph, settings.params.clone());
     let mut requested = scene_features(scene);
     requested.extend(settings.features.iter().cloned());
     let memory = memory_requirements(gpu);
