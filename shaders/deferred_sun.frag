@@ -9,6 +9,9 @@ layout(set = 0, binding = 3) uniform sampler2D depth;
 layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
 #endif
 #include "include/deferred.glsl"
+layout(push_constant) uniform Params {
+    float emissive_boost;  // graph parameter: scales material emission
+} params;
 
 layout(location = 0) in vec2 uv;
 layout(location = 0) out vec4 color;
@@ -20,7 +23,7 @@ void main() {
         return;
     }
     Material m = materials[s.material];
-    vec3 c = shade_ambient_emissive(s, m);
+    vec3 c = shade_ambient_emissive(s, m, params.emissive_boost);
     for (uint i = 0u; i < frame.counts.x; ++i) {
         c += shade_light(i, s, m);
     }

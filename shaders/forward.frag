@@ -7,6 +7,10 @@ layout(set = 0, binding = 0) uniform sampler2DShadow shadow_map;
 #endif
 #include "include/lighting.glsl"
 
+layout(push_constant) uniform Params {
+    float emissive_boost;  // graph parameter: scales material emission
+} params;
+
 layout(set = 2, binding = 0) uniform sampler2D base_color;
 layout(set = 2, binding = 1) uniform sampler2D metallic_roughness;
 layout(set = 2, binding = 2) uniform sampler2D normal_map;
@@ -26,7 +30,7 @@ void main() {
     vec3 bent = texture(normal_map, texcoord).rgb;
     n = mapped_normal(gl_FrontFacing ? n : -n, world, texcoord, bent, m.ambient.w);
     Surface s = Surface(world, n, texel.rgb, material, mr);
-    vec3 c = shade_ambient_emissive(s, m);
+    vec3 c = shade_ambient_emissive(s, m, params.emissive_boost);
     for (uint i = 0u; i < frame.counts.w; ++i) {
         c += shade_light(i, s, m);
     }

@@ -11,7 +11,10 @@ layout(set = 0, binding = 3) uniform sampler2D depth;
 layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
 #endif
 layout(std430, set = 0, binding = 5) readonly buffer TileLights { uint words[]; } tile_lights;
-layout(push_constant) uniform Push { uint max_per_tile; } pc;
+layout(push_constant) uniform Push {
+    uint max_per_tile;
+    float emissive_boost;
+} pc;
 #include "include/deferred.glsl"
 #include "include/tiles.glsl"
 
@@ -25,7 +28,7 @@ void main() {
         return;
     }
     Material m = materials[s.material];
-    vec3 c = shade_ambient_emissive(s, m);
+    vec3 c = shade_ambient_emissive(s, m, pc.emissive_boost);
     for (uint i = 0u; i < frame.counts.x; ++i) {
         c += shade_light(i, s, m);
     }

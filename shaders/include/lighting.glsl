@@ -219,17 +219,19 @@ vec3 shade_light(uint index, Surface s, Material m) {
 }
 
 // What the surface shows without any direct light: the suns' ambient on its
-// ambient reflectance, plus its emission. Blinn-Phong: Ka (or Kd) times the
-// texture; metallic-roughness: the diffuse colour plus F0, the response to
-// uniform surroundings without the GGX terms' angular detail.
-vec3 shade_ambient_emissive(Surface s, Material m) {
+// ambient reflectance, plus its emission scaled by `emissive_boost` (the graph
+// parameter of that name, so glowing materials can be pushed over the bloom
+// threshold). Blinn-Phong: Ka (or Kd) times the texture; metallic-roughness:
+// the diffuse colour plus F0, the response to uniform surroundings without the
+// GGX terms' angular detail.
+vec3 shade_ambient_emissive(Surface s, Material m, float emissive_boost) {
     vec3 reflectance = m.ambient.rgb * s.texel;
     if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
         vec3 base = m.diffuse.rgb * s.texel;
         float metallic = s.metal_rough.x;
         reflectance = base * (1.0 - metallic) + mix(vec3(DIELECTRIC_F0), base, metallic);
     }
-    return frame.ambient.rgb * reflectance + m.emissive.rgb;
+    return frame.ambient.rgb * reflectance + m.emissive.rgb * emissive_boost;
 }
 
 #endif
