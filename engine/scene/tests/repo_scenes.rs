@@ -30,6 +30,7 @@ fn every_example_scene_loads_without_warnings() {
             "area_lights.scene",
             "cameras.scene",
             "demo.scene",
+            "flight_helmet.scene",
             "gltf.scene",
             "include.scene",
             "many_lights.scene",
