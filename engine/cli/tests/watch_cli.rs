@@ -121,10 +121,7 @@ fn graph_edit_validation_error_and_fix() {
     let original = fixture.read(GRAPH);
     let first = fixture.pixels();
 
-    let brighter = original.replace(
-        "params: { \"exposure\": 1.0 }",
-        "params: { \"exposure\": 4.0 }",
-    );
+    let brighter = original.replace("\"exposure\": 1.0,", "\"exposure\": 4.0,");
     assert_ne!(brighter, original);
     fixture.save_by_rename(GRAPH, &brighter);
     let line = watch.line();
@@ -299,11 +296,10 @@ fn edit_to_image_latency() {
     let graph_edits = (0..11).map(|i| {
         let (fixture, graph) = (fixture.clone(), graph.clone());
         Box::new(move || {
-            let exposure = format!("params: {{ \"exposure\": 1.{i:02} }}");
-            fixture.save_by_rename(
-                GRAPH,
-                &graph.replace("params: { \"exposure\": 1.0 }", &exposure),
-            );
+            let exposure = format!("\"exposure\": 1.{i:02},");
+            let edited = graph.replace("\"exposure\": 1.0,", &exposure);
+            assert_ne!(edited, graph, "the graph edit changes the file");
+            fixture.save_by_rename(GRAPH, &edited);
         }) as Box<dyn Fn()>
     });
     let graph_ms = latencies(&mut watch, graph_edits);
