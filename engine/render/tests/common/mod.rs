@@ -112,3 +112,59 @@ pub fn agreement(a: &RgbaImage, b: &RgbaImage) -> Agreement {
         max: diffs.last().copied().unwrap_or(0),
     }
 }
+
+/// Writes a 2x2 quad at z = 0 facing a camera at z = 3, with material
+/// `material` (MTL statements), lit head-on by a unit white sun with no
+/// ambient; returns the scene file.
+pub fn write_quad_scene(dir: &Path, material: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).expect("temp dir");
+    std::fs::write(
+        dir.join("quad.obj"),
+        "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\nusemtl quad\nf 1//1 2//1 3//1\nf 1//1 3//1 4//1\n",
+    )
+    .expect("obj");
+    std::fs::write(dir.join("quad.mtl"), format!("newmtl quad\n{material}")).expect("mtl");
+    let scene = dir.join("quad.scene");
+    std::fs::write(
+        &scene,
+        "model\n{\n\tfile \"quad.obj\"\n}\nsunlight\n{\n\tdirection 0 0 -1\n\tcolor 1 1 1\n\tambient 0\n}\ncamera \"front\"\n{\n\tposition 0 0 3\n\ttarget 0 0 0\n\tfov_deg 40\n}\n",
+    )
+    .expect("scene");
+    scene
+}
+
+/// The HDR value (RGBA) at the centre of a 16x16 render of `scene` through the
+/// shipped `graph`, bloom off, with `params` set; asserts no validation message.
+pub fn centre_hdr(
+    scene: &Path,
+    graph: &str,
+    params: std::collections::BTreeMap<String, weft_graph::schema::ParamValue>,
+) -> [f32; 4] {
+    let scene = weft_scene::load_scene(scene).expect("scene loads");
+    let gpu = Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("device");
+    let log = gpu.validation();
+    let settings = RenderSettings {
+        graph: self::graph(graph),
+        extent: Extent {
+            width: 16,
+            height: 16,
+        },
+        features: vec!["!bloom".into()],
+        extra_readback: vec!["hdr".into()],
+        params,
+        ..RenderSettings::default()
+    };
+    let rendered = render(&gpu, &scene, &settings).expect("renders");
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+    let (_, hdr) = &rendered.report.readbacks[0];
+    let weft_gpu::Pixels::RgbaF32(values) = &hdr.pixels else {
+        panic!("hdr is float");
+    };
+    let at = (8 * 16 + 8) * 4;
+    [values[at], values[at + 1], values[at + 2], values[at + 3]]
+}
