@@ -104,6 +104,20 @@ fn check_shaders(graph: &LoadedGraph) -> Result<Vec<Diagnostic>> {
     Ok(found)
 }
 
+/// Refuses feature toggles typed on the command line that the graph does not
+/// know (a typo would otherwise be ignored silently). A graph that does not
+/// load is left to the command's own error, which locates the problem.
+pub fn check_feature_names(graph: &Path, features: &[String]) -> Result<()> {
+    let loaded = weft_graph::load(graph);
+    let Ok(prepared) = weft_graph::Prepared::new(&loaded) else {
+        return Ok(());
+    };
+    match prepared.unknown_features(features).as_slice() {
+        [] => Ok(()),
+        unknown => bail!("--features: {}", unknown.join("\n")),
+    }
+}
+
 fn print_diagnostics(diags: &[Diagnostic]) {
     for d in diags {
         eprintln!("{d}");
@@ -111,6 +125,7 @@ fn print_diagnostics(diags: &[Diagnostic]) {
 }
 
 fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Plan, f64)> {
+    check_feature_names(file, &target.features)?;
     let graph = weft_graph::load(file);
     let mut requested = Vec::new();
     let mut lights = target.lights;

@@ -39,7 +39,19 @@ enum Command {
     View(view::ViewArgs),
 }
 
+/// Lets a closed pipe (`weft scene check --json F | head`) end the process
+/// quietly, as it ends other Unix tools, instead of a panic in `println!`
+/// (Rust ignores SIGPIPE by default, turning it into a write error).
+fn die_quietly_on_closed_pipes() {
+    // SAFETY: called first thing in `main`, before any thread exists; restoring
+    // a signal's default disposition has no other effect on the process.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    die_quietly_on_closed_pipes();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Graph(cmd) => graph_cmd::run(cmd),

@@ -30,11 +30,11 @@ pub struct RenderArgs {
     /// Output size, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     size: Extent,
-    /// Frames to render; the last one is saved.
-    #[arg(long, default_value_t = 1)]
+    /// Frames to render (at least 1); the last one is saved.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     frames: u32,
     /// Scene time in seconds at the first frame (frames are 1/60 s apart).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_time)]
     time: f32,
     /// Camera name; the scene's first camera by default.
     #[arg(long)]
@@ -109,6 +109,18 @@ pub(crate) fn parse_param(text: &str) -> Result<(String, ParamValue), String> {
     Ok((name.trim().to_string(), value))
 }
 
+/// A scene time in seconds: a finite number (NaN or infinity would make every
+/// animated light and camera vanish).
+pub fn parse_time(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(t) if t.is_finite() => Ok(t),
+        Ok(_) => Err(format!(
+            "time must be a finite number of seconds, found \"{text}\""
+        )),
+        Err(_) => Err(format!("expected a number of seconds, found \"{text}\"")),
+    }
+}
+
 /// Whether the graph declares an image called `name` (EXR output reads it back).
 fn graph_has_image(graph: &Path, name: &str) -> bool {
     weft_graph::load(graph)
@@ -160,6 +172,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     } else {
         Vec::new()
     };
+    crate::graph_cmd::check_feature_names(&args.graph, &args.features)?;
     let settings = settings(&args, extra_readback);
     if args.watch {
         return crate::watch_cmd::run(crate::watch_cmd::WatchRequest {

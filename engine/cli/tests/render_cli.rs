@@ -115,3 +115,32 @@ fn image_size(path: &Path) -> (u32, u32) {
         |at: usize| u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
     (word(16), word(20))
 }
+
+#[test]
+fn bad_times_frame_counts_and_feature_names_are_refused() {
+    let cases: [(&[&str], &str); 5] = [
+        (&["--time", "NaN"], "time must be a finite number of seconds, found \"NaN\""),
+        (&["--time", "inf"], "time must be a finite number of seconds, found \"inf\""),
+        (&["--frames", "0"], "invalid value '0' for '--frames <FRAMES>'"),
+        (
+            &["--features", "blom"],
+            "error: --features: unknown feature \"blom\" (did you mean \"bloom\"?); this graph's features are: ",
+        ),
+        (
+            &["--features", "!shadow_caster"],
+            "unknown feature \"shadow_caster\" (did you mean \"shadow_casters\"?)",
+        ),
+    ];
+    for (extra, expected) in cases {
+        let mut args = vec!["render", "scenes/demo.scene", "--size", "8x8"];
+        args.extend_from_slice(extra);
+        let out = weft(&args);
+        assert_eq!(
+            out.status.code(),
+            Some(if extra[0] == "--features" { 1 } else { 2 }),
+            "{extra:?}"
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(expected), "{extra:?}: {err}");
+    }
+}

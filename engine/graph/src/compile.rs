@@ -90,6 +90,27 @@ impl<'g> Prepared<'g> {
         &self.ir
     }
 
+    /// The toggles a user typed (`name` on, `!name` off) that name no feature
+    /// of this graph — neither one its passes test nor a default — each as a
+    /// message with the nearest known name as a hint.
+    pub fn unknown_features<S: AsRef<str>>(&self, requested: &[S]) -> Vec<String> {
+        let mut known = feature_names(&self.ir);
+        known.extend(self.graph.default_features.iter().cloned());
+        requested
+            .iter()
+            .map(|f| f.as_ref().trim())
+            .map(|f| f.strip_prefix('!').unwrap_or(f))
+            .filter(|f| !f.is_empty() && !known.contains(*f))
+            .map(|f| {
+                let hint = crate::diagnostic::nearest(f, known.iter().map(String::as_str))
+                    .map(|n| format!(" (did you mean \"{n}\"?)"))
+                    .unwrap_or_default();
+                let list = known.iter().cloned().collect::<Vec<_>>().join(", ");
+                format!("unknown feature \"{f}\"{hint}; this graph's features are: {list}")
+            })
+            .collect()
+    }
+
     /// Compiles for one size and feature set.
     pub fn compile(&self, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
         compile_ir(self.graph, &self.ir, options)

@@ -36,6 +36,9 @@ pub struct DrawItem {
     pub draw_id: u32,
     /// Index into [`SceneGeometry::materials`].
     pub material: u32,
+    /// Whether the instance's transform mirrors (negative determinant), which
+    /// turns its triangles' winding around.
+    pub mirrored: bool,
 }
 
 /// The flattened scene, ready to upload.
@@ -93,6 +96,7 @@ impl SceneGeometry {
                 continue;
             };
             let normal = instance.transform.inverse().transpose();
+            let mirrored = instance.transform.determinant() < 0.0;
             for &(range, material) in model_ranges.iter().flatten() {
                 let draw_id = g.draws.len() as u32;
                 g.draw_records
@@ -106,6 +110,7 @@ impl SceneGeometry {
                     range,
                     draw_id,
                     material,
+                    mirrored,
                 });
             }
         }

@@ -64,6 +64,16 @@ fn stage_create_info(
         .name(c"main")
 }
 
+/// The front face of a draw: counter-clockwise model triangles, turned around
+/// by a mirroring (negative-determinant) model matrix.
+pub fn front_face(mirrored: bool) -> vk::FrontFace {
+    if mirrored {
+        vk::FrontFace::CLOCKWISE
+    } else {
+        vk::FrontFace::COUNTER_CLOCKWISE
+    }
+}
+
 fn depth_state(test: DepthTest) -> vk::PipelineDepthStencilStateCreateInfo<'static> {
     let (enable, write, op) = match test {
         DepthTest::Off => (false, false, vk::CompareOp::ALWAYS),
@@ -312,7 +322,8 @@ fn create_pipeline(
             None => (false, 0.0, 0.0),
         };
         // Every projection flips Y for Vulkan's downward framebuffer Y, which keeps
-        // counter-clockwise model triangles counter-clockwise in Vulkan's convention.
+        // counter-clockwise model triangles counter-clockwise in Vulkan's convention;
+        // the front face is dynamic (see `front_face`), this value is a placeholder.
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
             .cull_mode(match state.cull {
@@ -329,7 +340,13 @@ fn create_pipeline(
         let depth = depth_state(state.depth);
         let attachments: Vec<_> = state.blends.iter().map(|b| blend_state(*b)).collect();
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
-        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        // The front face is set per draw: a mirrored instance (negative
+        // determinant) turns its triangles' winding around.
+        let dynamic_states = [
+            vk::DynamicState::VIEWPORT,
+            vk::DynamicState::SCISSOR,
+            vk::DynamicState::FRONT_FACE,
+        ];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let info = vk::GraphicsPipelineCreateInfo::default()
             .stages(&stages)

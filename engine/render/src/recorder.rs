@@ -4,7 +4,7 @@
 //! selects or one instanced light volume per light.
 
 use crate::geometry::DrawItem;
-use crate::pipelines::{ScenePipeline, ScenePipelineKey, ScenePipelines, MATERIAL_SET};
+use crate::pipelines::{front_face, ScenePipeline, ScenePipelineKey, ScenePipelines, MATERIAL_SET};
 use crate::scene_gpu::GpuScene;
 use crate::shadows::ShadowSettings;
 use crate::state::{pass_state, DepthTest, PassState};
@@ -167,6 +167,7 @@ impl<'g> SceneRecorder<'g> {
             }
             device.cmd_bind_vertex_buffers(cmd, 0, &[self.scene.vertices.buffer], &[0]);
             device.cmd_bind_index_buffer(cmd, self.scene.indices.buffer, 0, vk::IndexType::UINT32);
+            device.cmd_set_front_face(cmd, front_face(false));
         }
     }
 
@@ -185,9 +186,14 @@ impl<'g> SceneRecorder<'g> {
             .keys()
             .any(|(set, _)| *set == MATERIAL_SET);
         let mut bound = None;
+        let mut face = None;
         let mut calls = 0;
         for d in draws {
             unsafe {
+                if face != Some(d.mirrored) {
+                    device.cmd_set_front_face(cmd, front_face(d.mirrored));
+                    face = Some(d.mirrored);
+                }
                 if textured && bound != Some(d.material) {
                     let set = self.scene.material_sets[d.material as usize];
                     device.cmd_bind_descriptor_sets(

@@ -120,7 +120,10 @@ fn scene_includes(path: &Path, depth: usize, files: &mut BTreeSet<PathBuf>) {
     if !files.insert(normalize(path)) || depth >= MAX_SCENE_INCLUDE_DEPTH {
         return;
     }
-    let Ok(text) = std::fs::read_to_string(path) else {
+    let asked_at = weft_scene::Location::file(path);
+    let Ok(text) =
+        weft_scene::source::read_text(path, &asked_at, weft_scene::source::MAX_SCENE_BYTES)
+    else {
         return;
     };
     let base = path.parent().unwrap_or(Path::new(""));

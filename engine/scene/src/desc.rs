@@ -344,8 +344,8 @@ fn spotlight(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<SpotLight,
                 ),
             ));
         }
-        let from = Vec3::new(v[0], v[1], v[2]).try_normalize();
-        let to = Vec3::new(v[3], v[4], v[5]).try_normalize();
+        let from = crate::props::normalize_wide(Vec3::new(v[0], v[1], v[2]));
+        let to = crate::props::normalize_wide(Vec3::new(v[3], v[4], v[5]));
         let (Some(from), Some(to)) = (from, to) else {
             return Err(props.error(p, "'swivel' directions must not be zero vectors"));
         };
@@ -453,13 +453,7 @@ fn arealight(props: &mut Props<'_>) -> Result<AreaLight, SceneError> {
         .unwrap_or_else(|| ("rect".to_string(), props.block_at().line.unwrap_or(1)));
     let shape = match shape_name.as_str() {
         "rect" => {
-            let (width, height) = match props.last("size") {
-                Some(p) => {
-                    let v = props.exactly(p, 2)?;
-                    (v[0], v[1])
-                }
-                None => (1.0, 1.0),
-            };
+            let (width, height) = positive_pair(props, "size", Order::Any)?.unwrap_or((1.0, 1.0));
             AreaShape::Rect { width, height }
         }
         "disc" => AreaShape::Disc {
@@ -509,7 +503,7 @@ fn generate(props: &mut Props<'_>) -> Result<Vec<PointLight>, SceneError> {
     let max = props.vec3("max")?.unwrap_or(Vec3::splat(1.0));
     let color_min = props.vec3("color_min")?.unwrap_or(Vec3::ONE);
     let color_max = props.vec3("color_max")?.unwrap_or(color_min);
-    let radius_range = pair(props, "radius")?;
+    let radius_range = positive_pair(props, "radius", Order::Increasing)?;
     let velocity_range = pair(props, "velocity")?.unwrap_or((0.0, 0.0));
     let amplitude = props.f32("amplitude")?.unwrap_or(1.0);
     let att = attenuation(props)?.unwrap_or(Attenuation::INVERSE_SQUARE);
@@ -551,6 +545,38 @@ fn pair(props: &mut Props<'_>, name: &str) -> Result<Option<(f32, f32)>, SceneEr
         }
         None => Ok(None),
     }
+}
+
+/// Whether the two numbers of a pair must be in increasing order (a range).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Order {
+    Any,
+    Increasing,
+}
+
+/// A `NAME a b` property whose numbers must both be > 0 (and, for a range,
+/// satisfy a <= b).
+fn positive_pair(
+    props: &mut Props<'_>,
+    name: &str,
+    order: Order,
+) -> Result<Option<(f32, f32)>, SceneError> {
+    let Some(p) = props.last(name) else {
+        return Ok(None);
+    };
+    let v = props.exactly(p, 2)?;
+    let ordered = order == Order::Any || v[0] <= v[1];
+    if v[0] > 0.0 && v[1] > 0.0 && ordered {
+        return Ok(Some((v[0], v[1])));
+    }
+    let expected = match order {
+        Order::Any => "two numbers > 0",
+        Order::Increasing => "a range lo hi with 0 < lo <= hi",
+    };
+    Err(props.error(
+        p,
+        format!("'{name}' must be {expected}, found {} {}", v[0], v[1]),
+    ))
 }
 
 /// A `camera` block; `index` names unlabelled cameras `camera0`, `camera1`, ...

@@ -94,6 +94,16 @@ pub enum SceneError {
         /// The resolved path that does not exist.
         path: PathBuf,
     },
+    /// A path that names a device, FIFO, socket or directory instead of a file.
+    #[error("{at}: {} is {kind}, not a regular file", path.display())]
+    NotRegular {
+        /// Where the file was asked for.
+        at: Location,
+        /// The path.
+        path: PathBuf,
+        /// What it is instead.
+        kind: &'static str,
+    },
     /// A file is larger than the loader accepts.
     #[error("{at}: file is {size} bytes, over the limit of {limit} bytes")]
     TooLarge {
@@ -144,6 +154,7 @@ impl SceneError {
         match self {
             Self::Io { at, .. }
             | Self::MissingFile { at, .. }
+            | Self::NotRegular { at, .. }
             | Self::TooLarge { at, .. }
             | Self::Syntax { at, .. }
             | Self::Model { at, .. } => at,

@@ -12,7 +12,7 @@ use crate::light::{
 use crate::material::{AlphaMode, Material, ShadingModel, TextureRef, TextureSource};
 use crate::mesh::{compute_normals, Mesh};
 use crate::model::Model;
-use crate::source::{read_bytes, MAX_MODEL_BYTES};
+use crate::source::{read_capped, MAX_MODEL_BYTES};
 use crate::uri::{decode_data_uri, percent_decode};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -23,7 +23,7 @@ pub fn load_gltf(
     asked_at: &Location,
     diag: &mut Diagnostics,
 ) -> Result<Model, SceneError> {
-    let bytes = read_bytes(path, asked_at, MAX_MODEL_BYTES)?;
+    let bytes = read_capped(path, asked_at, MAX_MODEL_BYTES)?;
     let model_error = |message: String| SceneError::Model {
         at: Location::file(path),
         message,
@@ -114,7 +114,7 @@ fn load_buffers(
                     None => {
                         let file = dir.join(percent_decode(uri));
                         sources.push(file.clone());
-                        read_bytes(&file, &Location::file(path), MAX_MODEL_BYTES)?
+                        read_capped(&file, &Location::file(path), MAX_MODEL_BYTES)?
                     }
                 },
             };

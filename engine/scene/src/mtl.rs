@@ -97,16 +97,19 @@ fn unit(v: f32, fallback: f32) -> f32 {
     }
 }
 
-/// A colour with non-finite channels replaced by 0.
+/// A colour, or `fallback` when the file gives none.
 fn color(c: Option<[f32; 3]>, fallback: Vec3) -> Vec3 {
-    c.map(Vec3::from_array)
-        .map(|v| if v.is_finite() { v } else { Vec3::ZERO })
-        .unwrap_or(fallback)
+    c.map(Vec3::from_array).unwrap_or(fallback)
 }
 
-/// Colour statements whose fields tobj cannot take (it panics on fewer than three):
-/// `Kd r` is widened to `Kd r r r` as the MTL spec allows; other short or non-numeric
-/// statements are blanked. Returns the text to parse and `(line, warning)` for each blanked line.
+/// Statements whose fields tobj cannot take: colours with fewer than three
+/// fields (it panics) — `Kd r` is widened to `Kd r r r` as the MTL spec allows,
+/// other short or non-numeric ones are blanked — and numeric statements with a
+/// NaN, infinite or out-of-range (beyond f32) value, which would make a surface
+/// vanish. Returns the text to parse and `(line, warning)` for each blanked line.
+/// MTL statements whose fields are numbers.
+const NUMERIC_KEYWORDS: [&str; 10] = ["Ka", "Kd", "Ks", "Ke", "Tf", "Ns", "Ni", "d", "Tr", "illum"];
+
 pub(crate) fn sanitize(text: &str) -> (String, Vec<(usize, String)>) {
     let mut out = String::with_capacity(text.len());
     let mut dropped = Vec::new();
@@ -114,7 +117,15 @@ pub(crate) fn sanitize(text: &str) -> (String, Vec<(usize, String)>) {
         let mut words = line.split_whitespace();
         let keyword = words.next().unwrap_or_default();
         let fields: Vec<&str> = words.collect();
-        if matches!(keyword, "Ka" | "Kd" | "Ks" | "Ke") && fields.len() < 3 {
+        let non_finite = fields
+            .iter()
+            .find(|f| f.parse::<f32>().is_ok_and(|v| !v.is_finite()));
+        if let (true, Some(bad)) = (NUMERIC_KEYWORDS.contains(&keyword), non_finite) {
+            dropped.push((
+                i + 1,
+                format!("'{keyword}' value '{bad}' is not a finite 32-bit number; line ignored"),
+            ));
+        } else if matches!(keyword, "Ka" | "Kd" | "Ks" | "Ke") && fields.len() < 3 {
             let numeric = fields.iter().all(|f| f.parse::<f32>().is_ok());
             match fields.as_slice() {
                 [r] if numeric => out.push_str(&format!("{keyword} {r} {r} {r}")),
@@ -228,6 +239,21 @@ mod tests {
                     4,
                     "'Ka' needs 1 or 3 numbers, found 0; line ignored".to_string()
                 ),
+            ]
+        );
+    }
+
+    #[test]
+    fn non_finite_numbers_are_dropped() {
+        let (text, dropped) = sanitize("newmtl a\nKd nan 0 0\nKs inf\nNs 1e39\nKe 1 2 3\n");
+        assert_eq!(text, "newmtl a\n\n\n\nKe 1 2 3\n");
+        let lines: Vec<_> = dropped.iter().map(|(l, m)| format!("{l}: {m}")).collect();
+        assert_eq!(
+            lines,
+            [
+                "2: 'Kd' value 'nan' is not a finite 32-bit number; line ignored",
+                "3: 'Ks' value 'inf' is not a finite 32-bit number; line ignored",
+                "4: 'Ns' value '1e39' is not a finite 32-bit number; line ignored",
             ]
         );
     }

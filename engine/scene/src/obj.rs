@@ -7,7 +7,7 @@ use crate::material::Material;
 use crate::mesh::{compute_normals, Mesh};
 use crate::model::Model;
 use crate::mtl;
-use crate::source::{read_bytes, MAX_MODEL_BYTES};
+use crate::source::{read_capped, MAX_MODEL_BYTES};
 use glam::{Vec2, Vec3};
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -19,7 +19,14 @@ pub fn load_obj(
     asked_at: &Location,
     diag: &mut Diagnostics,
 ) -> Result<Model, SceneError> {
-    let bytes = read_bytes(path, asked_at, MAX_MODEL_BYTES)?;
+    let bytes = read_capped(path, asked_at, MAX_MODEL_BYTES)?;
+    if let Some(nul) = bytes.iter().position(|&b| b == 0) {
+        let line = 1 + bytes[..nul].iter().filter(|&&b| b == b'\n').count();
+        return Err(SceneError::Model {
+            at: Location::line(path, line),
+            message: "binary data (a NUL byte), not OBJ text".into(),
+        });
+    }
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -77,6 +84,13 @@ pub fn load_obj(
             meshes.push(mesh);
         }
     }
+    if meshes.is_empty() {
+        return Err(SceneError::Model {
+            at: Location::file(path),
+            message: "no triangles: the file has no usable 'f' statements (is it an OBJ file?)"
+                .into(),
+        });
+    }
     let mut model = Model {
         path: path.to_path_buf(),
         meshes,
@@ -96,7 +110,7 @@ fn load_mtl_text(
     obj: &Path,
     warnings: &mut Vec<Warning>,
 ) -> Option<(Vec<tobj::Material>, HashMap<String, usize>)> {
-    let bytes = match read_bytes(file, &Location::file(obj), MAX_MODEL_BYTES) {
+    let bytes = match read_capped(file, &Location::file(obj), MAX_MODEL_BYTES) {
         Ok(bytes) => bytes,
         Err(e) => {
             warnings.push(Warning {

@@ -126,7 +126,7 @@ impl<'a> Props<'a> {
             return Ok(None);
         };
         let v = Vec3::from_slice(&self.exactly(p, 3)?);
-        v.try_normalize()
+        normalize_wide(v)
             .map(Some)
             .ok_or_else(|| self.error(p, format!("'{name}' must not be a zero vector")))
     }
@@ -156,4 +156,10 @@ impl<'a> Props<'a> {
             }
         }
     }
+}
+
+/// `v` normalised, computed in f64 so components near `f32::MAX` do not
+/// overflow the length; `None` only for the zero vector.
+pub(crate) fn normalize_wide(v: Vec3) -> Option<Vec3> {
+    v.as_dvec3().try_normalize().map(|n| n.as_vec3())
 }

@@ -141,6 +141,7 @@ pub(crate) fn parse(
 ) -> Result<Vec<Item>, SceneError> {
     let mut items = Vec::new();
     let mut state = State::Top;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (index, raw) in text.lines().enumerate() {
         let line = index + 1;
         let tokens = tokenize(raw, file, line)?;
@@ -166,6 +167,18 @@ pub(crate) fn parse(
                 Some(Token::Bare("}")) if tokens.len() == 1 => {
                     items.push(Item::Block(block));
                     State::Top
+                }
+                Some(Token::Bare(closing)) if closing.starts_with('}') => {
+                    return Err(SceneError::syntax(
+                        file,
+                        line,
+                        format!(
+                            "expected '}}' alone on its line to close '{}' (line {}), found '{}'",
+                            block.kind,
+                            block.line,
+                            raw.trim()
+                        ),
+                    ))
                 }
                 Some(Token::Bare("{")) => {
                     return Err(SceneError::syntax(
@@ -205,7 +218,7 @@ fn top_level(
     items: &mut Vec<Item>,
 ) -> Result<State, SceneError> {
     let kind = match tokens[0] {
-        Token::Bare("}") => {
+        Token::Bare(closing) if closing.starts_with('}') => {
             return Err(SceneError::syntax(file, line, "'}' without an open object"))
         }
         Token::Bare("{") => {
@@ -369,6 +382,14 @@ mod tests {
 
     #[test]
     fn located_errors() {
+        assert_eq!(
+            parse_err("sunlight\n{\nintensity 1\n}}\n"),
+            "t.scene:4: expected '}' alone on its line to close 'sunlight' (line 1), found '}}'"
+        );
+        assert_eq!(
+            parse_err("\u{feff}sunlight\n{\n}\n}}\n"),
+            "t.scene:4: '}' without an open object"
+        );
         assert_eq!(
             parse_err("model\n{\nscale 1 x2 nan\n"),
             "t.scene:1: 'model' is never closed (missing '}' before the end of the file)"

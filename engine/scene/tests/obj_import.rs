@@ -200,6 +200,14 @@ fn malformed_obj_is_a_located_error() {
             "v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n",
             "bad.obj:2: 'inf' is not a finite number",
         ),
+        (
+            "\u{89}PNG\r\n\u{1a}\n\0\0\0\rIHDR",
+            "bad.obj:3: binary data (a NUL byte), not OBJ text",
+        ),
+        (
+            "random words\nv 0 0 0\n",
+            "bad.obj: no triangles: the file has no usable 'f' statements (is it an OBJ file?)",
+        ),
     ];
     for (text, expected) in cases {
         let path = dir.join("bad.obj");

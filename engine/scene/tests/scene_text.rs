@@ -71,6 +71,12 @@ fn extension_errors_are_located() {
         ("pointlight\n{\n position 1 2\n}\n", "t.scene:3: 'position' expects 3 numbers, found 2"),
         ("pointlight\n{\n position 1 nan 2\n}\n", "t.scene:3: 'position' expects numbers, found 'nan'"),
         ("sunlight\n{\n direction 0 0 0\n}\n", "t.scene:3: 'direction' must not be a zero vector"),
+        ("arealight\n{\n size 0 0\n}\n", "t.scene:3: 'size' must be two numbers > 0, found 0 0"),
+        ("arealight\n{\n size 2 -1\n}\n", "t.scene:3: 'size' must be two numbers > 0, found 2 -1"),
+        ("arealight\n{\n shape disc\n radius 0\n}\n", "t.scene:4: 'radius' must be > 0, found 0"),
+        ("pointlights\n{\n radius -1 -5\n}\n", "t.scene:3: 'radius' must be a range lo hi with 0 < lo <= hi, found -1 -5"),
+        ("pointlights\n{\n radius 5 1\n}\n", "t.scene:3: 'radius' must be a range lo hi with 0 < lo <= hi, found 5 1"),
+        ("sunlight\n{\n intensity 1\n}}\n", "t.scene:4: expected '}' alone on its line to close 'sunlight' (line 1), found '}}'"),
         ("spotlight\n{\n angle 200\n}\n", "t.scene:3: 'angle' must be within 0..180 degrees, found 200"),
         ("spotlight\n{\n swivel 0 -1 0 1 0 0 -2\n}\n", "t.scene:3: 'swivel' period must be > 0"),
         ("model\n{\n orientation 1 0 0 0\n}\n", "t.scene:3: 'orientation' has a zero rotation axis"),
@@ -79,6 +85,59 @@ fn extension_errors_are_located() {
     for (text, expected) in cases {
         assert_eq!(error(text), expected, "{text}");
     }
+}
+
+#[test]
+fn huge_directions_normalise_without_overflow() {
+    let (d, _) = desc("sunlight\n{\n direction 3e38 3e38 3e38\n}\n");
+    let Light::Sun(sun) = &d.lights[0] else {
+        panic!("sun")
+    };
+    let expected = Vec3::splat(1.0 / 3f32.sqrt());
+    assert!(sun.direction.distance(expected) < 1e-6, "{}", sun.direction);
+}
+
+#[test]
+fn a_byte_order_mark_is_not_part_of_the_first_name() {
+    let (d, warnings) = desc("\u{feff}sunlight\n{\n direction 0 -1 0\n}\n");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(d.lights.len(), 1);
+    let dir = temp_dir("bom");
+    let path = dir.join("bom.scene");
+    std::fs::write(&path, b"\xEF\xBB\xBFsunlight\n{\n direction 0 -1 0\n}\n").expect("write");
+    let scene = load_scene(&path).expect("loads");
+    assert_eq!(scene.lights.len(), 1);
+}
+
+#[test]
+fn devices_and_fifos_are_refused_without_reading() {
+    let dir = temp_dir("special");
+    let scene = dir.join("s.scene");
+    std::fs::write(&scene, "include \"/dev/zero\"\n").expect("write");
+    let err = load_scene(&scene).expect_err("a device");
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "{}:1: /dev/zero is a device, not a regular file",
+            scene.display()
+        )
+    );
+    let fifo = dir.join("pipe.obj");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo");
+    assert!(made.success());
+    std::fs::write(&scene, "model\n{\n file \"pipe.obj\"\n}\n").expect("write");
+    let err = load_scene(&scene).expect_err("a FIFO");
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "{}:3: {} is a FIFO, not a regular file",
+            scene.display(),
+            fifo.display()
+        )
+    );
 }
 
 #[test]

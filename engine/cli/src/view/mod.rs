@@ -50,7 +50,7 @@ pub struct ViewArgs {
     #[arg(long)]
     camera: Option<String>,
     /// Scene time in seconds at the start.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = crate::render_cmd::parse_time)]
     time: f32,
     /// Start with scene time stopped (Space resumes).
     #[arg(long)]
@@ -65,8 +65,8 @@ pub struct ViewArgs {
     /// Use the first device whose name contains this.
     #[arg(long)]
     device: Option<String>,
-    /// Quit after presenting this many frames (for scripts and tests).
-    #[arg(long)]
+    /// Quit after presenting this many frames, at least 1 (for scripts and tests).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     frames: Option<u32>,
     /// Ask the window to become WIDTHxHEIGHT after half of --frames (tests resizing).
     #[arg(long, value_parser = parse_size, requires = "frames")]
@@ -87,6 +87,7 @@ pub struct ViewArgs {
 
 /// Runs `weft view`.
 pub fn run(args: ViewArgs) -> Result<ExitCode> {
+    crate::graph_cmd::check_feature_names(&args.graph, &args.features)?;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::SeqCst))
