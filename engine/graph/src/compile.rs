@@ -12,7 +12,8 @@ use crate::plan::{
     StoreOp,
 };
 use crate::resolve::{
-    access_path, expression_vars, image_extent, resolve, BufferSize, Ir, IrDispatch, IrKind, Usage,
+    access_path, expression_vars, image_extent, oversized_image, resolve, resource_path,
+    BufferSize, Ir, IrDispatch, IrKind, Usage, MAX_IMAGE_DIMENSION,
 };
 use crate::schema::{LoadDecl, PassKind, StoreDecl};
 use crate::spans::Seg;
@@ -143,6 +144,33 @@ pub fn feature_names(ir: &Ir) -> BTreeSet<String> {
         }
     }
     names
+}
+
+/// Every image the plan creates fits [`MAX_IMAGE_DIMENSION`] at this output size
+/// (`check` tries a few sizes; a command line can ask for another).
+fn check_image_sizes(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    kept: &[usize],
+    output: Extent,
+) -> Result<(), Vec<Diagnostic>> {
+    let errors: Vec<Diagnostic> = kept
+        .iter()
+        .filter_map(|&r| {
+            let e = image_extent(ir, r, output)?;
+            (e.width > MAX_IMAGE_DIMENSION || e.height > MAX_IMAGE_DIMENSION).then(|| {
+                let res = &ir.resources[r];
+                let (file, pos) =
+                    graph.locate(res.source, &resource_path(res.index, &[Seg::Field("size")]));
+                Diagnostic::error(file, pos, oversized_image(&res.name, e, output))
+            })
+        })
+        .collect();
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors)
+    }
 }
 
 fn locate(graph: &LoadedGraph, ir: &Ir, pass: usize, rest: &[Seg]) -> Diagnostic {
@@ -371,6 +399,7 @@ pub fn compile_ir(
     }
     warn_unread(graph, ir, &timeline, &uses, &is_root, &mut warnings);
     check_discarding_stores(graph, ir, &sequence, &timeline, &uses, &is_root)?;
+    check_image_sizes(graph, ir, &kept, options.extent)?;
 
     let mut resources: Vec<PlanResource> = Vec::with_capacity(kept.len());
     for &r in &kept {

@@ -201,7 +201,7 @@ fn pass_path<'p>(index: usize, rest: &[Seg<'p>]) -> Vec<Seg<'p>> {
     path
 }
 
-fn resource_path<'p>(index: usize, rest: &[Seg<'p>]) -> Vec<Seg<'p>> {
+pub(crate) fn resource_path<'p>(index: usize, rest: &[Seg<'p>]) -> Vec<Seg<'p>> {
     let mut path = vec![Seg::Field("resources"), Seg::Index(index)];
     path.extend_from_slice(rest);
     path
@@ -284,7 +284,31 @@ impl<'a> Resolver<'a> {
             output,
         };
         self.check_usages(&ir);
+        self.check_extents(&ir);
         ir
+    }
+
+    /// Every image fits [`MAX_IMAGE_DIMENSION`] at each size `check` tries
+    /// (images within it keep every output-sized dispatch within
+    /// [`MAX_WORKGROUP_COUNT`] groups).
+    fn check_extents(&mut self, ir: &Ir) {
+        for (r, res) in ir.resources.iter().enumerate() {
+            if !matches!(res.kind, IrKind::Image { .. }) {
+                continue;
+            }
+            let too_large = PROBE_SIZES.iter().find_map(|out| {
+                image_extent(ir, r, *out)
+                    .filter(|e| e.width > MAX_IMAGE_DIMENSION || e.height > MAX_IMAGE_DIMENSION)
+                    .map(|e| (*out, e))
+            });
+            if let Some((out, e)) = too_large {
+                self.error(
+                    res.source,
+                    &resource_path(res.index, &[Seg::Field("size")]),
+                    oversized_image(&res.name, e, out),
+                );
+            }
+        }
     }
 
     fn resolve_output(&mut self, resources: &[IrResource]) -> Option<usize> {
@@ -338,7 +362,21 @@ impl<'a> Resolver<'a> {
         }
     }
 
+    /// A number from the graph or a parameter; NaN and infinity are errors.
     fn dim(&mut self, source: usize, path: &[Seg], dim: &Dim, what: &str) -> Option<f64> {
+        let value = self.dim_value(source, path, dim, what)?;
+        if value.is_finite() {
+            return Some(value);
+        }
+        self.error(
+            source,
+            path,
+            format!("{what} must be a finite number, found {value}"),
+        );
+        None
+    }
+
+    fn dim_value(&mut self, source: usize, path: &[Seg], dim: &Dim, what: &str) -> Option<f64> {
         match dim {
             Dim::Number(n) => Some(*n),
             Dim::Reference(text) => {
@@ -368,6 +406,21 @@ impl<'a> Resolver<'a> {
                 }
             }
         }
+    }
+
+    /// A size's two scale factors, each in (0, 16].
+    fn scale_pair(&mut self, source: usize, path: &[Seg], x: &Dim, y: &Dim) -> (f64, f64) {
+        let sx = self.dim(source, path, x, "a scale").unwrap_or(1.0);
+        let sy = self.dim(source, path, y, "a scale").unwrap_or(1.0);
+        if !(sx > 0.0 && sy > 0.0 && sx <= 16.0 && sy <= 16.0) {
+            self.error(
+                source,
+                path,
+                format!("scale ({sx}, {sy}) must be in (0, 16]"),
+            );
+            return (1.0, 1.0);
+        }
+        (sx, sy)
     }
 
     fn count(&mut self, source: usize, path: &[Seg], dim: &Dim, what: &str, max: u32) -> u32 {
@@ -420,15 +473,7 @@ impl<'a> Resolver<'a> {
                 let size = match &img.size {
                     SizeDecl::Output => SizeSpec::Output,
                     SizeDecl::Scale(x, y) => {
-                        let sx = self.dim(source, &size_path, x, "a scale").unwrap_or(1.0);
-                        let sy = self.dim(source, &size_path, y, "a scale").unwrap_or(1.0);
-                        if !(sx > 0.0 && sy > 0.0 && sx <= 16.0 && sy <= 16.0) {
-                            self.error(
-                                source,
-                                &size_path,
-                                format!("scale ({sx}, {sy}) must be in (0, 16]"),
-                            );
-                        }
+                        let (sx, sy) = self.scale_pair(source, &size_path, x, y);
                         SizeSpec::Scale(sx, sy)
                     }
                     SizeDecl::Absolute(w, h) => {
@@ -437,8 +482,7 @@ impl<'a> Resolver<'a> {
                         SizeSpec::Absolute(w, h)
                     }
                     SizeDecl::Like(other, x, y) => {
-                        let sx = self.dim(source, &size_path, x, "a scale").unwrap_or(1.0);
-                        let sy = self.dim(source, &size_path, y, "a scale").unwrap_or(1.0);
+                        let (sx, sy) = self.scale_pair(source, &size_path, x, y);
                         match self.resource_index.get(other.as_str()) {
                             Some(&i) => SizeSpec::Like(i, sx, sy),
                             None => {
@@ -661,6 +705,7 @@ impl<'a> Resolver<'a> {
                 }
             }
         }
+        self.check_dispatch(source, index, decl.dispatch.as_ref());
         let dispatch = match &decl.dispatch {
             None => None,
             Some(Dispatch::Output(x, y)) => Some(IrDispatch::Output(*x, *y)),
@@ -694,6 +739,29 @@ impl<'a> Resolver<'a> {
         };
         self.check_pass_shape(&pass, decl, resources);
         pass
+    }
+
+    /// Work-group sizes of at least 1; fixed group counts within the count
+    /// every Vulkan device supports.
+    fn check_dispatch(&mut self, source: usize, index: usize, dispatch: Option<&Dispatch>) {
+        let at = pass_path(index, &[Seg::Field("dispatch")]);
+        let (values, what, max) = match dispatch {
+            None => return,
+            Some(Dispatch::Output(x, y) | Dispatch::Image(_, x, y)) => {
+                (vec![*x, *y], "work-group sizes", u32::MAX)
+            }
+            Some(Dispatch::Groups(x, y, z)) => {
+                (vec![*x, *y, *z], "group counts", MAX_WORKGROUP_COUNT)
+            }
+        };
+        if let Some(bad) = values.iter().find(|v| !(1..=max).contains(*v)) {
+            let range = if max == u32::MAX {
+                "at least 1".to_string()
+            } else {
+                format!("from 1 to {max}")
+            };
+            self.error(source, &at, format!("{what} must be {range}, found {bad}"));
+        }
     }
 
     /// Rules about what each pass kind must declare.
@@ -789,14 +857,21 @@ impl<'a> Resolver<'a> {
         }
         for (i, a) in decl.color.iter().enumerate() {
             if let LoadDecl::Clear(v) = &a.load {
+                let at = pass_path(
+                    index,
+                    &[Seg::Field("color"), Seg::Index(i), Seg::Field("load")],
+                );
                 if v.len() != 4 {
                     self.error(
                         source,
-                        &pass_path(
-                            index,
-                            &[Seg::Field("color"), Seg::Index(i), Seg::Field("load")],
-                        ),
+                        &at,
                         format!("a colour clear needs 4 values, found {}", v.len()),
+                    );
+                } else if let Some(bad) = v.iter().find(|x| !x.is_finite()) {
+                    self.error(
+                        source,
+                        &at,
+                        format!("clear values must be finite numbers, found {bad}"),
                     );
                 }
             }
@@ -812,14 +887,30 @@ impl<'a> Resolver<'a> {
             }
         }
         if let Some(a) = &decl.depth {
-            if let LoadDecl::Clear(v) = &a.load {
-                if v.len() != 1 {
+            let at = pass_path(index, &[Seg::Field("depth"), Seg::Field("load")]);
+            match &a.load {
+                LoadDecl::Clear(v) if v.len() != 1 => {
                     self.error(
                         source,
-                        &pass_path(index, &[Seg::Field("depth"), Seg::Field("load")]),
+                        &at,
                         format!("a depth clear needs 1 value, found {}", v.len()),
                     );
                 }
+                LoadDecl::Clear(v) if !(0.0..=1.0).contains(&v[0]) => {
+                    self.error(
+                        source,
+                        &at,
+                        format!("a depth clear must be in [0, 1], found {}", v[0]),
+                    );
+                }
+                LoadDecl::Clear(_) | LoadDecl::DontCare if a.read_only => {
+                    self.error(
+                        source,
+                        &at,
+                        "a read-only depth attachment tests against earlier depth, so it needs `load: Load`".to_string(),
+                    );
+                }
+                _ => {}
             }
             if a.blend.is_some() {
                 self.error(
@@ -914,7 +1005,21 @@ impl<'a> Resolver<'a> {
                                 format!("multisampled image \"{rname}\" cannot be a storage image"),
                             );
                         }
-                        if matches!(access.usage, Usage::Color { .. } | Usage::Depth { .. }) {
+                        let attachment =
+                            matches!(access.usage, Usage::Color { .. } | Usage::Depth { .. });
+                        if let (true, IrKind::Image { mips, layers, .. }) =
+                            (attachment, &ir.resources[access.resource].kind)
+                        {
+                            if *mips > 1 || *layers > 1 {
+                                self.error(
+                                    source,
+                                    &path,
+                                    format!("\"{rname}\" has {mips} mip level(s) and {layers} layer(s), but attachments render to a single mip level and layer"),
+                                )
+                                .hint = Some("give the attachment image `mips: 1` and `layers: 1`".into());
+                            }
+                        }
+                        if attachment {
                             let sizes = PROBE_SIZES
                                 .iter()
                                 .map(|out| {
@@ -1056,6 +1161,22 @@ fn resource_name(r: &ResourceDecl) -> &str {
         ResourceDecl::Image(i) => &i.name,
         ResourceDecl::Buffer(b) => &b.name,
     }
+}
+
+/// The work-group count per dimension every Vulkan device supports
+/// (`maxComputeWorkGroupCount`'s required minimum).
+pub const MAX_WORKGROUP_COUNT: u32 = 65_535;
+
+/// The largest image side weft creates: `maxImageDimension2D` on the devices
+/// it targets, and the limit of `Absolute` sizes.
+pub const MAX_IMAGE_DIMENSION: u32 = 16_384;
+
+/// The error for an image side over [`MAX_IMAGE_DIMENSION`].
+pub(crate) fn oversized_image(name: &str, size: Extent, output: Extent) -> String {
+    format!(
+        "\"{name}\" would be {}x{} at output size {}x{}, over the {MAX_IMAGE_DIMENSION} pixels an image side may have",
+        size.width, size.height, output.width, output.height
+    )
 }
 
 /// An image's size for a given output size; `None` for a `Like` cycle or a buffer.

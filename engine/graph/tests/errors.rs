@@ -439,3 +439,64 @@ fn warnings_for_unread_resources_and_culled_passes() {
     );
     assert_eq!(diags.len(), 1);
 }
+
+/// A graph with one compute pass writing the output, for dispatch rules.
+const COMPUTE: &str = r#"Graph(
+    resources: [
+        Image(name: "img", format: R8G8B8A8_UNORM),
+    ],
+    passes: [
+        Pass(
+            name: "fill",
+            kind: Compute,
+            shaders: (compute: "c.comp"),
+            storage_write: ["img"],
+            dispatch: Output(8, 8),
+        ),
+    ],
+    output: "img",
+)"#;
+
+/// Values the GPU would reject, or silently misuse, are errors at the line that
+/// gives them: each case is (base graph, edit, message, text at the location).
+#[test]
+fn out_of_range_values_are_located_errors() {
+    let cases: [(&str, (&str, &str), &str, &str); 11] = [
+        (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([2.0])"#),
+            "a depth clear must be in [0, 1], found 2", "Clear([2.0])"),
+        (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([NaN])"#),
+            "a depth clear must be in [0, 1], found NaN", "Clear([NaN])"),
+        (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([inf])"#),
+            "a depth clear must be in [0, 1], found inf", "Clear([inf])"),
+        (VALID, (r#"Clear([0.0, 0.0, 0.0, 1.0])"#, r#"Clear([0.0, NaN, 0.0, 1.0])"#),
+            "clear values must be finite numbers, found NaN", "Clear([0.0, NaN"),
+        (VALID, (r#"load: Clear([0.0]))"#, r#"load: DontCare, read_only: true)"#),
+            "a read-only depth attachment tests against earlier depth, so it needs `load: Load`", "DontCare"),
+        (VALID, (r#"format: R8G8B8A8_UNORM)"#, r#"format: R8G8B8A8_UNORM, mips: 4)"#),
+            "\"albedo\" has 4 mip level(s) and 1 layer(s), but attachments render to a single mip level and layer", "\"albedo\", load"),
+        (VALID, (r#"format: R8G8B8A8_UNORM)"#, r#"format: R8G8B8A8_UNORM, size: Like("ldr", 1.0, 4294967296))"#),
+            "scale (1, 4294967296) must be in (0, 16]", "Like("),
+        (VALID, (r#"format: R8G8B8A8_UNORM)"#, r#"format: R8G8B8A8_UNORM, size: Like("ldr", NaN, 1.0))"#),
+            "a scale must be a finite number, found NaN", "Like("),
+        (VALID, (r#"format: R8G8B8A8_UNORM)"#, r#"format: R8G8B8A8_UNORM, size: Scale(16.0, 16.0))"#),
+            "\"albedo\" would be 30720x17280 at output size 1920x1080, over the 16384 pixels an image side may have", "Scale("),
+        (COMPUTE, ("Output(8, 8)", "Output(0, 16)"),
+            "work-group sizes must be at least 1, found 0", "Output(0, 16)"),
+        (COMPUTE, ("Output(8, 8)", "Groups(1, 70000, 1)"),
+            "group counts must be from 1 to 65535, found 70000", "Groups("),
+    ];
+    for (base, (from, to), message, at) in cases {
+        assert!(base.contains(from), "{from}");
+        let text = base.replacen(from, to, 1);
+        let found = errors(&text);
+        let d = found
+            .iter()
+            .find(|d| d.message == message)
+            .unwrap_or_else(|| panic!("{to}: expected \"{message}\", got {found:#?}"));
+        assert!(
+            text_at(&text, d).starts_with(at),
+            "{to}: located at {:?}",
+            text_at(&text, d)
+        );
+    }
+}
