@@ -88,7 +88,9 @@ fn check_shaders(graph: &LoadedGraph) -> Result<Vec<Diagnostic>> {
             Ok(plan) => plan,
             Err(diags) => return Ok(diags),
         };
-        for weft_gpu::ShaderProblem { pass, message } in weft_gpu::check_shaders(&plan)? {
+        let mut cache = weft_gpu::pipeline::PipelineCache::new()?;
+        let problems = weft_render::scene_interface::check_plan_shaders(&mut cache, &plan);
+        for weft_gpu::ShaderProblem { pass, message } in problems {
             let at = plan
                 .passes
                 .iter()

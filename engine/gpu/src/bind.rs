@@ -4,10 +4,13 @@
 //! push-constant block by member name.
 
 use crate::gaussian::GaussianTaps;
-use crate::reflect::{DescriptorKind, PipelineInterface, PushBlock, ScalarKind, ShaderBinding};
+use crate::reflect::{
+    DescriptorKind, ImageShape, PipelineInterface, PushBlock, ScalarKind, ShaderBinding,
+};
 use std::collections::BTreeMap;
-use weft_graph::plan::{Binding, BindingKind, Plan, PlanPass, ResourceDesc};
+use weft_graph::plan::{Binding, BindingKind, ImageDesc, Plan, PlanPass, ResourceDesc};
 use weft_graph::schema::ParamValue;
+use weft_graph::vk::Aspect;
 
 /// A shader binding and the graph binding that feeds it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -81,7 +84,18 @@ pub fn resolve_bindings(
                 "shader binding {} `{}` is a {:?} but graph resource `{}` is bound as {:?} ({:?})",
                 shader.binding, shader.name, shader.kind, resource.name, graph.kind, expected
             ));
+            used[index] = true;
             continue;
+        }
+        if let (ResourceDesc::Image(desc), Some(shape)) = (&resource.desc, &shader.image) {
+            if let Some(problem) = image_mismatch(shader, shape, desc) {
+                problems.push(format!(
+                    "shader binding {} `{}` {problem}, but graph image `{}` is {} with {} layer(s) and {} sample(s)",
+                    shader.binding, shader.name, resource.name, desc.format, desc.layers, desc.samples
+                ));
+                used[index] = true;
+                continue;
+            }
         }
         used[index] = true;
         resolved.push(ResolvedBinding {
@@ -99,6 +113,40 @@ pub fn resolve_bindings(
         Ok(resolved)
     } else {
         Err(problems)
+    }
+}
+
+/// How a shader's image binding disagrees with the image bound to it, if it does.
+fn image_mismatch(shader: &ShaderBinding, shape: &ImageShape, desc: &ImageDesc) -> Option<String> {
+    let depth = desc.aspect != Aspect::Color;
+    let reads = if depth {
+        ScalarKind::Float
+    } else {
+        attachment_scalar(&desc.format)
+    };
+    if !shape.two_d {
+        return Some("is not a 2D image".into());
+    }
+    if shape.arrayed != (desc.layers > 1) {
+        return Some(format!(
+            "is {}an array image",
+            if shape.arrayed { "" } else { "not " }
+        ));
+    }
+    if shape.multisampled != (desc.samples > 1) {
+        return Some(format!(
+            "is {}multisampled",
+            if shape.multisampled { "" } else { "not " }
+        ));
+    }
+    if shader.depth_compare && !depth {
+        return Some("is a depth-comparison sampler (sampler2DShadow)".into());
+    }
+    match shape.scalar {
+        Some(scalar) if scalar != reads => Some(format!(
+            "reads {scalar:?} values (the format gives {reads:?})"
+        )),
+        _ => None,
     }
 }
 

@@ -106,6 +106,59 @@ pub fn pass_problems(
     }
 }
 
+/// Adds where a reflected problem's variable is declared — the first
+/// `` `name` `` in the message, looked up in the stages' files (each shader,
+/// then its includes; the fragment shader first for a message about a
+/// fragment input or output) — so the message names the shader file:line as well as
+/// the pass. Compile errors already carry theirs and are returned unchanged.
+pub fn with_declaration(cache: &mut PipelineCache, keys: &[ShaderKey], message: String) -> String {
+    let Some(name) = message.split('`').nth(1).filter(|n| !n.is_empty()) else {
+        return message;
+    };
+    // A message about one stage's variable is looked up in that stage first.
+    let mut ordered: Vec<&ShaderKey> = keys.iter().collect();
+    if message.starts_with("fragment") {
+        ordered.sort_by_key(|k| k.stage != ShaderStage::Fragment);
+    }
+    for key in ordered {
+        let Ok(module) = cache.shader(key) else {
+            continue;
+        };
+        let files = std::iter::once(&key.path).chain(
+            module
+                .compiled
+                .dependencies
+                .iter()
+                .filter(|d| **d != key.path),
+        );
+        for file in files {
+            if let Some(line) = declaration_line(file, name) {
+                return format!("{message} (declared at {}:{line})", file.display());
+            }
+        }
+    }
+    message
+}
+
+/// The 1-based line of `file` that declares `name`: a `layout(...)` line, or
+/// a block or variable declaration, naming it as a whole word.
+fn declaration_line(file: &std::path::Path, name: &str) -> Option<usize> {
+    let text = std::fs::read_to_string(file).ok()?;
+    let is_word = |line: &str| {
+        line.split(|c: char| !(c.is_alphanumeric() || c == '_'))
+            .any(|w| w == name)
+    };
+    text.lines()
+        .position(|line| {
+            let code = line.split("//").next().unwrap_or_default();
+            let declares = ["layout", "uniform", "buffer", " in ", " out "]
+                .iter()
+                .any(|k| code.contains(k));
+            declares && is_word(code)
+        })
+        .map(|i| i + 1)
+}
+
 /// A problem with a pass's shaders.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ShaderProblem {
@@ -130,9 +183,13 @@ pub fn check_with(cache: &mut PipelineCache, plan: &Plan) -> Vec<ShaderProblem> 
             None => Ok(Vec::new()),
             Some(shaders) => {
                 let interface = cache.interface(&shaders.keys())?;
+                let keys: Vec<ShaderKey> = shaders.keys().into_iter().cloned().collect();
                 Ok(pass_problems(plan, pass, &shaders, &interface)
                     .err()
-                    .unwrap_or_default())
+                    .unwrap_or_default()
+                    .into_iter()
+                    .map(|m| with_declaration(cache, &keys, m))
+                    .collect())
             }
         });
         let messages = match found {

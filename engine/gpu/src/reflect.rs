@@ -50,6 +50,23 @@ pub struct ShaderBinding {
     /// A depth-comparison sampler (`sampler2DShadow`): bound with the compare
     /// sampler, so `texture`/`textureProj` return filtered visibility.
     pub depth_compare: bool,
+    /// For image bindings, what the shader expects of the image, compared with
+    /// the graph resource's format, layers and samples.
+    pub image: Option<ImageShape>,
+}
+
+/// What a shader declares about an image binding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ImageShape {
+    /// Scalar type of what a read returns (`sampler2D` float, `usampler2D`
+    /// uint, `isampler2D` int); `None` for storage images, whose format says it.
+    pub scalar: Option<ScalarKind>,
+    /// A 2D image (`sampler2D`, `image2D`), the only kind of graph image.
+    pub two_d: bool,
+    /// An array image (`sampler2DArray`).
+    pub arrayed: bool,
+    /// A multisampled image (`sampler2DMS`).
+    pub multisampled: bool,
 }
 
 /// Scalar type of a push-constant member.
@@ -100,6 +117,19 @@ pub struct FragmentOutput {
     pub components: u32,
 }
 
+/// A shader input or output variable at a location (vertex attributes,
+/// values passed from the vertex to the fragment shader).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StageVariable {
+    /// The GLSL name, for messages.
+    pub name: String,
+    /// Location.
+    pub location: u32,
+    /// Scalar type and component count; `None` for types other than scalars
+    /// and vectors (matrices, arrays, blocks), which are not compared.
+    pub shape: Option<(ScalarKind, u32)>,
+}
+
 /// The resource interface of one shader stage.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ShaderInterface {
@@ -111,6 +141,10 @@ pub struct ShaderInterface {
     pub push: Option<PushBlock>,
     /// Colour outputs of fragment shaders, by location.
     pub outputs: Vec<FragmentOutput>,
+    /// Inputs by location: vertex attributes, or a fragment shader's inputs.
+    pub inputs: Vec<StageVariable>,
+    /// A vertex shader's outputs by location (what the fragment shader reads).
+    pub varyings: Vec<StageVariable>,
 }
 
 impl ShaderInterface {
@@ -133,6 +167,8 @@ impl ShaderInterface {
         let mut bindings = Vec::new();
         let mut push = None;
         let mut outputs = Vec::new();
+        let mut inputs = Vec::new();
+        let mut varyings = Vec::new();
         for var in entry.vars {
             match var {
                 Variable::Descriptor {
@@ -167,6 +203,7 @@ impl ShaderInterface {
                         kind,
                         count: nbind.max(1),
                         depth_compare: is_depth_sampler(&ty),
+                        image: image_shape(&ty),
                     });
                 }
                 Variable::PushConstant { ty, .. } => {
@@ -182,9 +219,23 @@ impl ShaderInterface {
                         components,
                     });
                 }
+                Variable::Input { name, location, ty } => inputs.push(StageVariable {
+                    name: name.unwrap_or_default(),
+                    location: location.loc(),
+                    shape: scalar_shape(&ty),
+                }),
+                Variable::Output { name, location, ty } if shader.stage == ShaderStage::Vertex => {
+                    varyings.push(StageVariable {
+                        name: name.unwrap_or_default(),
+                        location: location.loc(),
+                        shape: scalar_shape(&ty),
+                    })
+                }
                 _ => {}
             }
         }
+        inputs.sort_by_key(|v| v.location);
+        varyings.sort_by_key(|v| v.location);
         bindings.sort_by_key(|b| (b.set, b.binding));
         outputs.sort_by_key(|o| o.location);
         Ok(Self {
@@ -192,6 +243,8 @@ impl ShaderInterface {
             bindings,
             push,
             outputs,
+            inputs,
+            varyings,
         })
     }
 }
@@ -200,6 +253,28 @@ fn is_depth_sampler(ty: &Type) -> bool {
     match ty {
         Type::CombinedImageSampler(t) => t.sampled_image_ty.is_depth == Some(true),
         _ => false,
+    }
+}
+
+fn image_shape(ty: &Type) -> Option<ImageShape> {
+    use spirq::ty::Dim;
+    match ty {
+        Type::CombinedImageSampler(t) => {
+            let t = &t.sampled_image_ty;
+            Some(ImageShape {
+                scalar: scalar_kind(&t.scalar_ty),
+                two_d: t.dim == Dim::Dim2D,
+                arrayed: t.is_array,
+                multisampled: t.is_multisampled,
+            })
+        }
+        Type::StorageImage(t) => Some(ImageShape {
+            scalar: None,
+            two_d: t.dim == Dim::Dim2D,
+            arrayed: t.is_array,
+            multisampled: t.is_multisampled,
+        }),
+        _ => None,
     }
 }
 

@@ -243,11 +243,15 @@ fn parse_diagnostics(text: &str, root: &Path) -> Vec<ShaderDiagnostic> {
         if line.ends_with("generated.") {
             continue;
         }
-        out.push(locate(line).unwrap_or_else(|| ShaderDiagnostic {
-            file: root.to_path_buf(),
-            line: None,
-            message: line.to_string(),
-        }));
+        out.push(
+            locate(line)
+                .or_else(|| locate_file_level(line))
+                .unwrap_or_else(|| ShaderDiagnostic {
+                    file: root.to_path_buf(),
+                    line: None,
+                    message: line.to_string(),
+                }),
+        );
     }
     if out.is_empty() {
         out.push(ShaderDiagnostic {
@@ -280,9 +284,32 @@ fn locate(line: &str) -> Option<ShaderDiagnostic> {
     None
 }
 
+/// A message about a whole file (`PATH: error: #version ...` for an empty
+/// shader), placed at its first line.
+fn locate_file_level(line: &str) -> Option<ShaderDiagnostic> {
+    ["error:", "warning:"].iter().find_map(|kind| {
+        let (file, rest) = line.split_once(&format!(": {kind}"))?;
+        Some(ShaderDiagnostic {
+            file: PathBuf::from(file),
+            line: Some(1),
+            message: format!("{kind}{rest}"),
+        })
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn file_level_messages_name_the_file_once_at_line_one() {
+        let text = "s/t.frag: error: #version: Desktop shaders for Vulkan SPIR-V require version 140 or higher\n1 error generated.\n";
+        let d = parse_diagnostics(text, Path::new("s/t.frag"));
+        assert_eq!(
+            d.iter().map(ToString::to_string).collect::<Vec<_>>(),
+            ["s/t.frag:1: error: #version: Desktop shaders for Vulkan SPIR-V require version 140 or higher"]
+        );
+    }
 
     #[test]
     fn locates_compiler_messages() {

@@ -28,7 +28,34 @@ pub enum RenderError {
         /// What the decoder said.
         message: String,
     },
+    /// A pass failed while a frame was prepared or recorded; located at the
+    /// pass's declaration in its graph file.
+    #[error("{}:{}: {error}", at.file.display(), at.pos)]
+    AtPass {
+        /// Where the pass is declared.
+        at: weft_graph::plan::Location,
+        /// What went wrong (not a `source`: the message already includes it).
+        error: GpuError,
+    },
     /// The scene has more of something than the GPU layouts can index.
     #[error("scene too large: {0}")]
     TooLarge(String),
+}
+
+impl RenderError {
+    /// `error` located at the declaration of the pass it names, when it names
+    /// one of `plan`'s passes.
+    pub fn at_pass(error: GpuError, plan: &weft_graph::Plan) -> Self {
+        let name = match &error {
+            GpuError::Pass { pass, .. } | GpuError::Mismatch { pass, .. } => pass,
+            _ => return Self::Gpu(error),
+        };
+        match plan.passes.iter().find(|p| p.name == *name) {
+            Some(pass) => Self::AtPass {
+                at: pass.declared_at.clone(),
+                error,
+            },
+            None => Self::Gpu(error),
+        }
+    }
 }

@@ -157,17 +157,19 @@ pub fn render(
         )?;
         recorder.set_frame(time, frame);
         let started = std::time::Instant::now();
-        let report = renderer.execute(
-            &plan,
-            &mut resources,
-            &mut recorder,
-            &FrameOptions {
-                timing: settings.timing,
-                readback: settings.readback && frame + 1 == frames,
-                time,
-                frame,
-            },
-        )?;
+        let report = renderer
+            .execute(
+                &plan,
+                &mut resources,
+                &mut recorder,
+                &FrameOptions {
+                    timing: settings.timing,
+                    readback: settings.readback && frame + 1 == frames,
+                    time,
+                    frame,
+                },
+            )
+            .map_err(|e| RenderError::at_pass(e, &plan))?;
         frame_ms.push(started.elapsed().as_secs_f64() * 1e3);
         record_ms.push(report.record_ms);
         last = Some(report);

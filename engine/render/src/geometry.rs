@@ -10,6 +10,10 @@ use glam::{Mat4, Vec2, Vec3};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::{Material, Scene};
 
+/// The scene vertex's attributes: location, float count and what it holds.
+pub const VERTEX_ATTRIBUTES: [(u32, u32, &str); 3] =
+    [(0, 3, "position"), (1, 3, "normal"), (2, 2, "UV")];
+
 /// Bytes per vertex: position (3 floats), normal (3), uv (2).
 pub const VERTEX_BYTES: u32 = 32;
 /// Bytes of one draw record (`struct Draw` in `shaders/include/scene.glsl`).

@@ -27,6 +27,7 @@ pub mod recorder;
 pub mod reload;
 pub mod reload_worker;
 pub mod scene_gpu;
+pub mod scene_interface;
 pub mod shadow_reference;
 pub mod shadows;
 pub mod sources;

@@ -3,7 +3,8 @@
 //! reflection (graph resources), set 1 and 2 from the scene, push constants
 //! from reflection, and the fixed-function state the plan implies.
 
-use crate::geometry::VERTEX_BYTES;
+use crate::geometry::{VERTEX_ATTRIBUTES, VERTEX_BYTES};
+use crate::scene_interface::scene_pass_problems;
 use crate::state::{Cull, DepthTest, PassState};
 use ash::vk;
 use std::collections::HashMap;
@@ -11,7 +12,8 @@ use std::path::Path;
 use std::sync::Arc;
 use weft_gpu::pipeline::{blend_state, PipelineCache, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
-use weft_gpu::{GpuError, SCENE_SET};
+use weft_gpu::GpuError;
+use weft_graph::plan::{Plan, PlanPass};
 
 /// Set number of a material's texture.
 pub const MATERIAL_SET: u32 = 2;
@@ -97,23 +99,33 @@ impl ScenePipelines {
         })
     }
 
-    /// The pipeline for `key`, built on first use against the scene's set layouts.
+    /// The pipeline for `key`, built on first use against the scene's set
+    /// layouts, once its shaders pass the scene interface check for `pass`.
     pub fn get(
         &mut self,
         device: &ash::Device,
         key: &ScenePipelineKey,
-        scene_layout: vk::DescriptorSetLayout,
-        material_layout: vk::DescriptorSetLayout,
+        layouts: [vk::DescriptorSetLayout; 2],
+        (plan, pass): (&Plan, &PlanPass),
     ) -> Result<Arc<ScenePipeline>, GpuError> {
         if let Some(p) = self.pipelines.get(key) {
             return Ok(Arc::clone(p));
         }
+        let [scene_layout, material_layout] = layouts;
         let vs = self.shaders.shader(&key.vertex)?;
         let fs = key
             .fragment
             .as_ref()
             .map(|k| self.shaders.shader(k))
             .transpose()?;
+        let problems =
+            scene_pass_problems(plan, pass, &vs.interface, fs.as_ref().map(|f| &f.interface));
+        if !problems.is_empty() {
+            return Err(GpuError::Pass {
+                pass: pass.name.clone(),
+                message: problems.join("; "),
+            });
+        }
         let pipeline = build(
             device,
             key,
@@ -191,16 +203,6 @@ fn build(
     let mut stages = vec![&vs.interface];
     stages.extend(fs.map(|f| &f.interface));
     let interface = PipelineInterface::merge(&stages).map_err(|m| reflect_error(key, m))?;
-    if let Some(((set, binding), _)) = interface
-        .bindings
-        .iter()
-        .find(|((s, _), _)| *s > MATERIAL_SET)
-    {
-        return Err(reflect_error(
-            key,
-            format!("binding {binding} in set {set}: scene shaders use sets 0 (graph), {SCENE_SET} (scene) and {MATERIAL_SET} (material)"),
-        ));
-    }
     let graph_bindings: Vec<_> = interface
         .bindings
         .iter()
@@ -292,17 +294,20 @@ fn create_pipeline(
             stride: VERTEX_BYTES,
             input_rate: vk::VertexInputRate::VERTEX,
         }];
-        let attribute = |location, offset, format| vk::VertexInputAttributeDescription {
-            location,
-            binding: 0,
-            format,
-            offset,
-        };
-        let all = [
-            attribute(0, 0, vk::Format::R32G32B32_SFLOAT),
-            attribute(1, 12, vk::Format::R32G32B32_SFLOAT),
-            attribute(2, 24, vk::Format::R32G32_SFLOAT),
-        ];
+        let mut offset = 0;
+        let all = VERTEX_ATTRIBUTES.map(|(location, floats, _)| {
+            let attribute = vk::VertexInputAttributeDescription {
+                location,
+                binding: 0,
+                format: match floats {
+                    2 => vk::Format::R32G32_SFLOAT,
+                    _ => vk::Format::R32G32B32_SFLOAT,
+                },
+                offset,
+            };
+            offset += floats * 4;
+            attribute
+        });
         let attributes = if key.position_only {
             &all[..1]
         } else {

@@ -140,7 +140,7 @@ pub(crate) fn check_shaders(
             .shader(key)
             .map_err(|e| ReloadError::gpu(e, &key.path))?;
     }
-    let problems = weft_gpu::check::check_with(checker, plan);
+    let problems = crate::scene_interface::check_plan_shaders(checker, plan);
     match problems.first() {
         None => Ok(()),
         Some(problem) => {

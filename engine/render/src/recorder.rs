@@ -6,6 +6,7 @@
 use crate::geometry::DrawItem;
 use crate::pipelines::{front_face, ScenePipeline, ScenePipelineKey, ScenePipelines, MATERIAL_SET};
 use crate::scene_gpu::GpuScene;
+use crate::scene_interface::{position_only, scene_set_problems, SHADOW_VIEW_MEMBER};
 use crate::shadows::ShadowSettings;
 use crate::state::{pass_state, DepthTest, PassState};
 use ash::vk;
@@ -19,10 +20,6 @@ use weft_graph::schema::{Draw, LightKind, MaterialFilter, ParamValue};
 
 /// Descriptor sets for graph resources one frame may need.
 const FRAME_SETS: u32 = 64;
-/// The push-constant member that makes a pass a shadow pass: drawn once per
-/// shadow view (`shaders/shadow.vert`), into the view's atlas tile.
-const SHADOW_VIEW_MEMBER: &str = "shadow_view";
-
 fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
     move |result| GpuError::Vulkan { call, result }
 }
@@ -427,15 +424,13 @@ impl DrawRecorder for SceneRecorder<'_> {
                 .map(|f| shader(f, ShaderStage::Fragment)),
             render_pass: ctx.render_pass,
             state: pass_state(pass),
-            position_only: matches!(draw, Draw::LightVolumes(_)) || pass.shaders.fragment.is_none(),
+            position_only: position_only(pass),
         };
         let device = self.gpu.device();
-        let p = self.pipelines.get(
-            device,
-            &key,
-            self.scene.scene_layout,
-            self.scene.material_layout,
-        )?;
+        let layouts = [self.scene.scene_layout, self.scene.material_layout];
+        let p = self
+            .pipelines
+            .get(device, &key, layouts, (ctx.plan, pass))?;
         let graph_set = self.graph_set(ctx, p.graph_layout, &p.interface)?;
         let mut params = pass.params.clone();
         if is_shadow_pass(&p) {
@@ -467,12 +462,9 @@ impl DrawRecorder for SceneRecorder<'_> {
                         state: transparent_state(&key.state),
                         ..key.clone()
                     };
-                    let q = self.pipelines.get(
-                        device,
-                        &blended,
-                        self.scene.scene_layout,
-                        self.scene.material_layout,
-                    )?;
+                    let q = self
+                        .pipelines
+                        .get(device, &blended, layouts, (ctx.plan, pass))?;
                     self.bind(ctx.cmd, &q, &bindings);
                     calls += self.draw_meshes(ctx.cmd, &q, transparent.iter());
                 }
@@ -517,6 +509,13 @@ impl DrawRecorder for SceneRecorder<'_> {
     }
 
     fn bind_scene(&mut self, ctx: &RasterContext<'_>, pipeline: &Pipeline) -> Result<(), GpuError> {
+        let problems = scene_set_problems(&pipeline.interface, false);
+        if !problems.is_empty() {
+            return Err(GpuError::Pass {
+                pass: ctx.pass().name.clone(),
+                message: problems.join("; "),
+            });
+        }
         let bindings: Vec<u32> = pipeline
             .interface
             .bindings

@@ -222,12 +222,14 @@ impl<'g> LiveRender<'g> {
             time,
             frame,
         };
-        Ok(self.renderer.execute(
-            &self.plan,
-            &mut self.resources,
-            &mut self.recorder,
-            &options,
-        )?)
+        self.renderer
+            .execute(
+                &self.plan,
+                &mut self.resources,
+                &mut self.recorder,
+                &options,
+            )
+            .map_err(|e| RenderError::at_pass(e, &self.plan))
     }
 
     fn base(&self) -> ReloadBase {

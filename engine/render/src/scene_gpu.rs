@@ -14,6 +14,7 @@ use crate::texture::{self, Pixels, Texture};
 use ash::vk;
 use std::collections::HashMap;
 use std::path::PathBuf;
+use weft_gpu::reflect::DescriptorKind;
 use weft_gpu::{Gpu, GpuError};
 use weft_scene::material::{TextureRef, TextureSource};
 use weft_scene::{Camera, Scene};
@@ -34,11 +35,49 @@ pub const BASE_COLOR_BINDING: u32 = 0;
 pub const METALLIC_ROUGHNESS_BINDING: u32 = 1;
 /// Set 2 binding of a material's tangent-space normal map (UNORM).
 pub const NORMAL_BINDING: u32 = 2;
-/// The set 2 bindings, in the order of a material's texture slots.
-const MATERIAL_BINDINGS: [u32; 3] = [
-    BASE_COLOR_BINDING,
-    METALLIC_ROUGHNESS_BINDING,
-    NORMAL_BINDING,
+/// Set 1 as the engine creates and writes it: binding, descriptor kind and
+/// what it holds (for the shader check's messages).
+pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 5] = [
+    (
+        FRAME_BINDING,
+        DescriptorKind::UniformBuffer,
+        "the Frame block",
+    ),
+    (LIGHTS_BINDING, DescriptorKind::StorageBuffer, "the lights"),
+    (
+        DRAWS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the draw records",
+    ),
+    (
+        MATERIALS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the materials",
+    ),
+    (
+        SHADOWS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the shadow views",
+    ),
+];
+/// Set 2 as the engine creates it: a material's textures, in the order of its
+/// texture slots.
+pub const MATERIAL_SET_BINDINGS: [(u32, DescriptorKind, &str); 3] = [
+    (
+        BASE_COLOR_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the base-colour texture",
+    ),
+    (
+        METALLIC_ROUGHNESS_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the metallic-roughness texture",
+    ),
+    (
+        NORMAL_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the normal map",
+    ),
 ];
 /// Bytes of the `Frame` uniform block.
 pub const FRAME_BYTES: usize = 2 * 64 + 4 * 16;
@@ -224,22 +263,16 @@ impl<'g> GpuScene<'g> {
     fn create_sets(&mut self, material_texture: &[[usize; 3]]) -> Result<(), GpuError> {
         let device = self.gpu.device();
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-        let scene_bindings: Vec<_> = [
-            (FRAME_BINDING, vk::DescriptorType::UNIFORM_BUFFER),
-            (LIGHTS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
-            (DRAWS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
-            (MATERIALS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
-            (SHADOWS_BINDING, vk::DescriptorType::STORAGE_BUFFER),
-        ]
-        .iter()
-        .map(|&(b, ty)| {
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(b)
-                .descriptor_type(ty)
-                .descriptor_count(1)
-                .stage_flags(stages)
-        })
-        .collect();
+        let scene_bindings: Vec<_> = SCENE_SET_BINDINGS
+            .iter()
+            .map(|&(b, kind, _)| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(b)
+                    .descriptor_type(kind.vk())
+                    .descriptor_count(1)
+                    .stage_flags(stages)
+            })
+            .collect();
         self.scene_layout = unsafe {
             device.create_descriptor_set_layout(
                 &vk::DescriptorSetLayoutCreateInfo::default().bindings(&scene_bindings),
@@ -247,7 +280,7 @@ impl<'g> GpuScene<'g> {
             )
         }
         .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
-        let material_bindings = MATERIAL_BINDINGS.map(|b| {
+        let material_bindings = MATERIAL_SET_BINDINGS.map(|(b, _, _)| {
             vk::DescriptorSetLayoutBinding::default()
                 .binding(b)
                 .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
@@ -274,7 +307,7 @@ impl<'g> GpuScene<'g> {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                descriptor_count: MATERIAL_BINDINGS.len() as u32 * materials.max(1),
+                descriptor_count: MATERIAL_SET_BINDINGS.len() as u32 * materials.max(1),
             },
         ];
         self.pool = unsafe {
@@ -306,10 +339,10 @@ impl<'g> GpuScene<'g> {
                     image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
                 }]
             });
-            let writes: Vec<_> = MATERIAL_BINDINGS
+            let writes: Vec<_> = MATERIAL_SET_BINDINGS
                 .iter()
                 .zip(&infos)
-                .map(|(&binding, info)| {
+                .map(|(&(binding, _, _), info)| {
                     vk::WriteDescriptorSet::default()
                         .dst_set(set)
                         .dst_binding(binding)

@@ -1,0 +1,252 @@
+//! What the engine hands scene shaders — set 1 (scene buffers), set 2 (a
+//! material's textures), the vertex layout — and the check that a pass's
+//! shaders ask for exactly that. `weft graph check --shaders`, a hot reload and
+//! pipeline creation all run it, so a shader that declares the materials at
+//! binding 9 is refused with its pass's location instead of reading an
+//! unbound descriptor on the GPU.
+
+use crate::geometry::VERTEX_ATTRIBUTES;
+use crate::pipelines::MATERIAL_SET;
+use crate::scene_gpu::{MATERIAL_SET_BINDINGS, SCENE_SET_BINDINGS};
+use weft_gpu::bind::{check_outputs, pack_push, resolve_bindings, FrameValues};
+use weft_gpu::check::with_declaration;
+use weft_gpu::pipeline::{PipelineCache, ShaderKey};
+use weft_gpu::reflect::{DescriptorKind, PipelineInterface, ScalarKind, ShaderInterface};
+use weft_gpu::{GpuError, ShaderProblem, ShaderStage, SCENE_SET};
+use weft_graph::plan::{Plan, PlanPass};
+use weft_graph::schema::{Draw, ParamValue};
+
+/// The push-constant member that makes a pass a shadow pass: drawn once per
+/// shadow view (`shaders/shadow.vert`), into the view's atlas tile, with the
+/// view's index in this member.
+pub const SHADOW_VIEW_MEMBER: &str = "shadow_view";
+
+/// Whether a scene pass reads only vertex positions (depth-only passes and
+/// light volumes); mesh shading reads normals and UVs too.
+pub fn position_only(pass: &PlanPass) -> bool {
+    matches!(pass.draw, Some(Draw::LightVolumes(_))) || pass.shaders.fragment.is_none()
+}
+
+/// Problems with the scene sets (1, and 2 where `materials` allows it) that
+/// a pass's merged interface declares: every binding must be one the engine
+/// writes, with the descriptor type it writes.
+pub fn scene_set_problems(interface: &PipelineInterface, materials: bool) -> Vec<String> {
+    let mut problems = Vec::new();
+    for (shader, _) in interface.bindings.values() {
+        let table: &[(u32, DescriptorKind, &str)] = match shader.set {
+            SCENE_SET => &SCENE_SET_BINDINGS,
+            MATERIAL_SET if materials => &MATERIAL_SET_BINDINGS,
+            _ => continue,
+        };
+        match table.iter().find(|(b, _, _)| *b == shader.binding) {
+            Some((_, kind, _)) if *kind == shader.kind => {}
+            Some((_, kind, what)) => problems.push(format!(
+                "shader binding `{}` (set {} binding {}) is a {:?}, but the engine binds {what} there as a {kind:?}",
+                shader.name, shader.set, shader.binding, shader.kind
+            )),
+            None => problems.push(format!(
+                "shader binding `{}` (set {} binding {}) is not scene data the engine binds; set {} has {}",
+                shader.name,
+                shader.set,
+                shader.binding,
+                shader.set,
+                table
+                    .iter()
+                    .map(|(b, _, what)| format!("{b}: {what}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+        }
+    }
+    problems
+}
+
+/// Vertex attributes the shader reads that the scene's vertex buffer does
+/// not supply, or supplies with another type.
+fn vertex_input_problems(vs: &ShaderInterface, position_only: bool) -> Vec<String> {
+    let supplied = if position_only {
+        &VERTEX_ATTRIBUTES[..1]
+    } else {
+        &VERTEX_ATTRIBUTES[..]
+    };
+    vs.inputs
+        .iter()
+        .filter_map(|input| {
+            let found = supplied.iter().find(|(l, _, _)| *l == input.location);
+            match (found, input.shape) {
+                (Some((_, n, _)), Some((ScalarKind::Float, m))) if m <= *n => None,
+                (Some((l, n, what)), _) => Some(format!(
+                    "vertex input `{}` at location {l} is {}, but the scene supplies the {what} as {n} floats",
+                    input.name,
+                    shape_name(input.shape)
+                )),
+                (None, _) => Some(format!(
+                    "vertex input `{}` at location {} is not supplied; this pass's vertices have {}",
+                    input.name,
+                    input.location,
+                    supplied
+                        .iter()
+                        .map(|(l, _, what)| format!("{l}: {what}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )),
+            }
+        })
+        .collect()
+}
+
+/// Fragment inputs the vertex shader does not write at the same location
+/// with the same type.
+pub fn varying_problems(vs: &ShaderInterface, fs: &ShaderInterface) -> Vec<String> {
+    fs.inputs
+        .iter()
+        .filter_map(|input| {
+            match vs.varyings.iter().find(|v| v.location == input.location) {
+                None => Some(format!(
+                    "fragment input `{}` at location {} is not written by the vertex shader",
+                    input.name, input.location
+                )),
+                Some(out) if out.shape != input.shape => Some(format!(
+                    "fragment input `{}` at location {} is {}, but the vertex shader writes `{}` there as {}",
+                    input.name,
+                    input.location,
+                    shape_name(input.shape),
+                    out.name,
+                    shape_name(out.shape)
+                )),
+                Some(_) => None,
+            }
+        })
+        .collect()
+}
+
+fn shape_name(shape: Option<(ScalarKind, u32)>) -> String {
+    match shape {
+        Some((scalar, 1)) => format!("{scalar:?}").to_lowercase(),
+        Some((scalar, n)) => format!("a {n}-component {scalar:?} vector").to_lowercase(),
+        None => "not a scalar or vector".into(),
+    }
+}
+
+/// Every problem with a scene-drawing pass's shaders: graph bindings (set 0),
+/// scene sets, vertex inputs, vertex outputs against fragment inputs,
+/// fragment outputs against the attachments, push constants against params.
+pub fn scene_pass_problems(
+    plan: &Plan,
+    pass: &PlanPass,
+    vs: &ShaderInterface,
+    fs: Option<&ShaderInterface>,
+) -> Vec<String> {
+    let mut stages = vec![vs];
+    stages.extend(fs);
+    let merged = match PipelineInterface::merge(&stages) {
+        Ok(m) => m,
+        Err(message) => return vec![message],
+    };
+    let mut graph_only = merged.clone();
+    graph_only.bindings.retain(|(set, _), _| *set == 0);
+    let mut problems = resolve_bindings(plan, pass, &graph_only)
+        .err()
+        .unwrap_or_default();
+    problems.extend(
+        merged
+            .bindings
+            .values()
+            .filter(|(b, _)| b.set > MATERIAL_SET)
+            .map(|(b, _)| {
+                format!(
+                    "shader binding `{}` is in set {}; scene shaders use sets 0 (graph), {SCENE_SET} (scene) and {MATERIAL_SET} (material)",
+                    b.name, b.set
+                )
+            }),
+    );
+    problems.extend(scene_set_problems(&merged, true));
+    problems.extend(vertex_input_problems(vs, position_only(pass)));
+    if let Some(fs) = fs {
+        problems.extend(varying_problems(vs, fs));
+        problems.extend(check_outputs(plan, pass, &merged));
+    }
+    if let Some((block, _)) = &merged.push {
+        let mut params = pass.params.clone();
+        if block.members.iter().any(|m| m.name == SHADOW_VIEW_MEMBER) {
+            params.insert(SHADOW_VIEW_MEMBER.to_string(), ParamValue::Number(0.0));
+        }
+        if let Err(list) = pack_push(block, &params, &FrameValues::default()) {
+            problems.extend(list);
+        }
+    }
+    problems
+}
+
+/// Compiles, reflects and checks every shader a plan runs — the executor's
+/// fullscreen and compute passes through `weft_gpu::check`, scene-drawing
+/// passes here — and every pass's scene sets; each problem names its pass.
+pub fn check_plan_shaders(cache: &mut PipelineCache, plan: &Plan) -> Vec<ShaderProblem> {
+    let mut problems = weft_gpu::check::check_with(cache, plan);
+    for pass in &plan.passes {
+        let found = match weft_gpu::check::pass_shaders(pass) {
+            Ok(Some(shaders)) => {
+                let keys: Vec<ShaderKey> = shaders.keys().into_iter().cloned().collect();
+                cache.interface(&shaders.keys()).map(|merged| {
+                    scene_set_problems(&merged, false)
+                        .into_iter()
+                        .map(|m| with_declaration(cache, &keys, m))
+                        .collect()
+                })
+            }
+            Ok(None) => scene_pass_shaders(cache, plan, pass),
+            Err(_) => continue, // reported by `check_with`
+        };
+        let messages = match found {
+            Ok(list) => list,
+            Err(GpuError::Shader(weft_gpu::ShaderError::Compile(diagnostics))) => {
+                diagnostics.iter().map(ToString::to_string).collect()
+            }
+            Err(e) => vec![e.to_string()],
+        };
+        for message in messages {
+            let problem = ShaderProblem {
+                pass: pass.name.clone(),
+                message,
+            };
+            if !problems.contains(&problem) {
+                problems.push(problem);
+            }
+        }
+    }
+    problems
+}
+
+/// A scene-drawing pass's shaders compiled through `cache` and checked.
+fn scene_pass_shaders(
+    cache: &mut PipelineCache,
+    plan: &Plan,
+    pass: &PlanPass,
+) -> Result<Vec<String>, GpuError> {
+    if pass.draw.is_none() {
+        return Ok(Vec::new());
+    }
+    let key = |path: &std::path::Path, stage| ShaderKey {
+        path: path.to_path_buf(),
+        stage,
+        defines: pass.defines.clone(),
+    };
+    let Some(vertex) = pass.shaders.vertex.as_deref() else {
+        return Ok(vec!["needs a vertex shader".into()]);
+    };
+    let mut keys = vec![key(vertex, ShaderStage::Vertex)];
+    keys.extend(
+        pass.shaders
+            .fragment
+            .as_deref()
+            .map(|f| key(f, ShaderStage::Fragment)),
+    );
+    let vs = cache.shader(&keys[0])?;
+    let fs = keys.get(1).map(|k| cache.shader(k)).transpose()?;
+    let problems =
+        scene_pass_problems(plan, pass, &vs.interface, fs.as_ref().map(|f| &f.interface));
+    Ok(problems
+        .into_iter()
+        .map(|m| with_declaration(cache, &keys, m))
+        .collect())
+}
