@@ -144,3 +144,40 @@ fn bad_times_frame_counts_and_feature_names_are_refused() {
         assert!(err.contains(expected), "{extra:?}: {err}");
     }
 }
+
+#[test]
+fn more_light_volumes_than_the_limit_are_refused_at_the_pass() {
+    let dir = std::env::temp_dir().join(format!("weft-volumes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let scene = dir.join("many.scene");
+    std::fs::write(
+        &scene,
+        "pointlights\n{\n count 65537\n min -1 -1 -1\n max 1 1 1\n radius 0.1 0.2\n}\ncamera\n{\n position 0 0 4\n target 0 0 0\n}\n",
+    )
+    .expect("scene");
+    let out = weft(&[
+        "render",
+        scene.to_str().expect("utf-8"),
+        "--graph",
+        "graphs/deferred.ron",
+        "--size",
+        "16x16",
+        "--out",
+        dir.join("o.png").to_str().expect("utf-8"),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let line = std::fs::read_to_string(repo().join("graphs/deferred.ron"))
+        .expect("graph")
+        .lines()
+        .position(|l| l.contains("name: \"point_lights\""))
+        .expect("the pass")
+        + 1;
+    assert!(
+        err.contains(&format!(
+            "error: graphs/deferred.ron:{line}:19: pass `point_lights`: 65537 light volumes exceed the 65536 a frame draws this way"
+        )),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -84,7 +84,6 @@ pub fn resolve_bindings(
                 "shader binding {} `{}` is a {:?} but graph resource `{}` is bound as {:?} ({:?})",
                 shader.binding, shader.name, shader.kind, resource.name, graph.kind, expected
             ));
-            used[index] = true;
             continue;
         }
         if let (ResourceDesc::Image(desc), Some(shape)) = (&resource.desc, &shader.image) {
@@ -93,7 +92,6 @@ pub fn resolve_bindings(
                     "shader binding {} `{}` {problem}, but graph image `{}` is {} with {} layer(s) and {} sample(s)",
                     shader.binding, shader.name, resource.name, desc.format, desc.layers, desc.samples
                 ));
-                used[index] = true;
                 continue;
             }
         }

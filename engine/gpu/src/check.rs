@@ -112,7 +112,11 @@ pub fn pass_problems(
 /// fragment input or output) — so the message names the shader file:line as well as
 /// the pass. Compile errors already carry theirs and are returned unchanged.
 pub fn with_declaration(cache: &mut PipelineCache, keys: &[ShaderKey], message: String) -> String {
-    let Some(name) = message.split('`').nth(1).filter(|n| !n.is_empty()) else {
+    let about_a_shader_variable = SHADER_VARIABLE_MESSAGES
+        .iter()
+        .any(|start| message.starts_with(start));
+    let name = message.split('`').nth(1).filter(|n| !n.is_empty());
+    let Some(name) = name.filter(|_| about_a_shader_variable) else {
         return message;
     };
     // A message about one stage's variable is looked up in that stage first.
@@ -139,6 +143,15 @@ pub fn with_declaration(cache: &mut PipelineCache, keys: &[ShaderKey], message: 
     }
     message
 }
+
+/// How the messages about one shader variable (named first, in backticks)
+/// begin; others name graph resources or no variable at all.
+const SHADER_VARIABLE_MESSAGES: [&str; 4] = [
+    "shader binding",
+    "fragment input",
+    "vertex input",
+    "push-constant member",
+];
 
 /// The 1-based line of `file` that declares `name`: a `layout(...)` line, or
 /// a block or variable declaration, naming it as a whole word.

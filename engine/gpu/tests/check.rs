@@ -20,6 +20,8 @@ fn reports_every_disagreement_between_shaders_and_graph() {
         .map(|p| (p.pass, p.message))
         .collect();
     assert_eq!(without_device, problems);
+    // Problems with a shader variable name the line that declares it.
+    let consume = common::graph("shaders/consume_wrong.frag");
     let expected: Vec<(String, String)> = [
         (
             "produce",
@@ -27,11 +29,11 @@ fn reports_every_disagreement_between_shaders_and_graph() {
         ),
         (
             "consume",
-            "shader binding 1 `b` is a StorageImage but graph resource `b` is bound as Sampled (CombinedImageSampler)",
+            &format!("shader binding 1 `b` is a StorageImage but graph resource `b` is bound as Sampled (CombinedImageSampler) (declared at {}:5)", consume.display()),
         ),
         (
             "consume",
-            "shader binding 3 `extra` is fed by no graph resource (the pass binds `a`, `b`)",
+            &format!("shader binding 3 `extra` is fed by no graph resource (the pass binds `a`, `b`) (declared at {}:6)", consume.display()),
         ),
         (
             "consume",

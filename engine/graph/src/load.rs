@@ -351,6 +351,16 @@ fn resolve_params(
             );
         }
     }
+    for (name, value) in &params {
+        if let Some(bad) = non_finite(value) {
+            let (file, pos) = graph.locate(source, &[Seg::Field("params"), Seg::Key(name)]);
+            graph.diagnostics.push(Diagnostic::error(
+                file,
+                pos,
+                format!("parameter \"{name}\" must be finite, found {bad}"),
+            ));
+        }
+    }
     let snapshot = params.clone();
     for (name, value) in params.iter_mut() {
         if let Err(missing) = resolve_value(&snapshot, value).map(|v| *value = v) {
@@ -363,6 +373,15 @@ fn resolve_params(
         }
     }
     params
+}
+
+/// The first NaN or infinite number in a parameter value, if any.
+pub(crate) fn non_finite(value: &ParamValue) -> Option<f64> {
+    match value {
+        ParamValue::Number(n) => Some(*n).filter(|n| !n.is_finite()),
+        ParamValue::Vector(v) => v.iter().copied().find(|n| !n.is_finite()),
+        ParamValue::Bool(_) | ParamValue::Reference(_) => None,
+    }
 }
 
 /// Resolves a `"$name"` reference (one level; parameters may not chain) to its value.

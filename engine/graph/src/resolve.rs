@@ -686,6 +686,13 @@ impl<'a> Resolver<'a> {
         for (name, value) in &decl.params {
             match crate::load::resolve_value(&self.graph.sources[source].params, value) {
                 Ok(v) => {
+                    if let Some(bad) = crate::load::non_finite(&v) {
+                        self.error(
+                            source,
+                            &pass_path(index, &[Seg::Field("params"), Seg::Key(name)]),
+                            format!("parameter \"{name}\" must be finite, found {bad}"),
+                        );
+                    }
                     params.insert(name.clone(), v);
                 }
                 Err(missing) => {

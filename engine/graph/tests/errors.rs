@@ -461,7 +461,7 @@ const COMPUTE: &str = r#"Graph(
 /// gives them: each case is (base graph, edit, message, text at the location).
 #[test]
 fn out_of_range_values_are_located_errors() {
-    let cases: [(&str, (&str, &str), &str, &str); 11] = [
+    let cases: [(&str, (&str, &str), &str, &str); 13] = [
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([2.0])"#),
             "a depth clear must be in [0, 1], found 2", "Clear([2.0])"),
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([NaN])"#),
@@ -480,6 +480,10 @@ fn out_of_range_values_are_located_errors() {
             "a scale must be a finite number, found NaN", "Like("),
         (VALID, (r#"format: R8G8B8A8_UNORM)"#, r#"format: R8G8B8A8_UNORM, size: Scale(16.0, 16.0))"#),
             "\"albedo\" would be 30720x17280 at output size 1920x1080, over the 16384 pixels an image side may have", "Scale("),
+        (VALID, ("draw: Meshes(Opaque),", r#"draw: Meshes(Opaque), params: { "bias": NaN },"#),
+            "parameter \"bias\" must be finite, found NaN", "NaN },"),
+        (VALID, ("Graph(", r#"Graph(params: { "scale": [1.0, inf] },"#),
+            "parameter \"scale\" must be finite, found inf", "[1.0, inf] },"),
         (COMPUTE, ("Output(8, 8)", "Output(0, 16)"),
             "work-group sizes must be at least 1, found 0", "Output(0, 16)"),
         (COMPUTE, ("Output(8, 8)", "Groups(1, 70000, 1)"),

@@ -18,6 +18,12 @@ use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, ShaderStage, SCENE_SET};
 use weft_graph::schema::{Draw, LightKind, MaterialFilter, ParamValue};
 
+/// The most light volumes (point spheres, spot cones and spheres) one pass
+/// draws: 65,536 volumes of 320 triangles already take seconds a frame on a
+/// software rasteriser, and a million took minutes and gigabytes, so more are
+/// refused with a pointer to tiled shading (see docs/lights.md).
+pub const MAX_LIGHT_VOLUMES: u32 = 65_536;
+
 /// Descriptor sets for graph resources one frame may need.
 const FRAME_SETS: u32 = 64;
 fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
@@ -484,6 +490,13 @@ impl DrawRecorder for SceneRecorder<'_> {
                         (g.sphere, lights.spot_spheres, lights.first_spot_sphere()),
                     ],
                 };
+                let volumes: u64 = groups.iter().map(|g| u64::from(g.1)).sum();
+                if volumes > u64::from(MAX_LIGHT_VOLUMES) {
+                    return Err(fail(format!(
+                        "{volumes} light volumes exceed the {MAX_LIGHT_VOLUMES} a frame draws this way (each is {} triangles through the geometry front end); shade this many lights with a tiled graph such as graphs/tiled.ron",
+                        g.sphere.index_count / 3
+                    )));
+                }
                 for (mesh, count, first) in groups.into_iter().filter(|g| g.1 > 0) {
                     unsafe {
                         device.cmd_draw_indexed(
