@@ -1,7 +1,7 @@
 # Entry points: `make demo`, `make test`, `make bench`. Each runs tools/setup first.
 CARGO ?= cargo
 
-.PHONY: setup build demo test bench lint
+.PHONY: setup build demo test bench lint fuzz
 
 setup:
 	@bash tools/setup
@@ -19,6 +19,14 @@ lint: setup
 
 test: lint
 	$(CARGO) test --workspace
+
+# Long fuzzing runs (docs/fuzzing.md): the parser properties with FUZZ_CASES cases
+# each and MUTANTS graph/shader mutants rendered with validation.
+FUZZ_CASES ?= 20000
+MUTANTS ?= 2000
+fuzz: setup
+	WEFT_FUZZ_CASES=$(FUZZ_CASES) $(CARGO) test -p weft-scene -p weft-graph --test fuzz -- --nocapture
+	WEFT_MUTANTS=$(MUTANTS) $(CARGO) test -p weft-render --test mutants -- --nocapture
 
 bench: setup
 	$(CARGO) bench --workspace

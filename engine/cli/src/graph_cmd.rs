@@ -70,42 +70,6 @@ fn parse_size(text: &str) -> Result<Extent, String> {
     })
 }
 
-/// Shader problems of a graph, compiled with every feature off and every feature on,
-/// each located at the declaration of the pass whose shaders disagree with it.
-fn check_shaders(graph: &LoadedGraph) -> Result<Vec<Diagnostic>> {
-    let prepared = match weft_graph::Prepared::new(graph) {
-        Ok(p) => p,
-        Err(diags) => return Ok(diags),
-    };
-    let mentioned = weft_graph::compile::feature_names(prepared.ir());
-    let mut found: Vec<Diagnostic> = Vec::new();
-    for features in [Default::default(), mentioned] {
-        let options = CompileOptions {
-            features,
-            ..CompileOptions::default()
-        };
-        let plan = match prepared.compile(&options) {
-            Ok(plan) => plan,
-            Err(diags) => return Ok(diags),
-        };
-        let mut cache = weft_gpu::pipeline::PipelineCache::new()?;
-        let problems = weft_render::scene_interface::check_plan_shaders(&mut cache, &plan);
-        for weft_gpu::ShaderProblem { pass, message } in problems {
-            let at = plan
-                .passes
-                .iter()
-                .find(|p| p.name == pass)
-                .map(|p| p.declared_at.clone())
-                .unwrap_or_default();
-            let d = Diagnostic::error(at.file, at.pos, format!("pass \"{pass}\": {message}"));
-            if !found.contains(&d) {
-                found.push(d);
-            }
-        }
-    }
-    Ok(found)
-}
-
 /// Refuses feature toggles typed on the command line that the graph does not
 /// know (a typo would otherwise be ignored silently). A graph that does not
 /// load is left to the command's own error, which locates the problem.
@@ -173,10 +137,11 @@ pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
             let mut failed = false;
             for file in &files {
                 let graph = weft_graph::load(file);
-                let mut diags = weft_graph::check(&graph);
-                if shaders && !graph.is_fragment && !diags.iter().any(Diagnostic::is_error) {
-                    diags.extend(check_shaders(&graph)?);
-                }
+                let diags = if shaders {
+                    weft_render::check_graph_and_shaders(&graph)?
+                } else {
+                    weft_graph::check(&graph)
+                };
                 print_diagnostics(&diags);
                 let errors = diags.iter().filter(|d| d.is_error()).count();
                 let warnings = diags.len() - errors;

@@ -167,6 +167,41 @@ fn describe(plan: &Plan, bindings: &[Binding]) -> String {
         .join(", ")
 }
 
+/// Fragment inputs the vertex stage does not write at the same location with
+/// the same type (`InputNotProduced` and friends at pipeline creation).
+pub fn link_problems(interface: &PipelineInterface) -> Vec<String> {
+    interface
+        .fragment_inputs
+        .iter()
+        .filter_map(|input| {
+            match interface.varyings.iter().find(|v| v.location == input.location) {
+                None => Some(format!(
+                    "fragment input `{}` at location {} is not written by the vertex shader",
+                    input.name, input.location
+                )),
+                Some(out) if out.shape != input.shape => Some(format!(
+                    "fragment input `{}` at location {} is {}, but the vertex shader writes `{}` there as {}",
+                    input.name,
+                    input.location,
+                    shape_name(input.shape),
+                    out.name,
+                    shape_name(out.shape)
+                )),
+                Some(_) => None,
+            }
+        })
+        .collect()
+}
+
+/// A stage variable's type in words, for messages.
+pub fn shape_name(shape: Option<(ScalarKind, u32)>) -> String {
+    match shape {
+        Some((scalar, 1)) => format!("{scalar:?}").to_lowercase(),
+        Some((scalar, n)) => format!("a {n}-component {scalar:?} vector").to_lowercase(),
+        None => "not a scalar or vector".into(),
+    }
+}
+
 /// Checks that a fragment shader writes exactly the pass's colour attachments.
 pub fn check_outputs(plan: &Plan, pass: &PlanPass, interface: &PipelineInterface) -> Vec<String> {
     let Some(rp) = &pass.render_pass else {

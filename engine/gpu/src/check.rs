@@ -92,6 +92,7 @@ pub fn pass_problems(
         Err(list) => (Vec::new(), list),
     };
     if matches!(shaders, PassShaders::Fullscreen { .. }) {
+        problems.extend(bind::link_problems(interface));
         problems.extend(bind::check_outputs(plan, pass, interface));
     }
     if let Some((block, _)) = &interface.push {

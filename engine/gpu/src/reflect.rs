@@ -154,16 +154,7 @@ impl ShaderInterface {
             path: shader.path.clone(),
             message,
         };
-        let entries = ReflectConfig::new()
-            .spv(shader.spirv.as_slice())
-            .ref_all_rscs(false)
-            .combine_img_samplers(true)
-            .reflect()
-            .map_err(|e| fail(format!("SPIR-V reflection failed: {e}")))?;
-        let entry = entries
-            .into_iter()
-            .find(|e| e.name == "main")
-            .ok_or_else(|| fail("no `main` entry point".into()))?;
+        let entry = reflect_main(shader, false)?;
         let mut bindings = Vec::new();
         let mut push = None;
         let mut outputs = Vec::new();
@@ -219,17 +210,26 @@ impl ShaderInterface {
                         components,
                     });
                 }
-                Variable::Input { name, location, ty } => inputs.push(StageVariable {
-                    name: name.unwrap_or_default(),
-                    location: location.loc(),
-                    shape: scalar_shape(&ty),
-                }),
-                Variable::Output { name, location, ty } if shader.stage == ShaderStage::Vertex => {
-                    varyings.push(StageVariable {
+                _ => {}
+            }
+        }
+        // Stage inputs and outputs count whether or not the code reads them:
+        // pipeline creation matches every interface variable.
+        for var in reflect_main(shader, true)?.vars {
+            let variable =
+                |name: Option<String>, location: spirq::prelude::InterfaceLocation, ty: &Type| {
+                    StageVariable {
                         name: name.unwrap_or_default(),
                         location: location.loc(),
-                        shape: scalar_shape(&ty),
-                    })
+                        shape: scalar_shape(ty),
+                    }
+                };
+            match var {
+                Variable::Input { name, location, ty } => {
+                    inputs.push(variable(name, location, &ty))
+                }
+                Variable::Output { name, location, ty } if shader.stage == ShaderStage::Vertex => {
+                    varyings.push(variable(name, location, &ty))
                 }
                 _ => {}
             }
@@ -254,6 +254,26 @@ fn is_depth_sampler(ty: &Type) -> bool {
         Type::CombinedImageSampler(t) => t.sampled_image_ty.is_depth == Some(true),
         _ => false,
     }
+}
+
+/// The `main` entry point, with only the resources its code uses or with all.
+fn reflect_main(
+    shader: &CompiledShader,
+    all: bool,
+) -> Result<spirq::entry_point::EntryPoint, ShaderError> {
+    let fail = |message: String| ShaderError::Reflect {
+        path: shader.path.clone(),
+        message,
+    };
+    ReflectConfig::new()
+        .spv(shader.spirv.as_slice())
+        .ref_all_rscs(all)
+        .combine_img_samplers(true)
+        .reflect()
+        .map_err(|e| fail(format!("SPIR-V reflection failed: {e}")))?
+        .into_iter()
+        .find(|e| e.name == "main")
+        .ok_or_else(|| fail("no `main` entry point".into()))
 }
 
 fn image_shape(ty: &Type) -> Option<ImageShape> {
@@ -353,6 +373,10 @@ pub struct PipelineInterface {
     pub push: Option<(PushBlock, vk::ShaderStageFlags)>,
     /// Fragment outputs.
     pub outputs: Vec<FragmentOutput>,
+    /// What the vertex stage writes for the fragment stage, by location.
+    pub varyings: Vec<StageVariable>,
+    /// What the fragment stage reads from the vertex stage, by location.
+    pub fragment_inputs: Vec<StageVariable>,
 }
 
 impl PipelineInterface {
@@ -393,8 +417,13 @@ impl PipelineInterface {
                     None => (p.clone(), flag),
                 });
             }
-            if stage.stage == ShaderStage::Fragment {
-                merged.outputs.clone_from(&stage.outputs);
+            match stage.stage {
+                ShaderStage::Fragment => {
+                    merged.outputs.clone_from(&stage.outputs);
+                    merged.fragment_inputs.clone_from(&stage.inputs);
+                }
+                ShaderStage::Vertex => merged.varyings.clone_from(&stage.varyings),
+                ShaderStage::Compute => {}
             }
         }
         Ok(merged)

@@ -51,7 +51,9 @@ pub fn check(graph: &LoadedGraph) -> Vec<Diagnostic> {
     diags
 }
 
-fn feature_sets(names: &[String]) -> Vec<BTreeSet<String>> {
+/// The feature sets `check` compiles a graph under: every combination of up
+/// to ten features, else none, all and each alone.
+pub fn feature_sets(names: &[String]) -> Vec<BTreeSet<String>> {
     if names.len() <= EXHAUSTIVE_FEATURES {
         (0u32..1 << names.len())
             .map(|mask| {

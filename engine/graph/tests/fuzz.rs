@@ -5,7 +5,7 @@ mod support;
 
 use proptest::prelude::*;
 use std::path::Path;
-use support::repo_root;
+use support::{fuzz_cases, repo_root};
 use weft_graph::CompileOptions;
 
 /// Applies byte-level edits (delete, duplicate, replace with RON punctuation) at
@@ -109,7 +109,7 @@ fn run(root: &Path, text: String) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: fuzz_cases(400), ..ProptestConfig::default() })]
 
     #[test]
     fn mutated_graphs_never_panic(

@@ -8,7 +8,9 @@
 use crate::geometry::VERTEX_ATTRIBUTES;
 use crate::pipelines::MATERIAL_SET;
 use crate::scene_gpu::{MATERIAL_SET_BINDINGS, SCENE_SET_BINDINGS};
-use weft_gpu::bind::{check_outputs, pack_push, resolve_bindings, FrameValues};
+use weft_gpu::bind::{
+    check_outputs, link_problems, pack_push, resolve_bindings, shape_name, FrameValues,
+};
 use weft_gpu::check::with_declaration;
 use weft_gpu::pipeline::{PipelineCache, ShaderKey};
 use weft_gpu::reflect::{DescriptorKind, PipelineInterface, ScalarKind, ShaderInterface};
@@ -39,7 +41,17 @@ pub fn scene_set_problems(interface: &PipelineInterface, materials: bool) -> Vec
             _ => continue,
         };
         match table.iter().find(|(b, _, _)| *b == shader.binding) {
-            Some((_, kind, _)) if *kind == shader.kind => {}
+            Some((_, kind, what)) if *kind == shader.kind => {
+                let plain_2d = shader.image.is_none_or(|i| {
+                    i.scalar == Some(ScalarKind::Float) && i.two_d && !i.arrayed && !i.multisampled
+                });
+                if !plain_2d || shader.depth_compare {
+                    problems.push(format!(
+                        "shader binding `{}` (set {} binding {}) must be a sampler2D: the engine binds {what} there, a 2D colour texture",
+                        shader.name, shader.set, shader.binding
+                    ));
+                }
+            }
             Some((_, kind, what)) => problems.push(format!(
                 "shader binding `{}` (set {} binding {}) is a {:?}, but the engine binds {what} there as a {kind:?}",
                 shader.name, shader.set, shader.binding, shader.kind
@@ -95,39 +107,6 @@ fn vertex_input_problems(vs: &ShaderInterface, position_only: bool) -> Vec<Strin
         .collect()
 }
 
-/// Fragment inputs the vertex shader does not write at the same location
-/// with the same type.
-pub fn varying_problems(vs: &ShaderInterface, fs: &ShaderInterface) -> Vec<String> {
-    fs.inputs
-        .iter()
-        .filter_map(|input| {
-            match vs.varyings.iter().find(|v| v.location == input.location) {
-                None => Some(format!(
-                    "fragment input `{}` at location {} is not written by the vertex shader",
-                    input.name, input.location
-                )),
-                Some(out) if out.shape != input.shape => Some(format!(
-                    "fragment input `{}` at location {} is {}, but the vertex shader writes `{}` there as {}",
-                    input.name,
-                    input.location,
-                    shape_name(input.shape),
-                    out.name,
-                    shape_name(out.shape)
-                )),
-                Some(_) => None,
-            }
-        })
-        .collect()
-}
-
-fn shape_name(shape: Option<(ScalarKind, u32)>) -> String {
-    match shape {
-        Some((scalar, 1)) => format!("{scalar:?}").to_lowercase(),
-        Some((scalar, n)) => format!("a {n}-component {scalar:?} vector").to_lowercase(),
-        None => "not a scalar or vector".into(),
-    }
-}
-
 /// Every problem with a scene-drawing pass's shaders: graph bindings (set 0),
 /// scene sets, vertex inputs, vertex outputs against fragment inputs,
 /// fragment outputs against the attachments, push constants against params.
@@ -162,8 +141,8 @@ pub fn scene_pass_problems(
     );
     problems.extend(scene_set_problems(&merged, true));
     problems.extend(vertex_input_problems(vs, position_only(pass)));
-    if let Some(fs) = fs {
-        problems.extend(varying_problems(vs, fs));
+    if fs.is_some() {
+        problems.extend(link_problems(&merged));
         problems.extend(check_outputs(plan, pass, &merged));
     }
     if let Some((block, _)) = &merged.push {

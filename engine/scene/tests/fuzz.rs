@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{asset, temp_dir};
+use common::{asset, fuzz_cases, temp_dir};
 use proptest::prelude::*;
 use std::path::Path;
 use weft_scene::{scene_desc_from_str, Diagnostics, Location, SceneError};
@@ -144,7 +144,7 @@ fn load_obj_text(dir: &Path, obj: &str, mtl: &str) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(256))]
+    #![proptest_config(ProptestConfig::with_cases(fuzz_cases(256)))]
 
     #[test]
     fn random_scene_text_never_panics(pieces in proptest::collection::vec(0usize..1000, 0..200)) {
@@ -200,7 +200,7 @@ fn unreadable_and_binary_files_are_errors() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(512))]
+    #![proptest_config(ProptestConfig::with_cases(fuzz_cases(512)))]
 
     #[test]
     fn mutated_glb_never_panics(edits in proptest::collection::vec((0usize..100_000, any::<u8>()), 1..8)) {

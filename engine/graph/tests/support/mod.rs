@@ -35,3 +35,12 @@ pub fn check_text(text: &str) -> Vec<Diagnostic> {
 pub fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
+
+/// Cases per fuzzing property: `default` under `make test`, `WEFT_FUZZ_CASES`
+/// under `make fuzz` (see docs/fuzzing.md).
+pub fn fuzz_cases(default: u32) -> u32 {
+    std::env::var("WEFT_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}

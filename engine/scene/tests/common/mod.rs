@@ -100,3 +100,12 @@ pub fn unzip_member(zip: &Path, member: &str) -> Vec<u8> {
     }
     panic!("{member} not in {}", zip.display())
 }
+
+/// Cases per fuzzing property: `default` under `make test`, `WEFT_FUZZ_CASES`
+/// under `make fuzz` (see docs/fuzzing.md).
+pub fn fuzz_cases(default: u32) -> u32 {
+    std::env::var("WEFT_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}

@@ -1,0 +1,402 @@
+//! The promise `weft graph check --shaders` makes, as a property: every
+//! mutant of the shipped graphs and shaders it accepts renders the demo scene
+//! with zero validation messages (synchronization validation on), under no
+//! features and under all of them; and nothing panics, whatever the mutant.
+//!
+//! Mutants are made from a fixed seed, so a failure repeats. `make test` runs
+//! `WEFT_MUTANTS` of them (default 40); `make fuzz` runs many more. A failure
+//! prints the mutation, so it can be replayed by hand in a copy of the tree.
+
+mod common;
+
+use common::{demo_scene, root};
+use std::collections::BTreeSet;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+use weft_gpu::{Gpu, GpuOptions};
+use weft_graph::compile::feature_names;
+use weft_graph::plan::Extent;
+use weft_render::{check_graph_and_shaders, render, RenderSettings};
+
+/// SplitMix64: small, seedable, the same everywhere.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+
+    fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
+        &items[self.below(items.len())]
+    }
+}
+
+/// Words of one kind that may replace each other.
+const SWAPS: &[&[&str]] = &[
+    &[
+        "R16G16B16A16_SFLOAT",
+        "R8G8B8A8_UNORM",
+        "R8G8B8A8_SRGB",
+        "R32_UINT",
+        "R16G16_SFLOAT",
+        "D32_SFLOAT",
+        "R32G32B32A32_SFLOAT",
+    ],
+    &[
+        "Load",
+        "DontCare",
+        "Clear([0.0])",
+        "Clear([0.0, 0.0, 0.0, 1.0])",
+    ],
+    &["Raster", "Fullscreen", "Compute"],
+    &["Opaque", "Transparent", "All"],
+    &["Additive", "Alpha"],
+    &[
+        "Output",
+        "Scale(0.5, 0.5)",
+        "Absolute(64, 64)",
+        "Like(\"hdr\", 0.5, 0.5)",
+    ],
+    &["true", "false"],
+    &["sampled", "storage_read", "storage_write"],
+    &[
+        "sampler2D ",
+        "usampler2D ",
+        "isampler2D ",
+        "sampler2DShadow ",
+        "sampler2DArray ",
+    ],
+    &["vec2 ", "vec3 ", "vec4 ", "float ", "uint ", "int "],
+    &["set = 0", "set = 1", "set = 2", "set = 3"],
+    &["readonly buffer", "buffer", "uniform"],
+];
+
+/// Numbers a mutant may put in place of another.
+const NUMBERS: &[&str] = &["-1", "0", "1", "2", "9", "1e9", "NaN", "inf", "0.5"];
+
+/// One edit of one file's text, described for the failure report.
+fn mutate(text: &str, rng: &mut Rng) -> Option<(String, String)> {
+    let lines: Vec<&str> = text.lines().collect();
+    match rng.below(8) {
+        0 => {
+            let i = rng.below(lines.len());
+            let mut out = lines.clone();
+            out.remove(i);
+            Some((
+                out.join("\n"),
+                format!("deleted line {}: {}", i + 1, lines[i].trim()),
+            ))
+        }
+        1 => {
+            let i = rng.below(lines.len());
+            let mut out = lines.clone();
+            out.insert(i, lines[i]);
+            Some((
+                out.join("\n"),
+                format!("duplicated line {}: {}", i + 1, lines[i].trim()),
+            ))
+        }
+        2 => {
+            let quoted: Vec<(usize, usize)> = quoted_spans(text);
+            if quoted.len() < 2 {
+                return None;
+            }
+            let a = *rng.pick(&quoted);
+            let b = *rng.pick(&quoted);
+            let (first, second) = if a.0 < b.0 { (a, b) } else { (b, a) };
+            if first.1 > second.0 || first == second {
+                return None;
+            }
+            let (x, y) = (&text[first.0..first.1], &text[second.0..second.1]);
+            let out = format!(
+                "{}{y}{}{x}{}",
+                &text[..first.0],
+                &text[first.1..second.0],
+                &text[second.1..]
+            );
+            Some((out, format!("swapped {x} and {y}")))
+        }
+        3 | 4 => {
+            let group = rng.pick(SWAPS);
+            let present: Vec<&&str> = group.iter().filter(|w| text.contains(**w)).collect();
+            if present.is_empty() {
+                return None;
+            }
+            let from = **rng.pick(&present);
+            let to = *rng.pick(group);
+            let at: Vec<usize> = text.match_indices(from).map(|(i, _)| i).collect();
+            let i = *rng.pick(&at);
+            let out = format!("{}{to}{}", &text[..i], &text[i + from.len()..]);
+            Some((out, format!("replaced {from:?} with {to:?} at byte {i}")))
+        }
+        6 | 7 => {
+            let slots = layout_number_spans(text);
+            if slots.is_empty() {
+                return None;
+            }
+            let (start, end) = *rng.pick(&slots);
+            let to = rng.below(10).to_string();
+            let out = format!("{}{to}{}", &text[..start], &text[end..]);
+            Some((
+                out,
+                format!(
+                    "changed layout number {} to {to} at byte {start}",
+                    &text[start..end]
+                ),
+            ))
+        }
+        _ => {
+            let numbers = number_spans(text);
+            if numbers.is_empty() {
+                return None;
+            }
+            let (start, end) = *rng.pick(&numbers);
+            let to = *rng.pick(NUMBERS);
+            let out = format!("{}{to}{}", &text[..start], &text[end..]);
+            Some((
+                out,
+                format!(
+                    "replaced number {} with {to} at byte {start}",
+                    &text[start..end]
+                ),
+            ))
+        }
+    }
+}
+
+/// Byte ranges of `"..."` strings, quotes included.
+fn quoted_spans(text: &str) -> Vec<(usize, usize)> {
+    let starts: Vec<usize> = text.match_indices('"').map(|(i, _)| i).collect();
+    starts
+        .chunks(2)
+        .filter(|c| c.len() == 2)
+        .map(|c| (c[0], c[1] + 1))
+        .collect()
+}
+
+/// Byte ranges of the numbers in `binding = N`, `location = N` and `set = N`:
+/// where a shader meets the graph and the engine.
+fn layout_number_spans(text: &str) -> Vec<(usize, usize)> {
+    ["binding = ", "location = ", "set = "]
+        .iter()
+        .flat_map(|key| text.match_indices(key).map(move |(i, _)| i + key.len()))
+        .map(|start| {
+            let digits = text[start..].bytes().take_while(u8::is_ascii_digit).count();
+            (start, start + digits)
+        })
+        .filter(|(start, end)| end > start)
+        .collect()
+}
+
+/// Byte ranges of numbers outside words and comments (a digit run, with a
+/// fraction and exponent), e.g. `16`, `0.75`, `1e-3`.
+fn number_spans(text: &str) -> Vec<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let mut spans = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() {
+        let starts = bytes[i].is_ascii_digit()
+            && (i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_'));
+        if !starts {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < bytes.len() && (bytes[i].is_ascii_digit() || bytes[i] == b'.') {
+            i += 1;
+        }
+        spans.push((start, i));
+    }
+    spans
+}
+
+/// The shipped files a mutant may edit, relative to the repository root.
+fn mutable_files() -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for dir in ["graphs", "shaders", "shaders/include"] {
+        let mut found: Vec<PathBuf> = std::fs::read_dir(root().join(dir))
+            .expect("read dir")
+            .map(|e| e.expect("entry").path())
+            .filter(|p| {
+                p.extension().is_some_and(|e| {
+                    ["ron", "frag", "vert", "comp", "glsl"].contains(&e.to_str().unwrap_or(""))
+                })
+            })
+            .map(|p| Path::new(dir).join(p.file_name().expect("name")))
+            .collect();
+        found.sort();
+        files.extend(found);
+    }
+    files
+}
+
+/// A copy of `graphs/` and `shaders/`, removed on drop.
+struct Tree(PathBuf);
+
+impl Tree {
+    fn new(n: usize) -> Self {
+        let dir = std::env::temp_dir().join(format!("weft-mutant-{}-{n}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        for file in mutable_files() {
+            let to = dir.join(&file);
+            std::fs::create_dir_all(to.parent().expect("parent")).expect("dir");
+            std::fs::copy(root().join(&file), to).expect("copy");
+        }
+        Self(dir)
+    }
+}
+
+impl Drop for Tree {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Root graphs whose files (the graph, its fragments, their shaders) mention
+/// `file`'s name; every root for shared includes.
+fn roots_using(file: &Path) -> Vec<&'static str> {
+    let roots = ["forward.ron", "deferred.ron", "tiled.ron"];
+    let name = file
+        .file_name()
+        .expect("name")
+        .to_string_lossy()
+        .into_owned();
+    if file.starts_with("shaders/include") {
+        return roots.to_vec();
+    }
+    let text_of =
+        |f: &str| std::fs::read_to_string(root().join("graphs").join(f)).unwrap_or_default();
+    roots
+        .into_iter()
+        .filter(|r| {
+            let mut text = text_of(r);
+            for fragment in ["shadows.ron", "bloom.ron", "gbuffer.ron"] {
+                if text.contains(fragment) {
+                    text.push_str(&text_of(fragment));
+                }
+            }
+            *r == name || text.contains(&name)
+        })
+        .collect()
+}
+
+/// What happened to one mutant.
+enum Outcome {
+    Refused,
+    Rendered,
+}
+
+/// Checks the mutant's `graph`; when accepted, renders the demo under no
+/// features and under all, and returns an error naming anything wrong.
+fn run_mutant(gpu: &Gpu, scene: &weft_scene::Scene, graph: &Path) -> Result<Outcome, String> {
+    let loaded = weft_graph::load(graph);
+    let diags = check_graph_and_shaders(&loaded).map_err(|e| format!("check failed: {e}"))?;
+    if diags.iter().any(weft_graph::Diagnostic::is_error) {
+        return Ok(Outcome::Refused);
+    }
+    let prepared = weft_graph::Prepared::new(&loaded).map_err(|d| format!("{d:?}"))?;
+    let mut names: BTreeSet<String> = feature_names(prepared.ir());
+    names.extend(loaded.default_features.iter().cloned());
+    let none: Vec<String> = names.iter().map(|n| format!("!{n}")).collect();
+    let all: Vec<String> = names.iter().cloned().collect();
+    for features in [none, all] {
+        let before = gpu.validation().messages().len();
+        let settings = RenderSettings {
+            graph: graph.to_path_buf(),
+            extent: Extent {
+                width: 32,
+                height: 18,
+            },
+            features: features.clone(),
+            ..RenderSettings::default()
+        };
+        let result = render(gpu, scene, &settings);
+        let messages = gpu.validation().messages();
+        let new: Vec<String> = messages[before..]
+            .iter()
+            .map(|m| format!("{}: {}", m.id, m.text))
+            .collect();
+        if let Err(e) = result {
+            return Err(format!(
+                "accepted by check, but rendering with {features:?} failed: {e}"
+            ));
+        }
+        if !new.is_empty() {
+            return Err(format!(
+                "accepted by check, but rendering with {features:?} gave {} validation message(s):\n{}",
+                new.len(),
+                new.join("\n")
+            ));
+        }
+    }
+    Ok(Outcome::Rendered)
+}
+
+#[test]
+fn every_mutant_check_accepts_renders_clean() {
+    let count: usize = std::env::var("WEFT_MUTANTS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(40);
+    let seed: u64 = std::env::var("WEFT_MUTANT_SEED")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0x5EED);
+    let gpu = Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("a Vulkan 1.3 device with the validation layer (run tools/setup)");
+    let scene = weft_scene::load_scene(&demo_scene()).expect("demo scene");
+    let files = mutable_files();
+    let mut rng = Rng(seed);
+    let (mut refused, mut rendered, mut failures) = (0, 0, Vec::new());
+    let mut made = 0;
+    while made < count {
+        let file = rng.pick(&files).clone();
+        let text = std::fs::read_to_string(root().join(&file)).expect("read");
+        let Some((mutant, what)) = mutate(&text, &mut rng) else {
+            continue;
+        };
+        if mutant == text {
+            continue;
+        }
+        let roots = roots_using(&file);
+        if roots.is_empty() {
+            continue;
+        }
+        let graph = *rng.pick(&roots);
+        made += 1;
+        let tree = Tree::new(made);
+        std::fs::write(tree.0.join(&file), &mutant).expect("write mutant");
+        let label = format!(
+            "mutant {made}: {} ({what}) through graphs/{graph}",
+            file.display()
+        );
+        // Shown as it runs under `--nocapture` (`make fuzz`), so a crash names its mutant.
+        eprintln!("{label}");
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            run_mutant(&gpu, &scene, &tree.0.join("graphs").join(graph))
+        }));
+        match outcome {
+            Ok(Ok(Outcome::Refused)) => refused += 1,
+            Ok(Ok(Outcome::Rendered)) => rendered += 1,
+            Ok(Err(problem)) => failures.push(format!("{label}: {problem}")),
+            Err(_) => failures.push(format!("{label}: panicked")),
+        }
+    }
+    eprintln!("{count} mutants (seed {seed:#x}): {refused} refused by check, {rendered} accepted and rendered clean, {} failed", failures.len());
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+    assert!(
+        refused > 0 && rendered > 0,
+        "mutants exercise both sides: {refused} refused, {rendered} rendered"
+    );
+}
