@@ -249,6 +249,10 @@ fn attachment_scalar(format: &str) -> ScalarKind {
     }
 }
 
+/// The push-constant bytes every Vulkan device supports (the required
+/// minimum of `maxPushConstantsSize`).
+pub const MAX_PUSH_CONSTANT_BYTES: u32 = 128;
+
 /// Values the executor supplies to push-constant members no parameter names.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct FrameValues {
@@ -269,6 +273,12 @@ pub fn pack_push(
     params: &BTreeMap<String, ParamValue>,
     frame: &FrameValues,
 ) -> Result<Vec<u8>, Vec<String>> {
+    if block.size > MAX_PUSH_CONSTANT_BYTES {
+        return Err(vec![format!(
+            "the push-constant block is {} bytes, over the {MAX_PUSH_CONSTANT_BYTES} every Vulkan device supports (maxPushConstantsSize)",
+            block.size
+        )]);
+    }
     let mut bytes = vec![0u8; block.size as usize];
     let mut problems = Vec::new();
     for m in &block.members {
@@ -429,6 +439,23 @@ mod tests {
         assert_eq!(i32::from_ne_bytes(word(16)), 21);
         assert_eq!(u32::from_ne_bytes(word(20)), 7);
         assert_eq!(u32::from_ne_bytes(word(24)), 1);
+    }
+
+    #[test]
+    fn a_block_over_the_guaranteed_size_is_refused() {
+        let block = PushBlock {
+            size: 132,
+            members: vec![member("tint", 124, ScalarKind::Float, 1)],
+        };
+        let params = BTreeMap::from([("tint".to_string(), ParamValue::Number(1.0))]);
+        assert_eq!(
+            pack_push(&block, &params, &FrameValues::default()),
+            Err(vec![
+                "the push-constant block is 132 bytes, over the 128 every Vulkan device supports (maxPushConstantsSize)".to_string()
+            ])
+        );
+        let fits = PushBlock { size: 128, ..block };
+        assert!(pack_push(&fits, &params, &FrameValues::default()).is_ok());
     }
 
     #[test]

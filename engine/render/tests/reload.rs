@@ -357,3 +357,52 @@ fn a_reload_prepared_from_an_older_version_is_not_committed() {
     assert!(gpu.validation().messages().is_empty());
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+#[test]
+fn shader_edits_the_gpu_would_reject_are_refused_before_commit() {
+    let dir = fixture("interface");
+    let gpu = gpu();
+    let mut live =
+        LiveRender::new(&gpu, &dir.join("scenes/tiny.scene"), settings(&dir)).expect("live");
+    let first = pixels(&mut live);
+    let graph = dir.join("graphs/forward.ron");
+    let cases = [
+        (
+            "shaders/include/scene.glsl",
+            "set = 1, binding = 3)",
+            "set = 1, binding = 9)",
+            "pass `forward`: shader binding `Materials` (set 1 binding 9) is not scene data the engine binds",
+        ),
+        (
+            "shaders/tonemap.frag",
+            "uniform sampler2D hdr;",
+            "uniform sampler2DShadow hdr;",
+            "pass `tonemap`: shader binding 0 `hdr` is a depth-comparison sampler (sampler2DShadow)",
+        ),
+    ];
+    for (file, from, to, expected) in cases {
+        let path = dir.join(file);
+        let original = std::fs::read_to_string(&path).expect("read");
+        edit(&path, from, to);
+        if file.ends_with("tonemap.frag") {
+            edit(
+                &path,
+                "texture(hdr, uv).rgb",
+                "vec3(texture(hdr, vec3(uv, 0.5)))",
+            );
+        }
+        let err = live
+            .apply(&BTreeSet::from([normalize(&path)]))
+            .expect_err("refused");
+        assert_eq!(err.file, graph, "{err}");
+        assert!(err.line.is_some(), "{err}");
+        assert!(err.message.contains(expected), "{err}");
+        assert_eq!(pixels(&mut live), first, "the live version keeps rendering");
+        std::fs::write(&path, original).expect("restore");
+        live.apply(&BTreeSet::from([normalize(&path)]))
+            .expect("the restored file reloads");
+    }
+    drop(live);
+    assert_eq!(gpu.validation().messages(), Vec::new());
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
