@@ -31,7 +31,8 @@ pub fn position_only(pass: &PlanPass) -> bool {
 
 /// Problems with the scene sets (1, and 2 where `materials` allows it) that
 /// a pass's merged interface declares: every binding must be one the engine
-/// writes, with the descriptor type it writes.
+/// writes, with the descriptor type it writes (material textures as float 2D
+/// `sampler2D`s).
 pub fn scene_set_problems(interface: &PipelineInterface, materials: bool) -> Vec<String> {
     let mut problems = Vec::new();
     for (shader, _) in interface.bindings.values() {
