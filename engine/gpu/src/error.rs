@@ -62,8 +62,9 @@ pub enum GpuError {
     Plan(String),
 }
 
-/// Extension that turns `VkResult` errors into `GpuError::Vulkan` naming the call.
-pub(crate) trait VkCall<T> {
+/// Extension that turns `VkResult` errors into `GpuError::Vulkan` naming the
+/// call: the one conversion every crate uses (`result.call("vkCreateX")`).
+pub trait VkCall<T> {
     /// Labels a failed call.
     fn call(self, call: &'static str) -> Result<T, GpuError>;
 }

@@ -32,7 +32,7 @@ pub mod validation;
 pub use check::{check_shaders, ShaderProblem};
 pub use context::{DeviceInfo, DeviceKind, Gpu, GpuOptions, MemoryReport};
 pub use draw::{DrawRecorder, NoDraws, RasterContext, SCENE_SET};
-pub use error::GpuError;
+pub use error::{GpuError, VkCall};
 pub use executor::{FrameOptions, FrameReport, Renderer};
 pub use golden::{check_golden, Comparison, GoldenError, Tolerance};
 pub use present::{PresentSource, Presented, Presenter};

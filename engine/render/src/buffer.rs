@@ -5,6 +5,7 @@
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
+use weft_gpu::VkCall;
 use weft_gpu::{Gpu, GpuError};
 
 /// A buffer and its memory, freed on drop.
@@ -15,10 +16,6 @@ pub struct Buffer<'g> {
     allocation: Option<Allocation>,
     /// Size in bytes.
     pub size: u64,
-}
-
-fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
-    move |result| GpuError::Vulkan { call, result }
 }
 
 impl<'g> Buffer<'g> {
@@ -36,8 +33,7 @@ impl<'g> Buffer<'g> {
             .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         let device = gpu.device();
-        let buffer =
-            unsafe { device.create_buffer(&info, None) }.map_err(vk_err("vkCreateBuffer"))?;
+        let buffer = unsafe { device.create_buffer(&info, None) }.call("vkCreateBuffer")?;
         let mut this = Self {
             gpu,
             buffer,
@@ -59,7 +55,7 @@ impl<'g> Buffer<'g> {
                 message: e.to_string(),
             })?;
         unsafe { device.bind_buffer_memory(buffer, allocation.memory(), allocation.offset()) }
-            .map_err(vk_err("vkBindBufferMemory"))?;
+            .call("vkBindBufferMemory")?;
         this.allocation = Some(allocation);
         gpu.set_name(buffer, name);
         Ok(this)

@@ -13,6 +13,7 @@ use std::sync::Arc;
 use weft_gpu::pipeline::{blend_state, PipelineCache, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::GpuError;
+use weft_gpu::VkCall;
 use weft_graph::plan::{Plan, PlanPass};
 
 /// Set number of a material's texture.
@@ -50,10 +51,6 @@ pub struct ScenePipeline {
 pub struct ScenePipelines {
     shaders: PipelineCache,
     pipelines: HashMap<ScenePipelineKey, Arc<ScenePipeline>>,
-}
-
-fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
-    move |result| GpuError::Vulkan { call, result }
 }
 
 fn stage_create_info(
@@ -221,7 +218,7 @@ fn build(
             None,
         )
     }
-    .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
+    .call("vkCreateDescriptorSetLayout")?;
     let set_layouts = [graph_layout, scene_layout, material_layout];
     let ranges: Vec<_> = interface
         .push
@@ -284,8 +281,8 @@ fn create_pipeline(
         {
             let Some(module) = module else { continue };
             let info = vk::ShaderModuleCreateInfo::default().code(&module.compiled.spirv);
-            let m = unsafe { device.create_shader_module(&info, None) }
-                .map_err(vk_err("vkCreateShaderModule"))?;
+            let m =
+                unsafe { device.create_shader_module(&info, None) }.call("vkCreateShaderModule")?;
             modules.push(m);
             stages.push(stage_create_info(stage, m));
         }
@@ -369,7 +366,7 @@ fn create_pipeline(
         let created =
             unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
                 .map_err(|(_, r)| r)
-                .map_err(vk_err("vkCreateGraphicsPipelines"))?;
+                .call("vkCreateGraphicsPipelines")?;
         created.into_iter().next().ok_or(GpuError::Vulkan {
             call: "vkCreateGraphicsPipelines",
             result: vk::Result::ERROR_UNKNOWN,

@@ -15,6 +15,7 @@ use std::sync::Arc;
 use weft_gpu::bind::{pack_push, resolve_bindings, FrameValues};
 use weft_gpu::pipeline::{BlendCode, Pipeline, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
+use weft_gpu::VkCall;
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, ShaderStage, SCENE_SET};
 use weft_graph::schema::{Draw, LightKind, MaterialFilter, ParamValue};
 
@@ -26,9 +27,6 @@ pub const MAX_LIGHT_VOLUMES: u32 = 65_536;
 
 /// Descriptor sets for graph resources one frame may need.
 const FRAME_SETS: u32 = 64;
-fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
-    move |result| GpuError::Vulkan { call, result }
-}
 
 /// What a scene pass binds besides its pipeline.
 struct PassBindings {
@@ -98,7 +96,7 @@ impl<'g> SceneRecorder<'g> {
                 None,
             )
         }
-        .map_err(vk_err("vkCreateDescriptorPool"))?;
+        .call("vkCreateDescriptorPool")?;
         Ok(Self {
             gpu,
             scene,
@@ -140,7 +138,7 @@ impl<'g> SceneRecorder<'g> {
                     .device()
                     .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
             }
-            .map_err(vk_err("vkResetDescriptorPool"))?;
+            .call("vkResetDescriptorPool")?;
             self.draw_calls = 0;
         }
         self.last_pass = Some(index);
@@ -268,7 +266,7 @@ impl<'g> SceneRecorder<'g> {
                     .set_layouts(&layouts),
             )
         }
-        .map_err(vk_err("vkAllocateDescriptorSets"))?
+        .call("vkAllocateDescriptorSets")?
         .into_iter()
         .next()
         .ok_or(GpuError::Vulkan {

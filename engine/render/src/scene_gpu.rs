@@ -15,6 +15,7 @@ use ash::vk;
 use std::collections::HashMap;
 use std::path::PathBuf;
 use weft_gpu::reflect::DescriptorKind;
+use weft_gpu::VkCall;
 use weft_gpu::{Gpu, GpuError};
 use weft_scene::material::{TextureRef, TextureSource};
 use weft_scene::{Camera, Scene};
@@ -83,10 +84,6 @@ pub const MATERIAL_SET_BINDINGS: [(u32, DescriptorKind, &str); 3] = [
 pub const FRAME_BYTES: usize = 2 * 64 + 4 * 16;
 /// Scene sets that fullscreen pipelines built by the executor may ask for.
 const FOREIGN_SETS: u32 = 32;
-
-fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
-    move |result| GpuError::Vulkan { call, result }
-}
 
 /// Everything the scene shaders read, on the device.
 pub struct GpuScene<'g> {
@@ -222,8 +219,8 @@ impl<'g> GpuScene<'g> {
             .address_mode_v(vk::SamplerAddressMode::REPEAT)
             .address_mode_w(vk::SamplerAddressMode::REPEAT)
             .max_lod(vk::LOD_CLAMP_NONE);
-        let sampler = unsafe { device.create_sampler(&sampler_info, None) }
-            .map_err(vk_err("vkCreateSampler"))?;
+        let sampler =
+            unsafe { device.create_sampler(&sampler_info, None) }.call("vkCreateSampler")?;
         let mut this = Self {
             gpu,
             geometry,
@@ -279,7 +276,7 @@ impl<'g> GpuScene<'g> {
                 None,
             )
         }
-        .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
+        .call("vkCreateDescriptorSetLayout")?;
         let material_bindings = MATERIAL_SET_BINDINGS.map(|(b, _, _)| {
             vk::DescriptorSetLayoutBinding::default()
                 .binding(b)
@@ -293,7 +290,7 @@ impl<'g> GpuScene<'g> {
                 None,
             )
         }
-        .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
+        .call("vkCreateDescriptorSetLayout")?;
         let materials = material_texture.len() as u32;
         let scene_sets = 1 + FOREIGN_SETS;
         let sizes = [
@@ -318,7 +315,7 @@ impl<'g> GpuScene<'g> {
                 None,
             )
         }
-        .map_err(vk_err("vkCreateDescriptorPool"))?;
+        .call("vkCreateDescriptorPool")?;
         self.scene_set = self.allocate(self.scene_layout)?;
         self.write_scene_set(
             self.scene_set,
@@ -362,7 +359,7 @@ impl<'g> GpuScene<'g> {
             .descriptor_pool(self.pool)
             .set_layouts(&layouts);
         let sets = unsafe { self.gpu.device().allocate_descriptor_sets(&info) }
-            .map_err(vk_err("vkAllocateDescriptorSets"))?;
+            .call("vkAllocateDescriptorSets")?;
         sets.into_iter().next().ok_or(GpuError::Vulkan {
             call: "vkAllocateDescriptorSets",
             result: vk::Result::ERROR_OUT_OF_POOL_MEMORY,

@@ -8,6 +8,7 @@ use crate::error::RenderError;
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
+use weft_gpu::VkCall;
 use weft_gpu::{Gpu, GpuError};
 use weft_scene::material::TextureSource;
 
@@ -62,10 +63,6 @@ pub struct Texture<'g> {
     allocation: Option<Allocation>,
 }
 
-fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> GpuError {
-    move |result| GpuError::Vulkan { call, result }
-}
-
 impl<'g> Texture<'g> {
     /// Uploads `pixels` as an `R8G8B8A8_SRGB` image (colour, `srgb`) or
     /// `R8G8B8A8_UNORM` (data) with a full mip chain (made by linear blits, where
@@ -101,7 +98,7 @@ impl<'g> Texture<'g> {
                     | vk::ImageUsageFlags::TRANSFER_SRC,
             )
             .initial_layout(vk::ImageLayout::UNDEFINED);
-        let image = unsafe { device.create_image(&info, None) }.map_err(vk_err("vkCreateImage"))?;
+        let image = unsafe { device.create_image(&info, None) }.call("vkCreateImage")?;
         let mut this = Self {
             gpu,
             image,
@@ -123,7 +120,7 @@ impl<'g> Texture<'g> {
                 message: e.to_string(),
             })?;
         unsafe { device.bind_image_memory(image, allocation.memory(), allocation.offset()) }
-            .map_err(vk_err("vkBindImageMemory"))?;
+            .call("vkBindImageMemory")?;
         this.allocation = Some(allocation);
         gpu.set_name(image, name);
         let range = vk::ImageSubresourceRange {
@@ -138,8 +135,8 @@ impl<'g> Texture<'g> {
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(format)
             .subresource_range(range);
-        this.view = unsafe { device.create_image_view(&view_info, None) }
-            .map_err(vk_err("vkCreateImageView"))?;
+        this.view =
+            unsafe { device.create_image_view(&view_info, None) }.call("vkCreateImageView")?;
         let mut staging = Buffer::host(
             gpu,
             &format!("{name} (staging)"),
