@@ -5,7 +5,7 @@
 //! work is left to [`crate::LiveRender::commit`].
 
 use crate::frame::{compile_for_scene, RenderSettings};
-use crate::reload::ReloadError;
+use crate::reload_error::ReloadError;
 use crate::sources::{normalize, plan_shader_keys, scene_files, shader_files, Sources};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};

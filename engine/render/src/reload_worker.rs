@@ -5,7 +5,7 @@
 //! which commits it at a frame boundary.
 
 use crate::prepare::{PreparedReload, ReloadJob, ShaderChecker};
-use crate::reload::ReloadError;
+use crate::reload_error::ReloadError;
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::thread::{Scope, ThreadId};
 use std::time::{Duration, Instant};
