@@ -169,31 +169,6 @@ impl<'g> Renderer<'g> {
         Ok(Some((key, bindings)))
     }
 
-    /// Creates the plan's resources, runs `frames` frames (numbered from 0,
-    /// `time` advancing by `frame_time` seconds) and returns the last frame's
-    /// report; what `weft render` needs in one call.
-    pub fn render(
-        &mut self,
-        plan: &Plan,
-        draws: &mut dyn DrawRecorder,
-        frames: u32,
-        frame_time: f32,
-        options: &FrameOptions,
-    ) -> Result<FrameReport, GpuError> {
-        let mut resources = self.create_resources(plan)?;
-        let mut last = None;
-        for frame in 0..frames.max(1) {
-            let options = FrameOptions {
-                frame,
-                time: options.time + frame as f32 * frame_time,
-                readback: options.readback && frame + 1 == frames.max(1),
-                timing: options.timing,
-            };
-            last = Some(self.execute(plan, &mut resources, draws, &options)?);
-        }
-        last.ok_or_else(|| GpuError::Plan("no frame was rendered".into()))
-    }
-
     /// Runs one frame of the plan on `resources` (made by `create_resources`
     /// for the same plan); scene draws come from `draws`.
     pub fn execute(

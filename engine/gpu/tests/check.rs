@@ -3,6 +3,7 @@
 mod common;
 
 use weft_gpu::{FrameOptions, NoDraws, Renderer};
+use weft_testkit::render_frames;
 
 #[test]
 fn reports_every_disagreement_between_shaders_and_graph() {
@@ -79,18 +80,15 @@ fn reload_drops_pipelines_built_from_a_changed_file() {
         readback: true,
         ..FrameOptions::default()
     };
-    renderer
-        .render(&plan, &mut NoDraws, 1, 0.0, &options)
-        .expect("first frame");
+    render_frames(&mut renderer, &plan, &mut NoDraws, 1, 0.0, &options).expect("first frame");
     assert_eq!(renderer.pipelines().pipeline_count(), 3);
     let fill = common::graph("shaders/fill.frag");
     assert_eq!(renderer.reload(&fill).expect("reload"), 1);
     assert_eq!(renderer.pipelines().pipeline_count(), 2);
     let unrelated = common::graph("shaders/show.frag");
     assert_eq!(renderer.reload(&unrelated).expect("reload"), 0);
-    let report = renderer
-        .render(&plan, &mut NoDraws, 2, 0.5, &options)
-        .expect("after reload");
+    let report =
+        render_frames(&mut renderer, &plan, &mut NoDraws, 2, 0.5, &options).expect("after reload");
     assert_eq!(renderer.pipelines().pipeline_count(), 3);
     assert_eq!(
         report.output.expect("readback").rgba8_at(1, 2),

@@ -3,7 +3,8 @@
 
 mod common;
 
-use weft_gpu::{check_golden, FrameOptions, NoDraws, Renderer, Tolerance};
+use weft_gpu::{FrameOptions, NoDraws, Renderer};
+use weft_testkit::{check_golden, Tolerance};
 
 const TOLERANCE: Tolerance = Tolerance {
     per_channel: 2,

@@ -134,18 +134,18 @@ fn render_forward(features: &[&str]) -> ([u8; 4], Vec<String>) {
     let mut renderer = Renderer::new(&gpu).expect("renderer");
     assert_eq!(renderer.check_shaders(&plan), Vec::new());
     assert_eq!(weft_gpu::check_shaders(&plan).expect("shaderc"), Vec::new());
-    let report = renderer
-        .render(
-            &plan,
-            &mut Paint([1.0, 3.0, 0.0, 1.0]),
-            2,
-            1.0 / 60.0,
-            &FrameOptions {
-                readback: true,
-                ..FrameOptions::default()
-            },
-        )
-        .expect("frames");
+    let report = weft_testkit::render_frames(
+        &mut renderer,
+        &plan,
+        &mut Paint([1.0, 3.0, 0.0, 1.0]),
+        2,
+        1.0 / 60.0,
+        &FrameOptions {
+            readback: true,
+            ..FrameOptions::default()
+        },
+    )
+    .expect("frames");
     let output = report.output.expect("readback");
     let centre = output.rgba8_at(16, 9);
     for (x, y) in [(0, 0), (31, 17), (5, 12)] {
@@ -197,26 +197,26 @@ fn forward_bloom_matches_its_golden_image() {
     let gpu = common::gpu();
     let plan = common::compile(&gpu, &common::shipped("forward.ron"), 64, 36);
     let mut renderer = Renderer::new(&gpu).expect("renderer");
-    let report = renderer
-        .render(
-            &plan,
-            &mut BrightSquare,
-            1,
-            0.0,
-            &FrameOptions {
-                readback: true,
-                ..FrameOptions::default()
-            },
-        )
-        .expect("frame");
+    let report = weft_testkit::render_frames(
+        &mut renderer,
+        &plan,
+        &mut BrightSquare,
+        1,
+        0.0,
+        &FrameOptions {
+            readback: true,
+            ..FrameOptions::default()
+        },
+    )
+    .expect("frame");
     let image = report.output.expect("readback").to_rgba8();
     let golden = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/golden/forward_bloom_64x36.png");
-    let tolerance = weft_gpu::Tolerance {
+    let tolerance = weft_testkit::Tolerance {
         per_channel: 2,
         mean: 0.5,
     };
-    if let Err(e) = weft_gpu::check_golden(&image, &golden, &tolerance) {
+    if let Err(e) = weft_testkit::check_golden(&image, &golden, &tolerance) {
         panic!("{e}");
     }
     drop(renderer);

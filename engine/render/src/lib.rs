@@ -35,7 +35,6 @@ pub mod shadows;
 pub mod sources;
 pub mod state;
 pub mod texture;
-pub mod tiles;
 pub mod volumes;
 pub mod watch;
 

@@ -5,7 +5,7 @@
 //! deferred each within mean <= 0.25 and 99th percentile <= 1; tiled also
 //! against its golden image. The light heat map (`light_heatmap`) is checked
 //! exactly: per-tile counts read back against the CPU mirror of the culling test
-//! (`weft_render::tiles`) on a scene of known lights, and the legend's pixels.
+//! (`weft_testkit::tiles`) on a scene of known lights, and the legend's pixels.
 
 mod common;
 
@@ -14,7 +14,8 @@ use glam::{Mat4, Vec2, Vec3};
 use std::path::{Path, PathBuf};
 use weft_gpu::{Gpu, GpuOptions};
 use weft_graph::plan::Extent;
-use weft_render::{camera, render, tiles, RenderSettings};
+use weft_render::{camera, render, RenderSettings};
+use weft_testkit::tiles;
 
 /// A fresh folder under the system temp folder for this test's scene files.
 fn scratch(name: &str) -> PathBuf {
@@ -55,10 +56,10 @@ fn a_thousand_lights_agree_across_forward_deferred_and_tiled() {
     // The lights light the scene: not a comparison of two black images.
     let lit = tiled.image.pixels().filter(|p| p.0[0] > 32).count();
     assert!(lit > 320 * 180 / 4, "{lit} lit pixels");
-    if let Err(e) = weft_gpu::check_golden(
+    if let Err(e) = weft_testkit::check_golden(
         &tiled.image,
         &golden("lights1000_tiled_320x180.png"),
-        &weft_gpu::Tolerance {
+        &weft_testkit::Tolerance {
             per_channel: 12,
             mean: 0.5,
         },

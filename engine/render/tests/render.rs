@@ -8,7 +8,7 @@ mod common;
 
 use common::{agreement, cube_scene, demo_scene, gltf_scene, graph, render_validated};
 use std::path::Path;
-use weft_gpu::{check_golden, Tolerance};
+use weft_testkit::{check_golden, Tolerance};
 
 /// Golden tolerance: lavapipe is deterministic on one machine; the slack covers
 /// other LLVM versions' rounding of the sRGB conversion and of texture filtering.

@@ -60,9 +60,15 @@ pub fn render_readback(gpu: &Gpu, plan: &Plan, frames: u32) -> weft_gpu::FrameRe
         readback: true,
         ..weft_gpu::FrameOptions::default()
     };
-    renderer
-        .render(plan, &mut weft_gpu::NoDraws, frames, 0.0, &options)
-        .expect("frames render")
+    weft_testkit::render_frames(
+        &mut renderer,
+        plan,
+        &mut weft_gpu::NoDraws,
+        frames,
+        0.0,
+        &options,
+    )
+    .expect("frames render")
 }
 
 /// Destroys the context (so leak reports at destruction count too) and asserts

@@ -100,7 +100,7 @@ impl TileSlab {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::reverse_z_projection;
+    use weft_render::camera::reverse_z_projection;
 
     /// A camera at the origin looking down -Z, 90 degrees vertical field of view,
     /// square 64x64 image (4x4 tiles), and its reverse-Z depth of view distance `z`.
