@@ -2,7 +2,7 @@
 // Shadow views (include/shadows.glsl): meshes seen through view `shadow_view`'s
 // matrix (forward Z; the graph clears the map to 1). weft-render draws the pass
 // once per view into the view's atlas tile, setting `shadow_view` each time.
-// Depth bias is pipeline state (the pass's depth_bias and slope_bias).
+// Depth bias is pipeline state (the pass's `raster: (depth_bias: ...)`).
 #include "include/transform.glsl"
 #include "include/shadows.glsl"
 

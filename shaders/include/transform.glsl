@@ -1,6 +1,6 @@
 // The one place a mesh vertex becomes a clip position, shared by every vertex
 // shader that draws meshes, so a depth pre-pass and the shading pass that tests
-// `depth_equal` against it produce bit-identical depths.
+// with `depth_compare: Equal` against it produce bit-identical depths.
 #ifndef WEFT_TRANSFORM_GLSL
 #define WEFT_TRANSFORM_GLSL
 #include "scene.glsl"

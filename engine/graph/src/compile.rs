@@ -1112,5 +1112,6 @@ fn plan_pass(
         render_pass,
         bindings,
         transfer,
+        raster: pass.raster,
     }
 }

@@ -3,7 +3,7 @@
 //! transition between them. Nothing here needs Vulkan.
 
 use crate::diagnostic::Diagnostic;
-use crate::schema::{Blend, Draw, ParamValue, PassKind};
+use crate::schema::{Blend, Draw, ParamValue, PassKind, RasterState};
 use crate::vk::{Access, Aspect, BufferUsage, ImageUsage, Layout, Stage};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -158,6 +158,8 @@ pub struct PlanPass {
     pub bindings: Vec<Binding>,
     /// Source and destination of copy and blit passes.
     pub transfer: Option<(usize, usize)>,
+    /// Declared fixed-function state of a raster pass.
+    pub raster: RasterState,
 }
 
 /// Shader file paths.

@@ -7,7 +7,7 @@ use crate::load::{LoadedGraph, Located};
 use crate::plan::{Extent, ShaderFiles};
 use crate::schema::{
     AttachmentDecl, Blend, Dim, Dispatch, Draw, Expr, LoadDecl, ParamValue, PassDecl, PassKind,
-    ReadDecl, ResourceDecl, SizeDecl, StoreDecl,
+    RasterState, ReadDecl, ResourceDecl, SizeDecl, StoreDecl,
 };
 use crate::spans::Seg;
 use crate::vk::{format_by_name, Aspect, FormatFeatures, FormatInfo, FORMATS};
@@ -79,6 +79,8 @@ pub struct IrPass {
     pub accesses: Vec<IrAccess>,
     pub after: Vec<usize>,
     pub enabled_if: Vec<String>,
+    /// Fixed-function state of a raster pass.
+    pub raster: RasterState,
 }
 
 /// How many compute work groups, resolved.
@@ -743,9 +745,53 @@ impl<'a> Resolver<'a> {
             accesses,
             after,
             enabled_if: decl.enabled_if.clone(),
+            raster: self.raster_state(source, index, decl),
         };
         self.check_pass_shape(&pass, decl, resources);
         pass
+    }
+
+    /// A pass's declared fixed-function state, with bias parameters resolved;
+    /// only raster passes have it, and depth state needs a depth attachment.
+    fn raster_state(&mut self, source: usize, index: usize, decl: &PassDecl) -> RasterState {
+        let Some(raster) = &decl.raster else {
+            return RasterState::default();
+        };
+        let at = |field| pass_path(index, &[Seg::Field("raster"), Seg::Field(field)]);
+        if decl.kind != PassKind::Raster {
+            self.error(
+                source,
+                &pass_path(index, &[Seg::Field("raster")]),
+                format!(
+                    "a {:?} pass has no raster state (only Raster passes draw triangles with it)",
+                    decl.kind
+                ),
+            );
+        }
+        let depth_state = raster.depth_compare.is_some() || raster.depth_bias.is_some();
+        if depth_state && decl.depth.is_none() {
+            let field = if raster.depth_compare.is_some() {
+                "depth_compare"
+            } else {
+                "depth_bias"
+            };
+            self.error(
+                source,
+                &at(field),
+                format!("`{field}` needs a depth attachment, and the pass has none"),
+            );
+        }
+        let depth_bias = raster.depth_bias.as_ref().map(|(c, s)| {
+            let path = at("depth_bias");
+            let constant = self.dim(source, &path, c, "a depth bias").unwrap_or(0.0);
+            let slope = self.dim(source, &path, s, "a depth bias").unwrap_or(0.0);
+            (constant, slope)
+        });
+        RasterState {
+            depth_compare: raster.depth_compare,
+            depth_bias,
+            cull: raster.cull.unwrap_or_default(),
+        }
     }
 
     /// Work-group sizes of at least 1; fixed group counts within the count

@@ -238,6 +238,62 @@ pub struct PassDecl {
     /// Passes this one must run after, beyond what its data implies.
     #[serde(default)]
     pub after: Vec<String>,
+    /// Fixed-function state a raster pass bakes into its pipeline.
+    #[serde(default)]
+    pub raster: Option<RasterDecl>,
+}
+
+/// Fixed-function state of a raster pass: how depth is compared and biased,
+/// which faces are culled. Blending is declared per colour attachment, depth
+/// writes by the depth attachment's `read_only`.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RasterDecl {
+    /// How a fragment's depth is compared with the attachment's; without it
+    /// `GreaterOrEqual`, the reverse-Z test of camera passes.
+    #[serde(default)]
+    pub depth_compare: Option<CompareOp>,
+    /// Constant and slope-scaled depth bias (numbers or `"$param"`s), in units
+    /// of the depth format's resolution and of the primitive's depth slope.
+    #[serde(default)]
+    pub depth_bias: Option<(Dim, Dim)>,
+    /// Which faces are culled; without it `None`.
+    #[serde(default)]
+    pub cull: Option<CullMode>,
+}
+
+/// A depth comparison (`VkCompareOp`): the fragment passes when
+/// `fragment OP stored` holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize, Serialize)]
+pub enum CompareOp {
+    Never,
+    Less,
+    Equal,
+    LessOrEqual,
+    Greater,
+    NotEqual,
+    GreaterOrEqual,
+    Always,
+}
+
+/// Which triangle faces are culled (`VkCullModeFlags`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Deserialize, Serialize)]
+pub enum CullMode {
+    #[default]
+    None,
+    Front,
+    Back,
+}
+
+/// A raster pass's fixed-function state with parameters resolved.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct RasterState {
+    /// The declared depth comparison, if any.
+    pub depth_compare: Option<CompareOp>,
+    /// Constant and slope-scaled depth bias.
+    pub depth_bias: Option<(f64, f64)>,
+    /// Culled faces.
+    pub cull: CullMode,
 }
 
 /// Shader stages of a pass.

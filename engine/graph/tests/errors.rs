@@ -461,7 +461,7 @@ const COMPUTE: &str = r#"Graph(
 /// gives them: each case is (base graph, edit, message, text at the location).
 #[test]
 fn out_of_range_values_are_located_errors() {
-    let cases: [(&str, (&str, &str), &str, &str); 13] = [
+    let cases: [(&str, (&str, &str), &str, &str); 16] = [
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([2.0])"#),
             "a depth clear must be in [0, 1], found 2", "Clear([2.0])"),
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([NaN])"#),
@@ -484,6 +484,13 @@ fn out_of_range_values_are_located_errors() {
             "parameter \"bias\" must be finite, found NaN", "NaN },"),
         (VALID, ("Graph(", r#"Graph(params: { "scale": [1.0, inf] },"#),
             "parameter \"scale\" must be finite, found inf", "[1.0, inf] },"),
+        (VALID, ("draw: Meshes(Opaque),", r#"draw: Meshes(Opaque), raster: (depth_bias: (NaN, 1.0)),"#),
+            "a depth bias must be a finite number, found NaN", "(NaN, 1.0)"),
+        (VALID, ("kind: Fullscreen,", "kind: Fullscreen, raster: (cull: Back),"),
+            "a Fullscreen pass has no raster state (only Raster passes draw triangles with it)", "(cull: Back)"),
+        (VALID, (r#"            depth: (image: "depth", load: Clear([0.0])),
+"#, "            raster: (depth_compare: Less),\n"),
+            "`depth_compare` needs a depth attachment, and the pass has none", "Less)"),
         (COMPUTE, ("Output(8, 8)", "Output(0, 16)"),
             "work-group sizes must be at least 1, found 0", "Output(0, 16)"),
         (COMPUTE, ("Output(8, 8)", "Groups(1, 70000, 1)"),

@@ -5,7 +5,7 @@
 
 use crate::geometry::{VERTEX_ATTRIBUTES, VERTEX_BYTES};
 use crate::scene_interface::scene_pass_problems;
-use crate::state::{Cull, DepthTest, PassState};
+use crate::state::{DepthTest, PassState};
 use ash::vk;
 use std::collections::HashMap;
 use std::path::Path;
@@ -15,6 +15,7 @@ use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::GpuError;
 use weft_gpu::VkCall;
 use weft_graph::plan::{Plan, PlanPass};
+use weft_graph::schema::{CompareOp, CullMode};
 
 /// Set number of a material's texture.
 pub const MATERIAL_SET: u32 = 2;
@@ -76,15 +77,25 @@ pub fn front_face(mirrored: bool) -> vk::FrontFace {
 fn depth_state(test: DepthTest) -> vk::PipelineDepthStencilStateCreateInfo<'static> {
     let (enable, write, op) = match test {
         DepthTest::Off => (false, false, vk::CompareOp::ALWAYS),
-        DepthTest::Greater { write } => (true, write, vk::CompareOp::GREATER_OR_EQUAL),
-        DepthTest::Less { write } => (true, write, vk::CompareOp::LESS_OR_EQUAL),
-        DepthTest::Equal => (true, false, vk::CompareOp::EQUAL),
-        DepthTest::BehindSurface => (true, false, vk::CompareOp::LESS_OR_EQUAL),
+        DepthTest::On { compare, write } => (true, write, compare_op(compare)),
     };
     vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(enable)
         .depth_write_enable(write)
         .depth_compare_op(op)
+}
+
+fn compare_op(compare: CompareOp) -> vk::CompareOp {
+    match compare {
+        CompareOp::Never => vk::CompareOp::NEVER,
+        CompareOp::Less => vk::CompareOp::LESS,
+        CompareOp::Equal => vk::CompareOp::EQUAL,
+        CompareOp::LessOrEqual => vk::CompareOp::LESS_OR_EQUAL,
+        CompareOp::Greater => vk::CompareOp::GREATER,
+        CompareOp::NotEqual => vk::CompareOp::NOT_EQUAL,
+        CompareOp::GreaterOrEqual => vk::CompareOp::GREATER_OR_EQUAL,
+        CompareOp::Always => vk::CompareOp::ALWAYS,
+    }
 }
 
 impl ScenePipelines {
@@ -329,8 +340,9 @@ fn create_pipeline(
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
             .cull_mode(match state.cull {
-                Cull::None => vk::CullModeFlags::NONE,
-                Cull::Front => vk::CullModeFlags::FRONT,
+                CullMode::None => vk::CullModeFlags::NONE,
+                CullMode::Front => vk::CullModeFlags::FRONT,
+                CullMode::Back => vk::CullModeFlags::BACK,
             })
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .depth_bias_enable(bias)

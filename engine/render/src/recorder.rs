@@ -17,7 +17,7 @@ use weft_gpu::pipeline::{BlendCode, Pipeline, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::VkCall;
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, ShaderStage, SCENE_SET};
-use weft_graph::schema::{Draw, LightKind, MaterialFilter, ParamValue};
+use weft_graph::schema::{CompareOp, Draw, LightKind, MaterialFilter, ParamValue};
 
 /// The most light volumes (point spheres, spot cones and spheres) one pass
 /// draws: 65,536 volumes of 320 triangles already take seconds a frame on a
@@ -45,10 +45,18 @@ fn blends_transparency(state: &PassState) -> bool {
 fn transparent_state(state: &PassState) -> PassState {
     PassState {
         blends: vec![BlendCode::Alpha; state.blends.len()],
+        // Tested, not written; a pass that tests for equality with a depth
+        // pre-pass tests transparent meshes (which the pre-pass left out) with
+        // the reverse-Z test instead.
         depth: match state.depth {
             DepthTest::Off => DepthTest::Off,
-            DepthTest::Less { .. } => DepthTest::Less { write: false },
-            _ => DepthTest::Greater { write: false },
+            DepthTest::On { compare, .. } => DepthTest::On {
+                compare: match compare {
+                    CompareOp::Less | CompareOp::LessOrEqual => compare,
+                    _ => CompareOp::GreaterOrEqual,
+                },
+                write: false,
+            },
         },
         ..state.clone()
     }
