@@ -82,3 +82,176 @@ fn plans_match_snapshots_and_pass_the_checker() {
     }
     assert_eq!(compared, 9);
 }
+
+#[test]
+fn removing_any_barrier_makes_the_checker_fail() {
+    let graph = weft_graph::load(&repo_root().join("graphs/deferred.ron"));
+    let options = CompileOptions {
+        features: graph.features(&[
+            "shadow_casters",
+            "point_lights",
+            "spot_lights",
+            "area_lights",
+            "transparent",
+        ]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("deferred compiles");
+    let mut removed = 0;
+    for p in 0..plan.passes.len() {
+        for b in 0..plan.passes[p].barriers.len() {
+            let mut broken = plan.clone();
+            let barrier = broken.passes[p].barriers.remove(b);
+            let name = &plan.resources[barrier.resource].name;
+            assert!(
+                check_plan(&broken, 2).is_err(),
+                "removing the barrier on \"{name}\" before \"{}\" went unnoticed",
+                plan.passes[p].name
+            );
+            removed += 1;
+        }
+    }
+    for e in 0..plan.epilogue.len() {
+        let mut broken = plan.clone();
+        broken.epilogue.remove(e);
+        assert!(
+            check_plan(&broken, 2).is_err(),
+            "removing epilogue barrier {e} went unnoticed"
+        );
+    }
+    assert!(removed > 15, "only {removed} barriers");
+}
+
+#[test]
+fn scene_features_cull_passes_and_variants() {
+    let graph = weft_graph::load(&repo_root().join("graphs/deferred.ron"));
+    let options = CompileOptions {
+        features: graph.features::<&str>(&[]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let culled: Vec<(&str, &str)> = plan
+        .culled
+        .iter()
+        .map(|c| (c.name.as_str(), c.reason.as_str()))
+        .collect();
+    assert_eq!(
+        culled,
+        [
+            ("shadow_sun", "enabled_if [shadow_casters] is false"),
+            ("bloom_naive_h", "enabled_if [bloom_naive] is false"),
+            ("bloom_naive_v", "enabled_if [bloom_naive] is false"),
+            ("point_lights", "enabled_if [point_lights] is false"),
+            ("spot_lights", "enabled_if [spot_lights] is false"),
+            ("area_lights", "enabled_if [area_lights] is false"),
+            ("transparent", "enabled_if [transparent] is false"),
+        ]
+    );
+    let sun = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "sun")
+        .expect("sun pass");
+    assert!(
+        sun.defines.is_empty(),
+        "no shadow variant without shadow casters"
+    );
+    assert!(plan.resource("shadow_map").is_none());
+}
+
+#[test]
+fn the_annotated_example_in_graphs_readme_checks_clean() {
+    let readme = std::fs::read_to_string(repo_root().join("graphs/README.md")).expect("README");
+    let start = readme.find("```ron\n").expect("a ron block") + "```ron\n".len();
+    let end = start + readme[start..].find("```").expect("closed block");
+    let example = readme[start..end].to_string();
+    let graphs = repo_root().join("graphs");
+    let root = graphs.join("README-example.ron");
+    let read = |p: &std::path::Path| {
+        if p == root {
+            Ok(example.clone())
+        } else {
+            std::fs::read_to_string(p)
+        }
+    };
+    let graph = weft_graph::load_with(&root, &read);
+    assert_eq!(weft_graph::check(&graph), Vec::new());
+    assert_eq!(graph.sources.len(), 3);
+}
+
+#[test]
+fn images_read_back_after_the_frame_are_kept_and_left_readable() {
+    let graph = weft_graph::load(&repo_root().join("graphs/forward.ron"));
+    let options = CompileOptions {
+        features: graph.features::<&str>(&[]),
+        readback: vec!["hdr".into()],
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let hdr = plan.resource("hdr").expect("hdr");
+    assert_eq!(plan.readback, vec![hdr]);
+    assert_eq!(
+        plan.resources[hdr].residency,
+        weft_graph::plan::Residency::Output
+    );
+    assert_eq!(plan.resources[hdr].placement, None);
+    let last = plan
+        .epilogue
+        .iter()
+        .find(|b| b.resource == hdr)
+        .expect("epilogue barrier");
+    assert_eq!(
+        last.layouts.map(|l| l.1),
+        Some(weft_graph::vk::Layout::TransferSrcOptimal)
+    );
+    check_plan(&plan, 3).expect("synchronized");
+
+    let unknown = CompileOptions {
+        readback: vec!["hdrr".into()],
+        ..CompileOptions::default()
+    };
+    let errors = weft_graph::compile(&graph, &unknown).expect_err("unknown image");
+    assert_eq!(
+        errors[0].message,
+        "cannot read back \"hdrr\": the graph has no image of that name"
+    );
+    assert_eq!(errors[0].hint.as_deref(), Some("did you mean \"hdr\"?"));
+}
+
+#[test]
+fn top_level_parameters_can_be_set_when_loading() {
+    use std::collections::BTreeMap;
+    use weft_graph::schema::ParamValue;
+    let path = repo_root().join("graphs/forward.ron");
+    let set =
+        |name: &str, value: f64| BTreeMap::from([(name.to_string(), ParamValue::Number(value))]);
+    let graph = weft_graph::load_with_params(&path, set("exposure", 2.5));
+    let options = CompileOptions {
+        features: graph.features::<&str>(&[]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let tonemap = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "tonemap")
+        .expect("tonemap pass");
+    assert_eq!(tonemap.params["exposure"], ParamValue::Number(2.5));
+
+    let misspelt = weft_graph::load_with_params(&path, set("exposur", 2.5));
+    let errors: Vec<_> = misspelt
+        .diagnostics
+        .iter()
+        .filter(|d| d.is_error())
+        .collect();
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert_eq!(
+        errors[0].message,
+        "unknown parameter \"exposur\" for \"forward.ron\""
+    );
+    assert_eq!(
+        errors[0].hint.as_deref(),
+        Some("did you mean \"exposure\"?")
+    );
+    assert!(errors[0].file.ends_with("forward.ron"));
+}
