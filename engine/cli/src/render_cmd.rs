@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_gpu::{format_timings, Gpu, GpuOptions, TimingMode};
 use weft_graph::plan::Extent;
-use weft_graph::schema::{ParamValue, ResourceDecl};
+use weft_graph::schema::ParamValue;
 use weft_render::{render, RenderSettings, Rendered};
 
 /// Which per-pass times `--timings` measures.
@@ -39,9 +39,9 @@ pub struct RenderArgs {
     /// Camera name; the scene's first camera by default.
     #[arg(long)]
     camera: Option<String>,
-    /// Output image: .png (the graph's tonemapped sRGB output) or .exr (the linear
-    /// HDR image `hdr` where the graph has one, else the output as floats);
-    /// default out/<scene stem>.png.
+    /// Output image: .png (the graph's tonemapped sRGB output) or .exr (the first
+    /// image read back, where there is one — the graph's `readback` list or
+    /// --readback — else the output as floats); default out/<scene stem>.png.
     #[arg(long)]
     out: Option<PathBuf>,
     /// Enable the validation layer with synchronization validation; any error or
@@ -61,6 +61,11 @@ pub struct RenderArgs {
     /// comma-separated vector); repeatable.
     #[arg(long = "param", value_parser = parse_param)]
     params: Vec<(String, ParamValue)>,
+    /// Read back this graph image too (comma-separated or repeated), replacing the
+    /// graph's `readback` list; each is also written beside --out as
+    /// STEM.NAME.exr, in linear floats.
+    #[arg(long, value_delimiter = ',')]
+    readback: Vec<String>,
     /// Use the first device whose name contains this.
     #[arg(long)]
     device: Option<String>,
@@ -121,12 +126,23 @@ pub fn parse_time(text: &str) -> Result<f32, String> {
     }
 }
 
-/// Whether the graph declares an image called `name` (EXR output reads it back).
-fn graph_has_image(graph: &Path, name: &str) -> bool {
-    weft_graph::load(graph)
-        .resources
-        .iter()
-        .any(|r| matches!(&r.item, ResourceDecl::Image(image) if image.name == name))
+/// The images to read back besides the output: `--readback`, else the
+/// graph's own `readback` list.
+fn readback_names(args: &RenderArgs) -> Vec<String> {
+    if args.readback.is_empty() {
+        weft_graph::load(&args.graph).readback
+    } else {
+        args.readback.clone()
+    }
+}
+
+/// `out` with `.NAME.exr` in place of its extension: where `--readback NAME` goes.
+fn readback_path(out: &Path, name: &str) -> PathBuf {
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    out.with_file_name(format!("{stem}.{name}.exr"))
 }
 
 fn default_out(scene: &Path) -> PathBuf {
@@ -166,23 +182,15 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         Some("exr") => true,
         _ => bail!("--out {}: use a .png or .exr file name", out.display()),
     };
-    let hdr_name = "hdr";
-    let extra_readback = if exr && graph_has_image(&args.graph, hdr_name) {
-        vec![hdr_name.to_string()]
-    } else {
-        Vec::new()
-    };
+    let extra_readback = readback_names(&args);
+    let exr_image = extra_readback.first().filter(|_| exr).cloned();
     crate::graph_cmd::check_feature_names(&args.graph, &args.features)?;
     let settings = settings(&args, extra_readback);
     if args.watch {
         return crate::watch_cmd::run(crate::watch_cmd::WatchRequest {
             scene: &args.scene,
             out: &out,
-            image: settings
-                .extra_readback
-                .iter()
-                .any(|n| n == hdr_name)
-                .then_some(hdr_name),
+            image: exr_image.as_deref(),
             settings,
             gpu: GpuOptions {
                 validation: args.validate,
@@ -203,19 +211,31 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     }
     let rendered = render(&gpu, &scene, &settings)?;
     drop(gpu);
-    let hdr = rendered
-        .report
-        .readbacks
-        .iter()
-        .find(|(name, _)| name == hdr_name)
-        .map(|(_, image)| image);
-    let output = hdr
+    let read_back = |wanted: &str| {
+        rendered
+            .report
+            .readbacks
+            .iter()
+            .find(|(name, _)| name == wanted)
+            .map(|(_, image)| image)
+    };
+    let output = exr_image
+        .as_deref()
+        .and_then(read_back)
         .or(rendered.report.output.as_ref())
         .context("the frame produced no output image")?;
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     output.save(&out)?;
+    for name in &args.readback {
+        let image = read_back(name).with_context(|| format!("--readback {name}: not read back"))?;
+        let path = readback_path(&out, name);
+        image.save(&path)?;
+        if !args.json {
+            println!("wrote {} ({name})", path.display());
+        }
+    }
     for w in &rendered.warnings {
         eprintln!("warning: {w}");
     }

@@ -181,3 +181,55 @@ fn more_light_volumes_than_the_limit_are_refused_at_the_pass() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn readback_images_are_written_beside_the_output_and_the_first_is_the_exr() {
+    let dir = std::env::temp_dir().join(format!("weft-readback-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.join("o.exr");
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "render",
+            "scenes/demo.scene",
+            "--graph",
+            "graphs/deferred.ron",
+            "--size",
+            "16x16",
+            "--out",
+            out.to_str().expect("utf-8"),
+        ];
+        a.extend_from_slice(extra);
+        weft(&a)
+    };
+    let done = args(&["--readback", "hdr,gbuffer_albedo"]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let exr = std::fs::read(&out).expect("exr");
+    assert_eq!(&exr[..4], b"v/1\x01", "OpenEXR magic");
+    assert_eq!(
+        exr,
+        std::fs::read(dir.join("o.hdr.exr")).expect("hdr"),
+        "the first readback is the EXR"
+    );
+    assert!(dir.join("o.gbuffer_albedo.exr").is_file());
+    // Without --readback the graph's own list (`readback: ["hdr"]`) picks the EXR's image.
+    std::fs::remove_file(&out).expect("remove");
+    let done = args(&[]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert_eq!(std::fs::read(&out).expect("exr"), exr);
+    let failed = args(&["--readback", "nope"]);
+    assert_eq!(failed.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&failed.stderr);
+    assert!(
+        err.contains("cannot read back \"nope\": the graph has no image of that name"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

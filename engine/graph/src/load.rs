@@ -38,6 +38,8 @@ pub struct LoadedGraph {
     pub passes: Vec<Located<PassDecl>>,
     /// The output image name, from the root file.
     pub output: Option<String>,
+    /// Images tools read back besides the output, from the root file.
+    pub readback: Vec<String>,
     /// Human-readable name.
     pub name: String,
     /// Toggles declared on by default by the graph and its fragments.
@@ -227,6 +229,7 @@ fn load_file(
     }
     if site.is_none() {
         graph.output = parsed.output.clone();
+        graph.readback = parsed.readback.clone();
         graph.name = parsed.name.clone().unwrap_or_default();
         graph.is_fragment = parsed.fragment;
     }

@@ -280,6 +280,7 @@ impl<'a> Resolver<'a> {
             .map(|p| self.resolve_pass(p, &resources))
             .collect();
         let output = self.resolve_output(&resources);
+        self.check_readback(&resources);
         let ir = Ir {
             resources,
             passes,
@@ -309,6 +310,29 @@ impl<'a> Resolver<'a> {
                     &resource_path(res.index, &[Seg::Field("size")]),
                     oversized_image(&res.name, e, out),
                 );
+            }
+        }
+    }
+
+    /// Every name in the graph's `readback` list is one of its images.
+    fn check_readback(&mut self, resources: &[IrResource]) {
+        for (i, name) in self.graph.readback.iter().enumerate() {
+            let path = [Seg::Field("readback"), Seg::Index(i)];
+            match self.resource_index.get(name.as_str()) {
+                Some(&r) if matches!(resources[r].kind, IrKind::Buffer { .. }) => {
+                    self.error(
+                        0,
+                        &path,
+                        format!("readback \"{name}\" is a buffer; only images are read back"),
+                    );
+                }
+                Some(_) => {}
+                None => {
+                    let names = self.resource_names();
+                    self.error(0, &path, format!("unknown resource \"{name}\""))
+                        .hint = crate::diagnostic::nearest(name, names)
+                        .map(|n| format!("did you mean \"{n}\"?"));
+                }
             }
         }
     }

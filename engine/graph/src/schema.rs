@@ -37,6 +37,11 @@ pub struct GraphFile {
     /// The image presented or saved. Fragments leave it out.
     #[serde(default)]
     pub output: Option<String>,
+    /// Images besides the output that tools read back, first the linear
+    /// image an `.exr` output is written from (`weft render --out F.exr`);
+    /// `--readback` replaces the list.
+    #[serde(default)]
+    pub readback: Vec<String>,
 }
 
 /// An included fragment and the parameter values it is given.
