@@ -62,6 +62,13 @@ pub const SCENE_SET: u32 = 1;
 /// Records the draws of raster passes whose content comes from outside the
 /// graph (scene meshes, light volumes); the render crate implements it.
 pub trait DrawRecorder {
+    /// Called by the executor once at the start of every frame, before any
+    /// pass records; the previous frame has finished on the device, so
+    /// per-frame state (descriptor sets, counters) may be recycled.
+    fn begin_frame(&mut self) -> Result<(), GpuError> {
+        Ok(())
+    }
+
     /// Records the pass's draws into `ctx.cmd`.
     fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError>;
 

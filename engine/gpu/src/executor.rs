@@ -179,6 +179,7 @@ impl<'g> Renderer<'g> {
         options: &FrameOptions,
     ) -> Result<FrameReport, GpuError> {
         let started = Instant::now();
+        draws.begin_frame()?;
         let mut prepared = Vec::with_capacity(plan.passes.len());
         for pass in &plan.passes {
             prepared.push(self.prepare(plan, pass, resources, options)?);

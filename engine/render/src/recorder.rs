@@ -69,7 +69,6 @@ pub struct SceneRecorder<'g> {
     pub scene: GpuScene<'g>,
     pipelines: ScenePipelines,
     pool: vk::DescriptorPool,
-    last_pass: Option<usize>,
     frame: FrameValues,
     /// Draw calls recorded in the current frame.
     pub draw_calls: u64,
@@ -110,7 +109,6 @@ impl<'g> SceneRecorder<'g> {
             scene,
             pipelines: ScenePipelines::new()?,
             pool,
-            last_pass: None,
             frame: FrameValues::default(),
             draw_calls: 0,
         })
@@ -134,23 +132,6 @@ impl<'g> SceneRecorder<'g> {
     /// next frame only builds its pipeline.
     pub fn adopt(&mut self, key: ShaderKey, module: Arc<ShaderModule>) {
         self.pipelines.adopt(key, module);
-    }
-
-    /// Passes come in increasing order within a frame, so a pass index not above the
-    /// last one starts a new frame; the executor has waited for the previous one, so
-    /// its descriptor sets can be recycled.
-    fn begin_pass(&mut self, index: usize) -> Result<(), GpuError> {
-        if self.last_pass.is_some_and(|last| index <= last) {
-            unsafe {
-                self.gpu
-                    .device()
-                    .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
-            }
-            .call("vkResetDescriptorPool")?;
-            self.draw_calls = 0;
-        }
-        self.last_pass = Some(index);
-        Ok(())
     }
 
     /// Binds a scene pipeline with the pass's graph set, the scene set, push
@@ -406,8 +387,20 @@ impl SceneRecorder<'_> {
 }
 
 impl DrawRecorder for SceneRecorder<'_> {
+    /// The previous frame's graph descriptor sets are recycled and the draw
+    /// count starts again.
+    fn begin_frame(&mut self) -> Result<(), GpuError> {
+        unsafe {
+            self.gpu
+                .device()
+                .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
+        }
+        .call("vkResetDescriptorPool")?;
+        self.draw_calls = 0;
+        Ok(())
+    }
+
     fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError> {
-        self.begin_pass(ctx.pass_index)?;
         let pass = ctx.pass();
         let fail = |message: String| GpuError::Pass {
             pass: pass.name.clone(),
