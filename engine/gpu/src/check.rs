@@ -189,6 +189,19 @@ pub fn check_shaders(plan: &Plan) -> Result<Vec<ShaderProblem>, GpuError> {
     Ok(check_with(&mut cache, plan))
 }
 
+/// One line per problem a pass's check found: the problems themselves, or a
+/// compile failure's diagnostics (each with its file:line), or the error.
+pub fn problem_messages(found: Result<Vec<String>, GpuError>) -> Vec<String> {
+    match found {
+        Ok(list) => list,
+        Err(GpuError::Shader(crate::shader::ShaderError::Compile(diagnostics))) => {
+            diagnostics.iter().map(ToString::to_string).collect()
+        }
+        Err(GpuError::Pass { message, .. }) => vec![message],
+        Err(e) => vec![e.to_string()],
+    }
+}
+
 /// `check_shaders` with a given cache (the executor's).
 pub fn check_with(cache: &mut PipelineCache, plan: &Plan) -> Vec<ShaderProblem> {
     let mut problems = Vec::new();
@@ -206,18 +219,14 @@ pub fn check_with(cache: &mut PipelineCache, plan: &Plan) -> Vec<ShaderProblem> 
                     .collect())
             }
         });
-        let messages = match found {
-            Ok(list) => list,
-            Err(GpuError::Shader(crate::shader::ShaderError::Compile(diagnostics))) => {
-                diagnostics.iter().map(ToString::to_string).collect()
-            }
-            Err(GpuError::Pass { message, .. }) => vec![message],
-            Err(e) => vec![e.to_string()],
-        };
-        problems.extend(messages.into_iter().map(|message| ShaderProblem {
-            pass: pass.name.clone(),
-            message,
-        }));
+        problems.extend(
+            problem_messages(found)
+                .into_iter()
+                .map(|message| ShaderProblem {
+                    pass: pass.name.clone(),
+                    message,
+                }),
+        );
     }
     problems
 }

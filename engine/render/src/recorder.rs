@@ -521,20 +521,23 @@ impl DrawRecorder for SceneRecorder<'_> {
     }
 
     fn bind_scene(&mut self, ctx: &RasterContext<'_>, pipeline: &Pipeline) -> Result<(), GpuError> {
-        let problems = scene_set_problems(&pipeline.interface, false);
-        if !problems.is_empty() {
-            return Err(GpuError::Pass {
-                pass: ctx.pass().name.clone(),
-                message: problems.join("; "),
-            });
-        }
-        let bindings: Vec<u32> = pipeline
-            .interface
-            .bindings
-            .keys()
-            .filter(|(set, _)| *set == SCENE_SET)
-            .map(|(_, b)| *b)
-            .collect();
+        // Checked and collected once, when the layout's set is first made.
+        let bindings = || {
+            let problems = scene_set_problems(&pipeline.interface, false);
+            if !problems.is_empty() {
+                return Err(GpuError::Pass {
+                    pass: ctx.pass().name.clone(),
+                    message: problems.join("; "),
+                });
+            }
+            Ok(pipeline
+                .interface
+                .bindings
+                .keys()
+                .filter(|(set, _)| *set == SCENE_SET)
+                .map(|(_, b)| *b)
+                .collect())
+        };
         let layout = pipeline
             .set_layouts
             .get(SCENE_SET as usize)
@@ -543,7 +546,7 @@ impl DrawRecorder for SceneRecorder<'_> {
                 pass: ctx.pass().name.clone(),
                 message: "pipeline has no scene set layout".into(),
             })?;
-        let set = self.scene.foreign_set(layout, &bindings)?;
+        let set = self.scene.foreign_set(layout, bindings)?;
         unsafe {
             self.gpu.device().cmd_bind_descriptor_sets(
                 ctx.cmd,

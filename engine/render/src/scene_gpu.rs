@@ -368,28 +368,19 @@ impl<'g> GpuScene<'g> {
 
     /// Writes the scene buffers into the listed bindings of `set`.
     fn write_scene_set(&self, set: vk::DescriptorSet, bindings: &[u32]) {
-        let infos: Vec<(u32, vk::DescriptorType, [vk::DescriptorBufferInfo; 1])> = bindings
-            .iter()
-            .filter_map(|&b| {
-                let (buffer, ty) = match b {
-                    FRAME_BINDING => (&self.frame, vk::DescriptorType::UNIFORM_BUFFER),
-                    LIGHTS_BINDING => (&self.lights, vk::DescriptorType::STORAGE_BUFFER),
-                    DRAWS_BINDING => (&self.draws, vk::DescriptorType::STORAGE_BUFFER),
-                    MATERIALS_BINDING => (&self.materials, vk::DescriptorType::STORAGE_BUFFER),
-                    SHADOWS_BINDING => (&self.shadows, vk::DescriptorType::STORAGE_BUFFER),
-                    _ => return None,
-                };
-                Some((
-                    b,
-                    ty,
-                    [vk::DescriptorBufferInfo {
-                        buffer: buffer.buffer,
+        let infos: Vec<(u32, vk::DescriptorType, [vk::DescriptorBufferInfo; 1])> =
+            SCENE_SET_BINDINGS
+                .iter()
+                .filter(|(b, _, _)| bindings.contains(b))
+                .filter_map(|&(b, kind, _)| {
+                    let info = vk::DescriptorBufferInfo {
+                        buffer: self.scene_buffer(b)?.buffer,
                         offset: 0,
                         range: vk::WHOLE_SIZE,
-                    }],
-                ))
-            })
-            .collect();
+                    };
+                    Some((b, kind.vk(), [info]))
+                })
+                .collect();
         let writes: Vec<_> = infos
             .iter()
             .map(|(b, ty, info)| {
@@ -403,18 +394,32 @@ impl<'g> GpuScene<'g> {
         unsafe { self.gpu.device().update_descriptor_sets(&writes, &[]) };
     }
 
-    /// Set 1 for a pipeline the executor built: allocated from its reflected layout
-    /// once, with the scene bindings its shaders use (`bindings`).
+    /// The buffer behind a set 1 binding of [`SCENE_SET_BINDINGS`].
+    fn scene_buffer(&self, binding: u32) -> Option<&Buffer<'_>> {
+        match binding {
+            FRAME_BINDING => Some(&self.frame),
+            LIGHTS_BINDING => Some(&self.lights),
+            DRAWS_BINDING => Some(&self.draws),
+            MATERIALS_BINDING => Some(&self.materials),
+            SHADOWS_BINDING => Some(&self.shadows),
+            _ => None,
+        }
+    }
+
+    /// Set 1 for a pipeline the executor built: allocated from its reflected
+    /// layout once, with the scene bindings its shaders use. `bindings` is
+    /// asked only then, so it may check them; every later frame reuses the set.
     pub fn foreign_set(
         &mut self,
         layout: vk::DescriptorSetLayout,
-        bindings: &[u32],
+        bindings: impl FnOnce() -> Result<Vec<u32>, GpuError>,
     ) -> Result<vk::DescriptorSet, GpuError> {
         if let Some(&set) = self.foreign_sets.get(&layout) {
             return Ok(set);
         }
+        let bindings = bindings()?;
         let set = self.allocate(layout)?;
-        self.write_scene_set(set, bindings);
+        self.write_scene_set(set, &bindings);
         self.foreign_sets.insert(layout, set);
         Ok(set)
     }

@@ -8,13 +8,14 @@
 use crate::geometry::VERTEX_ATTRIBUTES;
 use crate::pipelines::MATERIAL_SET;
 use crate::scene_gpu::{MATERIAL_SET_BINDINGS, SCENE_SET_BINDINGS};
+use crate::sources::scene_pass_keys;
 use weft_gpu::bind::{
     check_outputs, link_problems, pack_push, resolve_bindings, shape_name, FrameValues,
 };
-use weft_gpu::check::with_declaration;
+use weft_gpu::check::{problem_messages, with_declaration};
 use weft_gpu::pipeline::{PipelineCache, ShaderKey};
 use weft_gpu::reflect::{DescriptorKind, PipelineInterface, ScalarKind, ShaderInterface};
-use weft_gpu::{GpuError, ShaderProblem, ShaderStage, SCENE_SET};
+use weft_gpu::{GpuError, ShaderProblem, SCENE_SET};
 use weft_graph::plan::{Plan, PlanPass};
 use weft_graph::schema::{Draw, ParamValue};
 
@@ -63,15 +64,20 @@ pub fn scene_set_problems(interface: &PipelineInterface, materials: bool) -> Vec
                 shader.set,
                 shader.binding,
                 shader.set,
-                table
-                    .iter()
-                    .map(|(b, _, what)| format!("{b}: {what}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                slot_list(table.iter().map(|(b, _, what)| (*b, *what)))
             )),
         }
     }
     problems
+}
+
+/// Numbered slots as `0: what, 1: what`, for messages listing what the
+/// engine supplies.
+fn slot_list<'a>(slots: impl Iterator<Item = (u32, &'a str)>) -> String {
+    slots
+        .map(|(n, what)| format!("{n}: {what}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Vertex attributes the shader reads that the scene's vertex buffer does
@@ -97,11 +103,7 @@ fn vertex_input_problems(vs: &ShaderInterface, position_only: bool) -> Vec<Strin
                     "vertex input `{}` at location {} is not supplied; this pass's vertices have {}",
                     input.name,
                     input.location,
-                    supplied
-                        .iter()
-                        .map(|(l, _, what)| format!("{l}: {what}"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
+                    slot_list(supplied.iter().map(|(l, _, what)| (*l, *what)))
                 )),
             }
         })
@@ -177,13 +179,7 @@ pub fn check_plan_shaders(cache: &mut PipelineCache, plan: &Plan) -> Vec<ShaderP
             Ok(None) => scene_pass_shaders(cache, plan, pass),
             Err(_) => continue, // reported by `check_with`
         };
-        let messages = match found {
-            Ok(list) => list,
-            Err(GpuError::Shader(weft_gpu::ShaderError::Compile(diagnostics))) => {
-                diagnostics.iter().map(ToString::to_string).collect()
-            }
-            Err(e) => vec![e.to_string()],
-        };
+        let messages = problem_messages(found);
         for message in messages {
             let problem = ShaderProblem {
                 pass: pass.name.clone(),
@@ -206,21 +202,10 @@ fn scene_pass_shaders(
     if pass.draw.is_none() {
         return Ok(Vec::new());
     }
-    let key = |path: &std::path::Path, stage| ShaderKey {
-        path: path.to_path_buf(),
-        stage,
-        defines: pass.defines.clone(),
-    };
-    let Some(vertex) = pass.shaders.vertex.as_deref() else {
+    if pass.shaders.vertex.is_none() {
         return Ok(vec!["needs a vertex shader".into()]);
-    };
-    let mut keys = vec![key(vertex, ShaderStage::Vertex)];
-    keys.extend(
-        pass.shaders
-            .fragment
-            .as_deref()
-            .map(|f| key(f, ShaderStage::Fragment)),
-    );
+    }
+    let keys = scene_pass_keys(pass);
     let vs = cache.shader(&keys[0])?;
     let fs = keys.get(1).map(|k| cache.shader(k)).transpose()?;
     let problems =

@@ -6,7 +6,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use weft_gpu::pipeline::{PipelineCache, ShaderKey};
 use weft_gpu::{GpuError, ShaderStage};
-use weft_graph::plan::Plan;
+use weft_graph::plan::{Plan, PlanPass};
 use weft_scene::Scene;
 
 /// How deep scene `include`s are followed (the loader's own limit).
@@ -55,25 +55,30 @@ pub fn plan_shader_keys(plan: &Plan) -> Result<Vec<ShaderKey>, GpuError> {
             keys.extend(shaders.keys().into_iter().cloned());
             continue;
         }
-        let key = |path: &Path, stage| ShaderKey {
-            path: path.to_path_buf(),
-            stage,
-            defines: pass.defines.clone(),
-        };
-        keys.extend(
-            pass.shaders
-                .vertex
-                .as_deref()
-                .map(|p| key(p, ShaderStage::Vertex)),
-        );
-        keys.extend(
-            pass.shaders
-                .fragment
-                .as_deref()
-                .map(|p| key(p, ShaderStage::Fragment)),
-        );
+        keys.extend(scene_pass_keys(pass));
     }
     Ok(keys)
+}
+
+/// The variants a scene-drawing pass runs, as the scene recorder builds them:
+/// its vertex shader, then its fragment shader when it has one.
+pub fn scene_pass_keys(pass: &PlanPass) -> Vec<ShaderKey> {
+    let key = |path: &Path, stage| ShaderKey {
+        path: path.to_path_buf(),
+        stage,
+        defines: pass.defines.clone(),
+    };
+    let vertex = pass
+        .shaders
+        .vertex
+        .as_deref()
+        .map(|p| key(p, ShaderStage::Vertex));
+    let fragment = pass
+        .shaders
+        .fragment
+        .as_deref()
+        .map(|p| key(p, ShaderStage::Fragment));
+    vertex.into_iter().chain(fragment).collect()
 }
 
 /// Every file the plan's shaders depend on, by normalized path, compiled through
