@@ -11,9 +11,9 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 use std::collections::HashMap;
-use weft_graph::memory::MemoryRequirements;
 use weft_graph::plan::{BufferDesc, ImageDesc, Plan, PlanResource, Residency, ResourceDesc};
 use weft_graph::vk::{Aspect, Layout};
+use weft_graph::MemoryRequirements;
 
 /// A created image with the views passes need.
 #[derive(Debug)]

@@ -1,8 +1,39 @@
-//! Transient memory: images whose lifetimes do not overlap share memory. Each image
-//! is placed at the lowest aligned offset that does not collide with any image alive
-//! at the same time (largest first), inside one block.
+//! Step 5, memory: transient images whose lifetimes do not overlap share memory.
+//! Each image is placed at the lowest aligned offset that does not collide with
+//! any image alive at the same time (largest first), inside one block.
 
-use crate::plan::{ImageDesc, MemoryBlock, MemoryPlan, Placement};
+use crate::plan::{
+    ImageDesc, MemoryBlock, MemoryPlan, Placement, PlanResource, Residency, ResourceDesc,
+};
+
+/// Places every transient image of `resources` (setting its `placement`) with the
+/// device's memory requirements; returns the memory plan.
+pub(crate) fn alias(
+    resources: &mut [PlanResource],
+    requirements: &dyn Fn(&ImageDesc) -> MemoryRequirements,
+) -> MemoryPlan {
+    let transient: Vec<(usize, Transient)> = resources
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.residency == Residency::Transient)
+        .filter_map(|(i, r)| match &r.desc {
+            ResourceDesc::Image(desc) => Some((
+                i,
+                Transient {
+                    requirements: requirements(desc),
+                    lifetime: r.lifetime,
+                },
+            )),
+            ResourceDesc::Buffer(_) => None,
+        })
+        .collect();
+    let requests: Vec<Transient> = transient.iter().map(|(_, t)| *t).collect();
+    let (memory, placements) = place(&requests);
+    for ((i, _), placement) in transient.iter().zip(placements) {
+        resources[*i].placement = Some(placement);
+    }
+    memory
+}
 
 /// Size and alignment of an image's memory, as `vkGetImageMemoryRequirements` reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

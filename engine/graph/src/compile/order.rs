@@ -1,10 +1,57 @@
-//! Execution order from data: edges from writers to readers (and from history
+//! Step 1, order: which passes and accesses the features make live, and their
+//! execution order from data: edges from writers to readers (and from history
 //! readers to this frame's writer), explicit `after`, a stable topological sort,
-//! and the checks that need an order: cycles, unordered writers, reads of nothing.
+//! and the checks that need an order (cycles, unordered writers, reads of nothing)
+//! as located diagnostics.
 
-use crate::resolve::Ir;
+use super::{conditions_hold, locate};
+use crate::diagnostic::Diagnostic;
+use crate::load::LoadedGraph;
+use crate::resolve::{access_path, Ir, Usage};
+use crate::spans::Seg;
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
+use std::collections::{BTreeSet, BinaryHeap};
+
+/// The live passes of one feature set, ordered, with what each does to each resource.
+pub(crate) struct Ordered {
+    /// Per IR pass: whether its `enabled_if` holds.
+    pub live: Vec<bool>,
+    /// Per IR pass: its merged active uses (empty when not live).
+    pub uses: Vec<Vec<PassUse>>,
+    pub order: Order,
+}
+
+/// Decides what is live under `features` and orders it, or reports every ordering error.
+pub(crate) fn order_live(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    features: &BTreeSet<String>,
+) -> Result<Ordered, Vec<Diagnostic>> {
+    let live: Vec<bool> = ir
+        .passes
+        .iter()
+        .map(|p| conditions_hold(&p.enabled_if, features))
+        .collect();
+    let uses: Vec<Vec<PassUse>> = (0..ir.passes.len())
+        .map(|p| {
+            if live[p] {
+                pass_uses(ir, p, |c| conditions_hold(c, features))
+            } else {
+                Vec::new()
+            }
+        })
+        .collect();
+    match order(ir, &live, &uses) {
+        Ok(order) => Ok(Ordered { live, uses, order }),
+        Err(errors) => {
+            let disabled: Vec<usize> = (0..live.len()).filter(|&p| !live[p]).collect();
+            Err(errors
+                .iter()
+                .map(|e| order_error(graph, ir, &uses, e, &disabled))
+                .collect())
+        }
+    }
+}
 
 /// What one live pass does to one resource, with all its accesses in the pass merged.
 #[derive(Debug, Clone)]
@@ -257,36 +304,143 @@ pub fn reachability(sequence: &[usize], succ: &[Vec<usize>], n: usize) -> Vec<Bi
     reach
 }
 
-/// Passes that contribute to the roots (the output and images read back): their writers, and transitively the writers
-/// of everything a contributing pass reads (history resources: all their writers,
-/// since the next frame reads them).
-pub fn contributing(ir: &Ir, order: &Order, uses: &[Vec<PassUse>], roots: &[usize]) -> Vec<bool> {
-    let n = ir.passes.len();
-    let mut position = vec![usize::MAX; n];
-    for (i, &p) in order.sequence.iter().enumerate() {
-        position[p] = i;
-    }
-    let mut needed = vec![false; n];
-    let mut stack: Vec<usize> = roots
-        .iter()
-        .flat_map(|&r| order.writers[r].iter().copied())
-        .collect();
-    while let Some(p) = stack.pop() {
-        if needed[p] {
-            continue;
+/// The located diagnostic for one ordering problem.
+fn order_error(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    uses: &[Vec<PassUse>],
+    e: &OrderError,
+    disabled: &[usize],
+) -> Diagnostic {
+    let name = |p: usize| ir.passes[p].name.as_str();
+    match e {
+        OrderError::Cycle(cycle) => {
+            let first = cycle.first().copied().unwrap_or(0);
+            let mut names: Vec<&str> = cycle.iter().map(|&p| name(p)).collect();
+            names.push(name(first));
+            let mut d = locate(graph, ir, first, &[Seg::Field("name")]);
+            d.message = format!("passes form a cycle: {}", names.join(" -> "));
+            d.with_hint("break the cycle: remove an `after` or read a different resource")
         }
-        needed[p] = true;
-        for u in &uses[p] {
-            if !u.reads_previous {
-                continue;
-            }
-            let history = ir.resources[u.resource].history;
-            for &w in &order.writers[u.resource] {
-                if w != p && (history || position[w] < position[p]) {
-                    stack.push(w);
-                }
-            }
+        OrderError::UnorderedWriters {
+            resource,
+            first,
+            second,
+        } => {
+            let mut d = locate(graph, ir, *second, &[Seg::Field("name")]);
+            d.message = format!(
+                "passes \"{}\" and \"{}\" both write \"{}\" with no order between them",
+                name(*first),
+                name(*second),
+                ir.resources[*resource].name
+            );
+            d.with_hint(format!(
+                "add `after: [\"{}\"]` to \"{}\"",
+                name(*first),
+                name(*second)
+            ))
+        }
+        OrderError::ReadBeforeWrite { resource, pass } => {
+            let access = uses[*pass]
+                .iter()
+                .find(|u| u.resource == *resource)
+                .and_then(|u| u.accesses.first())
+                .map(|&i| &ir.passes[*pass].accesses[i]);
+            let path = access
+                .map(|a| access_path(ir.passes[*pass].index, a))
+                .unwrap_or_default();
+            let (file, pos) = graph.locate(ir.passes[*pass].source, &path);
+            let rname = &ir.resources[*resource].name;
+            let disabled_writers: Vec<&str> = disabled
+                .iter()
+                .filter(|&&p| {
+                    ir.passes[p]
+                        .accesses
+                        .iter()
+                        .any(|a| a.resource == *resource && a.usage.writes())
+                })
+                .map(|&p| name(p))
+                .collect();
+            let mut d = Diagnostic::error(
+                file,
+                pos,
+                format!(
+                    "pass \"{}\" reads \"{rname}\" before anything writes it",
+                    name(*pass)
+                ),
+            );
+            d.hint = Some(if let Some(w) = disabled_writers.first() {
+                format!("its writer \"{w}\" is disabled by its `enabled_if`; make this read conditional with `(name: \"{rname}\", enabled_if: [...])`")
+            } else if matches!(
+                access.map(|a| &a.usage),
+                Some(Usage::Color { .. } | Usage::Depth { .. })
+            ) {
+                "use `load: Clear(...)` or `load: DontCare` for the first pass that writes it"
+                    .into()
+            } else {
+                "add a pass that writes it, or mark it `history: true` to read last frame's contents".into()
+            });
+            d
         }
     }
-    needed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::fixture::{ordered, pass, resolved, CHAIN};
+    use super::*;
+
+    #[test]
+    fn disabled_passes_are_not_live_and_have_no_uses() {
+        let (_, ir, o) = ordered(CHAIN, &[]);
+        let d = pass(&ir, "d");
+        assert!(!o.live[d]);
+        assert!(o.uses[d].is_empty());
+        assert_eq!(o.order.sequence, vec![0, 1, 2]);
+    }
+
+    #[test]
+    fn a_reader_runs_after_its_writer_whatever_the_declaration_order() {
+        let a_decl = r#"Pass(name: "a", kind: Fullscreen, shaders: (fragment: "a.frag"),
+                 color: [(image: "x", load: Clear([0.0, 0.0, 0.0, 0.0]))]),"#;
+        assert!(CHAIN.contains(a_decl));
+        let reader_first = CHAIN.replace(a_decl, "").replace(
+            r#"Pass(name: "c""#,
+            &format!("{a_decl}\n            Pass(name: \"c\""),
+        );
+        let (_, ir, o) = ordered(&reader_first, &["extra"]);
+        let (a, b, d) = (pass(&ir, "a"), pass(&ir, "b"), pass(&ir, "d"));
+        assert!(a > b, "a is declared after b");
+        let at = |p| o.order.sequence.iter().position(|&q| q == p).unwrap();
+        assert!(at(a) < at(b) && at(b) < at(d));
+        assert_eq!(o.order.writers[1], vec![b, d]);
+    }
+
+    #[test]
+    fn cycles_are_reported_from_their_lowest_pass() {
+        let succ = vec![vec![1], vec![2], vec![0]];
+        let live = vec![true; 3];
+        assert_eq!(topological(3, &live, &succ), Err(vec![0, 1, 2]));
+        let chain = vec![vec![2], vec![], vec![1]];
+        assert_eq!(topological(3, &live, &chain), Ok(vec![0, 2, 1]));
+    }
+
+    #[test]
+    fn ordering_errors_are_located_at_the_pass() {
+        let two_writers = CHAIN.replace(r#"after: ["b"], "#, "");
+        let (graph, ir) = resolved(&two_writers);
+        let features = ["extra".to_string()].into_iter().collect();
+        let Err(errors) = order_live(&graph, &ir, &features) else {
+            panic!("two unordered writers of out");
+        };
+        assert_eq!(errors.len(), 1);
+        assert!(errors[0]
+            .message
+            .contains("passes \"b\" and \"d\" both write \"out\""));
+        assert_eq!(
+            errors[0].hint.as_deref(),
+            Some("add `after: [\"b\"]` to \"d\"")
+        );
+        assert_eq!((errors[0].pos.line, errors[0].pos.col), (15, 24));
+    }
 }

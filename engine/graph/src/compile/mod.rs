@@ -1,0 +1,321 @@
+//! The compiler, as a list of steps (read [`compile_ir`] top to bottom): features
+//! decide which passes and reads are live and data decides their order (`order`),
+//! the output and read-back images decide what is culled (`cull`), then each
+//! resource's span of passes (`lifetimes`), its description (`resources`), shared
+//! transient memory (`memory`), every barrier (`sync`) and the pass descriptions
+//! with their render passes (`passes`), all for one output size.
+
+mod cull;
+mod lifetimes;
+pub(crate) mod memory;
+pub(crate) mod order;
+mod passes;
+mod resources;
+pub(crate) mod sync;
+
+use crate::diagnostic::Diagnostic;
+use crate::load::LoadedGraph;
+use crate::plan::{Extent, ImageDesc, Plan};
+use crate::resolve::{resolve, Ir};
+use crate::spans::{Pos, Seg};
+use memory::MemoryRequirements;
+use std::collections::BTreeSet;
+
+/// What to compile a graph for.
+pub struct CompileOptions<'a> {
+    pub extent: Extent,
+    /// Scene features and user toggles that are on.
+    pub features: BTreeSet<String>,
+    /// Light count, for buffer size expressions.
+    pub lights: u32,
+    /// Memory requirements of an image; the executor passes the device's.
+    pub memory: &'a dyn Fn(&ImageDesc) -> MemoryRequirements,
+    /// Images to keep readable after the frame besides the output (e.g. the HDR
+    /// buffer for EXR output): never aliased, left in `TRANSFER_SRC_OPTIMAL`.
+    pub readback: Vec<String>,
+}
+
+impl Default for CompileOptions<'_> {
+    fn default() -> Self {
+        CompileOptions {
+            extent: Extent {
+                width: 1280,
+                height: 720,
+            },
+            features: BTreeSet::new(),
+            lights: 1,
+            memory: &memory::estimate_requirements,
+            readback: Vec::new(),
+        }
+    }
+}
+
+/// A loaded graph that passed the checks that do not depend on features or size,
+/// ready to compile many times (on resize, on a feature toggle) without re-validating.
+pub struct Prepared<'g> {
+    graph: &'g LoadedGraph,
+    ir: Ir,
+}
+
+impl<'g> Prepared<'g> {
+    /// Validates names, formats, parameters and per-pass rules; returns every error found.
+    pub fn new(graph: &'g LoadedGraph) -> Result<Self, Vec<Diagnostic>> {
+        if graph.has_errors() {
+            return Err(graph.diagnostics.clone());
+        }
+        if graph.is_fragment {
+            let file = root_file(graph);
+            return Err(vec![Diagnostic::error(
+                file,
+                Pos { line: 1, col: 1 },
+                "this file is a fragment (`fragment: true`) and cannot be compiled on its own",
+            )
+            .with_hint(
+                "include it from a graph that declares its inputs and an output",
+            )]);
+        }
+        let (ir, mut diags) = resolve(graph);
+        if diags.iter().any(Diagnostic::is_error) {
+            diags.retain(Diagnostic::is_error);
+            return Err(diags);
+        }
+        Ok(Prepared { graph, ir })
+    }
+
+    /// The resolved graph.
+    pub fn ir(&self) -> &Ir {
+        &self.ir
+    }
+
+    /// The toggles a user typed (`name` on, `!name` off) that name no feature
+    /// of this graph — neither one its passes test nor a default — each as a
+    /// message with the nearest known name as a hint.
+    pub fn unknown_features<S: AsRef<str>>(&self, requested: &[S]) -> Vec<String> {
+        let mut known = feature_names(&self.ir);
+        known.extend(self.graph.default_features.iter().cloned());
+        requested
+            .iter()
+            .map(|f| f.as_ref().trim())
+            .map(|f| f.strip_prefix('!').unwrap_or(f))
+            .filter(|f| !f.is_empty() && !known.contains(*f))
+            .map(|f| {
+                let hint = crate::diagnostic::nearest(f, known.iter().map(String::as_str))
+                    .map(|n| format!(" (did you mean \"{n}\"?)"))
+                    .unwrap_or_default();
+                let list = known.iter().cloned().collect::<Vec<_>>().join(", ");
+                format!("unknown feature \"{f}\"{hint}; this graph's features are: {list}")
+            })
+            .collect()
+    }
+
+    /// Compiles for one size and feature set.
+    pub fn compile(&self, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
+        compile_ir(self.graph, &self.ir, options)
+    }
+}
+
+/// Validates and compiles a loaded graph, or returns every error found.
+pub fn compile(graph: &LoadedGraph, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
+    Prepared::new(graph)?.compile(options)
+}
+
+/// Whether every condition (`"name"` on, `"!name"` off) holds.
+pub fn conditions_hold(conditions: &[String], features: &BTreeSet<String>) -> bool {
+    conditions.iter().all(|c| match c.strip_prefix('!') {
+        Some(name) => !features.contains(name),
+        None => features.contains(c),
+    })
+}
+
+/// Every feature name a graph's conditions mention.
+pub fn feature_names(ir: &Ir) -> BTreeSet<String> {
+    let mut names = BTreeSet::new();
+    for pass in &ir.passes {
+        let conditions = pass
+            .enabled_if
+            .iter()
+            .chain(pass.accesses.iter().flat_map(|a| a.conditions.iter()));
+        for c in conditions {
+            names.insert(c.trim_start_matches('!').to_string());
+        }
+    }
+    names
+}
+
+/// The file of the graph's root source, for errors about the graph as a whole.
+fn root_file(graph: &LoadedGraph) -> std::path::PathBuf {
+    graph
+        .sources
+        .first()
+        .map(|s| s.file.clone())
+        .unwrap_or_default()
+}
+
+/// An error (message left to the caller) located at a field of an IR pass.
+fn locate(graph: &LoadedGraph, ir: &Ir, pass: usize, rest: &[Seg]) -> Diagnostic {
+    let p = &ir.passes[pass];
+    let mut path = vec![Seg::Field("passes"), Seg::Index(p.index)];
+    path.extend_from_slice(rest);
+    let (file, pos) = graph.locate(p.source, &path);
+    Diagnostic::error(file, pos, String::new())
+}
+
+/// Compiles a resolved graph for one feature set and size.
+pub fn compile_ir(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    options: &CompileOptions,
+) -> Result<Plan, Vec<Diagnostic>> {
+    let Some(output) = ir.output else {
+        return Err(vec![Diagnostic::error(
+            root_file(graph),
+            Pos { line: 1, col: 1 },
+            "the graph has no output",
+        )]);
+    };
+    let ordered = order::order_live(graph, ir, &options.features)?;
+    let roots = cull::roots(graph, ir, output, &options.readback, &ordered)?;
+    let cull::Culled {
+        sequence,
+        culled,
+        mut warnings,
+    } = cull::cull(graph, ir, &ordered, &roots, &options.features);
+    let lifetimes = lifetimes::Lifetimes::new(ir, &sequence, &ordered.uses, &roots);
+    lifetimes.check(graph, ir, &sequence, &ordered.uses, &roots, &mut warnings)?;
+    let mut resources = resources::describe(
+        graph,
+        ir,
+        &ordered.uses,
+        &lifetimes,
+        &roots,
+        sequence.len(),
+        options,
+    )?;
+    let memory = memory::alias(&mut resources, options.memory);
+    let sync = sync::synchronize(ir, &sequence, &ordered.uses, &lifetimes, &mut resources);
+    let passes = passes::describe(
+        &passes::PassContext {
+            graph,
+            ir,
+            uses: &ordered.uses,
+            lifetimes: &lifetimes,
+            roots: &roots,
+            resources: &resources,
+            options,
+        },
+        &sequence,
+        sync.pass_barriers,
+    );
+    Ok(Plan {
+        name: graph.name.clone(),
+        file: root_file(graph),
+        files: graph.files(),
+        extent: options.extent,
+        features: options.features.iter().cloned().collect(),
+        output: lifetimes.plan_index(output),
+        readback: roots.list[1..]
+            .iter()
+            .map(|&r| lifetimes.plan_index(r))
+            .collect(),
+        resources,
+        passes,
+        culled,
+        memory,
+        epilogue: sync.epilogue,
+        warnings,
+    })
+}
+
+/// Small graphs for the steps' unit tests.
+#[cfg(test)]
+pub(crate) mod fixture {
+    use super::order::{order_live, Ordered};
+    use crate::load::{load_with, LoadedGraph};
+    use crate::resolve::{resolve, Ir};
+    use std::collections::BTreeSet;
+    use std::path::Path;
+
+    /// `a` draws `x`; `b` samples `x` into `out` (the output); `c` draws `unused`,
+    /// which nothing reads; `d`, enabled by feature `extra`, adds to `out` after `b`.
+    pub const CHAIN: &str = r#"Graph(
+        output: "out",
+        resources: [
+            Image(name: "x", format: R8G8B8A8_UNORM),
+            Image(name: "out", format: R8G8B8A8_UNORM),
+            Image(name: "unused", format: R8G8B8A8_UNORM, size: Scale(0.5, 0.5)),
+        ],
+        passes: [
+            Pass(name: "a", kind: Fullscreen, shaders: (fragment: "a.frag"),
+                 color: [(image: "x", load: Clear([0.0, 0.0, 0.0, 0.0]))]),
+            Pass(name: "b", kind: Fullscreen, shaders: (fragment: "b.frag"),
+                 sampled: ["x"], color: [(image: "out")]),
+            Pass(name: "c", kind: Fullscreen, shaders: (fragment: "c.frag"),
+                 color: [(image: "unused")]),
+            Pass(name: "d", kind: Fullscreen, shaders: (fragment: "d.frag"),
+                 color: [(image: "out", load: Load)], after: ["b"], enabled_if: ["extra"]),
+        ],
+    )"#;
+
+    /// Loads and resolves graph text, which must resolve cleanly.
+    pub fn resolved(text: &str) -> (LoadedGraph, Ir) {
+        let root = Path::new("/fixture/graph.ron");
+        let graph = load_with(root, &|p: &Path| {
+            if p == root {
+                Ok(text.to_string())
+            } else {
+                Err(std::io::ErrorKind::NotFound.into())
+            }
+        });
+        assert!(!graph.has_errors(), "{:#?}", graph.diagnostics);
+        let (ir, diags) = resolve(&graph);
+        assert!(diags.iter().all(|d| !d.is_error()), "{diags:#?}");
+        (graph, ir)
+    }
+
+    /// The live passes of `text` under `features`, ordered.
+    pub fn ordered(text: &str, features: &[&str]) -> (LoadedGraph, Ir, Ordered) {
+        let (graph, ir) = resolved(text);
+        let features: BTreeSet<String> = features.iter().map(|f| f.to_string()).collect();
+        let ordered = order_live(&graph, &ir, &features).expect("orders");
+        (graph, ir, ordered)
+    }
+
+    /// The IR index of a pass by name.
+    pub fn pass(ir: &Ir, name: &str) -> usize {
+        ir.passes.iter().position(|p| p.name == name).expect("pass")
+    }
+
+    /// The IR index of a resource by name.
+    pub fn resource(ir: &Ir, name: &str) -> usize {
+        ir.resources
+            .iter()
+            .position(|r| r.name == name)
+            .expect("resource")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fixture::{resolved, CHAIN};
+    use super::*;
+
+    /// Compiles graph text with `features` at the default size.
+    pub(crate) fn plan_of(text: &str, features: &[&str]) -> Plan {
+        let (graph, ir) = resolved(text);
+        let options = CompileOptions {
+            features: features.iter().map(|f| f.to_string()).collect(),
+            ..CompileOptions::default()
+        };
+        compile_ir(&graph, &ir, &options).expect("compiles")
+    }
+
+    #[test]
+    fn the_steps_together_make_a_plan_of_the_running_passes() {
+        let plan = plan_of(CHAIN, &["extra"]);
+        let names: Vec<&str> = plan.passes.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(names, ["a", "b", "d"]);
+        assert_eq!(plan.features, ["extra"]);
+        assert_eq!(plan.resources[plan.output].name, "out");
+        assert_eq!(plan.culled.len(), 1);
+    }
+}

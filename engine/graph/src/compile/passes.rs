@@ -1,0 +1,265 @@
+//! Step 7, passes: each running pass as the executor needs it — descriptor
+//! bindings, shader defines for optional reads, the render pass (attachments with
+//! load and store ops chosen from what later work needs), dispatch size, copy
+//! endpoints and fixed-function state.
+
+use super::cull::Roots;
+use super::lifetimes::Lifetimes;
+use super::order::PassUse;
+use super::CompileOptions;
+use crate::load::LoadedGraph;
+use crate::plan::{
+    AttachmentDesc, Barrier, Binding, BindingKind, LoadOp, Location, PlanPass, PlanResource,
+    RenderPassDesc, ResourceDesc, StoreOp,
+};
+use crate::resolve::{image_extent, Ir, IrDispatch, Usage};
+use crate::schema::{LoadDecl, PassKind, StoreDecl};
+use crate::spans::Seg;
+use crate::vk::Layout;
+use std::collections::BTreeSet;
+
+/// What every pass description reads.
+pub(crate) struct PassContext<'a> {
+    pub graph: &'a LoadedGraph,
+    pub ir: &'a Ir,
+    pub uses: &'a [Vec<PassUse>],
+    pub lifetimes: &'a Lifetimes,
+    pub roots: &'a Roots,
+    pub resources: &'a [PlanResource],
+    pub options: &'a CompileOptions<'a>,
+}
+
+/// Describes the passes of `sequence`, each with the barriers recorded before it.
+pub(crate) fn describe(
+    cx: &PassContext,
+    sequence: &[usize],
+    barriers: Vec<Vec<Barrier>>,
+) -> Vec<PlanPass> {
+    sequence
+        .iter()
+        .zip(barriers)
+        .enumerate()
+        .map(|(i, (&p, barriers))| plan_pass(cx, p, i, barriers))
+        .collect()
+}
+
+/// One pass: bindings, defines, render pass, dispatch size and copy endpoints.
+fn plan_pass(cx: &PassContext, p: usize, i: usize, barriers: Vec<Barrier>) -> PlanPass {
+    let PassContext {
+        graph,
+        ir,
+        uses: all_uses,
+        lifetimes,
+        roots,
+        resources,
+        options,
+    } = *cx;
+    let pass = &ir.passes[p];
+    let uses = &all_uses[p];
+    let mut is_active = vec![false; pass.accesses.len()];
+    for u in uses {
+        for &k in &u.accesses {
+            is_active[k] = true;
+        }
+    }
+    let active_accesses = || {
+        pass.accesses
+            .iter()
+            .zip(&is_active)
+            .filter(|(_, on)| **on)
+            .map(|(a, _)| a)
+    };
+    let mut bindings = Vec::new();
+    let mut defines: BTreeSet<String> = BTreeSet::new();
+    for access in active_accesses() {
+        let kind = match access.usage {
+            Usage::Sampled => BindingKind::Sampled,
+            Usage::StorageRead => BindingKind::StorageRead,
+            Usage::StorageWrite => BindingKind::StorageWrite,
+            _ => continue,
+        };
+        let r = lifetimes.plan_index(access.resource);
+        if let Some(existing) = bindings.iter_mut().find(|b: &&mut Binding| b.resource == r) {
+            if matches!(
+                (existing.kind, kind),
+                (BindingKind::StorageRead, BindingKind::StorageWrite)
+                    | (BindingKind::StorageWrite, BindingKind::StorageRead)
+            ) {
+                existing.kind = BindingKind::StorageReadWrite;
+            }
+            continue;
+        }
+        bindings.push(Binding { resource: r, kind });
+        if !access.conditions.is_empty() {
+            defines.insert(format!(
+                "HAS_{}",
+                ir.resources[access.resource].name.to_ascii_uppercase()
+            ));
+        }
+    }
+    let render_pass = matches!(pass.kind, PassKind::Raster | PassKind::Fullscreen).then(|| {
+        let mut attachments = Vec::new();
+        let mut color = Vec::new();
+        let mut depth = None;
+        let mut extent = options.extent;
+        for access in active_accesses() {
+            let (load, store, blend, read_only, is_depth) = match &access.usage {
+                Usage::Color { load, store, blend } => (load, *store, *blend, false, false),
+                Usage::Depth {
+                    load,
+                    store,
+                    read_only,
+                } => (load, *store, None, *read_only, true),
+                _ => continue,
+            };
+            let r = lifetimes.plan_index(access.resource);
+            let ResourceDesc::Image(desc) = &resources[r].desc else {
+                continue;
+            };
+            extent = desc.extent;
+            let layout = if read_only {
+                Layout::DepthStencilReadOnlyOptimal
+            } else if is_depth {
+                Layout::DepthStencilAttachmentOptimal
+            } else {
+                Layout::ColorAttachmentOptimal
+            };
+            let store = if read_only {
+                StoreOp::None
+            } else if store == StoreDecl::Store
+                && lifetimes
+                    .timeline
+                    .needed_later(ir, all_uses, i, access.resource, &roots.is_root)
+            {
+                StoreOp::Store
+            } else {
+                StoreOp::DontCare
+            };
+            let (load, clear) = match load {
+                LoadDecl::Load => (LoadOp::Load, Vec::new()),
+                LoadDecl::Clear(v) => (LoadOp::Clear, v.clone()),
+                LoadDecl::DontCare => (LoadOp::DontCare, Vec::new()),
+            };
+            let index = attachments.len();
+            if is_depth {
+                depth = Some(index);
+            } else {
+                color.push(index);
+            }
+            attachments.push(AttachmentDesc {
+                resource: r,
+                format_raw: desc.format_raw,
+                samples: desc.samples,
+                load,
+                store,
+                clear,
+                initial_layout: layout,
+                layout,
+                final_layout: layout,
+                blend,
+                read_only,
+            });
+        }
+        RenderPassDesc {
+            extent,
+            attachments,
+            color,
+            depth,
+        }
+    });
+    let dispatch = pass.dispatch.map(|d| match d {
+        IrDispatch::Groups(x, y, z) => [x, y, z],
+        IrDispatch::Output(x, y) => [
+            options.extent.width.div_ceil(x.max(1)),
+            options.extent.height.div_ceil(y.max(1)),
+            1,
+        ],
+        IrDispatch::Image(r, x, y) => {
+            let e = image_extent(ir, r, options.extent).unwrap_or(options.extent);
+            [e.width.div_ceil(x.max(1)), e.height.div_ceil(y.max(1)), 1]
+        }
+    });
+    let transfer = if matches!(pass.kind, PassKind::Copy | PassKind::Blit) {
+        let find = |want: fn(&Usage) -> bool| {
+            pass.accesses
+                .iter()
+                .find(|a| want(&a.usage))
+                .map(|a| lifetimes.plan_index(a.resource))
+        };
+        find(|u| *u == Usage::TransferSrc).zip(find(|u| *u == Usage::TransferDst))
+    } else {
+        None
+    };
+    let (file, pos) = graph.locate(
+        pass.source,
+        &[
+            Seg::Field("passes"),
+            Seg::Index(pass.index),
+            Seg::Field("name"),
+        ],
+    );
+    PlanPass {
+        name: pass.name.clone(),
+        declared_at: Location { file, pos },
+        kind: pass.kind,
+        shaders: pass.shaders.clone(),
+        draw: pass.draw.clone(),
+        dispatch,
+        params: pass.params.clone(),
+        defines: defines.into_iter().collect(),
+        barriers,
+        render_pass,
+        bindings,
+        transfer,
+        raster: pass.raster,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::fixture::CHAIN;
+    use super::super::tests::plan_of;
+    use super::*;
+
+    #[test]
+    fn stores_are_kept_only_for_contents_read_later() {
+        let plan = plan_of(CHAIN, &[]);
+        let ops = |pass: usize| {
+            let rp = plan.passes[pass].render_pass.as_ref().expect("fullscreen");
+            let a = &rp.attachments[0];
+            (a.load, a.store, a.final_layout)
+        };
+        assert_eq!(
+            ops(0),
+            (
+                LoadOp::Clear,
+                StoreOp::Store,
+                Layout::ColorAttachmentOptimal
+            )
+        );
+        assert_eq!(plan.passes[1].bindings.len(), 1);
+        assert_eq!(plan.passes[1].bindings[0].kind, BindingKind::Sampled);
+        assert_eq!(
+            ops(1),
+            (
+                LoadOp::DontCare,
+                StoreOp::Store,
+                Layout::ColorAttachmentOptimal
+            )
+        );
+    }
+
+    #[test]
+    fn a_conditional_read_defines_has_name() {
+        let text = CHAIN.replace(
+            r#"sampled: ["x"]"#,
+            r#"sampled: ["x", (name: "x", enabled_if: ["extra"])]"#,
+        );
+        let plain = plan_of(&text, &[]);
+        assert!(plain.passes[1].defines.is_empty());
+        let text = text.replace(r#"sampled: ["x", "#, "sampled: [");
+        let with = plan_of(&text, &["extra"]);
+        let b = with.passes.iter().find(|p| p.name == "b").expect("b runs");
+        assert_eq!(b.defines, ["HAS_X"]);
+    }
+}

@@ -1,0 +1,215 @@
+//! Step 4, resources: a description of each kept resource — its residency
+//! (transient, history, output), the plan passes it lives through, and the
+//! format, extent and usage flags an image or buffer is created with.
+
+use super::cull::Roots;
+use super::lifetimes::Lifetimes;
+use super::order::PassUse;
+use super::CompileOptions;
+use crate::diagnostic::Diagnostic;
+use crate::load::LoadedGraph;
+use crate::plan::{BufferDesc, Extent, ImageDesc, PlanResource, Residency, ResourceDesc};
+use crate::resolve::{
+    expression_vars, image_extent, oversized_image, resource_path, BufferSize, Ir, IrKind, Usage,
+    MAX_IMAGE_DIMENSION,
+};
+use crate::spans::Seg;
+use crate::vk::{BufferUsage, ImageUsage, Layout};
+
+/// Describes every kept resource, after checking that every image fits the device limit.
+pub(crate) fn describe(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    uses: &[Vec<PassUse>],
+    lifetimes: &Lifetimes,
+    roots: &Roots,
+    passes: usize,
+    options: &CompileOptions,
+) -> Result<Vec<PlanResource>, Vec<Diagnostic>> {
+    check_image_sizes(graph, ir, &lifetimes.kept, options.extent)?;
+    let mut resources: Vec<PlanResource> = Vec::with_capacity(lifetimes.kept.len());
+    for &r in &lifetimes.kept {
+        let res = &ir.resources[r];
+        let residency = if roots.is_root[r] {
+            Residency::Output
+        } else if res.history {
+            Residency::History
+        } else {
+            Residency::Transient
+        };
+        let touches = &lifetimes.timeline.per_resource[r];
+        let first = touches.first().map_or(usize::MAX, |t| t.0);
+        let last = touches.last().map_or(0, |t| t.0);
+        let accesses = || {
+            touches.iter().flat_map(|&(_, p, k)| {
+                uses[p][k]
+                    .accesses
+                    .iter()
+                    .map(move |&a| &ir.passes[p].accesses[a].usage)
+            })
+        };
+        let desc = match &res.kind {
+            IrKind::Image {
+                format,
+                mips,
+                layers,
+                samples,
+                ..
+            } => {
+                let extent = image_extent(ir, r, options.extent).unwrap_or(options.extent);
+                let mut usage = ImageUsage::empty();
+                for u in accesses() {
+                    usage |= match u {
+                        Usage::Sampled => ImageUsage::SAMPLED,
+                        Usage::StorageRead | Usage::StorageWrite => ImageUsage::STORAGE,
+                        Usage::Color { .. } => ImageUsage::COLOR_ATTACHMENT,
+                        Usage::Depth { .. } => ImageUsage::DEPTH_STENCIL_ATTACHMENT,
+                        Usage::TransferSrc => ImageUsage::TRANSFER_SRC,
+                        Usage::TransferDst => ImageUsage::TRANSFER_DST,
+                    };
+                }
+                if residency == Residency::Output {
+                    usage |= ImageUsage::TRANSFER_SRC;
+                }
+                ResourceDesc::Image(ImageDesc {
+                    format: format.name.to_string(),
+                    format_raw: format.raw,
+                    aspect: format.aspect,
+                    extent,
+                    mips: *mips,
+                    layers: *layers,
+                    samples: *samples,
+                    usage,
+                    texel_bytes: format.bytes,
+                })
+            }
+            IrKind::External => unreachable!(
+                "only fragments have external resources, and fragments are not compiled"
+            ),
+            IrKind::Buffer { size } => {
+                let bytes = match size {
+                    BufferSize::Bytes(b) => *b,
+                    BufferSize::Expression(text) => {
+                        let vars = expression_vars(
+                            &graph.sources[res.source].params,
+                            options.extent,
+                            options.lights,
+                        );
+                        crate::expr::eval(text, &vars)
+                            .map(|v| v.max(1.0).ceil() as u64)
+                            .unwrap_or(1)
+                    }
+                };
+                let mut usage = BufferUsage::empty();
+                for u in accesses() {
+                    usage |= match u {
+                        Usage::Sampled => BufferUsage::UNIFORM,
+                        Usage::TransferSrc => BufferUsage::TRANSFER_SRC,
+                        Usage::TransferDst => BufferUsage::TRANSFER_DST,
+                        _ => BufferUsage::STORAGE,
+                    };
+                }
+                ResourceDesc::Buffer(BufferDesc { size: bytes, usage })
+            }
+        };
+        resources.push(PlanResource {
+            name: res.name.clone(),
+            desc,
+            residency,
+            lifetime: (first.min(passes.saturating_sub(1)), last),
+            placement: None,
+            frame_start_layout: Layout::Undefined,
+        });
+    }
+
+    Ok(resources)
+}
+
+/// Every image the plan creates fits [`MAX_IMAGE_DIMENSION`] at this output size
+/// (`check` tries a few sizes; a command line can ask for another).
+fn check_image_sizes(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    kept: &[usize],
+    output: Extent,
+) -> Result<(), Vec<Diagnostic>> {
+    let errors: Vec<Diagnostic> = kept
+        .iter()
+        .filter_map(|&r| {
+            let e = image_extent(ir, r, output)?;
+            (e.width > MAX_IMAGE_DIMENSION || e.height > MAX_IMAGE_DIMENSION).then(|| {
+                let res = &ir.resources[r];
+                let (file, pos) =
+                    graph.locate(res.source, &resource_path(res.index, &[Seg::Field("size")]));
+                Diagnostic::error(file, pos, oversized_image(&res.name, e, output))
+            })
+        })
+        .collect();
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::fixture::CHAIN;
+    use super::super::tests::plan_of;
+    use super::*;
+
+    #[test]
+    fn usage_flags_and_residency_come_from_the_accesses() {
+        let plan = plan_of(CHAIN, &[]);
+        let image = |name: &str| {
+            let r = plan.resource(name).expect("kept");
+            match &plan.resources[r].desc {
+                ResourceDesc::Image(d) => (d.usage, plan.resources[r].residency),
+                ResourceDesc::Buffer(_) => panic!("{name} is an image"),
+            }
+        };
+        assert_eq!(
+            image("x"),
+            (
+                ImageUsage::COLOR_ATTACHMENT | ImageUsage::SAMPLED,
+                Residency::Transient
+            )
+        );
+        assert_eq!(
+            image("out"),
+            (
+                ImageUsage::COLOR_ATTACHMENT | ImageUsage::TRANSFER_SRC,
+                Residency::Output
+            )
+        );
+        assert_eq!(plan.resources[0].lifetime, (0, 1));
+    }
+
+    #[test]
+    fn an_image_over_the_device_limit_is_an_error_at_its_size() {
+        let text = CHAIN.replace("size: Scale(0.5, 0.5)", "size: Scale(8.0, 1.0)");
+        let (graph, ir) = super::super::fixture::resolved(&text);
+        let options = CompileOptions {
+            readback: vec!["unused".into()],
+            extent: Extent {
+                width: 2100,
+                height: 100,
+            },
+            ..CompileOptions::default()
+        };
+        let errors =
+            super::super::compile_ir(&graph, &ir, &options).expect_err("8 x 2100 texels wide");
+        assert_eq!(
+            errors[0].message,
+            oversized_image(
+                "unused",
+                Extent {
+                    width: 16800,
+                    height: 100
+                },
+                options.extent
+            )
+        );
+        assert_eq!(errors[0].pos.line, 6);
+    }
+}

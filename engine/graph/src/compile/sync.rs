@@ -1,0 +1,394 @@
+//! Step 6, sync: all synchronization of a plan. Each pass's accesses as the GPU
+//! sees them; the barriers before each pass, from the per-resource state walk in
+//! `state`; the hand-over of aliased memory; the previous frame simulated so the
+//! steady state is synchronized too; and the epilogue that leaves the output and
+//! history images ready for the next frame.
+
+mod state;
+
+pub use state::{sampled_layout, shader_stages, GpuAccess, ResourceState};
+
+use super::lifetimes::Lifetimes;
+use super::order::PassUse;
+use crate::plan::{Barrier, PlanResource, Residency, ResourceDesc};
+use crate::resolve::{Ir, IrKind, Usage};
+use crate::schema::{LoadDecl, PassKind};
+use crate::vk::{Access, Layout, Stage};
+
+/// The barriers of a plan.
+pub(crate) struct Synchronization {
+    /// Per plan pass, the barriers recorded before it.
+    pub pass_barriers: Vec<Vec<Barrier>>,
+    /// Barriers after the last pass.
+    pub epilogue: Vec<Barrier>,
+}
+
+/// Derives every barrier of the plan, and each output and history image's layout
+/// at the start of a frame (set on `resources`).
+pub(crate) fn synchronize(
+    ir: &Ir,
+    sequence: &[usize],
+    uses: &[Vec<PassUse>],
+    lifetimes: &Lifetimes,
+    resources: &mut [PlanResource],
+) -> Synchronization {
+    // Per-pass GPU accesses, then barriers.
+    let gpu_uses = gpu_uses(ir, sequence, uses, lifetimes);
+    let scopes = read_scopes(&gpu_uses);
+    let sharing = memory_sharing(resources);
+    let mut states = frame_start_states(resources, &gpu_uses, &scopes);
+    inherit_previous_frame(resources, &sharing, &gpu_uses, &scopes, &mut states);
+    let (pass_barriers, end_of_frame) =
+        record_barriers(resources, &sharing, &gpu_uses, &scopes, states);
+    let epilogue = epilogue(resources, &gpu_uses, &scopes, &end_of_frame);
+    Synchronization {
+        pass_barriers,
+        epilogue,
+    }
+}
+
+/// Per plan pass, each resource it uses (plan index) and how the GPU accesses it.
+fn gpu_uses(
+    ir: &Ir,
+    sequence: &[usize],
+    uses: &[Vec<PassUse>],
+    lifetimes: &Lifetimes,
+) -> Vec<Vec<(usize, GpuAccess)>> {
+    sequence
+        .iter()
+        .map(|&p| {
+            uses[p]
+                .iter()
+                .map(|u| (lifetimes.plan_index(u.resource), gpu_access(ir, p, u)))
+                .collect()
+        })
+        .collect()
+}
+
+/// Each resource's state when a frame starts: transient ones fresh, the output as
+/// the previous frame's copy left it, history images as their first reader needs
+/// them (the epilogue puts them there). Sets `frame_start_layout` to match.
+fn frame_start_states(
+    resources: &mut [PlanResource],
+    gpu_uses: &[Vec<(usize, GpuAccess)>],
+    scopes: &[Vec<Scope>],
+) -> Vec<ResourceState> {
+    let mut states: Vec<ResourceState> = resources
+        .iter()
+        .map(|r| ResourceState::fresh(matches!(r.desc, ResourceDesc::Image(_))))
+        .collect();
+    for (i, r) in resources.iter_mut().enumerate() {
+        match r.residency {
+            Residency::Transient => {}
+            Residency::Output => {
+                states[i].layout = Layout::TransferSrcOptimal;
+                states[i].reads = Stage::COPY | Stage::BLIT;
+                r.frame_start_layout = Layout::TransferSrcOptimal;
+            }
+            Residency::History => {
+                if let Some((first, scope)) = first_access(gpu_uses, scopes, i) {
+                    if states[i].image {
+                        states[i].layout = first.layout;
+                        r.frame_start_layout = first.layout;
+                    }
+                    states[i].write = Some((scope.0, Access::empty()));
+                    states[i].visible = vec![scope];
+                }
+            }
+        }
+    }
+    states
+}
+
+/// The first frame starts from `states`; every later frame starts where the previous
+/// one ended, so a transient image's first barrier must also wait for the previous
+/// frame's last use of its memory. Simulates one frame to learn that.
+fn inherit_previous_frame(
+    resources: &[PlanResource],
+    sharing: &[Vec<usize>],
+    gpu_uses: &[Vec<(usize, GpuAccess)>],
+    scopes: &[Vec<Scope>],
+    states: &mut [ResourceState],
+) {
+    let (_, end_of_frame) = record_barriers(resources, sharing, gpu_uses, scopes, states.to_vec());
+    for (r, state) in states.iter_mut().enumerate() {
+        if resources[r].residency == Residency::Transient {
+            let (stage, access) = pending_of(&end_of_frame, sharing[r].iter().copied().chain([r]));
+            state.inherit(stage, access);
+        }
+    }
+}
+
+/// Barriers after the last pass that bring the output to `TRANSFER_SRC_OPTIMAL`
+/// and each history image to the state its first reader next frame expects.
+fn epilogue(
+    resources: &[PlanResource],
+    gpu_uses: &[Vec<(usize, GpuAccess)>],
+    scopes: &[Vec<Scope>],
+    states: &[ResourceState],
+) -> Vec<Barrier> {
+    let mut epilogue = Vec::new();
+    for (i, r) in resources.iter().enumerate() {
+        let target = match r.residency {
+            Residency::Transient => continue,
+            Residency::Output => GpuAccess {
+                stage: Stage::COPY | Stage::BLIT,
+                access: Access::TRANSFER_READ,
+                layout: Layout::TransferSrcOptimal,
+                discards: false,
+            },
+            Residency::History => match first_access(gpu_uses, scopes, i) {
+                Some((first, (stage, access))) => GpuAccess {
+                    stage,
+                    access,
+                    discards: false,
+                    ..first
+                },
+                None => continue,
+            },
+        };
+        let (src_stage, src_access) = states[i].pending();
+        epilogue.push(Barrier {
+            resource: i,
+            src_stage,
+            src_access,
+            dst_stage: target.stage,
+            dst_access: target.access,
+            layouts: states[i].image.then_some((states[i].layout, target.layout)),
+        });
+    }
+
+    epilogue
+}
+
+type Scope = (Stage, Access);
+
+fn first_access(
+    gpu_uses: &[Vec<(usize, GpuAccess)>],
+    scopes: &[Vec<Scope>],
+    r: usize,
+) -> Option<(GpuAccess, Scope)> {
+    gpu_uses
+        .iter()
+        .zip(scopes)
+        .flat_map(|(u, s)| u.iter().zip(s))
+        .find(|((i, _), _)| *i == r)
+        .map(|((_, a), s)| (*a, *s))
+}
+
+/// For every access, the destination scope its barrier should have: its own, or for a
+/// read, the union with the reads after it in the same layout up to the next write.
+fn read_scopes(gpu_uses: &[Vec<(usize, GpuAccess)>]) -> Vec<Vec<Scope>> {
+    let mut scopes: Vec<Vec<Scope>> = gpu_uses
+        .iter()
+        .map(|u| u.iter().map(|(_, a)| (a.stage, a.access)).collect())
+        .collect();
+    let mut run: std::collections::HashMap<usize, (Layout, Scope)> =
+        std::collections::HashMap::new();
+    for i in (0..gpu_uses.len()).rev() {
+        for (k, &(r, a)) in gpu_uses[i].iter().enumerate() {
+            if a.access.is_write() {
+                run.remove(&r);
+                continue;
+            }
+            let mut scope = (a.stage, a.access);
+            if let Some((layout, later)) = run.get(&r) {
+                if *layout == a.layout {
+                    scope = (scope.0 | later.0, scope.1 | later.1);
+                }
+            }
+            scopes[i][k] = scope;
+            run.insert(r, (a.layout, scope));
+        }
+    }
+    scopes
+}
+
+/// Walks the passes once, returning each pass's barriers and the final states.
+fn record_barriers(
+    resources: &[PlanResource],
+    sharing: &[Vec<usize>],
+    gpu_uses: &[Vec<(usize, GpuAccess)>],
+    scopes: &[Vec<Scope>],
+    mut states: Vec<ResourceState>,
+) -> (Vec<Vec<Barrier>>, Vec<ResourceState>) {
+    let mut all = Vec::with_capacity(gpu_uses.len());
+    for (i, accesses) in gpu_uses.iter().enumerate() {
+        let mut barriers = Vec::new();
+        for (k, &(r, access)) in accesses.iter().enumerate() {
+            if resources[r].lifetime.0 == i && resources[r].residency == Residency::Transient {
+                let before = sharing[r]
+                    .iter()
+                    .copied()
+                    .filter(|&j| resources[j].lifetime.1 < resources[r].lifetime.0);
+                let (stage, acc) = pending_of(&states, before);
+                states[r].inherit(stage, acc);
+            }
+            if let Some(b) = states[r].access(r, access, scopes[i][k]) {
+                barriers.push(b);
+            }
+        }
+        all.push(barriers);
+    }
+    (all, states)
+}
+
+/// For each resource, the other transient images whose memory overlaps its own.
+fn memory_sharing(resources: &[PlanResource]) -> Vec<Vec<usize>> {
+    let mut placed: Vec<(usize, u64, u64, usize)> = resources
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| {
+            r.placement
+                .map(|p| (p.block, p.offset, p.offset + p.size, i))
+        })
+        .collect();
+    placed.sort_unstable();
+    let mut sharing = vec![Vec::new(); resources.len()];
+    for (k, &(block, _, end, i)) in placed.iter().enumerate() {
+        for &(other_block, start, _, j) in &placed[k + 1..] {
+            if other_block != block || start >= end {
+                break;
+            }
+            sharing[i].push(j);
+            sharing[j].push(i);
+        }
+    }
+    sharing
+}
+
+/// The union of the pending stages and accesses of some resources.
+fn pending_of(states: &[ResourceState], which: impl Iterator<Item = usize>) -> (Stage, Access) {
+    which.fold((Stage::empty(), Access::empty()), |(s, a), j| {
+        let (js, ja) = states[j].pending();
+        (s | js, a | ja)
+    })
+}
+
+/// How the GPU sees a pass's merged use of a resource.
+fn gpu_access(ir: &Ir, pass: usize, u: &PassUse) -> GpuAccess {
+    let p = &ir.passes[pass];
+    let aspect = match ir.resources[u.resource].kind {
+        IrKind::Image { format, .. } => Some(format.aspect),
+        IrKind::Buffer { .. } | IrKind::External => None,
+    };
+    let mut stage = Stage::empty();
+    let mut access = Access::empty();
+    let mut layout = Layout::General;
+    for &a in &u.accesses {
+        let (s, acc, l) = match &p.accesses[a].usage {
+            Usage::Sampled => match aspect {
+                Some(aspect) => (
+                    image_read_stages(p.kind),
+                    Access::SHADER_SAMPLED_READ,
+                    sampled_layout(aspect),
+                ),
+                None => (shader_stages(p.kind), Access::UNIFORM_READ, Layout::General),
+            },
+            Usage::StorageRead => (
+                shader_stages(p.kind),
+                Access::SHADER_STORAGE_READ,
+                Layout::General,
+            ),
+            Usage::StorageWrite => (
+                shader_stages(p.kind),
+                Access::SHADER_STORAGE_WRITE,
+                Layout::General,
+            ),
+            Usage::Color { load, .. } => {
+                let read = if *load == LoadDecl::Load {
+                    Access::COLOR_ATTACHMENT_READ
+                } else {
+                    Access::empty()
+                };
+                (
+                    Stage::COLOR_ATTACHMENT_OUTPUT,
+                    Access::COLOR_ATTACHMENT_WRITE | read,
+                    Layout::ColorAttachmentOptimal,
+                )
+            }
+            Usage::Depth {
+                read_only: true, ..
+            } => (
+                Stage::EARLY_FRAGMENT_TESTS | Stage::LATE_FRAGMENT_TESTS,
+                Access::DEPTH_STENCIL_ATTACHMENT_READ,
+                Layout::DepthStencilReadOnlyOptimal,
+            ),
+            Usage::Depth { .. } => (
+                Stage::EARLY_FRAGMENT_TESTS | Stage::LATE_FRAGMENT_TESTS,
+                Access::DEPTH_STENCIL_ATTACHMENT_READ | Access::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                Layout::DepthStencilAttachmentOptimal,
+            ),
+            Usage::TransferSrc => (
+                shader_stages(p.kind),
+                Access::TRANSFER_READ,
+                Layout::TransferSrcOptimal,
+            ),
+            Usage::TransferDst => (
+                shader_stages(p.kind),
+                Access::TRANSFER_WRITE,
+                Layout::TransferDstOptimal,
+            ),
+        };
+        stage |= s;
+        access |= acc;
+        layout = l;
+    }
+    if aspect.is_none() {
+        layout = Layout::General;
+    }
+    GpuAccess {
+        stage,
+        access,
+        layout,
+        discards: u.discards,
+    }
+}
+
+/// Images are sampled in fragment shaders in raster passes (vertex shaders read buffers).
+fn image_read_stages(kind: PassKind) -> Stage {
+    match kind {
+        PassKind::Raster => Stage::FRAGMENT_SHADER,
+        other => shader_stages(other),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::fixture::CHAIN;
+    use super::super::tests::plan_of;
+    use super::*;
+
+    #[test]
+    fn a_sampled_attachment_gets_one_barrier_and_the_output_an_epilogue() {
+        let plan = plan_of(CHAIN, &[]);
+        let x = plan.resource("x").expect("x");
+        let before_b = &plan.passes[1].barriers;
+        let to_sampled = before_b
+            .iter()
+            .find(|b| b.resource == x)
+            .expect("x barrier");
+        assert_eq!(to_sampled.src_stage, Stage::COLOR_ATTACHMENT_OUTPUT);
+        assert_eq!(to_sampled.src_access, Access::COLOR_ATTACHMENT_WRITE);
+        assert_eq!(to_sampled.dst_stage, Stage::FRAGMENT_SHADER);
+        assert_eq!(to_sampled.dst_access, Access::SHADER_SAMPLED_READ);
+        assert_eq!(
+            to_sampled.layouts,
+            Some((
+                Layout::ColorAttachmentOptimal,
+                Layout::ShaderReadOnlyOptimal
+            ))
+        );
+        let out = plan.resource("out").expect("out");
+        assert_eq!(plan.epilogue.len(), 1);
+        assert_eq!(plan.epilogue[0].resource, out);
+        assert_eq!(
+            plan.epilogue[0].layouts,
+            Some((Layout::ColorAttachmentOptimal, Layout::TransferSrcOptimal))
+        );
+        assert_eq!(
+            plan.resources[out].frame_start_layout,
+            Layout::TransferSrcOptimal
+        );
+    }
+}
