@@ -1,0 +1,151 @@
+//! The resolved graph: names replaced by indices, parameters by numbers.
+
+use crate::plan::ShaderFiles;
+use crate::schema::{Blend, Draw, LoadDecl, ParamValue, PassKind, RasterState, StoreDecl};
+use crate::vk::FormatInfo;
+use std::collections::BTreeMap;
+
+/// A graph with names resolved to indices.
+#[derive(Debug, Clone)]
+pub struct Ir {
+    pub resources: Vec<IrResource>,
+    pub passes: Vec<IrPass>,
+    pub output: Option<usize>,
+}
+
+/// A resolved resource.
+#[derive(Debug, Clone)]
+pub struct IrResource {
+    pub name: String,
+    pub source: usize,
+    pub index: usize,
+    pub kind: IrKind,
+    pub history: bool,
+}
+
+/// Image or buffer specifics.
+#[derive(Debug, Clone)]
+pub enum IrKind {
+    Image {
+        format: &'static FormatInfo,
+        size: SizeSpec,
+        mips: u32,
+        layers: u32,
+        samples: u32,
+    },
+    Buffer {
+        size: BufferSize,
+    },
+    /// A fragment's input when the fragment is checked on its own, or an image
+    /// whose format is unknown: names resolve, but nothing more is checked.
+    External,
+}
+
+/// An image size with parameters resolved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SizeSpec {
+    Output,
+    Scale(f64, f64),
+    Absolute(u32, u32),
+    Like(usize, f64, f64),
+}
+
+/// A buffer size: fixed, or an expression evaluated per compile.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BufferSize {
+    Bytes(u64),
+    Expression(String),
+}
+
+/// A resolved pass.
+#[derive(Debug, Clone)]
+pub struct IrPass {
+    pub name: String,
+    pub source: usize,
+    pub index: usize,
+    pub kind: PassKind,
+    pub shaders: ShaderFiles,
+    pub draw: Option<Draw>,
+    pub dispatch: Option<IrDispatch>,
+    pub params: BTreeMap<String, ParamValue>,
+    pub accesses: Vec<IrAccess>,
+    pub after: Vec<usize>,
+    pub enabled_if: Vec<String>,
+    /// Fixed-function state of a raster pass.
+    pub raster: RasterState,
+}
+
+/// How many compute work groups, resolved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum IrDispatch {
+    Output(u32, u32),
+    Image(usize, u32, u32),
+    Groups(u32, u32, u32),
+}
+
+/// One use of a resource by a pass.
+#[derive(Debug, Clone)]
+pub struct IrAccess {
+    pub resource: usize,
+    pub usage: Usage,
+    /// Features that must hold for this access to happen.
+    pub conditions: Vec<String>,
+    /// The field and index in the pass declaration, for diagnostics.
+    pub field: &'static str,
+    pub item: Option<usize>,
+}
+
+/// How a pass uses a resource.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Usage {
+    Sampled,
+    StorageRead,
+    StorageWrite,
+    Color {
+        load: LoadDecl,
+        store: StoreDecl,
+        blend: Option<Blend>,
+    },
+    Depth {
+        load: LoadDecl,
+        store: StoreDecl,
+        read_only: bool,
+    },
+    TransferSrc,
+    TransferDst,
+}
+
+impl Usage {
+    /// Whether the access needs what earlier passes left in the resource.
+    pub fn reads_previous(&self) -> bool {
+        match self {
+            Usage::Sampled | Usage::StorageRead | Usage::TransferSrc => true,
+            Usage::Color { load, .. } => *load == LoadDecl::Load,
+            Usage::Depth {
+                load, read_only, ..
+            } => *load == LoadDecl::Load || *read_only,
+            Usage::StorageWrite | Usage::TransferDst => false,
+        }
+    }
+
+    /// Whether the access changes the resource.
+    pub fn writes(&self) -> bool {
+        match self {
+            Usage::Sampled | Usage::StorageRead | Usage::TransferSrc => false,
+            Usage::Depth { read_only, .. } => !read_only,
+            Usage::Color { .. } | Usage::StorageWrite | Usage::TransferDst => true,
+        }
+    }
+
+    /// Whether the access overwrites every texel without reading, so older contents may be discarded.
+    pub fn discards(&self) -> bool {
+        match self {
+            Usage::Color { load, .. } => *load != LoadDecl::Load,
+            Usage::Depth {
+                load, read_only, ..
+            } => *load != LoadDecl::Load && !read_only,
+            Usage::TransferDst => true,
+            _ => false,
+        }
+    }
+}

@@ -1,0 +1,274 @@
+//! Turns a loaded graph into an index-based intermediate form, checking every name,
+//! format, parameter and per-pass rule that does not depend on execution order.
+//! All problems are collected; none stops the others from being found.
+
+mod ir;
+mod passes;
+mod resources;
+mod rules;
+mod values;
+
+pub use ir::*;
+pub use rules::{access_path, usage_name};
+pub(crate) use values::oversized_image;
+pub use values::{expression_vars, image_extent, MAX_IMAGE_DIMENSION, MAX_WORKGROUP_COUNT};
+
+use crate::diagnostic::Diagnostic;
+use crate::load::LoadedGraph;
+use crate::plan::Extent;
+use crate::schema::ResourceDecl;
+use crate::spans::Seg;
+use std::collections::HashMap;
+
+/// An attachment's extent and sample count at one probe size (`None` when unknown).
+type SizeAtProbe = Option<(Extent, u32)>;
+
+/// Output sizes at which attachment sizes are compared, so that sizes which only
+/// coincide at one output size are still reported.
+const PROBE_SIZES: [Extent; 3] = [
+    Extent {
+        width: 1920,
+        height: 1080,
+    },
+    Extent {
+        width: 1280,
+        height: 720,
+    },
+    Extent {
+        width: 641,
+        height: 359,
+    },
+];
+
+/// Resolves and checks a loaded graph; returns the IR (possibly partial) and diagnostics.
+pub fn resolve(graph: &LoadedGraph) -> (Ir, Vec<Diagnostic>) {
+    let mut r = Resolver {
+        graph,
+        diags: Vec::new(),
+        resource_index: HashMap::new(),
+        pass_index: HashMap::new(),
+    };
+    let ir = r.run();
+    (ir, r.diags)
+}
+
+struct Resolver<'a> {
+    graph: &'a LoadedGraph,
+    diags: Vec<Diagnostic>,
+    resource_index: HashMap<&'a str, usize>,
+    pass_index: HashMap<&'a str, usize>,
+}
+
+fn pass_path<'p>(index: usize, rest: &[Seg<'p>]) -> Vec<Seg<'p>> {
+    let mut path = vec![Seg::Field("passes"), Seg::Index(index)];
+    path.extend_from_slice(rest);
+    path
+}
+
+pub(crate) fn resource_path<'p>(index: usize, rest: &[Seg<'p>]) -> Vec<Seg<'p>> {
+    let mut path = vec![Seg::Field("resources"), Seg::Index(index)];
+    path.extend_from_slice(rest);
+    path
+}
+
+impl<'a> Resolver<'a> {
+    fn error(&mut self, source: usize, path: &[Seg], message: String) -> &mut Diagnostic {
+        let (file, pos) = self.graph.locate(source, path);
+        self.diags.push(Diagnostic::error(file, pos, message));
+        self.diags.last_mut().expect("just pushed")
+    }
+
+    fn resource_names(&self) -> Vec<&'a str> {
+        self.graph
+            .resources
+            .iter()
+            .map(|r| resource_name(&r.item))
+            .collect()
+    }
+
+    fn run(&mut self) -> Ir {
+        let graph = self.graph;
+        for (i, r) in graph.resources.iter().enumerate() {
+            let name = resource_name(&r.item);
+            if self.resource_index.insert(name, i).is_some() {
+                self.error(
+                    r.source,
+                    &resource_path(r.index, &[Seg::Field("name")]),
+                    format!("resource \"{name}\" is declared twice"),
+                )
+                .hint = Some("resource names are shared by a graph and its includes".into());
+            }
+        }
+        for (i, p) in graph.passes.iter().enumerate() {
+            if self.pass_index.insert(p.item.name.as_str(), i).is_some() {
+                let name = p.item.name.clone();
+                self.error(
+                    p.source,
+                    &pass_path(p.index, &[Seg::Field("name")]),
+                    format!("pass \"{name}\" is declared twice"),
+                );
+            }
+        }
+        let mut resources: Vec<IrResource> = graph
+            .resources
+            .iter()
+            .map(|r| self.resolve_resource(r))
+            .collect();
+        for (source, names) in graph.inputs.iter().enumerate() {
+            for (k, name) in names.iter().enumerate() {
+                if self.resource_index.contains_key(name.as_str()) {
+                    continue;
+                }
+                if source == 0 && graph.is_fragment {
+                    self.resource_index.insert(name, resources.len());
+                    resources.push(IrResource {
+                        name: name.clone(),
+                        source,
+                        index: k,
+                        kind: IrKind::External,
+                        history: false,
+                    });
+                } else {
+                    let fragment = graph.sources[source].file.display().to_string();
+                    self.error(source, &[Seg::Field("inputs"), Seg::Index(k)], format!(
+                        "fragment \"{fragment}\" needs resource \"{name}\", which the including graph does not declare"))
+                        .hint = Some(format!("declare \"{name}\" in the graph that includes this fragment"));
+                }
+            }
+        }
+        let passes: Vec<IrPass> = graph
+            .passes
+            .iter()
+            .map(|p| self.resolve_pass(p, &resources))
+            .collect();
+        let output = self.resolve_output(&resources);
+        self.check_readback(&resources);
+        let ir = Ir {
+            resources,
+            passes,
+            output,
+        };
+        self.check_usages(&ir);
+        self.check_extents(&ir);
+        ir
+    }
+
+    /// Every image fits [`MAX_IMAGE_DIMENSION`] at each size `check` tries
+    /// (images within it keep every output-sized dispatch within
+    /// [`MAX_WORKGROUP_COUNT`] groups).
+    fn check_extents(&mut self, ir: &Ir) {
+        for (r, res) in ir.resources.iter().enumerate() {
+            if !matches!(res.kind, IrKind::Image { .. }) {
+                continue;
+            }
+            let too_large = PROBE_SIZES.iter().find_map(|out| {
+                image_extent(ir, r, *out)
+                    .filter(|e| e.width > MAX_IMAGE_DIMENSION || e.height > MAX_IMAGE_DIMENSION)
+                    .map(|e| (*out, e))
+            });
+            if let Some((out, e)) = too_large {
+                self.error(
+                    res.source,
+                    &resource_path(res.index, &[Seg::Field("size")]),
+                    oversized_image(&res.name, e, out),
+                );
+            }
+        }
+    }
+
+    /// Every name in the graph's `readback` list is one of its images.
+    fn check_readback(&mut self, resources: &[IrResource]) {
+        for (i, name) in self.graph.readback.iter().enumerate() {
+            let path = [Seg::Field("readback"), Seg::Index(i)];
+            match self.resource_index.get(name.as_str()) {
+                Some(&r) if matches!(resources[r].kind, IrKind::Buffer { .. }) => {
+                    self.error(
+                        0,
+                        &path,
+                        format!("readback \"{name}\" is a buffer; only images are read back"),
+                    );
+                }
+                Some(_) => {}
+                None => {
+                    let names = self.resource_names();
+                    self.error(0, &path, format!("unknown resource \"{name}\""))
+                        .hint = crate::diagnostic::nearest(name, names)
+                        .map(|n| format!("did you mean \"{n}\"?"));
+                }
+            }
+        }
+    }
+
+    fn resolve_output(&mut self, resources: &[IrResource]) -> Option<usize> {
+        let graph = self.graph;
+        if graph.is_fragment {
+            return None;
+        }
+        let Some(name) = &graph.output else {
+            let names: Vec<&str> = self.resource_names();
+            let mut d = Diagnostic::error(
+                graph
+                    .sources
+                    .first()
+                    .map(|s| s.file.clone())
+                    .unwrap_or_default(),
+                crate::spans::Pos { line: 1, col: 1 },
+                "the graph has no output",
+            );
+            d.hint = Some(match names.last() {
+                Some(last) => format!("add `output: \"{last}\"` naming the image to present"),
+                None => "add `output: \"name\"` naming the image to present".into(),
+            });
+            if !graph.sources.is_empty() {
+                self.diags.push(d);
+            }
+            return None;
+        };
+        match self.resource_index.get(name.as_str()) {
+            Some(&i) => {
+                if matches!(resources[i].kind, IrKind::Buffer { .. }) {
+                    self.error(
+                        0,
+                        &[Seg::Field("output")],
+                        format!("output \"{name}\" is a buffer"),
+                    )
+                    .hint = Some("the output must be an image".into());
+                }
+                Some(i)
+            }
+            None => {
+                let names = self.resource_names();
+                self.error(
+                    0,
+                    &[Seg::Field("output")],
+                    format!("unknown output \"{name}\""),
+                )
+                .hint = crate::diagnostic::nearest(name, names)
+                    .map(|n| format!("did you mean \"{n}\"?"));
+                None
+            }
+        }
+    }
+
+    fn lookup(&mut self, source: usize, path: &[Seg], name: &str) -> Option<usize> {
+        match self.resource_index.get(name) {
+            Some(&i) => Some(i),
+            None => {
+                let names = self.resource_names();
+                let hint = crate::diagnostic::nearest(name, names.iter().copied())
+                    .map(|n| format!("did you mean \"{n}\"?"))
+                    .or_else(|| Some("declare it under `resources`".into()));
+                self.error(source, path, format!("unknown resource \"{name}\""))
+                    .hint = hint;
+                None
+            }
+        }
+    }
+}
+
+fn resource_name(r: &ResourceDecl) -> &str {
+    match r {
+        ResourceDecl::Image(i) => &i.name,
+        ResourceDecl::Buffer(b) => &b.name,
+    }
+}

@@ -1,0 +1,268 @@
+//! Resolving pass declarations: accesses, shaders, dispatch and fixed-function state.
+
+use super::{
+    pass_path, IrAccess, IrDispatch, IrPass, IrResource, Resolver, Usage, MAX_WORKGROUP_COUNT,
+};
+use crate::load::Located;
+use crate::plan::ShaderFiles;
+use crate::schema::{AttachmentDecl, Dispatch, PassDecl, PassKind, RasterState, ReadDecl};
+use crate::spans::Seg;
+use std::collections::BTreeMap;
+
+impl Resolver<'_> {
+    pub(super) fn resolve_pass(
+        &mut self,
+        p: &Located<PassDecl>,
+        resources: &[IrResource],
+    ) -> IrPass {
+        let (source, index) = (p.source, p.index);
+        let decl = &p.item;
+        let mut accesses = Vec::new();
+        for (i, a) in decl.color.iter().enumerate() {
+            let path = pass_path(
+                index,
+                &[Seg::Field("color"), Seg::Index(i), Seg::Field("image")],
+            );
+            if let Some(r) = self.lookup(source, &path, &a.image) {
+                accesses.push(attachment_access(r, a, false, "color", Some(i)));
+            }
+        }
+        if let Some(a) = &decl.depth {
+            let path = pass_path(index, &[Seg::Field("depth"), Seg::Field("image")]);
+            if let Some(r) = self.lookup(source, &path, &a.image) {
+                accesses.push(attachment_access(r, a, true, "depth", None));
+            }
+        }
+        let read_lists: [(&'static str, &Vec<ReadDecl>, Usage); 3] = [
+            ("sampled", &decl.sampled, Usage::Sampled),
+            ("storage_read", &decl.storage_read, Usage::StorageRead),
+            ("storage_write", &decl.storage_write, Usage::StorageWrite),
+        ];
+        for (field, list, usage) in read_lists {
+            for (i, read) in list.iter().enumerate() {
+                let mut path = pass_path(index, &[Seg::Field(field), Seg::Index(i)]);
+                if matches!(read, ReadDecl::Conditional(_)) {
+                    path.push(Seg::Field("name"));
+                }
+                if let Some(r) = self.lookup(source, &path, read.name()) {
+                    accesses.push(IrAccess {
+                        resource: r,
+                        usage: usage.clone(),
+                        conditions: read.conditions().to_vec(),
+                        field,
+                        item: Some(i),
+                    });
+                }
+            }
+        }
+        for (field, name, usage) in [
+            ("src", &decl.src, Usage::TransferSrc),
+            ("dst", &decl.dst, Usage::TransferDst),
+        ] {
+            if let Some(name) = name {
+                let path = pass_path(index, &[Seg::Field(field)]);
+                if let Some(r) = self.lookup(source, &path, name) {
+                    accesses.push(IrAccess {
+                        resource: r,
+                        usage,
+                        conditions: Vec::new(),
+                        field,
+                        item: None,
+                    });
+                }
+            }
+        }
+        let mut after = Vec::new();
+        for (i, name) in decl.after.iter().enumerate() {
+            match self.pass_index.get(name.as_str()) {
+                Some(&target) => after.push(target),
+                None => {
+                    let names: Vec<&str> = self
+                        .graph
+                        .passes
+                        .iter()
+                        .map(|p| p.item.name.as_str())
+                        .collect();
+                    let hint = crate::diagnostic::nearest(name, names)
+                        .map(|n| format!("did you mean \"{n}\"?"));
+                    self.error(
+                        source,
+                        &pass_path(index, &[Seg::Field("after"), Seg::Index(i)]),
+                        format!("unknown pass \"{name}\""),
+                    )
+                    .hint = hint;
+                }
+            }
+        }
+        let mut params = BTreeMap::new();
+        for (name, value) in &decl.params {
+            match crate::load::resolve_value(&self.graph.sources[source].params, value) {
+                Ok(v) => {
+                    if let Some(bad) = crate::load::non_finite(&v) {
+                        self.error(
+                            source,
+                            &pass_path(index, &[Seg::Field("params"), Seg::Key(name)]),
+                            format!("parameter \"{name}\" must be finite, found {bad}"),
+                        );
+                    }
+                    params.insert(name.clone(), v);
+                }
+                Err(missing) => {
+                    let names: Vec<&str> = self.graph.sources[source]
+                        .params
+                        .keys()
+                        .map(String::as_str)
+                        .collect();
+                    let hint = crate::diagnostic::nearest(&missing, names)
+                        .map(|n| format!("did you mean \"${n}\"?"));
+                    self.error(
+                        source,
+                        &pass_path(index, &[Seg::Field("params"), Seg::Key(name)]),
+                        format!("unknown parameter \"${missing}\""),
+                    )
+                    .hint = hint;
+                }
+            }
+        }
+        self.check_dispatch(source, index, decl.dispatch.as_ref());
+        let dispatch = match &decl.dispatch {
+            None => None,
+            Some(Dispatch::Output(x, y)) => Some(IrDispatch::Output(*x, *y)),
+            Some(Dispatch::Groups(x, y, z)) => Some(IrDispatch::Groups(*x, *y, *z)),
+            Some(Dispatch::Image(name, x, y)) => self
+                .lookup(source, &pass_path(index, &[Seg::Field("dispatch")]), name)
+                .map(|r| IrDispatch::Image(r, *x, *y)),
+        };
+        let dir = self.graph.sources[source]
+            .file
+            .parent()
+            .map(|d| d.to_path_buf())
+            .unwrap_or_default();
+        let shaders = ShaderFiles {
+            vertex: decl.shaders.vertex.as_ref().map(|s| dir.join(s)),
+            fragment: decl.shaders.fragment.as_ref().map(|s| dir.join(s)),
+            compute: decl.shaders.compute.as_ref().map(|s| dir.join(s)),
+        };
+        let pass = IrPass {
+            name: decl.name.clone(),
+            source,
+            index,
+            kind: decl.kind,
+            shaders,
+            draw: decl.draw.clone(),
+            dispatch,
+            params,
+            accesses,
+            after,
+            enabled_if: decl.enabled_if.clone(),
+            raster: self.raster_state(source, index, decl),
+        };
+        self.check_pass_shape(&pass, decl, resources);
+        pass
+    }
+
+    /// A pass's declared fixed-function state, with bias parameters resolved;
+    /// only raster passes have it, and depth state needs a depth attachment.
+    pub(super) fn raster_state(
+        &mut self,
+        source: usize,
+        index: usize,
+        decl: &PassDecl,
+    ) -> RasterState {
+        let Some(raster) = &decl.raster else {
+            return RasterState::default();
+        };
+        let at = |field| pass_path(index, &[Seg::Field("raster"), Seg::Field(field)]);
+        if decl.kind != PassKind::Raster {
+            self.error(
+                source,
+                &pass_path(index, &[Seg::Field("raster")]),
+                format!(
+                    "a {:?} pass has no raster state (only Raster passes draw triangles with it)",
+                    decl.kind
+                ),
+            );
+        }
+        let depth_state = raster.depth_compare.is_some() || raster.depth_bias.is_some();
+        if depth_state && decl.depth.is_none() {
+            let field = if raster.depth_compare.is_some() {
+                "depth_compare"
+            } else {
+                "depth_bias"
+            };
+            self.error(
+                source,
+                &at(field),
+                format!("`{field}` needs a depth attachment, and the pass has none"),
+            );
+        }
+        let depth_bias = raster.depth_bias.as_ref().map(|(c, s)| {
+            let path = at("depth_bias");
+            let constant = self.dim(source, &path, c, "a depth bias").unwrap_or(0.0);
+            let slope = self.dim(source, &path, s, "a depth bias").unwrap_or(0.0);
+            (constant, slope)
+        });
+        RasterState {
+            depth_compare: raster.depth_compare,
+            depth_bias,
+            cull: raster.cull.unwrap_or_default(),
+        }
+    }
+
+    /// Work-group sizes of at least 1; fixed group counts within the count
+    /// every Vulkan device supports.
+    pub(super) fn check_dispatch(
+        &mut self,
+        source: usize,
+        index: usize,
+        dispatch: Option<&Dispatch>,
+    ) {
+        let at = pass_path(index, &[Seg::Field("dispatch")]);
+        let (values, what, max) = match dispatch {
+            None => return,
+            Some(Dispatch::Output(x, y) | Dispatch::Image(_, x, y)) => {
+                (vec![*x, *y], "work-group sizes", u32::MAX)
+            }
+            Some(Dispatch::Groups(x, y, z)) => {
+                (vec![*x, *y, *z], "group counts", MAX_WORKGROUP_COUNT)
+            }
+        };
+        if let Some(bad) = values.iter().find(|v| !(1..=max).contains(*v)) {
+            let range = if max == u32::MAX {
+                "at least 1".to_string()
+            } else {
+                format!("from 1 to {max}")
+            };
+            self.error(source, &at, format!("{what} must be {range}, found {bad}"));
+        }
+    }
+}
+
+fn attachment_access(
+    resource: usize,
+    a: &AttachmentDecl,
+    depth: bool,
+    field: &'static str,
+    item: Option<usize>,
+) -> IrAccess {
+    let usage = if depth {
+        Usage::Depth {
+            load: a.load.clone(),
+            store: a.store,
+            read_only: a.read_only,
+        }
+    } else {
+        Usage::Color {
+            load: a.load.clone(),
+            store: a.store,
+            blend: a.blend,
+        }
+    };
+    IrAccess {
+        resource,
+        usage,
+        conditions: Vec::new(),
+        field,
+        item,
+    }
+}
