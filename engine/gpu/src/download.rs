@@ -8,20 +8,21 @@ use crate::resources::FrameResources;
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
+use weft_graph::id::ResourceId;
 use weft_graph::plan::{Plan, ResourceDesc};
 
 /// A host-visible buffer the output image is copied into.
 pub(crate) struct ReadbackBuffer<'g> {
     gpu: &'g Gpu,
     /// The image copied: the output or one of `Plan::readback`.
-    resource: usize,
+    resource: ResourceId,
     buffer: vk::Buffer,
     allocation: Option<Allocation>,
     size: u64,
 }
 
 impl<'g> ReadbackBuffer<'g> {
-    pub(crate) fn new(gpu: &'g Gpu, plan: &Plan, resource: usize) -> Result<Self, GpuError> {
+    pub(crate) fn new(gpu: &'g Gpu, plan: &Plan, resource: ResourceId) -> Result<Self, GpuError> {
         let ResourceDesc::Image(desc) = &plan
             .resources
             .get(resource)

@@ -6,6 +6,7 @@ use crate::error::GpuError;
 use crate::pipeline::Pipeline;
 use crate::resources::FrameResources;
 use ash::vk;
+use weft_graph::id::{PassId, ResourceId};
 use weft_graph::plan::{Plan, PlanPass};
 
 /// What a draw recorder gets for a raster pass that draws scene content: it
@@ -19,7 +20,7 @@ pub struct RasterContext<'a> {
     /// The plan being executed.
     pub plan: &'a Plan,
     /// Index of the pass in `plan.passes`.
-    pub pass_index: usize,
+    pub pass_index: PassId,
     /// The render pass the recorder's pipelines must be compatible with (subpass 0);
     /// null for a compute pass, which only gets `bind_scene` calls.
     pub render_pass: vk::RenderPass,
@@ -44,7 +45,7 @@ impl RasterContext<'_> {
 
     /// The layout a graph image is in during this pass, for the recorder's
     /// own descriptors (e.g. a shadow map sampled while drawing meshes).
-    pub fn image_layout(&self, resource: usize) -> vk::ImageLayout {
+    pub fn image_layout(&self, resource: ResourceId) -> vk::ImageLayout {
         crate::convert::layout(crate::layouts::layout_at(
             self.plan,
             self.pass_index,

@@ -22,6 +22,7 @@ use crate::timing::{PassTiming, QueryPool, TimingMode, TimingSource};
 use ash::vk;
 use std::sync::Arc;
 use std::time::Instant;
+use weft_graph::id::PassId;
 use weft_graph::plan::{Plan, PlanPass, PlanResource, ResourceDesc};
 use weft_graph::schema::PassKind;
 
@@ -233,7 +234,15 @@ impl<'g> Renderer<'g> {
             if let Some(s) = &stats {
                 s.begin(cmd, i as u32);
             }
-            self.record_pass(plan, i, pass, &prepared[i], resources, draws, cmd)?;
+            self.record_pass(
+                plan,
+                PassId::new(i),
+                pass,
+                &prepared[i],
+                resources,
+                draws,
+                cmd,
+            )?;
             if let Some(s) = &stats {
                 s.end(cmd, i as u32);
             }
@@ -367,7 +376,7 @@ impl<'g> Renderer<'g> {
     ) -> Result<(), GpuError> {
         let mut layouts = layouts::frame_start(plan);
         for (index, prep) in prepared.iter_mut().enumerate() {
-            layouts::apply_pass(plan, index, &mut layouts);
+            layouts::apply_pass(plan, PassId::new(index), &mut layouts);
             let Some(pipeline) = &prep.pipeline else {
                 continue;
             };
@@ -435,7 +444,7 @@ impl<'g> Renderer<'g> {
     fn record_pass(
         &self,
         plan: &Plan,
-        index: usize,
+        index: PassId,
         pass: &PlanPass,
         prep: &Prepared,
         resources: &FrameResources<'g>,

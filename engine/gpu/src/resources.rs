@@ -11,6 +11,7 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 use std::collections::HashMap;
+use weft_graph::id::ResourceId;
 use weft_graph::plan::{BufferDesc, ImageDesc, Plan, PlanResource, Residency, ResourceDesc};
 use weft_graph::vk::{Aspect, Layout};
 use weft_graph::MemoryRequirements;
@@ -134,24 +135,24 @@ impl<'g> FrameResources<'g> {
         Ok(this)
     }
 
-    /// The resource at a plan index.
-    pub fn get(&self, index: usize) -> Option<&GpuResource> {
-        self.resources.get(index)
+    /// A plan resource's GPU object.
+    pub fn get(&self, id: ResourceId) -> Option<&GpuResource> {
+        self.resources.get(id.index())
     }
 
-    /// The image at a plan index, or an error naming what was expected.
-    pub fn image(&self, index: usize) -> Result<&GpuImage, GpuError> {
-        match self.resources.get(index) {
+    /// A plan image, or an error naming what was expected.
+    pub fn image(&self, id: ResourceId) -> Result<&GpuImage, GpuError> {
+        match self.get(id) {
             Some(GpuResource::Image(i)) => Ok(i),
-            _ => Err(GpuError::Plan(format!("resource {index} is not an image"))),
+            _ => Err(GpuError::Plan(format!("resource {id} is not an image"))),
         }
     }
 
-    /// The buffer at a plan index.
-    pub fn buffer(&self, index: usize) -> Result<&GpuBuffer, GpuError> {
-        match self.resources.get(index) {
+    /// A plan buffer, or an error naming what was expected.
+    pub fn buffer(&self, id: ResourceId) -> Result<&GpuBuffer, GpuError> {
+        match self.get(id) {
             Some(GpuResource::Buffer(b)) => Ok(b),
-            _ => Err(GpuError::Plan(format!("resource {index} is not a buffer"))),
+            _ => Err(GpuError::Plan(format!("resource {id} is not a buffer"))),
         }
     }
 

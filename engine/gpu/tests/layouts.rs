@@ -18,12 +18,7 @@ fn layouts_follow_the_plan_barriers() {
         ..CompileOptions::default()
     };
     let plan = weft_graph::compile(&loaded, &options).expect("compiles");
-    let pass = |name: &str| {
-        plan.passes
-            .iter()
-            .position(|p| p.name == name)
-            .expect("pass")
-    };
+    let pass = |name: &str| plan.passes.position(|p| p.name == name).expect("pass");
     let inverted = plan.resource("inverted").expect("inverted");
     let half = plan.resource("half").expect("half");
     assert_eq!(layout_at(&plan, pass("fill"), inverted), Layout::Undefined);

@@ -8,6 +8,7 @@ pub mod compile;
 pub mod diagnostic;
 pub mod dot;
 pub mod expr;
+pub mod id;
 pub mod load;
 pub mod plan;
 pub mod resolve;

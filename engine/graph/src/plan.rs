@@ -3,6 +3,7 @@
 //! transition between them. Nothing here needs Vulkan.
 
 use crate::diagnostic::Diagnostic;
+use crate::id::{IdVec, PassId, ResourceId};
 use crate::schema::{Blend, Draw, ParamValue, PassKind, RasterState};
 use crate::vk::{Access, Aspect, BufferUsage, ImageUsage, Layout, Stage};
 use serde::Serialize;
@@ -27,15 +28,15 @@ pub struct Plan {
     pub extent: Extent,
     /// Features that were on while compiling.
     pub features: Vec<String>,
-    pub resources: Vec<PlanResource>,
+    pub resources: IdVec<ResourceId, PlanResource>,
     /// Passes in execution order.
-    pub passes: Vec<PlanPass>,
+    pub passes: IdVec<PassId, PlanPass>,
     /// Passes left out, and why.
     pub culled: Vec<CulledPass>,
-    /// Index of the output image in `resources`.
-    pub output: usize,
+    /// The output image.
+    pub output: ResourceId,
     /// Further images left readable after the frame (`CompileOptions::readback`).
-    pub readback: Vec<usize>,
+    pub readback: Vec<ResourceId>,
     /// Where transient images live.
     pub memory: MemoryPlan,
     /// Barriers after the last pass: the output to `TRANSFER_SRC_OPTIMAL` for presenting or
@@ -50,8 +51,8 @@ pub struct PlanResource {
     pub name: String,
     pub desc: ResourceDesc,
     pub residency: Residency,
-    /// First and last pass (indices into `Plan::passes`) that use it.
-    pub lifetime: (usize, usize),
+    /// First and last pass that use it.
+    pub lifetime: (PassId, PassId),
     /// Where a transient image lives inside the shared memory blocks.
     pub placement: Option<Placement>,
     /// For persistent resources: the layout it must be in when a frame starts
@@ -157,7 +158,7 @@ pub struct PlanPass {
     /// Sampled and storage bindings in declaration order.
     pub bindings: Vec<Binding>,
     /// Source and destination of copy and blit passes.
-    pub transfer: Option<(usize, usize)>,
+    pub transfer: Option<(ResourceId, ResourceId)>,
     /// Declared fixed-function state of a raster pass.
     pub raster: RasterState,
 }
@@ -173,7 +174,7 @@ pub struct ShaderFiles {
 /// A resource bound to a pass's shaders.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Binding {
-    pub resource: usize,
+    pub resource: ResourceId,
     pub kind: BindingKind,
 }
 
@@ -197,8 +198,7 @@ pub struct CulledPass {
 /// A synchronization2 barrier.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Barrier {
-    /// Index into `Plan::resources`.
-    pub resource: usize,
+    pub resource: ResourceId,
     pub src_stage: Stage,
     pub src_access: Access,
     pub dst_stage: Stage,
@@ -237,7 +237,7 @@ pub enum StoreOp {
 /// One attachment of a render pass.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AttachmentDesc {
-    pub resource: usize,
+    pub resource: ResourceId,
     pub format_raw: i32,
     pub samples: u32,
     pub load: LoadOp,
@@ -277,8 +277,8 @@ impl Plan {
         }
     }
 
-    /// Looks up a resource index by name.
-    pub fn resource(&self, name: &str) -> Option<usize> {
-        self.resources.iter().position(|r| r.name == name)
+    /// Looks up a resource by name.
+    pub fn resource(&self, name: &str) -> Option<ResourceId> {
+        self.resources.position(|r| r.name == name)
     }
 }

@@ -98,7 +98,7 @@ fn removing_any_barrier_makes_the_checker_fail() {
     };
     let plan = weft_graph::compile(&graph, &options).expect("deferred compiles");
     let mut removed = 0;
-    for p in 0..plan.passes.len() {
+    for p in plan.passes.ids() {
         for b in 0..plan.passes[p].barriers.len() {
             let mut broken = plan.clone();
             let barrier = broken.passes[p].barriers.remove(b);

@@ -10,6 +10,7 @@ use std::collections::BTreeSet;
 use support::checker::{check_aliasing, check_plan};
 use support::load_files;
 use support::random_graph::random_graph;
+use weft_graph::id::{PassId, ResourceId};
 use weft_graph::plan::{LoadOp, Plan};
 use weft_graph::{CompileOptions, Extent};
 
@@ -35,9 +36,9 @@ fn compile(seed: u64, passes: usize, features: u8) -> Plan {
 }
 
 /// Resources a plan pass reads (needs the previous contents of).
-fn reads(plan: &Plan, pass: usize) -> BTreeSet<usize> {
+fn reads(plan: &Plan, pass: PassId) -> BTreeSet<ResourceId> {
     let p = &plan.passes[pass];
-    let mut out: BTreeSet<usize> = p.bindings.iter().map(|b| b.resource).collect();
+    let mut out: BTreeSet<ResourceId> = p.bindings.iter().map(|b| b.resource).collect();
     if let Some(rp) = &p.render_pass {
         out.extend(
             rp.attachments
@@ -53,10 +54,10 @@ fn reads(plan: &Plan, pass: usize) -> BTreeSet<usize> {
 }
 
 /// Resources a plan pass writes.
-fn writes(plan: &Plan, pass: usize) -> BTreeSet<usize> {
+fn writes(plan: &Plan, pass: PassId) -> BTreeSet<ResourceId> {
     use weft_graph::plan::BindingKind;
     let p = &plan.passes[pass];
-    let mut out: BTreeSet<usize> = p
+    let mut out: BTreeSet<ResourceId> = p
         .bindings
         .iter()
         .filter(|b| {
@@ -94,11 +95,11 @@ proptest! {
         prop_assert_eq!(check_plan(&plan, 3), Ok(()));
         prop_assert_eq!(check_aliasing(&plan), Ok(()));
         // Every pass that runs feeds a later pass or writes the output (history: the next frame).
-        for i in 0..plan.passes.len() {
+        for i in plan.passes.ids() {
             let w = writes(&plan, i);
             let feeds = w.contains(&plan.output)
                 || w.iter().any(|r| plan.resources[*r].residency == weft_graph::plan::Residency::History)
-                || (i + 1..plan.passes.len()).any(|j| !reads(&plan, j).is_disjoint(&w));
+                || plan.passes.ids().skip(i.index() + 1).any(|j| !reads(&plan, j).is_disjoint(&w));
             prop_assert!(feeds, "seed {}: pass {} contributes nothing", seed, plan.passes[i].name);
         }
         // Culled passes write nothing that a running pass reads.
@@ -111,10 +112,9 @@ proptest! {
     #[test]
     fn removing_a_random_barrier_is_caught(seed in any::<u64>(), pick in any::<usize>()) {
         let plan = compile(seed, 120, 0b0101);
-        let all: Vec<(usize, usize)> = plan
+        let all: Vec<(PassId, usize)> = plan
             .passes
-            .iter()
-            .enumerate()
+            .iter_enumerated()
             .flat_map(|(p, pass)| (0..pass.barriers.len()).map(move |b| (p, b)))
             .collect();
         prop_assume!(!all.is_empty());

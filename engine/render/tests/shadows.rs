@@ -111,7 +111,7 @@ fn render_hdr(scene: &Path, graph: &Path) -> Vec<f32> {
     let rendered = render(&gpu, &scene, &settings).expect("renders");
     drop(gpu);
     assert_eq!(log.messages(), Vec::new());
-    assert_eq!(rendered.plan.passes[0].name, "shadow_sun");
+    assert_eq!(rendered.plan.passes.as_slice()[0].name, "shadow_sun");
     let (_, hdr) = &rendered.report.readbacks[0];
     let Pixels::RgbaF32(values) = &hdr.pixels else {
         panic!("hdr is float");

@@ -2,9 +2,10 @@
 //! and the passes that contribute to them; every other pass is culled, with the
 //! reason recorded in the plan and a warning when it is live but useless.
 
-use super::order::{Order, Ordered, PassUse};
+use super::order::{Order, Ordered, Uses};
 use super::{conditions_hold, locate, root_file};
 use crate::diagnostic::{Diagnostic, Severity};
+use crate::id::{IdVec, IrPassId, IrResourceId};
 use crate::load::LoadedGraph;
 use crate::plan::CulledPass;
 use crate::resolve::{Ir, IrKind};
@@ -14,16 +15,16 @@ use std::collections::BTreeSet;
 /// The resources that must hold valid contents when the frame ends.
 pub(crate) struct Roots {
     /// The output first, then the read-back images in the order asked for.
-    pub list: Vec<usize>,
+    pub list: Vec<IrResourceId>,
     /// Per IR resource: whether it is a root.
-    pub is_root: Vec<bool>,
+    pub is_root: IdVec<IrResourceId, bool>,
 }
 
 /// The output and the images named in `readback`, each of which some live pass writes.
 pub(crate) fn roots(
     graph: &LoadedGraph,
     ir: &Ir,
-    output: usize,
+    output: IrResourceId,
     readback: &[String],
     ordered: &Ordered,
 ) -> Result<Roots, Vec<Diagnostic>> {
@@ -31,7 +32,6 @@ pub(crate) fn roots(
     for name in readback {
         match ir
             .resources
-            .iter()
             .position(|r| r.name == *name && matches!(r.kind, IrKind::Image { .. }))
         {
             Some(r) if !list.contains(&r) => list.push(r),
@@ -61,7 +61,7 @@ pub(crate) fn roots(
             "the passes that write it may be disabled by `enabled_if` for these features",
         )]);
     }
-    let mut is_root = vec![false; ir.resources.len()];
+    let mut is_root = IdVec::filled(false, ir.resources.len());
     for &r in &list {
         is_root[r] = true;
     }
@@ -70,8 +70,8 @@ pub(crate) fn roots(
 
 /// The passes that run, in order, and those that do not, with why.
 pub(crate) struct Culled {
-    /// IR pass indices in execution order.
-    pub sequence: Vec<usize>,
+    /// The passes that run, in execution order.
+    pub sequence: Vec<IrPassId>,
     pub culled: Vec<CulledPass>,
     /// A warning for each live pass that contributes nothing.
     pub warnings: Vec<Diagnostic>,
@@ -88,7 +88,7 @@ pub(crate) fn cull(
     let needed = contributing(ir, &ordered.order, &ordered.uses, &roots.list);
     let mut culled = Vec::new();
     let mut warnings = Vec::new();
-    for (p, pass) in ir.passes.iter().enumerate() {
+    for (p, pass) in ir.passes.iter_enumerated() {
         let reason = if !ordered.live[p] {
             let failing: Vec<&str> = pass
                 .enabled_if
@@ -131,14 +131,19 @@ pub(crate) fn cull(
 /// Passes that contribute to the roots (the output and images read back): their writers, and transitively the writers
 /// of everything a contributing pass reads (history resources: all their writers,
 /// since the next frame reads them).
-fn contributing(ir: &Ir, order: &Order, uses: &[Vec<PassUse>], roots: &[usize]) -> Vec<bool> {
+fn contributing(
+    ir: &Ir,
+    order: &Order,
+    uses: &Uses,
+    roots: &[IrResourceId],
+) -> IdVec<IrPassId, bool> {
     let n = ir.passes.len();
-    let mut position = vec![usize::MAX; n];
+    let mut position: IdVec<IrPassId, usize> = IdVec::filled(usize::MAX, n);
     for (i, &p) in order.sequence.iter().enumerate() {
         position[p] = i;
     }
-    let mut needed = vec![false; n];
-    let mut stack: Vec<usize> = roots
+    let mut needed = IdVec::filled(false, n);
+    let mut stack: Vec<IrPassId> = roots
         .iter()
         .flat_map(|&r| order.writers[r].iter().copied())
         .collect();
@@ -196,7 +201,7 @@ mod tests {
         let roots = roots(&graph, &ir, out, &["unused".into()], &o).expect("roots");
         assert_eq!(roots.list, vec![out, resource(&ir, "unused")]);
         let culled = cull(&graph, &ir, &o, &roots, &BTreeSet::new());
-        assert_eq!(culled.sequence, vec![0, 1, 2]);
+        assert_eq!(culled.sequence, ir.passes.ids().take(3).collect::<Vec<_>>());
         assert!(culled.warnings.is_empty());
     }
 

@@ -3,8 +3,9 @@
 //! a `store: DontCare` whose contents are needed later).
 
 use super::cull::Roots;
-use super::order::PassUse;
+use super::order::Uses;
 use crate::diagnostic::Diagnostic;
+use crate::id::{IdVec, IrPassId, IrResourceId, PassId, ResourceId};
 use crate::load::LoadedGraph;
 use crate::resolve::{access_path, Ir, Usage};
 use crate::schema::StoreDecl;
@@ -15,21 +16,20 @@ pub(crate) struct Lifetimes {
     pub timeline: Timeline,
     /// IR resources the plan keeps, in declaration order; the plan's index of a
     /// resource is its position here.
-    pub kept: Vec<usize>,
-    /// Per IR resource: its plan index, when kept.
-    plan_index: Vec<Option<usize>>,
+    pub kept: IdVec<ResourceId, IrResourceId>,
+    /// Per IR resource: its plan id, when kept.
+    plan_index: IdVec<IrResourceId, Option<ResourceId>>,
 }
 
 impl Lifetimes {
     /// The resources the passes in `sequence` use, and the roots.
-    pub fn new(ir: &Ir, sequence: &[usize], uses: &[Vec<PassUse>], roots: &Roots) -> Self {
+    pub fn new(ir: &Ir, sequence: &[IrPassId], uses: &Uses, roots: &Roots) -> Self {
         let timeline = Timeline::new(ir, sequence, uses);
-        let mut kept = Vec::new();
-        let mut plan_index = vec![None; ir.resources.len()];
-        for (r, index) in plan_index.iter_mut().enumerate() {
+        let mut kept = IdVec::new();
+        let mut plan_index = IdVec::filled(None, ir.resources.len());
+        for (r, index) in plan_index.iter_enumerated_mut() {
             if roots.is_root[r] || !timeline.per_resource[r].is_empty() {
-                *index = Some(kept.len());
-                kept.push(r);
+                *index = Some(kept.push(r));
             }
         }
         Lifetimes {
@@ -39,8 +39,8 @@ impl Lifetimes {
         }
     }
 
-    /// The plan index of an IR resource the plan uses.
-    pub fn plan_index(&self, r: usize) -> usize {
+    /// The plan id of an IR resource the plan uses.
+    pub fn plan_index(&self, r: IrResourceId) -> ResourceId {
         self.plan_index[r].expect("every resource a running pass uses is kept")
     }
 
@@ -49,8 +49,8 @@ impl Lifetimes {
         &self,
         graph: &LoadedGraph,
         ir: &Ir,
-        sequence: &[usize],
-        uses: &[Vec<PassUse>],
+        sequence: &[IrPassId],
+        uses: &Uses,
         roots: &Roots,
         warnings: &mut Vec<Diagnostic>,
     ) -> Result<(), Vec<Diagnostic>> {
@@ -62,16 +62,16 @@ impl Lifetimes {
 /// For each resource, the passes that use it in plan order, so per-resource questions
 /// cost the resource's uses, not the whole plan.
 pub(crate) struct Timeline {
-    /// `(plan index, IR pass, index into that pass's uses)` per resource.
-    pub per_resource: Vec<Vec<(usize, usize, usize)>>,
+    /// `(plan pass, IR pass, index into that pass's uses)` per resource.
+    pub per_resource: IdVec<IrResourceId, Vec<(PassId, IrPassId, usize)>>,
 }
 
 impl Timeline {
-    fn new(ir: &Ir, sequence: &[usize], uses: &[Vec<PassUse>]) -> Self {
-        let mut per_resource = vec![Vec::new(); ir.resources.len()];
+    fn new(ir: &Ir, sequence: &[IrPassId], uses: &Uses) -> Self {
+        let mut per_resource = IdVec::filled(Vec::new(), ir.resources.len());
         for (i, &p) in sequence.iter().enumerate() {
             for (k, u) in uses[p].iter().enumerate() {
-                per_resource[u.resource].push((i, p, k));
+                per_resource[u.resource].push((PassId::new(i), p, k));
             }
         }
         Timeline { per_resource }
@@ -81,10 +81,10 @@ impl Timeline {
     pub fn needed_later(
         &self,
         ir: &Ir,
-        uses: &[Vec<PassUse>],
-        i: usize,
-        r: usize,
-        is_root: &[bool],
+        uses: &Uses,
+        i: PassId,
+        r: IrResourceId,
+        is_root: &IdVec<IrResourceId, bool>,
     ) -> bool {
         let touches = &self.per_resource[r];
         let next = touches.partition_point(|t| t.0 <= i);
@@ -100,11 +100,11 @@ fn warn_unread(
     graph: &LoadedGraph,
     ir: &Ir,
     timeline: &Timeline,
-    uses: &[Vec<PassUse>],
-    is_root: &[bool],
+    uses: &Uses,
+    is_root: &IdVec<IrResourceId, bool>,
     warnings: &mut Vec<Diagnostic>,
 ) {
-    for (r, res) in ir.resources.iter().enumerate() {
+    for (r, res) in ir.resources.iter_enumerated() {
         if is_root[r] || res.history {
             continue;
         }
@@ -140,13 +140,14 @@ fn warn_unread(
 fn check_discarding_stores(
     graph: &LoadedGraph,
     ir: &Ir,
-    sequence: &[usize],
+    sequence: &[IrPassId],
     timeline: &Timeline,
-    uses: &[Vec<PassUse>],
-    is_root: &[bool],
+    uses: &Uses,
+    is_root: &IdVec<IrResourceId, bool>,
 ) -> Result<(), Vec<Diagnostic>> {
     let mut errors = Vec::new();
     for (i, &p) in sequence.iter().enumerate() {
+        let i = PassId::new(i);
         for access in &ir.passes[p].accesses {
             let store = match &access.usage {
                 Usage::Color { store, .. }
@@ -187,7 +188,7 @@ mod tests {
     use super::*;
     use std::collections::BTreeSet;
 
-    fn lifetimes_of(text: &str) -> (LoadedGraph, Ir, Lifetimes, Vec<usize>, Roots) {
+    fn lifetimes_of(text: &str) -> (LoadedGraph, Ir, Lifetimes, Vec<IrPassId>, Roots) {
         let (graph, ir, o) = ordered(text, &[]);
         let roots = roots(&graph, &ir, resource(&ir, "out"), &[], &o).expect("roots");
         let sequence = cull(&graph, &ir, &o, &roots, &BTreeSet::new()).sequence;
@@ -198,10 +199,13 @@ mod tests {
     #[test]
     fn only_resources_running_passes_use_are_kept_in_declaration_order() {
         let (_, ir, l, _, _) = lifetimes_of(CHAIN);
-        assert_eq!(l.kept, vec![resource(&ir, "x"), resource(&ir, "out")]);
-        assert_eq!(l.plan_index(resource(&ir, "out")), 1);
+        assert_eq!(
+            l.kept.as_slice(),
+            [resource(&ir, "x"), resource(&ir, "out")]
+        );
+        assert_eq!(l.plan_index(resource(&ir, "out")), ResourceId::new(1));
         let x = &l.timeline.per_resource[resource(&ir, "x")];
-        assert_eq!(x.iter().map(|t| t.0).collect::<Vec<_>>(), vec![0, 1]);
+        assert_eq!(x.iter().map(|t| t.0.index()).collect::<Vec<_>>(), [0, 1]);
     }
 
     #[test]
@@ -209,11 +213,15 @@ mod tests {
         let (_, ir, l, _, roots) = lifetimes_of(CHAIN);
         let (x, out) = (resource(&ir, "x"), resource(&ir, "out"));
         let o = ordered(CHAIN, &[]).2;
-        assert!(l.timeline.needed_later(&ir, &o.uses, 0, x, &roots.is_root));
-        assert!(!l.timeline.needed_later(&ir, &o.uses, 1, x, &roots.is_root));
         assert!(l
             .timeline
-            .needed_later(&ir, &o.uses, 1, out, &roots.is_root));
+            .needed_later(&ir, &o.uses, PassId::new(0), x, &roots.is_root));
+        assert!(!l
+            .timeline
+            .needed_later(&ir, &o.uses, PassId::new(1), x, &roots.is_root));
+        assert!(l
+            .timeline
+            .needed_later(&ir, &o.uses, PassId::new(1), out, &roots.is_root));
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! Each image is placed at the lowest aligned offset that does not collide with
 //! any image alive at the same time (largest first), inside one block.
 
+use crate::id::{IdVec, ResourceId};
 use crate::plan::{
     ImageDesc, MemoryBlock, MemoryPlan, Placement, PlanResource, Residency, ResourceDesc,
 };
@@ -9,19 +10,18 @@ use crate::plan::{
 /// Places every transient image of `resources` (setting its `placement`) with the
 /// device's memory requirements; returns the memory plan.
 pub(crate) fn alias(
-    resources: &mut [PlanResource],
+    resources: &mut IdVec<ResourceId, PlanResource>,
     requirements: &dyn Fn(&ImageDesc) -> MemoryRequirements,
 ) -> MemoryPlan {
-    let transient: Vec<(usize, Transient)> = resources
-        .iter()
-        .enumerate()
+    let transient: Vec<(ResourceId, Transient)> = resources
+        .iter_enumerated()
         .filter(|(_, r)| r.residency == Residency::Transient)
         .filter_map(|(i, r)| match &r.desc {
             ResourceDesc::Image(desc) => Some((
                 i,
                 Transient {
                     requirements: requirements(desc),
-                    lifetime: r.lifetime,
+                    lifetime: (r.lifetime.0.index(), r.lifetime.1.index()),
                 },
             )),
             ResourceDesc::Buffer(_) => None,

@@ -14,6 +14,7 @@ mod resources;
 pub(crate) mod sync;
 
 use crate::diagnostic::Diagnostic;
+use crate::id::IrPassId;
 use crate::load::LoadedGraph;
 use crate::plan::{Extent, ImageDesc, Plan};
 use crate::resolve::{resolve, Ir};
@@ -152,7 +153,7 @@ fn root_file(graph: &LoadedGraph) -> std::path::PathBuf {
 }
 
 /// An error (message left to the caller) located at a field of an IR pass.
-fn locate(graph: &LoadedGraph, ir: &Ir, pass: usize, rest: &[Seg]) -> Diagnostic {
+fn locate(graph: &LoadedGraph, ir: &Ir, pass: IrPassId, rest: &[Seg]) -> Diagnostic {
     let p = &ir.passes[pass];
     let mut path = vec![Seg::Field("passes"), Seg::Index(p.index)];
     path.extend_from_slice(rest);
@@ -230,6 +231,7 @@ pub fn compile_ir(
 #[cfg(test)]
 pub(crate) mod fixture {
     use super::order::{order_live, Ordered};
+    use crate::id::{IrPassId, IrResourceId};
     use crate::load::{load_with, LoadedGraph};
     use crate::resolve::{resolve, Ir};
     use std::collections::BTreeSet;
@@ -280,17 +282,14 @@ pub(crate) mod fixture {
         (graph, ir, ordered)
     }
 
-    /// The IR index of a pass by name.
-    pub fn pass(ir: &Ir, name: &str) -> usize {
-        ir.passes.iter().position(|p| p.name == name).expect("pass")
+    /// A pass of the IR by name.
+    pub fn pass(ir: &Ir, name: &str) -> IrPassId {
+        ir.passes.position(|p| p.name == name).expect("pass")
     }
 
-    /// The IR index of a resource by name.
-    pub fn resource(ir: &Ir, name: &str) -> usize {
-        ir.resources
-            .iter()
-            .position(|r| r.name == name)
-            .expect("resource")
+    /// A resource of the IR by name.
+    pub fn resource(ir: &Ir, name: &str) -> IrResourceId {
+        ir.resources.position(|r| r.name == name).expect("resource")
     }
 }
 

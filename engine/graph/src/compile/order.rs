@@ -6,18 +6,22 @@
 
 use super::{conditions_hold, locate};
 use crate::diagnostic::Diagnostic;
+use crate::id::{IdVec, IrPassId, IrResourceId};
 use crate::load::LoadedGraph;
 use crate::resolve::{access_path, Ir, Usage};
 use crate::spans::Seg;
 use std::cmp::Reverse;
 use std::collections::{BTreeSet, BinaryHeap};
 
+/// Per IR pass, its merged active uses.
+pub(crate) type Uses = IdVec<IrPassId, Vec<PassUse>>;
+
 /// The live passes of one feature set, ordered, with what each does to each resource.
 pub(crate) struct Ordered {
     /// Per IR pass: whether its `enabled_if` holds.
-    pub live: Vec<bool>,
+    pub live: IdVec<IrPassId, bool>,
     /// Per IR pass: its merged active uses (empty when not live).
-    pub uses: Vec<Vec<PassUse>>,
+    pub uses: Uses,
     pub order: Order,
 }
 
@@ -27,12 +31,14 @@ pub(crate) fn order_live(
     ir: &Ir,
     features: &BTreeSet<String>,
 ) -> Result<Ordered, Vec<Diagnostic>> {
-    let live: Vec<bool> = ir
+    let live: IdVec<IrPassId, bool> = ir
         .passes
         .iter()
         .map(|p| conditions_hold(&p.enabled_if, features))
         .collect();
-    let uses: Vec<Vec<PassUse>> = (0..ir.passes.len())
+    let uses: Uses = ir
+        .passes
+        .ids()
         .map(|p| {
             if live[p] {
                 pass_uses(ir, p, |c| conditions_hold(c, features))
@@ -44,7 +50,7 @@ pub(crate) fn order_live(
     match order(ir, &live, &uses) {
         Ok(order) => Ok(Ordered { live, uses, order }),
         Err(errors) => {
-            let disabled: Vec<usize> = (0..live.len()).filter(|&p| !live[p]).collect();
+            let disabled: Vec<IrPassId> = live.ids().filter(|&p| !live[p]).collect();
             Err(errors
                 .iter()
                 .map(|e| order_error(graph, ir, &uses, e, &disabled))
@@ -56,7 +62,7 @@ pub(crate) fn order_live(
 /// What one live pass does to one resource, with all its accesses in the pass merged.
 #[derive(Debug, Clone)]
 pub struct PassUse {
-    pub resource: usize,
+    pub resource: IrResourceId,
     /// Indices into the pass's `accesses` that are active.
     pub accesses: Vec<usize>,
     pub reads_previous: bool,
@@ -65,7 +71,7 @@ pub struct PassUse {
 }
 
 /// Merges a pass's active accesses per resource, in first-use order.
-pub fn pass_uses(ir: &Ir, pass: usize, active: impl Fn(&[String]) -> bool) -> Vec<PassUse> {
+pub fn pass_uses(ir: &Ir, pass: IrPassId, active: impl Fn(&[String]) -> bool) -> Vec<PassUse> {
     let mut uses: Vec<PassUse> = Vec::new();
     for (i, access) in ir.passes[pass].accesses.iter().enumerate() {
         if !active(&access.conditions) {
@@ -100,34 +106,42 @@ pub fn pass_uses(ir: &Ir, pass: usize, active: impl Fn(&[String]) -> bool) -> Ve
 /// An ordering problem, to be turned into a located diagnostic by the caller.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum OrderError {
-    /// Passes (indices into `Ir::passes`) that form a cycle, in cycle order.
-    Cycle(Vec<usize>),
+    /// Passes that form a cycle, in cycle order.
+    Cycle(Vec<IrPassId>),
     /// Two writers of a resource with no order between them.
     UnorderedWriters {
-        resource: usize,
-        first: usize,
-        second: usize,
+        resource: IrResourceId,
+        first: IrPassId,
+        second: IrPassId,
     },
     /// A pass reads a resource that no earlier pass writes.
-    ReadBeforeWrite { resource: usize, pass: usize },
+    ReadBeforeWrite {
+        resource: IrResourceId,
+        pass: IrPassId,
+    },
 }
 
 /// The result of ordering the live passes.
 #[derive(Debug, Clone)]
 pub struct Order {
-    /// Live pass indices (into `Ir::passes`) in execution order.
-    pub sequence: Vec<usize>,
+    /// Live passes in execution order.
+    pub sequence: Vec<IrPassId>,
     /// For each resource, its live writers in execution order.
-    pub writers: Vec<Vec<usize>>,
+    pub writers: IdVec<IrResourceId, Vec<IrPassId>>,
 }
 
+/// Successors of each pass in the dependency graph.
+type Edges = IdVec<IrPassId, Vec<IrPassId>>;
+
 /// Orders the live passes. `uses[p]` holds the merged uses of pass `p` (empty when not live).
-pub fn order(ir: &Ir, live: &[bool], uses: &[Vec<PassUse>]) -> Result<Order, Vec<OrderError>> {
+pub fn order(ir: &Ir, live: &IdVec<IrPassId, bool>, uses: &Uses) -> Result<Order, Vec<OrderError>> {
     let n = ir.passes.len();
-    let mut succ: Vec<Vec<usize>> = vec![Vec::new(); n];
-    let mut writers: Vec<Vec<usize>> = vec![Vec::new(); ir.resources.len()];
-    let mut readers: Vec<Vec<usize>> = vec![Vec::new(); ir.resources.len()];
-    for p in (0..n).filter(|&p| live[p]) {
+    let mut succ: Edges = IdVec::filled(Vec::new(), n);
+    let mut writers: IdVec<IrResourceId, Vec<IrPassId>> =
+        IdVec::filled(Vec::new(), ir.resources.len());
+    let mut readers: IdVec<IrResourceId, Vec<IrPassId>> =
+        IdVec::filled(Vec::new(), ir.resources.len());
+    for p in live.ids().filter(|&p| live[p]) {
         for u in &uses[p] {
             if u.writes {
                 writers[u.resource].push(p);
@@ -141,7 +155,7 @@ pub fn order(ir: &Ir, live: &[bool], uses: &[Vec<PassUse>]) -> Result<Order, Vec
             }
         }
     }
-    for (r, resource) in ir.resources.iter().enumerate() {
+    for (r, resource) in ir.resources.iter_enumerated() {
         for &w in &writers[r] {
             for &x in &readers[r] {
                 if resource.history {
@@ -152,20 +166,20 @@ pub fn order(ir: &Ir, live: &[bool], uses: &[Vec<PassUse>]) -> Result<Order, Vec
             }
         }
     }
-    for s in &mut succ {
+    for s in succ.iter_mut() {
         s.sort_unstable();
         s.dedup();
     }
 
-    let sequence = topological(n, live, &succ).map_err(|cycle| vec![OrderError::Cycle(cycle)])?;
-    let mut position = vec![usize::MAX; n];
+    let sequence = topological(live, &succ).map_err(|cycle| vec![OrderError::Cycle(cycle)])?;
+    let mut position: IdVec<IrPassId, usize> = IdVec::filled(usize::MAX, n);
     for (i, &p) in sequence.iter().enumerate() {
         position[p] = i;
     }
-    let reach = reachability(&sequence, &succ, n);
+    let reach = reachability(&sequence, &succ);
 
     let mut errors = Vec::new();
-    for (r, resource) in ir.resources.iter().enumerate() {
+    for (r, resource) in ir.resources.iter_enumerated() {
         let w = &mut writers[r];
         w.sort_by_key(|&p| position[p]);
         for pair in w.windows(2) {
@@ -211,18 +225,19 @@ pub fn order(ir: &Ir, live: &[bool], uses: &[Vec<PassUse>]) -> Result<Order, Vec
 
 /// Kahn's algorithm taking the lowest declaration index first, so the order is
 /// stable under edits that do not change dependencies. On a cycle, returns one.
-fn topological(n: usize, live: &[bool], succ: &[Vec<usize>]) -> Result<Vec<usize>, Vec<usize>> {
-    let mut indegree = vec![0usize; n];
-    for p in (0..n).filter(|&p| live[p]) {
+fn topological(live: &IdVec<IrPassId, bool>, succ: &Edges) -> Result<Vec<IrPassId>, Vec<IrPassId>> {
+    let mut indegree: IdVec<IrPassId, usize> = IdVec::filled(0, live.len());
+    for p in live.ids().filter(|&p| live[p]) {
         for &s in &succ[p] {
             indegree[s] += 1;
         }
     }
-    let mut ready: BinaryHeap<Reverse<usize>> = (0..n)
+    let mut ready: BinaryHeap<Reverse<IrPassId>> = live
+        .ids()
         .filter(|&p| live[p] && indegree[p] == 0)
         .map(Reverse)
         .collect();
-    let mut sequence = Vec::with_capacity(n);
+    let mut sequence = Vec::with_capacity(live.len());
     while let Some(Reverse(p)) = ready.pop() {
         sequence.push(p);
         for &s in &succ[p] {
@@ -236,20 +251,20 @@ fn topological(n: usize, live: &[bool], succ: &[Vec<usize>]) -> Result<Vec<usize
     if sequence.len() == live_count {
         return Ok(sequence);
     }
-    Err(find_cycle(n, &indegree, succ))
+    Err(find_cycle(&indegree, succ))
 }
 
 /// Walks successors among the passes left with positive in-degree until one repeats.
-fn find_cycle(n: usize, indegree: &[usize], succ: &[Vec<usize>]) -> Vec<usize> {
-    let Some(start) = (0..n).find(|&p| indegree[p] > 0) else {
+fn find_cycle(indegree: &IdVec<IrPassId, usize>, succ: &Edges) -> Vec<IrPassId> {
+    let Some(start) = indegree.ids().find(|&p| indegree[p] > 0) else {
         return Vec::new();
     };
-    let mut seen_at = vec![usize::MAX; n];
+    let mut seen_at: IdVec<IrPassId, Option<usize>> = IdVec::filled(None, indegree.len());
     let mut path = Vec::new();
     let mut current = start;
     loop {
-        if seen_at[current] != usize::MAX {
-            let mut cycle = path[seen_at[current]..].to_vec();
+        if let Some(at) = seen_at[current] {
+            let mut cycle = path[at..].to_vec();
             let min = cycle
                 .iter()
                 .enumerate()
@@ -259,7 +274,7 @@ fn find_cycle(n: usize, indegree: &[usize], succ: &[Vec<usize>]) -> Vec<usize> {
             cycle.rotate_left(min);
             return cycle;
         }
-        seen_at[current] = path.len();
+        seen_at[current] = Some(path.len());
         path.push(current);
         match succ[current].iter().find(|&&s| indegree[s] > 0) {
             Some(&next) => current = next,
@@ -268,7 +283,7 @@ fn find_cycle(n: usize, indegree: &[usize], succ: &[Vec<usize>]) -> Vec<usize> {
     }
 }
 
-/// A fixed-size set of pass indices.
+/// A fixed-size set of passes.
 #[derive(Debug, Clone)]
 pub struct BitSet(Vec<u64>);
 
@@ -276,11 +291,13 @@ impl BitSet {
     fn new(n: usize) -> Self {
         BitSet(vec![0; n.div_ceil(64)])
     }
-    fn insert(&mut self, i: usize) {
+    fn insert(&mut self, p: IrPassId) {
+        let i = p.index();
         self.0[i / 64] |= 1 << (i % 64);
     }
-    /// Whether `i` is in the set.
-    pub fn contains(&self, i: usize) -> bool {
+    /// Whether `p` is in the set.
+    pub fn contains(&self, p: IrPassId) -> bool {
+        let i = p.index();
         self.0[i / 64] & (1 << (i % 64)) != 0
     }
     fn union_with(&mut self, other: &BitSet) {
@@ -291,8 +308,9 @@ impl BitSet {
 }
 
 /// For each pass, the passes reachable from it, computed in reverse topological order.
-pub fn reachability(sequence: &[usize], succ: &[Vec<usize>], n: usize) -> Vec<BitSet> {
-    let mut reach = vec![BitSet::new(n); n];
+fn reachability(sequence: &[IrPassId], succ: &Edges) -> IdVec<IrPassId, BitSet> {
+    let n = succ.len();
+    let mut reach: IdVec<IrPassId, BitSet> = IdVec::filled(BitSet::new(n), n);
     for &p in sequence.iter().rev() {
         let mut set = BitSet::new(n);
         for &s in &succ[p] {
@@ -308,14 +326,14 @@ pub fn reachability(sequence: &[usize], succ: &[Vec<usize>], n: usize) -> Vec<Bi
 fn order_error(
     graph: &LoadedGraph,
     ir: &Ir,
-    uses: &[Vec<PassUse>],
+    uses: &Uses,
     e: &OrderError,
-    disabled: &[usize],
+    disabled: &[IrPassId],
 ) -> Diagnostic {
-    let name = |p: usize| ir.passes[p].name.as_str();
+    let name = |p: IrPassId| ir.passes[p].name.as_str();
     match e {
         OrderError::Cycle(cycle) => {
-            let first = cycle.first().copied().unwrap_or(0);
+            let first = cycle.first().copied().unwrap_or(IrPassId::new(0));
             let mut names: Vec<&str> = cycle.iter().map(|&p| name(p)).collect();
             names.push(name(first));
             let mut d = locate(graph, ir, first, &[Seg::Field("name")]);
@@ -387,7 +405,7 @@ fn order_error(
 
 #[cfg(test)]
 mod tests {
-    use super::super::fixture::{ordered, pass, resolved, CHAIN};
+    use super::super::fixture::{ordered, pass, resolved, resource, CHAIN};
     use super::*;
 
     #[test]
@@ -396,7 +414,10 @@ mod tests {
         let d = pass(&ir, "d");
         assert!(!o.live[d]);
         assert!(o.uses[d].is_empty());
-        assert_eq!(o.order.sequence, vec![0, 1, 2]);
+        assert_eq!(
+            o.order.sequence,
+            ir.passes.ids().take(3).collect::<Vec<_>>()
+        );
     }
 
     #[test]
@@ -413,16 +434,18 @@ mod tests {
         assert!(a > b, "a is declared after b");
         let at = |p| o.order.sequence.iter().position(|&q| q == p).unwrap();
         assert!(at(a) < at(b) && at(b) < at(d));
-        assert_eq!(o.order.writers[1], vec![b, d]);
+        assert_eq!(o.order.writers[resource(&ir, "out")], vec![b, d]);
     }
 
     #[test]
     fn cycles_are_reported_from_their_lowest_pass() {
-        let succ = vec![vec![1], vec![2], vec![0]];
-        let live = vec![true; 3];
-        assert_eq!(topological(3, &live, &succ), Err(vec![0, 1, 2]));
-        let chain = vec![vec![2], vec![], vec![1]];
-        assert_eq!(topological(3, &live, &chain), Ok(vec![0, 2, 1]));
+        let ids = |list: &[usize]| list.iter().map(|&i| IrPassId::new(i)).collect::<Vec<_>>();
+        let edges = |lists: &[&[usize]]| lists.iter().map(|l| ids(l)).collect::<Edges>();
+        let live = IdVec::filled(true, 3);
+        let cycle = edges(&[&[1], &[2], &[0]]);
+        assert_eq!(topological(&live, &cycle), Err(ids(&[0, 1, 2])));
+        let chain = edges(&[&[2], &[], &[1]]);
+        assert_eq!(topological(&live, &chain), Ok(ids(&[0, 2, 1])));
     }
 
     #[test]

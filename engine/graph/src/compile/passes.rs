@@ -5,8 +5,9 @@
 
 use super::cull::Roots;
 use super::lifetimes::Lifetimes;
-use super::order::PassUse;
+use super::order::Uses;
 use super::CompileOptions;
+use crate::id::{IdVec, IrPassId, PassId, ResourceId};
 use crate::load::LoadedGraph;
 use crate::plan::{
     AttachmentDesc, Barrier, Binding, BindingKind, LoadOp, Location, PlanPass, PlanResource,
@@ -22,29 +23,29 @@ use std::collections::BTreeSet;
 pub(crate) struct PassContext<'a> {
     pub graph: &'a LoadedGraph,
     pub ir: &'a Ir,
-    pub uses: &'a [Vec<PassUse>],
+    pub uses: &'a Uses,
     pub lifetimes: &'a Lifetimes,
     pub roots: &'a Roots,
-    pub resources: &'a [PlanResource],
+    pub resources: &'a IdVec<ResourceId, PlanResource>,
     pub options: &'a CompileOptions<'a>,
 }
 
 /// Describes the passes of `sequence`, each with the barriers recorded before it.
 pub(crate) fn describe(
     cx: &PassContext,
-    sequence: &[usize],
-    barriers: Vec<Vec<Barrier>>,
-) -> Vec<PlanPass> {
+    sequence: &[IrPassId],
+    barriers: IdVec<PassId, Vec<Barrier>>,
+) -> IdVec<PassId, PlanPass> {
     sequence
         .iter()
         .zip(barriers)
         .enumerate()
-        .map(|(i, (&p, barriers))| plan_pass(cx, p, i, barriers))
+        .map(|(i, (&p, barriers))| plan_pass(cx, p, PassId::new(i), barriers))
         .collect()
 }
 
 /// One pass: bindings, defines, render pass, dispatch size and copy endpoints.
-fn plan_pass(cx: &PassContext, p: usize, i: usize, barriers: Vec<Barrier>) -> PlanPass {
+fn plan_pass(cx: &PassContext, p: IrPassId, i: PassId, barriers: Vec<Barrier>) -> PlanPass {
     let PassContext {
         graph,
         ir,
@@ -225,7 +226,10 @@ mod tests {
     fn stores_are_kept_only_for_contents_read_later() {
         let plan = plan_of(CHAIN, &[]);
         let ops = |pass: usize| {
-            let rp = plan.passes[pass].render_pass.as_ref().expect("fullscreen");
+            let rp = plan.passes[PassId::new(pass)]
+                .render_pass
+                .as_ref()
+                .expect("fullscreen");
             let a = &rp.attachments[0];
             (a.load, a.store, a.final_layout)
         };
@@ -237,8 +241,11 @@ mod tests {
                 Layout::ColorAttachmentOptimal
             )
         );
-        assert_eq!(plan.passes[1].bindings.len(), 1);
-        assert_eq!(plan.passes[1].bindings[0].kind, BindingKind::Sampled);
+        assert_eq!(plan.passes[PassId::new(1)].bindings.len(), 1);
+        assert_eq!(
+            plan.passes[PassId::new(1)].bindings[0].kind,
+            BindingKind::Sampled
+        );
         assert_eq!(
             ops(1),
             (
@@ -256,7 +263,7 @@ mod tests {
             r#"sampled: ["x", (name: "x", enabled_if: ["extra"])]"#,
         );
         let plain = plan_of(&text, &[]);
-        assert!(plain.passes[1].defines.is_empty());
+        assert!(plain.passes[PassId::new(1)].defines.is_empty());
         let text = text.replace(r#"sampled: ["x", "#, "sampled: [");
         let with = plan_of(&text, &["extra"]);
         let b = with.passes.iter().find(|p| p.name == "b").expect("b runs");

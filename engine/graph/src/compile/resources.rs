@@ -4,9 +4,10 @@
 
 use super::cull::Roots;
 use super::lifetimes::Lifetimes;
-use super::order::PassUse;
+use super::order::Uses;
 use super::CompileOptions;
 use crate::diagnostic::Diagnostic;
+use crate::id::{IdVec, IrResourceId, PassId, ResourceId};
 use crate::load::LoadedGraph;
 use crate::plan::{BufferDesc, Extent, ImageDesc, PlanResource, Residency, ResourceDesc};
 use crate::resolve::{
@@ -20,14 +21,14 @@ use crate::vk::{BufferUsage, ImageUsage, Layout};
 pub(crate) fn describe(
     graph: &LoadedGraph,
     ir: &Ir,
-    uses: &[Vec<PassUse>],
+    uses: &Uses,
     lifetimes: &Lifetimes,
     roots: &Roots,
     passes: usize,
     options: &CompileOptions,
-) -> Result<Vec<PlanResource>, Vec<Diagnostic>> {
+) -> Result<IdVec<ResourceId, PlanResource>, Vec<Diagnostic>> {
     check_image_sizes(graph, ir, &lifetimes.kept, options.extent)?;
-    let mut resources: Vec<PlanResource> = Vec::with_capacity(lifetimes.kept.len());
+    let mut resources = IdVec::new();
     for &r in &lifetimes.kept {
         let res = &ir.resources[r];
         let residency = if roots.is_root[r] {
@@ -38,8 +39,12 @@ pub(crate) fn describe(
             Residency::Transient
         };
         let touches = &lifetimes.timeline.per_resource[r];
-        let first = touches.first().map_or(usize::MAX, |t| t.0);
-        let last = touches.last().map_or(0, |t| t.0);
+        let final_pass = passes.saturating_sub(1);
+        let first = touches
+            .first()
+            .map_or(final_pass, |t| t.0.index())
+            .min(final_pass);
+        let last = touches.last().map_or(0, |t| t.0.index());
         let accesses = || {
             touches.iter().flat_map(|&(_, p, k)| {
                 uses[p][k]
@@ -116,7 +121,7 @@ pub(crate) fn describe(
             name: res.name.clone(),
             desc,
             residency,
-            lifetime: (first.min(passes.saturating_sub(1)), last),
+            lifetime: (PassId::new(first), PassId::new(last)),
             placement: None,
             frame_start_layout: Layout::Undefined,
         });
@@ -130,7 +135,7 @@ pub(crate) fn describe(
 fn check_image_sizes(
     graph: &LoadedGraph,
     ir: &Ir,
-    kept: &[usize],
+    kept: &IdVec<ResourceId, IrResourceId>,
     output: Extent,
 ) -> Result<(), Vec<Diagnostic>> {
     let errors: Vec<Diagnostic> = kept
@@ -182,7 +187,10 @@ mod tests {
                 Residency::Output
             )
         );
-        assert_eq!(plan.resources[0].lifetime, (0, 1));
+        assert_eq!(
+            plan.resources[ResourceId::new(0)].lifetime,
+            (PassId::new(0), PassId::new(1))
+        );
     }
 
     #[test]

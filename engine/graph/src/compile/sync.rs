@@ -9,7 +9,8 @@ mod state;
 pub use state::{sampled_layout, shader_stages, GpuAccess, ResourceState};
 
 use super::lifetimes::Lifetimes;
-use super::order::PassUse;
+use super::order::{PassUse, Uses};
+use crate::id::{IdVec, IrPassId, PassId, ResourceId};
 use crate::plan::{Barrier, PlanResource, Residency, ResourceDesc};
 use crate::resolve::{Ir, IrKind, Usage};
 use crate::schema::{LoadDecl, PassKind};
@@ -18,19 +19,28 @@ use crate::vk::{Access, Layout, Stage};
 /// The barriers of a plan.
 pub(crate) struct Synchronization {
     /// Per plan pass, the barriers recorded before it.
-    pub pass_barriers: Vec<Vec<Barrier>>,
+    pub pass_barriers: IdVec<PassId, Vec<Barrier>>,
     /// Barriers after the last pass.
     pub epilogue: Vec<Barrier>,
 }
+
+type Resources = IdVec<ResourceId, PlanResource>;
+type States = IdVec<ResourceId, ResourceState>;
+/// Per resource, the other transient images whose memory overlaps its own.
+type Sharing = IdVec<ResourceId, Vec<ResourceId>>;
+/// Per plan pass, each resource it uses and how the GPU accesses it.
+type GpuUses = IdVec<PassId, Vec<(ResourceId, GpuAccess)>>;
+/// Per plan pass, the destination scope of each of its accesses' barriers.
+type Scopes = IdVec<PassId, Vec<Scope>>;
 
 /// Derives every barrier of the plan, and each output and history image's layout
 /// at the start of a frame (set on `resources`).
 pub(crate) fn synchronize(
     ir: &Ir,
-    sequence: &[usize],
-    uses: &[Vec<PassUse>],
+    sequence: &[IrPassId],
+    uses: &Uses,
     lifetimes: &Lifetimes,
-    resources: &mut [PlanResource],
+    resources: &mut Resources,
 ) -> Synchronization {
     // Per-pass GPU accesses, then barriers.
     let gpu_uses = gpu_uses(ir, sequence, uses, lifetimes);
@@ -48,12 +58,7 @@ pub(crate) fn synchronize(
 }
 
 /// Per plan pass, each resource it uses (plan index) and how the GPU accesses it.
-fn gpu_uses(
-    ir: &Ir,
-    sequence: &[usize],
-    uses: &[Vec<PassUse>],
-    lifetimes: &Lifetimes,
-) -> Vec<Vec<(usize, GpuAccess)>> {
+fn gpu_uses(ir: &Ir, sequence: &[IrPassId], uses: &Uses, lifetimes: &Lifetimes) -> GpuUses {
     sequence
         .iter()
         .map(|&p| {
@@ -68,16 +73,12 @@ fn gpu_uses(
 /// Each resource's state when a frame starts: transient ones fresh, the output as
 /// the previous frame's copy left it, history images as their first reader needs
 /// them (the epilogue puts them there). Sets `frame_start_layout` to match.
-fn frame_start_states(
-    resources: &mut [PlanResource],
-    gpu_uses: &[Vec<(usize, GpuAccess)>],
-    scopes: &[Vec<Scope>],
-) -> Vec<ResourceState> {
-    let mut states: Vec<ResourceState> = resources
+fn frame_start_states(resources: &mut Resources, gpu_uses: &GpuUses, scopes: &Scopes) -> States {
+    let mut states: States = resources
         .iter()
         .map(|r| ResourceState::fresh(matches!(r.desc, ResourceDesc::Image(_))))
         .collect();
-    for (i, r) in resources.iter_mut().enumerate() {
+    for (i, r) in resources.iter_enumerated_mut() {
         match r.residency {
             Residency::Transient => {}
             Residency::Output => {
@@ -104,14 +105,14 @@ fn frame_start_states(
 /// one ended, so a transient image's first barrier must also wait for the previous
 /// frame's last use of its memory. Simulates one frame to learn that.
 fn inherit_previous_frame(
-    resources: &[PlanResource],
-    sharing: &[Vec<usize>],
-    gpu_uses: &[Vec<(usize, GpuAccess)>],
-    scopes: &[Vec<Scope>],
-    states: &mut [ResourceState],
+    resources: &Resources,
+    sharing: &Sharing,
+    gpu_uses: &GpuUses,
+    scopes: &Scopes,
+    states: &mut States,
 ) {
-    let (_, end_of_frame) = record_barriers(resources, sharing, gpu_uses, scopes, states.to_vec());
-    for (r, state) in states.iter_mut().enumerate() {
+    let (_, end_of_frame) = record_barriers(resources, sharing, gpu_uses, scopes, states.clone());
+    for (r, state) in states.iter_enumerated_mut() {
         if resources[r].residency == Residency::Transient {
             let (stage, access) = pending_of(&end_of_frame, sharing[r].iter().copied().chain([r]));
             state.inherit(stage, access);
@@ -122,13 +123,13 @@ fn inherit_previous_frame(
 /// Barriers after the last pass that bring the output to `TRANSFER_SRC_OPTIMAL`
 /// and each history image to the state its first reader next frame expects.
 fn epilogue(
-    resources: &[PlanResource],
-    gpu_uses: &[Vec<(usize, GpuAccess)>],
-    scopes: &[Vec<Scope>],
-    states: &[ResourceState],
+    resources: &Resources,
+    gpu_uses: &GpuUses,
+    scopes: &Scopes,
+    states: &States,
 ) -> Vec<Barrier> {
     let mut epilogue = Vec::new();
-    for (i, r) in resources.iter().enumerate() {
+    for (i, r) in resources.iter_enumerated() {
         let target = match r.residency {
             Residency::Transient => continue,
             Residency::Output => GpuAccess {
@@ -163,11 +164,7 @@ fn epilogue(
 
 type Scope = (Stage, Access);
 
-fn first_access(
-    gpu_uses: &[Vec<(usize, GpuAccess)>],
-    scopes: &[Vec<Scope>],
-    r: usize,
-) -> Option<(GpuAccess, Scope)> {
+fn first_access(gpu_uses: &GpuUses, scopes: &Scopes, r: ResourceId) -> Option<(GpuAccess, Scope)> {
     gpu_uses
         .iter()
         .zip(scopes)
@@ -178,14 +175,14 @@ fn first_access(
 
 /// For every access, the destination scope its barrier should have: its own, or for a
 /// read, the union with the reads after it in the same layout up to the next write.
-fn read_scopes(gpu_uses: &[Vec<(usize, GpuAccess)>]) -> Vec<Vec<Scope>> {
-    let mut scopes: Vec<Vec<Scope>> = gpu_uses
+fn read_scopes(gpu_uses: &GpuUses) -> Scopes {
+    let mut scopes: Scopes = gpu_uses
         .iter()
         .map(|u| u.iter().map(|(_, a)| (a.stage, a.access)).collect())
         .collect();
-    let mut run: std::collections::HashMap<usize, (Layout, Scope)> =
+    let mut run: std::collections::HashMap<ResourceId, (Layout, Scope)> =
         std::collections::HashMap::new();
-    for i in (0..gpu_uses.len()).rev() {
+    for i in gpu_uses.ids().rev() {
         for (k, &(r, a)) in gpu_uses[i].iter().enumerate() {
             if a.access.is_write() {
                 run.remove(&r);
@@ -206,14 +203,14 @@ fn read_scopes(gpu_uses: &[Vec<(usize, GpuAccess)>]) -> Vec<Vec<Scope>> {
 
 /// Walks the passes once, returning each pass's barriers and the final states.
 fn record_barriers(
-    resources: &[PlanResource],
-    sharing: &[Vec<usize>],
-    gpu_uses: &[Vec<(usize, GpuAccess)>],
-    scopes: &[Vec<Scope>],
-    mut states: Vec<ResourceState>,
-) -> (Vec<Vec<Barrier>>, Vec<ResourceState>) {
-    let mut all = Vec::with_capacity(gpu_uses.len());
-    for (i, accesses) in gpu_uses.iter().enumerate() {
+    resources: &Resources,
+    sharing: &Sharing,
+    gpu_uses: &GpuUses,
+    scopes: &Scopes,
+    mut states: States,
+) -> (IdVec<PassId, Vec<Barrier>>, States) {
+    let mut all = IdVec::new();
+    for (i, accesses) in gpu_uses.iter_enumerated() {
         let mut barriers = Vec::new();
         for (k, &(r, access)) in accesses.iter().enumerate() {
             if resources[r].lifetime.0 == i && resources[r].residency == Residency::Transient {
@@ -234,17 +231,16 @@ fn record_barriers(
 }
 
 /// For each resource, the other transient images whose memory overlaps its own.
-fn memory_sharing(resources: &[PlanResource]) -> Vec<Vec<usize>> {
-    let mut placed: Vec<(usize, u64, u64, usize)> = resources
-        .iter()
-        .enumerate()
+fn memory_sharing(resources: &Resources) -> Sharing {
+    let mut placed: Vec<(usize, u64, u64, ResourceId)> = resources
+        .iter_enumerated()
         .filter_map(|(i, r)| {
             r.placement
                 .map(|p| (p.block, p.offset, p.offset + p.size, i))
         })
         .collect();
     placed.sort_unstable();
-    let mut sharing = vec![Vec::new(); resources.len()];
+    let mut sharing = IdVec::filled(Vec::new(), resources.len());
     for (k, &(block, _, end, i)) in placed.iter().enumerate() {
         for &(other_block, start, _, j) in &placed[k + 1..] {
             if other_block != block || start >= end {
@@ -258,7 +254,7 @@ fn memory_sharing(resources: &[PlanResource]) -> Vec<Vec<usize>> {
 }
 
 /// The union of the pending stages and accesses of some resources.
-fn pending_of(states: &[ResourceState], which: impl Iterator<Item = usize>) -> (Stage, Access) {
+fn pending_of(states: &States, which: impl Iterator<Item = ResourceId>) -> (Stage, Access) {
     which.fold((Stage::empty(), Access::empty()), |(s, a), j| {
         let (js, ja) = states[j].pending();
         (s | js, a | ja)
@@ -266,7 +262,7 @@ fn pending_of(states: &[ResourceState], which: impl Iterator<Item = usize>) -> (
 }
 
 /// How the GPU sees a pass's merged use of a resource.
-fn gpu_access(ir: &Ir, pass: usize, u: &PassUse) -> GpuAccess {
+fn gpu_access(ir: &Ir, pass: IrPassId, u: &PassUse) -> GpuAccess {
     let p = &ir.passes[pass];
     let aspect = match ir.resources[u.resource].kind {
         IrKind::Image { format, .. } => Some(format.aspect),
@@ -363,7 +359,7 @@ mod tests {
     fn a_sampled_attachment_gets_one_barrier_and_the_output_an_epilogue() {
         let plan = plan_of(CHAIN, &[]);
         let x = plan.resource("x").expect("x");
-        let before_b = &plan.passes[1].barriers;
+        let before_b = &plan.passes[PassId::new(1)].barriers;
         let to_sampled = before_b
             .iter()
             .find(|b| b.resource == x)

@@ -1,5 +1,6 @@
 //! The resolved graph: names replaced by indices, parameters by numbers.
 
+use crate::id::{IdVec, IrPassId, IrResourceId};
 use crate::plan::ShaderFiles;
 use crate::schema::{Blend, Draw, LoadDecl, ParamValue, PassKind, RasterState, StoreDecl};
 use crate::vk::FormatInfo;
@@ -8,9 +9,9 @@ use std::collections::BTreeMap;
 /// A graph with names resolved to indices.
 #[derive(Debug, Clone)]
 pub struct Ir {
-    pub resources: Vec<IrResource>,
-    pub passes: Vec<IrPass>,
-    pub output: Option<usize>,
+    pub resources: IdVec<IrResourceId, IrResource>,
+    pub passes: IdVec<IrPassId, IrPass>,
+    pub output: Option<IrResourceId>,
 }
 
 /// A resolved resource.
@@ -47,7 +48,7 @@ pub enum SizeSpec {
     Output,
     Scale(f64, f64),
     Absolute(u32, u32),
-    Like(usize, f64, f64),
+    Like(IrResourceId, f64, f64),
 }
 
 /// A buffer size: fixed, or an expression evaluated per compile.
@@ -69,7 +70,7 @@ pub struct IrPass {
     pub dispatch: Option<IrDispatch>,
     pub params: BTreeMap<String, ParamValue>,
     pub accesses: Vec<IrAccess>,
-    pub after: Vec<usize>,
+    pub after: Vec<IrPassId>,
     pub enabled_if: Vec<String>,
     /// Fixed-function state of a raster pass.
     pub raster: RasterState,
@@ -79,14 +80,14 @@ pub struct IrPass {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum IrDispatch {
     Output(u32, u32),
-    Image(usize, u32, u32),
+    Image(IrResourceId, u32, u32),
     Groups(u32, u32, u32),
 }
 
 /// One use of a resource by a pass.
 #[derive(Debug, Clone)]
 pub struct IrAccess {
-    pub resource: usize,
+    pub resource: IrResourceId,
     pub usage: Usage,
     /// Features that must hold for this access to happen.
     pub conditions: Vec<String>,

@@ -14,6 +14,7 @@ pub(crate) use values::oversized_image;
 pub use values::{expression_vars, image_extent, MAX_IMAGE_DIMENSION, MAX_WORKGROUP_COUNT};
 
 use crate::diagnostic::Diagnostic;
+use crate::id::{IdVec, IrPassId, IrResourceId};
 use crate::load::LoadedGraph;
 use crate::plan::Extent;
 use crate::schema::ResourceDecl;
@@ -55,8 +56,8 @@ pub fn resolve(graph: &LoadedGraph) -> (Ir, Vec<Diagnostic>) {
 struct Resolver<'a> {
     graph: &'a LoadedGraph,
     diags: Vec<Diagnostic>,
-    resource_index: HashMap<&'a str, usize>,
-    pass_index: HashMap<&'a str, usize>,
+    resource_index: HashMap<&'a str, IrResourceId>,
+    pass_index: HashMap<&'a str, IrPassId>,
 }
 
 fn pass_path<'p>(index: usize, rest: &[Seg<'p>]) -> Vec<Seg<'p>> {
@@ -90,7 +91,11 @@ impl<'a> Resolver<'a> {
         let graph = self.graph;
         for (i, r) in graph.resources.iter().enumerate() {
             let name = resource_name(&r.item);
-            if self.resource_index.insert(name, i).is_some() {
+            if self
+                .resource_index
+                .insert(name, IrResourceId::new(i))
+                .is_some()
+            {
                 self.error(
                     r.source,
                     &resource_path(r.index, &[Seg::Field("name")]),
@@ -100,7 +105,11 @@ impl<'a> Resolver<'a> {
             }
         }
         for (i, p) in graph.passes.iter().enumerate() {
-            if self.pass_index.insert(p.item.name.as_str(), i).is_some() {
+            if self
+                .pass_index
+                .insert(p.item.name.as_str(), IrPassId::new(i))
+                .is_some()
+            {
                 let name = p.item.name.clone();
                 self.error(
                     p.source,
@@ -109,7 +118,7 @@ impl<'a> Resolver<'a> {
                 );
             }
         }
-        let mut resources: Vec<IrResource> = graph
+        let mut resources: IdVec<IrResourceId, IrResource> = graph
             .resources
             .iter()
             .map(|r| self.resolve_resource(r))
@@ -120,14 +129,14 @@ impl<'a> Resolver<'a> {
                     continue;
                 }
                 if source == 0 && graph.is_fragment {
-                    self.resource_index.insert(name, resources.len());
-                    resources.push(IrResource {
+                    let id = resources.push(IrResource {
                         name: name.clone(),
                         source,
                         index: k,
                         kind: IrKind::External,
                         history: false,
                     });
+                    self.resource_index.insert(name, id);
                 } else {
                     let fragment = graph.sources[source].file.display().to_string();
                     self.error(source, &[Seg::Field("inputs"), Seg::Index(k)], format!(
@@ -136,7 +145,7 @@ impl<'a> Resolver<'a> {
                 }
             }
         }
-        let passes: Vec<IrPass> = graph
+        let passes: IdVec<IrPassId, IrPass> = graph
             .passes
             .iter()
             .map(|p| self.resolve_pass(p, &resources))
@@ -157,7 +166,7 @@ impl<'a> Resolver<'a> {
     /// (images within it keep every output-sized dispatch within
     /// [`MAX_WORKGROUP_COUNT`] groups).
     fn check_extents(&mut self, ir: &Ir) {
-        for (r, res) in ir.resources.iter().enumerate() {
+        for (r, res) in ir.resources.iter_enumerated() {
             if !matches!(res.kind, IrKind::Image { .. }) {
                 continue;
             }
@@ -177,7 +186,7 @@ impl<'a> Resolver<'a> {
     }
 
     /// Every name in the graph's `readback` list is one of its images.
-    fn check_readback(&mut self, resources: &[IrResource]) {
+    fn check_readback(&mut self, resources: &IdVec<IrResourceId, IrResource>) {
         for (i, name) in self.graph.readback.iter().enumerate() {
             let path = [Seg::Field("readback"), Seg::Index(i)];
             match self.resource_index.get(name.as_str()) {
@@ -199,7 +208,10 @@ impl<'a> Resolver<'a> {
         }
     }
 
-    fn resolve_output(&mut self, resources: &[IrResource]) -> Option<usize> {
+    fn resolve_output(
+        &mut self,
+        resources: &IdVec<IrResourceId, IrResource>,
+    ) -> Option<IrResourceId> {
         let graph = self.graph;
         if graph.is_fragment {
             return None;
@@ -250,7 +262,7 @@ impl<'a> Resolver<'a> {
         }
     }
 
-    fn lookup(&mut self, source: usize, path: &[Seg], name: &str) -> Option<usize> {
+    fn lookup(&mut self, source: usize, path: &[Seg], name: &str) -> Option<IrResourceId> {
         match self.resource_index.get(name) {
             Some(&i) => Some(i),
             None => {

@@ -3,6 +3,7 @@
 use super::{
     pass_path, IrAccess, IrDispatch, IrPass, IrResource, Resolver, Usage, MAX_WORKGROUP_COUNT,
 };
+use crate::id::{IdVec, IrResourceId};
 use crate::load::Located;
 use crate::plan::ShaderFiles;
 use crate::schema::{AttachmentDecl, Dispatch, PassDecl, PassKind, RasterState, ReadDecl};
@@ -13,7 +14,7 @@ impl Resolver<'_> {
     pub(super) fn resolve_pass(
         &mut self,
         p: &Located<PassDecl>,
-        resources: &[IrResource],
+        resources: &IdVec<IrResourceId, IrResource>,
     ) -> IrPass {
         let (source, index) = (p.source, p.index);
         let decl = &p.item;
@@ -239,7 +240,7 @@ impl Resolver<'_> {
 }
 
 fn attachment_access(
-    resource: usize,
+    resource: IrResourceId,
     a: &AttachmentDecl,
     depth: bool,
     field: &'static str,

@@ -5,6 +5,7 @@ use super::{
     image_extent, pass_path, resource_path, Ir, IrAccess, IrKind, IrPass, IrResource, Resolver,
     SizeAtProbe, SizeSpec, Usage, PROBE_SIZES,
 };
+use crate::id::{IdVec, IrResourceId};
 use crate::plan::Extent;
 use crate::schema::{LoadDecl, PassDecl, PassKind};
 use crate::spans::Seg;
@@ -17,7 +18,7 @@ impl Resolver<'_> {
         &mut self,
         pass: &IrPass,
         decl: &PassDecl,
-        resources: &[IrResource],
+        resources: &IdVec<IrResourceId, IrResource>,
     ) {
         let (source, index) = (pass.source, pass.index);
         let name = &pass.name;
@@ -179,7 +180,7 @@ impl Resolver<'_> {
     pub(super) fn check_usages(&mut self, ir: &Ir) {
         for pass in &ir.passes {
             let (source, index) = (pass.source, pass.index);
-            let mut seen: HashMap<usize, &IrAccess> = HashMap::new();
+            let mut seen: HashMap<IrResourceId, &IrAccess> = HashMap::new();
             let mut attachment_sizes: Vec<(&IrAccess, Vec<SizeAtProbe>)> = Vec::new();
             for access in &pass.accesses {
                 let path = access_path(index, access);
@@ -302,7 +303,7 @@ impl Resolver<'_> {
                 }
             }
         }
-        for (i, r) in ir.resources.iter().enumerate() {
+        for (i, r) in ir.resources.iter_enumerated() {
             if let IrKind::Image {
                 size: SizeSpec::Like(..),
                 ..

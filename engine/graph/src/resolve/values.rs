@@ -2,6 +2,7 @@
 //! checked for range, and the sizes and expression variables derived from them.
 
 use super::{Ir, IrKind, Resolver, SizeSpec};
+use crate::id::IrResourceId;
 use crate::plan::Extent;
 use crate::schema::{Dim, ParamValue};
 use crate::spans::Seg;
@@ -127,7 +128,7 @@ pub(crate) fn oversized_image(name: &str, size: Extent, output: Extent) -> Strin
 }
 
 /// An image's size for a given output size; `None` for a `Like` cycle or a buffer.
-pub fn image_extent(ir: &Ir, resource: usize, output: Extent) -> Option<Extent> {
+pub fn image_extent(ir: &Ir, resource: IrResourceId, output: Extent) -> Option<Extent> {
     let scale = |v: u32, s: f64| ((v as f64 * s).floor() as u32).max(1);
     let mut current = resource;
     let (mut fx, mut fy) = (1.0, 1.0);

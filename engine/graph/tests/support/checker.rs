@@ -7,6 +7,7 @@
 //! synchronization pass.
 
 use std::collections::BTreeMap;
+use weft_graph::id::{PassId, ResourceId};
 use weft_graph::plan::{BindingKind, LoadOp, Plan, Residency, ResourceDesc};
 use weft_graph::schema::PassKind;
 use weft_graph::vk::{Access, Aspect, Layout, Stage};
@@ -78,7 +79,7 @@ fn shader_stage(kind: PassKind, image: bool) -> Stage {
 
 /// Every access of one pass, derived from the plan's description of it.
 fn uses_of(plan: &Plan, pass: usize) -> Vec<(usize, Use)> {
-    let p = &plan.passes[pass];
+    let p = &plan.passes[PassId::new(pass)];
     let mut out = Vec::new();
     if let Some(rp) = &p.render_pass {
         for (i, a) in rp.attachments.iter().enumerate() {
@@ -114,7 +115,7 @@ fn uses_of(plan: &Plan, pass: usize) -> Vec<(usize, Use)> {
             };
             assert_eq!(a.layout, u.layout, "attachment layout of pass {}", p.name);
             assert_eq!((a.initial_layout, a.final_layout), (a.layout, a.layout));
-            out.push((a.resource, u));
+            out.push((a.resource.index(), u));
         }
     }
     for b in &p.bindings {
@@ -146,7 +147,7 @@ fn uses_of(plan: &Plan, pass: usize) -> Vec<(usize, Use)> {
             ),
         };
         out.push((
-            b.resource,
+            b.resource.index(),
             Use {
                 stage: if image {
                     stage
@@ -162,7 +163,7 @@ fn uses_of(plan: &Plan, pass: usize) -> Vec<(usize, Use)> {
     if let Some((src, dst)) = p.transfer {
         let stage = shader_stage(p.kind, true);
         out.push((
-            src,
+            src.index(),
             Use {
                 stage,
                 access: Access::TRANSFER_READ,
@@ -171,7 +172,7 @@ fn uses_of(plan: &Plan, pass: usize) -> Vec<(usize, Use)> {
             },
         ));
         out.push((
-            dst,
+            dst.index(),
             Use {
                 stage,
                 access: Access::TRANSFER_WRITE,
@@ -184,19 +185,26 @@ fn uses_of(plan: &Plan, pass: usize) -> Vec<(usize, Use)> {
 }
 
 fn is_image(plan: &Plan, r: usize) -> bool {
-    matches!(plan.resources[r].desc, ResourceDesc::Image(_))
+    matches!(
+        plan.resources[ResourceId::new(r)].desc,
+        ResourceDesc::Image(_)
+    )
 }
 
 fn overlapping(plan: &Plan, r: usize) -> Vec<usize> {
-    let Some(a) = plan.resources[r].placement else {
+    let Some(a) = plan.resources[ResourceId::new(r)].placement else {
         return Vec::new();
     };
     (0..plan.resources.len())
         .filter(|&j| j != r)
         .filter(|&j| {
-            plan.resources[j].placement.is_some_and(|b| {
-                a.block == b.block && a.offset < b.offset + b.size && b.offset < a.offset + a.size
-            })
+            plan.resources[ResourceId::new(j)]
+                .placement
+                .is_some_and(|b| {
+                    a.block == b.block
+                        && a.offset < b.offset + b.size
+                        && b.offset < a.offset + a.size
+                })
         })
         .collect()
 }
@@ -216,7 +224,7 @@ fn apply_barrier(
         let (old, new) = b.layouts.expect("transition has layouts");
         if old == Layout::Undefined {
             // Memory shared with other images: everything they did must be finished.
-            for j in overlapping(plan, b.resource) {
+            for j in overlapping(plan, b.resource.index()) {
                 let m = &models[j];
                 let touched = m.write.is_some() || !m.reads.is_empty();
                 if touched {
@@ -228,14 +236,14 @@ fn apply_barrier(
                     {
                         return Err(format!(
                             "{at}: \"{name}\" takes over memory of \"{}\" without waiting for its last use",
-                            plan.resources[j].name
+                            plan.resources[ResourceId::new(j)].name
                         ));
                     }
                     models[j] = Model::fresh();
                 }
             }
         }
-        let m = &mut models[b.resource];
+        let m = &mut models[b.resource.index()];
         if old != Layout::Undefined && old != m.layout {
             return Err(format!(
                 "{at}: barrier on \"{name}\" says old layout {old:?} but it is in {:?}",
@@ -268,7 +276,7 @@ fn apply_barrier(
         m.reads.clear();
         return Ok(());
     }
-    let m = &mut models[b.resource];
+    let m = &mut models[b.resource.index()];
     if let Some((old, _)) = b.layouts {
         if old != m.layout {
             return Err(format!(
@@ -292,7 +300,7 @@ fn apply_barrier(
 }
 
 fn check_use(plan: &Plan, models: &[Model], r: usize, u: &Use, at: &str) -> Result<(), String> {
-    let name = &plan.resources[r].name;
+    let name = &plan.resources[ResourceId::new(r)].name;
     let m = &models[r];
     if is_image(plan, r) && m.layout != u.layout {
         return Err(format!(
@@ -398,11 +406,16 @@ pub fn check_plan(plan: &Plan, frames: usize) -> Result<(), String> {
         check_use(
             plan,
             &models,
-            plan.output,
+            plan.output.index(),
             &readback,
             &format!("frame {frame}, read-back"),
         )?;
-        record(&mut models, plan.output, Stage::COPY, Access::TRANSFER_READ);
+        record(
+            &mut models,
+            plan.output.index(),
+            Stage::COPY,
+            Access::TRANSFER_READ,
+        );
     }
     Ok(())
 }
@@ -411,7 +424,7 @@ pub fn check_plan(plan: &Plan, frames: usize) -> Result<(), String> {
 pub fn check_aliasing(plan: &Plan) -> Result<(), String> {
     for (i, a) in plan.resources.iter().enumerate() {
         for j in overlapping(plan, i) {
-            let b = &plan.resources[j];
+            let b = &plan.resources[ResourceId::new(j)];
             if a.lifetime.0 <= b.lifetime.1 && b.lifetime.0 <= a.lifetime.1 {
                 return Err(format!(
                     "\"{}\" and \"{}\" share memory while both alive",

@@ -3,6 +3,7 @@
 //! to, and emits the fewest synchronization2 barriers that order every access after
 //! the previous conflicting one with the layout it needs.
 
+use crate::id::ResourceId;
 use crate::plan::Barrier;
 use crate::schema::PassKind;
 use crate::vk::{Access, Aspect, Layout, Stage};
@@ -83,7 +84,7 @@ impl ResourceState {
     /// the same layout, so they need no barrier of their own.
     pub fn access(
         &mut self,
-        resource: usize,
+        resource: ResourceId,
         a: GpuAccess,
         scope: (Stage, Access),
     ) -> Option<Barrier> {
@@ -162,6 +163,8 @@ pub fn sampled_layout(aspect: Aspect) -> Layout {
 mod tests {
     use super::*;
 
+    const R: ResourceId = ResourceId::new(0);
+
     const COLOR_WRITE: GpuAccess = GpuAccess {
         stage: Stage::COLOR_ATTACHMENT_OUTPUT,
         access: Access::COLOR_ATTACHMENT_WRITE,
@@ -186,21 +189,21 @@ mod tests {
     #[test]
     fn a_widened_scope_covers_later_reads_in_the_same_layout() {
         let mut s = ResourceState::fresh(true);
-        s.access(0, COLOR_WRITE, own(COLOR_WRITE));
+        s.access(R, COLOR_WRITE, own(COLOR_WRITE));
         let both = (
             Stage::FRAGMENT_SHADER | Stage::COMPUTE_SHADER,
             Access::SHADER_SAMPLED_READ,
         );
-        let b = s.access(0, FRAG_SAMPLE, both).expect("RAW barrier");
+        let b = s.access(R, FRAG_SAMPLE, both).expect("RAW barrier");
         assert_eq!((b.dst_stage, b.dst_access), both);
-        assert_eq!(s.access(0, COMPUTE_SAMPLE, own(COMPUTE_SAMPLE)), None);
+        assert_eq!(s.access(R, COMPUTE_SAMPLE, own(COMPUTE_SAMPLE)), None);
     }
 
     #[test]
     fn write_then_two_reads_in_one_stage_needs_one_barrier() {
         let mut s = ResourceState::fresh(true);
         let first = s
-            .access(0, COLOR_WRITE, own(COLOR_WRITE))
+            .access(R, COLOR_WRITE, own(COLOR_WRITE))
             .expect("initial transition");
         assert_eq!(
             first.layouts,
@@ -208,7 +211,7 @@ mod tests {
         );
         assert_eq!(first.src_stage, Stage::empty());
         let b = s
-            .access(0, FRAG_SAMPLE, own(FRAG_SAMPLE))
+            .access(R, FRAG_SAMPLE, own(FRAG_SAMPLE))
             .expect("RAW barrier");
         assert_eq!(b.src_stage, Stage::COLOR_ATTACHMENT_OUTPUT);
         assert_eq!(b.src_access, Access::COLOR_ATTACHMENT_WRITE);
@@ -219,16 +222,16 @@ mod tests {
                 Layout::ShaderReadOnlyOptimal
             ))
         );
-        assert_eq!(s.access(0, FRAG_SAMPLE, own(FRAG_SAMPLE)), None);
+        assert_eq!(s.access(R, FRAG_SAMPLE, own(FRAG_SAMPLE)), None);
     }
 
     #[test]
     fn a_read_in_a_new_stage_chains_after_the_transition() {
         let mut s = ResourceState::fresh(true);
-        s.access(0, COLOR_WRITE, own(COLOR_WRITE));
-        s.access(0, FRAG_SAMPLE, own(FRAG_SAMPLE));
+        s.access(R, COLOR_WRITE, own(COLOR_WRITE));
+        s.access(R, FRAG_SAMPLE, own(FRAG_SAMPLE));
         let b = s
-            .access(0, COMPUTE_SAMPLE, own(COMPUTE_SAMPLE))
+            .access(R, COMPUTE_SAMPLE, own(COMPUTE_SAMPLE))
             .expect("new stage needs a barrier");
         assert_eq!(b.src_stage, Stage::FRAGMENT_SHADER);
         assert_eq!(b.dst_stage, Stage::COMPUTE_SHADER);
@@ -241,11 +244,11 @@ mod tests {
     #[test]
     fn write_after_reads_waits_for_the_readers() {
         let mut s = ResourceState::fresh(true);
-        s.access(0, COLOR_WRITE, own(COLOR_WRITE));
-        s.access(0, FRAG_SAMPLE, own(FRAG_SAMPLE));
-        s.access(0, COMPUTE_SAMPLE, own(COMPUTE_SAMPLE));
+        s.access(R, COLOR_WRITE, own(COLOR_WRITE));
+        s.access(R, FRAG_SAMPLE, own(FRAG_SAMPLE));
+        s.access(R, COMPUTE_SAMPLE, own(COMPUTE_SAMPLE));
         let b = s
-            .access(0, COLOR_WRITE, own(COLOR_WRITE))
+            .access(R, COLOR_WRITE, own(COLOR_WRITE))
             .expect("WAR barrier");
         assert_eq!(b.src_stage, Stage::FRAGMENT_SHADER | Stage::COMPUTE_SHADER);
         assert_eq!(b.src_access, Access::empty());
@@ -264,8 +267,10 @@ mod tests {
             layout: Layout::General,
             discards: false,
         };
-        assert_eq!(s.access(1, write, own(write)), None);
-        let b = s.access(1, write, own(write)).expect("WAW barrier");
+        assert_eq!(s.access(ResourceId::new(1), write, own(write)), None);
+        let b = s
+            .access(ResourceId::new(1), write, own(write))
+            .expect("WAW barrier");
         assert_eq!(b.layouts, None);
         assert_eq!(b.src_access, Access::SHADER_STORAGE_WRITE);
     }
