@@ -1,6 +1,6 @@
 #version 450
 // One direction of a separable Gaussian (bloom). The engine derives the taps
-// from the pass's `sigma` and `radius` parameters (engine/gpu/src/gaussian.rs):
+// with the pass's `Gaussian` provider (engine/render/src/gaussian.rs):
 // neighbouring texels are paired into one linear-filtered fetch between them,
 // so radius 21 (a 43-texel footprint) takes 12 taps: the centre and 11 offsets
 // applied on both sides, 23 fetches instead of 43. Weights sum to 1.

@@ -1,8 +1,8 @@
 #version 450
 // One direction of a separable Gaussian with one fetch per texel: the
 // reference the linear-sampled blur (bloom_blur.frag) is measured against
-// (feature `bloom_naive`). The engine derives the weights from `sigma` and
-// `radius` with `linear_taps: false`; tap i sits i texels either side.
+// (feature `bloom_naive`). The `Gaussian` provider derives the weights with
+// `linear_taps: false`; tap i sits i texels either side.
 layout(set = 0, binding = 0) uniform sampler2D source;
 layout(push_constant) uniform Params {
     vec2 direction;

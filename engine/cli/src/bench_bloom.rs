@@ -146,9 +146,8 @@ fn measure(
         features: loaded.features(features),
         memory: &memory,
         readback: vec!["bloom".into()],
-        ..CompileOptions::default()
     };
-    let plan = match weft_graph::compile(&loaded, &options) {
+    let plan = match weft_render::providers::compile(&loaded, &options) {
         Ok(plan) => plan,
         Err(diagnostics) => bail!("the bench graph does not compile: {diagnostics:?}"),
     };

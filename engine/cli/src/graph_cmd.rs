@@ -45,10 +45,7 @@ pub struct Target {
     /// Features on (comma-separated); `!name` turns off a graph default.
     #[arg(long, value_delimiter = ',')]
     features: Vec<String>,
-    /// Light count for buffer size expressions (a `--scene` supplies its own).
-    #[arg(long, default_value_t = 1)]
-    lights: u32,
-    /// Take features (spot_lights, shadow_casters, ...) and the light count from a scene,
+    /// Take features (spot_lights, shadow_casters, ...) from a scene,
     /// so the plan shows what this scene culls and why.
     #[arg(long)]
     scene: Option<PathBuf>,
@@ -94,7 +91,6 @@ fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Pla
     check_feature_names(file, &target.features)?;
     let graph = weft_graph::load(file);
     let mut requested = Vec::new();
-    let mut lights = target.lights;
     if let Some(path) = &target.scene {
         let scene = weft_scene::load_scene(path)
             .with_context(|| format!("loading scene {}", path.display()))?;
@@ -105,17 +101,15 @@ fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Pla
             from_scene.join(", ")
         );
         requested.extend(from_scene);
-        lights = u32::try_from(scene.lights.len()).unwrap_or(u32::MAX);
     }
     requested.extend(target.features.iter().cloned());
     let options = CompileOptions {
         extent: target.size,
         features: graph.features(&requested),
-        lights,
         ..CompileOptions::default()
     };
     let start = Instant::now();
-    let result = weft_graph::compile(&graph, &options);
+    let result = weft_render::providers::compile(&graph, &options);
     let compile_us = start.elapsed().as_secs_f64() * 1e6;
     match result {
         Ok(plan) => Ok((graph, plan, compile_us)),
@@ -140,7 +134,9 @@ pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
                 let diags = if shaders {
                     weft_render::check_graph_and_shaders(&graph)?
                 } else {
-                    weft_graph::check(&graph)
+                    let mut diags = weft_graph::check(&graph);
+                    diags.extend(weft_render::providers::check(&graph));
+                    diags
                 };
                 print_diagnostics(&diags);
                 let errors = diags.iter().filter(|d| d.is_error()).count();

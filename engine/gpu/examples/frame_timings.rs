@@ -73,7 +73,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let options = CompileOptions {
         extent,
         features: loaded.features::<&str>(&[]),
-        lights: 1,
         memory: &memory,
         ..CompileOptions::default()
     };

@@ -3,7 +3,6 @@
 //! outputs match the colour attachments; and packs graph parameters into the
 //! push-constant block by member name.
 
-use crate::gaussian::GaussianTaps;
 use crate::reflect::{
     DescriptorKind, ImageShape, PipelineInterface, PushBlock, ScalarKind, ShaderBinding,
 };
@@ -265,9 +264,9 @@ pub struct FrameValues {
 }
 
 /// Packs parameters into the push-constant block; every member must be a
-/// graph parameter of the pass, one of `time`, `frame`, `extent`, or one of the
-/// values the engine derives from the pass's parameters (`gauss_*`, see
-/// [`derived_value`]).
+/// parameter of the pass (declared in the graph, or derived by a provider and
+/// added to the plan's parameters) or one of `time`, `frame`, `extent`. An
+/// array member may be given fewer elements than it holds; the rest are zero.
 pub fn pack_push(
     block: &PushBlock,
     params: &BTreeMap<String, ParamValue>,
@@ -298,32 +297,18 @@ pub fn pack_push(
                 "time" => vec![f64::from(frame.time)],
                 "frame" => vec![f64::from(frame.frame)],
                 "extent" => frame.extent.iter().map(|&v| f64::from(v)).collect(),
-                name => match derived_value(name, params) {
-                    Some(Ok(values)) if values.len() > capacity => {
-                        problems.push(format!(
-                            "push-constant member `{name}` holds {capacity} value(s) but the pass's `sigma` and `radius` need {}",
-                            values.len()
-                        ));
-                        continue;
-                    }
-                    Some(Ok(mut values)) => {
-                        values.resize(capacity, 0.0);
-                        values
-                    }
-                    Some(Err(problem)) => {
-                        problems.push(format!("push-constant member `{name}`: {problem}"));
-                        continue;
-                    }
-                    None => {
-                        problems.push(format!(
-                            "push-constant member `{name}` has no graph parameter of that name"
-                        ));
-                        continue;
-                    }
-                },
+                name => {
+                    problems.push(format!(
+                        "push-constant member `{name}` has no graph parameter of that name"
+                    ));
+                    continue;
+                }
             },
         };
-        if values.len() != capacity {
+        let short_array = m.count > 1
+            && values.len() < capacity
+            && values.len().is_multiple_of(m.components as usize);
+        if values.len() != capacity && !short_array {
             problems.push(format!(
                 "parameter `{}` has {} component(s) but the shader member has {}",
                 m.name,
@@ -355,42 +340,6 @@ pub fn pack_push(
     } else {
         Err(problems)
     }
-}
-
-/// Values the engine computes from a pass's parameters rather than taking
-/// them literally: a Gaussian blur's taps from `sigma` and `radius`
-/// (`gauss_weights`, `gauss_offsets` and the tap count `gauss_taps`, centre
-/// included). With `linear_taps: false` the taps are one per texel (offsets
-/// 0, 1, 2, ...), otherwise neighbours are paired into linear-filtered fetches.
-/// `None` for a name that is not derived.
-pub fn derived_value(
-    name: &str,
-    params: &BTreeMap<String, ParamValue>,
-) -> Option<Result<Vec<f64>, String>> {
-    if !matches!(name, "gauss_weights" | "gauss_offsets" | "gauss_taps") {
-        return None;
-    }
-    let number = |key: &str| match params.get(key) {
-        Some(ParamValue::Number(n)) => Ok(*n),
-        _ => Err(format!("the pass needs a numeric parameter `{key}`")),
-    };
-    let linear = !matches!(params.get("linear_taps"), Some(ParamValue::Bool(false)));
-    Some(number("sigma").and_then(|sigma| {
-        let radius = number("radius")?;
-        if radius.fract() != 0.0 || radius < 0.0 {
-            return Err(format!("`radius` must be a whole number, got {radius}"));
-        }
-        let taps = if linear {
-            GaussianTaps::linear(sigma, radius as u32)?
-        } else {
-            GaussianTaps::discrete(sigma, radius as u32)?
-        };
-        Ok(match name {
-            "gauss_weights" => taps.weights,
-            "gauss_offsets" => taps.offsets,
-            _ => vec![taps.len() as f64],
-        })
-    }))
 }
 
 #[cfg(test)]
@@ -487,75 +436,22 @@ mod tests {
     }
 
     #[test]
-    fn derives_gaussian_taps_from_sigma_and_radius() {
+    fn a_short_vector_fills_an_array_and_the_rest_is_zero() {
         let block = PushBlock {
-            size: 108,
-            members: vec![
-                member("direction", 0, ScalarKind::Float, 2),
-                member("gauss_taps", 8, ScalarKind::Int, 1),
-                array("gauss_weights", 12, ScalarKind::Float, 12),
-                array("gauss_offsets", 60, ScalarKind::Float, 12),
-            ],
+            size: 16,
+            members: vec![array("weights", 0, ScalarKind::Float, 4)],
         };
-        let params = BTreeMap::from([
-            ("direction".to_string(), ParamValue::Vector(vec![1.0, 0.0])),
-            ("sigma".to_string(), ParamValue::Number(9.0)),
-            ("radius".to_string(), ParamValue::Number(21.0)),
-        ]);
-        let bytes = pack_push(&block, &params, &FrameValues::default()).expect("packs");
-        let float = |i: usize| f32::from_ne_bytes(bytes[i..i + 4].try_into().unwrap());
-        let taps = GaussianTaps::linear(9.0, 21).unwrap();
-        assert_eq!(i32::from_ne_bytes(bytes[8..12].try_into().unwrap()), 12);
-        for k in 0..12 {
-            assert_eq!(float(12 + 4 * k), taps.weights[k] as f32);
-            assert_eq!(float(60 + 4 * k), taps.offsets[k] as f32);
-        }
-    }
-
-    #[test]
-    fn one_tap_per_texel_when_linear_taps_is_off_and_padding_is_zero() {
-        let block = PushBlock {
-            size: 4 * 24,
-            members: vec![array("gauss_weights", 0, ScalarKind::Float, 24)],
-        };
-        let params = BTreeMap::from([
-            ("sigma".to_string(), ParamValue::Number(9.0)),
-            ("radius".to_string(), ParamValue::Number(21.0)),
-            ("linear_taps".to_string(), ParamValue::Bool(false)),
-        ]);
+        let params = BTreeMap::from([("weights".to_string(), ParamValue::Vector(vec![0.5, 0.25]))]);
         let bytes = pack_push(&block, &params, &FrameValues::default()).expect("packs");
         let float = |k: usize| f32::from_ne_bytes(bytes[4 * k..4 * k + 4].try_into().unwrap());
-        let taps = GaussianTaps::discrete(9.0, 21).unwrap();
-        for k in 0..22 {
-            assert_eq!(float(k), taps.weights[k] as f32);
-        }
-        assert_eq!((float(22), float(23)), (0.0, 0.0));
-    }
-
-    #[test]
-    fn reports_a_kernel_that_does_not_fit_and_missing_sigma() {
-        let block = PushBlock {
-            size: 48,
-            members: vec![array("gauss_weights", 0, ScalarKind::Float, 12)],
-        };
-        let wide = BTreeMap::from([
-            ("sigma".to_string(), ParamValue::Number(12.0)),
-            ("radius".to_string(), ParamValue::Number(30.0)),
-        ]);
         assert_eq!(
-            pack_push(&block, &wide, &FrameValues::default()).unwrap_err(),
-            vec![
-                "push-constant member `gauss_weights` holds 12 value(s) but the pass's `sigma` and `radius` need 16"
-                    .to_string()
-            ]
+            [float(0), float(1), float(2), float(3)],
+            [0.5, 0.25, 0.0, 0.0]
         );
-        let missing = BTreeMap::from([("radius".to_string(), ParamValue::Number(21.0))]);
+        let long = BTreeMap::from([("weights".to_string(), ParamValue::Vector(vec![1.0; 5]))]);
         assert_eq!(
-            pack_push(&block, &missing, &FrameValues::default()).unwrap_err(),
-            vec![
-                "push-constant member `gauss_weights`: the pass needs a numeric parameter `sigma`"
-                    .to_string()
-            ]
+            pack_push(&block, &long, &FrameValues::default()).unwrap_err(),
+            ["parameter `weights` has 5 component(s) but the shader member has 4"]
         );
     }
 }

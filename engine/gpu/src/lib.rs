@@ -12,7 +12,6 @@ pub mod draw;
 pub mod error;
 pub mod executor;
 mod frame;
-pub mod gaussian;
 pub mod layouts;
 pub mod pipeline;
 pub mod present;

@@ -1,4 +1,4 @@
-//! Arithmetic for buffer sizes: `"lights * 32 + 16"`, `"pixels * 4"`, `"$tile_bytes * 64"`.
+//! Arithmetic for buffer sizes: `"pixels * 4"`, `"(width / $tile + 1) * 64"`, `"$tile_bytes * 64"`.
 //! Numbers, variables, `+ - * /` and parentheses; errors name the column.
 
 use std::collections::BTreeMap;

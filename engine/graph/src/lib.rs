@@ -11,6 +11,7 @@ pub mod expr;
 pub mod id;
 pub mod load;
 pub mod plan;
+pub mod provider;
 pub mod resolve;
 pub mod schema;
 pub mod spans;

@@ -4,7 +4,7 @@
 
 use crate::diagnostic::Diagnostic;
 use crate::id::{IdVec, PassId, ResourceId};
-use crate::schema::{Blend, Draw, ParamValue, PassKind, RasterState};
+use crate::schema::{Blend, Draw, ParamValue, PassKind, ProviderDecl, RasterState};
 use crate::vk::{Access, Aspect, BufferUsage, ImageUsage, Layout, Stage};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -161,6 +161,10 @@ pub struct PlanPass {
     pub transfer: Option<(ResourceId, ResourceId)>,
     /// Declared fixed-function state of a raster pass.
     pub raster: RasterState,
+    /// Values the renderer's providers derive for this pass, with arguments
+    /// resolved (checked against the registry by `check_providers`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub derive: Vec<ProviderDecl>,
 }
 
 /// Shader file paths.

@@ -246,6 +246,57 @@ pub struct PassDecl {
     /// Fixed-function state a raster pass bakes into its pipeline.
     #[serde(default)]
     pub raster: Option<RasterDecl>,
+    /// Values the engine derives for this pass, each from a provider the
+    /// renderer registers: `derive: [Gaussian(sigma: "$sigma", radius: 21)]`.
+    #[serde(default)]
+    pub derive: Vec<ProviderDecl>,
+}
+
+/// A use of a named value provider: its name and arguments (numbers, vectors,
+/// booleans or `"$param"` references). The graph crate knows no provider; the
+/// renderer's registry (`weft_graph::provider::ProviderSpec`) says which names
+/// and arguments exist, and `check_providers` holds a graph to it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProviderDecl {
+    pub name: String,
+    pub args: BTreeMap<String, ParamValue>,
+}
+
+impl<'de> Deserialize<'de> for ProviderDecl {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct ArgsVisitor;
+        impl<'de> Visitor<'de> for ArgsVisitor {
+            type Value = BTreeMap<String, ParamValue>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("named arguments such as `(sigma: 9.0, radius: \"$radius\")`")
+            }
+            fn visit_map<M: de::MapAccess<'de>>(self, mut map: M) -> Result<Self::Value, M::Error> {
+                let mut args = BTreeMap::new();
+                while let Some((key, value)) = map.next_entry::<Identifier, ParamValue>()? {
+                    if args.insert(key.0.clone(), value).is_some() {
+                        return Err(de::Error::custom(format!(
+                            "argument `{}` is given twice",
+                            key.0
+                        )));
+                    }
+                }
+                Ok(args)
+            }
+        }
+        struct ProviderVisitor;
+        impl<'de> Visitor<'de> for ProviderVisitor {
+            type Value = ProviderDecl;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a provider such as `Gaussian(sigma: 9.0, radius: 21)`")
+            }
+            fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<ProviderDecl, A::Error> {
+                let (name, variant): (Identifier, _) = data.variant()?;
+                let args = variant.struct_variant(&[], ArgsVisitor)?;
+                Ok(ProviderDecl { name: name.0, args })
+            }
+        }
+        deserializer.deserialize_enum("Provider", &[], ProviderVisitor)
+    }
 }
 
 /// Fixed-function state of a raster pass: how depth is compared and biased,
@@ -431,4 +482,31 @@ pub enum Dispatch {
     Image(String, u32, u32),
     /// A fixed number of work groups.
     Groups(u32, u32, u32),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_provider_is_a_name_with_named_arguments() {
+        let decl: Vec<ProviderDecl> = ron::from_str(
+            r#"[Gaussian(sigma: 9.0, radius: "$radius", linear_taps: false), ShadowAtlas()]"#,
+        )
+        .expect("parses");
+        assert_eq!(decl[0].name, "Gaussian");
+        assert_eq!(decl[0].args["sigma"], ParamValue::Number(9.0));
+        assert_eq!(
+            decl[0].args["radius"],
+            ParamValue::Reference("$radius".into())
+        );
+        assert_eq!(decl[0].args["linear_taps"], ParamValue::Bool(false));
+        assert_eq!(decl[1].name, "ShadowAtlas");
+        assert!(decl[1].args.is_empty());
+        let twice = ron::from_str::<ProviderDecl>("Gaussian(sigma: 1.0, sigma: 2.0)");
+        assert!(twice
+            .expect_err("duplicate")
+            .to_string()
+            .contains("`sigma` is given twice"));
+    }
 }

@@ -4,11 +4,12 @@
 
 use crate::error::RenderError;
 use crate::features::scene_features;
-use crate::recorder::SceneRecorder;
+use crate::frame_loop::{FrameLoop, FrameRequest};
 use crate::scene_gpu::GpuScene;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
-use weft_gpu::{memory_requirements, FrameOptions, FrameReport, Gpu, Renderer, TimingMode};
+use std::sync::Arc;
+use weft_gpu::{memory_requirements, FrameReport, Gpu, TimingMode};
 use weft_graph::plan::{Extent, Plan};
 use weft_graph::schema::ParamValue;
 use weft_graph::CompileOptions;
@@ -109,12 +110,10 @@ pub fn compile_for_scene(
     let options = CompileOptions {
         extent: settings.extent,
         features: loaded.features(&requested),
-        lights: scene.lights.len().max(1) as u32,
         memory: &memory,
         readback: settings.extra_readback.clone(),
     };
-    let prepared = weft_graph::Prepared::new(&loaded).map_err(RenderError::Graph)?;
-    prepared.compile(&options).map_err(RenderError::Graph)
+    crate::providers::compile(&loaded, &options).map_err(RenderError::Graph)
 }
 
 /// Renders `scene` through the graph in `settings`.
@@ -138,48 +137,32 @@ pub fn render(
             available: "none".into(),
         })?,
     };
-    let plan = compile_for_scene(gpu, scene, settings)?;
-    let mut renderer = Renderer::new(gpu)?;
+    let plan = Arc::new(compile_for_scene(gpu, scene, settings)?);
     let uploaded = GpuScene::new(gpu, scene)?;
     let warnings = uploaded.warnings.clone();
-    let mut recorder = SceneRecorder::new(gpu, uploaded)?;
-    let mut resources = renderer.create_resources(&plan)?;
-    let frames = settings.frames.max(1);
-    let mut record_ms = Vec::with_capacity(frames as usize);
-    let mut frame_ms = Vec::with_capacity(frames as usize);
+    let mut frames = FrameLoop::new(gpu, Arc::clone(&plan), uploaded)?;
+    let count = settings.frames.max(1);
+    let mut record_ms = Vec::with_capacity(count as usize);
+    let mut frame_ms = Vec::with_capacity(count as usize);
     let mut last = None;
-    for frame in 0..frames {
-        let time = settings.time + frame as f32 * settings.frame_time;
-        recorder.scene.update(
-            camera,
-            time,
-            [settings.extent.width, settings.extent.height],
-        )?;
-        recorder.set_frame(time, frame);
+    for frame in 0..count {
         let started = std::time::Instant::now();
-        let report = renderer
-            .execute(
-                &plan,
-                &mut resources,
-                &mut recorder,
-                &FrameOptions {
-                    timing: settings.timing,
-                    readback: settings.readback && frame + 1 == frames,
-                    time,
-                    frame,
-                },
-            )
-            .map_err(|e| RenderError::at_pass(e, &plan))?;
+        let report = frames.draw(&FrameRequest {
+            camera,
+            time: settings.time + frame as f32 * settings.frame_time,
+            frame,
+            timing: settings.timing,
+            readback: settings.readback && frame + 1 == count,
+        })?;
         frame_ms.push(started.elapsed().as_secs_f64() * 1e3);
         record_ms.push(report.record_ms);
         last = Some(report);
     }
     let report =
         last.ok_or_else(|| RenderError::Gpu(weft_gpu::GpuError::Plan("no frame".into())))?;
-    let draw_calls = recorder.draw_calls;
-    drop(resources);
-    drop(recorder);
-    drop(renderer);
+    let draw_calls = frames.draw_calls();
+    drop(frames);
+    let plan = Arc::try_unwrap(plan).unwrap_or_else(|shared| (*shared).clone());
     Ok(Rendered {
         plan,
         report,

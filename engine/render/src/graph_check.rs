@@ -15,6 +15,7 @@ use weft_graph::{CompileOptions, Diagnostic, LoadedGraph, Prepared};
 /// declaration of its pass.
 pub fn check_graph_and_shaders(graph: &LoadedGraph) -> Result<Vec<Diagnostic>, GpuError> {
     let mut diags = weft_graph::check(graph);
+    diags.extend(crate::providers::check(graph));
     if graph.is_fragment || diags.iter().any(Diagnostic::is_error) {
         return Ok(diags);
     }
@@ -32,9 +33,17 @@ pub fn check_graph_and_shaders(graph: &LoadedGraph) -> Result<Vec<Diagnostic>, G
             features,
             ..CompileOptions::default()
         };
-        let Ok(plan) = prepared.compile(&options) else {
+        let Ok(mut plan) = prepared.compile(&options) else {
             continue; // reported by `weft_graph::check`
         };
+        if let Err(errors) = crate::providers::derive_values(&mut plan) {
+            for d in errors {
+                if !diags.contains(&d) {
+                    diags.push(d);
+                }
+            }
+            continue;
+        }
         for ShaderProblem { pass, message } in check_plan_shaders(&mut cache, &plan) {
             let at = plan
                 .passes

@@ -5,8 +5,9 @@
 
 use crate::geometry::DrawItem;
 use crate::pipelines::{front_face, ScenePipeline, ScenePipelineKey, ScenePipelines, MATERIAL_SET};
+use crate::providers::{self, SHADOW_VIEW};
 use crate::scene_gpu::GpuScene;
-use crate::scene_interface::{position_only, scene_set_problems, SHADOW_VIEW_MEMBER};
+use crate::scene_interface::{position_only, scene_set_problems};
 use crate::shadows::ShadowSettings;
 use crate::state::{pass_state, DepthTest, PassState};
 use ash::vk;
@@ -316,26 +317,19 @@ impl<'g> SceneRecorder<'g> {
     }
 }
 
-/// Whether the pipeline's vertex shader picks a shadow view by push constant.
-fn is_shadow_pass(p: &ScenePipeline) -> bool {
-    p.interface
-        .push
-        .as_ref()
-        .is_some_and(|(block, _)| block.members.iter().any(|m| m.name == SHADOW_VIEW_MEMBER))
-}
-
 impl SceneRecorder<'_> {
-    /// A shadow pass: fits this frame's views to the attachment's size with the
-    /// pass's parameters, then draws the casters once per view into its tile.
+    /// A `ShadowAtlas` pass: fits this frame's views to the attachment's size
+    /// with the provider's settings, then draws the casters once per view into
+    /// its tile.
     fn draw_shadow_views(
         &mut self,
         ctx: &RasterContext<'_>,
         p: &ScenePipeline,
         filter: MaterialFilter,
+        settings: &ShadowSettings,
     ) -> Result<u64, GpuError> {
         let pass = ctx.pass();
-        let settings = ShadowSettings::from_params(&pass.params);
-        let views = self.scene.prepare_shadows(&settings, ctx.extent.width)?;
+        let views = self.scene.prepare_shadows(settings, ctx.extent.width)?;
         let (block, stages) = p.interface.push.as_ref().ok_or_else(|| GpuError::Pass {
             pass: pass.name.clone(),
             message: "shadow pass without push constants".into(),
@@ -344,7 +338,7 @@ impl SceneRecorder<'_> {
         let mut calls = 0;
         for (i, view) in views.iter().enumerate() {
             let mut params = pass.params.clone();
-            params.insert(SHADOW_VIEW_MEMBER.to_string(), ParamValue::Number(i as f64));
+            params.insert(SHADOW_VIEW.to_string(), ParamValue::Number(i as f64));
             let bytes =
                 pack_push(block, &params, &self.frame).map_err(|problems| GpuError::Pass {
                     pass: pass.name.clone(),
@@ -437,9 +431,10 @@ impl DrawRecorder for SceneRecorder<'_> {
             .pipelines
             .get(device, &key, layouts, (ctx.plan, pass))?;
         let graph_set = self.graph_set(ctx, p.graph_layout, &p.interface)?;
+        let shadow_atlas = providers::shadow_atlas(pass);
         let mut params = pass.params.clone();
-        if is_shadow_pass(&p) {
-            params.insert(SHADOW_VIEW_MEMBER.to_string(), ParamValue::Number(0.0));
+        if shadow_atlas.is_some() {
+            params.insert(SHADOW_VIEW.to_string(), ParamValue::Number(0.0));
         }
         let push = match &p.interface.push {
             Some((block, stages)) => {
@@ -474,8 +469,9 @@ impl DrawRecorder for SceneRecorder<'_> {
                     calls += self.draw_meshes(ctx.cmd, &q, transparent.iter());
                 }
             }
-            Draw::Meshes(filter) if is_shadow_pass(&p) => {
-                calls += self.draw_shadow_views(ctx, &p, filter)?;
+            Draw::Meshes(filter) if shadow_atlas.is_some() => {
+                let settings = shadow_atlas.unwrap_or_default();
+                calls += self.draw_shadow_views(ctx, &p, filter, &settings)?;
             }
             Draw::Meshes(filter) => {
                 calls += self.draw_meshes(ctx.cmd, &p, g.filtered(filter));

@@ -8,6 +8,7 @@
 
 use crate::error::RenderError;
 use crate::frame::{compile_for_scene, RenderSettings};
+use crate::frame_loop::{FrameLoop, FrameRequest};
 use crate::prepare::{
     check_shaders, graph_files, pick_camera, PreparedReload, ReloadBase, ReloadChange, ReloadJob,
     ShaderChecker,
@@ -23,22 +24,19 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use weft_gpu::pipeline::PipelineCache;
 use weft_gpu::resources::GpuImage;
-use weft_gpu::{FrameOptions, FrameReport, FrameResources, Gpu, GpuError, Renderer};
+use weft_gpu::{FrameReport, Gpu, GpuError};
 use weft_graph::plan::Plan;
 use weft_scene::{Camera, Scene};
 
 /// A render kept alive across edits of its graph, shaders and scene.
 pub struct LiveRender<'g> {
-    resources: FrameResources<'g>,
-    recorder: SceneRecorder<'g>,
-    renderer: Renderer<'g>,
+    frames: FrameLoop<'g>,
     /// Checks reloads prepared on this thread ([`LiveRender::apply`]).
     checker: ShaderChecker,
     gpu: &'g Gpu,
     settings: RenderSettings,
     scene_path: PathBuf,
     scene: Arc<Scene>,
-    plan: Arc<Plan>,
     sources: Sources,
     /// Files changed since the last successful reload; a refused reload keeps
     /// them, so the next attempt still reloads everything that changed.
@@ -72,26 +70,21 @@ impl<'g> LiveRender<'g> {
         let fail = |e: GpuError| ReloadError::gpu(e, &settings.graph);
         let mut cache = PipelineCache::new().map_err(fail)?;
         check_shaders(&mut cache, &plan, &settings.graph)?;
-        let renderer = Renderer::new(gpu).map_err(fail)?;
         let uploaded =
             GpuScene::new(gpu, &scene).map_err(|e| ReloadError::render(e, scene_path))?;
-        let recorder = SceneRecorder::new(gpu, uploaded).map_err(fail)?;
-        let resources = renderer.create_resources(&plan).map_err(fail)?;
         let sources = Sources {
             graph: graph_files(&settings.graph),
             shaders: shader_files(&mut cache, &plan).map_err(fail)?,
             scene: scene_files(&scene),
         };
+        let frames = FrameLoop::new(gpu, Arc::new(plan), uploaded).map_err(fail)?;
         Ok(Self {
-            resources,
-            recorder,
-            renderer,
+            frames,
             checker: ShaderChecker::new().map_err(fail)?,
             gpu,
             settings,
             scene_path: scene_path.to_path_buf(),
             scene: Arc::new(scene),
-            plan: Arc::new(plan),
             sources,
             pending: BTreeSet::new(),
             version: 0,
@@ -105,7 +98,7 @@ impl<'g> LiveRender<'g> {
 
     /// The plan that renders now.
     pub fn plan(&self) -> &Plan {
-        &self.plan
+        self.frames.plan()
     }
 
     /// The scene that renders now.
@@ -126,7 +119,7 @@ impl<'g> LiveRender<'g> {
     /// The live plan's output image; after a frame it is in
     /// `TRANSFER_SRC_OPTIMAL`, ready to be presented or copied.
     pub fn output(&self) -> Result<&GpuImage, GpuError> {
-        self.resources.image(self.plan.output)
+        self.frames.output()
     }
 
     /// Renders one frame of the live version at the settings' time, reading the
@@ -146,23 +139,13 @@ impl<'g> LiveRender<'g> {
         frame: u32,
         readback: bool,
     ) -> Result<FrameReport, RenderError> {
-        let extent = [self.settings.extent.width, self.settings.extent.height];
-        self.recorder.scene.update(camera, time, extent)?;
-        self.recorder.set_frame(time, frame);
-        let options = FrameOptions {
-            timing: self.settings.timing,
-            readback,
+        self.frames.draw(&FrameRequest {
+            camera,
             time,
             frame,
-        };
-        self.renderer
-            .execute(
-                &self.plan,
-                &mut self.resources,
-                &mut self.recorder,
-                &options,
-            )
-            .map_err(|e| RenderError::at_pass(e, &self.plan))
+            timing: self.settings.timing,
+            readback,
+        })
     }
 
     fn base(&self) -> ReloadBase {
@@ -171,7 +154,7 @@ impl<'g> LiveRender<'g> {
             scene_path: self.scene_path.clone(),
             settings: self.settings.clone(),
             scene: Arc::clone(&self.scene),
-            plan: Arc::clone(&self.plan),
+            plan: Arc::clone(self.frames.plan()),
             sources: self.sources.clone(),
         }
     }
@@ -218,7 +201,7 @@ impl<'g> LiveRender<'g> {
             None => None,
         };
         let new_resources = match &prepared.plan {
-            Some(p) => Some(self.renderer.create_resources(p).map_err(fail)?),
+            Some(p) => Some(self.frames.create_resources(p).map_err(fail)?),
             None => None,
         };
         let unwatched = prepared
@@ -230,19 +213,20 @@ impl<'g> LiveRender<'g> {
         let rebuild: BTreeSet<PathBuf> =
             prepared.shaders.iter().chain(unwatched).cloned().collect();
         if let Some(recorder) = new_recorder {
-            self.recorder = recorder;
+            self.frames.swap_scene(recorder);
         }
         for raw in &rebuild {
-            self.renderer.reload(raw).map_err(fail)?;
-            self.recorder.reload(raw).map_err(fail)?;
+            self.frames.renderer().reload(raw).map_err(fail)?;
+            self.frames.recorder().reload(raw).map_err(fail)?;
         }
         for (key, module) in prepared.modules {
-            self.recorder.adopt(key.clone(), Arc::clone(&module));
-            self.renderer.pipelines().adopt(key, module);
+            self.frames
+                .recorder()
+                .adopt(key.clone(), Arc::clone(&module));
+            self.frames.renderer().pipelines().adopt(key, module);
         }
         if let (Some(plan), Some(resources)) = (prepared.plan, new_resources) {
-            self.resources = resources;
-            self.plan = plan;
+            self.frames.swap_plan(plan, resources);
         }
         if let Some(scene) = prepared.scene {
             self.scene = scene;

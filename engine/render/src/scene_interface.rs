@@ -7,6 +7,7 @@
 
 use crate::geometry::VERTEX_ATTRIBUTES;
 use crate::pipelines::MATERIAL_SET;
+use crate::providers::SHADOW_VIEW;
 use crate::scene_gpu::{MATERIAL_SET_BINDINGS, SCENE_SET_BINDINGS};
 use crate::sources::scene_pass_keys;
 use weft_gpu::bind::{
@@ -18,11 +19,6 @@ use weft_gpu::reflect::{DescriptorKind, PipelineInterface, ScalarKind, ShaderInt
 use weft_gpu::{GpuError, ShaderProblem, SCENE_SET};
 use weft_graph::plan::{Plan, PlanPass};
 use weft_graph::schema::{Draw, ParamValue};
-
-/// The push-constant member that makes a pass a shadow pass: drawn once per
-/// shadow view (`shaders/shadow.vert`), into the view's atlas tile, with the
-/// view's index in this member.
-pub const SHADOW_VIEW_MEMBER: &str = "shadow_view";
 
 /// Whether a scene pass reads only vertex positions (depth-only passes and
 /// light volumes); mesh shading reads normals and UVs too.
@@ -150,8 +146,8 @@ pub fn scene_pass_problems(
     }
     if let Some((block, _)) = &merged.push {
         let mut params = pass.params.clone();
-        if block.members.iter().any(|m| m.name == SHADOW_VIEW_MEMBER) {
-            params.insert(SHADOW_VIEW_MEMBER.to_string(), ParamValue::Number(0.0));
+        if crate::providers::supplied(pass, SHADOW_VIEW) {
+            params.insert(SHADOW_VIEW.to_string(), ParamValue::Number(0.0));
         }
         if let Err(list) = pack_push(block, &params, &FrameValues::default()) {
             problems.extend(list);

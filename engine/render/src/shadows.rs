@@ -10,15 +10,13 @@
 use crate::lights::{LightSet, LIGHT_BYTES};
 use crate::packing::Words;
 use glam::{Mat4, Vec3, Vec4};
-use std::collections::BTreeMap;
-use weft_graph::schema::ParamValue;
 use weft_scene::Aabb;
 
-/// Most sun cascades (`cascades` is clamped to 1..=this).
+/// Most sun cascades (`ShadowAtlas` rejects more).
 pub const MAX_CASCADES: u32 = 4;
 /// Most spot cones given a shadow view; later spots are unshadowed.
 pub const MAX_SPOT_SHADOWS: u32 = 8;
-/// Largest manual PCF radius honoured (a 15x15 kernel of 2x2 filtered taps).
+/// Largest manual PCF radius (a 15x15 kernel of 2x2 filtered taps; `ShadowAtlas` rejects more).
 pub const MAX_PCF_RADIUS: u32 = 7;
 /// Bytes before the first view record: counts, splits, camera forward + normal bias.
 pub const HEADER_BYTES: usize = 48;
@@ -28,7 +26,8 @@ pub const VIEW_BYTES: usize = 160;
 pub const SHADOWS_BYTES: usize =
     HEADER_BYTES + VIEW_BYTES * (MAX_CASCADES + MAX_SPOT_SHADOWS) as usize;
 
-/// The shadow pass's parameters (`graphs/shadows.ron` documents the defaults).
+/// A shadow pass's settings: the `ShadowAtlas` provider's arguments
+/// (`providers.rs` declares their ranges and defaults).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadowSettings {
     /// Sun cascades, 1..=[`MAX_CASCADES`].
@@ -54,27 +53,6 @@ impl Default for ShadowSettings {
 }
 
 impl ShadowSettings {
-    /// Settings from a pass's parameters; missing or non-numeric ones keep their
-    /// defaults, out-of-range ones are clamped.
-    pub fn from_params(params: &BTreeMap<String, ParamValue>) -> Self {
-        let d = Self::default();
-        let number = |name: &str| match params.get(name) {
-            Some(ParamValue::Number(n)) if n.is_finite() => Some(*n),
-            _ => None,
-        };
-        Self {
-            cascades: number("cascades").map_or(d.cascades, |n| {
-                (n.round() as i64).clamp(1, i64::from(MAX_CASCADES)) as u32
-            }),
-            pcf_radius: number("pcf_radius").map_or(d.pcf_radius, |n| {
-                (n.round() as i64).clamp(0, i64::from(MAX_PCF_RADIUS)) as u32
-            }),
-            normal_bias: number("normal_bias").map_or(d.normal_bias, |n| n.max(0.0) as f32),
-            split_lambda: number("split_lambda")
-                .map_or(d.split_lambda, |n| n.clamp(0.0, 1.0) as f32),
-        }
-    }
-
     /// Texels kept free at a tile's edge so a kernel never reads a neighbour tile.
     fn margin(&self) -> f32 {
         self.pcf_radius as f32 + 2.0
@@ -548,20 +526,6 @@ mod tests {
                 0.5 - 4.0 / 2048.0,
                 1.0 - 4.0 / 2048.0
             )
-        );
-    }
-
-    #[test]
-    fn settings_come_from_params_clamped() {
-        let mut p = BTreeMap::new();
-        p.insert("cascades".to_string(), ParamValue::Number(9.0));
-        p.insert("pcf_radius".to_string(), ParamValue::Number(2.0));
-        p.insert("normal_bias".to_string(), ParamValue::Bool(true));
-        let s = ShadowSettings::from_params(&p);
-        assert_eq!((s.cascades, s.pcf_radius, s.normal_bias), (4, 2, 1.0));
-        assert_eq!(
-            ShadowSettings::from_params(&BTreeMap::new()),
-            ShadowSettings::default()
         );
     }
 

@@ -43,7 +43,6 @@ pub fn compile_with(gpu: &Gpu, path: &Path, width: u32, height: u32, features: &
     let options = CompileOptions {
         extent: Extent { width, height },
         features: loaded.features(features),
-        lights: 1,
         memory: &memory,
         ..CompileOptions::default()
     };

@@ -27,8 +27,6 @@ pub struct CompileOptions<'a> {
     pub extent: Extent,
     /// Scene features and user toggles that are on.
     pub features: BTreeSet<String>,
-    /// Light count, for buffer size expressions.
-    pub lights: u32,
     /// Memory requirements of an image; the executor passes the device's.
     pub memory: &'a dyn Fn(&ImageDesc) -> MemoryRequirements,
     /// Images to keep readable after the frame besides the output (e.g. the HDR
@@ -44,7 +42,6 @@ impl Default for CompileOptions<'_> {
                 height: 720,
             },
             features: BTreeSet::new(),
-            lights: 1,
             memory: &memory::estimate_requirements,
             readback: Vec::new(),
         }

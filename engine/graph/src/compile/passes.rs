@@ -213,6 +213,7 @@ fn plan_pass(cx: &PassContext, p: IrPassId, i: PassId, barriers: Vec<Barrier>) -
         bindings,
         transfer,
         raster: pass.raster,
+        derive: pass.derive.clone(),
     }
 }
 

@@ -95,11 +95,8 @@ pub(crate) fn describe(
                 let bytes = match size {
                     BufferSize::Bytes(b) => *b,
                     BufferSize::Expression(text) => {
-                        let vars = expression_vars(
-                            &graph.sources[res.source].params,
-                            options.extent,
-                            options.lights,
-                        );
+                        let vars =
+                            expression_vars(&graph.sources[res.source].params, options.extent);
                         crate::expr::eval(text, &vars)
                             .map(|v| v.max(1.0).ceil() as u64)
                             .unwrap_or(1)

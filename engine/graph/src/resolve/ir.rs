@@ -2,7 +2,9 @@
 
 use crate::id::{IdVec, IrPassId, IrResourceId};
 use crate::plan::ShaderFiles;
-use crate::schema::{Blend, Draw, LoadDecl, ParamValue, PassKind, RasterState, StoreDecl};
+use crate::schema::{
+    Blend, Draw, LoadDecl, ParamValue, PassKind, ProviderDecl, RasterState, StoreDecl,
+};
 use crate::vk::FormatInfo;
 use std::collections::BTreeMap;
 
@@ -74,6 +76,8 @@ pub struct IrPass {
     pub enabled_if: Vec<String>,
     /// Fixed-function state of a raster pass.
     pub raster: RasterState,
+    /// Provider uses with their arguments resolved.
+    pub derive: Vec<ProviderDecl>,
 }
 
 /// How many compute work groups, resolved.

@@ -6,11 +6,58 @@ use super::{
 use crate::id::{IdVec, IrResourceId};
 use crate::load::Located;
 use crate::plan::ShaderFiles;
-use crate::schema::{AttachmentDecl, Dispatch, PassDecl, PassKind, RasterState, ReadDecl};
+use crate::schema::{
+    AttachmentDecl, Dispatch, ParamValue, PassDecl, PassKind, ProviderDecl, RasterState, ReadDecl,
+};
 use crate::spans::Seg;
 use std::collections::BTreeMap;
 
 impl Resolver<'_> {
+    /// `values` with `"$param"` references replaced by the declaring file's
+    /// parameters; unknown references and non-finite numbers are errors at the
+    /// value (`at` is the map's path; `keyed`: a map, else a struct's fields).
+    pub(super) fn resolve_values(
+        &mut self,
+        source: usize,
+        at: &[Seg],
+        keyed: bool,
+        values: &BTreeMap<String, ParamValue>,
+    ) -> BTreeMap<String, ParamValue> {
+        let mut resolved = BTreeMap::new();
+        for (name, value) in values {
+            let mut path = at.to_vec();
+            path.push(if keyed {
+                Seg::Key(name)
+            } else {
+                Seg::Field(name)
+            });
+            match crate::load::resolve_value(&self.graph.sources[source].params, value) {
+                Ok(v) => {
+                    if let Some(bad) = crate::load::non_finite(&v) {
+                        self.error(
+                            source,
+                            &path,
+                            format!("parameter \"{name}\" must be finite, found {bad}"),
+                        );
+                    }
+                    resolved.insert(name.clone(), v);
+                }
+                Err(missing) => {
+                    let names: Vec<&str> = self.graph.sources[source]
+                        .params
+                        .keys()
+                        .map(String::as_str)
+                        .collect();
+                    let hint = crate::diagnostic::nearest(&missing, names)
+                        .map(|n| format!("did you mean \"${n}\"?"));
+                    self.error(source, &path, format!("unknown parameter \"${missing}\""))
+                        .hint = hint;
+                }
+            }
+        }
+        resolved
+    }
+
     pub(super) fn resolve_pass(
         &mut self,
         p: &Located<PassDecl>,
@@ -95,36 +142,26 @@ impl Resolver<'_> {
                 }
             }
         }
-        let mut params = BTreeMap::new();
-        for (name, value) in &decl.params {
-            match crate::load::resolve_value(&self.graph.sources[source].params, value) {
-                Ok(v) => {
-                    if let Some(bad) = crate::load::non_finite(&v) {
-                        self.error(
-                            source,
-                            &pass_path(index, &[Seg::Field("params"), Seg::Key(name)]),
-                            format!("parameter \"{name}\" must be finite, found {bad}"),
-                        );
-                    }
-                    params.insert(name.clone(), v);
-                }
-                Err(missing) => {
-                    let names: Vec<&str> = self.graph.sources[source]
-                        .params
-                        .keys()
-                        .map(String::as_str)
-                        .collect();
-                    let hint = crate::diagnostic::nearest(&missing, names)
-                        .map(|n| format!("did you mean \"${n}\"?"));
-                    self.error(
-                        source,
-                        &pass_path(index, &[Seg::Field("params"), Seg::Key(name)]),
-                        format!("unknown parameter \"${missing}\""),
-                    )
-                    .hint = hint;
-                }
-            }
-        }
+        let params = self.resolve_values(
+            source,
+            &pass_path(index, &[Seg::Field("params")]),
+            true,
+            &decl.params,
+        );
+        let derive = decl
+            .derive
+            .iter()
+            .enumerate()
+            .map(|(k, call)| ProviderDecl {
+                name: call.name.clone(),
+                args: self.resolve_values(
+                    source,
+                    &pass_path(index, &[Seg::Field("derive"), Seg::Index(k)]),
+                    false,
+                    &call.args,
+                ),
+            })
+            .collect();
         self.check_dispatch(source, index, decl.dispatch.as_ref());
         let dispatch = match &decl.dispatch {
             None => None,
@@ -153,6 +190,7 @@ impl Resolver<'_> {
             draw: decl.draw.clone(),
             dispatch,
             params,
+            derive,
             accesses,
             after,
             enabled_if: decl.enabled_if.clone(),

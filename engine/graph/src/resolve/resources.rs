@@ -128,7 +128,6 @@ impl Resolver<'_> {
                                 width: 1920,
                                 height: 1080,
                             },
-                            1,
                         );
                         if let Err(e) = crate::expr::eval(text, &vars) {
                             let mut names: Vec<String> = vars.keys().cloned().collect();

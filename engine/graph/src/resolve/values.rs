@@ -165,11 +165,12 @@ pub fn image_extent(ir: &Ir, resource: IrResourceId, output: Extent) -> Option<E
     None
 }
 
-/// Variables available to buffer size expressions.
+/// Variables available to buffer size expressions: the output size and the
+/// declaring file's numeric parameters. Nothing about scenes or techniques;
+/// a graph that sizes a buffer by a scene count declares a parameter for it.
 pub fn expression_vars(
     params: &BTreeMap<String, ParamValue>,
     output: Extent,
-    lights: u32,
 ) -> BTreeMap<String, f64> {
     let mut vars: BTreeMap<String, f64> = params
         .iter()
@@ -181,6 +182,5 @@ pub fn expression_vars(
     vars.insert("width".into(), output.width as f64);
     vars.insert("height".into(), output.height as f64);
     vars.insert("pixels".into(), output.width as f64 * output.height as f64);
-    vars.insert("lights".into(), lights as f64);
     vars
 }

@@ -174,7 +174,7 @@ pub fn random_graph(seed: u64, passes: usize) -> String {
                 if rng.chance(30) {
                     let rname = format!("r{}", resources.len());
                     resources.push(format!(
-                        "Buffer(name: \"{rname}\", size: \"pixels * 4 + lights * 16\")"
+                        "Buffer(name: \"{rname}\", size: \"pixels * 4 + $lights * 16\")"
                     ));
                     fields.push(format!("storage_write: [\"{rname}\"]"));
                     writes.push(Res {
@@ -273,7 +273,7 @@ pub fn random_graph(seed: u64, passes: usize) -> String {
         finals.join(", ")
     ));
     format!(
-        "Graph(\n  resources: [\n    {}\n  ],\n  passes: [\n    {}\n  ],\n  output: \"out\",\n)\n",
+        "Graph(\n  params: {{ \"lights\": 8 }},\n  resources: [\n    {}\n  ],\n  passes: [\n    {}\n  ],\n  output: \"out\",\n)\n",
         resources.join(",\n    "),
         pass_text.join(",\n    ")
     )

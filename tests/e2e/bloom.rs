@@ -3,13 +3,11 @@
 //! linear-sampled blur matches a brute-force 43x43 Gaussian computed here, and
 //! an image with nothing above the threshold is composited unchanged.
 
-mod common;
-
-use weft_gpu::gaussian::GaussianTaps;
-use weft_gpu::{memory_requirements, FrameOptions, Gpu, NoDraws, Readback, Renderer};
+use weft_gpu::{FrameOptions, Gpu, NoDraws, Readback, Renderer};
 use weft_graph::plan::Extent;
 use weft_graph::schema::ParamValue;
-use weft_graph::CompileOptions;
+use weft_render::gaussian::GaussianTaps;
+use weft_tests as common;
 
 const WIDTH: u32 = 128;
 const HEIGHT: u32 = 96;
@@ -64,25 +62,23 @@ fn render(
     peak: f64,
     level: f64,
 ) -> (Readback, Vec<(String, Readback)>) {
-    let loaded = weft_graph::load(&common::graph("bloom_check.ron"));
-    let memory = memory_requirements(gpu);
     let bloom_on = !features.contains(&"!bloom");
     let readback = if bloom_on {
         vec!["hdr".into(), "bloom_bright".into(), "bloom".into()]
     } else {
         vec!["hdr".into()]
     };
-    let options = CompileOptions {
-        extent: Extent {
-            width: WIDTH,
-            height: HEIGHT,
-        },
-        features: loaded.features(features),
-        memory: &memory,
-        readback,
-        ..CompileOptions::default()
+    let extent = Extent {
+        width: WIDTH,
+        height: HEIGHT,
     };
-    let mut plan = weft_graph::compile(&loaded, &options).expect("compiles");
+    let mut plan = common::compile(
+        gpu,
+        &common::graph("bloom_check.ron"),
+        extent,
+        features,
+        readback,
+    );
     let pattern = plan
         .passes
         .iter_mut()

@@ -1,7 +1,8 @@
 //! The graphs shipped in `graphs/` run end to end under validation, with the
 //! scene draws supplied by a test recorder that paints a constant HDR colour.
 
-mod common;
+use weft_graph::plan::Extent;
+use weft_tests as common;
 
 use ash::vk;
 use weft_gpu::{DrawRecorder, FrameOptions, GpuError, RasterContext, Renderer};
@@ -129,7 +130,17 @@ fn assert_close(actual: [u8; 4], expected: [u8; 4]) {
 
 fn render_forward(features: &[&str]) -> ([u8; 4], Vec<String>) {
     let gpu = common::gpu();
-    let plan = common::compile_with(&gpu, &common::shipped("forward.ron"), 32, 18, features);
+    let extent = Extent {
+        width: 32,
+        height: 18,
+    };
+    let plan = common::compile(
+        &gpu,
+        &common::shipped("forward.ron"),
+        extent,
+        features,
+        Vec::new(),
+    );
     let passes = plan.passes.iter().map(|p| p.name.clone()).collect();
     let mut renderer = Renderer::new(&gpu).expect("renderer");
     assert_eq!(renderer.check_shaders(&plan), Vec::new());
@@ -195,7 +206,17 @@ fn forward_without_bloom_with_prepass_and_shadows() {
 #[test]
 fn forward_bloom_matches_its_golden_image() {
     let gpu = common::gpu();
-    let plan = common::compile(&gpu, &common::shipped("forward.ron"), 64, 36);
+    let extent = Extent {
+        width: 64,
+        height: 36,
+    };
+    let plan = common::compile(
+        &gpu,
+        &common::shipped("forward.ron"),
+        extent,
+        &[],
+        Vec::new(),
+    );
     let mut renderer = Renderer::new(&gpu).expect("renderer");
     let report = weft_testkit::render_frames(
         &mut renderer,
@@ -210,8 +231,7 @@ fn forward_bloom_matches_its_golden_image() {
     )
     .expect("frame");
     let image = report.output.expect("readback").to_rgba8();
-    let golden = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden/forward_bloom_64x36.png");
+    let golden = common::golden("forward_bloom_64x36.png");
     let tolerance = weft_testkit::Tolerance {
         per_channel: 2,
         mean: 0.5,

@@ -1,4 +1,4 @@
-//! Gaussian blur taps derived from a pass's `sigma` and `radius` parameters.
+//! Gaussian blur taps derived from the `Gaussian` provider's `sigma` and `radius`.
 //!
 //! A separable Gaussian of radius R needs 2R + 1 fetches per direction. Pairing
 //! neighbouring taps k and k + 1 into one bilinear fetch placed between them,

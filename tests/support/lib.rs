@@ -1,0 +1,74 @@
+//! Helpers for the end-to-end tests in `tests/e2e/`: a validating context,
+//! paths of the repository's graphs and this package's fixtures, and plans
+//! compiled as the renderer compiles them (provider values included).
+
+use std::path::{Path, PathBuf};
+use weft_gpu::{memory_requirements, Gpu, GpuOptions};
+use weft_graph::plan::{Extent, Plan};
+use weft_graph::CompileOptions;
+
+/// A context with validation and synchronization validation on.
+pub fn gpu() -> Gpu {
+    Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("a Vulkan 1.3 device with the validation layer (run tools/setup)")
+}
+
+/// The repository root.
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests/ sits in the repository")
+        .to_path_buf()
+}
+
+/// Path of a fixture graph in `tests/graphs/`.
+pub fn graph(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("graphs")
+        .join(name)
+}
+
+/// Path of a graph shipped in the repository's `graphs/`.
+pub fn shipped(name: &str) -> PathBuf {
+    repo().join("graphs").join(name)
+}
+
+/// Path of a golden image in `tests/golden/`.
+pub fn golden(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("golden")
+        .join(name)
+}
+
+/// Compiles a graph as the renderer does, for `gpu`'s memory requirements,
+/// with features requested as on the command line (`name`, `!name`) and
+/// extra images to read back.
+pub fn compile(
+    gpu: &Gpu,
+    path: &Path,
+    extent: Extent,
+    features: &[&str],
+    readback: Vec<String>,
+) -> Plan {
+    let loaded = weft_graph::load(path);
+    let memory = memory_requirements(gpu);
+    let options = CompileOptions {
+        extent,
+        features: loaded.features(features),
+        memory: &memory,
+        readback,
+    };
+    weft_render::providers::compile(&loaded, &options)
+        .unwrap_or_else(|d| panic!("{} does not compile: {d:?}", path.display()))
+}
+
+/// Destroys the context (so leak reports at destruction count too) and asserts
+/// the validation layer said nothing.
+pub fn assert_no_validation_messages(gpu: Gpu) {
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}
