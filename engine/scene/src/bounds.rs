@@ -1,10 +1,10 @@
 //! Axis-aligned bounding boxes, for culling, camera framing and light radii.
 
 use glam::{Mat4, Vec3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// An axis-aligned box; `min > max` on any axis means empty.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Aabb {
     /// The smallest corner.
     pub min: Vec3,

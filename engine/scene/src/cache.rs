@@ -3,33 +3,38 @@
 //! import looked at (model, material libraries, buffers, textures, missing ones included) has
 //! the same size and modification time as when the entry was written; otherwise the model is
 //! imported again and the entry rewritten. A damaged entry is a miss, never an error.
+//!
+//! An entry is the magic bytes, the format version (u32, little endian), then two
+//! postcard messages: the header (source stamps and the import's warnings), read
+//! first so a stale entry costs no model decoding, and the model.
 
-use crate::binio::{bin_struct, Bin, Reader, Writer};
 use crate::error::{Diagnostics, Location, SceneError, Warning};
 use crate::model::Model;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::UNIX_EPOCH;
 
 /// Bumped whenever the encoding or the importers' output changes; older entries are ignored.
-pub const CACHE_FORMAT_VERSION: u32 = 2;
+pub const CACHE_FORMAT_VERSION: u32 = 3;
 
 /// The first bytes of every entry.
 const MAGIC: [u8; 8] = *b"WEFTMDL\0";
 
 /// What a source file looked like when the entry was written.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 struct Stamp {
     path: PathBuf,
     present: bool,
     len: u64,
     modified_ns: u64,
 }
-bin_struct!(Stamp {
-    path,
-    present,
-    len,
-    modified_ns
-});
+
+/// Everything in an entry before the model.
+#[derive(Serialize, Deserialize)]
+struct Header {
+    stamps: Vec<Stamp>,
+    warnings: Vec<Warning>,
+}
 
 impl Stamp {
     /// The file's current stamp.
@@ -100,21 +105,21 @@ pub(crate) fn load_cached(
 
 /// Decodes an entry, `None` when it is damaged, of another version, or stale.
 fn decode(bytes: &[u8]) -> Option<(Model, Vec<Warning>)> {
-    let mut r = Reader::new(bytes);
-    if r.take(MAGIC.len())? != MAGIC || u32::read(&mut r)? != CACHE_FORMAT_VERSION {
+    let rest = bytes.strip_prefix(&MAGIC)?;
+    let (version, rest) = rest.split_first_chunk::<4>()?;
+    if u32::from_le_bytes(*version) != CACHE_FORMAT_VERSION {
         return None;
     }
-    let stamps = Vec::<Stamp>::read(&mut r)?;
-    if stamps.iter().any(|s| Stamp::of(&s.path) != *s) {
+    let (header, rest) = postcard::take_from_bytes::<Header>(rest).ok()?;
+    if header.stamps.iter().any(|s| Stamp::of(&s.path) != *s) {
         return None;
     }
-    let warnings = Vec::<Warning>::read(&mut r)?;
-    let model = Model::read(&mut r)?;
+    let (model, rest) = postcard::take_from_bytes::<Model>(rest).ok()?;
     let sound = model
         .meshes
         .iter()
         .all(|m| m.is_consistent() && m.material.is_none_or(|i| i < model.materials.len()));
-    (r.is_empty() && sound).then_some((model, warnings))
+    (rest.is_empty() && sound).then_some((model, header.warnings))
 }
 
 /// Writes an entry atomically (a temporary file renamed into place).
@@ -125,20 +130,22 @@ fn write_entry(
     warnings: &[Warning],
 ) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
-    let mut w = Writer::default();
-    w.bytes.extend_from_slice(&MAGIC);
-    CACHE_FORMAT_VERSION.write(&mut w);
-    // Absolute paths, so an entry stays valid when read from another working folder.
-    let stamps: Vec<Stamp> = model
-        .sources
-        .iter()
-        .map(|s| Stamp::of(&std::path::absolute(s).unwrap_or_else(|_| s.clone())))
-        .collect();
-    stamps.write(&mut w);
-    warnings.to_vec().write(&mut w);
-    model.write(&mut w);
+    let header = Header {
+        // Absolute paths, so an entry stays valid when read from another working folder.
+        stamps: model
+            .sources
+            .iter()
+            .map(|s| Stamp::of(&std::path::absolute(s).unwrap_or_else(|_| s.clone())))
+            .collect(),
+        warnings: warnings.to_vec(),
+    };
+    let mut bytes = MAGIC.to_vec();
+    bytes.extend_from_slice(&CACHE_FORMAT_VERSION.to_le_bytes());
+    let encode = |e: postcard::Error| std::io::Error::other(e.to_string());
+    bytes = postcard::to_extend(&header, bytes).map_err(encode)?;
+    bytes = postcard::to_extend(model, bytes).map_err(encode)?;
     let temp = entry.with_extension(format!("tmp{}", std::process::id()));
-    std::fs::write(&temp, &w.bytes)?;
+    std::fs::write(&temp, &bytes)?;
     std::fs::rename(&temp, entry)
 }
 

@@ -2,10 +2,10 @@
 
 use crate::bounds::Aabb;
 use glam::{Mat4, Quat, Vec3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// One key of a camera path.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CameraKey {
     /// Seconds from the start.
     pub time: f32,
@@ -16,7 +16,7 @@ pub struct CameraKey {
 }
 
 /// Where a camera came from, for reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum CameraOrigin {
     /// A `camera` block.
     Scene,
@@ -27,7 +27,7 @@ pub enum CameraOrigin {
 }
 
 /// A perspective camera.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Camera {
     /// Name used to select it (`"default"` for the framing camera).
     pub name: String,

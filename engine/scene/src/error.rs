@@ -1,12 +1,12 @@
 //! Errors and warnings, each located at a file and (where known) a line.
 
 use serde::ser::SerializeStruct;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// Where a problem is: a file and, when the problem belongs to one line, that line (1-based).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Location {
     /// The file, as the user named it (resolved against the including file).
     pub file: PathBuf,
@@ -42,7 +42,7 @@ impl fmt::Display for Location {
 }
 
 /// Something the loader accepted but that the author should look at (unknown names, quirks).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Warning {
     /// Where it was found.
     pub at: Location,

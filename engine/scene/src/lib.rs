@@ -24,11 +24,9 @@
 #![warn(missing_docs)]
 
 pub mod animation;
-mod binio;
 pub mod bounds;
 pub mod cache;
 pub mod camera;
-mod codec;
 pub mod desc;
 pub mod error;
 pub mod gltf_import;

@@ -1,10 +1,10 @@
 //! Light types (sun, spot, point, area) and the point-light cutoff radius.
 
 use glam::{Quat, Vec3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Distance falloff `1 / (constant + linear d + quadratic d²)`, as in fixed-function GL.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Attenuation {
     /// Constant term.
     pub constant: f32,
@@ -35,7 +35,7 @@ impl Attenuation {
 }
 
 /// Rotation of the sun direction over time.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SunMotion {
     /// The axis the direction turns around (unit).
     pub axis: Vec3,
@@ -44,7 +44,7 @@ pub struct SunMotion {
 }
 
 /// A directional light with an ambient term.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SunLight {
     /// Unit direction the light travels.
     pub direction: Vec3,
@@ -57,7 +57,7 @@ pub struct SunLight {
 }
 
 /// A spotlight turning back and forth between two directions.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Swivel {
     /// The first direction (unit); the light starts here.
     pub from: Vec3,
@@ -68,7 +68,7 @@ pub struct Swivel {
 }
 
 /// A cone light.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SpotLight {
     /// World position.
     pub position: Vec3,
@@ -91,7 +91,7 @@ pub struct SpotLight {
 }
 
 /// Where a point light's cutoff radius came from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum RadiusSource {
     /// The scene's `radius` property.
     Given,
@@ -102,7 +102,7 @@ pub enum RadiusSource {
 }
 
 /// A point light with a cutoff radius for tiled/clustered shading.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PointLight {
     /// World position at time 0.
     pub position: Vec3,
@@ -121,7 +121,7 @@ pub struct PointLight {
 }
 
 /// The outline of an area light.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum AreaShape {
     /// A rectangle, centred, in the light's local XY plane.
     Rect {
@@ -138,7 +138,7 @@ pub enum AreaShape {
 }
 
 /// An emitting surface; it faces its local -Z axis (the way a camera looks).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AreaLight {
     /// The outline.
     pub shape: AreaShape,
@@ -168,7 +168,7 @@ impl AreaLight {
 }
 
 /// Any light in a scene.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Light {
     /// Directional.
     Sun(SunLight),

@@ -1,12 +1,13 @@
 //! Materials: Blinn-Phong parameters from MTL and metallic-roughness from glTF in one type,
 //! with texture references resolved to absolute paths or embedded bytes.
 
+use serde::{Deserialize, Serialize};
 use glam::{Vec3, Vec4};
 use std::path::PathBuf;
 use std::sync::Arc;
 
 /// Which parameter set the source defined, so a renderer picks the matching shading.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum ShadingModel {
     /// MTL: diffuse, specular, shininess.
     BlinnPhong,
@@ -15,7 +16,7 @@ pub enum ShadingModel {
 }
 
 /// How alpha is used, as glTF defines it (MTL dissolve < 1 maps to `Blend`).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum AlphaMode {
     /// Alpha is ignored.
     Opaque,
@@ -26,7 +27,7 @@ pub enum AlphaMode {
 }
 
 /// Where a texture's pixels are.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub enum TextureSource {
     /// An image file, as an absolute path.
     File(PathBuf),
@@ -42,7 +43,7 @@ pub enum TextureSource {
 }
 
 /// A texture used by a material.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TextureRef {
     /// The image.
     pub source: TextureSource,
@@ -61,7 +62,7 @@ impl TextureRef {
 }
 
 /// The textures of a material, each optional.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct MaterialTextures {
     /// `map_Kd` or `baseColorTexture`.
     pub base_color: Option<TextureRef>,
@@ -111,7 +112,7 @@ impl MaterialTextures {
 }
 
 /// A surface description that either importer fills; fields the source lacks keep defaults.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Material {
     /// The name in the source file.
     pub name: String,

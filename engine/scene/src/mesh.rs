@@ -1,10 +1,11 @@
 //! Triangle meshes in the layout a renderer uploads: separate attribute arrays and u32 indices.
 
+use serde::{Deserialize, Serialize};
 use crate::bounds::Aabb;
 use glam::{Vec2, Vec3, Vec4};
 
 /// One triangle list with one material.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Mesh {
     /// The object or group name from the source file.
     pub name: String,

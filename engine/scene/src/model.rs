@@ -1,5 +1,6 @@
 //! A loaded model file: meshes, materials, and the lights and cameras a glTF file brings.
 
+use serde::{Deserialize, Serialize};
 use crate::bounds::Aabb;
 use crate::camera::Camera;
 use crate::light::Light;
@@ -8,7 +9,7 @@ use crate::mesh::Mesh;
 use std::path::PathBuf;
 
 /// The contents of one OBJ or glTF file, in the file's own space.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Model {
     /// The file it came from.
     pub path: PathBuf,
