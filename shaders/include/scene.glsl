@@ -1,6 +1,6 @@
 // Scene data every scene-drawing and lighting shader reads: set 1 is bound by
-// weft-render (engine/render/src/scene_gpu.rs and packing.rs hold the Rust
-// side of these layouts; keep them in step).
+// weft-render (engine/render/src/gpu_types.rs holds the Rust side of these
+// layouts, with their sizes asserted; keep them in step).
 #ifndef WEFT_SCENE_GLSL
 #define WEFT_SCENE_GLSL
 

@@ -1,5 +1,5 @@
 // Shadow lookups shared by forward and deferred (engine/render/src/shadows.rs
-// writes the record). The shadow map is an atlas of square tiles: the sun's
+// writes the record, laid out by gpu_types.rs). The shadow map is an atlas of square tiles: the sun's
 // cascades, then one perspective view per shadow-casting spot cone. A lookup is
 // one matrix multiply (world to atlas coordinates, precomputed per view) and
 // textureProj on a compare sampler, whose 2x2 hardware filter is widened by a

@@ -3,10 +3,10 @@
 //! (transform and material), and draws sorted by material so a pass rebinds
 //! textures as rarely as possible.
 
+use crate::gpu_types::{GpuDraw, GpuVertex};
 use crate::materials;
-use crate::packing::Words;
 use crate::volumes::{self, VolumeMesh};
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, UVec4, Vec2, Vec3};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::{Material, Scene};
 
@@ -15,9 +15,7 @@ pub const VERTEX_ATTRIBUTES: [(u32, u32, &str); 3] =
     [(0, 3, "position"), (1, 3, "normal"), (2, 2, "UV")];
 
 /// Bytes per vertex: position (3 floats), normal (3), uv (2).
-pub const VERTEX_BYTES: u32 = 32;
-/// Bytes of one draw record (`struct Draw` in `shaders/include/scene.glsl`).
-pub const DRAW_BYTES: usize = 144;
+pub const VERTEX_BYTES: u32 = std::mem::size_of::<GpuVertex>() as u32;
 
 /// Where a mesh lies in the shared arrays.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -48,12 +46,12 @@ pub struct DrawItem {
 /// The flattened scene, ready to upload.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SceneGeometry {
-    /// `VERTEX_BYTES` per vertex.
-    pub vertices: Words,
+    /// Every vertex.
+    pub vertices: Vec<GpuVertex>,
     /// Triangle corners of every mesh, each range relative to its vertex offset.
     pub indices: Vec<u32>,
     /// Draw records (model matrix, normal matrix, material).
-    pub draw_records: Words,
+    pub draw_records: Vec<GpuDraw>,
     /// Draws sorted by material.
     pub draws: Vec<DrawItem>,
     /// Every material, index 0 being the default for meshes without one.
@@ -103,13 +101,11 @@ impl SceneGeometry {
             let mirrored = instance.transform.determinant() < 0.0;
             for &(range, material) in model_ranges.iter().flatten() {
                 let draw_id = g.draws.len() as u32;
-                g.draw_records
-                    .mat4(&instance.transform)
-                    .mat4(&normal)
-                    .u32(material)
-                    .u32(0)
-                    .u32(0)
-                    .u32(0);
+                g.draw_records.push(GpuDraw {
+                    model: instance.transform,
+                    normal,
+                    material: UVec4::new(material, 0, 0, 0),
+                });
                 g.draws.push(DrawItem {
                     range,
                     draw_id,
@@ -134,20 +130,16 @@ impl SceneGeometry {
         let range = MeshRange {
             first_index: self.indices.len() as u32,
             index_count: indices.len() as u32,
-            vertex_offset: (self.vertices.0.len() as u32 * 4 / VERTEX_BYTES) as i32,
+            vertex_offset: self.vertices.len() as i32,
         };
         for (i, p) in positions.iter().enumerate() {
             let n = normals.get(i).copied().unwrap_or(Vec3::Y);
             let uv = uvs.get(i).copied().unwrap_or(Vec2::ZERO);
-            self.vertices
-                .f32(p.x)
-                .f32(p.y)
-                .f32(p.z)
-                .f32(n.x)
-                .f32(n.y)
-                .f32(n.z)
-                .f32(uv.x)
-                .f32(uv.y);
+            self.vertices.push(GpuVertex {
+                position: p.to_array(),
+                normal: n.to_array(),
+                uv: uv.to_array(),
+            });
         }
         self.indices.extend_from_slice(indices);
         range
@@ -173,9 +165,6 @@ impl SceneGeometry {
 
     /// The model matrix of a draw record (transparent meshes sort by its origin).
     pub fn model_matrix(&self, draw_id: u32) -> Option<Mat4> {
-        let start = draw_id as usize * DRAW_BYTES / 4;
-        let words = self.draw_records.0.get(start..start + 16)?;
-        let cols: Vec<f32> = words.iter().map(|w| f32::from_bits(*w)).collect();
-        Some(Mat4::from_cols_slice(&cols))
+        self.draw_records.get(draw_id as usize).map(|d| d.model)
     }
 }

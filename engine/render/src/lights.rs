@@ -3,13 +3,13 @@
 //! and the per-pixel loop cut light off at the same distance; area lights last.
 
 use crate::brdf::AreaGeometry;
-use crate::packing::Words;
-use glam::Vec3;
+use crate::gpu_types::GpuLight;
+use glam::{Vec3, Vec4};
 use weft_scene::light::{derive_radius, DEFAULT_LUMINANCE_THRESHOLD};
 use weft_scene::{Aabb, AreaLight, AreaShape, Attenuation, Light};
 
 /// Bytes of one light record (`struct Light` in `shaders/include/scene.glsl`).
-pub const LIGHT_BYTES: usize = 64;
+pub const LIGHT_BYTES: usize = std::mem::size_of::<GpuLight>();
 /// Type code of a sun.
 pub const SUN: f32 = 0.0;
 /// Type code of a point light.
@@ -28,8 +28,8 @@ pub const CONE_MAX_ANGLE: f32 = 70.0;
 /// The scene's lights packed for the shaders.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LightSet {
-    /// Records in order: suns, points, spot cones, spot spheres.
-    pub words: Words,
+    /// Records in order: suns, points, spot cones, spot spheres, areas.
+    pub records: Vec<GpuLight>,
     /// Number of suns.
     pub suns: u32,
     /// Number of point lights.
@@ -99,15 +99,14 @@ struct Record {
 }
 
 impl Record {
-    fn pack(&self, words: &mut Words) {
-        words
-            .vec3w(self.position, self.range)
-            .vec3w(self.direction, self.kind)
-            .vec3w(self.color, self.exponent)
-            .f32(self.attenuation.constant)
-            .f32(self.attenuation.linear)
-            .f32(self.attenuation.quadratic)
-            .f32(self.cos_cutoff);
+    fn pack(&self, records: &mut Vec<GpuLight>) {
+        let a = &self.attenuation;
+        records.push(GpuLight {
+            position_range: self.position.extend(self.range),
+            direction_type: self.direction.extend(self.kind),
+            color_exponent: self.color.extend(self.exponent),
+            attenuation_cos: Vec4::new(a.constant, a.linear, a.quadratic, self.cos_cutoff),
+        });
     }
 }
 
@@ -133,7 +132,7 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
                 attenuation: Attenuation::NONE,
                 cos_cutoff: -1.0,
             }
-            .pack(&mut set.words);
+            .pack(&mut set.records);
             set.suns += 1;
             set.ambient += s.ambient;
             set.sun_direction.get_or_insert(dir);
@@ -156,7 +155,7 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
                 attenuation: p.attenuation,
                 cos_cutoff: -1.0,
             }
-            .pack(&mut set.words);
+            .pack(&mut set.records);
             set.points += 1;
         }
     }
@@ -183,7 +182,7 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
                 attenuation: s.attenuation,
                 cos_cutoff,
             }
-            .pack(&mut set.words);
+            .pack(&mut set.records);
             if wide {
                 set.spot_spheres += 1;
             } else {
@@ -193,7 +192,7 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
     }
     for light in lights {
         if let Light::Area(a) = light {
-            if pack_area(a, &mut set.words) {
+            if pack_area(a, &mut set.records) {
                 set.areas += 1;
             }
         }
@@ -225,15 +224,18 @@ pub fn area_shape(a: &AreaLight) -> Option<AreaGeometry> {
 
 /// Appends an area light's record (layout in `scene.glsl`); lights without a
 /// usable shape are left out: false.
-fn pack_area(a: &AreaLight, words: &mut Words) -> bool {
+fn pack_area(a: &AreaLight, records: &mut Vec<GpuLight>) -> bool {
     let Some(shape) = area_shape(a) else {
         return false;
     };
-    words
-        .vec3w(shape.centre, 0.0)
-        .vec3w(shape.x, if shape.disc { AREA_DISC } else { AREA_RECT })
-        .vec3w(a.emission, if shape.two_sided { 1.0 } else { 0.0 })
-        .vec3w(shape.y, 0.0);
+    records.push(GpuLight {
+        position_range: shape.centre.extend(0.0),
+        direction_type: shape
+            .x
+            .extend(if shape.disc { AREA_DISC } else { AREA_RECT }),
+        color_exponent: a.emission.extend(if shape.two_sided { 1.0 } else { 0.0 }),
+        attenuation_cos: shape.y.extend(0.0),
+    });
     true
 }
 
@@ -287,8 +289,9 @@ mod tests {
             (set.suns, set.points, set.spot_cones, set.spot_spheres),
             (1, 1, 1, 1)
         );
-        assert_eq!(set.words.byte_len(), 4 * LIGHT_BYTES);
-        let word = |record: usize, i: usize| f32::from_bits(set.words.0[record * 16 + i]);
+        assert_eq!(set.records.len(), 4);
+        let floats: &[f32] = bytemuck::cast_slice(&set.records);
+        let word = |record: usize, i: usize| floats[record * 16 + i];
         assert_eq!(word(0, 5), -1.0, "sun direction normalised");
         assert_eq!(word(1, 3), 3.0, "point range is its radius");
         assert_eq!(word(1, 7), POINT);
@@ -338,12 +341,8 @@ mod tests {
             "the empty rectangle is left out"
         );
         assert_eq!(set.first_area(), 1);
-        let record = |r: usize| -> Vec<f32> {
-            set.words.0[r * 16..(r + 1) * 16]
-                .iter()
-                .map(|&w| f32::from_bits(w))
-                .collect()
-        };
+        let floats: &[f32] = bytemuck::cast_slice(&set.records);
+        let record = |r: usize| -> Vec<f32> { floats[r * 16..(r + 1) * 16].to_vec() };
         let close = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-6);
         let rect = record(1);
         assert!(

@@ -2,14 +2,14 @@
 //! Blinn-Phong parameters as given, glTF metallic-roughness factors for the GGX
 //! shading in `shaders/include/lighting.glsl`.
 
-use crate::packing::Words;
+use crate::gpu_types::GpuMaterial;
 use glam::{Vec3, Vec4};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::material::{AlphaMode, ShadingModel};
 use weft_scene::Material;
 
 /// Bytes of one material record (`struct Material` in `shaders/include/scene.glsl`).
-pub const MATERIAL_BYTES: usize = 64;
+pub const MATERIAL_BYTES: usize = std::mem::size_of::<GpuMaterial>();
 /// Shading-model code of MTL materials (`SHADING_BLINN_PHONG`).
 pub const BLINN_PHONG: f32 = 0.0;
 /// Shading-model code of glTF materials (`SHADING_METALLIC_ROUGHNESS`).
@@ -39,11 +39,11 @@ pub fn blinn_phong(m: &Material) -> (Vec3, Vec3, f32, Vec3) {
     (base, m.specular, m.shininess.max(0.0), ambient)
 }
 
-/// Appends one material record; `normal_mapped` says whether a normal map is
+/// One material record; `normal_mapped` says whether a normal map is
 /// bound, whose strength (`normal_scale`) goes in the ambient slot's w (0: none).
 /// glTF materials keep their metallic and roughness factors (which the shaders
 /// multiply by the metallicRoughness texture) in the specular slot.
-pub fn pack_material(words: &mut Words, m: &Material, normal_mapped: bool) {
+pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
     let normal_scale = if normal_mapped && m.normal_scale.is_finite() {
         m.normal_scale
     } else {
@@ -52,11 +52,12 @@ pub fn pack_material(words: &mut Words, m: &Material, normal_mapped: bool) {
     match m.shading {
         ShadingModel::BlinnPhong => {
             let (diffuse, specular, shininess, ambient) = blinn_phong(m);
-            words
-                .vec3w(diffuse, m.base_color.w)
-                .vec3w(specular, shininess)
-                .vec3w(ambient, normal_scale)
-                .vec3w(m.emissive, BLINN_PHONG);
+            GpuMaterial {
+                diffuse: diffuse.extend(m.base_color.w),
+                specular: specular.extend(shininess),
+                ambient: ambient.extend(normal_scale),
+                emissive: m.emissive.extend(BLINN_PHONG),
+            }
         }
         ShadingModel::MetallicRoughness => {
             let factors = Vec4::new(
@@ -65,11 +66,12 @@ pub fn pack_material(words: &mut Words, m: &Material, normal_mapped: bool) {
                 0.0,
                 0.0,
             );
-            words
-                .vec4(m.base_color)
-                .vec4(factors)
-                .vec3w(Vec3::ZERO, normal_scale)
-                .vec3w(m.emissive, METALLIC_ROUGHNESS);
+            GpuMaterial {
+                diffuse: m.base_color,
+                specular: factors,
+                ambient: Vec3::ZERO.extend(normal_scale),
+                emissive: m.emissive.extend(METALLIC_ROUGHNESS),
+            }
         }
     }
 }
@@ -126,9 +128,8 @@ mod tests {
         );
         m.ambient = Vec3::splat(0.2);
         assert_eq!(blinn_phong(&m).3, Vec3::splat(0.2));
-        let mut w = Words::default();
-        pack_material(&mut w, &m, false);
-        let floats = |w: &Words| w.0.iter().map(|&b| f32::from_bits(b)).collect::<Vec<_>>();
+        let w = pack_material(&m, false);
+        let floats = |w: &GpuMaterial| bytemuck::cast_slice::<GpuMaterial, f32>(&[*w]).to_vec();
         assert_eq!(
             floats(&w),
             [
@@ -155,9 +156,7 @@ mod tests {
         m.roughness = 0.25;
         m.emissive = Vec3::new(2.0, 3.0, 4.0);
         m.normal_scale = 0.5;
-        let mut w = Words::default();
-        pack_material(&mut w, &m, true);
-        assert_eq!(w.byte_len(), MATERIAL_BYTES);
+        let w = pack_material(&m, true);
         assert_eq!(
             floats(&w),
             [
@@ -180,12 +179,7 @@ mod tests {
             ]
         );
         m.roughness = f32::NAN;
-        let mut w = Words::default();
-        pack_material(&mut w, &m, true);
-        assert_eq!(
-            f32::from_bits(w.0[5]),
-            1.0,
-            "NaN roughness falls back to rough"
-        );
+        let w = pack_material(&m, true);
+        assert_eq!(w.specular.y, 1.0, "NaN roughness falls back to rough");
     }
 }

@@ -6,12 +6,13 @@ use crate::buffer::Buffer;
 use crate::camera;
 use crate::error::RenderError;
 use crate::geometry::SceneGeometry;
+use crate::gpu_types::{bytes_of, GpuFrame, GpuMaterial};
 use crate::lights::{pack_lights, LightSet, LIGHT_BYTES};
 use crate::materials::pack_material;
-use crate::packing::Words;
 use crate::shadows::{self, ShadowSettings, ShadowView, ViewVolume};
 use crate::texture::{self, Pixels, Texture};
 use ash::vk;
+use glam::{UVec4, Vec4};
 use std::collections::HashMap;
 use std::path::PathBuf;
 use weft_gpu::reflect::DescriptorKind;
@@ -81,7 +82,7 @@ pub const MATERIAL_SET_BINDINGS: [(u32, DescriptorKind, &str); 3] = [
     ),
 ];
 /// Bytes of the `Frame` uniform block.
-pub const FRAME_BYTES: usize = 2 * 64 + 4 * 16;
+pub const FRAME_BYTES: usize = std::mem::size_of::<GpuFrame>();
 /// Scene sets that fullscreen pipelines built by the executor may ask for.
 const FOREIGN_SETS: u32 = 32;
 
@@ -143,7 +144,7 @@ impl<'g> GpuScene<'g> {
         let vertices = Buffer::device_local(
             gpu,
             "scene vertices",
-            &geometry.vertices.bytes(),
+            bytes_of(&geometry.vertices),
             vk::BufferUsageFlags::VERTEX_BUFFER,
         )?;
         let index_bytes: Vec<u8> = geometry
@@ -157,12 +158,16 @@ impl<'g> GpuScene<'g> {
             &index_bytes,
             vk::BufferUsageFlags::INDEX_BUFFER,
         )?;
-        let draws =
-            Buffer::device_local(gpu, "scene draws", &geometry.draw_records.bytes(), storage)?;
+        let draws = Buffer::device_local(
+            gpu,
+            "scene draws",
+            bytes_of(&geometry.draw_records),
+            storage,
+        )?;
         let mut textures = vec![Texture::upload(gpu, "white", &Pixels::white(), true)?];
         let mut by_source: HashMap<(String, bool), usize> = HashMap::new();
         let mut material_texture = Vec::with_capacity(geometry.materials.len());
-        let mut material_words = Words::default();
+        let mut material_records: Vec<GpuMaterial> = Vec::with_capacity(geometry.materials.len());
         let mut slot = |t: Option<&TextureRef>, srgb: bool| -> Result<usize, GpuError> {
             let Some(t) = t else { return Ok(0) };
             let key = (source_key(&t.source), srgb);
@@ -186,11 +191,11 @@ impl<'g> GpuScene<'g> {
             let base = slot(m.textures.base_color.as_ref(), true)?;
             let metal_rough = slot(m.textures.metallic_roughness.as_ref(), false)?;
             let normal = slot(m.textures.normal.as_ref(), false)?;
-            pack_material(&mut material_words, m, normal != 0);
+            material_records.push(pack_material(m, normal != 0));
             material_texture.push([base, metal_rough, normal]);
         }
         let materials =
-            Buffer::device_local(gpu, "scene materials", &material_words.bytes(), storage)?;
+            Buffer::device_local(gpu, "scene materials", bytes_of(&material_records), storage)?;
         let frame = Buffer::host(
             gpu,
             "frame",
@@ -438,23 +443,22 @@ impl<'g> GpuScene<'g> {
             &weft_scene::animation::lights_at(&self.source_lights, time, 0),
             &self.bounds,
         );
-        let mut words = Words::default();
-        words
-            .mat4(&view_proj)
-            .mat4(&view_proj.inverse())
-            .vec3w(eye, 1.0)
-            .vec3w(lights.ambient, 0.0)
-            .u32(lights.suns)
-            .u32(lights.points)
-            .u32(lights.spot_cones + lights.spot_spheres)
-            .u32(lights.len())
-            .f32(w)
-            .f32(h)
-            .f32(1.0 / w)
-            .f32(1.0 / h);
-        self.frame.write(&words.bytes())?;
+        let frame = GpuFrame {
+            view_proj,
+            inv_view_proj: view_proj.inverse(),
+            camera_position: eye.extend(1.0),
+            ambient: lights.ambient.extend(0.0),
+            counts: UVec4::new(
+                lights.suns,
+                lights.points,
+                lights.spot_cones + lights.spot_spheres,
+                lights.len(),
+            ),
+            viewport: Vec4::new(w, h, 1.0 / w, 1.0 / h),
+        };
+        self.frame.write(bytes_of(&[frame]))?;
         if !lights.is_empty() {
-            self.lights.write(&lights.words.bytes())?;
+            self.lights.write(bytes_of(&lights.records))?;
         }
         self.light_set = lights;
         Ok(())
@@ -478,7 +482,7 @@ impl GpuScene<'_> {
             &self.light_set,
             &self.bounds,
         );
-        self.shadows.write(&frame.pack(settings).bytes())?;
+        self.shadows.write(&frame.pack(settings))?;
         Ok(frame.views)
     }
 }

@@ -7,8 +7,8 @@
 //! `grid` x `grid` array of square tiles, `grid = ceil(sqrt(views))`; views are
 //! the cascades, then the spots. One cascade and no spot uses the whole map.
 
-use crate::lights::{LightSet, LIGHT_BYTES};
-use crate::packing::Words;
+use crate::gpu_types::{bytes_of, GpuShadowView, GpuShadowsHeader};
+use crate::lights::LightSet;
 use glam::{Mat4, Vec3, Vec4};
 use weft_scene::Aabb;
 
@@ -19,9 +19,9 @@ pub const MAX_SPOT_SHADOWS: u32 = 8;
 /// Largest manual PCF radius (a 15x15 kernel of 2x2 filtered taps; `ShadowAtlas` rejects more).
 pub const MAX_PCF_RADIUS: u32 = 7;
 /// Bytes before the first view record: counts, splits, camera forward + normal bias.
-pub const HEADER_BYTES: usize = 48;
+pub const HEADER_BYTES: usize = std::mem::size_of::<GpuShadowsHeader>();
 /// Bytes of one view record: clip matrix, lookup matrix, tile bounds, texel size.
-pub const VIEW_BYTES: usize = 160;
+pub const VIEW_BYTES: usize = std::mem::size_of::<GpuShadowView>();
 /// Bytes of the whole record with room for every view.
 pub const SHADOWS_BYTES: usize =
     HEADER_BYTES + VIEW_BYTES * (MAX_CASCADES + MAX_SPOT_SHADOWS) as usize;
@@ -352,18 +352,6 @@ pub struct ShadowFrame {
     pub forward: Vec3,
 }
 
-fn word_f32(words: &Words, at: usize) -> f32 {
-    words.0.get(at).map_or(0.0, |w| f32::from_bits(*w))
-}
-
-fn word_vec3(words: &Words, at: usize) -> Vec3 {
-    Vec3::new(
-        word_f32(words, at),
-        word_f32(words, at + 1),
-        word_f32(words, at + 2),
-    )
-}
-
 /// Lays out and fits this frame's views for a `atlas_size` squared shadow map.
 pub fn shadow_frame(
     settings: &ShadowSettings,
@@ -393,15 +381,17 @@ pub fn shadow_frame(
         splits[i] = end;
         start = end;
     }
-    let words_per_light = LIGHT_BYTES / 4;
     let first_spot = lights.first_spot_cone();
-    for k in 0..spots {
-        let at = (first_spot + k) as usize * words_per_light;
-        let position = word_vec3(&lights.words, at);
-        let range = word_f32(&lights.words, at + 3);
-        let direction = word_vec3(&lights.words, at + 4);
-        let cos_cutoff = word_f32(&lights.words, at + 15);
-        let (clip, texel) = spot_clip(position, direction, cos_cutoff, range, atlas.tile, margin);
+    let spot_records = lights.records.iter().skip(first_spot as usize);
+    for (k, spot) in (0..spots).zip(spot_records) {
+        let (clip, texel) = spot_clip(
+            spot.position_range.truncate(),
+            spot.direction_type.truncate(),
+            spot.attenuation_cos.w,
+            spot.position_range.w,
+            atlas.tile,
+            margin,
+        );
         views.push(view(&atlas, cascades + k, clip, texel, true, margin));
     }
     ShadowFrame {
@@ -433,29 +423,35 @@ fn view(
 }
 
 impl ShadowFrame {
-    /// The `Shadows` record: counts (cascades, spot views, first spot light, PCF
-    /// radius), cascade splits, camera forward and normal bias, then the views.
-    pub fn pack(&self, settings: &ShadowSettings) -> Words {
-        let mut w = Words::default();
-        w.u32(self.cascades)
-            .u32(self.spots)
-            .u32(self.first_spot)
-            .u32(settings.pcf_radius)
-            .vec4(Vec4::from_array(self.splits))
-            .vec3w(
-                self.forward,
-                settings.normal_bias * (settings.pcf_radius as f32 + 1.0),
-            );
-        for v in &self.views {
-            w.mat4(&v.clip)
-                .mat4(&v.lookup)
-                .vec4(v.rect)
-                .f32(v.texel)
-                .f32(if v.perspective { 1.0 } else { 0.0 })
-                .f32(0.0)
-                .f32(0.0);
-        }
-        w
+    /// The bytes of the `Shadows` record: counts (cascades, spot views, first
+    /// spot light, PCF radius), cascade splits, camera forward and normal bias,
+    /// then the views.
+    pub fn pack(&self, settings: &ShadowSettings) -> Vec<u8> {
+        let header = GpuShadowsHeader {
+            counts: glam::UVec4::new(
+                self.cascades,
+                self.spots,
+                self.first_spot,
+                settings.pcf_radius,
+            ),
+            splits: Vec4::from_array(self.splits),
+            forward: self
+                .forward
+                .extend(settings.normal_bias * (settings.pcf_radius as f32 + 1.0)),
+        };
+        let views: Vec<GpuShadowView> = self
+            .views
+            .iter()
+            .map(|v| GpuShadowView {
+                clip: v.clip,
+                lookup: v.lookup,
+                rect: v.rect,
+                texel: Vec4::new(v.texel, if v.perspective { 1.0 } else { 0.0 }, 0.0, 0.0),
+            })
+            .collect();
+        let mut bytes = bytes_of(&[header]).to_vec();
+        bytes.extend_from_slice(bytes_of(&views));
+        bytes
     }
 }
 

@@ -1,8 +1,8 @@
 //! Materials: Blinn-Phong parameters from MTL and metallic-roughness from glTF in one type,
 //! with texture references resolved to absolute paths or embedded bytes.
 
-use serde::{Deserialize, Serialize};
 use glam::{Vec3, Vec4};
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use std::sync::Arc;
 

@@ -1,8 +1,8 @@
 //! Triangle meshes in the layout a renderer uploads: separate attribute arrays and u32 indices.
 
-use serde::{Deserialize, Serialize};
 use crate::bounds::Aabb;
 use glam::{Vec2, Vec3, Vec4};
+use serde::{Deserialize, Serialize};
 
 /// One triangle list with one material.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

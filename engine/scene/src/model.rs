@@ -1,11 +1,11 @@
 //! A loaded model file: meshes, materials, and the lights and cameras a glTF file brings.
 
-use serde::{Deserialize, Serialize};
 use crate::bounds::Aabb;
 use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::Material;
 use crate::mesh::Mesh;
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
 /// The contents of one OBJ or glTF file, in the file's own space.

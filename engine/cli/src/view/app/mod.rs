@@ -4,6 +4,8 @@
 //! (all-or-nothing, at the frame boundary), renders the live graph from the fly
 //! camera and presents it.
 
+mod reload;
+
 use super::controls::{self, Action, Status};
 use super::fly::{self, FlyCamera, FlyInput};
 use super::ViewArgs;
@@ -18,7 +20,7 @@ use std::time::{Duration, Instant};
 use weft_gpu::{Gpu, PresentSource, Presented, Presenter, Readback, Swapchain};
 use weft_graph::plan::Extent;
 use weft_render::watch::{FileWatcher, QUIET};
-use weft_render::{Committed, LiveRender, ReloadWorker, RenderSettings};
+use weft_render::{LiveRender, ReloadWorker, RenderSettings};
 use weft_scene::Camera;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
@@ -291,82 +293,6 @@ impl<'g> Viewer<'g> {
             ..self.live.settings().clone()
         };
         self.reconfigure(settings);
-    }
-
-    /// Switches the live render to `settings`; a refusal keeps the last good version.
-    fn reconfigure(&mut self, settings: RenderSettings) -> bool {
-        let graph_changed = settings.graph != self.live.settings().graph;
-        let features_changed = settings.features != self.live.settings().features;
-        match self.live.reconfigure(settings) {
-            Ok(()) => {
-                if graph_changed {
-                    self.features = controls::graph_features(&self.live.settings().graph);
-                }
-                if graph_changed || features_changed {
-                    self.print_features();
-                }
-                self.watch();
-                self.error = None;
-                true
-            }
-            Err(err) => {
-                self.report_error(err.to_string());
-                false
-            }
-        }
-    }
-
-    fn report_error(&mut self, error: String) {
-        eprintln!("error: {error} (kept last good)");
-        self.error = Some(error);
-        self.update_title(true);
-    }
-
-    fn watch(&mut self) {
-        if let Err(err) = self.watcher.watch(&self.live.sources().all()) {
-            eprintln!("error: {err} (still watching the other files)");
-        }
-    }
-
-    /// Hands edited files, if any, to the worker (superseding a reload still
-    /// being prepared), and commits the newest prepared reload, if one is ready.
-    fn hot_reload(&mut self) -> Result<()> {
-        let changed = self.watcher.poll_batch()?;
-        if !changed.is_empty() {
-            self.reload.get_or_insert(ReloadProgress {
-                taken: Instant::now(),
-                frames: 0,
-                longest_ms: 0.0,
-            });
-            let job = self.live.files_job(&changed);
-            self.worker.submit(job);
-        }
-        let Some(prepared) = self.worker.poll() else {
-            return Ok(());
-        };
-        let prepare_ms = prepared.elapsed.as_secs_f64() * 1e3;
-        let committed = prepared.result.and_then(|reload| self.live.commit(reload));
-        match committed {
-            Ok(Committed::Applied(paths)) => {
-                self.watch();
-                self.error = None;
-                let progress = self.reload.take();
-                if let (false, Some(progress)) = (paths.is_empty(), progress) {
-                    let files: Vec<String> =
-                        paths.iter().map(|p| p.display().to_string()).collect();
-                    self.reloaded = Some((files.join(", "), progress, prepare_ms));
-                }
-            }
-            Ok(Committed::Stale) => {
-                let job = self.live.files_job(&Default::default());
-                self.worker.submit(job);
-            }
-            Err(err) => {
-                self.reload = None;
-                self.report_error(err.to_string());
-            }
-        }
-        Ok(())
     }
 
     /// What the held keys, drag and wheel ask for since the last frame.

@@ -1,0 +1,324 @@
+//! Runs a compiled `Plan`: prepares pipelines, descriptor sets and push
+//! constants for every pass, records the plan's barriers and work into one
+//! command buffer (or one per pass when profiling), submits, and reads the
+//! output back.
+
+use crate::bind::ResolvedBinding;
+use crate::check::{self, PassShaders, ShaderProblem};
+use crate::context::{Gpu, MemoryReport};
+use crate::download::ReadbackBuffer;
+use crate::draw::DrawRecorder;
+use crate::error::GpuError;
+use crate::frame::CommandBuffers;
+use crate::pipeline::{Pipeline, PipelineCache, PipelineKey};
+use crate::readback::Readback;
+use crate::record;
+use crate::renderpass::RenderPassCache;
+use crate::resources::FrameResources;
+use crate::samplers::Samplers;
+use crate::statistics::{PassStatistics, StatisticsPool};
+use crate::timing::{PassTiming, QueryPool, TimingMode, TimingSource};
+mod prepare;
+mod record_pass;
+
+use prepare::descriptor_pool;
+
+use ash::vk;
+use std::sync::Arc;
+use std::time::Instant;
+use weft_graph::id::PassId;
+use weft_graph::plan::{Plan, PlanPass};
+
+/// Options for one frame.
+#[derive(Debug, Clone, Default)]
+pub struct FrameOptions {
+    /// Whether and how per-pass times are measured.
+    pub timing: TimingMode,
+    /// Copy the output image back to the CPU.
+    pub readback: bool,
+    /// Seconds, for `time` push constants.
+    pub time: f32,
+    /// Frame number, for `frame` push constants.
+    pub frame: u32,
+}
+
+/// What a frame produced; serialises (without the image) for `--json`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FrameReport {
+    /// Per-pass times, labelled with how they were measured.
+    pub timings: Vec<PassTiming>,
+    /// Per-pass pipeline statistics, collected with GPU timestamps.
+    pub statistics: Vec<PassStatistics>,
+    /// The output image, when `readback` was asked for.
+    #[serde(skip)]
+    pub output: Option<Readback>,
+    /// The plan's other images to read back (`Plan::readback`, e.g. the HDR buffer
+    /// for EXR output), by name, when `readback` was asked for.
+    #[serde(skip)]
+    pub readbacks: Vec<(String, Readback)>,
+    /// Host time spent preparing and recording commands (excluding GPU waits).
+    pub record_ms: f64,
+    /// Device memory of the plan's transient blocks (aliased images count once).
+    pub transient_bytes: u64,
+    /// Device memory of resources with their own allocations.
+    pub dedicated_bytes: u64,
+    /// The allocator's view of all device memory in use.
+    pub memory: MemoryReport,
+}
+
+/// Everything a pass needs at record time.
+struct Prepared {
+    pipeline: Option<Arc<Pipeline>>,
+    render_pass: vk::RenderPass,
+    framebuffer: vk::Framebuffer,
+    extent: vk::Extent2D,
+    clears: Vec<vk::ClearValue>,
+    bindings: Vec<ResolvedBinding>,
+    push: Vec<u8>,
+    set: vk::DescriptorSet,
+}
+
+/// Executes plans; owns the render-pass and pipeline caches and the samplers.
+pub struct Renderer<'g> {
+    gpu: &'g Gpu,
+    render_passes: RenderPassCache,
+    pipelines: PipelineCache,
+    samplers: Samplers,
+}
+
+impl<'g> Renderer<'g> {
+    /// A renderer with empty caches.
+    pub fn new(gpu: &'g Gpu) -> Result<Self, GpuError> {
+        let pipelines = PipelineCache::new()?;
+        let samplers = Samplers::new(gpu)?;
+        Ok(Self {
+            gpu,
+            render_passes: RenderPassCache::default(),
+            pipelines,
+            samplers,
+        })
+    }
+
+    /// The context this renderer runs on.
+    pub fn gpu(&self) -> &'g Gpu {
+        self.gpu
+    }
+
+    /// The shader and pipeline cache (for hot reload and inspection).
+    pub fn pipelines(&mut self) -> &mut PipelineCache {
+        &mut self.pipelines
+    }
+
+    /// Drops every shader and pipeline built from `changed` so the next frame
+    /// recompiles them (hot reload); returns how many pipelines were dropped.
+    pub fn reload(&mut self, changed: &std::path::Path) -> Result<usize, GpuError> {
+        self.gpu.wait_idle()?;
+        Ok(self.pipelines.invalidate(self.gpu.device(), changed))
+    }
+
+    /// Number of distinct render passes created so far.
+    pub fn render_pass_count(&self) -> usize {
+        self.render_passes.len()
+    }
+
+    /// Creates the plan's resources.
+    pub fn create_resources(&self, plan: &Plan) -> Result<FrameResources<'g>, GpuError> {
+        FrameResources::new(self.gpu, plan)
+    }
+
+    /// Compiles and reflects every pass's shaders and cross-checks them with
+    /// the graph (see `check::check_shaders`); no pipeline is built.
+    pub fn check_shaders(&mut self, plan: &Plan) -> Vec<ShaderProblem> {
+        check::check_with(&mut self.pipelines, plan)
+    }
+
+    /// The pass's pipeline key and resolved bindings, after checking that
+    /// its shaders agree with the graph; `None` for passes without shaders of ours.
+    fn checked_interface(
+        &mut self,
+        plan: &Plan,
+        pass: &PlanPass,
+    ) -> Result<Option<(PipelineKey, Vec<ResolvedBinding>)>, GpuError> {
+        let Some(shaders) = check::pass_shaders(pass)? else {
+            return Ok(None);
+        };
+        let interface = self.pipelines.interface(&shaders.keys())?;
+        let bindings =
+            check::pass_problems(plan, pass, &shaders, &interface).map_err(|problems| {
+                GpuError::Mismatch {
+                    pass: pass.name.clone(),
+                    problems,
+                }
+            })?;
+        let key = match shaders {
+            PassShaders::Compute(shader) => PipelineKey::Compute { shader },
+            PassShaders::Fullscreen { vertex, fragment } => {
+                let rp = pass.render_pass.as_ref().ok_or_else(|| GpuError::Pass {
+                    pass: pass.name.clone(),
+                    message: "has no render pass description".into(),
+                })?;
+                PipelineKey::Fullscreen {
+                    vertex,
+                    fragment,
+                    render_pass: self.render_passes.get(self.gpu.device(), rp)?,
+                    blends: rp
+                        .color
+                        .iter()
+                        .map(|&i| rp.attachments.get(i).and_then(|a| a.blend).into())
+                        .collect(),
+                    samples: rp.attachments.first().map(|a| a.samples).unwrap_or(1),
+                }
+            }
+        };
+        Ok(Some((key, bindings)))
+    }
+
+    /// Runs one frame of the plan on `resources` (made by `create_resources`
+    /// for the same plan); scene draws come from `draws`.
+    pub fn execute(
+        &mut self,
+        plan: &Plan,
+        resources: &mut FrameResources<'g>,
+        draws: &mut dyn DrawRecorder,
+        options: &FrameOptions,
+    ) -> Result<FrameReport, GpuError> {
+        let started = Instant::now();
+        draws.begin_frame()?;
+        let mut prepared = Vec::with_capacity(plan.passes.len());
+        for pass in &plan.passes {
+            prepared.push(self.prepare(plan, pass, resources, options)?);
+        }
+        let pool = descriptor_pool(self.gpu, &prepared)?;
+        self.write_descriptors(plan, resources, &pool, &mut prepared)?;
+        let readbacks = if options.readback {
+            std::iter::once(plan.output)
+                .chain(plan.readback.iter().copied())
+                .map(|r| ReadbackBuffer::new(self.gpu, plan, r))
+                .collect::<Result<Vec<_>, _>>()?
+        } else {
+            Vec::new()
+        };
+        let queries = if options.timing == TimingMode::GpuTimestamps && self.gpu.info().timestamps {
+            Some(QueryPool::new(self.gpu, 2 * plan.passes.len() as u32)?)
+        } else {
+            None
+        };
+        let stats =
+            if options.timing == TimingMode::GpuTimestamps && self.gpu.info().pipeline_statistics {
+                Some(StatisticsPool::new(self.gpu, plan.passes.len() as u32)?)
+            } else {
+                None
+            };
+        let mut record_ms = started.elapsed().as_secs_f64() * 1e3;
+        let mut timings = Vec::new();
+        let per_pass = options.timing == TimingMode::CpuPerPass;
+        let mut buffers = CommandBuffers::new(self.gpu);
+        let mut cmd = buffers.begin()?;
+        if let Some(q) = &queries {
+            unsafe {
+                self.gpu
+                    .device()
+                    .cmd_reset_query_pool(cmd, q.pool, 0, q.count)
+            };
+        }
+        if let Some(s) = &stats {
+            s.reset(cmd);
+        }
+        for (i, pass) in plan.passes.iter().enumerate() {
+            let t = Instant::now();
+            if let Some(q) = &queries {
+                q.write(
+                    self.gpu,
+                    cmd,
+                    2 * i as u32,
+                    vk::PipelineStageFlags2::TOP_OF_PIPE,
+                );
+            }
+            if let Some(s) = &stats {
+                s.begin(cmd, i as u32);
+            }
+            self.record_pass(
+                plan,
+                PassId::new(i),
+                pass,
+                &prepared[i],
+                resources,
+                draws,
+                cmd,
+            )?;
+            if let Some(s) = &stats {
+                s.end(cmd, i as u32);
+            }
+            if let Some(q) = &queries {
+                q.write(
+                    self.gpu,
+                    cmd,
+                    2 * i as u32 + 1,
+                    vk::PipelineStageFlags2::BOTTOM_OF_PIPE,
+                );
+            }
+            record_ms += t.elapsed().as_secs_f64() * 1e3;
+            if per_pass {
+                let wall = Instant::now();
+                buffers.submit_and_wait(cmd)?;
+                timings.push(PassTiming {
+                    pass: pass.name.clone(),
+                    kind: pass.kind,
+                    source: TimingSource::CpuWall,
+                    ms: wall.elapsed().as_secs_f64() * 1e3,
+                });
+                cmd = buffers.begin()?;
+            }
+        }
+        let t = Instant::now();
+        record::barriers(self.gpu.device(), cmd, &plan.epilogue, resources)?;
+        for rb in &readbacks {
+            rb.record(self.gpu, cmd, resources)?;
+        }
+        record_ms += t.elapsed().as_secs_f64() * 1e3;
+        buffers.submit_and_wait(cmd)?;
+        if let Some(q) = &queries {
+            timings = q.timings(self.gpu, plan)?;
+        }
+        let statistics = match &stats {
+            Some(s) => s.read(plan)?,
+            None => Vec::new(),
+        };
+        let mut images = readbacks
+            .iter()
+            .map(|rb| rb.read(plan))
+            .collect::<Result<Vec<_>, _>>()?
+            .into_iter();
+        let output = images.next();
+        let readbacks: Vec<(String, Readback)> = plan
+            .readback
+            .iter()
+            .map(|&r| plan.resources[r].name.clone())
+            .zip(images)
+            .collect();
+        drop(buffers);
+        drop(pool);
+        Ok(FrameReport {
+            timings,
+            statistics,
+            output,
+            readbacks,
+            record_ms,
+            transient_bytes: resources.transient_bytes,
+            dedicated_bytes: resources.dedicated_bytes,
+            memory: self.gpu.memory_report(),
+        })
+    }
+}
+
+impl Drop for Renderer<'_> {
+    fn drop(&mut self) {
+        let device = self.gpu.device();
+        unsafe {
+            let _ = device.device_wait_idle();
+        }
+        self.samplers.destroy(self.gpu);
+        self.pipelines.destroy(device);
+        self.render_passes.destroy(device);
+    }
+}

@@ -1,0 +1,189 @@
+//! Per-pass preparation before recording: pipelines, render passes and
+//! framebuffers, push-constant bytes, descriptor sets written with image
+//! layouts as the plan's barriers leave them.
+
+use super::{FrameOptions, Prepared, Renderer};
+use crate::bind::{self, FrameValues};
+use crate::context::Gpu;
+use crate::error::GpuError;
+use crate::frame::DescriptorPool;
+use crate::layouts;
+use crate::resources::{FrameResources, GpuResource};
+use ash::vk;
+use weft_graph::id::PassId;
+use weft_graph::plan::{Plan, PlanPass, PlanResource, ResourceDesc};
+
+impl<'g> Renderer<'g> {
+    pub(super) fn prepare(
+        &mut self,
+        plan: &Plan,
+        pass: &PlanPass,
+        resources: &mut FrameResources<'g>,
+        options: &FrameOptions,
+    ) -> Result<Prepared, GpuError> {
+        let fail = |problems: Vec<String>| GpuError::Pass {
+            pass: pass.name.clone(),
+            message: problems.join("; "),
+        };
+        let checked = self.checked_interface(plan, pass)?;
+        let mut prepared = Prepared {
+            pipeline: None,
+            render_pass: vk::RenderPass::null(),
+            framebuffer: vk::Framebuffer::null(),
+            extent: vk::Extent2D {
+                width: plan.extent.width,
+                height: plan.extent.height,
+            },
+            clears: Vec::new(),
+            bindings: Vec::new(),
+            push: Vec::new(),
+            set: vk::DescriptorSet::null(),
+        };
+        if let Some((key, bindings)) = checked {
+            prepared.pipeline = Some(self.pipelines.pipeline(self.gpu.device(), &key)?);
+            prepared.bindings = bindings;
+        }
+        if let Some(rp) = &pass.render_pass {
+            prepared.render_pass = self.render_passes.get(self.gpu.device(), rp)?;
+            prepared.extent = vk::Extent2D {
+                width: rp.extent.width,
+                height: rp.extent.height,
+            };
+            let mut views = Vec::with_capacity(rp.attachments.len());
+            for a in &rp.attachments {
+                views.push(resources.image(a.resource)?.attachment_view);
+                prepared
+                    .clears
+                    .push(clear_value(&plan.resources[a.resource], &a.clear));
+            }
+            prepared.framebuffer =
+                resources.framebuffer(prepared.render_pass, views, prepared.extent)?;
+        }
+        if let Some(p) = &prepared.pipeline {
+            if let Some((block, _)) = &p.interface.push {
+                let frame = FrameValues {
+                    time: options.time,
+                    frame: options.frame,
+                    extent: [prepared.extent.width, prepared.extent.height],
+                };
+                prepared.push = bind::pack_push(block, &pass.params, &frame).map_err(fail)?;
+            }
+        }
+        Ok(prepared)
+    }
+
+    /// Writes every pass's descriptor set, with image layouts as the plan's
+    /// barriers leave them at that pass.
+    pub(super) fn write_descriptors(
+        &self,
+        plan: &Plan,
+        resources: &FrameResources<'g>,
+        pool: &DescriptorPool,
+        prepared: &mut [Prepared],
+    ) -> Result<(), GpuError> {
+        let mut layouts = layouts::frame_start(plan);
+        for (index, prep) in prepared.iter_mut().enumerate() {
+            layouts::apply_pass(plan, PassId::new(index), &mut layouts);
+            let Some(pipeline) = &prep.pipeline else {
+                continue;
+            };
+            let Some(&set_layout) = pipeline.set_layouts.first() else {
+                continue;
+            };
+            prep.set = pool.allocate(self.gpu, set_layout)?;
+            let mut image_infos = Vec::new();
+            let mut buffer_infos = Vec::new();
+            for rb in &prep.bindings {
+                match resources.get(rb.graph.resource) {
+                    Some(GpuResource::Image(img)) => image_infos.push((
+                        rb,
+                        [vk::DescriptorImageInfo {
+                            sampler: self.samplers.for_binding(
+                                self.gpu,
+                                rb.shader.depth_compare,
+                                img.desc.format_raw,
+                            ),
+                            image_view: img.shader_view,
+                            image_layout: crate::convert::layout(layouts[rb.graph.resource]),
+                        }],
+                    )),
+                    Some(GpuResource::Buffer(buf)) => buffer_infos.push((
+                        rb,
+                        [vk::DescriptorBufferInfo {
+                            buffer: buf.buffer,
+                            offset: 0,
+                            range: vk::WHOLE_SIZE,
+                        }],
+                    )),
+                    None => {
+                        return Err(GpuError::Plan(format!(
+                            "resource {} missing",
+                            rb.graph.resource
+                        )))
+                    }
+                }
+            }
+            let mut writes = Vec::new();
+            for (rb, info) in &image_infos {
+                writes.push(
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(prep.set)
+                        .dst_binding(rb.shader.binding)
+                        .descriptor_type(rb.shader.kind.vk())
+                        .image_info(info),
+                );
+            }
+            for (rb, info) in &buffer_infos {
+                writes.push(
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(prep.set)
+                        .dst_binding(rb.shader.binding)
+                        .descriptor_type(rb.shader.kind.vk())
+                        .buffer_info(info),
+                );
+            }
+            unsafe { self.gpu.device().update_descriptor_sets(&writes, &[]) };
+        }
+        Ok(())
+    }
+}
+
+/// A pool with room for every prepared pass's descriptor set.
+pub(super) fn descriptor_pool<'g>(
+    gpu: &'g Gpu,
+    prepared: &[Prepared],
+) -> Result<DescriptorPool<'g>, GpuError> {
+    let mut counts: Vec<(vk::DescriptorType, u32)> = Vec::new();
+    let mut sets = 0;
+    for p in prepared.iter().filter(|p| p.pipeline.is_some()) {
+        sets += 1;
+        for b in &p.bindings {
+            let ty = b.shader.kind.vk();
+            match counts.iter_mut().find(|(t, _)| *t == ty) {
+                Some((_, n)) => *n += b.shader.count,
+                None => counts.push((ty, b.shader.count)),
+            }
+        }
+    }
+    DescriptorPool::new(gpu, sets, &counts)
+}
+
+fn clear_value(resource: &PlanResource, clear: &[f64]) -> vk::ClearValue {
+    let depth = matches!(&resource.desc, ResourceDesc::Image(d) if d.aspect != weft_graph::vk::Aspect::Color);
+    if depth {
+        vk::ClearValue {
+            depth_stencil: vk::ClearDepthStencilValue {
+                depth: clear.first().copied().unwrap_or(0.0) as f32,
+                stencil: 0,
+            },
+        }
+    } else {
+        let mut c = [0f32; 4];
+        for (slot, v) in c.iter_mut().zip(clear) {
+            *slot = *v as f32;
+        }
+        vk::ClearValue {
+            color: vk::ClearColorValue { float32: c },
+        }
+    }
+}

@@ -1,0 +1,143 @@
+//! Recording one prepared pass: its barriers, then a copy, a dispatch, a
+//! fullscreen triangle or the draw recorder's scene draws inside its render pass.
+
+use super::{Prepared, Renderer};
+use crate::draw::{DrawRecorder, RasterContext, SCENE_SET};
+use crate::error::GpuError;
+use crate::frame::Label;
+use crate::record;
+use crate::resources::FrameResources;
+use ash::vk;
+use weft_graph::id::PassId;
+use weft_graph::plan::{Plan, PlanPass};
+use weft_graph::schema::PassKind;
+
+impl<'g> Renderer<'g> {
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn record_pass(
+        &self,
+        plan: &Plan,
+        index: PassId,
+        pass: &PlanPass,
+        prep: &Prepared,
+        resources: &FrameResources<'g>,
+        draws: &mut dyn DrawRecorder,
+        cmd: vk::CommandBuffer,
+    ) -> Result<(), GpuError> {
+        let device = self.gpu.device();
+        let label = Label::begin(self.gpu, cmd, &pass.name);
+        record::barriers(device, cmd, &pass.barriers, resources)?;
+        let result = match pass.kind {
+            PassKind::Copy => record::transfer(self.gpu, cmd, plan, pass, resources, false),
+            PassKind::Blit => record::transfer(self.gpu, cmd, plan, pass, resources, true),
+            PassKind::Compute => {
+                let dispatch = pass.dispatch.ok_or_else(|| GpuError::Pass {
+                    pass: pass.name.clone(),
+                    message: "compute pass without a dispatch size".into(),
+                })?;
+                self.bind(cmd, prep);
+                // A compute pass that reads scene data (tiled light culling reads the
+                // camera and the lights) gets set 1 from the draw recorder, as a
+                // fullscreen pass does; there is no render pass around it.
+                let scene = prep
+                    .pipeline
+                    .as_ref()
+                    .filter(|p| p.interface.bindings.keys().any(|(s, _)| *s == SCENE_SET));
+                let bound = match scene {
+                    Some(p) => draws.bind_scene(
+                        &RasterContext {
+                            gpu: self.gpu,
+                            cmd,
+                            plan,
+                            pass_index: index,
+                            render_pass: vk::RenderPass::null(),
+                            extent: prep.extent,
+                            resources,
+                            sampler: self.samplers.linear,
+                            nearest_sampler: self.samplers.nearest,
+                            compare_sampler: self.samplers.compare,
+                        },
+                        p,
+                    ),
+                    None => Ok(()),
+                };
+                bound.map(|()| unsafe {
+                    device.cmd_dispatch(cmd, dispatch[0], dispatch[1], dispatch[2])
+                })
+            }
+            PassKind::Fullscreen | PassKind::Raster => {
+                let area = vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent: prep.extent,
+                };
+                let begin = vk::RenderPassBeginInfo::default()
+                    .render_pass(prep.render_pass)
+                    .framebuffer(prep.framebuffer)
+                    .render_area(area)
+                    .clear_values(&prep.clears);
+                let subpass = vk::SubpassBeginInfo::default().contents(vk::SubpassContents::INLINE);
+                unsafe {
+                    device.cmd_begin_render_pass2(cmd, &begin, &subpass);
+                    device.cmd_set_viewport(
+                        cmd,
+                        0,
+                        &[vk::Viewport {
+                            x: 0.0,
+                            y: 0.0,
+                            width: prep.extent.width as f32,
+                            height: prep.extent.height as f32,
+                            min_depth: 0.0,
+                            max_depth: 1.0,
+                        }],
+                    );
+                    device.cmd_set_scissor(cmd, 0, &[area]);
+                }
+                let ctx = RasterContext {
+                    gpu: self.gpu,
+                    cmd,
+                    plan,
+                    pass_index: index,
+                    render_pass: prep.render_pass,
+                    extent: prep.extent,
+                    resources,
+                    sampler: self.samplers.linear,
+                    nearest_sampler: self.samplers.nearest,
+                    compare_sampler: self.samplers.compare,
+                };
+                let drawn = match &prep.pipeline {
+                    Some(p) => {
+                        self.bind(cmd, prep);
+                        let scene = p.interface.bindings.keys().any(|(s, _)| *s == SCENE_SET);
+                        let bound = if scene {
+                            draws.bind_scene(&ctx, p)
+                        } else {
+                            Ok(())
+                        };
+                        bound.map(|()| unsafe { device.cmd_draw(cmd, 3, 1, 0, 0) })
+                    }
+                    None => draws.record(&ctx),
+                };
+                unsafe { device.cmd_end_render_pass2(cmd, &vk::SubpassEndInfo::default()) };
+                drawn
+            }
+        };
+        label.end(self.gpu, cmd);
+        result
+    }
+
+    pub(super) fn bind(&self, cmd: vk::CommandBuffer, prep: &Prepared) {
+        let Some(p) = &prep.pipeline else {
+            return;
+        };
+        let device = self.gpu.device();
+        unsafe {
+            device.cmd_bind_pipeline(cmd, p.bind_point, p.pipeline);
+            if prep.set != vk::DescriptorSet::null() {
+                device.cmd_bind_descriptor_sets(cmd, p.bind_point, p.layout, 0, &[prep.set], &[]);
+            }
+            if let Some((_, stages)) = &p.interface.push {
+                device.cmd_push_constants(cmd, p.layout, *stages, 0, &prep.push);
+            }
+        }
+    }
+}

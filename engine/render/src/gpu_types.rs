@@ -1,0 +1,149 @@
+//! Every struct the shaders read from weft-render's buffers, as `#[repr(C)]`
+//! plain-old-data (`bytemuck`), field for field with the GLSL declarations in
+//! `shaders/include/scene.glsl` and `shadows.glsl`. The compiler lays the
+//! bytes out, so no offset is kept by hand; each struct's size is asserted
+//! against the std430/std140 size its GLSL twin has. Every member is a vec4,
+//! mat4 or uvec4 (or, for the vertex, tightly packed floats), so the two
+//! layouts agree and there is no padding.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, UVec4, Vec4};
+
+/// One vertex of the shared vertex buffer (`layout(location = 0..2)` inputs).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuVertex {
+    /// Model-space position.
+    pub position: [f32; 3],
+    /// Model-space normal.
+    pub normal: [f32; 3],
+    /// Texture coordinates.
+    pub uv: [f32; 2],
+}
+
+/// `struct Draw`: one placed mesh.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuDraw {
+    /// Model to world.
+    pub model: Mat4,
+    /// Inverse transpose of `model`.
+    pub normal: Mat4,
+    /// x: index into the materials.
+    pub material: UVec4,
+}
+
+/// `struct Light`. Area lights reuse the fields (see `scene.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    /// xyz world position, w cutoff range.
+    pub position_range: Vec4,
+    /// xyz unit direction the light travels, w type.
+    pub direction_type: Vec4,
+    /// rgb colour, w spot exponent.
+    pub color_exponent: Vec4,
+    /// Constant, linear, quadratic attenuation, cos(spot half-angle).
+    pub attenuation_cos: Vec4,
+}
+
+/// `struct Material`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// Kd or base colour, alpha.
+    pub diffuse: Vec4,
+    /// Ks, Ns (metallic-roughness: metallic, roughness, 0, 0).
+    pub specular: Vec4,
+    /// Ambient reflectance, normal-map scale (0: none).
+    pub ambient: Vec4,
+    /// Ke, shading model.
+    pub emissive: Vec4,
+}
+
+/// The `Frame` uniform block.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuFrame {
+    /// World to clip space.
+    pub view_proj: Mat4,
+    /// Clip to world space.
+    pub inv_view_proj: Mat4,
+    /// xyz the camera's world position, w 1.
+    pub camera_position: Vec4,
+    /// Sum of the suns' ambient terms.
+    pub ambient: Vec4,
+    /// Suns, point lights, spots, all lights.
+    pub counts: UVec4,
+    /// Width, height, 1/width, 1/height.
+    pub viewport: Vec4,
+}
+
+/// The head of the `Shadows` buffer, before the views.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuShadowsHeader {
+    /// Cascades, spot views, light index of the first spot cone, PCF radius.
+    pub counts: UVec4,
+    /// Far view depth of each cascade.
+    pub splits: Vec4,
+    /// Camera view direction, w: normal offset in texels.
+    pub forward: Vec4,
+}
+
+/// `struct ShadowView`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuShadowView {
+    /// World to the view's clip space.
+    pub clip: Mat4,
+    /// World to atlas coordinates.
+    pub lookup: Mat4,
+    /// Texture-coordinate bounds the kernel stays inside.
+    pub rect: Vec4,
+    /// x: world size of a texel, y: 1 for perspective views.
+    pub texel: Vec4,
+}
+
+const _: () = {
+    use std::mem::size_of;
+    assert!(size_of::<GpuVertex>() == 32);
+    assert!(size_of::<GpuDraw>() == 144);
+    assert!(size_of::<GpuLight>() == 64);
+    assert!(size_of::<GpuMaterial>() == 64);
+    assert!(size_of::<GpuFrame>() == 2 * 64 + 4 * 16);
+    assert!(size_of::<GpuShadowsHeader>() == 48);
+    assert!(size_of::<GpuShadowView>() == 160);
+};
+
+/// The bytes of a slice of records, for uploading.
+pub fn bytes_of<T: Pod>(records: &[T]) -> &[u8] {
+    bytemuck::cast_slice(records)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fields_lie_where_the_glsl_declares_them() {
+        let light = GpuLight {
+            position_range: Vec4::new(1.0, 2.0, 3.0, 4.0),
+            direction_type: Vec4::new(0.0, -1.0, 0.0, 2.0),
+            color_exponent: Vec4::splat(0.5),
+            attenuation_cos: Vec4::new(1.0, 0.0, 0.0, 0.25),
+        };
+        let words: &[f32] = bytemuck::cast_slice(std::slice::from_ref(&light));
+        assert_eq!(words[3], 4.0, "range is position_range.w");
+        assert_eq!(words[7], 2.0, "type is direction_type.w");
+        assert_eq!(words[15], 0.25, "cos cutoff is attenuation_cos.w");
+        let draw = GpuDraw {
+            model: Mat4::from_translation(glam::Vec3::new(9.0, 8.0, 7.0)),
+            normal: Mat4::IDENTITY,
+            material: UVec4::new(5, 0, 0, 0),
+        };
+        let words: &[u32] = bytemuck::cast_slice(std::slice::from_ref(&draw));
+        assert_eq!(f32::from_bits(words[12]), 9.0, "column-major translation");
+        assert_eq!(words[32], 5, "material index after two mat4s");
+    }
+}

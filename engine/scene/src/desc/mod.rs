@@ -1,0 +1,319 @@
+//! Gives meaning to parsed `.scene` blocks: models to load, lights, cameras, bounds,
+//! includes and light generators, with the 15-462 quirks accepted and reported.
+
+use crate::bounds::Aabb;
+use crate::camera::{look_at_rotation, Camera, CameraKey, CameraOrigin, DEFAULT_FOV_Y};
+use crate::error::{Diagnostics, Location, SceneError};
+use crate::light::Light;
+use crate::props::Props;
+use crate::source::{read_text, MAX_SCENE_BYTES};
+use crate::syntax::{parse, Block, Item, Prop};
+use glam::{EulerRot, Mat4, Quat, Vec3};
+use std::path::{Path, PathBuf};
+
+mod lights;
+
+use lights::{arealight, generate, pointlight, spotlight, sunlight};
+
+/// How deep `include` may nest.
+pub const MAX_INCLUDE_DEPTH: usize = 16;
+/// The most lights one generator block may make.
+pub const MAX_GENERATED_LIGHTS: u32 = 1_000_000;
+/// The default period of a spotlight swivel, in seconds.
+pub const DEFAULT_SWIVEL_PERIOD: f32 = 4.0;
+
+/// A model file placed in the world.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Placement {
+    /// The model file, resolved against the scene file.
+    pub file: PathBuf,
+    /// The `file` line that names it.
+    pub at: Location,
+    /// Model-to-world transform (translate · rotate · scale).
+    pub transform: Mat4,
+}
+
+/// Everything a `.scene` file (with its includes) declares, before models are loaded.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SceneDesc {
+    /// Model placements in file order.
+    pub models: Vec<Placement>,
+    /// Lights in file order (generated ones where their block is).
+    pub lights: Vec<Light>,
+    /// Cameras in file order.
+    pub cameras: Vec<Camera>,
+    /// A `boundingbox` block, when present.
+    pub bounding_box: Option<Aabb>,
+}
+
+/// Reads a `.scene` file and its includes.
+pub fn read_scene_desc(path: &Path, diag: &mut Diagnostics) -> Result<SceneDesc, SceneError> {
+    let mut desc = SceneDesc::default();
+    let mut stack = Vec::new();
+    read_into(path, &Location::file(path), &mut desc, &mut stack, diag)?;
+    Ok(desc)
+}
+
+/// Parses `text` as if it were the file `path` (includes resolve against `path`'s folder).
+pub fn scene_desc_from_str(
+    text: &str,
+    path: &Path,
+    diag: &mut Diagnostics,
+) -> Result<SceneDesc, SceneError> {
+    let mut desc = SceneDesc::default();
+    let mut stack = vec![path.to_path_buf()];
+    interpret(text, path, &mut desc, &mut stack, diag)?;
+    Ok(desc)
+}
+
+/// Reads one file into `desc`; `stack` holds the files being included, to stop cycles.
+fn read_into(
+    path: &Path,
+    asked_at: &Location,
+    desc: &mut SceneDesc,
+    stack: &mut Vec<PathBuf>,
+    diag: &mut Diagnostics,
+) -> Result<(), SceneError> {
+    let text = read_text(path, asked_at, MAX_SCENE_BYTES)?;
+    let key = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+    if stack.contains(&key) {
+        return Err(SceneError::Syntax {
+            at: asked_at.clone(),
+            message: format!("include cycle: {} includes itself", path.display()),
+        });
+    }
+    if stack.len() >= MAX_INCLUDE_DEPTH {
+        return Err(SceneError::Syntax {
+            at: asked_at.clone(),
+            message: format!("includes nest deeper than {MAX_INCLUDE_DEPTH}"),
+        });
+    }
+    stack.push(key);
+    let result = interpret(&text, path, desc, stack, diag);
+    stack.pop();
+    result
+}
+
+/// Interprets the text of one file.
+fn interpret(
+    text: &str,
+    path: &Path,
+    desc: &mut SceneDesc,
+    stack: &mut Vec<PathBuf>,
+    diag: &mut Diagnostics,
+) -> Result<(), SceneError> {
+    for item in parse(text, path, diag)? {
+        match item {
+            Item::Include { path: name, line } => {
+                let target = resolve(path, &name);
+                read_into(&target, &Location::line(path, line), desc, stack, diag)?;
+            }
+            Item::Block(block) => block_into(&block, path, desc, diag)?,
+        }
+    }
+    Ok(())
+}
+
+/// A path from a scene file, relative to the scene's folder; backslashes are separators.
+pub(crate) fn resolve(scene: &Path, name: &str) -> PathBuf {
+    let cleaned = name.replace('\\', "/");
+    let base = scene.parent().unwrap_or(Path::new(""));
+    base.join(cleaned)
+}
+
+/// Adds one block to `desc`.
+fn block_into(
+    block: &Block,
+    file: &Path,
+    desc: &mut SceneDesc,
+    diag: &mut Diagnostics,
+) -> Result<(), SceneError> {
+    let mut props = Props::new(block, file);
+    let first_warning = diag.warnings.len();
+    match block.kind.as_str() {
+        "model" => {
+            if let Some(p) = model(&mut props, diag)? {
+                desc.models.push(p);
+            }
+        }
+        "sunlight" => desc.lights.push(Light::Sun(sunlight(&mut props, diag)?)),
+        "spotlight" => desc.lights.push(Light::Spot(spotlight(&mut props, diag)?)),
+        "pointlight" => desc.lights.push(Light::Point(pointlight(&mut props)?)),
+        "arealight" => desc.lights.push(Light::Area(arealight(&mut props)?)),
+        "pointlights" => desc
+            .lights
+            .extend(generate(&mut props)?.into_iter().map(Light::Point)),
+        "camera" => {
+            let index = desc.cameras.len();
+            desc.cameras
+                .push(camera(&mut props, block.label.clone(), index)?);
+        }
+        "boundingbox" => {
+            let min = props.vec3("min")?.unwrap_or(Vec3::ZERO);
+            let max = props.vec3("max")?.unwrap_or(Vec3::ZERO);
+            desc.bounding_box = Some(Aabb::from_points(&[min, max]));
+        }
+        other => {
+            diag.warn(
+                Location::line(file, block.line),
+                format!("unknown object '{other}'; skipped"),
+            );
+            return Ok(());
+        }
+    }
+    props.finish(diag);
+    diag.warnings[first_warning..].sort_by_key(|w| w.at.line);
+    Ok(())
+}
+
+/// A rotation from 3 values (pitch, yaw, roll in degrees, applied roll then pitch then yaw)
+/// or 4 values (angle in radians, then axis: the 15-462 reference loader's reading).
+fn rotation(props: &Props<'_>, prop: &Prop) -> Result<Quat, SceneError> {
+    let v = props.numbers(prop)?;
+    match v.as_slice() {
+        [pitch, yaw, roll] => Ok(Quat::from_euler(
+            EulerRot::YXZ,
+            yaw.to_radians(),
+            pitch.to_radians(),
+            roll.to_radians(),
+        )),
+        [angle, x, y, z] => {
+            let axis = Vec3::new(*x, *y, *z)
+                .try_normalize()
+                .ok_or_else(|| props.error(prop, format!("'{}' has a zero rotation axis", prop.name)))?;
+            Ok(Quat::from_axis_angle(axis, *angle))
+        }
+        _ => Err(props.error(
+            prop,
+            format!(
+                "'{}' expects 3 numbers (pitch yaw roll, degrees) or 4 (angle in radians, axis x y z), found {}",
+                prop.name,
+                v.len()
+            ),
+        )),
+    }
+}
+
+/// Warns that a 4-value orientation was read as angle-axis.
+fn warn_angle_axis(props: &Props<'_>, prop: &Prop, diag: &mut Diagnostics) {
+    if prop.values.len() == 4 {
+        diag.warn(
+            Location::line(props.file(), prop.line),
+            format!(
+                "'{}' has 4 values; read as angle (radians) and axis, as the 15-462 reference loader does",
+                prop.name
+            ),
+        );
+    }
+}
+
+/// A `model` block; `None` (with a warning) when it names no file.
+fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placement>, SceneError> {
+    let file = props.text("file")?;
+    let position = props.vec3("position")?.unwrap_or(Vec3::ZERO);
+    let rot = match props.last("orientation") {
+        Some(p) => {
+            warn_angle_axis(props, p, diag);
+            rotation(props, p)?
+        }
+        None => Quat::IDENTITY,
+    };
+    let scale = match props.last("scale") {
+        Some(p) => match props.numbers(p)?.as_slice() {
+            [s] => Vec3::splat(*s),
+            [x, y, z] => Vec3::new(*x, *y, *z),
+            other => {
+                return Err(props.error(
+                    p,
+                    format!("'scale' expects 1 or 3 numbers, found {}", other.len()),
+                ))
+            }
+        },
+        None => Vec3::ONE,
+    };
+    let Some((name, line)) = file else {
+        diag.warn(props.block_at(), "model without a 'file'; skipped");
+        return Ok(None);
+    };
+    Ok(Some(Placement {
+        file: resolve(props.file(), &name),
+        at: Location::line(props.file(), line),
+        transform: Mat4::from_scale_rotation_translation(scale, rot, position),
+    }))
+}
+
+/// A `camera` block; `index` names unlabelled cameras `camera0`, `camera1`, ...
+fn camera(
+    props: &mut Props<'_>,
+    label: Option<String>,
+    index: usize,
+) -> Result<Camera, SceneError> {
+    let position = props.vec3("position")?.unwrap_or(Vec3::ZERO);
+    let target = props.vec3("target")?;
+    let orientation = match (props.last("orientation"), target) {
+        (Some(p), None) => rotation(props, p)?,
+        (None, Some(t)) => look_at_rotation(position, t),
+        (None, None) => Quat::IDENTITY,
+        (Some(p), Some(_)) => {
+            return Err(props.error(p, "give 'orientation' or 'target', not both"))
+        }
+    };
+    let fov_y = match (
+        props.last("fov"),
+        props.f32_where("fov_deg", |d| d > 0.0 && d < 180.0, "in (0, 180)")?,
+    ) {
+        (Some(p), None) => {
+            let f = props.exactly(p, 1)?[0];
+            if !(f > 0.0 && f < std::f32::consts::PI) {
+                return Err(props.error(p, format!("'fov' is in radians and must be in (0, pi), found {f}; use 'fov_deg' for degrees")));
+            }
+            f
+        }
+        (None, Some(d)) => d.to_radians(),
+        (None, None) => DEFAULT_FOV_Y,
+        (Some(p), Some(_)) => return Err(props.error(p, "give 'fov' or 'fov_deg', not both")),
+    };
+    let near = clip(props, "near", "near_clip")?.unwrap_or(0.01);
+    let far = clip(props, "far", "far_clip")?.unwrap_or(1000.0);
+    if near <= 0.0 || far <= near {
+        return Err(SceneError::Syntax {
+            at: props.block_at(),
+            message: format!(
+                "camera clip distances must satisfy 0 < near < far, found near {near} far {far}"
+            ),
+        });
+    }
+    let mut path = Vec::new();
+    for p in props.all("key") {
+        let v = props.exactly(p, 7)?;
+        let key_position = Vec3::new(v[1], v[2], v[3]);
+        path.push(CameraKey {
+            time: v[0],
+            position: key_position,
+            orientation: look_at_rotation(key_position, Vec3::new(v[4], v[5], v[6])),
+        });
+        if path.len() > 1 && path[path.len() - 2].time >= v[0] {
+            return Err(props.error(p, "camera 'key' times must increase"));
+        }
+    }
+    Ok(Camera {
+        name: label.unwrap_or_else(|| format!("camera{index}")),
+        position,
+        orientation,
+        fov_y,
+        near,
+        far,
+        path,
+        origin: CameraOrigin::Scene,
+    })
+}
+
+/// A clip distance under its new or its 15-462 name (the last one given wins).
+fn clip(props: &mut Props<'_>, name: &str, legacy: &str) -> Result<Option<f32>, SceneError> {
+    let a = props.last(name).map(|p| (p.line, name));
+    let b = props.last(legacy).map(|p| (p.line, legacy));
+    match a.max(b) {
+        Some((_, chosen)) => props.f32(chosen),
+        None => Ok(None),
+    }
+}
