@@ -40,7 +40,7 @@ pub enum GraphCommand {
 #[derive(Args)]
 pub struct Target {
     /// Output size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    #[arg(long, default_value = "1280x720", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Features on (comma-separated); `!name` turns off a graph default.
     #[arg(long, value_delimiter = ',')]
@@ -49,22 +49,6 @@ pub struct Target {
     /// so the plan shows what this scene culls and why.
     #[arg(long)]
     scene: Option<PathBuf>,
-}
-
-fn parse_size(text: &str) -> Result<Extent, String> {
-    let (w, h) = text
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT, found \"{text}\""))?;
-    let parse = |v: &str| -> Result<u32, String> {
-        match v.trim().parse::<u32>() {
-            Ok(n) if (1..=16384).contains(&n) => Ok(n),
-            _ => Err(format!("size must be 1..=16384, found \"{v}\"")),
-        }
-    };
-    Ok(Extent {
-        width: parse(w)?,
-        height: parse(h)?,
-    })
 }
 
 /// Refuses feature toggles typed on the command line that the graph does not

@@ -1,11 +1,6 @@
 //! The `weft` command.
 
-mod bench_bloom;
-mod bench_cmd;
-mod bench_lights;
-mod bench_shadows;
 mod graph_cmd;
-mod plot;
 mod render_cmd;
 mod scene_cmd;
 mod view;
@@ -34,7 +29,7 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Benchmarks that write figures and plots (into docs/ by default).
     #[command(subcommand)]
-    Bench(bench_cmd::BenchCommand),
+    Bench(weft_bench::BenchCommand),
     /// Show a scene in a window: fly around, switch graphs and features, hot reload.
     View(view::ViewArgs),
 }
@@ -57,7 +52,7 @@ fn main() -> ExitCode {
         Command::Graph(cmd) => graph_cmd::run(cmd),
         Command::Scene(cmd) => scene_cmd::run(cmd),
         Command::Render(args) => render_cmd::run(args),
-        Command::Bench(cmd) => bench_cmd::run(cmd),
+        Command::Bench(cmd) => weft_bench::run(cmd),
         Command::View(args) => view::run(args),
     };
     match result {

@@ -28,7 +28,7 @@ pub struct RenderArgs {
     #[arg(long, default_value = "graphs/forward.ron")]
     graph: PathBuf,
     /// Output size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    #[arg(long, default_value = "1280x720", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Frames to render (at least 1); the last one is saved.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
@@ -74,21 +74,6 @@ pub struct RenderArgs {
     /// stop with Ctrl-C (SIGINT) or SIGTERM.
     #[arg(long)]
     watch: bool,
-}
-
-/// Parses `WIDTHxHEIGHT` (each 1..=16384), as `--size` takes it.
-pub(crate) fn parse_size(text: &str) -> Result<Extent, String> {
-    let (w, h) = text
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("size must look like 1280x720, found \"{text}\""))?;
-    let parse = |v: &str| match v.trim().parse::<u32>() {
-        Ok(n) if (1..=16384).contains(&n) => Ok(n),
-        _ => Err(format!("size must be 1..=16384, found \"{v}\"")),
-    };
-    Ok(Extent {
-        width: parse(w)?,
-        height: parse(h)?,
-    })
 }
 
 /// Parses `NAME=VALUE` as `--param` takes it.

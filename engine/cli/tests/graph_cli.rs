@@ -158,7 +158,8 @@ fn dot_greys_culled_passes() {
 fn bad_size_is_rejected_by_the_argument_parser() {
     let out = weft(&["graph", "plan", "graphs/forward.ron", "--size", "wide"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("expected WIDTHxHEIGHT, found \"wide\""));
+    assert!(String::from_utf8_lossy(&out.stderr)
+        .contains("expected WIDTHxHEIGHT such as 1280x720, found \"wide\""));
 }
 
 #[test]

@@ -17,6 +17,31 @@ pub struct Extent {
     pub height: u32,
 }
 
+impl std::str::FromStr for Extent {
+    type Err = String;
+
+    /// Parses `WIDTHxHEIGHT` (`1280x720`), each side 1..=[`MAX_IMAGE_DIMENSION`],
+    /// as command lines take sizes.
+    ///
+    /// [`MAX_IMAGE_DIMENSION`]: crate::resolve::MAX_IMAGE_DIMENSION
+    fn from_str(text: &str) -> Result<Self, String> {
+        let (w, h) = text
+            .split_once(['x', 'X'])
+            .ok_or_else(|| format!("expected WIDTHxHEIGHT such as 1280x720, found \"{text}\""))?;
+        let max = crate::resolve::MAX_IMAGE_DIMENSION;
+        let side = |v: &str| match v.trim().parse::<u32>() {
+            Ok(n) if (1..=max).contains(&n) => Ok(n),
+            _ => Err(format!(
+                "each side of a size must be 1..={max}, found \"{v}\""
+            )),
+        };
+        Ok(Extent {
+            width: side(w)?,
+            height: side(h)?,
+        })
+    }
+}
+
 /// A compiled graph, ready to execute for one output size and feature set.
 #[derive(Debug, Clone, Serialize)]
 pub struct Plan {
@@ -284,5 +309,30 @@ impl Plan {
     /// Looks up a resource by name.
     pub fn resource(&self, name: &str) -> Option<ResourceId> {
         self.resources.position(|r| r.name == name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_as_command_lines_write_them() {
+        assert_eq!(
+            "1280x720".parse::<Extent>(),
+            Ok(Extent {
+                width: 1280,
+                height: 720
+            })
+        );
+        assert_eq!(
+            "wide".parse::<Extent>(),
+            Err("expected WIDTHxHEIGHT such as 1280x720, found \"wide\"".to_string())
+        );
+        assert_eq!(
+            "0x10".parse::<Extent>(),
+            Err("each side of a size must be 1..=16384, found \"0\"".to_string())
+        );
+        assert!("16385X2".parse::<Extent>().is_err());
     }
 }

@@ -6,7 +6,6 @@ mod app;
 mod controls;
 mod fly;
 
-use crate::render_cmd::parse_size;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -44,7 +43,7 @@ pub struct ViewArgs {
     #[arg(long, default_value = "graphs/forward.ron")]
     graph: PathBuf,
     /// Window size, WIDTHxHEIGHT (the graph renders at the window's size).
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    #[arg(long, default_value = "1280x720", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Camera to start from; the scene's first by default.
     #[arg(long)]
@@ -69,7 +68,7 @@ pub struct ViewArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     frames: Option<u32>,
     /// Ask the window to become WIDTHxHEIGHT after half of --frames (tests resizing).
-    #[arg(long, value_parser = parse_size, requires = "frames")]
+    #[arg(long, value_parser = clap::value_parser!(Extent), requires = "frames")]
     resize_to: Option<Extent>,
     /// Press keys without a keyboard (for scripts and tests): FRAME:KEY,... where KEY
     /// is g, G (Shift+G), 1-9, f12, space, r or esc, pressed before frame FRAME.

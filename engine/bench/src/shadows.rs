@@ -41,7 +41,7 @@ pub struct ShadowsArgs {
     #[arg(long, default_value_t = 1)]
     cascades: u32,
     /// Output size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "960x540", value_parser = crate::render_cmd::parse_size)]
+    #[arg(long, default_value = "960x540", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Frames per render; times are the last frame's.
     #[arg(long, default_value_t = 3)]

@@ -26,7 +26,7 @@ pub struct BloomArgs {
     #[arg(long, value_delimiter = ',', default_value = "3,7,11,15,21")]
     radii: Vec<u32>,
     /// Output size, WIDTHxHEIGHT (bloom runs at half of it).
-    #[arg(long, default_value = "1920x1080", value_parser = crate::render_cmd::parse_size)]
+    #[arg(long, default_value = "1920x1080", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Frames per measurement; the first (pipeline builds) is left out of the mean.
     #[arg(long, default_value_t = 6)]

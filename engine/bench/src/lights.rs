@@ -26,7 +26,7 @@ pub struct LightsArgs {
     )]
     graphs: Vec<PathBuf>,
     /// Output size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = crate::render_cmd::parse_size)]
+    #[arg(long, default_value = "1280x720", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Frames per measurement; the first (pipeline builds) is left out of the mean.
     #[arg(long, default_value_t = 3)]
