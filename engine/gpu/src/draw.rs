@@ -38,6 +38,11 @@ pub struct RasterContext<'a> {
 }
 
 impl RasterContext<'_> {
+    /// Safe recording into this pass's command buffer.
+    pub fn commands(&self) -> crate::commands::Commands<'_> {
+        crate::commands::Commands::new(self.gpu.device(), self.cmd)
+    }
+
     /// The pass being recorded.
     pub fn pass(&self) -> &PlanPass {
         &self.plan.passes[self.pass_index]

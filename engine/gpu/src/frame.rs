@@ -26,57 +26,6 @@ impl Label {
     }
 }
 
-/// One frame's descriptor pool, sized for every pass's set.
-pub(crate) struct DescriptorPool<'g> {
-    gpu: &'g Gpu,
-    pool: vk::DescriptorPool,
-}
-
-impl<'g> DescriptorPool<'g> {
-    pub(crate) fn new(
-        gpu: &'g Gpu,
-        sets: u32,
-        counts: &[(vk::DescriptorType, u32)],
-    ) -> Result<Self, GpuError> {
-        let sizes: Vec<_> = counts
-            .iter()
-            .map(|&(ty, n)| vk::DescriptorPoolSize {
-                ty,
-                descriptor_count: n,
-            })
-            .collect();
-        let info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(sets.max(1))
-            .pool_sizes(&sizes);
-        let pool = unsafe { gpu.device().create_descriptor_pool(&info, None) }
-            .call("vkCreateDescriptorPool")?;
-        Ok(Self { gpu, pool })
-    }
-
-    pub(crate) fn allocate(
-        &self,
-        gpu: &Gpu,
-        layout: vk::DescriptorSetLayout,
-    ) -> Result<vk::DescriptorSet, GpuError> {
-        let layouts = [layout];
-        let info = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(self.pool)
-            .set_layouts(&layouts);
-        let sets = unsafe { gpu.device().allocate_descriptor_sets(&info) }
-            .call("vkAllocateDescriptorSets")?;
-        sets.into_iter().next().ok_or(GpuError::Vulkan {
-            call: "vkAllocateDescriptorSets",
-            result: vk::Result::ERROR_OUT_OF_POOL_MEMORY,
-        })
-    }
-}
-
-impl Drop for DescriptorPool<'_> {
-    fn drop(&mut self) {
-        unsafe { self.gpu.device().destroy_descriptor_pool(self.pool, None) };
-    }
-}
-
 /// The command buffers of one frame, freed on drop.
 pub(crate) struct CommandBuffers<'g> {
     gpu: &'g Gpu,

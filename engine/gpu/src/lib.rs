@@ -4,14 +4,18 @@
 #![warn(missing_docs)]
 
 pub mod bind;
+pub mod buffer;
 pub mod check;
+pub mod commands;
 pub mod context;
 pub mod convert;
+pub mod descriptors;
 mod download;
 pub mod draw;
 pub mod error;
 pub mod executor;
 mod frame;
+pub mod graphics;
 pub mod layouts;
 pub mod pipeline;
 pub mod present;
@@ -24,6 +28,7 @@ pub mod samplers;
 pub mod shader;
 pub mod statistics;
 pub mod swapchain;
+pub mod texture;
 pub mod timing;
 pub mod validation;
 

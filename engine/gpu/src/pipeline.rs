@@ -236,13 +236,7 @@ impl PipelineCache {
 }
 
 fn destroy_pipeline(device: &ash::Device, p: &Pipeline) {
-    unsafe {
-        device.destroy_pipeline(p.pipeline, None);
-        device.destroy_pipeline_layout(p.layout, None);
-        for &l in &p.set_layouts {
-            device.destroy_descriptor_set_layout(l, None);
-        }
-    }
+    crate::graphics::destroy_pipeline(device, p.pipeline, p.layout, &p.set_layouts);
 }
 
 /// Descriptor set layouts and the pipeline layout for a merged interface.
@@ -254,32 +248,20 @@ fn build_layout(
     let result = (|| {
         for set in 0..interface.set_count() {
             let bindings = interface.set_layout_bindings(set);
-            let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
-            set_layouts.push(
-                unsafe { device.create_descriptor_set_layout(&info, None) }
-                    .call("vkCreateDescriptorSetLayout")?,
-            );
+            set_layouts.push(crate::descriptors::create_set_layout(device, &bindings)?);
         }
         let ranges = interface.push_constant_ranges();
-        let info = vk::PipelineLayoutCreateInfo::default()
-            .set_layouts(&set_layouts)
-            .push_constant_ranges(&ranges);
-        unsafe { device.create_pipeline_layout(&info, None) }.call("vkCreatePipelineLayout")
+        crate::graphics::create_pipeline_layout(device, &set_layouts, &ranges)
     })();
     match result {
         Ok(layout) => Ok((set_layouts, layout)),
         Err(e) => {
             for l in set_layouts {
-                unsafe { device.destroy_descriptor_set_layout(l, None) };
+                crate::descriptors::destroy_set_layout(device, l);
             }
             Err(e)
         }
     }
-}
-
-fn module(device: &ash::Device, shader: &CompiledShader) -> Result<vk::ShaderModule, GpuError> {
-    let info = vk::ShaderModuleCreateInfo::default().code(&shader.spirv);
-    unsafe { device.create_shader_module(&info, None) }.call("vkCreateShaderModule")
 }
 
 fn merged(modules: &[&ShaderModule]) -> Result<PipelineInterface, GpuError> {
@@ -347,82 +329,26 @@ fn build_graphics(
         dependencies: dependencies(&[vs, fs]),
         shaders: vec![vs.compiled.path.clone(), fs.compiled.path.clone()],
     };
-    let vm = match module(device, &vs.compiled) {
-        Ok(m) => m,
-        Err(e) => {
-            destroy_pipeline(device, &pipeline);
-            return Err(e);
-        }
+    let state = crate::graphics::GraphicsState {
+        vertex_input: None,
+        cull: vk::CullModeFlags::NONE,
+        depth_bias: None,
+        samples,
+        depth: crate::graphics::DepthState::OFF,
+        blends,
+        dynamic_front_face: false,
     };
-    let fm = match module(device, &fs.compiled) {
-        Ok(m) => m,
-        Err(e) => {
-            unsafe { device.destroy_shader_module(vm, None) };
-            destroy_pipeline(device, &pipeline);
-            return Err(e);
-        }
-    };
-    let result = {
-        let stages = [
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::VERTEX)
-                .module(vm)
-                .name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::FRAGMENT)
-                .module(fm)
-                .name(c"main"),
-        ];
-        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
-        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
-            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-        let viewport = vk::PipelineViewportStateCreateInfo::default()
-            .viewport_count(1)
-            .scissor_count(1);
-        let raster = vk::PipelineRasterizationStateCreateInfo::default()
-            .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(vk::CullModeFlags::NONE)
-            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
-            .line_width(1.0);
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(crate::convert::samples(samples));
-        let depth = vk::PipelineDepthStencilStateCreateInfo::default();
-        let attachments: Vec<_> = blends.iter().map(|b| blend_state(*b)).collect();
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
-        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
-        let info = vk::GraphicsPipelineCreateInfo::default()
-            .stages(&stages)
-            .vertex_input_state(&vertex_input)
-            .input_assembly_state(&assembly)
-            .viewport_state(&viewport)
-            .rasterization_state(&raster)
-            .multisample_state(&multisample)
-            .depth_stencil_state(&depth)
-            .color_blend_state(&blend)
-            .dynamic_state(&dynamic)
-            .layout(layout)
-            .render_pass(render_pass)
-            .subpass(0);
-        unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
-            .map_err(|(_, r)| r)
-            .call("vkCreateGraphicsPipelines")
-    };
-    unsafe {
-        device.destroy_shader_module(vm, None);
-        device.destroy_shader_module(fm, None);
-    }
-    match result.map(|v| v.into_iter().next()) {
-        Ok(Some(p)) => {
+    match crate::graphics::create_graphics_pipeline(
+        device,
+        &vs.compiled,
+        Some(&fs.compiled),
+        &state,
+        layout,
+        render_pass,
+    ) {
+        Ok(p) => {
             pipeline.pipeline = p;
             Ok(pipeline)
-        }
-        Ok(None) => {
-            destroy_pipeline(device, &pipeline);
-            Err(GpuError::Vulkan {
-                call: "vkCreateGraphicsPipelines",
-                result: vk::Result::ERROR_UNKNOWN,
-            })
         }
         Err(e) => {
             destroy_pipeline(device, &pipeline);
@@ -443,7 +369,7 @@ fn build_compute(device: &ash::Device, cs: &ShaderModule) -> Result<Pipeline, Gp
         dependencies: dependencies(&[cs]),
         shaders: vec![cs.compiled.path.clone()],
     };
-    let result = module(device, &cs.compiled).and_then(|m| {
+    let result = crate::graphics::shader_module(device, &cs.compiled).and_then(|m| {
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(m)

@@ -109,3 +109,39 @@ impl Samplers {
         }
     }
 }
+
+/// A sampler destroyed on drop, for samplers outside the three above (a scene's
+/// material textures, which repeat).
+pub struct Sampler<'g> {
+    gpu: &'g Gpu,
+    sampler: vk::Sampler,
+}
+
+impl<'g> Sampler<'g> {
+    /// Linear filtering and mips, repeating in every direction: material textures.
+    pub fn linear_repeat(gpu: &'g Gpu) -> Result<Self, GpuError> {
+        let repeat = vk::SamplerAddressMode::REPEAT;
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
+            .address_mode_u(repeat)
+            .address_mode_v(repeat)
+            .address_mode_w(repeat)
+            .max_lod(vk::LOD_CLAMP_NONE);
+        let sampler =
+            unsafe { gpu.device().create_sampler(&info, None) }.call("vkCreateSampler")?;
+        Ok(Self { gpu, sampler })
+    }
+
+    /// The Vulkan handle.
+    pub fn handle(&self) -> vk::Sampler {
+        self.sampler
+    }
+}
+
+impl Drop for Sampler<'_> {
+    fn drop(&mut self) {
+        unsafe { self.gpu.device().destroy_sampler(self.sampler, None) };
+    }
+}

@@ -10,7 +10,6 @@
 #![warn(missing_docs)]
 
 pub mod brdf;
-pub mod buffer;
 pub mod camera;
 pub mod error;
 pub mod features;

@@ -10,10 +10,14 @@ use ash::vk;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
-use weft_gpu::pipeline::{blend_state, PipelineCache, ShaderKey, ShaderModule};
+use weft_gpu::descriptors::{create_set_layout, destroy_set_layout};
+use weft_gpu::graphics::{
+    create_graphics_pipeline, create_pipeline_layout, destroy_pipeline, DepthState, GraphicsState,
+    VertexInput,
+};
+use weft_gpu::pipeline::{PipelineCache, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::GpuError;
-use weft_gpu::VkCall;
 use weft_graph::plan::{Plan, PlanPass};
 use weft_graph::schema::{CompareOp, CullMode};
 
@@ -54,16 +58,6 @@ pub struct ScenePipelines {
     pipelines: HashMap<ScenePipelineKey, Arc<ScenePipeline>>,
 }
 
-fn stage_create_info(
-    stage: vk::ShaderStageFlags,
-    module: vk::ShaderModule,
-) -> vk::PipelineShaderStageCreateInfo<'static> {
-    vk::PipelineShaderStageCreateInfo::default()
-        .stage(stage)
-        .module(module)
-        .name(c"main")
-}
-
 /// The front face of a draw: counter-clockwise model triangles, turned around
 /// by a mirroring (negative-determinant) model matrix.
 pub fn front_face(mirrored: bool) -> vk::FrontFace {
@@ -74,15 +68,15 @@ pub fn front_face(mirrored: bool) -> vk::FrontFace {
     }
 }
 
-fn depth_state(test: DepthTest) -> vk::PipelineDepthStencilStateCreateInfo<'static> {
-    let (enable, write, op) = match test {
-        DepthTest::Off => (false, false, vk::CompareOp::ALWAYS),
-        DepthTest::On { compare, write } => (true, write, compare_op(compare)),
-    };
-    vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(enable)
-        .depth_write_enable(write)
-        .depth_compare_op(op)
+fn depth_state(test: DepthTest) -> DepthState {
+    match test {
+        DepthTest::Off => DepthState::OFF,
+        DepthTest::On { compare, write } => DepthState {
+            test: true,
+            write,
+            compare: compare_op(compare),
+        },
+    }
 }
 
 fn compare_op(compare: CompareOp) -> vk::CompareOp {
@@ -186,11 +180,7 @@ impl ScenePipelines {
 }
 
 fn destroy(device: &ash::Device, p: &ScenePipeline) {
-    unsafe {
-        device.destroy_pipeline(p.pipeline, None);
-        device.destroy_pipeline_layout(p.layout, None);
-        device.destroy_descriptor_set_layout(p.graph_layout, None);
-    }
+    destroy_pipeline(device, p.pipeline, p.layout, &[p.graph_layout]);
 }
 
 fn reflect_error(key: &ScenePipelineKey, message: String) -> GpuError {
@@ -223,13 +213,7 @@ fn build(
                 .stage_flags(*stages)
         })
         .collect();
-    let graph_layout = unsafe {
-        device.create_descriptor_set_layout(
-            &vk::DescriptorSetLayoutCreateInfo::default().bindings(&graph_bindings),
-            None,
-        )
-    }
-    .call("vkCreateDescriptorSetLayout")?;
+    let graph_layout = create_set_layout(device, &graph_bindings)?;
     let set_layouts = [graph_layout, scene_layout, material_layout];
     let ranges: Vec<_> = interface
         .push
@@ -241,21 +225,11 @@ fn build(
                 .size(block.size)
         })
         .collect();
-    let layout = match unsafe {
-        device.create_pipeline_layout(
-            &vk::PipelineLayoutCreateInfo::default()
-                .set_layouts(&set_layouts)
-                .push_constant_ranges(&ranges),
-            None,
-        )
-    } {
+    let layout = match create_pipeline_layout(device, &set_layouts, &ranges) {
         Ok(l) => l,
-        Err(result) => {
-            unsafe { device.destroy_descriptor_set_layout(graph_layout, None) };
-            return Err(GpuError::Vulkan {
-                call: "vkCreatePipelineLayout",
-                result,
-            });
+        Err(e) => {
+            destroy_set_layout(device, graph_layout);
+            return Err(e);
         }
     };
     let mut pipeline = ScenePipeline {
@@ -283,109 +257,54 @@ fn create_pipeline(
     fs: Option<&ShaderModule>,
     layout: vk::PipelineLayout,
 ) -> Result<vk::Pipeline, GpuError> {
-    let mut modules = Vec::new();
-    let result = (|| {
-        let mut stages = Vec::new();
-        for (module, stage) in [(Some(vs), vk::ShaderStageFlags::VERTEX)]
-            .into_iter()
-            .chain([(fs, vk::ShaderStageFlags::FRAGMENT)])
-        {
-            let Some(module) = module else { continue };
-            let info = vk::ShaderModuleCreateInfo::default().code(&module.compiled.spirv);
-            let m =
-                unsafe { device.create_shader_module(&info, None) }.call("vkCreateShaderModule")?;
-            modules.push(m);
-            stages.push(stage_create_info(stage, m));
-        }
-        let bindings = [vk::VertexInputBindingDescription {
+    let mut offset = 0;
+    let all = VERTEX_ATTRIBUTES.map(|(location, floats, _)| {
+        let attribute = vk::VertexInputAttributeDescription {
+            location,
             binding: 0,
+            format: match floats {
+                2 => vk::Format::R32G32_SFLOAT,
+                _ => vk::Format::R32G32B32_SFLOAT,
+            },
+            offset,
+        };
+        offset += floats * 4;
+        attribute
+    });
+    let attributes = if key.position_only {
+        &all[..1]
+    } else {
+        &all[..]
+    };
+    let state = &key.state;
+    // Every projection flips Y for Vulkan's downward framebuffer Y, which keeps
+    // counter-clockwise model triangles counter-clockwise in Vulkan's convention;
+    // the front face is set per draw, since a mirrored instance (negative
+    // determinant) turns its triangles' winding around (see `front_face`).
+    let graphics = GraphicsState {
+        vertex_input: Some(VertexInput {
             stride: VERTEX_BYTES,
-            input_rate: vk::VertexInputRate::VERTEX,
-        }];
-        let mut offset = 0;
-        let all = VERTEX_ATTRIBUTES.map(|(location, floats, _)| {
-            let attribute = vk::VertexInputAttributeDescription {
-                location,
-                binding: 0,
-                format: match floats {
-                    2 => vk::Format::R32G32_SFLOAT,
-                    _ => vk::Format::R32G32B32_SFLOAT,
-                },
-                offset,
-            };
-            offset += floats * 4;
-            attribute
-        });
-        let attributes = if key.position_only {
-            &all[..1]
-        } else {
-            &all[..]
-        };
-        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
-            .vertex_binding_descriptions(&bindings)
-            .vertex_attribute_descriptions(attributes);
-        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
-            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-        let viewport = vk::PipelineViewportStateCreateInfo::default()
-            .viewport_count(1)
-            .scissor_count(1);
-        let state = &key.state;
-        let (bias, constant, slope) = match state.depth_bias {
-            Some((c, s)) => (true, f32::from_bits(c), f32::from_bits(s)),
-            None => (false, 0.0, 0.0),
-        };
-        // Every projection flips Y for Vulkan's downward framebuffer Y, which keeps
-        // counter-clockwise model triangles counter-clockwise in Vulkan's convention;
-        // the front face is dynamic (see `front_face`), this value is a placeholder.
-        let raster = vk::PipelineRasterizationStateCreateInfo::default()
-            .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(match state.cull {
-                CullMode::None => vk::CullModeFlags::NONE,
-                CullMode::Front => vk::CullModeFlags::FRONT,
-                CullMode::Back => vk::CullModeFlags::BACK,
-            })
-            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
-            .depth_bias_enable(bias)
-            .depth_bias_constant_factor(constant)
-            .depth_bias_slope_factor(slope)
-            .line_width(1.0);
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::from_raw(state.samples.max(1)));
-        let depth = depth_state(state.depth);
-        let attachments: Vec<_> = state.blends.iter().map(|b| blend_state(*b)).collect();
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
-        // The front face is set per draw: a mirrored instance (negative
-        // determinant) turns its triangles' winding around.
-        let dynamic_states = [
-            vk::DynamicState::VIEWPORT,
-            vk::DynamicState::SCISSOR,
-            vk::DynamicState::FRONT_FACE,
-        ];
-        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
-        let info = vk::GraphicsPipelineCreateInfo::default()
-            .stages(&stages)
-            .vertex_input_state(&vertex_input)
-            .input_assembly_state(&assembly)
-            .viewport_state(&viewport)
-            .rasterization_state(&raster)
-            .multisample_state(&multisample)
-            .depth_stencil_state(&depth)
-            .color_blend_state(&blend)
-            .dynamic_state(&dynamic)
-            .layout(layout)
-            .render_pass(key.render_pass)
-            .subpass(0);
-        let created =
-            unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
-                .map_err(|(_, r)| r)
-                .call("vkCreateGraphicsPipelines")?;
-        created.into_iter().next().ok_or(GpuError::Vulkan {
-            call: "vkCreateGraphicsPipelines",
-            result: vk::Result::ERROR_UNKNOWN,
-        })
-    })();
-    for m in modules {
-        unsafe { device.destroy_shader_module(m, None) };
-    }
-    result
+            attributes,
+        }),
+        cull: match state.cull {
+            CullMode::None => vk::CullModeFlags::NONE,
+            CullMode::Front => vk::CullModeFlags::FRONT,
+            CullMode::Back => vk::CullModeFlags::BACK,
+        },
+        depth_bias: state
+            .depth_bias
+            .map(|(c, s)| (f32::from_bits(c), f32::from_bits(s))),
+        samples: state.samples,
+        depth: depth_state(state.depth),
+        blends: &state.blends,
+        dynamic_front_face: true,
+    };
+    create_graphics_pipeline(
+        device,
+        &vs.compiled,
+        fs.map(|f| &f.compiled),
+        &graphics,
+        layout,
+        key.render_pass,
+    )
 }

@@ -14,9 +14,10 @@ use ash::vk;
 use glam::Vec3;
 use std::sync::Arc;
 use weft_gpu::bind::{pack_push, resolve_bindings, FrameValues};
+use weft_gpu::commands::Commands;
+use weft_gpu::descriptors::{write_graph_set, DescriptorPool};
 use weft_gpu::pipeline::{BlendCode, Pipeline, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
-use weft_gpu::VkCall;
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, ShaderStage, SCENE_SET};
 use weft_graph::schema::{CompareOp, Draw, LightKind, MaterialFilter, ParamValue};
 
@@ -69,7 +70,7 @@ pub struct SceneRecorder<'g> {
     /// The uploaded scene; update it before each frame.
     pub scene: GpuScene<'g>,
     pipelines: ScenePipelines,
-    pool: vk::DescriptorPool,
+    pool: DescriptorPool<'g>,
     frame: FrameValues,
     /// Draw calls recorded in the current frame.
     pub draw_calls: u64,
@@ -78,33 +79,16 @@ pub struct SceneRecorder<'g> {
 impl<'g> SceneRecorder<'g> {
     /// A recorder for an uploaded scene.
     pub fn new(gpu: &'g Gpu, scene: GpuScene<'g>) -> Result<Self, GpuError> {
-        let sizes = [
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                descriptor_count: FRAME_SETS * 8,
-            },
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::UNIFORM_BUFFER,
-                descriptor_count: FRAME_SETS,
-            },
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: FRAME_SETS * 4,
-            },
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::STORAGE_IMAGE,
-                descriptor_count: FRAME_SETS,
-            },
-        ];
-        let pool = unsafe {
-            gpu.device().create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(FRAME_SETS)
-                    .pool_sizes(&sizes),
-                None,
-            )
-        }
-        .call("vkCreateDescriptorPool")?;
+        let pool = DescriptorPool::new(
+            gpu,
+            FRAME_SETS,
+            &[
+                (vk::DescriptorType::COMBINED_IMAGE_SAMPLER, FRAME_SETS * 8),
+                (vk::DescriptorType::UNIFORM_BUFFER, FRAME_SETS),
+                (vk::DescriptorType::STORAGE_BUFFER, FRAME_SETS * 4),
+                (vk::DescriptorType::STORAGE_IMAGE, FRAME_SETS),
+            ],
+        )?;
         Ok(Self {
             gpu,
             scene,
@@ -138,28 +122,18 @@ impl<'g> SceneRecorder<'g> {
     /// Binds a scene pipeline with the pass's graph set, the scene set, push
     /// constants and the shared vertex and index buffers.
     fn bind(&self, cmd: vk::CommandBuffer, p: &ScenePipeline, b: &PassBindings) {
-        let device = self.gpu.device();
+        let commands = Commands::new(self.gpu.device(), cmd);
         let point = vk::PipelineBindPoint::GRAPHICS;
-        unsafe {
-            device.cmd_bind_pipeline(cmd, point, p.pipeline);
-            if let Some(set) = b.graph_set {
-                device.cmd_bind_descriptor_sets(cmd, point, p.layout, 0, &[set], &[]);
-            }
-            device.cmd_bind_descriptor_sets(
-                cmd,
-                point,
-                p.layout,
-                SCENE_SET,
-                &[self.scene.scene_set],
-                &[],
-            );
-            if let Some((stages, bytes)) = &b.push {
-                device.cmd_push_constants(cmd, p.layout, *stages, 0, bytes);
-            }
-            device.cmd_bind_vertex_buffers(cmd, 0, &[self.scene.vertices.buffer], &[0]);
-            device.cmd_bind_index_buffer(cmd, self.scene.indices.buffer, 0, vk::IndexType::UINT32);
-            device.cmd_set_front_face(cmd, front_face(false));
+        commands.bind_pipeline(point, p.pipeline);
+        if let Some(set) = b.graph_set {
+            commands.bind_sets(point, p.layout, 0, &[set]);
         }
+        commands.bind_sets(point, p.layout, SCENE_SET, &[self.scene.scene_set]);
+        if let Some((stages, bytes)) = &b.push {
+            commands.push_constants(p.layout, *stages, bytes);
+        }
+        commands.bind_geometry(self.scene.vertices.buffer, self.scene.indices.buffer);
+        commands.set_front_face(front_face(false));
     }
 
     /// Draws meshes one indexed draw each (the draw record as `firstInstance`),
@@ -170,7 +144,7 @@ impl<'g> SceneRecorder<'g> {
         p: &ScenePipeline,
         draws: impl Iterator<Item = &'a DrawItem>,
     ) -> u64 {
-        let device = self.gpu.device();
+        let commands = Commands::new(self.gpu.device(), cmd);
         let textured = p
             .interface
             .bindings
@@ -180,32 +154,26 @@ impl<'g> SceneRecorder<'g> {
         let mut face = None;
         let mut calls = 0;
         for d in draws {
-            unsafe {
-                if face != Some(d.mirrored) {
-                    device.cmd_set_front_face(cmd, front_face(d.mirrored));
-                    face = Some(d.mirrored);
-                }
-                if textured && bound != Some(d.material) {
-                    let set = self.scene.material_sets[d.material as usize];
-                    device.cmd_bind_descriptor_sets(
-                        cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        p.layout,
-                        MATERIAL_SET,
-                        &[set],
-                        &[],
-                    );
-                    bound = Some(d.material);
-                }
-                device.cmd_draw_indexed(
-                    cmd,
-                    d.range.index_count,
-                    1,
-                    d.range.first_index,
-                    d.range.vertex_offset,
-                    d.draw_id,
-                );
+            if face != Some(d.mirrored) {
+                commands.set_front_face(front_face(d.mirrored));
+                face = Some(d.mirrored);
             }
+            if textured && bound != Some(d.material) {
+                let set = self.scene.material_sets[d.material as usize];
+                commands.bind_sets(
+                    vk::PipelineBindPoint::GRAPHICS,
+                    p.layout,
+                    MATERIAL_SET,
+                    &[set],
+                );
+                bound = Some(d.material);
+            }
+            commands.draw_indexed(
+                d.range.index_count,
+                d.range.first_index,
+                d.range.vertex_offset,
+                d.draw_id,
+            );
             calls += 1;
         }
         calls
@@ -248,71 +216,23 @@ impl<'g> SceneRecorder<'g> {
                 problems,
             }
         })?;
-        let layouts = [layout];
-        let set = unsafe {
-            self.gpu.device().allocate_descriptor_sets(
-                &vk::DescriptorSetAllocateInfo::default()
-                    .descriptor_pool(self.pool)
-                    .set_layouts(&layouts),
-            )
-        }
-        .call("vkAllocateDescriptorSets")?
-        .into_iter()
-        .next()
-        .ok_or(GpuError::Vulkan {
-            call: "vkAllocateDescriptorSets",
-            result: vk::Result::ERROR_OUT_OF_POOL_MEMORY,
-        })?;
-        let mut images = Vec::new();
-        let mut buffers = Vec::new();
-        for rb in &resolved {
-            let resource = rb.graph.resource;
-            match ctx.resources.get(resource) {
-                Some(weft_gpu::resources::GpuResource::Image(img)) => images.push((
-                    rb,
-                    [vk::DescriptorImageInfo {
-                        sampler: if rb.shader.depth_compare {
-                            ctx.compare_sampler
-                        } else if ctx.gpu.linear_filter(img.desc.format_raw) {
-                            ctx.sampler
-                        } else {
-                            ctx.nearest_sampler
-                        },
-                        image_view: img.shader_view,
-                        image_layout: ctx.image_layout(resource),
-                    }],
-                )),
-                Some(weft_gpu::resources::GpuResource::Buffer(buf)) => buffers.push((
-                    rb,
-                    [vk::DescriptorBufferInfo {
-                        buffer: buf.buffer,
-                        offset: 0,
-                        range: vk::WHOLE_SIZE,
-                    }],
-                )),
-                None => return Err(GpuError::Plan(format!("resource {resource} missing"))),
-            }
-        }
-        let mut writes = Vec::new();
-        for (rb, info) in &images {
-            writes.push(
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(rb.shader.binding)
-                    .descriptor_type(rb.shader.kind.vk())
-                    .image_info(info),
-            );
-        }
-        for (rb, info) in &buffers {
-            writes.push(
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(rb.shader.binding)
-                    .descriptor_type(rb.shader.kind.vk())
-                    .buffer_info(info),
-            );
-        }
-        unsafe { self.gpu.device().update_descriptor_sets(&writes, &[]) };
+        let set = self.pool.allocate(layout)?;
+        write_graph_set(
+            self.gpu,
+            set,
+            &resolved,
+            ctx.resources,
+            |compare, format| {
+                if compare {
+                    ctx.compare_sampler
+                } else if ctx.gpu.linear_filter(format) {
+                    ctx.sampler
+                } else {
+                    ctx.nearest_sampler
+                }
+            },
+            |resource| ctx.image_layout(resource),
+        )?;
         Ok(Some(set))
     }
 }
@@ -334,7 +254,7 @@ impl SceneRecorder<'_> {
             pass: pass.name.clone(),
             message: "shadow pass without push constants".into(),
         })?;
-        let device = self.gpu.device();
+        let commands = ctx.commands();
         let mut calls = 0;
         for (i, view) in views.iter().enumerate() {
             let mut params = pass.params.clone();
@@ -345,35 +265,17 @@ impl SceneRecorder<'_> {
                     message: problems.join("; "),
                 })?;
             let [x, y, side] = view.viewport;
-            unsafe {
-                device.cmd_set_viewport(
-                    ctx.cmd,
-                    0,
-                    &[vk::Viewport {
-                        x: x as f32,
-                        y: y as f32,
-                        width: side as f32,
-                        height: side as f32,
-                        min_depth: 0.0,
-                        max_depth: 1.0,
-                    }],
-                );
-                device.cmd_set_scissor(
-                    ctx.cmd,
-                    0,
-                    &[vk::Rect2D {
-                        offset: vk::Offset2D {
-                            x: x as i32,
-                            y: y as i32,
-                        },
-                        extent: vk::Extent2D {
-                            width: side,
-                            height: side,
-                        },
-                    }],
-                );
-                device.cmd_push_constants(ctx.cmd, p.layout, *stages, 0, &bytes);
-            }
+            commands.set_viewport_and_scissor(vk::Rect2D {
+                offset: vk::Offset2D {
+                    x: x as i32,
+                    y: y as i32,
+                },
+                extent: vk::Extent2D {
+                    width: side,
+                    height: side,
+                },
+            });
+            commands.push_constants(p.layout, *stages, &bytes);
             calls += self.draw_meshes(ctx.cmd, p, self.scene.geometry.filtered(filter));
         }
         Ok(calls)
@@ -384,12 +286,7 @@ impl DrawRecorder for SceneRecorder<'_> {
     /// The previous frame's graph descriptor sets are recycled and the draw
     /// count starts again.
     fn begin_frame(&mut self) -> Result<(), GpuError> {
-        unsafe {
-            self.gpu
-                .device()
-                .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
-        }
-        .call("vkResetDescriptorPool")?;
+        self.pool.reset()?;
         self.draw_calls = 0;
         Ok(())
     }
@@ -426,7 +323,10 @@ impl DrawRecorder for SceneRecorder<'_> {
             position_only: position_only(pass),
         };
         let device = self.gpu.device();
-        let layouts = [self.scene.scene_layout, self.scene.material_layout];
+        let layouts = [
+            self.scene.scene_layout.handle(),
+            self.scene.material_layout.handle(),
+        ];
         let p = self
             .pipelines
             .get(device, &key, layouts, (ctx.plan, pass))?;
@@ -493,16 +393,13 @@ impl DrawRecorder for SceneRecorder<'_> {
                     )));
                 }
                 for (mesh, count, first) in groups.into_iter().filter(|g| g.1 > 0) {
-                    unsafe {
-                        device.cmd_draw_indexed(
-                            ctx.cmd,
-                            mesh.index_count,
-                            count,
-                            mesh.first_index,
-                            mesh.vertex_offset,
-                            first,
-                        );
-                    }
+                    ctx.commands().draw_indexed_instanced(
+                        mesh.index_count,
+                        count,
+                        mesh.first_index,
+                        mesh.vertex_offset,
+                        first,
+                    );
                     calls += 1;
                 }
             }
@@ -543,27 +440,15 @@ impl DrawRecorder for SceneRecorder<'_> {
                 message: "pipeline has no scene set layout".into(),
             })?;
         let set = self.scene.foreign_set(layout, bindings)?;
-        unsafe {
-            self.gpu.device().cmd_bind_descriptor_sets(
-                ctx.cmd,
-                pipeline.bind_point,
-                pipeline.layout,
-                SCENE_SET,
-                &[set],
-                &[],
-            )
-        };
+        ctx.commands()
+            .bind_sets(pipeline.bind_point, pipeline.layout, SCENE_SET, &[set]);
         Ok(())
     }
 }
 
 impl Drop for SceneRecorder<'_> {
     fn drop(&mut self) {
-        let device = self.gpu.device();
-        unsafe {
-            let _ = device.device_wait_idle();
-            device.destroy_descriptor_pool(self.pool, None);
-        }
-        self.pipelines.destroy(device);
+        let _ = self.gpu.wait_idle();
+        self.pipelines.destroy(self.gpu.device());
     }
 }

@@ -2,7 +2,6 @@
 //! textures, and the per-frame camera and light buffers; descriptor set 1 (scene
 //! data) and set 2 (a material's textures) that every scene shader binds.
 
-use crate::buffer::Buffer;
 use crate::camera;
 use crate::error::RenderError;
 use crate::geometry::SceneGeometry;
@@ -10,13 +9,16 @@ use crate::gpu_types::{bytes_of, GpuFrame, GpuMaterial};
 use crate::lights::{pack_lights, LightSet, LIGHT_BYTES};
 use crate::materials::pack_material;
 use crate::shadows::{self, ShadowSettings, ShadowView, ViewVolume};
-use crate::texture::{self, Pixels, Texture};
+use crate::texture;
 use ash::vk;
 use glam::{UVec4, Vec4};
 use std::collections::HashMap;
 use std::path::PathBuf;
+use weft_gpu::buffer::Buffer;
+use weft_gpu::descriptors::{DescriptorPool, DescriptorWriter, SetLayout};
 use weft_gpu::reflect::DescriptorKind;
-use weft_gpu::VkCall;
+use weft_gpu::samplers::Sampler;
+use weft_gpu::texture::{Rgba8Image, Texture};
 use weft_gpu::{Gpu, GpuError};
 use weft_scene::material::{TextureRef, TextureSource};
 use weft_scene::{Camera, Scene};
@@ -83,6 +85,50 @@ pub const MATERIAL_SET_BINDINGS: [(u32, DescriptorKind, &str); 3] = [
 ];
 /// Bytes of the `Frame` uniform block.
 pub const FRAME_BYTES: usize = std::mem::size_of::<GpuFrame>();
+/// The layouts of set 1 (scene data, [`SCENE_SET_BINDINGS`]) and set 2 (one
+/// material's textures, [`MATERIAL_SET_BINDINGS`]).
+fn set_layouts(gpu: &Gpu) -> Result<(SetLayout<'_>, SetLayout<'_>), GpuError> {
+    let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+    let scene_bindings: Vec<_> = SCENE_SET_BINDINGS
+        .iter()
+        .map(|&(b, kind, _)| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(b)
+                .descriptor_type(kind.vk())
+                .descriptor_count(1)
+                .stage_flags(stages)
+        })
+        .collect();
+    let material_bindings = MATERIAL_SET_BINDINGS.map(|(b, _, _)| {
+        vk::DescriptorSetLayoutBinding::default()
+            .binding(b)
+            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+            .descriptor_count(1)
+            .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+    });
+    Ok((
+        SetLayout::new(gpu, &scene_bindings)?,
+        SetLayout::new(gpu, &material_bindings)?,
+    ))
+}
+
+/// A pool for the scene set, the executor-built scene sets and one set per material.
+fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuError> {
+    let scene_sets = 1 + FOREIGN_SETS;
+    DescriptorPool::new(
+        gpu,
+        scene_sets + materials,
+        &[
+            (vk::DescriptorType::UNIFORM_BUFFER, scene_sets),
+            (vk::DescriptorType::STORAGE_BUFFER, 4 * scene_sets),
+            (
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                MATERIAL_SET_BINDINGS.len() as u32 * materials.max(1),
+            ),
+        ],
+    )
+}
+
 /// Scene sets that fullscreen pipelines built by the executor may ask for.
 const FOREIGN_SETS: u32 = 32;
 
@@ -101,12 +147,12 @@ pub struct GpuScene<'g> {
     lights: Buffer<'g>,
     shadows: Buffer<'g>,
     textures: Vec<Texture<'g>>,
-    sampler: vk::Sampler,
-    pool: vk::DescriptorPool,
+    sampler: Sampler<'g>,
+    pool: DescriptorPool<'g>,
     /// Layout of set 1 (scene data) in pipelines built here.
-    pub scene_layout: vk::DescriptorSetLayout,
+    pub scene_layout: SetLayout<'g>,
     /// Layout of set 2 (one material's textures).
-    pub material_layout: vk::DescriptorSetLayout,
+    pub material_layout: SetLayout<'g>,
     /// Set 1 for `scene_layout`.
     pub scene_set: vk::DescriptorSet,
     /// Set 2 per material.
@@ -164,7 +210,7 @@ impl<'g> GpuScene<'g> {
             bytes_of(&geometry.draw_records),
             storage,
         )?;
-        let mut textures = vec![Texture::upload(gpu, "white", &Pixels::white(), true)?];
+        let mut textures = vec![Texture::upload(gpu, "white", &Rgba8Image::white(), true)?];
         let mut by_source: HashMap<(String, bool), usize> = HashMap::new();
         let mut material_texture = Vec::with_capacity(geometry.materials.len());
         let mut material_records: Vec<GpuMaterial> = Vec::with_capacity(geometry.materials.len());
@@ -215,17 +261,9 @@ impl<'g> GpuScene<'g> {
         )?;
         let mut shadows = Buffer::host(gpu, "shadows", shadows::SHADOWS_BYTES as u64, storage)?;
         shadows.write(&vec![0u8; shadows::SHADOWS_BYTES])?;
-        let device = gpu.device();
-        let sampler_info = vk::SamplerCreateInfo::default()
-            .mag_filter(vk::Filter::LINEAR)
-            .min_filter(vk::Filter::LINEAR)
-            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
-            .address_mode_u(vk::SamplerAddressMode::REPEAT)
-            .address_mode_v(vk::SamplerAddressMode::REPEAT)
-            .address_mode_w(vk::SamplerAddressMode::REPEAT)
-            .max_lod(vk::LOD_CLAMP_NONE);
-        let sampler =
-            unsafe { device.create_sampler(&sampler_info, None) }.call("vkCreateSampler")?;
+        let sampler = Sampler::linear_repeat(gpu)?;
+        let (scene_layout, material_layout) = set_layouts(gpu)?;
+        let pool = descriptor_pool(gpu, material_texture.len() as u32)?;
         let mut this = Self {
             gpu,
             geometry,
@@ -238,9 +276,9 @@ impl<'g> GpuScene<'g> {
             shadows,
             textures,
             sampler,
-            pool: vk::DescriptorPool::null(),
-            scene_layout: vk::DescriptorSetLayout::null(),
-            material_layout: vk::DescriptorSetLayout::null(),
+            pool,
+            scene_layout,
+            material_layout,
             scene_set: vk::DescriptorSet::null(),
             material_sets: Vec::new(),
             foreign_sets: HashMap::new(),
@@ -263,65 +301,7 @@ impl<'g> GpuScene<'g> {
     }
 
     fn create_sets(&mut self, material_texture: &[[usize; 3]]) -> Result<(), GpuError> {
-        let device = self.gpu.device();
-        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-        let scene_bindings: Vec<_> = SCENE_SET_BINDINGS
-            .iter()
-            .map(|&(b, kind, _)| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(b)
-                    .descriptor_type(kind.vk())
-                    .descriptor_count(1)
-                    .stage_flags(stages)
-            })
-            .collect();
-        self.scene_layout = unsafe {
-            device.create_descriptor_set_layout(
-                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&scene_bindings),
-                None,
-            )
-        }
-        .call("vkCreateDescriptorSetLayout")?;
-        let material_bindings = MATERIAL_SET_BINDINGS.map(|(b, _, _)| {
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(b)
-                .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                .descriptor_count(1)
-                .stage_flags(vk::ShaderStageFlags::FRAGMENT)
-        });
-        self.material_layout = unsafe {
-            device.create_descriptor_set_layout(
-                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&material_bindings),
-                None,
-            )
-        }
-        .call("vkCreateDescriptorSetLayout")?;
-        let materials = material_texture.len() as u32;
-        let scene_sets = 1 + FOREIGN_SETS;
-        let sizes = [
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::UNIFORM_BUFFER,
-                descriptor_count: scene_sets,
-            },
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: 4 * scene_sets,
-            },
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                descriptor_count: MATERIAL_SET_BINDINGS.len() as u32 * materials.max(1),
-            },
-        ];
-        self.pool = unsafe {
-            device.create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(scene_sets + materials)
-                    .pool_sizes(&sizes),
-                None,
-            )
-        }
-        .call("vkCreateDescriptorPool")?;
-        self.scene_set = self.allocate(self.scene_layout)?;
+        self.scene_set = self.pool.allocate(self.scene_layout.handle())?;
         self.write_scene_set(
             self.scene_set,
             &[
@@ -333,70 +313,35 @@ impl<'g> GpuScene<'g> {
             ],
         );
         for slots in material_texture {
-            let set = self.allocate(self.material_layout)?;
-            let infos = slots.map(|slot| {
-                [vk::DescriptorImageInfo {
-                    sampler: self.sampler,
-                    image_view: self.textures[slot].view,
-                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                }]
-            });
-            let writes: Vec<_> = MATERIAL_SET_BINDINGS
-                .iter()
-                .zip(&infos)
-                .map(|(&(binding, _, _), info)| {
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(set)
-                        .dst_binding(binding)
-                        .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                        .image_info(info)
-                })
-                .collect();
-            unsafe { device.update_descriptor_sets(&writes, &[]) };
+            let set = self.pool.allocate(self.material_layout.handle())?;
+            let mut writer = DescriptorWriter::default();
+            for (&(binding, _, _), slot) in MATERIAL_SET_BINDINGS.iter().zip(slots) {
+                writer.image(
+                    binding,
+                    vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                    self.sampler.handle(),
+                    self.textures[*slot].view,
+                    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                );
+            }
+            writer.write(self.gpu, set);
             self.material_sets.push(set);
         }
         Ok(())
     }
 
-    fn allocate(&self, layout: vk::DescriptorSetLayout) -> Result<vk::DescriptorSet, GpuError> {
-        let layouts = [layout];
-        let info = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(self.pool)
-            .set_layouts(&layouts);
-        let sets = unsafe { self.gpu.device().allocate_descriptor_sets(&info) }
-            .call("vkAllocateDescriptorSets")?;
-        sets.into_iter().next().ok_or(GpuError::Vulkan {
-            call: "vkAllocateDescriptorSets",
-            result: vk::Result::ERROR_OUT_OF_POOL_MEMORY,
-        })
-    }
-
     /// Writes the scene buffers into the listed bindings of `set`.
     fn write_scene_set(&self, set: vk::DescriptorSet, bindings: &[u32]) {
-        let infos: Vec<(u32, vk::DescriptorType, [vk::DescriptorBufferInfo; 1])> =
-            SCENE_SET_BINDINGS
-                .iter()
-                .filter(|(b, _, _)| bindings.contains(b))
-                .filter_map(|&(b, kind, _)| {
-                    let info = vk::DescriptorBufferInfo {
-                        buffer: self.scene_buffer(b)?.buffer,
-                        offset: 0,
-                        range: vk::WHOLE_SIZE,
-                    };
-                    Some((b, kind.vk(), [info]))
-                })
-                .collect();
-        let writes: Vec<_> = infos
+        let mut writer = DescriptorWriter::default();
+        for &(b, kind, _) in SCENE_SET_BINDINGS
             .iter()
-            .map(|(b, ty, info)| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(*b)
-                    .descriptor_type(*ty)
-                    .buffer_info(info)
-            })
-            .collect();
-        unsafe { self.gpu.device().update_descriptor_sets(&writes, &[]) };
+            .filter(|(b, _, _)| bindings.contains(b))
+        {
+            if let Some(buffer) = self.scene_buffer(b) {
+                writer.buffer(b, kind.vk(), buffer.buffer);
+            }
+        }
+        writer.write(self.gpu, set);
     }
 
     /// The buffer behind a set 1 binding of [`SCENE_SET_BINDINGS`].
@@ -423,7 +368,7 @@ impl<'g> GpuScene<'g> {
             return Ok(set);
         }
         let bindings = bindings()?;
-        let set = self.allocate(layout)?;
+        let set = self.pool.allocate(layout)?;
         self.write_scene_set(set, &bindings);
         self.foreign_sets.insert(layout, set);
         Ok(set)
@@ -495,14 +440,9 @@ fn source_key(source: &TextureSource) -> String {
 }
 
 impl Drop for GpuScene<'_> {
+    /// The sets, layouts, sampler and buffers are freed when the fields drop;
+    /// the device must have finished with them first.
     fn drop(&mut self) {
-        let device = self.gpu.device();
-        unsafe {
-            let _ = device.device_wait_idle();
-            device.destroy_descriptor_pool(self.pool, None);
-            device.destroy_descriptor_set_layout(self.scene_layout, None);
-            device.destroy_descriptor_set_layout(self.material_layout, None);
-            device.destroy_sampler(self.sampler, None);
-        }
+        let _ = self.gpu.wait_idle();
     }
 }

@@ -5,10 +5,10 @@
 use super::{FrameOptions, Prepared, Renderer};
 use crate::bind::{self, FrameValues};
 use crate::context::Gpu;
+use crate::descriptors::DescriptorPool;
 use crate::error::GpuError;
-use crate::frame::DescriptorPool;
 use crate::layouts;
-use crate::resources::{FrameResources, GpuResource};
+use crate::resources::FrameResources;
 use ash::vk;
 use weft_graph::id::PassId;
 use weft_graph::plan::{Plan, PlanPass, PlanResource, ResourceDesc};
@@ -90,59 +90,15 @@ impl<'g> Renderer<'g> {
             let Some(&set_layout) = pipeline.set_layouts.first() else {
                 continue;
             };
-            prep.set = pool.allocate(self.gpu, set_layout)?;
-            let mut image_infos = Vec::new();
-            let mut buffer_infos = Vec::new();
-            for rb in &prep.bindings {
-                match resources.get(rb.graph.resource) {
-                    Some(GpuResource::Image(img)) => image_infos.push((
-                        rb,
-                        [vk::DescriptorImageInfo {
-                            sampler: self.samplers.for_binding(
-                                self.gpu,
-                                rb.shader.depth_compare,
-                                img.desc.format_raw,
-                            ),
-                            image_view: img.shader_view,
-                            image_layout: crate::convert::layout(layouts[rb.graph.resource]),
-                        }],
-                    )),
-                    Some(GpuResource::Buffer(buf)) => buffer_infos.push((
-                        rb,
-                        [vk::DescriptorBufferInfo {
-                            buffer: buf.buffer,
-                            offset: 0,
-                            range: vk::WHOLE_SIZE,
-                        }],
-                    )),
-                    None => {
-                        return Err(GpuError::Plan(format!(
-                            "resource {} missing",
-                            rb.graph.resource
-                        )))
-                    }
-                }
-            }
-            let mut writes = Vec::new();
-            for (rb, info) in &image_infos {
-                writes.push(
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(prep.set)
-                        .dst_binding(rb.shader.binding)
-                        .descriptor_type(rb.shader.kind.vk())
-                        .image_info(info),
-                );
-            }
-            for (rb, info) in &buffer_infos {
-                writes.push(
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(prep.set)
-                        .dst_binding(rb.shader.binding)
-                        .descriptor_type(rb.shader.kind.vk())
-                        .buffer_info(info),
-                );
-            }
-            unsafe { self.gpu.device().update_descriptor_sets(&writes, &[]) };
+            prep.set = pool.allocate(set_layout)?;
+            crate::descriptors::write_graph_set(
+                self.gpu,
+                prep.set,
+                &prep.bindings,
+                resources,
+                |compare, format| self.samplers.for_binding(self.gpu, compare, format),
+                |r| crate::convert::layout(layouts[r]),
+            )?;
         }
         Ok(())
     }

@@ -1,12 +1,12 @@
-//! Buffers for scene data through the gpu crate's allocator: device-local ones
+//! Buffers outside a plan's resources (scene data, for one) through the allocator: device-local ones
 //! filled once through a staging copy (geometry, draws, materials), and
 //! host-visible ones rewritten every frame (camera, animated lights).
 
+use crate::context::Gpu;
+use crate::error::{GpuError, VkCall};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
-use weft_gpu::VkCall;
-use weft_gpu::{Gpu, GpuError};
 
 /// A buffer and its memory, freed on drop.
 pub struct Buffer<'g> {
