@@ -18,6 +18,10 @@ pub enum GraphCommand {
         /// the graph: bindings, push constants, outputs.
         #[arg(long)]
         shaders: bool,
+        /// Print the diagnostics as JSON (an array of objects with severity,
+        /// file, pos, message, hint and notes) on stdout.
+        #[arg(long)]
+        json: bool,
     },
     /// Compile a graph and print its plan: pass order, culled passes, barriers, render-pass ops.
     Plan {
@@ -65,10 +69,9 @@ pub fn check_feature_names(graph: &Path, features: &[String]) -> Result<()> {
     }
 }
 
+/// Each diagnostic with its source line and a caret under the position.
 fn print_diagnostics(diags: &[Diagnostic]) {
-    for d in diags {
-        eprintln!("{d}");
-    }
+    eprint!("{}", weft_graph::diagnostic::render(diags));
 }
 
 fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Plan, f64)> {
@@ -111,8 +114,13 @@ fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Pla
 /// Runs a graph subcommand.
 pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
     match cmd {
-        GraphCommand::Check { files, shaders } => {
+        GraphCommand::Check {
+            files,
+            shaders,
+            json,
+        } => {
             let mut failed = false;
+            let mut all = Vec::new();
             for file in &files {
                 let graph = weft_graph::load(file);
                 let diags = if shaders {
@@ -122,9 +130,12 @@ pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
                     diags.extend(weft_render::providers::check(&graph));
                     diags
                 };
-                print_diagnostics(&diags);
+                if !json {
+                    print_diagnostics(&diags);
+                }
                 let errors = diags.iter().filter(|d| d.is_error()).count();
                 let warnings = diags.len() - errors;
+                all.extend(diags);
                 if errors > 0 {
                     failed = true;
                     eprintln!(
@@ -134,6 +145,9 @@ pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
                 } else {
                     eprintln!("{}: ok ({warnings} warning(s))", file.display());
                 }
+            }
+            if json {
+                println!("{}", weft_graph::diagnostic::to_json(&all));
             }
             Ok(if failed {
                 ExitCode::FAILURE

@@ -36,6 +36,9 @@ pub fn run(cmd: SceneCommand) -> Result<ExitCode> {
                     println!("{}", serde_json::to_string_pretty(&value)?);
                 } else {
                     eprintln!("error: {err}");
+                    if let Some(snippet) = weft_diagnostic::source_snippet(&err.diagnostic()) {
+                        eprint!("{snippet}");
+                    }
                 }
                 Ok(ExitCode::FAILURE)
             }

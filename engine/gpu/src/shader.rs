@@ -43,6 +43,23 @@ pub struct ShaderDiagnostic {
     pub message: String,
 }
 
+impl ShaderDiagnostic {
+    /// The compiler's message as weft's one diagnostic type: its `error:` or
+    /// `warning:` prefix becomes the severity.
+    pub fn diagnostic(&self) -> weft_diagnostic::Diagnostic {
+        use weft_diagnostic::{Diagnostic, Severity};
+        let text = self.message.trim();
+        let (severity, message) = match text.strip_prefix("warning:") {
+            Some(rest) => (Severity::Warning, rest),
+            None => (Severity::Error, text.strip_prefix("error:").unwrap_or(text)),
+        };
+        Diagnostic {
+            severity,
+            ..Diagnostic::in_file(&self.file, self.line, message.trim())
+        }
+    }
+}
+
 impl fmt::Display for ShaderDiagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.line {

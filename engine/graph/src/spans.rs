@@ -2,21 +2,7 @@
 //! this reads the same text into a tree of positions that validation queries by
 //! path (`passes[3].color[0].image`) to point errors at the exact line and column.
 
-use serde::Serialize;
-use std::fmt;
-
-/// A 1-based line and column.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Default)]
-pub struct Pos {
-    pub line: u32,
-    pub col: u32,
-}
-
-impl fmt::Display for Pos {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(f, "{}:{}", self.line, self.col)
-    }
-}
+pub use weft_diagnostic::Pos;
 
 /// One step of a path into a RON value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,7 +1,8 @@
 //! Errors of the render crate: what can fail turning a scene and a graph into frames.
 
 use std::path::PathBuf;
-use weft_gpu::GpuError;
+use weft_gpu::{GpuError, ShaderDiagnostic, ShaderError};
+use weft_graph::Diagnostic;
 
 /// Anything that can go wrong uploading a scene or rendering it through a graph.
 #[derive(Debug, thiserror::Error)]
@@ -43,6 +44,23 @@ pub enum RenderError {
 }
 
 impl RenderError {
+    /// The located problems behind this error, as weft's one diagnostic type:
+    /// the graph's diagnostics, a shader compiler's, or the pass a frame failed
+    /// in. Empty when the error names no file.
+    pub fn diagnostics(&self) -> Vec<Diagnostic> {
+        match self {
+            Self::Graph(diagnostics) => diagnostics.clone(),
+            Self::Gpu(GpuError::Shader(ShaderError::Compile(list))) => {
+                list.iter().map(ShaderDiagnostic::diagnostic).collect()
+            }
+            Self::AtPass { at, error } => {
+                vec![Diagnostic::error(&at.file, at.pos, error.to_string())]
+            }
+            Self::Texture { path, message } => vec![Diagnostic::in_file(path, None, message)],
+            Self::Gpu(_) | Self::Camera { .. } | Self::TooLarge(_) => Vec::new(),
+        }
+    }
+
     /// `error` located at the declaration of the pass it names, when it names
     /// one of `plan`'s passes.
     pub fn at_pass(error: GpuError, plan: &weft_graph::Plan) -> Self {

@@ -1,10 +1,12 @@
 //! A refused reload, located at the file and line to fix, whichever step
-//! refused it (scene, graph, shader or device).
+//! refused it (scene, graph, shader or device). It is built from the refusing
+//! step's own diagnostic, not from its message text.
 
 use crate::error::RenderError;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use weft_gpu::{GpuError, ShaderError};
+use weft_gpu::GpuError;
+use weft_graph::Diagnostic;
 use weft_scene::SceneError;
 
 /// Why a reload was refused, located at the file and line to fix.
@@ -16,6 +18,8 @@ pub struct ReloadError {
     pub line: Option<u32>,
     /// What is wrong, on one line.
     pub message: String,
+    /// How to fix it, when the refusing step knows.
+    pub hint: Option<String>,
 }
 
 impl fmt::Display for ReloadError {
@@ -27,52 +31,50 @@ impl fmt::Display for ReloadError {
     }
 }
 
-impl ReloadError {
-    pub(crate) fn new(file: &Path, line: Option<u32>, message: &str) -> Self {
+impl From<Diagnostic> for ReloadError {
+    fn from(d: Diagnostic) -> Self {
         Self {
-            file: file.to_path_buf(),
-            line,
-            message: message
-                .lines()
-                .next()
-                .map(|l| l.strip_prefix("error: ").unwrap_or(l).trim())
-                .unwrap_or_default()
-                .to_string(),
+            line: d.line(),
+            file: d.file,
+            message: d.message,
+            hint: d.hint,
         }
+    }
+}
+
+impl ReloadError {
+    /// A refusal with no diagnostic behind it (a device error, a race), put on `file`.
+    pub(crate) fn new(file: &Path, line: Option<u32>, message: &str) -> Self {
+        let first_line = message.lines().next().unwrap_or_default().trim();
+        Diagnostic::in_file(file, line, first_line).into()
+    }
+
+    /// The refusal as weft's one diagnostic type, hint included.
+    pub fn diagnostic(&self) -> Diagnostic {
+        let mut d = Diagnostic::in_file(&self.file, self.line, &self.message);
+        d.hint = self.hint.clone();
+        d
     }
 
     pub(crate) fn scene(err: &SceneError) -> Self {
-        let at = err.location();
-        let line = at.line.and_then(|l| u32::try_from(l).ok());
-        Self::new(&at.file, line, &err.message())
+        err.diagnostic().into()
     }
 
-    /// Locates a render error; errors that name no file are put on `fallback`.
+    /// Locates a render error at its first error diagnostic; errors that name
+    /// no file are put on `fallback`.
     pub(crate) fn render(err: RenderError, fallback: &Path) -> Self {
-        match err {
-            RenderError::Graph(diagnostics) => diagnostics
-                .iter()
-                .find(|d| d.is_error())
-                .or(diagnostics.first())
-                .map(|d| Self::new(&d.file, Some(d.pos.line), &d.message))
-                .unwrap_or_else(|| Self::new(fallback, None, "the graph did not compile")),
-            RenderError::Gpu(err) => Self::gpu(err, fallback),
-            RenderError::AtPass { at, error } => {
-                Self::new(&at.file, Some(at.pos.line), &error.to_string())
-            }
-            other => Self::new(fallback, None, &other.to_string()),
+        let diagnostics = err.diagnostics();
+        match diagnostics
+            .iter()
+            .find(|d| d.is_error())
+            .or(diagnostics.first())
+        {
+            Some(d) => d.clone().into(),
+            None => Self::new(fallback, None, &err.to_string()),
         }
     }
 
     pub(crate) fn gpu(err: GpuError, fallback: &Path) -> Self {
-        match err {
-            GpuError::Shader(ShaderError::Compile(diagnostics)) => diagnostics
-                .iter()
-                .find(|d| d.message.starts_with("error"))
-                .or(diagnostics.first())
-                .map(|d| Self::new(&d.file, d.line, &d.message))
-                .unwrap_or_else(|| Self::new(fallback, None, "shader compilation failed")),
-            other => Self::new(fallback, None, &other.to_string()),
-        }
+        Self::render(RenderError::Gpu(err), fallback)
     }
 }

@@ -50,6 +50,17 @@ pub struct Warning {
     pub message: String,
 }
 
+impl Warning {
+    /// The warning as weft's one diagnostic type.
+    pub fn diagnostic(&self) -> weft_diagnostic::Diagnostic {
+        let line = self.at.line.and_then(|l| u32::try_from(l).ok());
+        weft_diagnostic::Diagnostic {
+            severity: weft_diagnostic::Severity::Warning,
+            ..weft_diagnostic::Diagnostic::in_file(&self.at.file, line, &self.message)
+        }
+    }
+}
+
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}: warning: {}", self.at, self.message)
@@ -147,6 +158,17 @@ impl SceneError {
         let prefix = format!("{}: ", self.location());
         full.strip_prefix(&prefix)
             .map_or(full.clone(), str::to_string)
+    }
+
+    /// The error as weft's one diagnostic type, for printing it like graph and
+    /// shader errors (with the source line) or as JSON.
+    pub fn diagnostic(&self) -> weft_diagnostic::Diagnostic {
+        let at = self.location();
+        weft_diagnostic::Diagnostic::in_file(
+            &at.file,
+            at.line.and_then(|l| u32::try_from(l).ok()),
+            self.message(),
+        )
     }
 
     /// Where the error is.
