@@ -59,6 +59,8 @@ pub struct FrameResources<'g> {
     pub transient_bytes: u64,
     /// Bytes of resources with memory of their own (history, output, buffers).
     pub dedicated_bytes: u64,
+    /// The plan's passes as the executor prepared them on these resources.
+    pub(crate) prepared: Option<crate::executor::PreparedPlan<'g>>,
 }
 
 /// The memory requirements the device reports for an image, without creating
@@ -114,6 +116,7 @@ impl<'g> FrameResources<'g> {
             framebuffers: HashMap::new(),
             transient_bytes: 0,
             dedicated_bytes: 0,
+            prepared: None,
         };
         for r in &plan.resources {
             let created = match &r.desc {

@@ -21,7 +21,7 @@ use crate::timing::{PassTiming, QueryPool, TimingMode, TimingSource};
 mod prepare;
 mod record_pass;
 
-use prepare::descriptor_pool;
+use crate::descriptors::DescriptorPool;
 
 use ash::vk;
 use std::sync::Arc;
@@ -67,7 +67,7 @@ pub struct FrameReport {
 }
 
 /// Everything a pass needs at record time.
-struct Prepared {
+pub(crate) struct Prepared {
     pipeline: Option<Arc<Pipeline>>,
     render_pass: vk::RenderPass,
     framebuffer: vk::Framebuffer,
@@ -78,9 +78,24 @@ struct Prepared {
     set: vk::DescriptorSet,
 }
 
+/// A plan's passes made ready on its resources, once: pipelines, render
+/// passes, framebuffers, clear values, resolved bindings and written descriptor
+/// sets. Kept with the resources ([`FrameResources`]) until the pipelines it
+/// uses change; a frame then only packs push constants and records.
+pub(crate) struct PreparedPlan<'g> {
+    /// The renderer's pipeline generation it was built against.
+    generation: u64,
+    passes: Vec<Prepared>,
+    /// Holds the passes' descriptor sets.
+    _pool: DescriptorPool<'g>,
+}
+
 /// Executes plans; owns the render-pass and pipeline caches and the samplers.
 pub struct Renderer<'g> {
     gpu: &'g Gpu,
+    /// Bumped whenever pipelines may have been replaced, so plans prepared
+    /// against the old ones are prepared again.
+    generation: u64,
     render_passes: RenderPassCache,
     pipelines: PipelineCache,
     samplers: Samplers,
@@ -93,6 +108,7 @@ impl<'g> Renderer<'g> {
         let samplers = Samplers::new(gpu)?;
         Ok(Self {
             gpu,
+            generation: 0,
             render_passes: RenderPassCache::default(),
             pipelines,
             samplers,
@@ -106,6 +122,7 @@ impl<'g> Renderer<'g> {
 
     /// The shader and pipeline cache (for hot reload and inspection).
     pub fn pipelines(&mut self) -> &mut PipelineCache {
+        self.generation += 1;
         &mut self.pipelines
     }
 
@@ -113,6 +130,7 @@ impl<'g> Renderer<'g> {
     /// recompiles them (hot reload); returns how many pipelines were dropped.
     pub fn reload(&mut self, changed: &std::path::Path) -> Result<usize, GpuError> {
         self.gpu.wait_idle()?;
+        self.generation += 1;
         Ok(self.pipelines.invalidate(self.gpu.device(), changed))
     }
 
@@ -184,12 +202,14 @@ impl<'g> Renderer<'g> {
     ) -> Result<FrameReport, GpuError> {
         let started = Instant::now();
         draws.begin_frame()?;
-        let mut prepared = Vec::with_capacity(plan.passes.len());
-        for pass in &plan.passes {
-            prepared.push(self.prepare(plan, pass, resources, options)?);
+        let mut ready = match resources.prepared.take() {
+            Some(ready) if ready.generation == self.generation => ready,
+            _ => self.prepare_plan(plan, resources)?,
+        };
+        for (pass, prep) in plan.passes.iter().zip(&mut ready.passes) {
+            prep.push = self.pack_push(pass, prep, options)?;
         }
-        let pool = descriptor_pool(self.gpu, &prepared)?;
-        self.write_descriptors(plan, resources, &pool, &mut prepared)?;
+        let prepared = &ready.passes;
         let readbacks = if options.readback {
             std::iter::once(plan.output)
                 .chain(plan.readback.iter().copied())
@@ -297,7 +317,7 @@ impl<'g> Renderer<'g> {
             .zip(images)
             .collect();
         drop(buffers);
-        drop(pool);
+        resources.prepared = Some(ready);
         Ok(FrameReport {
             timings,
             statistics,

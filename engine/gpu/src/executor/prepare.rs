@@ -2,7 +2,7 @@
 //! framebuffers, push-constant bytes, descriptor sets written with image
 //! layouts as the plan's barriers leave them.
 
-use super::{FrameOptions, Prepared, Renderer};
+use super::{FrameOptions, Prepared, PreparedPlan, Renderer};
 use crate::bind::{self, FrameValues};
 use crate::context::Gpu;
 use crate::descriptors::DescriptorPool;
@@ -14,17 +14,57 @@ use weft_graph::id::PassId;
 use weft_graph::plan::{Plan, PlanPass, PlanResource, ResourceDesc};
 
 impl<'g> Renderer<'g> {
-    pub(super) fn prepare(
+    /// Prepares every pass of `plan` on `resources` and writes their descriptor sets.
+    pub(super) fn prepare_plan(
+        &mut self,
+        plan: &Plan,
+        resources: &mut FrameResources<'g>,
+    ) -> Result<PreparedPlan<'g>, GpuError> {
+        let mut passes = Vec::with_capacity(plan.passes.len());
+        for pass in &plan.passes {
+            passes.push(self.prepare(plan, pass, resources)?);
+        }
+        let pool = descriptor_pool(self.gpu, &passes)?;
+        self.write_descriptors(plan, resources, &pool, &mut passes)?;
+        Ok(PreparedPlan {
+            generation: self.generation,
+            passes,
+            _pool: pool,
+        })
+    }
+
+    /// This frame's push-constant bytes of a prepared pass: its parameters and
+    /// the frame's time, number and extent.
+    pub(super) fn pack_push(
+        &self,
+        pass: &PlanPass,
+        prep: &Prepared,
+        options: &FrameOptions,
+    ) -> Result<Vec<u8>, GpuError> {
+        let Some((block, _)) = prep
+            .pipeline
+            .as_ref()
+            .and_then(|p| p.interface.push.as_ref())
+        else {
+            return Ok(Vec::new());
+        };
+        let frame = FrameValues {
+            time: options.time,
+            frame: options.frame,
+            extent: [prep.extent.width, prep.extent.height],
+        };
+        bind::pack_push(block, &pass.params, &frame).map_err(|problems| GpuError::Pass {
+            pass: pass.name.clone(),
+            message: problems.join("; "),
+        })
+    }
+
+    fn prepare(
         &mut self,
         plan: &Plan,
         pass: &PlanPass,
         resources: &mut FrameResources<'g>,
-        options: &FrameOptions,
     ) -> Result<Prepared, GpuError> {
-        let fail = |problems: Vec<String>| GpuError::Pass {
-            pass: pass.name.clone(),
-            message: problems.join("; "),
-        };
         let checked = self.checked_interface(plan, pass)?;
         let mut prepared = Prepared {
             pipeline: None,
@@ -59,22 +99,12 @@ impl<'g> Renderer<'g> {
             prepared.framebuffer =
                 resources.framebuffer(prepared.render_pass, views, prepared.extent)?;
         }
-        if let Some(p) = &prepared.pipeline {
-            if let Some((block, _)) = &p.interface.push {
-                let frame = FrameValues {
-                    time: options.time,
-                    frame: options.frame,
-                    extent: [prepared.extent.width, prepared.extent.height],
-                };
-                prepared.push = bind::pack_push(block, &pass.params, &frame).map_err(fail)?;
-            }
-        }
         Ok(prepared)
     }
 
     /// Writes every pass's descriptor set, with image layouts as the plan's
     /// barriers leave them at that pass.
-    pub(super) fn write_descriptors(
+    fn write_descriptors(
         &self,
         plan: &Plan,
         resources: &FrameResources<'g>,
@@ -105,7 +135,7 @@ impl<'g> Renderer<'g> {
 }
 
 /// A pool with room for every prepared pass's descriptor set.
-pub(super) fn descriptor_pool<'g>(
+fn descriptor_pool<'g>(
     gpu: &'g Gpu,
     prepared: &[Prepared],
 ) -> Result<DescriptorPool<'g>, GpuError> {
