@@ -26,7 +26,7 @@ FUZZ_CASES ?= 20000
 MUTANTS ?= 2000
 fuzz: setup
 	WEFT_FUZZ_CASES=$(FUZZ_CASES) $(CARGO) test -p weft-scene -p weft-graph --test fuzz -- --nocapture
-	WEFT_MUTANTS=$(MUTANTS) $(CARGO) test -p weft-render --test mutants -- --nocapture
+	WEFT_MUTANTS=$(MUTANTS) $(CARGO) test -p weft-tests --test mutants -- --nocapture
 
 bench: setup
 	$(CARGO) bench --workspace

@@ -2,6 +2,8 @@
 //! paths of the repository's graphs and this package's fixtures, and plans
 //! compiled as the renderer compiles them (provider values included).
 
+pub mod render;
+
 use std::path::{Path, PathBuf};
 use weft_gpu::{memory_requirements, Gpu, GpuOptions};
 use weft_graph::plan::{Extent, Plan};

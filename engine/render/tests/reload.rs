@@ -5,7 +5,10 @@
 //! a `ReloadWorker` thread leave frames coming and the live version untouched
 //! until committed; a newer request supersedes an older one.
 
-mod common;
+/// The repository root.
+fn repo_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -38,8 +41,8 @@ fn copy_dir(from: &Path, to: &Path) {
 fn fixture(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("weft-reload-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    copy_dir(&common::root().join("graphs"), &dir.join("graphs"));
-    copy_dir(&common::root().join("shaders"), &dir.join("shaders"));
+    copy_dir(&repo_root().join("graphs"), &dir.join("graphs"));
+    copy_dir(&repo_root().join("shaders"), &dir.join("shaders"));
     std::fs::create_dir_all(dir.join("scenes")).expect("scenes");
     std::fs::write(dir.join("scenes/quad.obj"), QUAD_OBJ).expect("obj");
     std::fs::write(dir.join("scenes/tiny.scene"), SCENE).expect("scene");

@@ -1,7 +1,7 @@
 //! The graphs' `emissive_boost` parameter scales material emission (MTL `Ke`)
 //! in linear HDR, the same in forward, deferred and tiled, and only emission.
 
-mod common;
+use weft_tests::render as common;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;

@@ -1,7 +1,5 @@
-//! Helpers shared by the render tests: scenes rendered through shipped graphs on
-//! a validating context, and image agreement measured in 8-bit units.
-// Each test crate compiles this module and uses only part of it.
-#![allow(dead_code)]
+//! Helpers for the tests that render scenes: scenes rendered through shipped
+//! graphs on a validating context, and image agreement measured in 8-bit units.
 
 use image::RgbaImage;
 use std::path::{Path, PathBuf};
@@ -11,7 +9,7 @@ use weft_render::{render, RenderSettings};
 
 /// The repository root.
 pub fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    crate::repo()
 }
 
 /// The project's demo scene.

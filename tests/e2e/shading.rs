@@ -44,9 +44,7 @@ fn render_hdr(scene: &Path, graph: &str) -> Vec<f32> {
     .expect("device");
     let log = gpu.validation();
     let settings = RenderSettings {
-        graph: Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../graphs")
-            .join(graph),
+        graph: weft_tests::shipped(graph),
         extent: Extent {
             width: SIZE,
             height: SIZE,

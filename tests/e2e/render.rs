@@ -4,10 +4,9 @@
 //! (RGB channel differences: mean <= 0.25 and 99th percentile <= 1, 8-bit units;
 //! measured 0.12 / 1 on cube.scene and 0.14 / 1 on demo.scene).
 
-mod common;
+use weft_tests::render as common;
 
 use common::{agreement, cube_scene, demo_scene, gltf_scene, graph, render_validated};
-use std::path::Path;
 use weft_testkit::{check_golden, Tolerance};
 
 /// Golden tolerance: lavapipe is deterministic on one machine; the slack covers
@@ -18,9 +17,7 @@ const GOLDEN: Tolerance = Tolerance {
 };
 
 fn golden(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden")
-        .join(name)
+    weft_tests::golden(name)
 }
 
 fn assert_golden(image: &image::RgbaImage, name: &str) {

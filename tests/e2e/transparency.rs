@@ -2,7 +2,7 @@
 //! deferred's transparent pass after lighting: blended over what lies behind them
 //! with their opacity (MTL `d`), in linear HDR.
 
-mod common;
+use weft_tests::render as common;
 
 use std::collections::BTreeMap;
 

@@ -7,7 +7,7 @@
 //! `WEFT_MUTANTS` of them (default 40); `make fuzz` runs many more. A failure
 //! prints the mutation, so it can be replayed by hand in a copy of the tree.
 
-mod common;
+use weft_tests::render as common;
 
 use common::{demo_scene, root};
 use std::collections::BTreeSet;

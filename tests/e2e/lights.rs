@@ -7,7 +7,7 @@
 //! exactly: per-tile counts read back against the CPU mirror of the culling test
 //! (`weft_testkit::tiles`) on a scene of known lights, and the legend's pixels.
 
-mod common;
+use weft_tests::render as common;
 
 use common::{agreement, graph, render_validated};
 use glam::{Mat4, Vec2, Vec3};
@@ -25,9 +25,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn golden(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden")
-        .join(name)
+    weft_tests::golden(name)
 }
 
 #[test]

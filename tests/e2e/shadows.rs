@@ -4,7 +4,7 @@
 //! PCF never narrows the penumbra; every configuration (forward or deferred,
 //! shadows and bloom on or off) runs cleanly.
 
-mod common;
+use weft_tests::render as common;
 
 use glam::{Vec3, Vec4Swizzles};
 use std::path::{Path, PathBuf};

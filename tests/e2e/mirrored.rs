@@ -2,7 +2,7 @@
 //! unmirrored twin: the winding, `gl_FrontFacing` and the normal transform all
 //! follow the sign of the model matrix's determinant.
 
-mod common;
+use weft_tests::render as common;
 
 use common::{agreement, graph, render_validated, root};
 use image::RgbaImage;
