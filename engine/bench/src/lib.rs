@@ -7,6 +7,7 @@ use clap::Subcommand;
 use std::process::ExitCode;
 
 mod bloom;
+mod bvh;
 mod lights;
 mod plot;
 mod shadows;
@@ -20,6 +21,8 @@ pub enum BenchCommand {
     Bloom(crate::bloom::BloomArgs),
     /// Shadow-map resolution and PCF radius against error (vs ray-traced visibility) and time.
     Shadows(crate::shadows::ShadowsArgs),
+    /// Build time and shape of the ray tracer's BVH over each scene's triangles.
+    Bvh(crate::bvh::BvhArgs),
 }
 
 /// Runs `weft bench ...`.
@@ -28,5 +31,6 @@ pub fn run(cmd: BenchCommand) -> Result<ExitCode> {
         BenchCommand::Lights(args) => crate::lights::run(args),
         BenchCommand::Bloom(args) => crate::bloom::run(args),
         BenchCommand::Shadows(args) => crate::shadows::run(args),
+        BenchCommand::Bvh(args) => crate::bvh::run(args),
     }
 }

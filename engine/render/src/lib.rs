@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod brdf;
+pub mod bvh;
 pub mod camera;
 pub mod error;
 pub mod features;

@@ -1,0 +1,91 @@
+//! `weft bench bvh`: how long the ray tracer's BVH takes to build over a
+//! scene's world-space triangles, and its shape (nodes, leaves, depth).
+
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+use weft_render::bvh::{scene_triangles, Bvh};
+
+/// Options of `weft bench bvh`.
+#[derive(Args)]
+pub struct BvhArgs {
+    /// Scenes to build a BVH for.
+    #[arg(required = true)]
+    pub scenes: Vec<PathBuf>,
+    /// Builds per scene; the median time is reported.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    pub runs: u32,
+}
+
+/// One scene's figures.
+struct Row {
+    scene: String,
+    triangles: usize,
+    build_ms: f64,
+    nodes: usize,
+    leaves: usize,
+    depth: usize,
+}
+
+/// Runs `weft bench bvh`.
+pub fn run(args: BvhArgs) -> Result<ExitCode> {
+    let mut rows = Vec::new();
+    for path in &args.scenes {
+        let scene = weft_scene::load_scene(path)
+            .with_context(|| format!("loading scene {}", path.display()))?;
+        let triangles = scene_triangles(&scene);
+        let mut times = Vec::new();
+        let mut bvh = None;
+        for _ in 0..args.runs {
+            let started = Instant::now();
+            bvh = Some(Bvh::build(&triangles));
+            times.push(started.elapsed().as_secs_f64() * 1e3);
+        }
+        times.sort_by(f64::total_cmp);
+        let bvh = bvh.context("at least one build")?;
+        rows.push(Row {
+            scene: path.display().to_string(),
+            triangles: triangles.len(),
+            build_ms: times[times.len() / 2],
+            nodes: bvh.nodes.len(),
+            leaves: bvh.leaf_count(),
+            depth: bvh.depth(),
+        });
+    }
+    print!("{}", table(&rows));
+    Ok(ExitCode::SUCCESS)
+}
+
+fn table(rows: &[Row]) -> String {
+    let mut out = String::from("| scene | triangles | build (ms, median) | nodes | leaves | depth |\n|---|---|---|---|---|---|\n");
+    for r in rows {
+        out.push_str(&format!(
+            "| {} | {} | {:.1} | {} | {} | {} |\n",
+            r.scene, r.triangles, r.build_ms, r.nodes, r.leaves, r.depth
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_table_lists_every_scene() {
+        let rows = [Row {
+            scene: "a.scene".into(),
+            triangles: 12,
+            build_ms: 0.25,
+            nodes: 7,
+            leaves: 4,
+            depth: 3,
+        }];
+        assert_eq!(
+            table(&rows),
+            "| scene | triangles | build (ms, median) | nodes | leaves | depth |\n|---|---|---|---|---|---|\n| a.scene | 12 | 0.2 | 7 | 4 | 3 |\n"
+        );
+    }
+}
