@@ -163,6 +163,29 @@ impl SceneGeometry {
         })
     }
 
+    /// Every placed mesh's triangles in world space, draw by draw: what the
+    /// ray tracer traces (light-volume meshes are not drawn, so not included).
+    pub fn world_triangles(&self) -> Vec<[Vec3; 3]> {
+        let mut out = Vec::new();
+        for d in &self.draws {
+            let Some(record) = self.draw_records.get(d.draw_id as usize) else {
+                continue;
+            };
+            let first = d.range.first_index as usize;
+            let indices = &self.indices[first..first + d.range.index_count as usize];
+            let corner = |i: u32| {
+                let v = &self.vertices[(d.range.vertex_offset + i as i32) as usize];
+                record.model.transform_point3(Vec3::from(v.position))
+            };
+            out.extend(
+                indices
+                    .chunks_exact(3)
+                    .map(|t| [corner(t[0]), corner(t[1]), corner(t[2])]),
+            );
+        }
+        out
+    }
+
     /// The model matrix of a draw record (transparent meshes sort by its origin).
     pub fn model_matrix(&self, draw_id: u32) -> Option<Mat4> {
         self.draw_records.get(draw_id as usize).map(|d| d.model)

@@ -10,6 +10,8 @@
 //!   views of a depth-only scene pass, fitted every frame; the pass is drawn
 //!   once per view with the push-constant member `shadow_view` set to the
 //!   view's index (see `shadows.rs`).
+//! - `RayTracing()`: the scene's world-space triangles and a BVH over them
+//!   (`bvh.rs`), built on first use and bound in set 1 of the compute pass.
 
 use crate::gaussian::{self, GaussianTaps};
 use crate::shadows::{ShadowSettings, MAX_CASCADES, MAX_PCF_RADIUS};
@@ -92,8 +94,24 @@ pub const SHADOW_ATLAS: ProviderSpec = ProviderSpec {
 /// learns which view it draws.
 pub const SHADOW_VIEW: &str = "shadow_view";
 
+/// The ray-tracing provider: the scene's world-space triangles and a BVH over
+/// them, bound in set 1 (`shaders/include/trace.glsl`) of a compute pass.
+pub const RAY_TRACING: ProviderSpec = ProviderSpec {
+    name: "RayTracing",
+    summary: "the scene's triangles and their BVH for compute shaders that trace rays",
+    kinds: &[PassKind::Compute],
+    args: &[],
+    supplies: &["Triangles", "BvhNodes", "BvhTriangles"],
+};
+
 /// Every provider a graph may name.
-pub const PROVIDERS: &[ProviderSpec] = &[GAUSSIAN, SHADOW_ATLAS];
+pub const PROVIDERS: &[ProviderSpec] = &[GAUSSIAN, SHADOW_ATLAS, RAY_TRACING];
+
+/// Whether a pass declares `RayTracing`, so its shaders may read the ray
+/// tracer's scene data.
+pub fn traces(pass: &PlanPass) -> bool {
+    pass.derive.iter().any(|c| c.name == RAY_TRACING.name)
+}
 
 /// The graph's provider uses checked against [`PROVIDERS`].
 pub fn check(graph: &weft_graph::LoadedGraph) -> Vec<Diagnostic> {

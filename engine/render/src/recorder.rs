@@ -416,7 +416,8 @@ impl DrawRecorder for SceneRecorder<'_> {
     fn bind_scene(&mut self, ctx: &RasterContext<'_>, pipeline: &Pipeline) -> Result<(), GpuError> {
         // Checked and collected once, when the layout's set is first made.
         let bindings = || {
-            let problems = scene_set_problems(&pipeline.interface, false);
+            let tracing = providers::traces(ctx.pass());
+            let problems = scene_set_problems(&pipeline.interface, false, tracing);
             if !problems.is_empty() {
                 return Err(GpuError::Pass {
                     pass: ctx.pass().name.clone(),

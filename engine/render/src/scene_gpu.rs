@@ -33,6 +33,13 @@ pub const DRAWS_BINDING: u32 = 2;
 pub const MATERIALS_BINDING: u32 = 3;
 /// Binding of the shadow views (`Shadows` in `shaders/include/shadows.glsl`).
 pub const SHADOWS_BINDING: u32 = 4;
+/// Binding of the ray tracer's triangles: three world-space corners per
+/// triangle, each a vec4 (`Triangles` in `shaders/include/trace.glsl`).
+pub const TRIANGLES_BINDING: u32 = 5;
+/// Binding of the ray tracer's BVH nodes (`BvhNodes`).
+pub const BVH_NODES_BINDING: u32 = 6;
+/// Binding of the BVH's triangle order (`BvhTriangles`): leaves index it.
+pub const BVH_TRIANGLES_BINDING: u32 = 7;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -62,6 +69,26 @@ pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 5] = [
         SHADOWS_BINDING,
         DescriptorKind::StorageBuffer,
         "the shadow views",
+    ),
+];
+/// Set 1 bindings for ray tracing: built only when a compute pass that
+/// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
+/// a build (docs/pathtrace.md) that raster graphs should not pay.
+pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 3] = [
+    (
+        TRIANGLES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the ray tracer's triangles",
+    ),
+    (
+        BVH_NODES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the BVH nodes",
+    ),
+    (
+        BVH_TRIANGLES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the BVH's triangle order",
     ),
 ];
 /// Set 2 as the engine creates it: a material's textures, in the order of its
@@ -120,7 +147,10 @@ fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuE
         scene_sets + materials,
         &[
             (vk::DescriptorType::UNIFORM_BUFFER, scene_sets),
-            (vk::DescriptorType::STORAGE_BUFFER, 4 * scene_sets),
+            (
+                vk::DescriptorType::STORAGE_BUFFER,
+                (SCENE_SET_BINDINGS.len() + TRACE_SET_BINDINGS.len()) as u32 * scene_sets,
+            ),
             (
                 vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
                 MATERIAL_SET_BINDINGS.len() as u32 * materials.max(1),
@@ -131,6 +161,13 @@ fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuE
 
 /// Scene sets that fullscreen pipelines built by the executor may ask for.
 const FOREIGN_SETS: u32 = 32;
+
+/// The ray tracer's scene data on the device.
+struct TraceBuffers<'g> {
+    triangles: Buffer<'g>,
+    nodes: Buffer<'g>,
+    order: Buffer<'g>,
+}
 
 /// Everything the scene shaders read, on the device.
 pub struct GpuScene<'g> {
@@ -159,6 +196,8 @@ pub struct GpuScene<'g> {
     pub material_sets: Vec<vk::DescriptorSet>,
     /// Set 1 for layouts the executor built from reflection.
     foreign_sets: HashMap<vk::DescriptorSetLayout, vk::DescriptorSet>,
+    /// Built on first use by a ray-tracing pass.
+    trace: Option<TraceBuffers<'g>>,
     source_lights: Vec<weft_scene::Light>,
     bounds: weft_scene::Aabb,
     /// The camera's view volume at the last update, what sun cascades are fitted to.
@@ -283,6 +322,7 @@ impl<'g> GpuScene<'g> {
             material_sets: Vec::new(),
             foreign_sets: HashMap::new(),
             source_lights: scene.lights.clone(),
+            trace: None,
             bounds,
             view_volume: ViewVolume::new(
                 glam::Vec3::ZERO,
@@ -335,6 +375,7 @@ impl<'g> GpuScene<'g> {
         let mut writer = DescriptorWriter::default();
         for &(b, kind, _) in SCENE_SET_BINDINGS
             .iter()
+            .chain(&TRACE_SET_BINDINGS)
             .filter(|(b, _, _)| bindings.contains(b))
         {
             if let Some(buffer) = self.scene_buffer(b) {
@@ -342,6 +383,36 @@ impl<'g> GpuScene<'g> {
             }
         }
         writer.write(self.gpu, set);
+    }
+
+    /// Builds the BVH over the scene's triangles and uploads it with them, once.
+    fn ensure_trace_buffers(&mut self) -> Result<(), GpuError> {
+        if self.trace.is_some() {
+            return Ok(());
+        }
+        let triangles = self.geometry.world_triangles();
+        let bvh = crate::bvh::Bvh::build(&triangles);
+        let corners: Vec<[f32; 4]> = triangles
+            .iter()
+            .flat_map(|t| t.map(|p| p.extend(1.0).to_array()))
+            .collect();
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        self.trace = Some(TraceBuffers {
+            triangles: Buffer::device_local(
+                self.gpu,
+                "trace triangles",
+                bytes_of(&corners),
+                storage,
+            )?,
+            nodes: Buffer::device_local(self.gpu, "bvh nodes", bytes_of(&bvh.nodes), storage)?,
+            order: Buffer::device_local(
+                self.gpu,
+                "bvh triangles",
+                bytes_of(&bvh.triangles),
+                storage,
+            )?,
+        });
+        Ok(())
     }
 
     /// The buffer behind a set 1 binding of [`SCENE_SET_BINDINGS`].
@@ -352,6 +423,9 @@ impl<'g> GpuScene<'g> {
             DRAWS_BINDING => Some(&self.draws),
             MATERIALS_BINDING => Some(&self.materials),
             SHADOWS_BINDING => Some(&self.shadows),
+            TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.triangles),
+            BVH_NODES_BINDING => self.trace.as_ref().map(|t| &t.nodes),
+            BVH_TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.order),
             _ => None,
         }
     }
@@ -368,6 +442,12 @@ impl<'g> GpuScene<'g> {
             return Ok(set);
         }
         let bindings = bindings()?;
+        if TRACE_SET_BINDINGS
+            .iter()
+            .any(|(b, _, _)| bindings.contains(b))
+        {
+            self.ensure_trace_buffers()?;
+        }
         let set = self.pool.allocate(layout)?;
         self.write_scene_set(set, &bindings);
         self.foreign_sets.insert(layout, set);

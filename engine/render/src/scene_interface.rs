@@ -8,7 +8,7 @@
 use crate::geometry::VERTEX_ATTRIBUTES;
 use crate::pipelines::MATERIAL_SET;
 use crate::providers::SHADOW_VIEW;
-use crate::scene_gpu::{MATERIAL_SET_BINDINGS, SCENE_SET_BINDINGS};
+use crate::scene_gpu::{MATERIAL_SET_BINDINGS, SCENE_SET_BINDINGS, TRACE_SET_BINDINGS};
 use crate::sources::scene_pass_keys;
 use weft_gpu::bind::{
     check_outputs, link_problems, pack_push, resolve_bindings, shape_name, FrameValues,
@@ -29,12 +29,34 @@ pub fn position_only(pass: &PlanPass) -> bool {
 /// Problems with the scene sets (1, and 2 where `materials` allows it) that
 /// a pass's merged interface declares: every binding must be one the engine
 /// writes, with the descriptor type it writes (material textures as float 2D
-/// `sampler2D`s).
-pub fn scene_set_problems(interface: &PipelineInterface, materials: bool) -> Vec<String> {
+/// `sampler2D`s). The ray tracer's bindings are fed only to passes that
+/// declare `derive: [RayTracing()]` (`tracing`).
+pub fn scene_set_problems(
+    interface: &PipelineInterface,
+    materials: bool,
+    tracing: bool,
+) -> Vec<String> {
     let mut problems = Vec::new();
+    let scene: Vec<(u32, DescriptorKind, &str)> = SCENE_SET_BINDINGS
+        .iter()
+        .chain(TRACE_SET_BINDINGS.iter().filter(|_| tracing))
+        .copied()
+        .collect();
     for (shader, _) in interface.bindings.values() {
+        if shader.set == SCENE_SET
+            && !tracing
+            && TRACE_SET_BINDINGS
+                .iter()
+                .any(|(b, _, _)| *b == shader.binding)
+        {
+            problems.push(format!(
+                "shader binding `{}` (set {} binding {}) is ray-tracing scene data, which the engine feeds only to passes that declare `derive: [RayTracing()]`",
+                shader.name, shader.set, shader.binding
+            ));
+            continue;
+        }
         let table: &[(u32, DescriptorKind, &str)] = match shader.set {
-            SCENE_SET => &SCENE_SET_BINDINGS,
+            SCENE_SET => &scene,
             MATERIAL_SET if materials => &MATERIAL_SET_BINDINGS,
             _ => continue,
         };
@@ -138,7 +160,7 @@ pub fn scene_pass_problems(
                 )
             }),
     );
-    problems.extend(scene_set_problems(&merged, true));
+    problems.extend(scene_set_problems(&merged, true, false));
     problems.extend(vertex_input_problems(vs, position_only(pass)));
     if fs.is_some() {
         problems.extend(link_problems(&merged));
@@ -166,7 +188,7 @@ pub fn check_plan_shaders(cache: &mut PipelineCache, plan: &Plan) -> Vec<ShaderP
             Ok(Some(shaders)) => {
                 let keys: Vec<ShaderKey> = shaders.keys().into_iter().cloned().collect();
                 cache.interface(&shaders.keys()).map(|merged| {
-                    scene_set_problems(&merged, false)
+                    scene_set_problems(&merged, false, crate::providers::traces(pass))
                         .into_iter()
                         .map(|m| with_declaration(cache, &keys, m))
                         .collect()

@@ -1,0 +1,94 @@
+// Ray tracing against the scene (the `RayTracing` provider; engine/render/src/bvh.rs
+// builds the BVH and mirrors this traversal on the CPU, where its tests hold it
+// to brute force). Set 1, beside scene.glsl's bindings 0..4.
+#ifndef WEFT_TRACE_GLSL
+#define WEFT_TRACE_GLSL
+
+// Inner node: count 0, children at first and first + 1. Leaf: triangles
+// bvh_triangles[first .. first + count].
+struct BvhNode {
+    vec3 bmin;
+    uint first;
+    vec3 bmax;
+    uint count;
+};
+
+layout(std430, set = 1, binding = 5) readonly buffer Triangles { vec4 corners[]; };
+layout(std430, set = 1, binding = 6) readonly buffer BvhNodes { BvhNode nodes[]; };
+layout(std430, set = 1, binding = 7) readonly buffer BvhTriangles { uint bvh_triangles[]; };
+
+// Deepest traversal the stack allows; the builder's trees stay far below it
+// (docs/pathtrace.md: depth 26 on demo.scene).
+#define TRACE_STACK 64
+
+// Entry distance into a node's box, or a negative value when the ray misses it.
+float trace_slab(BvhNode node, vec3 origin, vec3 inv_dir) {
+    vec3 t0 = (node.bmin - origin) * inv_dir;
+    vec3 t1 = (node.bmax - origin) * inv_dir;
+    vec3 lo = min(t0, t1);
+    vec3 hi = max(t0, t1);
+    float near = max(max(max(lo.x, lo.y), lo.z), 0.0);
+    float far = min(min(hi.x, hi.y), hi.z);
+    return near <= far ? near : -1.0;
+}
+
+// Moller-Trumbore: the ray parameter of a hit in front of the origin, or -1.
+float trace_triangle(uint tri, vec3 origin, vec3 dir) {
+    vec3 a = corners[3u * tri].xyz;
+    vec3 e1 = corners[3u * tri + 1u].xyz - a;
+    vec3 e2 = corners[3u * tri + 2u].xyz - a;
+    vec3 p = cross(dir, e2);
+    float det = dot(e1, p);
+    if (abs(det) < 1e-12) {
+        return -1.0;
+    }
+    float inv_det = 1.0 / det;
+    vec3 s = origin - a;
+    float u = dot(s, p) * inv_det;
+    vec3 q = cross(s, e1);
+    float v = dot(dir, q) * inv_det;
+    float t = dot(e2, q) * inv_det;
+    return (u < 0.0 || u > 1.0 || v < 0.0 || u + v > 1.0 || t <= 0.0) ? -1.0 : t;
+}
+
+// The nearest hit with t in (0, t_max): its distance in .x and triangle in .y
+// (as uint bits), or x = -1 when nothing is hit.
+vec2 trace_closest(vec3 origin, vec3 dir, float t_max) {
+    float best_t = t_max;
+    uint best_tri = 0u;
+    bool hit = false;
+    // An empty scene still has a (minimum-size) buffer: fewer than 3 corners.
+    if (uint(corners.length()) < 3u) {
+        return vec2(-1.0, 0.0);
+    }
+    vec3 inv_dir = 1.0 / dir;
+    uint stack[TRACE_STACK];
+    int top = 0;
+    stack[top++] = 0u;
+    while (top > 0) {
+        BvhNode node = nodes[stack[--top]];
+        float entry = trace_slab(node, origin, inv_dir);
+        if (entry < 0.0 || entry >= best_t) {
+            continue;
+        }
+        if (node.count == 0u) {
+            if (top + 2 <= TRACE_STACK) {
+                stack[top++] = node.first;
+                stack[top++] = node.first + 1u;
+            }
+            continue;
+        }
+        for (uint i = 0u; i < node.count; ++i) {
+            uint tri = bvh_triangles[node.first + i];
+            float t = trace_triangle(tri, origin, dir);
+            if (t > 0.0 && t < best_t) {
+                best_t = t;
+                best_tri = tri;
+                hit = true;
+            }
+        }
+    }
+    return hit ? vec2(best_t, uintBitsToFloat(best_tri)) : vec2(-1.0, 0.0);
+}
+
+#endif
