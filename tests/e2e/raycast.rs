@@ -8,7 +8,7 @@
 //! printed by the test.
 
 use glam::Vec4;
-use weft_gpu::{Gpu, GpuOptions, Pixels};
+use weft_gpu::Pixels;
 use weft_graph::plan::Extent;
 use weft_render::bvh::{scene_triangles, Bvh};
 use weft_render::camera::{camera_position, view_projection};
@@ -21,11 +21,7 @@ const HEIGHT: u32 = 48;
 #[test]
 fn gpu_bvh_traversal_matches_the_cpu_on_every_pixel_of_the_demo_scene() {
     let scene = weft_scene::load_scene(&common::demo_scene()).expect("scene loads");
-    let gpu = Gpu::new(&GpuOptions {
-        validation: true,
-        device: None,
-    })
-    .expect("a Vulkan 1.3 device with the validation layer (run tools/setup)");
+    let gpu = weft_tests::gpu();
     let log = gpu.validation();
     let settings = RenderSettings {
         graph: weft_tests::graph("raycast.ron"),

@@ -89,16 +89,7 @@ impl<'a> Commands<'a> {
         vertex_offset: i32,
         first_instance: u32,
     ) {
-        unsafe {
-            self.device.cmd_draw_indexed(
-                self.cmd,
-                index_count,
-                1,
-                first_index,
-                vertex_offset,
-                first_instance,
-            )
-        }
+        self.draw_indexed_instanced(index_count, 1, first_index, vertex_offset, first_instance)
     }
 
     /// An indexed draw of `instances` instances.

@@ -45,15 +45,26 @@ pub struct Bvh {
 }
 
 /// Every placed mesh's triangles in world space, instance by instance in the
-/// scene's order and mesh by mesh within a model: the triangle list the ray
-/// tracer and [`Bvh::build`] index.
+/// scene's order and mesh by mesh within a model.
 pub fn scene_triangles(scene: &weft_scene::Scene) -> Vec<[Vec3; 3]> {
+    scene_triangles_where(scene, |_, _| true)
+}
+
+/// The world-space triangles of every placed mesh for which
+/// `include(model, mesh)` holds.
+pub fn scene_triangles_where(
+    scene: &weft_scene::Scene,
+    include: impl Fn(usize, usize) -> bool,
+) -> Vec<[Vec3; 3]> {
     let mut out = Vec::new();
     for instance in &scene.instances {
         let Some(model) = scene.models.get(instance.model) else {
             continue;
         };
-        for mesh in &model.meshes {
+        for (k, mesh) in model.meshes.iter().enumerate() {
+            if !include(instance.model, k) {
+                continue;
+            }
             let world: Vec<Vec3> = mesh
                 .positions
                 .iter()
@@ -187,15 +198,43 @@ impl Bvh {
         dir: Vec3,
         t_max: f32,
     ) -> Option<(f32, u32)> {
+        let mut best = None;
+        self.walk(triangles, origin, dir, t_max, |t, tri| {
+            best = Some((t, tri));
+            false
+        });
+        best
+    }
+
+    /// Whether anything lies on the ray with `t` in `(0, t_max)`; stops at the
+    /// first hit found (shadow rays).
+    pub fn any_hit(&self, triangles: &[[Vec3; 3]], origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        let mut hit = false;
+        self.walk(triangles, origin, dir, t_max, |_, _| {
+            hit = true;
+            true
+        });
+        hit
+    }
+
+    /// Visits hits nearer than every hit before them, nearest boxes' order
+    /// aside, until `visit` returns true.
+    fn walk(
+        &self,
+        triangles: &[[Vec3; 3]],
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        mut visit: impl FnMut(f32, u32) -> bool,
+    ) {
         if self.triangles.is_empty() {
-            return None;
+            return;
         }
         let inv = dir.recip();
-        let mut best: Option<(f32, u32)> = None;
+        let mut limit = t_max;
         let mut stack = vec![0u32];
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
-            let limit = best.map_or(t_max, |b| b.0);
             if slab(node, origin, inv).is_none_or(|t| t >= limit) {
                 continue;
             }
@@ -206,15 +245,16 @@ impl Bvh {
             }
             let leaf = &self.triangles[node.first as usize..(node.first + node.count) as usize];
             for &tri in leaf {
-                let limit = best.map_or(t_max, |b| b.0);
                 if let Some(t) = intersect(&triangles[tri as usize], origin, dir) {
                     if t < limit {
-                        best = Some((t, tri));
+                        limit = t;
+                        if visit(t, tri) {
+                            return;
+                        }
                     }
                 }
             }
         }
-        best
     }
 }
 
