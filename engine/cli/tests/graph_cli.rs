@@ -219,3 +219,61 @@ fn plan_with_a_scene_culls_what_the_scene_lacks() {
     );
     assert!(text.contains("  0. shadow_sun (Raster)"), "{text}");
 }
+
+#[test]
+fn check_shows_the_offending_line_with_a_caret_and_json_carries_the_same() {
+    let path = temp_graph(
+        "snippet",
+        "Graph(\n    output: \"hdx\",\n    resources: [Image(name: \"hdr\", format: R16G16B16A16_SFLOAT)],\n    passes: [],\n)\n",
+    );
+    let file = path.to_str().expect("utf-8 path");
+    let out = weft(&["graph", "check", file]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!(
+            "{file}:2:13: error: unknown output \"hdx\"\n  hint: did you mean \"hdr\"?\n   |\n 2 |     output: \"hdx\",\n   |             ^^^^^\n"
+        )),
+        "{stderr}"
+    );
+    let json = weft(&["graph", "check", "--json", file]);
+    assert_eq!(json.status.code(), Some(1));
+    let value: serde_json::Value =
+        serde_json::from_slice(&json.stdout).expect("--json prints JSON on stdout");
+    let first = &value[0];
+    assert_eq!(first["severity"], "error");
+    assert_eq!(first["file"], file);
+    assert_eq!(
+        (first["pos"]["line"].as_u64(), first["pos"]["col"].as_u64()),
+        (Some(2), Some(13))
+    );
+    assert_eq!(first["message"], "unknown output \"hdx\"");
+    assert_eq!(first["hint"], "did you mean \"hdr\"?");
+}
+
+#[test]
+fn provider_arguments_out_of_range_are_errors_at_the_argument() {
+    let shadows = std::fs::read_to_string(repo().join("graphs/shadows.ron")).expect("shipped");
+    let text = shadows
+        .replace("\"cascades\": 1,", "\"cascades\": 9,")
+        .replace("../shaders/", &format!("{}/shaders/", repo().display()));
+    let path = temp_graph("provider", &text);
+    let out = weft(&["graph", "check", path.to_str().expect("utf-8 path")]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("error: `ShadowAtlas` argument `cascades`: 9 is out of range 1..=4"),
+        "{stderr}"
+    );
+    let misspelled = text.replace(
+        "pcf_radius: \"$pcf_radius\"",
+        "pcf_radiuss: \"$pcf_radius\"",
+    );
+    let path = temp_graph("misspelled", &misspelled);
+    let out = weft(&["graph", "check", path.to_str().expect("utf-8 path")]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("error: provider `ShadowAtlas` has no argument `pcf_radiuss`\n  hint: did you mean `pcf_radius`?"),
+        "{stderr}"
+    );
+}

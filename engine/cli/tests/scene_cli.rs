@@ -85,3 +85,22 @@ fn a_closed_pipe_ends_the_command_quietly() {
     const SIGPIPE: i32 = 13;
     assert_eq!(status.signal(), Some(SIGPIPE), "{status:?}");
 }
+
+#[test]
+fn a_scene_error_shows_the_offending_line() {
+    let dir = std::env::temp_dir().join(format!("weft-scene-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("bad.scene");
+    std::fs::write(&path, "camera {\n  position 0 0 5\n  fov banana\n}\n").expect("write");
+    let out = weft(&["scene", "check", path.to_str().expect("utf-8 path")]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.ends_with(&format!(
+            "error: {}:3: 'fov' expects numbers, found 'banana'\n   |\n 3 |   fov banana\n   |   ^^^^^^^^^^\n",
+            path.display()
+        )),
+        "{stderr}"
+    );
+}
