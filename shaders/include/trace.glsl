@@ -16,6 +16,11 @@ struct BvhNode {
 layout(std430, set = 1, binding = 5) readonly buffer Triangles { vec4 corners[]; };
 layout(std430, set = 1, binding = 6) readonly buffer BvhNodes { BvhNode nodes[]; };
 layout(std430, set = 1, binding = 7) readonly buffer BvhTriangles { uint bvh_triangles[]; };
+// Per corner (3 per triangle, in Triangles' order): unit world normal, UV.
+layout(std430, set = 1, binding = 8) readonly buffer TriangleNormals { vec4 corner_normals[]; };
+layout(std430, set = 1, binding = 9) readonly buffer TriangleUvs { vec2 corner_uvs[]; };
+// Per triangle: index into the Materials buffer (scene.glsl, binding 3).
+layout(std430, set = 1, binding = 10) readonly buffer TriangleMaterials { uint triangle_materials[]; };
 
 // Deepest traversal the stack allows; the builder's trees stay far below it
 // (docs/pathtrace.md: depth 26 on demo.scene).
@@ -89,6 +94,44 @@ vec2 trace_closest(vec3 origin, vec3 dir, float t_max) {
         }
     }
     return hit ? vec2(best_t, uintBitsToFloat(best_tri)) : vec2(-1.0, 0.0);
+}
+
+// What a ray hit: the point, the interpolated unit normal (not flipped to
+// face the ray), the unit geometric normal, the UV and the material index.
+struct TraceSurface {
+    vec3 position;
+    vec3 normal;
+    vec3 geometric_normal;
+    vec2 uv;
+    uint material;
+};
+
+// The surface of triangle `tri` where the ray reaches it at distance `t`.
+TraceSurface trace_surface(uint tri, vec3 origin, vec3 dir, float t) {
+    vec3 a = corners[3u * tri].xyz;
+    vec3 e1 = corners[3u * tri + 1u].xyz - a;
+    vec3 e2 = corners[3u * tri + 2u].xyz - a;
+    vec3 p = origin + t * dir;
+    // Barycentrics of p: solve p - a = u e1 + v e2 in the triangle's plane.
+    vec3 d = p - a;
+    float d00 = dot(e1, e1);
+    float d01 = dot(e1, e2);
+    float d11 = dot(e2, e2);
+    float d20 = dot(d, e1);
+    float d21 = dot(d, e2);
+    float denom = d00 * d11 - d01 * d01;
+    float u = denom != 0.0 ? (d11 * d20 - d01 * d21) / denom : 0.0;
+    float v = denom != 0.0 ? (d00 * d21 - d01 * d20) / denom : 0.0;
+    float w = 1.0 - u - v;
+    TraceSurface s;
+    s.position = p;
+    vec3 n = w * corner_normals[3u * tri].xyz + u * corner_normals[3u * tri + 1u].xyz
+        + v * corner_normals[3u * tri + 2u].xyz;
+    s.geometric_normal = normalize(cross(e1, e2));
+    s.normal = dot(n, n) > 0.0 ? normalize(n) : s.geometric_normal;
+    s.uv = w * corner_uvs[3u * tri] + u * corner_uvs[3u * tri + 1u] + v * corner_uvs[3u * tri + 2u];
+    s.material = triangle_materials[tri];
+    return s;
 }
 
 #endif

@@ -1,17 +1,21 @@
 //! The ray tracer's scene data on the GPU: a compute pass that declares
 //! `derive: [RayTracing()]` casts one camera ray per pixel through the BVH
-//! (`shaders/include/trace.glsl`), and every pixel's hit distance matches the
-//! CPU traversal (`weft_render::bvh`) of the same ray over the same triangles.
-//! Tolerance: distances within 1e-4 relative; at most 0.5% of pixels may
-//! disagree on hit or miss, for rays that graze a silhouette edge where the
-//! GPU's and the CPU's float rounding can fall on different sides. Measured:
-//! printed by the test.
+//! (`shaders/include/trace.glsl`), and every pixel's hit distance, triangle,
+//! interpolated normal and UV, and material match the CPU traversal
+//! (`weft_render::bvh`) of the same ray over the same triangles
+//! (`SceneGeometry::trace_mesh`, the order the GPU buffers use). The CPU
+//! traces the very ray the GPU traced (read back), so only traversal and
+//! surface interpolation are compared.
+//! Tolerance: distances within 1e-4 relative, normals and UVs within 1e-3,
+//! and no pixel may disagree. Measured on both scenes: distances and UVs
+//! exactly equal, normals within 9e-8 (printed by the test).
 
-use glam::Vec4;
+use glam::Vec3;
 use weft_gpu::Pixels;
 use weft_graph::plan::Extent;
-use weft_render::bvh::{scene_triangles, Bvh};
-use weft_render::camera::{camera_position, view_projection};
+use weft_render::bvh::Bvh;
+use weft_render::camera::camera_position;
+use weft_render::geometry::SceneGeometry;
 use weft_render::{render, RenderSettings};
 use weft_tests::render as common;
 
@@ -20,7 +24,18 @@ const HEIGHT: u32 = 48;
 
 #[test]
 fn gpu_bvh_traversal_matches_the_cpu_on_every_pixel_of_the_demo_scene() {
-    let scene = weft_scene::load_scene(&common::demo_scene()).expect("scene loads");
+    traced_pixels_match_the_cpu(&common::demo_scene(), false);
+}
+
+#[test]
+fn gpu_surfaces_match_the_cpu_on_a_textured_gltf_model() {
+    traced_pixels_match_the_cpu(&common::gltf_scene(), true);
+}
+
+/// Casts the fixture's rays on `scene` and compares every pixel with the CPU;
+/// `textured`: the scene's meshes have UVs, so some must be non-zero.
+fn traced_pixels_match_the_cpu(scene: &std::path::Path, textured: bool) {
+    let scene = weft_scene::load_scene(scene).expect("scene loads");
     let gpu = weft_tests::gpu();
     let log = gpu.validation();
     let settings = RenderSettings {
@@ -29,6 +44,7 @@ fn gpu_bvh_traversal_matches_the_cpu_on_every_pixel_of_the_demo_scene() {
             width: WIDTH,
             height: HEIGHT,
         },
+        extra_readback: vec!["surface".into(), "ray".into()],
         ..RenderSettings::default()
     };
     let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
@@ -38,27 +54,50 @@ fn gpu_bvh_traversal_matches_the_cpu_on_every_pixel_of_the_demo_scene() {
     let Pixels::RgbaF32(texels) = &output.pixels else {
         panic!("hit is a float image");
     };
+    let image = |name: &str| -> &Vec<f32> {
+        let readback = &rendered
+            .report
+            .readbacks
+            .iter()
+            .find(|(n, _)| n == name)
+            .unwrap_or_else(|| panic!("{name} read back"))
+            .1;
+        match &readback.pixels {
+            Pixels::RgbaF32(texels) => texels,
+            Pixels::Rgba8(_) => panic!("{name} is a float image"),
+        }
+    };
+    let (surfaces, rays) = (image("surface"), image("ray"));
 
-    let triangles = scene_triangles(&scene);
-    let bvh = Bvh::build(&triangles);
-    let camera = &scene.cameras[0];
-    let inverse = view_projection(camera, 0.0, WIDTH as f32 / HEIGHT as f32).inverse();
-    let eye = camera_position(camera, 0.0);
-    let (mut hits, mut disagree, mut worst) = (0, 0, 0.0f32);
+    let mesh = SceneGeometry::new(&scene).trace_mesh();
+    let triangles = &mesh.corners;
+    let bvh = Bvh::build(triangles);
+    let eye = camera_position(&scene.cameras[0], 0.0);
+    let (mut hits, mut disagree) = (0, 0);
+    let (mut worst, mut worst_normal, mut worst_uv) = (0.0f32, 0.0f32, 0.0f32);
     for y in 0..HEIGHT {
         for x in 0..WIDTH {
-            let ndc_x = (x as f32 + 0.5) / WIDTH as f32 * 2.0 - 1.0;
-            let ndc_y = (y as f32 + 0.5) / HEIGHT as f32 * 2.0 - 1.0;
-            let on_near = inverse * Vec4::new(ndc_x, ndc_y, 1.0, 1.0);
-            let dir = (on_near.truncate() / on_near.w - eye).normalize();
-            let cpu = bvh.closest_hit(&triangles, eye, dir, 1e30).map(|h| h.0);
-            let gpu_t = texels[((y * WIDTH + x) * 4) as usize];
+            let at = ((y * WIDTH + x) * 4) as usize;
+            let dir = Vec3::new(rays[at], rays[at + 1], rays[at + 2]);
+            assert!(dir.is_normalized(), "pixel ({x}, {y}) traced {dir}");
+            let cpu = bvh.closest_hit(triangles, eye, dir, 1e30);
+            let gpu_t = texels[at];
             match (cpu, gpu_t >= 0.0) {
-                (Some(t), true) => {
+                (Some((t, tri)), true) => {
                     hits += 1;
                     let relative = (t - gpu_t).abs() / t.max(1e-3);
                     worst = worst.max(relative);
-                    if relative > 1e-4 {
+                    let (normal, uv) = interpolated(&mesh, tri as usize, eye + t * dir);
+                    let gpu_uv = glam::Vec2::new(texels[at + 2], texels[at + 3]);
+                    worst_uv = worst_uv.max((uv - gpu_uv).length());
+                    let gpu_normal = Vec3::new(surfaces[at], surfaces[at + 1], surfaces[at + 2]);
+                    worst_normal = worst_normal.max((normal - gpu_normal).length());
+                    let same = relative <= 1e-4
+                        && texels[at + 1] == tri as f32
+                        && surfaces[at + 3] == mesh.materials[tri as usize] as f32
+                        && (normal - gpu_normal).length() <= 1e-3
+                        && (uv - gpu_uv).length() <= 1e-3;
+                    if !same {
                         disagree += 1;
                     }
                 }
@@ -69,16 +108,43 @@ fn gpu_bvh_traversal_matches_the_cpu_on_every_pixel_of_the_demo_scene() {
     }
     let pixels = (WIDTH * HEIGHT) as usize;
     eprintln!(
-        "{hits} of {pixels} rays hit; {disagree} disagree; worst relative distance error {worst:e}"
+        "{hits} of {pixels} rays hit; {disagree} disagree; worst relative distance error {worst:e}, worst normal error {worst_normal:e}, worst UV error {worst_uv:e}"
     );
     assert!(
-        hits > pixels / 2,
-        "the demo camera looks into the box: {hits} hits"
+        hits > pixels / 8,
+        "the camera looks at the scene: {hits} hits"
     );
-    assert!(
-        disagree * 200 <= pixels,
-        "{disagree} of {pixels} pixels disagree"
+    assert_eq!(disagree, 0, "{disagree} of {pixels} pixels disagree");
+    assert_eq!(
+        texels
+            .chunks_exact(4)
+            .any(|t| t[0] >= 0.0 && (t[2] != 0.0 || t[3] != 0.0)),
+        textured,
+        "UVs are interpolated where the meshes have them"
     );
+}
+
+/// The normal and UV at `p` on triangle `tri`, interpolated from its corners
+/// by barycentric weights (the CPU side of `trace_surface`).
+fn interpolated(
+    mesh: &weft_render::geometry::TraceMesh,
+    tri: usize,
+    p: Vec3,
+) -> (Vec3, glam::Vec2) {
+    let [a, b, c] = mesh.corners[tri];
+    let (e1, e2, d) = (b - a, c - a, p - a);
+    let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (d20, d21) = (d.dot(e1), d.dot(e2));
+    let denom = d00 * d11 - d01 * d01;
+    let u = (d11 * d20 - d01 * d21) / denom;
+    let v = (d00 * d21 - d01 * d20) / denom;
+    let [na, nb, nc] = mesh.normals[tri];
+    let n = (1.0 - u - v) * na + u * nb + v * nc;
+    let [ta, tb, tc] = mesh.uvs[tri];
+    (
+        n.try_normalize().unwrap_or((e1.cross(e2)).normalize()),
+        (1.0 - u - v) * ta + u * tb + v * tc,
+    )
 }
 
 #[test]

@@ -43,6 +43,19 @@ pub struct DrawItem {
     pub mirrored: bool,
 }
 
+/// The scene's triangles as the ray tracer reads them, one entry per triangle.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TraceMesh {
+    /// World-space corners.
+    pub corners: Vec<[Vec3; 3]>,
+    /// Unit world-space normals at the corners.
+    pub normals: Vec<[Vec3; 3]>,
+    /// Texture coordinates at the corners.
+    pub uvs: Vec<[Vec2; 3]>,
+    /// Index into [`SceneGeometry::materials`].
+    pub materials: Vec<u32>,
+}
+
 /// The flattened scene, ready to upload.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SceneGeometry {
@@ -163,25 +176,31 @@ impl SceneGeometry {
         })
     }
 
-    /// Every placed mesh's triangles in world space, draw by draw: what the
-    /// ray tracer traces (light-volume meshes are not drawn, so not included).
-    pub fn world_triangles(&self) -> Vec<[Vec3; 3]> {
-        let mut out = Vec::new();
+    /// Every placed mesh's triangles in world space, draw by draw, with their
+    /// corners' world normals and UVs and their material: what the ray tracer
+    /// traces (light-volume meshes are not drawn, so not included).
+    pub fn trace_mesh(&self) -> TraceMesh {
+        let mut out = TraceMesh::default();
         for d in &self.draws {
             let Some(record) = self.draw_records.get(d.draw_id as usize) else {
                 continue;
             };
             let first = d.range.first_index as usize;
             let indices = &self.indices[first..first + d.range.index_count as usize];
-            let corner = |i: u32| {
-                let v = &self.vertices[(d.range.vertex_offset + i as i32) as usize];
-                record.model.transform_point3(Vec3::from(v.position))
-            };
-            out.extend(
-                indices
-                    .chunks_exact(3)
-                    .map(|t| [corner(t[0]), corner(t[1]), corner(t[2])]),
-            );
+            let vertex = |i: u32| &self.vertices[(d.range.vertex_offset + i as i32) as usize];
+            for t in indices.chunks_exact(3) {
+                let corners = [vertex(t[0]), vertex(t[1]), vertex(t[2])];
+                out.corners
+                    .push(corners.map(|v| record.model.transform_point3(Vec3::from(v.position))));
+                out.normals.push(corners.map(|v| {
+                    record
+                        .normal
+                        .transform_vector3(Vec3::from(v.normal))
+                        .normalize_or_zero()
+                }));
+                out.uvs.push(corners.map(|v| Vec2::from(v.uv)));
+                out.materials.push(d.material);
+            }
         }
         out
     }

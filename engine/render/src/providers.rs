@@ -10,8 +10,9 @@
 //!   views of a depth-only scene pass, fitted every frame; the pass is drawn
 //!   once per view with the push-constant member `shadow_view` set to the
 //!   view's index (see `shadows.rs`).
-//! - `RayTracing()`: the scene's world-space triangles and a BVH over them
-//!   (`bvh.rs`), built on first use and bound in set 1 of the compute pass.
+//! - `RayTracing()`: the scene's world-space triangles, their corners'
+//!   normals and UVs, their materials, and a BVH over them (`bvh.rs`), built
+//!   on first use and bound in set 1 of the compute pass.
 
 use crate::gaussian::{self, GaussianTaps};
 use crate::shadows::{ShadowSettings, MAX_CASCADES, MAX_PCF_RADIUS};
@@ -101,7 +102,14 @@ pub const RAY_TRACING: ProviderSpec = ProviderSpec {
     summary: "the scene's triangles and their BVH for compute shaders that trace rays",
     kinds: &[PassKind::Compute],
     args: &[],
-    supplies: &["Triangles", "BvhNodes", "BvhTriangles"],
+    supplies: &[
+        "Triangles",
+        "BvhNodes",
+        "BvhTriangles",
+        "TriangleNormals",
+        "TriangleUvs",
+        "TriangleMaterials",
+    ],
 };
 
 /// Every provider a graph may name.

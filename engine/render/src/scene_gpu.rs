@@ -40,6 +40,12 @@ pub const TRIANGLES_BINDING: u32 = 5;
 pub const BVH_NODES_BINDING: u32 = 6;
 /// Binding of the BVH's triangle order (`BvhTriangles`): leaves index it.
 pub const BVH_TRIANGLES_BINDING: u32 = 7;
+/// Binding of the corners' world normals (`TriangleNormals`, a vec4 each).
+pub const TRIANGLE_NORMALS_BINDING: u32 = 8;
+/// Binding of the corners' UVs (`TriangleUvs`, a vec2 each).
+pub const TRIANGLE_UVS_BINDING: u32 = 9;
+/// Binding of each triangle's material index (`TriangleMaterials`).
+pub const TRIANGLE_MATERIALS_BINDING: u32 = 10;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -74,7 +80,7 @@ pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 5] = [
 /// Set 1 bindings for ray tracing: built only when a compute pass that
 /// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
-pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 3] = [
+pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 6] = [
     (
         TRIANGLES_BINDING,
         DescriptorKind::StorageBuffer,
@@ -89,6 +95,21 @@ pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 3] = [
         BVH_TRIANGLES_BINDING,
         DescriptorKind::StorageBuffer,
         "the BVH's triangle order",
+    ),
+    (
+        TRIANGLE_NORMALS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the corners' normals",
+    ),
+    (
+        TRIANGLE_UVS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the corners' UVs",
+    ),
+    (
+        TRIANGLE_MATERIALS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the triangles' materials",
     ),
 ];
 /// Set 2 as the engine creates it: a material's textures, in the order of its
@@ -167,6 +188,9 @@ struct TraceBuffers<'g> {
     triangles: Buffer<'g>,
     nodes: Buffer<'g>,
     order: Buffer<'g>,
+    normals: Buffer<'g>,
+    uvs: Buffer<'g>,
+    materials: Buffer<'g>,
 }
 
 /// Everything the scene shaders read, on the device.
@@ -390,11 +414,22 @@ impl<'g> GpuScene<'g> {
         if self.trace.is_some() {
             return Ok(());
         }
-        let triangles = self.geometry.world_triangles();
-        let bvh = crate::bvh::Bvh::build(&triangles);
-        let corners: Vec<[f32; 4]> = triangles
+        let mesh = self.geometry.trace_mesh();
+        let bvh = crate::bvh::Bvh::build(&mesh.corners);
+        let corners: Vec<[f32; 4]> = mesh
+            .corners
             .iter()
             .flat_map(|t| t.map(|p| p.extend(1.0).to_array()))
+            .collect();
+        let normals: Vec<[f32; 4]> = mesh
+            .normals
+            .iter()
+            .flat_map(|t| t.map(|n| n.extend(0.0).to_array()))
+            .collect();
+        let uvs: Vec<[f32; 2]> = mesh
+            .uvs
+            .iter()
+            .flat_map(|t| t.map(|uv| uv.to_array()))
             .collect();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         self.trace = Some(TraceBuffers {
@@ -409,6 +444,14 @@ impl<'g> GpuScene<'g> {
                 self.gpu,
                 "bvh triangles",
                 bytes_of(&bvh.triangles),
+                storage,
+            )?,
+            normals: Buffer::device_local(self.gpu, "trace normals", bytes_of(&normals), storage)?,
+            uvs: Buffer::device_local(self.gpu, "trace uvs", bytes_of(&uvs), storage)?,
+            materials: Buffer::device_local(
+                self.gpu,
+                "trace materials",
+                bytes_of(&mesh.materials),
                 storage,
             )?,
         });
@@ -426,6 +469,9 @@ impl<'g> GpuScene<'g> {
             TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.triangles),
             BVH_NODES_BINDING => self.trace.as_ref().map(|t| &t.nodes),
             BVH_TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.order),
+            TRIANGLE_NORMALS_BINDING => self.trace.as_ref().map(|t| &t.normals),
+            TRIANGLE_UVS_BINDING => self.trace.as_ref().map(|t| &t.uvs),
+            TRIANGLE_MATERIALS_BINDING => self.trace.as_ref().map(|t| &t.materials),
             _ => None,
         }
     }
