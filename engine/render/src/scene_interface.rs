@@ -2,7 +2,7 @@
 //! material's textures), the vertex layout — and the check that a pass's
 //! shaders ask for exactly that. `weft graph check --shaders`, a hot reload and
 //! pipeline creation all run it, so a shader that declares the materials at
-//! binding 9 is refused with its pass's location instead of reading an
+//! binding 19 is refused with its pass's location instead of reading an
 //! unbound descriptor on the GPU.
 
 use crate::geometry::VERTEX_ATTRIBUTES;
