@@ -12,7 +12,6 @@ use weft_tests::render as common;
 use common::{agreement, graph, render_validated};
 use glam::{Mat4, Vec2, Vec3};
 use std::path::{Path, PathBuf};
-use weft_gpu::{Gpu, GpuOptions};
 use weft_graph::plan::Extent;
 use weft_render::{camera, render, RenderSettings};
 use weft_testkit::tiles;
@@ -129,11 +128,7 @@ fn the_heat_map_counts_known_lights_per_tile_and_draws_its_legend() {
     let path = known_scene(&dir);
     let scene = weft_scene::load_scene(&path).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
-    let gpu = Gpu::new(&GpuOptions {
-        validation: true,
-        device: None,
-    })
-    .expect("a Vulkan 1.3 device with the validation layer (run tools/setup)");
+    let gpu = weft_tests::gpu();
     let log = gpu.validation();
     let settings = RenderSettings {
         graph: graph("tiled.ron"),

@@ -13,7 +13,7 @@ use common::{demo_scene, root};
 use std::collections::BTreeSet;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
-use weft_gpu::{Gpu, GpuOptions};
+use weft_gpu::Gpu;
 use weft_graph::compile::feature_names;
 use weft_graph::plan::Extent;
 use weft_render::{check_graph_and_shaders, render, RenderSettings};
@@ -350,11 +350,7 @@ fn every_mutant_check_accepts_renders_clean() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(0x5EED);
-    let gpu = Gpu::new(&GpuOptions {
-        validation: true,
-        device: None,
-    })
-    .expect("a Vulkan 1.3 device with the validation layer (run tools/setup)");
+    let gpu = weft_tests::gpu();
     let scene = weft_scene::load_scene(&demo_scene()).expect("demo scene");
     let files = mutable_files();
     let mut rng = Rng(seed);

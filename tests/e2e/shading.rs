@@ -10,7 +10,7 @@
 
 use glam::Vec3;
 use std::path::{Path, PathBuf};
-use weft_gpu::{Gpu, GpuOptions, Pixels};
+use weft_gpu::Pixels;
 use weft_graph::plan::Extent;
 use weft_render::brdf::{cook_torrance, AreaGeometry};
 use weft_render::lights::area_shape;
@@ -37,11 +37,7 @@ fn camera_block() -> String {
 /// Renders `scene` through `graph` with validation and returns the HDR image as RGBA floats.
 fn render_hdr(scene: &Path, graph: &str) -> Vec<f32> {
     let scene = weft_scene::load_scene(scene).expect("scene loads");
-    let gpu = Gpu::new(&GpuOptions {
-        validation: true,
-        device: None,
-    })
-    .expect("device");
+    let gpu = weft_tests::gpu();
     let log = gpu.validation();
     let settings = RenderSettings {
         graph: weft_tests::shipped(graph),

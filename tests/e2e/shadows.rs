@@ -8,7 +8,7 @@ use weft_tests::render as common;
 
 use glam::{Vec3, Vec4Swizzles};
 use std::path::{Path, PathBuf};
-use weft_gpu::{Gpu, GpuOptions, Pixels};
+use weft_gpu::Pixels;
 use weft_graph::plan::Extent;
 use weft_render::{render, RenderSettings};
 
@@ -92,11 +92,7 @@ fn graph_with(dir: &Path, graph: &str, shadow_params: &str) -> PathBuf {
 /// Renders `scene` through `graph` and returns the HDR image's red channel, row by row.
 fn render_hdr(scene: &Path, graph: &Path) -> Vec<f32> {
     let scene = weft_scene::load_scene(scene).expect("scene loads");
-    let gpu = Gpu::new(&GpuOptions {
-        validation: true,
-        device: None,
-    })
-    .expect("device");
+    let gpu = weft_tests::gpu();
     let log = gpu.validation();
     let settings = RenderSettings {
         graph: graph.to_path_buf(),

@@ -3,7 +3,7 @@
 
 use image::RgbaImage;
 use std::path::{Path, PathBuf};
-use weft_gpu::{Gpu, GpuOptions, ValidationMessage};
+use weft_gpu::ValidationMessage;
 use weft_graph::plan::Extent;
 use weft_render::{render, RenderSettings};
 
@@ -52,11 +52,7 @@ pub fn render_validated(
     features: &[&str],
 ) -> Output {
     let scene = weft_scene::load_scene(scene).expect("scene loads");
-    let gpu = Gpu::new(&GpuOptions {
-        validation: true,
-        device: None,
-    })
-    .expect("a Vulkan 1.3 device with the validation layer (run tools/setup)");
+    let gpu = crate::gpu();
     let log = gpu.validation();
     let settings = RenderSettings {
         graph: graph.to_path_buf(),
@@ -139,11 +135,7 @@ pub fn centre_hdr(
     params: std::collections::BTreeMap<String, weft_graph::schema::ParamValue>,
 ) -> [f32; 4] {
     let scene = weft_scene::load_scene(scene).expect("scene loads");
-    let gpu = Gpu::new(&GpuOptions {
-        validation: true,
-        device: None,
-    })
-    .expect("device");
+    let gpu = crate::gpu();
     let log = gpu.validation();
     let settings = RenderSettings {
         graph: self::graph(graph),

@@ -1,12 +1,14 @@
 //! `weft bench bvh`: how long the ray tracer's BVH takes to build over a
-//! scene's world-space triangles, and its shape (nodes, leaves, depth).
+//! scene's world-space triangles (the ones the `RayTracing` provider uploads),
+//! and its shape (nodes, leaves, depth).
 
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use weft_render::bvh::{scene_triangles, Bvh};
+use weft_render::bvh::Bvh;
+use weft_render::geometry::SceneGeometry;
 
 /// Options of `weft bench bvh`.
 #[derive(Args)]
@@ -35,7 +37,7 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
     for path in &args.scenes {
         let scene = weft_scene::load_scene(path)
             .with_context(|| format!("loading scene {}", path.display()))?;
-        let triangles = scene_triangles(&scene);
+        let triangles = SceneGeometry::new(&scene).trace_mesh().corners;
         let mut times = Vec::new();
         let mut bvh = None;
         for _ in 0..args.runs {

@@ -199,21 +199,20 @@ fn snippet(text: &str, pos: Pos) -> Option<String> {
     let line_text = text.lines().nth(pos.line.checked_sub(1)? as usize)?;
     let number = pos.line.to_string();
     let gutter = " ".repeat(number.len());
-    if pos.col == 0 {
-        let start = line_text.len() - line_text.trim_start().len();
-        let width = line_text.trim().chars().count().max(1);
-        let indent: String = line_text[..start].to_string();
-        return Some(format!(
-            " {gutter} |\n {number} | {line_text}\n {gutter} | {indent}{}\n",
-            "^".repeat(width)
-        ));
-    }
-    let col = pos.col as usize - 1;
-    let rest: String = line_text.chars().skip(col).collect();
-    let width = rest
-        .find(|c: char| c.is_whitespace() || matches!(c, ',' | ')' | ']' | '}' | ':'))
-        .map_or(rest.chars().count(), |end| rest[..end].chars().count())
-        .max(1);
+    // Column 0 underlines the whole line, leading white space aside; otherwise
+    // the word (or the one character) at the column.
+    let (col, width) = if pos.col == 0 {
+        let trimmed = line_text.trim_start();
+        let col = line_text.chars().count() - trimmed.chars().count();
+        (col, trimmed.trim_end().chars().count())
+    } else {
+        let col = pos.col as usize - 1;
+        let rest: String = line_text.chars().skip(col).collect();
+        let width = rest
+            .find(|c: char| c.is_whitespace() || matches!(c, ',' | ')' | ']' | '}' | ':'))
+            .map_or(rest.chars().count(), |end| rest[..end].chars().count());
+        (col, width)
+    };
     // Tabs stay tabs under the line so the caret keeps its place.
     let indent: String = line_text
         .chars()
@@ -222,7 +221,7 @@ fn snippet(text: &str, pos: Pos) -> Option<String> {
         .collect();
     Some(format!(
         " {gutter} |\n {number} | {line_text}\n {gutter} | {indent}{}\n",
-        "^".repeat(width)
+        "^".repeat(width.max(1))
     ))
 }
 

@@ -9,6 +9,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
+use weft_scene::Aabb;
 
 /// Bins per axis when choosing a split.
 const BINS: usize = 16;
@@ -44,12 +45,6 @@ pub struct Bvh {
     pub triangles: Vec<u32>,
 }
 
-/// Every placed mesh's triangles in world space, instance by instance in the
-/// scene's order and mesh by mesh within a model.
-pub fn scene_triangles(scene: &weft_scene::Scene) -> Vec<[Vec3; 3]> {
-    scene_triangles_where(scene, |_, _| true)
-}
-
 /// The world-space triangles of every placed mesh for which
 /// `include(model, mesh)` holds.
 pub fn scene_triangles_where(
@@ -82,39 +77,15 @@ pub fn scene_triangles_where(
     out
 }
 
-/// An axis-aligned box.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Bounds {
-    min: Vec3,
-    max: Vec3,
-}
-
-impl Bounds {
-    const EMPTY: Bounds = Bounds {
-        min: Vec3::splat(f32::INFINITY),
-        max: Vec3::splat(f32::NEG_INFINITY),
-    };
-
-    fn grow(&mut self, p: Vec3) {
-        self.min = self.min.min(p);
-        self.max = self.max.max(p);
-    }
-
-    fn union(&mut self, other: &Bounds) {
-        self.min = self.min.min(other.min);
-        self.max = self.max.max(other.max);
-    }
-
-    /// Half the surface area, 0 for an empty box.
-    fn half_area(&self) -> f32 {
-        let d = (self.max - self.min).max(Vec3::ZERO);
-        d.x * d.y + d.y * d.z + d.z * d.x
-    }
+/// Half a box's surface area, 0 for an empty box: the SAH's cost measure.
+fn half_area(b: &Aabb) -> f32 {
+    let d = (b.max - b.min).max(Vec3::ZERO);
+    d.x * d.y + d.y * d.z + d.z * d.x
 }
 
 /// A triangle's box and centroid.
 struct Primitive {
-    bounds: Bounds,
+    bounds: Aabb,
     centroid: Vec3,
 }
 
@@ -145,13 +116,9 @@ impl Bvh {
     pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
         let prims: Vec<Primitive> = triangles
             .iter()
-            .map(|t| {
-                let mut bounds = Bounds::EMPTY;
-                t.iter().for_each(|&p| bounds.grow(p));
-                Primitive {
-                    bounds,
-                    centroid: (t[0] + t[1] + t[2]) / 3.0,
-                }
+            .map(|t| Primitive {
+                bounds: Aabb::from_points(t),
+                centroid: (t[0] + t[1] + t[2]) / 3.0,
             })
             .collect();
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
@@ -160,12 +127,10 @@ impl Bvh {
         let mut pending = vec![(0usize, 0usize, order.len())];
         while let Some((node, first, count)) = pending.pop() {
             let slice = &mut order[first..first + count];
-            let mut bounds = Bounds::EMPTY;
-            let mut centroids = Bounds::EMPTY;
-            for &i in slice.iter() {
-                bounds.union(&prims[i as usize].bounds);
-                centroids.grow(prims[i as usize].centroid);
-            }
+            let bounds = slice
+                .iter()
+                .fold(Aabb::EMPTY, |b, &i| b.union(&prims[i as usize].bounds));
+            let centroids = Aabb::from_points(slice.iter().map(|&i| &prims[i as usize].centroid));
             nodes[node] = GpuBvhNode {
                 min: bounds.min.to_array(),
                 first: first as u32,
@@ -260,12 +225,7 @@ impl Bvh {
 
 /// Where to split `slice` (reordered in place) by the surface area heuristic:
 /// the size of the left part, or `None` to make a leaf.
-fn split(
-    prims: &[Primitive],
-    slice: &mut [u32],
-    bounds: &Bounds,
-    centroids: &Bounds,
-) -> Option<usize> {
+fn split(prims: &[Primitive], slice: &mut [u32], bounds: &Aabb, centroids: &Aabb) -> Option<usize> {
     let count = slice.len();
     if count <= 1 {
         return None;
@@ -279,34 +239,34 @@ fn split(
         }
         let scale = BINS as f32 / extent[axis];
         let bin_of = |c: Vec3| (((c[axis] - centroids.min[axis]) * scale) as usize).min(BINS - 1);
-        let mut bin_bounds = [Bounds::EMPTY; BINS];
+        let mut bin_bounds = [Aabb::EMPTY; BINS];
         let mut bin_counts = [0usize; BINS];
         for &i in slice.iter() {
             let b = bin_of(prims[i as usize].centroid);
-            bin_bounds[b].union(&prims[i as usize].bounds);
+            bin_bounds[b] = bin_bounds[b].union(&prims[i as usize].bounds);
             bin_counts[b] += 1;
         }
         // Left sweeps: areas and counts of bins 0..=k; right: k+1..BINS.
         let mut left_area = [0.0f32; BINS - 1];
         let mut left_count = [0usize; BINS - 1];
-        let (mut acc, mut n) = (Bounds::EMPTY, 0);
+        let (mut acc, mut n) = (Aabb::EMPTY, 0);
         for k in 0..BINS - 1 {
-            acc.union(&bin_bounds[k]);
+            acc = acc.union(&bin_bounds[k]);
             n += bin_counts[k];
-            left_area[k] = acc.half_area();
+            left_area[k] = half_area(&acc);
             left_count[k] = n;
         }
-        let (mut acc, mut n) = (Bounds::EMPTY, 0);
+        let (mut acc, mut n) = (Aabb::EMPTY, 0);
         for k in (1..BINS).rev() {
-            acc.union(&bin_bounds[k]);
+            acc = acc.union(&bin_bounds[k]);
             n += bin_counts[k];
             let (l, r) = (left_count[k - 1], n);
             if l == 0 || r == 0 {
                 continue;
             }
             let cost = TRAVERSAL_COST
-                + (left_area[k - 1] * l as f32 + acc.half_area() * r as f32)
-                    / bounds.half_area().max(f32::MIN_POSITIVE);
+                + (left_area[k - 1] * l as f32 + half_area(&acc) * r as f32)
+                    / half_area(bounds).max(f32::MIN_POSITIVE);
             if best.is_none_or(|b| cost < b.0) {
                 let position = centroids.min[axis] + k as f32 / scale;
                 best = Some((cost, axis, position));

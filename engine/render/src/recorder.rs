@@ -369,13 +369,10 @@ impl DrawRecorder for SceneRecorder<'_> {
                     calls += self.draw_meshes(ctx.cmd, &q, transparent.iter());
                 }
             }
-            Draw::Meshes(filter) if shadow_atlas.is_some() => {
-                let settings = shadow_atlas.unwrap_or_default();
-                calls += self.draw_shadow_views(ctx, &p, filter, &settings)?;
-            }
-            Draw::Meshes(filter) => {
-                calls += self.draw_meshes(ctx.cmd, &p, g.filtered(filter));
-            }
+            Draw::Meshes(filter) => match &shadow_atlas {
+                Some(settings) => calls += self.draw_shadow_views(ctx, &p, filter, settings)?,
+                None => calls += self.draw_meshes(ctx.cmd, &p, g.filtered(filter)),
+            },
             Draw::LightVolumes(kind) => {
                 let lights = &self.scene.light_set;
                 let groups = match kind {

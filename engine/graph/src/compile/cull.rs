@@ -137,12 +137,8 @@ fn contributing(
     uses: &Uses,
     roots: &[IrResourceId],
 ) -> IdVec<IrPassId, bool> {
-    let n = ir.passes.len();
-    let mut position: IdVec<IrPassId, usize> = IdVec::filled(usize::MAX, n);
-    for (i, &p) in order.sequence.iter().enumerate() {
-        position[p] = i;
-    }
-    let mut needed = IdVec::filled(false, n);
+    let position = &order.position;
+    let mut needed = IdVec::filled(false, ir.passes.len());
     let mut stack: Vec<IrPassId> = roots
         .iter()
         .flat_map(|&r| order.writers[r].iter().copied())

@@ -128,6 +128,8 @@ pub struct Order {
     pub sequence: Vec<IrPassId>,
     /// For each resource, its live writers in execution order.
     pub writers: IdVec<IrResourceId, Vec<IrPassId>>,
+    /// Each pass's index in `sequence` (`usize::MAX` when not live).
+    pub position: IdVec<IrPassId, usize>,
 }
 
 /// Successors of each pass in the dependency graph.
@@ -217,7 +219,11 @@ pub fn order(ir: &Ir, live: &IdVec<IrPassId, bool>, uses: &Uses) -> Result<Order
         }
     }
     if errors.is_empty() {
-        Ok(Order { sequence, writers })
+        Ok(Order {
+            sequence,
+            writers,
+            position,
+        })
     } else {
         Err(errors)
     }
