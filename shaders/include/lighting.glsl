@@ -37,6 +37,9 @@ vec2 metal_rough(Material m, vec4 texel) {
     return round(clamp(m.specular.xy * texel.bg, 0.0, 1.0) * 255.0) / 255.0;
 }
 
+// Compute shaders (which have no derivatives) define NO_DERIVATIVES before
+// including this file and go without `mapped_normal`.
+#ifndef NO_DERIVATIVES
 // The normal `n` bent by a tangent-space normal-map texel (glTF convention:
 // +X along increasing u, +Y up in the image) with strength `scale`; 0 leaves
 // `n` as it is. The tangent frame comes from screen-space derivatives of the
@@ -58,6 +61,7 @@ vec3 mapped_normal(vec3 n, vec3 p, vec2 uv, vec3 texel, float scale) {
     bent.xy *= scale;
     return normalize(mat3(t, cross(n, t), n) * bent);
 }
+#endif
 
 // Cook-Torrance times N.L: GGX distribution, Smith height-correlated visibility,
 // Schlick Fresnel with F0 = mix(0.04, base, metallic), and Lambert diffuse

@@ -15,6 +15,9 @@
 // Shading models (engine/render/src/materials.rs), in Material.emissive.w.
 #define SHADING_BLINN_PHONG 0.0
 #define SHADING_METALLIC_ROUGHNESS 1.0
+// MTL illum 3 or 5: a perfect mirror of Ks to the path tracer, Blinn-Phong to
+// raster passes.
+#define SHADING_MIRROR 2.0
 
 // Area lights reuse the fields: position_range = centre, 0; direction_type =
 // local X times the half width (or the disc radius), type; color_exponent =

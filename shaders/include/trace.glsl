@@ -21,6 +21,14 @@ layout(std430, set = 1, binding = 8) readonly buffer TriangleNormals { vec4 corn
 layout(std430, set = 1, binding = 9) readonly buffer TriangleUvs { vec2 corner_uvs[]; };
 // Per triangle: index into the Materials buffer (scene.glsl, binding 3).
 layout(std430, set = 1, binding = 10) readonly buffer TriangleMaterials { uint triangle_materials[]; };
+// The emissive triangles as an alias table over emitted power
+// (engine/render/src/emitters.rs): emitter_info = (count, bits of the sum of
+// luminance x area, 0, 0); per emitter (triangle, alias, bits of the keep
+// threshold, 0).
+layout(std430, set = 1, binding = 11) readonly buffer Emitters {
+    uvec4 emitter_info;
+    uvec4 emitters[];
+};
 
 // Deepest traversal the stack allows; the builder's trees stay far below it
 // (docs/pathtrace.md: depth 26 on demo.scene).

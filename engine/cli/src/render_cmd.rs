@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use weft_gpu::{format_timings, Gpu, GpuOptions, TimingMode};
 use weft_graph::plan::Extent;
 use weft_graph::schema::ParamValue;
-use weft_render::{render, RenderSettings, Rendered};
+use weft_render::{render_with_progress, RenderSettings, Rendered};
 
 /// Which per-pass times `--timings` measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -66,6 +66,18 @@ pub struct RenderArgs {
     /// STEM.NAME.exr, in linear floats.
     #[arg(long, value_delimiter = ',')]
     readback: Vec<String>,
+    /// Progressive graphs (graphs/pathtrace.ron): render until this many samples
+    /// per pixel, at a fixed scene time, instead of --frames frames.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    spp: Option<u64>,
+    /// Stop early once another frame would end past this many seconds (the
+    /// samples reached are reported); at least one frame is drawn.
+    #[arg(long, value_parser = parse_seconds)]
+    time_limit: Option<f64>,
+    /// Random seed: sets the graph parameter `seed` (the path tracer's), so a
+    /// seed renders the same image every run.
+    #[arg(long)]
+    seed: Option<u32>,
     /// Use the first device whose name contains this.
     #[arg(long)]
     device: Option<String>,
@@ -74,6 +86,16 @@ pub struct RenderArgs {
     /// stop with Ctrl-C (SIGINT) or SIGTERM.
     #[arg(long)]
     watch: bool,
+}
+
+/// Parses a positive, finite number of seconds.
+fn parse_seconds(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(s) if s.is_finite() && s > 0.0 => Ok(s),
+        _ => Err(format!(
+            "expected a positive number of seconds, found \"{text}\""
+        )),
+    }
 }
 
 /// Parses `NAME=VALUE` as `--param` takes it.
@@ -138,6 +160,23 @@ fn default_out(scene: &Path) -> PathBuf {
     Path::new("out").join(format!("{stem}.png"))
 }
 
+/// A progress bar on stderr for renders to a sample count or a time limit
+/// (hidden when stderr is not a terminal, and with --json).
+fn progress_bar(args: &RenderArgs) -> indicatif::ProgressBar {
+    if args.json || (args.spp.is_none() && args.time_limit.is_none()) {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:30}] frame {pos}/{len} {msg} (ETA {eta})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+        .progress_chars("=> "),
+    );
+    bar
+}
+
 /// The render settings the arguments ask for.
 fn settings(args: &RenderArgs, extra_readback: Vec<String>) -> RenderSettings {
     RenderSettings {
@@ -154,7 +193,17 @@ fn settings(args: &RenderArgs, extra_readback: Vec<String>) -> RenderSettings {
         },
         readback: true,
         extra_readback,
-        params: args.params.iter().cloned().collect(),
+        params: args
+            .params
+            .iter()
+            .cloned()
+            .chain(
+                args.seed
+                    .map(|k| ("seed".to_string(), ParamValue::Number(f64::from(k)))),
+            )
+            .collect(),
+        samples: args.spp,
+        time_limit: args.time_limit,
         ..RenderSettings::default()
     }
 }
@@ -171,6 +220,9 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     let exr_image = extra_readback.first().filter(|_| exr).cloned();
     crate::graph_cmd::check_feature_names(&args.graph, &args.features)?;
     let settings = settings(&args, extra_readback);
+    if args.watch && (args.spp.is_some() || args.time_limit.is_some()) {
+        bail!("--spp and --time-limit render once; use them without --watch (`weft view` shows a progressive graph converging)");
+    }
     if args.watch {
         return crate::watch_cmd::run(crate::watch_cmd::WatchRequest {
             scene: &args.scene,
@@ -194,7 +246,18 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     if !args.json {
         println!("device: {device} ({:?})", gpu.info().kind);
     }
-    let rendered = render(&gpu, &scene, &settings)?;
+    let bar = progress_bar(&args);
+    let rendered = render_with_progress(&gpu, &scene, &settings, &mut |p| {
+        bar.set_length(p.planned_frames.into());
+        bar.set_position(p.frames.into());
+        if let Some(samples) = p.samples {
+            bar.set_message(format!(
+                "{samples} spp, {:.1} spp/s",
+                samples as f64 / p.elapsed.max(1e-9)
+            ));
+        }
+    })?;
+    bar.finish_and_clear();
     drop(gpu);
     let read_back = |wanted: &str| {
         rendered
@@ -248,7 +311,8 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             "scene": args.scene,
             "graph": args.graph,
             "size": [args.size.width, args.size.height],
-            "frames": args.frames.max(1),
+            "frames": rendered.frame_ms.len(),
+            "samples_per_pixel": rendered.samples,
             "camera": rendered.camera,
             "features": rendered.plan.features,
             "passes": passes,
@@ -275,10 +339,18 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             args.graph.display(),
             args.size.width,
             args.size.height,
-            args.frames.max(1),
+            rendered.frame_ms.len(),
             rendered.camera,
             passes.join(" -> ")
         );
+        if let Some(samples) = rendered.samples {
+            let seconds = rendered.frame_ms.iter().sum::<f64>() / 1e3;
+            println!(
+                "samples: {samples} per pixel in {seconds:.2} s ({:.0} samples per second)",
+                samples as f64 * f64::from(args.size.width) * f64::from(args.size.height)
+                    / seconds.max(1e-9)
+            );
+        }
         println!(
             "draw calls: {}; host recording: {record_ms:.3} ms per frame; frame: {frame_ms:.3} ms wall{}",
             rendered.draw_calls,

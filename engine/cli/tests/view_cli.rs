@@ -489,9 +489,9 @@ fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
                 "--size",
                 "96x54",
                 "--frames",
-                "5",
+                "6",
                 "--press",
-                "1:g,2:1,3:f12",
+                "1:g,2:g,3:1,4:f12",
                 "--validate",
             ],
             &dir,
@@ -501,14 +501,18 @@ fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
     assert_clean(&out);
     let stdout = text(&out.stdout);
     let graphs: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
-    assert_eq!(graphs.len(), 3, "{stdout}");
+    assert_eq!(graphs.len(), 4, "{stdout}");
     assert!(graphs[0].contains("forward.ron: features"), "{stdout}");
-    assert!(!graphs[1].contains("forward.ron"), "G moved on: {stdout}");
+    assert!(
+        graphs[1].contains("pathtrace.ron: features none"),
+        "G moved on to the next graph in graphs/: {stdout}"
+    );
+    assert!(!graphs[2].contains("pathtrace.ron"), "G moved on: {stdout}");
     let first_feature = |line: &str| {
         let list = line.split(": features ").nth(1).expect("feature list");
         list.split(", ").next().expect("first feature").to_string()
     };
-    let (before, after) = (first_feature(graphs[1]), first_feature(graphs[2]));
+    let (before, after) = (first_feature(graphs[2]), first_feature(graphs[3]));
     assert_ne!(before, after, "key 1 flips the first feature");
     assert_eq!(
         before.replace("[on]", "[off]").replace("[off]", ""),

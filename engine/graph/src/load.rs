@@ -40,6 +40,8 @@ pub struct LoadedGraph {
     pub output: Option<String>,
     /// Images tools read back besides the output, from the root file.
     pub readback: Vec<String>,
+    /// How the graph accumulates over frames, from the root file.
+    pub progressive: Option<crate::schema::Progressive>,
     /// Human-readable name.
     pub name: String,
     /// Toggles declared on by default by the graph and its fragments.
@@ -230,6 +232,7 @@ fn load_file(
     if site.is_none() {
         graph.output = parsed.output.clone();
         graph.readback = parsed.readback.clone();
+        graph.progressive = parsed.progressive.clone();
         graph.name = parsed.name.clone().unwrap_or_default();
         graph.is_fragment = parsed.fragment;
     }

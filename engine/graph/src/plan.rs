@@ -62,6 +62,9 @@ pub struct Plan {
     pub output: ResourceId,
     /// Further images left readable after the frame (`CompileOptions::readback`).
     pub readback: Vec<ResourceId>,
+    /// For a progressive graph (`progressive` in the file), the samples per
+    /// pixel each frame adds to its history.
+    pub samples_per_frame: Option<u32>,
     /// Where transient images live.
     pub memory: MemoryPlan,
     /// Barriers after the last pass: the output to `TRANSFER_SRC_OPTIMAL` for presenting or

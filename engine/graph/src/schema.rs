@@ -42,6 +42,19 @@ pub struct GraphFile {
     /// `--readback` replaces the list.
     #[serde(default)]
     pub readback: Vec<String>,
+    /// Marks a graph whose output converges over frames (a path tracer): each
+    /// frame adds `samples_per_frame` samples per pixel to its history images,
+    /// so tools can render to a sample count and the viewer can show it.
+    #[serde(default)]
+    pub progressive: Option<Progressive>,
+}
+
+/// How a progressive graph accumulates (see [`GraphFile::progressive`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Progressive {
+    /// Samples per pixel each frame adds: a whole number or a `"$param"`.
+    pub samples_per_frame: Dim,
 }
 
 /// An included fragment and the parameter values it is given.

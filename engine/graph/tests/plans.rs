@@ -80,7 +80,10 @@ fn plans_match_snapshots_and_pass_the_checker() {
             });
         }
     }
-    assert_eq!(compared, 9);
+    assert_eq!(
+        compared, 12,
+        "forward, deferred, tiled and pathtrace, three feature sets each"
+    );
 }
 
 #[test]

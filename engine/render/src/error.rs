@@ -13,6 +13,12 @@ pub enum RenderError {
     /// The graph failed to load or compile; every diagnostic, one per line.
     #[error("{}", .0.iter().map(ToString::to_string).collect::<Vec<_>>().join("\n"))]
     Graph(Vec<weft_graph::Diagnostic>),
+    /// A sample count was asked of a graph that does not accumulate.
+    #[error("{}: --spp needs a progressive graph (one that declares `progressive: (samples_per_frame: ...)`, such as graphs/pathtrace.ron)", graph.display())]
+    NotProgressive {
+        /// The graph file.
+        graph: PathBuf,
+    },
     /// No scene camera has the requested name.
     #[error("no camera named \"{name}\"; the scene has: {available}")]
     Camera {
@@ -57,6 +63,14 @@ impl RenderError {
                 vec![Diagnostic::error(&at.file, at.pos, error.to_string())]
             }
             Self::Texture { path, message } => vec![Diagnostic::in_file(path, None, message)],
+            Self::NotProgressive { graph } => vec![Diagnostic::in_file(
+                graph,
+                None,
+                "--spp needs a progressive graph",
+            )
+            .with_hint(
+                "declare `progressive: (samples_per_frame: ...)`, as graphs/pathtrace.ron does",
+            )],
             Self::Gpu(_) | Self::Camera { .. } | Self::TooLarge(_) => Vec::new(),
         }
     }

@@ -41,6 +41,12 @@ pub struct RenderSettings {
     /// Values for the graph's top-level parameters, replacing those in the file
     /// (`--param exposure=2`), so a sweep needs no edited copies of the graph.
     pub params: BTreeMap<String, ParamValue>,
+    /// For a progressive graph: render until this many samples per pixel,
+    /// at a fixed time, instead of `frames` frames.
+    pub samples: Option<u64>,
+    /// Stop before a frame that would end past this many seconds of
+    /// rendering (at least one frame is drawn).
+    pub time_limit: Option<f64>,
 }
 
 impl Default for RenderSettings {
@@ -60,6 +66,8 @@ impl Default for RenderSettings {
             readback: true,
             extra_readback: Vec::new(),
             params: BTreeMap::new(),
+            samples: None,
+            time_limit: None,
         }
     }
 }
@@ -82,6 +90,21 @@ pub struct Rendered {
     pub frame_ms: Vec<f64>,
     /// Textures that could not be loaded, meshes skipped.
     pub warnings: Vec<String>,
+    /// Samples per pixel the output holds, for a progressive graph.
+    pub samples: Option<u64>,
+}
+
+/// Where a render stands after a frame, for progress displays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// Frames drawn so far.
+    pub frames: u32,
+    /// Frames the render will draw (fewer if a time limit stops it).
+    pub planned_frames: u32,
+    /// Samples per pixel accumulated so far (progressive graphs).
+    pub samples: Option<u64>,
+    /// Seconds since the first frame started.
+    pub elapsed: f64,
 }
 
 impl Rendered {
@@ -122,6 +145,32 @@ pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
 ) -> Result<Rendered, RenderError> {
+    render_with_progress(gpu, scene, settings, &mut |_| {})
+}
+
+/// Frames to draw: `settings.frames`, or as many as `settings.samples` needs
+/// at the plan's samples per frame.
+fn planned_frames(plan: &Plan, settings: &RenderSettings) -> Result<u32, RenderError> {
+    let Some(samples) = settings.samples else {
+        return Ok(settings.frames.max(1));
+    };
+    let per_frame = plan
+        .samples_per_frame
+        .ok_or_else(|| RenderError::NotProgressive {
+            graph: settings.graph.clone(),
+        })?;
+    Ok(samples
+        .div_ceil(u64::from(per_frame))
+        .clamp(1, u64::from(u32::MAX)) as u32)
+}
+
+/// [`render`], calling `progress` after every frame.
+pub fn render_with_progress(
+    gpu: &Gpu,
+    scene: &Scene,
+    settings: &RenderSettings,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Rendered, RenderError> {
     let camera = match &settings.camera {
         Some(name) => scene.camera(name).ok_or_else(|| RenderError::Camera {
             name: name.clone(),
@@ -138,26 +187,49 @@ pub fn render(
         })?,
     };
     let plan = Arc::new(compile_for_scene(gpu, scene, settings)?);
+    let count = planned_frames(&plan, settings)?;
+    // Accumulating to a sample count keeps the scene still.
+    let frame_time = if settings.samples.is_some() {
+        0.0
+    } else {
+        settings.frame_time
+    };
     let uploaded = GpuScene::new(gpu, scene)?;
     let warnings = uploaded.warnings.clone();
     let mut frames = FrameLoop::new(gpu, Arc::clone(&plan), uploaded)?;
-    let count = settings.frames.max(1);
-    let mut record_ms = Vec::with_capacity(count as usize);
-    let mut frame_ms = Vec::with_capacity(count as usize);
+    let mut record_ms = Vec::with_capacity(count.min(4096) as usize);
+    let mut frame_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut last = None;
+    let start = std::time::Instant::now();
     for frame in 0..count {
+        let elapsed = start.elapsed().as_secs_f64();
+        let typical = frame_ms.last().copied().unwrap_or(0.0) / 1e3;
+        let out_of_time = settings
+            .time_limit
+            .is_some_and(|limit| frame > 0 && elapsed + 2.0 * typical > limit);
+        let final_frame = frame + 1 == count || out_of_time;
         let started = std::time::Instant::now();
         let report = frames.draw(&FrameRequest {
             camera,
-            time: settings.time + frame as f32 * settings.frame_time,
+            time: settings.time + frame as f32 * frame_time,
             frame,
             timing: settings.timing,
-            readback: settings.readback && frame + 1 == count,
+            readback: settings.readback && final_frame,
         })?;
         frame_ms.push(started.elapsed().as_secs_f64() * 1e3);
         record_ms.push(report.record_ms);
         last = Some(report);
+        progress(Progress {
+            frames: frame + 1,
+            planned_frames: count,
+            samples: frames.samples(),
+            elapsed: start.elapsed().as_secs_f64(),
+        });
+        if final_frame {
+            break;
+        }
     }
+    let samples = frames.samples();
     let report =
         last.ok_or_else(|| RenderError::Gpu(weft_gpu::GpuError::Plan("no frame".into())))?;
     let draw_calls = frames.draw_calls();
@@ -171,5 +243,6 @@ pub fn render(
         record_ms,
         frame_ms,
         warnings,
+        samples,
     })
 }

@@ -22,6 +22,36 @@ pub struct FrameLoop<'g> {
     recorder: SceneRecorder<'g>,
     renderer: Renderer<'g>,
     plan: Arc<Plan>,
+    accumulation: Accumulation,
+}
+
+/// Counts the frames in a row that drew the same inputs, so history images
+/// can accumulate (`history_frames` push constants). Anything that can
+/// change the image starts the count again: the camera, a light, the plan
+/// (graph, parameters, size, features), the scene, a shader.
+#[derive(Debug, Default)]
+struct Accumulation {
+    /// The scene inputs of the last frame drawn, `None` after a change.
+    last: Option<u64>,
+    /// Frames in a row before the next one with inputs equal to `last`.
+    frames: u32,
+}
+
+impl Accumulation {
+    /// The count for a frame whose scene inputs hash to `inputs`.
+    fn next(&mut self, inputs: u64) -> u32 {
+        if self.last == Some(inputs) {
+            self.frames = self.frames.saturating_add(1);
+        } else {
+            self.frames = 0;
+            self.last = Some(inputs);
+        }
+        self.frames
+    }
+
+    fn reset(&mut self) {
+        self.last = None;
+    }
 }
 
 /// What one frame is: when, and what to measure and copy back.
@@ -51,6 +81,7 @@ impl<'g> FrameLoop<'g> {
             recorder,
             renderer,
             plan,
+            accumulation: Accumulation::default(),
         })
     }
 
@@ -58,15 +89,19 @@ impl<'g> FrameLoop<'g> {
     /// recorded and submitted, waited for, read back when asked.
     pub fn draw(&mut self, request: &FrameRequest<'_>) -> Result<FrameReport, RenderError> {
         let extent = [self.plan.extent.width, self.plan.extent.height];
-        self.recorder
+        let inputs = self
+            .recorder
             .scene
             .update(request.camera, request.time, extent)?;
-        self.recorder.set_frame(request.time, request.frame);
+        let history_frames = self.accumulation.next(inputs);
+        self.recorder
+            .set_frame(request.time, request.frame, history_frames);
         let options = FrameOptions {
             timing: request.timing,
             readback: request.readback,
             time: request.time,
             frame: request.frame,
+            history_frames,
         };
         self.renderer
             .execute(
@@ -101,22 +136,53 @@ impl<'g> FrameLoop<'g> {
 
     /// Runs `plan` from the next frame, on `resources` made for it.
     pub fn swap_plan(&mut self, plan: Arc<Plan>, resources: FrameResources<'g>) {
+        self.accumulation.reset();
         self.resources = resources;
         self.plan = plan;
     }
 
     /// Draws another scene from the next frame.
     pub fn swap_scene(&mut self, recorder: SceneRecorder<'g>) {
+        self.accumulation.reset();
         self.recorder = recorder;
     }
 
-    /// The executor (its pipeline cache takes reloaded shader modules).
+    /// The executor (its pipeline cache takes reloaded shader modules, so
+    /// accumulation starts again).
     pub fn renderer(&mut self) -> &mut Renderer<'g> {
+        self.accumulation.reset();
         &mut self.renderer
     }
 
-    /// The scene recorder (its pipeline cache takes reloaded shader modules).
+    /// The scene recorder (its pipeline cache takes reloaded shader modules, so
+    /// accumulation starts again).
     pub fn recorder(&mut self) -> &mut SceneRecorder<'g> {
+        self.accumulation.reset();
         &mut self.recorder
+    }
+
+    /// Samples per pixel the plan's history holds after the last frame drawn:
+    /// `None` unless the plan is progressive.
+    pub fn samples(&self) -> Option<u64> {
+        self.plan
+            .samples_per_frame
+            .map(|spf| u64::from(spf) * (u64::from(self.accumulation.frames) + 1))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Accumulation;
+
+    #[test]
+    fn accumulation_counts_equal_inputs_and_restarts_on_change() {
+        let mut a = Accumulation::default();
+        assert_eq!(a.next(7), 0);
+        assert_eq!(a.next(7), 1);
+        assert_eq!(a.next(7), 2);
+        assert_eq!(a.next(8), 0, "a moved camera or light starts again");
+        assert_eq!(a.next(8), 1);
+        a.reset();
+        assert_eq!(a.next(8), 0, "a reload starts again even with equal inputs");
     }
 }

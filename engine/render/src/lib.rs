@@ -12,6 +12,7 @@
 pub mod brdf;
 pub mod bvh;
 pub mod camera;
+pub mod emitters;
 pub mod error;
 pub mod features;
 pub mod frame;
@@ -43,7 +44,9 @@ pub mod watch;
 
 pub use error::RenderError;
 pub use features::scene_features;
-pub use frame::{compile_for_scene, render, RenderSettings, Rendered};
+pub use frame::{
+    compile_for_scene, render, render_with_progress, Progress, RenderSettings, Rendered,
+};
 pub use frame_loop::{FrameLoop, FrameRequest};
 pub use graph_check::check_graph_and_shaders;
 pub use prepare::{PreparedReload, ReloadJob};

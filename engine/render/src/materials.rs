@@ -14,6 +14,10 @@ pub const MATERIAL_BYTES: usize = std::mem::size_of::<GpuMaterial>();
 pub const BLINN_PHONG: f32 = 0.0;
 /// Shading-model code of glTF materials (`SHADING_METALLIC_ROUGHNESS`).
 pub const METALLIC_ROUGHNESS: f32 = 1.0;
+/// Shading-model code of MTL materials with `illum` 3 or 5 (`SHADING_MIRROR`):
+/// the path tracer reflects `Ks` as a perfect mirror; raster passes shade
+/// them as Blinn-Phong.
+pub const MIRROR: f32 = 2.0;
 
 /// Whether a mesh with this material is drawn by a pass with `filter`.
 pub fn matches(filter: MaterialFilter, m: &Material) -> bool {
@@ -56,7 +60,11 @@ pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
                 diffuse: diffuse.extend(m.base_color.w),
                 specular: specular.extend(shininess),
                 ambient: ambient.extend(normal_scale),
-                emissive: m.emissive.extend(BLINN_PHONG),
+                emissive: m.emissive.extend(if matches!(m.illum, Some(3 | 5)) {
+                    MIRROR
+                } else {
+                    BLINN_PHONG
+                }),
             }
         }
         ShadingModel::MetallicRoughness => {

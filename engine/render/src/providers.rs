@@ -339,6 +339,7 @@ mod tests {
             culled: Vec::new(),
             output: weft_graph::id::ResourceId::new(0),
             readback: Vec::new(),
+            samples_per_frame: None,
             memory: Default::default(),
             epilogue: Vec::new(),
             warnings: Vec::new(),

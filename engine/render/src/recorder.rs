@@ -99,10 +99,11 @@ impl<'g> SceneRecorder<'g> {
         })
     }
 
-    /// Sets the `time` and `frame` values push constants receive.
-    pub fn set_frame(&mut self, time: f32, frame: u32) {
+    /// Sets the `time`, `frame` and `history_frames` values push constants receive.
+    pub fn set_frame(&mut self, time: f32, frame: u32, history_frames: u32) {
         self.frame.time = time;
         self.frame.frame = frame;
+        self.frame.history_frames = history_frames;
     }
 
     /// Drops every scene pipeline built from `changed` so the next frame rebuilds

@@ -106,6 +106,11 @@ impl<'g> LiveRender<'g> {
         &self.scene
     }
 
+    /// Samples per pixel the last frame's history holds (progressive graphs).
+    pub fn samples(&self) -> Option<u64> {
+        self.frames.samples()
+    }
+
     /// The settings the live version was built with.
     pub fn settings(&self) -> &RenderSettings {
         &self.settings

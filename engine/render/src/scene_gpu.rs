@@ -46,6 +46,9 @@ pub const TRIANGLE_NORMALS_BINDING: u32 = 8;
 pub const TRIANGLE_UVS_BINDING: u32 = 9;
 /// Binding of each triangle's material index (`TriangleMaterials`).
 pub const TRIANGLE_MATERIALS_BINDING: u32 = 10;
+/// Binding of the emissive triangles' alias table (`Emitters`,
+/// [`crate::emitters::EmitterTable`]).
+pub const EMITTERS_BINDING: u32 = 11;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -80,7 +83,7 @@ pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 5] = [
 /// Set 1 bindings for ray tracing: built only when a compute pass that
 /// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
-pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 6] = [
+pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 7] = [
     (
         TRIANGLES_BINDING,
         DescriptorKind::StorageBuffer,
@@ -110,6 +113,11 @@ pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 6] = [
         TRIANGLE_MATERIALS_BINDING,
         DescriptorKind::StorageBuffer,
         "the triangles' materials",
+    ),
+    (
+        EMITTERS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the emissive triangles",
     ),
 ];
 /// Set 2 as the engine creates it: a material's textures, in the order of its
@@ -191,6 +199,7 @@ struct TraceBuffers<'g> {
     normals: Buffer<'g>,
     uvs: Buffer<'g>,
     materials: Buffer<'g>,
+    emitters: Buffer<'g>,
 }
 
 /// Everything the scene shaders read, on the device.
@@ -431,6 +440,9 @@ impl<'g> GpuScene<'g> {
             .iter()
             .flat_map(|t| t.map(|uv| uv.to_array()))
             .collect();
+        let emitters = crate::emitters::EmitterTable::build(&mesh.corners, |t| {
+            self.geometry.materials[mesh.materials[t] as usize].emissive
+        });
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         self.trace = Some(TraceBuffers {
             triangles: Buffer::device_local(
@@ -454,6 +466,7 @@ impl<'g> GpuScene<'g> {
                 bytes_of(&mesh.materials),
                 storage,
             )?,
+            emitters: Buffer::device_local(self.gpu, "emitters", &emitters.bytes(), storage)?,
         });
         Ok(())
     }
@@ -472,6 +485,7 @@ impl<'g> GpuScene<'g> {
             TRIANGLE_NORMALS_BINDING => self.trace.as_ref().map(|t| &t.normals),
             TRIANGLE_UVS_BINDING => self.trace.as_ref().map(|t| &t.uvs),
             TRIANGLE_MATERIALS_BINDING => self.trace.as_ref().map(|t| &t.materials),
+            EMITTERS_BINDING => self.trace.as_ref().map(|t| &t.emitters),
             _ => None,
         }
     }
@@ -502,7 +516,14 @@ impl<'g> GpuScene<'g> {
 
     /// Writes the camera and the lights as they are at `time` for a target of `extent`;
     /// call it before each frame (the previous frame must have finished).
-    pub fn update(&mut self, camera: &Camera, time: f32, extent: [u32; 2]) -> Result<(), GpuError> {
+    /// Returns a hash of what it uploaded (camera and lights), so callers can
+    /// tell whether two frames see the same inputs.
+    pub fn update(
+        &mut self,
+        camera: &Camera,
+        time: f32,
+        extent: [u32; 2],
+    ) -> Result<u64, GpuError> {
         let [w, h] = [extent[0].max(1) as f32, extent[1].max(1) as f32];
         let view_proj = camera::view_projection(camera, time, w / h);
         let eye = camera::camera_position(camera, time);
@@ -531,8 +552,11 @@ impl<'g> GpuScene<'g> {
         if !lights.is_empty() {
             self.lights.write(bytes_of(&lights.records))?;
         }
+        let mut inputs = std::collections::hash_map::DefaultHasher::new();
+        std::hash::Hash::hash(bytes_of(&[frame]), &mut inputs);
+        std::hash::Hash::hash(bytes_of(&lights.records), &mut inputs);
         self.light_set = lights;
-        Ok(())
+        Ok(std::hash::Hasher::finish(&inputs))
     }
 }
 

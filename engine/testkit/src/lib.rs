@@ -29,6 +29,7 @@ pub fn render_frames(
             time: options.time + frame as f32 * frame_time,
             readback: options.readback && frame + 1 == frames.max(1),
             timing: options.timing,
+            history_frames: options.history_frames + frame,
         };
         last = Some(renderer.execute(plan, &mut resources, draws, &options)?);
     }

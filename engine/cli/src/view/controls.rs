@@ -165,6 +165,8 @@ pub struct Status<'a> {
     pub timings: &'a [PassTiming],
     /// The last refused reload, shown until one succeeds.
     pub error: Option<&'a str>,
+    /// Samples per pixel accumulated, for a progressive graph.
+    pub samples: Option<u64>,
 }
 
 /// The window title: graph, features, frame time and per-pass times, or the
@@ -185,6 +187,9 @@ pub fn title(status: &Status) -> String {
         status.features.join(" "),
         status.frame_ms
     );
+    if let Some(samples) = status.samples {
+        line.push_str(&format!(" {samples} spp"));
+    }
     if !status.timings.is_empty() {
         let passes: Vec<String> = status
             .timings
@@ -295,11 +300,18 @@ mod tests {
             frame_ms: 20.0,
             timings: &timings,
             error: None,
+            samples: None,
         };
         assert_eq!(
             title(&status),
             "weft view: forward.ron [bloom shadow_casters] 20.0 ms (50 fps) | forward 1.23"
         );
+        status.samples = Some(48);
+        assert_eq!(
+            title(&status),
+            "weft view: forward.ron [bloom shadow_casters] 20.0 ms (50 fps) 48 spp | forward 1.23"
+        );
+        status.samples = None;
         status.error = Some("graphs/forward.ron:3: unknown pass kind");
         assert!(title(&status)
             .starts_with("ERROR graphs/forward.ron:3: unknown pass kind (kept last good) | weft view: forward.ron"));

@@ -29,7 +29,9 @@ Controls:
   Space          pause / resume scene time            R       back to the scene camera
   F12            save a screenshot (weft-<time>-<n>.png, name printed)
   Esc            quit
-The title shows the graph, its features, frame time and per-pass GPU times, or the
+The title shows the graph, its features, frame time, samples per pixel for a
+progressive graph such as graphs/pathtrace.ron (it converges while nothing moves;
+moving the camera or a light starts it again) and per-pass GPU times, or the
 last refused reload as file:line (also on stderr); edits to the graph, its includes,
 its shaders or the scene reload all-or-nothing.";
 

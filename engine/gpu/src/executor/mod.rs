@@ -40,6 +40,9 @@ pub struct FrameOptions {
     pub time: f32,
     /// Frame number, for `frame` push constants.
     pub frame: u32,
+    /// For `history_frames` push constants: frames in a row before this one
+    /// that drew the same inputs (see [`crate::bind::FrameValues`]).
+    pub history_frames: u32,
 }
 
 /// What a frame produced; serialises (without the image) for `--json`.

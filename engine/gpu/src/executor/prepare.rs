@@ -52,6 +52,7 @@ impl<'g> Renderer<'g> {
             time: options.time,
             frame: options.frame,
             extent: [prep.extent.width, prep.extent.height],
+            history_frames: options.history_frames,
         };
         bind::pack_push(block, &pass.params, &frame).map_err(|problems| GpuError::Pass {
             pass: pass.name.clone(),

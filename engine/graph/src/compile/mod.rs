@@ -215,6 +215,7 @@ pub fn compile_ir(
             .iter()
             .map(|&r| lifetimes.plan_index(r))
             .collect(),
+        samples_per_frame: ir.samples_per_frame,
         resources,
         passes,
         culled,

@@ -14,6 +14,8 @@ pub struct Ir {
     pub resources: IdVec<IrResourceId, IrResource>,
     pub passes: IdVec<IrPassId, IrPass>,
     pub output: Option<IrResourceId>,
+    /// Samples per pixel each frame adds, for a progressive graph.
+    pub samples_per_frame: Option<u32>,
 }
 
 /// A resolved resource.

@@ -11,7 +11,9 @@ mod values;
 pub use ir::*;
 pub use rules::{access_path, usage_name};
 pub(crate) use values::oversized_image;
-pub use values::{expression_vars, image_extent, MAX_IMAGE_DIMENSION, MAX_WORKGROUP_COUNT};
+pub use values::{
+    expression_vars, image_extent, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_FRAME, MAX_WORKGROUP_COUNT,
+};
 
 use crate::diagnostic::Diagnostic;
 use crate::id::{IdVec, IrPassId, IrResourceId};
@@ -152,10 +154,12 @@ impl<'a> Resolver<'a> {
             .collect();
         let output = self.resolve_output(&resources);
         self.check_readback(&resources);
+        let samples_per_frame = self.resolve_progressive();
         let ir = Ir {
             resources,
             passes,
             output,
+            samples_per_frame,
         };
         self.check_usages(&ir);
         self.check_extents(&ir);
@@ -183,6 +187,20 @@ impl<'a> Resolver<'a> {
                 );
             }
         }
+    }
+
+    /// A progressive graph's samples per frame: a whole number from 1 to
+    /// [`MAX_SAMPLES_PER_FRAME`].
+    fn resolve_progressive(&mut self) -> Option<u32> {
+        let progressive = self.graph.progressive.as_ref()?;
+        let path = [Seg::Field("progressive"), Seg::Field("samples_per_frame")];
+        Some(self.count(
+            0,
+            &path,
+            &progressive.samples_per_frame,
+            "samples_per_frame",
+            MAX_SAMPLES_PER_FRAME,
+        ))
     }
 
     /// Every name in the graph's `readback` list is one of its images.

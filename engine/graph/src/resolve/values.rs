@@ -115,6 +115,10 @@ impl Resolver<'_> {
 /// (`maxComputeWorkGroupCount`'s required minimum).
 pub const MAX_WORKGROUP_COUNT: u32 = 65_535;
 
+/// The most samples per pixel a progressive graph may add in one frame: more
+/// would make a single frame run for seconds even on a fast GPU.
+pub const MAX_SAMPLES_PER_FRAME: u32 = 4096;
+
 /// The largest image side weft creates: `maxImageDimension2D` on the devices
 /// it targets, and the limit of `Absolute` sizes.
 pub const MAX_IMAGE_DIMENSION: u32 = 16_384;

@@ -475,6 +475,7 @@ impl<'g> Viewer<'g> {
             frame_ms: self.stats.mean_ms,
             timings: &self.timings,
             error: self.error.as_deref(),
+            samples: self.live.samples(),
         });
         if let Some(window) = &self.window {
             window.set_title(&title);

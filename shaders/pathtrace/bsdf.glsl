@@ -1,0 +1,114 @@
+// The path tracer's materials: the raster path's shading models
+// (include/lighting.glsl) as energy-conserving BSDFs with matching sampling
+// routines and pdfs. Blinn-Phong is the raster lobe divided by pi, so a
+// punctual light of colour C (irradiance pi C, lights.glsl) shades exactly as
+// the raster path does; GGX metallic-roughness is `cook_torrance` itself; a
+// mirror (MTL illum 3 or 5) reflects Ks perfectly over a Lambert Kd. Textures
+// are not traced yet: every surface shades with a white texel.
+#ifndef WEFT_PT_BSDF_GLSL
+#define WEFT_PT_BSDF_GLSL
+
+float luminance(vec3 c) {
+    return dot(c, vec3(0.2126, 0.7152, 0.0722));
+}
+
+struct Bsdf {
+    float model;       // SHADING_* (scene.glsl)
+    vec3 diffuse;      // Lambert albedo
+    vec3 specular;     // Blinn-Phong or mirror Ks; GGX F0
+    float exponent;    // Blinn-Phong Ns
+    vec3 base;         // GGX base colour
+    vec2 metal_rough;  // GGX metallic and roughness, as the raster path rounds them
+    float alpha;       // GGX alpha = roughness^2
+    float p_specular;  // probability that sampling picks the specular lobe
+};
+
+Bsdf bsdf_of(Material m) {
+    Bsdf b;
+    b.model = m.emissive.w;
+    if (b.model == SHADING_METALLIC_ROUGHNESS) {
+        b.base = m.diffuse.rgb;
+        b.metal_rough = metal_rough(m, vec4(1.0));
+        float r = max(b.metal_rough.y, MIN_ROUGHNESS);
+        b.alpha = r * r;
+        b.specular = mix(vec3(DIELECTRIC_F0), b.base, b.metal_rough.x);
+        b.diffuse = (1.0 - b.metal_rough.x) * b.base;
+        b.exponent = 0.0;
+    } else {
+        b.base = vec3(0.0);
+        b.metal_rough = vec2(0.0);
+        b.alpha = 1.0;
+        b.diffuse = m.diffuse.rgb;
+        b.exponent = m.specular.w;
+        bool lobe = b.model == SHADING_MIRROR || b.exponent > 0.0;
+        b.specular = lobe ? m.specular.rgb : vec3(0.0);
+    }
+    float ws = luminance(b.specular);
+    float wd = luminance(b.diffuse);
+    b.p_specular = ws + wd > 0.0 ? ws / (ws + wd) : 0.0;
+    // Dielectric GGX: F0 = 0.04 would almost never pick the highlight.
+    if (b.model == SHADING_METALLIC_ROUGHNESS) {
+        b.p_specular = wd > 0.0 ? clamp(b.p_specular, 0.25, 0.75) : 1.0;
+    }
+    return b;
+}
+
+// f(wo, wi) cos(wi, n) for unit wo, wi and a normal n on wo's side, and in
+// `pdf` the solid-angle density with which bsdf_sample picks wi (a mirror's
+// delta lobe contributes to neither).
+vec3 bsdf_eval(Bsdf b, vec3 n, vec3 wo, vec3 wi, out float pdf) {
+    pdf = 0.0;
+    float cos_i = dot(n, wi);
+    if (cos_i <= 0.0) {
+        return vec3(0.0);
+    }
+    float p_diffuse = (1.0 - b.p_specular) * cos_i / PI;
+    if (b.model == SHADING_MIRROR) {
+        pdf = p_diffuse;
+        return b.diffuse * cos_i / PI;
+    }
+    vec3 h = normalize(wo + wi);
+    float cos_h = max(dot(n, h), 0.0);
+    if (b.model == SHADING_METALLIC_ROUGHNESS) {
+        float cos_o = max(dot(n, wo), 1e-4);
+        float p_glossy = ggx_g1(cos_o, b.alpha) * ggx_d(cos_h, b.alpha) / (4.0 * cos_o);
+        pdf = p_diffuse + b.p_specular * p_glossy;
+        return cook_torrance(b.base, b.metal_rough, n, wo, wi);
+    }
+    float lobe = b.exponent > 0.0 ? pow(cos_h, b.exponent) : 0.0;
+    float p_glossy = (b.exponent + 1.0) / (2.0 * PI) * lobe / (4.0 * max(dot(wo, h), 1e-6));
+    pdf = p_diffuse + b.p_specular * p_glossy;
+    return (b.diffuse + b.specular * lobe) * cos_i / PI;
+}
+
+// Picks a direction wi for wo with the uniform numbers u; `weight` is
+// f cos / pdf. False when the sample carries nothing (below the surface).
+// `delta` marks a mirror bounce, whose pdf is not a density.
+bool bsdf_sample(Bsdf b, vec3 n, vec3 wo, vec3 u, out vec3 wi, out vec3 weight, out float pdf, out bool delta) {
+    delta = false;
+    weight = vec3(0.0);
+    mat3 frame = basis(n);
+    if (u.z < b.p_specular) {
+        if (b.model == SHADING_MIRROR) {
+            wi = reflect(-wo, n);
+            weight = b.specular / b.p_specular;
+            pdf = 0.0;
+            delta = true;
+            return true;
+        }
+        vec3 h = b.model == SHADING_METALLIC_ROUGHNESS
+            ? frame * sample_ggx_visible(transpose(frame) * wo, b.alpha, u.xy)
+            : frame * sample_phong_half(u.xy, b.exponent);
+        wi = reflect(-wo, h);
+    } else {
+        wi = frame * sample_cosine(u.xy);
+    }
+    vec3 f = bsdf_eval(b, n, wo, wi, pdf);
+    if (pdf <= 0.0) {
+        return false;
+    }
+    weight = f / pdf;
+    return true;
+}
+
+#endif

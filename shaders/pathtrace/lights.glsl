@@ -1,0 +1,171 @@
+// Lights for the path tracer: next-event estimation and the densities that
+// multiple importance sampling needs when a BSDF-sampled ray finds a light.
+//
+// Units follow the raster path (include/lighting.glsl): a sun, point or spot
+// light of colour C gives a surface facing it irradiance pi C times its
+// attenuation and cone (so a white Lambertian surface shows C, as the raster
+// path's Kd N.L shading does); area lights and emissive triangles (MTL Ke,
+// glTF emissive) emit radiance equal to their colour. A light is chosen
+// uniformly among the scene's lights plus, when the scene has any, the set of
+// emissive triangles; within that set a triangle is chosen by power.
+// Area lights are sampled uniformly by area; they are not in the BVH, so
+// they neither cast shadows nor block one another.
+#ifndef WEFT_PT_LIGHTS_GLSL
+#define WEFT_PT_LIGHTS_GLSL
+
+// Lights are sorted suns, points, spots, areas (engine/render/src/lights.rs).
+uint first_area_light() {
+    return frame.counts.x + frame.counts.y + frame.counts.z;
+}
+
+float light_choices() {
+    return float(frame.counts.w + (emitter_info.x > 0u ? 1u : 0u));
+}
+
+struct LightSample {
+    vec3 direction;  // unit, from the surface towards the light
+    float distance;  // to the sampled point; 1e30 for a sun
+    vec3 value;      // incident radiance over the pdf (selection included)
+    float pdf;       // solid-angle density with selection, 0 for a delta light
+};
+
+// Area light `index` as centre, half-extent vectors, area and the unit normal
+// it emits along.
+void area_shape(uint index, out vec3 centre, out vec3 x, out vec3 y, out float area, out vec3 facing) {
+    centre = lights[index].position_range.xyz;
+    x = lights[index].direction_type.xyz;
+    y = lights[index].attenuation_cos.xyz;
+    bool disc = lights[index].direction_type.w == LIGHT_AREA_DISC;
+    area = (disc ? PI : 4.0) * length(x) * length(y);
+    facing = -normalize(cross(x, y));
+}
+
+// The cosine at an area light's surface towards a ray leaving it along -l,
+// zero when it does not emit that way.
+float area_cosine(uint index, vec3 facing, vec3 l) {
+    float c = -dot(l, facing);
+    return lights[index].color_exponent.w > 0.5 ? abs(c) : max(c, 0.0);
+}
+
+bool sample_area(uint index, vec3 p, vec2 u, float p_select, out LightSample ls) {
+    vec3 centre, x, y, facing;
+    float area;
+    area_shape(index, centre, x, y, area, facing);
+    vec2 q = u * 2.0 - 1.0;
+    if (lights[index].direction_type.w == LIGHT_AREA_DISC) {
+        q = concentric(q);
+    }
+    vec3 to_light = centre + q.x * x + q.y * y - p;
+    float d2 = dot(to_light, to_light);
+    ls.distance = sqrt(d2);
+    ls.direction = to_light / max(ls.distance, 1e-20);
+    float cos_light = area_cosine(index, facing, ls.direction);
+    if (cos_light <= 0.0 || d2 <= 0.0 || area <= 0.0) {
+        return false;
+    }
+    ls.pdf = p_select * d2 / (cos_light * area);
+    ls.value = lights[index].color_exponent.rgb / ls.pdf;
+    return true;
+}
+
+// The density by area of a point on emissive triangle material `emitted`.
+float emitter_area_pdf(vec3 emitted) {
+    return luminance(emitted) / uintBitsToFloat(emitter_info.y);
+}
+
+bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
+    uint count = emitter_info.x;
+    uvec4 e = emitters[min(uint(u.x * float(count)), count - 1u)];
+    if (u.y >= uintBitsToFloat(e.z)) {
+        e = emitters[e.y];
+    }
+    uint tri = e.x;
+    vec3 a = corners[3u * tri].xyz;
+    vec3 b = corners[3u * tri + 1u].xyz;
+    vec3 c = corners[3u * tri + 2u].xyz;
+    float su = sqrt(u.z);
+    vec3 point = (1.0 - su) * a + (u.w * su) * b + (su - u.w * su) * c;
+    vec3 ng = normalize(cross(b - a, c - a));
+    vec3 to_light = point - p;
+    float d2 = dot(to_light, to_light);
+    ls.distance = sqrt(d2);
+    ls.direction = to_light / max(ls.distance, 1e-20);
+    float cos_light = -dot(ls.direction, ng);
+    vec3 emitted = materials[triangle_materials[tri]].emissive.rgb;
+    if (cos_light <= 0.0 || d2 <= 0.0) {
+        return false;
+    }
+    ls.pdf = p_select * emitter_area_pdf(emitted) * d2 / cos_light;
+    ls.value = emitted / ls.pdf;
+    return true;
+}
+
+// Picks a light and a point on it for a surface at p with normal n. False
+// when there is no light or it sends nothing towards p.
+bool sample_light(vec3 p, vec3 n, vec4 u_pick, vec4 u_point, out LightSample ls) {
+    float choices = light_choices();
+    if (choices == 0.0) {
+        return false;
+    }
+    uint pick = min(uint(u_pick.x * choices), uint(choices) - 1u);
+    float p_select = 1.0 / choices;
+    if (pick >= frame.counts.w) {
+        return sample_emitter(p, u_point, p_select, ls);
+    }
+    if (lights[pick].direction_type.w >= LIGHT_AREA_RECT) {
+        return sample_area(pick, p, u_point.xy, p_select, ls);
+    }
+    Surface s;
+    s.position = p;
+    s.normal = n;
+    s.texel = vec3(1.0);
+    s.material = 0u;
+    s.metal_rough = vec2(0.0);
+    vec3 l;
+    vec3 radiance = incoming(pick, s, l);
+    ls.direction = l;
+    ls.distance = lights[pick].direction_type.w == LIGHT_SUN ? 1e30 : length(lights[pick].position_range.xyz - p);
+    ls.value = PI * radiance / p_select;
+    ls.pdf = 0.0;
+    return any(greaterThan(radiance, vec3(0.0)));
+}
+
+// The nearest area light a ray meets before `t` (then lowered to its
+// distance): its index, or -1.
+int hit_area_light(vec3 origin, vec3 dir, inout float t) {
+    int found = -1;
+    for (uint i = first_area_light(); i < frame.counts.w; ++i) {
+        vec3 centre, x, y, facing;
+        float area;
+        area_shape(i, centre, x, y, area, facing);
+        float along = dot(dir, facing);
+        if (along == 0.0) {
+            continue;
+        }
+        float s = dot(centre - origin, facing) / along;
+        if (s <= 0.0 || s >= t) {
+            continue;
+        }
+        vec3 offset = origin + s * dir - centre;
+        vec2 q = vec2(dot(offset, x) / dot(x, x), dot(offset, y) / dot(y, y));
+        bool inside = lights[i].direction_type.w == LIGHT_AREA_DISC ? dot(q, q) <= 1.0 : max(abs(q.x), abs(q.y)) <= 1.0;
+        if (inside) {
+            t = s;
+            found = int(i);
+        }
+    }
+    return found;
+}
+
+// Radiance area light `index` sends back along a ray `dir` that met it at
+// distance t, and in `pdf` the density NEE would have picked that point with.
+vec3 area_emitted(uint index, vec3 dir, float t, out float pdf) {
+    vec3 centre, x, y, facing;
+    float area;
+    area_shape(index, centre, x, y, area, facing);
+    float cos_light = area_cosine(index, facing, dir);
+    pdf = cos_light > 0.0 ? t * t / (light_choices() * cos_light * area) : 0.0;
+    return cos_light > 0.0 ? lights[index].color_exponent.rgb : vec3(0.0);
+}
+
+#endif

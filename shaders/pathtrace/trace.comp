@@ -1,0 +1,146 @@
+#version 450
+// Progressive unidirectional path tracer (docs/pathtrace.md). Each frame adds
+// `samples_per_frame` samples per pixel to the running mean in `accumulation`
+// (a history image: rgb the mean, a the sample count), and writes the mean to
+// `hdr`. `history_frames` (0 after any change of camera, scene, graph or
+// parameter) says whether the history holds earlier samples of this image.
+//
+// Paths: primary rays through uniformly jittered positions in the pixel (a
+// box filter); next-event estimation at every non-mirror vertex, combined
+// with BSDF sampling by the power heuristic, so each light is counted once;
+// delta lights only through NEE; Russian roulette from `rr_depth`; at most
+// `max_depth` segments, counting the camera ray as 1 (Mitsuba's max_depth).
+// A ray that leaves the scene sees the suns' ambient as uniform sky radiance,
+// which gives unoccluded diffuse surfaces the raster path's ambient term.
+#define NO_DERIVATIVES
+#include "../include/lighting.glsl"
+#include "../include/trace.glsl"
+#include "random.glsl"
+#include "sampling.glsl"
+#include "bsdf.glsl"
+#include "lights.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0, rgba32f) uniform image2D accumulation;
+layout(set = 0, binding = 1, rgba32f) uniform writeonly image2D hdr;
+
+layout(push_constant) uniform Params {
+    uint max_depth;
+    uint rr_depth;
+    uint samples_per_frame;
+    uint seed;
+    uint history_frames;
+} params;
+
+// Where a ray leaving surface point p on the side of unit normal n starts, so
+// that it does not find the surface it leaves.
+vec3 leave(vec3 p, vec3 n) {
+    float scale = max(1.0, max(max(abs(p.x), abs(p.y)), abs(p.z)));
+    return p + n * (1e-4 * scale);
+}
+
+bool unoccluded(vec3 origin, vec3 dir, float distance) {
+    return trace_closest(origin, dir, distance * (1.0 - 1e-3)).x < 0.0;
+}
+
+vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
+    vec3 radiance = vec3(0.0);
+    vec3 throughput = vec3(1.0);
+    float bsdf_pdf = 0.0;
+    bool counted_fully = true;  // camera rays and mirror bounces: no MIS
+    for (uint depth = 1u; depth <= params.max_depth; ++depth) {
+        vec2 found = trace_closest(origin, dir, 1e30);
+        float t = found.x < 0.0 ? 1e30 : found.x;
+        int area = hit_area_light(origin, dir, t);
+        if (area >= 0) {
+            float light_pdf;
+            vec3 emitted = area_emitted(uint(area), dir, t, light_pdf);
+            float w = counted_fully ? 1.0 : power_heuristic(bsdf_pdf, light_pdf);
+            radiance += throughput * emitted * w;
+            break;
+        }
+        if (found.x < 0.0) {
+            radiance += throughput * frame.ambient.rgb;
+            break;
+        }
+        uint tri = floatBitsToUint(found.y);
+        TraceSurface s = trace_surface(tri, origin, dir, t);
+        Material m = materials[s.material];
+        vec3 wo = -dir;
+        vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
+        vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
+        if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
+            float cos_light = dot(s.geometric_normal, wo);
+            float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t / (light_choices() * cos_light);
+            float w = counted_fully ? 1.0 : power_heuristic(bsdf_pdf, light_pdf);
+            radiance += throughput * m.emissive.rgb * w;
+        }
+        if (depth == params.max_depth) {
+            break;
+        }
+        Bsdf b = bsdf_of(m);
+        vec3 from = leave(s.position, ng);
+        vec4 u_pick = rng_next(rng);
+        vec4 u_point = rng_next(rng);
+        LightSample ls;
+        if (b.p_specular < 1.0 || b.model != SHADING_MIRROR) {
+            if (sample_light(s.position, n, u_pick, u_point, ls) && dot(ls.direction, ng) > 0.0) {
+                float pdf;
+                vec3 f = bsdf_eval(b, n, wo, ls.direction, pdf);
+                if (any(greaterThan(f, vec3(0.0))) && unoccluded(from, ls.direction, ls.distance)) {
+                    float w = ls.pdf > 0.0 ? power_heuristic(ls.pdf, pdf) : 1.0;
+                    radiance += throughput * f * ls.value * w;
+                }
+            }
+        }
+        vec4 u = rng_next(rng);
+        vec3 weight;
+        bool delta;
+        if (!bsdf_sample(b, n, wo, u.xyz, dir, weight, bsdf_pdf, delta) || dot(dir, ng) <= 0.0) {
+            break;
+        }
+        throughput *= weight;
+        counted_fully = delta;
+        origin = from;
+        if (depth + 1u >= params.rr_depth) {
+            float q = min(max(max(throughput.r, throughput.g), throughput.b), 0.95);
+            if (u.w >= q) {
+                break;
+            }
+            throughput /= q;
+        }
+    }
+    return radiance;
+}
+
+void main() {
+    ivec2 size = imageSize(hdr);
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(pixel, size))) {
+        return;
+    }
+    vec3 eye = frame.camera_position.xyz;
+    uint spf = max(params.samples_per_frame, 1u);
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < spf; ++i) {
+        Rng rng = rng_start(uvec2(pixel), params.history_frames * spf + i, params.seed);
+        vec2 jitter = rng_next(rng).xy;
+        vec2 ndc = (vec2(pixel) + jitter) / vec2(size) * 2.0 - 1.0;
+        vec4 on_near = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+        vec3 dir = normalize(on_near.xyz / on_near.w - eye);
+        vec3 sample_radiance = path(eye, dir, rng);
+        // A sample that overflowed or met a degenerate case counts as black
+        // rather than poisoning the pixel's mean for good.
+        bool finite = !any(isnan(sample_radiance)) && !any(isinf(sample_radiance));
+        sum += finite ? sample_radiance : vec3(0.0);
+    }
+    vec3 mean = sum / float(spf);
+    float count = float(spf);
+    if (params.history_frames > 0u) {
+        vec4 previous = imageLoad(accumulation, pixel);
+        count += previous.a;
+        mean = previous.rgb + (mean - previous.rgb) * (float(spf) / count);
+    }
+    imageStore(accumulation, pixel, vec4(mean, count));
+    imageStore(hdr, pixel, vec4(mean, 1.0));
+}
