@@ -45,6 +45,11 @@ float trace_slab(BvhNode node, vec3 origin, vec3 inv_dir) {
     return near <= far ? near : -1.0;
 }
 
+// How far outside a triangle, in barycentric units, a hit still counts, so a
+// ray through an edge two triangles share cannot slip between them
+// (bvh.rs EDGE_TOLERANCE).
+#define EDGE_TOLERANCE 1e-5
+
 // Moller-Trumbore: the ray parameter of a hit in front of the origin, or -1.
 float trace_triangle(uint tri, vec3 origin, vec3 dir) {
     vec3 a = corners[3u * tri].xyz;
@@ -61,7 +66,9 @@ float trace_triangle(uint tri, vec3 origin, vec3 dir) {
     vec3 q = cross(s, e1);
     float v = dot(dir, q) * inv_det;
     float t = dot(e2, q) * inv_det;
-    return (u < 0.0 || u > 1.0 || v < 0.0 || u + v > 1.0 || t <= 0.0) ? -1.0 : t;
+    bool outside = u < -EDGE_TOLERANCE || u > 1.0 + EDGE_TOLERANCE || v < -EDGE_TOLERANCE
+        || u + v > 1.0 + EDGE_TOLERANCE;
+    return (outside || t <= 0.0) ? -1.0 : t;
 }
 
 // The nearest hit with t in (0, t_max): its distance in .x and triangle in .y

@@ -8,8 +8,10 @@
 // glTF emissive) emit radiance equal to their colour. A light is chosen
 // uniformly among the scene's lights plus, when the scene has any, the set of
 // emissive triangles; within that set a triangle is chosen by power.
-// Area lights are sampled uniformly by area; they are not in the BVH, so
-// they neither cast shadows nor block one another.
+// Area lights are sampled uniformly by area. They are not in the BVH; rays
+// (BSDF-sampled and shadow rays alike) test them one by one, and they are
+// opaque: a light's back and a light between a point and another light
+// block, so NEE and BSDF sampling see the same scene.
 #ifndef WEFT_PT_LIGHTS_GLSL
 #define WEFT_PT_LIGHTS_GLSL
 

@@ -11,7 +11,15 @@
 // delta lights only through NEE; Russian roulette from `rr_depth`; at most
 // `max_depth` segments, counting the camera ray as 1 (Mitsuba's max_depth).
 // A ray that leaves the scene sees the suns' ambient as uniform sky radiance,
-// which gives unoccluded diffuse surfaces the raster path's ambient term.
+// which gives unoccluded diffuse surfaces the raster path's ambient term; the
+// camera does not see that sky (as with Mitsuba's hide_emitters), so the
+// background stays black as in the raster graphs.
+//
+// `sampling` chooses how lights with area are found: 0 combines NEE and BSDF
+// sampling by MIS; 1 is NEE only (a BSDF-sampled ray that finds such a light
+// adds nothing); 2 is BSDF sampling only (no NEE towards them). All three
+// converge to the same image (tests/e2e/pathtrace.rs); delta lights always use
+// NEE.
 #define NO_DERIVATIVES
 #include "../include/lighting.glsl"
 #include "../include/trace.glsl"
@@ -29,8 +37,22 @@ layout(push_constant) uniform Params {
     uint rr_depth;
     uint samples_per_frame;
     uint seed;
+    uint sampling;
     uint history_frames;
 } params;
+
+const uint SAMPLING_MIS = 0u;
+const uint SAMPLING_NEE = 1u;
+const uint SAMPLING_BSDF = 2u;
+
+// The weight of light found by a BSDF-sampled ray whose direction had density
+// bsdf_pdf, where NEE would have picked it with light_pdf.
+float found_weight(bool counted_fully, float bsdf_pdf, float light_pdf) {
+    if (counted_fully || params.sampling == SAMPLING_BSDF) {
+        return 1.0;
+    }
+    return params.sampling == SAMPLING_NEE ? 0.0 : power_heuristic(bsdf_pdf, light_pdf);
+}
 
 // Where a ray leaving surface point p on the side of unit normal n starts, so
 // that it does not find the surface it leaves.
@@ -39,8 +61,11 @@ vec3 leave(vec3 p, vec3 n) {
     return p + n * (1e-4 * scale);
 }
 
+// Whether nothing lies between a point and a light sample `distance` away:
+// no triangle, and no other area light (they block BSDF-sampled rays too).
 bool unoccluded(vec3 origin, vec3 dir, float distance) {
-    return trace_closest(origin, dir, distance * (1.0 - 1e-3)).x < 0.0;
+    float t = distance * (1.0 - 1e-3);
+    return hit_area_light(origin, dir, t) < 0 && trace_closest(origin, dir, t).x < 0.0;
 }
 
 vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
@@ -55,12 +80,11 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         if (area >= 0) {
             float light_pdf;
             vec3 emitted = area_emitted(uint(area), dir, t, light_pdf);
-            float w = counted_fully ? 1.0 : power_heuristic(bsdf_pdf, light_pdf);
-            radiance += throughput * emitted * w;
+            radiance += throughput * emitted * found_weight(counted_fully, bsdf_pdf, light_pdf);
             break;
         }
         if (found.x < 0.0) {
-            radiance += throughput * frame.ambient.rgb;
+            radiance += depth > 1u ? throughput * frame.ambient.rgb : vec3(0.0);
             break;
         }
         uint tri = floatBitsToUint(found.y);
@@ -72,8 +96,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
             float cos_light = dot(s.geometric_normal, wo);
             float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t / (light_choices() * cos_light);
-            float w = counted_fully ? 1.0 : power_heuristic(bsdf_pdf, light_pdf);
-            radiance += throughput * m.emissive.rgb * w;
+            radiance += throughput * m.emissive.rgb * found_weight(counted_fully, bsdf_pdf, light_pdf);
         }
         if (depth == params.max_depth) {
             break;
@@ -84,11 +107,13 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         vec4 u_point = rng_next(rng);
         LightSample ls;
         if (b.p_specular < 1.0 || b.model != SHADING_MIRROR) {
-            if (sample_light(s.position, n, u_pick, u_point, ls) && dot(ls.direction, ng) > 0.0) {
+            bool found = sample_light(s.position, n, u_pick, u_point, ls) && dot(ls.direction, ng) > 0.0;
+            if (found && (ls.pdf == 0.0 || params.sampling != SAMPLING_BSDF)) {
                 float pdf;
                 vec3 f = bsdf_eval(b, n, wo, ls.direction, pdf);
                 if (any(greaterThan(f, vec3(0.0))) && unoccluded(from, ls.direction, ls.distance)) {
-                    float w = ls.pdf > 0.0 ? power_heuristic(ls.pdf, pdf) : 1.0;
+                    bool mis = ls.pdf > 0.0 && params.sampling == SAMPLING_MIS;
+                    float w = mis ? power_heuristic(ls.pdf, pdf) : 1.0;
                     radiance += throughput * f * ls.value * w;
                 }
             }

@@ -233,3 +233,77 @@ fn readback_images_are_written_beside_the_output_and_the_first_is_the_exr() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Renders the Cornell box through the path tracer to `spp` samples per pixel
+/// with `seed`; returns the JSON summary and the PNG's bytes.
+fn path_traced(name: &str, spp: &str, seed: &str, extra: &[&str]) -> (serde_json::Value, Vec<u8>) {
+    let out_path = temp_png(name);
+    let out_arg = out_path.to_string_lossy().into_owned();
+    let mut args = vec![
+        "render",
+        "scenes/cornell.scene",
+        "--graph",
+        "graphs/pathtrace.ron",
+        "--size",
+        "24x24",
+        "--spp",
+        spp,
+        "--seed",
+        seed,
+        "--validate",
+        "--json",
+        "--out",
+        &out_arg,
+    ];
+    args.extend_from_slice(extra);
+    let out = weft(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(json["validation"]["errors"], 0);
+    assert_eq!(json["validation"]["warnings"], 0);
+    (json, std::fs::read(&out_path).expect("png"))
+}
+
+#[test]
+fn spp_renders_a_progressive_graph_to_a_sample_count_the_same_for_a_seed() {
+    // Two samples per frame: 5 spp takes 3 frames and holds 6 samples.
+    let (json, first) = path_traced("pt-a.png", "5", "7", &["--param", "samples_per_frame=2"]);
+    assert_eq!(json["frames"], 3);
+    assert_eq!(json["samples_per_pixel"], 6);
+    let (_, again) = path_traced("pt-b.png", "5", "7", &["--param", "samples_per_frame=2"]);
+    assert_eq!(first, again, "a seed renders the same image every run");
+    let (_, other) = path_traced("pt-c.png", "5", "8", &["--param", "samples_per_frame=2"]);
+    assert_ne!(first, other, "another seed, other samples");
+}
+
+#[test]
+fn a_time_limit_stops_early_and_reports_the_samples_reached() {
+    let (json, _) = path_traced("pt-limit.png", "100000", "1", &["--time-limit", "0.5"]);
+    let frames = json["frames"].as_u64().expect("frames");
+    assert!((1..100_000).contains(&frames), "{json}");
+    assert_eq!(json["samples_per_pixel"], frames);
+}
+
+#[test]
+fn spp_on_a_graph_that_does_not_accumulate_is_refused() {
+    let out = weft(&[
+        "render",
+        "scenes/cornell.scene",
+        "--graph",
+        "graphs/forward.ron",
+        "--spp",
+        "4",
+        "--size",
+        "16x16",
+    ]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--spp needs a progressive graph") && stderr.contains("graphs/forward.ron"),
+        "{stderr}"
+    );
+}

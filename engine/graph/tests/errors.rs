@@ -513,3 +513,29 @@ fn out_of_range_values_are_located_errors() {
         );
     }
 }
+
+#[test]
+fn progressive_samples_per_frame_must_be_a_whole_number_in_range() {
+    let graph = |value: &str| {
+        VALID.replace(
+            r#"    output: "ldr","#,
+            &format!("    output: \"ldr\",\n    params: {{ \"spf\": 0.5 }},\n    progressive: (samples_per_frame: {value}),"),
+        )
+    };
+    let text = graph("0");
+    let d = only_error(&text);
+    assert_eq!(
+        d.message,
+        "samples_per_frame must be a whole number from 1 to 4096, found 0"
+    );
+    assert!(text_at(&text, &d).starts_with("0)"), "{d:?}");
+    let d = only_error(&graph("\"$spf\""));
+    assert_eq!(
+        d.message,
+        "samples_per_frame must be a whole number from 1 to 4096, found 0.5"
+    );
+    let d = only_error(&graph("\"$spp\""));
+    assert_eq!(d.message, "unknown parameter \"$spp\"");
+    assert_eq!(d.hint.as_deref(), Some("did you mean \"$spf\"?"));
+    assert!(check_text(&graph("16")).is_empty());
+}

@@ -307,6 +307,12 @@ fn slab(node: &GpuBvhNode, origin: Vec3, inv: Vec3) -> Option<f32> {
     (near <= far).then_some(near)
 }
 
+/// How far outside a triangle, in barycentric units, a hit still counts.
+/// Two triangles that share an edge compute their barycentrics with different
+/// rounding, so a ray through the edge could miss both; accepting this little
+/// overlap closes such cracks (`EDGE_TOLERANCE` in `trace.glsl`).
+pub const EDGE_TOLERANCE: f32 = 1e-5;
+
 /// Möller–Trumbore: the ray parameter of the hit, if in front of the origin.
 pub fn intersect(tri: &[Vec3; 3], origin: Vec3, dir: Vec3) -> Option<f32> {
     let e1 = tri[1] - tri[0];
@@ -319,12 +325,12 @@ pub fn intersect(tri: &[Vec3; 3], origin: Vec3, dir: Vec3) -> Option<f32> {
     let inv_det = 1.0 / det;
     let s = origin - tri[0];
     let u = s.dot(p) * inv_det;
-    if !(0.0..=1.0).contains(&u) {
+    if !(-EDGE_TOLERANCE..=1.0 + EDGE_TOLERANCE).contains(&u) {
         return None;
     }
     let q = s.cross(e1);
     let v = dir.dot(q) * inv_det;
-    if v < 0.0 || u + v > 1.0 {
+    if v < -EDGE_TOLERANCE || u + v > 1.0 + EDGE_TOLERANCE {
         return None;
     }
     let t = e2.dot(q) * inv_det;
