@@ -71,9 +71,11 @@ float trace_triangle(uint tri, vec3 origin, vec3 dir) {
     return (outside || t <= 0.0) ? -1.0 : t;
 }
 
-// The nearest hit with t in (0, t_max): its distance in .x and triangle in .y
-// (as uint bits), or x = -1 when nothing is hit.
-vec2 trace_closest(vec3 origin, vec3 dir, float t_max) {
+// Walks the BVH nearest child first: a hit with t in (0, t_max), its
+// distance in .x and triangle in .y (as uint bits), or x = -1 when nothing is
+// hit. With `first_hit` it stops at the first hit found (shadow rays);
+// otherwise it returns the nearest.
+vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
     float best_t = t_max;
     uint best_tri = 0u;
     bool hit = false;
@@ -83,18 +85,41 @@ vec2 trace_closest(vec3 origin, vec3 dir, float t_max) {
     }
     vec3 inv_dir = 1.0 / dir;
     uint stack[TRACE_STACK];
+    float entry[TRACE_STACK];
     int top = 0;
-    stack[top++] = 0u;
+    float root = trace_slab(nodes[0], origin, inv_dir);
+    if (root >= 0.0) {
+        stack[0] = 0u;
+        entry[0] = root;
+        top = 1;
+    }
     while (top > 0) {
-        BvhNode node = nodes[stack[--top]];
-        float entry = trace_slab(node, origin, inv_dir);
-        if (entry < 0.0 || entry >= best_t) {
+        --top;
+        if (entry[top] >= best_t) {
             continue;
         }
+        BvhNode node = nodes[stack[top]];
         if (node.count == 0u) {
-            if (top + 2 <= TRACE_STACK) {
-                stack[top++] = node.first;
-                stack[top++] = node.first + 1u;
+            uint near = node.first;
+            uint far = node.first + 1u;
+            float t_near = trace_slab(nodes[near], origin, inv_dir);
+            float t_far = trace_slab(nodes[far], origin, inv_dir);
+            if (t_near > t_far) {
+                uint n = near;
+                near = far;
+                far = n;
+                float t = t_near;
+                t_near = t_far;
+                t_far = t;
+            }
+            // Push the farther child first, so the nearer one is walked first.
+            if (t_far >= 0.0 && t_far < best_t && top < TRACE_STACK) {
+                stack[top] = far;
+                entry[top++] = t_far;
+            }
+            if (t_near >= 0.0 && t_near < best_t && top < TRACE_STACK) {
+                stack[top] = near;
+                entry[top++] = t_near;
             }
             continue;
         }
@@ -107,8 +132,22 @@ vec2 trace_closest(vec3 origin, vec3 dir, float t_max) {
                 hit = true;
             }
         }
+        if (hit && first_hit) {
+            break;
+        }
     }
     return hit ? vec2(best_t, uintBitsToFloat(best_tri)) : vec2(-1.0, 0.0);
+}
+
+// The nearest hit with t in (0, t_max): its distance in .x and triangle in .y
+// (as uint bits), or x = -1 when nothing is hit.
+vec2 trace_closest(vec3 origin, vec3 dir, float t_max) {
+    return trace_walk(origin, dir, t_max, false);
+}
+
+// Whether anything lies on the ray with t in (0, t_max).
+bool trace_any(vec3 origin, vec3 dir, float t_max) {
+    return trace_walk(origin, dir, t_max, true).x >= 0.0;
 }
 
 // What a ray hit: the point, the interpolated unit normal (not flipped to

@@ -5,6 +5,12 @@
 // the raster path does; GGX metallic-roughness is `cook_torrance` itself; a
 // mirror (MTL illum 3 or 5) reflects Ks perfectly over a Lambert Kd. Textures
 // are not traced yet: every surface shades with a white texel.
+//
+// Code for shading models the scene lacks is compiled out: the includer
+// defines SCENE_GLOSSY (Blinn-Phong with a specular lobe), SCENE_MIRRORS and
+// SCENE_METALLIC_ROUGHNESS for the models present (graphs/pathtrace.ron sets
+// them from scene features). lavapipe, like a GPU with divergent lanes, runs
+// every side of a branch, so code a scene does not need costs time.
 #ifndef WEFT_PT_BSDF_GLSL
 #define WEFT_PT_BSDF_GLSL
 
@@ -63,22 +69,34 @@ vec3 bsdf_eval(Bsdf b, vec3 n, vec3 wo, vec3 wi, out float pdf) {
         return vec3(0.0);
     }
     float p_diffuse = (1.0 - b.p_specular) * cos_i / PI;
+#ifdef SCENE_MIRRORS
     if (b.model == SHADING_MIRROR) {
         pdf = p_diffuse;
         return b.diffuse * cos_i / PI;
     }
+#endif
+#if defined(SCENE_METALLIC_ROUGHNESS) || defined(SCENE_GLOSSY)
     vec3 h = normalize(wo + wi);
     float cos_h = max(dot(n, h), 0.0);
+#endif
+#ifdef SCENE_METALLIC_ROUGHNESS
     if (b.model == SHADING_METALLIC_ROUGHNESS) {
         float cos_o = max(dot(n, wo), 1e-4);
         float p_glossy = ggx_g1(cos_o, b.alpha) * ggx_d(cos_h, b.alpha) / (4.0 * cos_o);
         pdf = p_diffuse + b.p_specular * p_glossy;
         return cook_torrance(b.base, b.metal_rough, n, wo, wi);
     }
+#endif
+#ifdef SCENE_GLOSSY
     float lobe = b.exponent > 0.0 ? pow(cos_h, b.exponent) : 0.0;
     float p_glossy = (b.exponent + 1.0) / (2.0 * PI) * lobe / (4.0 * max(dot(wo, h), 1e-6));
     pdf = p_diffuse + b.p_specular * p_glossy;
     return (b.diffuse + b.specular * lobe) * cos_i / PI;
+#else
+    // Lambert: without glossy Blinn-Phong materials p_specular is 0 here.
+    pdf = p_diffuse;
+    return b.diffuse * cos_i / PI;
+#endif
 }
 
 // Picks a direction wi for wo with the uniform numbers u; `weight` is
@@ -89,6 +107,7 @@ bool bsdf_sample(Bsdf b, vec3 n, vec3 wo, vec3 u, out vec3 wi, out vec3 weight, 
     weight = vec3(0.0);
     mat3 frame = basis(n);
     if (u.z < b.p_specular) {
+#ifdef SCENE_MIRRORS
         if (b.model == SHADING_MIRROR) {
             wi = reflect(-wo, n);
             weight = b.specular / b.p_specular;
@@ -96,9 +115,19 @@ bool bsdf_sample(Bsdf b, vec3 n, vec3 wo, vec3 u, out vec3 wi, out vec3 weight, 
             delta = true;
             return true;
         }
+#endif
+#if defined(SCENE_METALLIC_ROUGHNESS) && defined(SCENE_GLOSSY)
         vec3 h = b.model == SHADING_METALLIC_ROUGHNESS
             ? frame * sample_ggx_visible(transpose(frame) * wo, b.alpha, u.xy)
             : frame * sample_phong_half(u.xy, b.exponent);
+#elif defined(SCENE_METALLIC_ROUGHNESS)
+        vec3 h = frame * sample_ggx_visible(transpose(frame) * wo, b.alpha, u.xy);
+#elif defined(SCENE_GLOSSY)
+        vec3 h = frame * sample_phong_half(u.xy, b.exponent);
+#else
+        // Only mirrors have a specular lobe, and they returned above.
+        vec3 h = n;
+#endif
         wi = reflect(-wo, h);
     } else {
         wi = frame * sample_cosine(u.xy);

@@ -12,6 +12,10 @@
 // (BSDF-sampled and shadow rays alike) test them one by one, and they are
 // opaque: a light's back and a light between a point and another light
 // block, so NEE and BSDF sampling see the same scene.
+//
+// Code for light kinds the scene lacks is compiled out: the includer defines
+// SCENE_AREA_LIGHTS, SCENE_EMISSIVE and SCENE_PUNCTUAL_LIGHTS (sun, point or
+// spot) for the kinds present.
 #ifndef WEFT_PT_LIGHTS_GLSL
 #define WEFT_PT_LIGHTS_GLSL
 
@@ -111,12 +115,17 @@ bool sample_light(vec3 p, vec3 n, vec4 u_pick, vec4 u_point, out LightSample ls)
     }
     uint pick = min(uint(u_pick.x * choices), uint(choices) - 1u);
     float p_select = 1.0 / choices;
+#ifdef SCENE_EMISSIVE
     if (pick >= frame.counts.w) {
         return sample_emitter(p, u_point, p_select, ls);
     }
+#endif
+#ifdef SCENE_AREA_LIGHTS
     if (lights[pick].direction_type.w >= LIGHT_AREA_RECT) {
         return sample_area(pick, p, u_point.xy, p_select, ls);
     }
+#endif
+#ifdef SCENE_PUNCTUAL_LIGHTS
     Surface s;
     s.position = p;
     s.normal = n;
@@ -130,12 +139,16 @@ bool sample_light(vec3 p, vec3 n, vec4 u_pick, vec4 u_point, out LightSample ls)
     ls.value = PI * radiance / p_select;
     ls.pdf = 0.0;
     return any(greaterThan(radiance, vec3(0.0)));
+#else
+    return false;
+#endif
 }
 
 // The nearest area light a ray meets before `t` (then lowered to its
 // distance): its index, or -1.
 int hit_area_light(vec3 origin, vec3 dir, inout float t) {
     int found = -1;
+#ifdef SCENE_AREA_LIGHTS
     for (uint i = first_area_light(); i < frame.counts.w; ++i) {
         vec3 centre, x, y, facing;
         float area;
@@ -156,6 +169,7 @@ int hit_area_light(vec3 origin, vec3 dir, inout float t) {
             found = int(i);
         }
     }
+#endif
     return found;
 }
 

@@ -5,6 +5,10 @@
 // `hdr`. `history_frames` (0 after any change of camera, scene, graph or
 // parameter) says whether the history holds earlier samples of this image.
 //
+// Only the code for what the scene has is compiled: the graph defines
+// SCENE_AREA_LIGHTS, SCENE_EMISSIVE, SCENE_PUNCTUAL_LIGHTS, SCENE_GLOSSY,
+// SCENE_MIRRORS and SCENE_METALLIC_ROUGHNESS from scene features.
+//
 // Paths: primary rays through uniformly jittered positions in the pixel (a
 // box filter); next-event estimation at every non-mirror vertex, combined
 // with BSDF sampling by the power heuristic, so each light is counted once;
@@ -65,7 +69,7 @@ vec3 leave(vec3 p, vec3 n) {
 // no triangle, and no other area light (they block BSDF-sampled rays too).
 bool unoccluded(vec3 origin, vec3 dir, float distance) {
     float t = distance * (1.0 - 1e-3);
-    return hit_area_light(origin, dir, t) < 0 && trace_closest(origin, dir, t).x < 0.0;
+    return hit_area_light(origin, dir, t) < 0 && !trace_any(origin, dir, t);
 }
 
 vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
@@ -93,11 +97,13 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         vec3 wo = -dir;
         vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
         vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
+#ifdef SCENE_EMISSIVE
         if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
             float cos_light = dot(s.geometric_normal, wo);
             float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t / (light_choices() * cos_light);
             radiance += throughput * m.emissive.rgb * found_weight(counted_fully, bsdf_pdf, light_pdf);
         }
+#endif
         if (depth == params.max_depth) {
             break;
         }

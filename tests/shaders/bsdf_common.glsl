@@ -2,6 +2,9 @@
 // material given by push constants, so tests/e2e/bsdf_sampling.rs can hold
 // the shader's own sampling routine to the shader's own pdf.
 #define NO_DERIVATIVES
+#define SCENE_GLOSSY
+#define SCENE_MIRRORS
+#define SCENE_METALLIC_ROUGHNESS
 #include "../../shaders/include/lighting.glsl"
 #include "../../shaders/pathtrace/random.glsl"
 #include "../../shaders/pathtrace/sampling.glsl"

@@ -9,6 +9,7 @@ use std::process::ExitCode;
 mod bloom;
 mod bvh;
 mod lights;
+mod pathtrace;
 mod plot;
 mod shadows;
 
@@ -23,6 +24,8 @@ pub enum BenchCommand {
     Shadows(crate::shadows::ShadowsArgs),
     /// Build time and shape of the ray tracer's BVH over each scene's triangles.
     Bvh(crate::bvh::BvhArgs),
+    /// Path tracer samples per second, and convergence against a reference image.
+    Pathtrace(crate::pathtrace::PathtraceArgs),
 }
 
 /// Runs `weft bench ...`.
@@ -32,5 +35,6 @@ pub fn run(cmd: BenchCommand) -> Result<ExitCode> {
         BenchCommand::Bloom(args) => crate::bloom::run(args),
         BenchCommand::Shadows(args) => crate::shadows::run(args),
         BenchCommand::Bvh(args) => crate::bvh::run(args),
+        BenchCommand::Pathtrace(args) => crate::pathtrace::run(args),
     }
 }

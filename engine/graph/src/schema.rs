@@ -263,6 +263,23 @@ pub struct PassDecl {
     /// renderer registers: `derive: [Gaussian(sigma: "$sigma", radius: 21)]`.
     #[serde(default)]
     pub derive: Vec<ProviderDecl>,
+    /// Preprocessor defines for the pass's shaders, each under the features
+    /// it needs: `defines: [(name: "SCENE_MIRRORS", enabled_if: ["mirrors"])]`
+    /// compiles mirror code only for scenes with mirrors.
+    #[serde(default)]
+    pub defines: Vec<DefineDecl>,
+}
+
+/// A shader define a pass sets when its features hold.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DefineDecl {
+    /// A preprocessor name: capitals, digits and underscores, not `HAS_...`
+    /// (conditional reads define those).
+    pub name: String,
+    /// Features that must all hold (`"name"`) or not hold (`"!name"`).
+    #[serde(default)]
+    pub enabled_if: Vec<String>,
 }
 
 /// A use of a named value provider: its name and arguments (numbers, vectors,

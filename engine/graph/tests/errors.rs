@@ -539,3 +539,30 @@ fn progressive_samples_per_frame_must_be_a_whole_number_in_range() {
     assert_eq!(d.hint.as_deref(), Some("did you mean \"$spf\"?"));
     assert!(check_text(&graph("16")).is_empty());
 }
+
+#[test]
+fn a_define_must_be_a_preprocessor_name_the_engine_does_not_own() {
+    let graph = |name: &str| {
+        VALID.replace(
+            r#"draw: Meshes(Opaque),"#,
+            &format!("draw: Meshes(Opaque),\n            defines: [(name: \"{name}\", enabled_if: [\"x\"])],"),
+        )
+    };
+    let text = graph("scene-mirrors");
+    let d = only_error(&text);
+    assert_eq!(
+        d.message,
+        "define \"scene-mirrors\" is not a preprocessor name: use capitals, digits and underscores"
+    );
+    assert!(text_at(&text, &d).starts_with("\"scene-mirrors\""), "{d:?}");
+    let d = only_error(&graph("HAS_X"));
+    assert!(
+        d.message.contains("names starting HAS_ are the engine's"),
+        "{d:?}"
+    );
+    assert_eq!(
+        d.hint.as_deref(),
+        Some("choose another prefix, e.g. SCENE_")
+    );
+    assert!(errors(&graph("SCENE_MIRRORS")).is_empty());
+}

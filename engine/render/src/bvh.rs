@@ -182,8 +182,9 @@ impl Bvh {
         hit
     }
 
-    /// Visits hits nearer than every hit before them, nearest boxes' order
-    /// aside, until `visit` returns true.
+    /// Visits hits nearer than every hit before them, nearer child boxes
+    /// first (the order `trace_walk` in `trace.glsl` uses), until `visit`
+    /// returns true.
     fn walk(
         &self,
         triangles: &[[Vec3; 3]],
@@ -197,15 +198,27 @@ impl Bvh {
         }
         let inv = dir.recip();
         let mut limit = t_max;
-        let mut stack = vec![0u32];
-        while let Some(n) = stack.pop() {
-            let node = &self.nodes[n as usize];
-            if slab(node, origin, inv).is_none_or(|t| t >= limit) {
+        let mut stack: Vec<(u32, f32)> = slab(&self.nodes[0], origin, inv)
+            .map(|t| (0, t))
+            .into_iter()
+            .collect();
+        while let Some((n, entry)) = stack.pop() {
+            if entry >= limit {
                 continue;
             }
+            let node = &self.nodes[n as usize];
             if node.count == 0 {
-                stack.push(node.first);
-                stack.push(node.first + 1);
+                // Nearer child on top of the stack, ties to the first.
+                let mut children = [node.first, node.first + 1]
+                    .map(|c| (c, slab(&self.nodes[c as usize], origin, inv)));
+                if children[0].1.unwrap_or(-1.0) > children[1].1.unwrap_or(-1.0) {
+                    children.swap(0, 1);
+                }
+                for (child, t) in children.into_iter().rev() {
+                    if let Some(t) = t.filter(|&t| t < limit) {
+                        stack.push((child, t));
+                    }
+                }
                 continue;
             }
             let leaf = &self.triangles[node.first as usize..(node.first + node.count) as usize];

@@ -1,14 +1,19 @@
 //! Scene features a graph's `enabled_if` conditions test: what the scene has,
 //! so passes for things it lacks (spot lights, shadow casters) are culled.
 
-use crate::materials::matches;
+use crate::materials::{is_mirror, matches};
 use weft_graph::schema::MaterialFilter;
+use weft_scene::material::ShadingModel;
 use weft_scene::{Light, Scene};
 
 /// The features `scene` switches on: `shadow_casters` when a placed mesh casts,
 /// `point_lights` / `spot_lights` when there are such lights, `emissive` when a
 /// placed mesh glows, `transparent` when a placed mesh blends, `area_lights` when
-/// there are area lights.
+/// there are area lights, `punctual_lights` when there is a sun, point or spot
+/// light; and by the shading models placed meshes use (so shaders compile only
+/// the models a scene has): `glossy` for a Blinn-Phong material with a
+/// specular lobe (Ks and Ns above 0), `mirrors` for MTL `illum` 3 or 5,
+/// `metallic_roughness` for glTF materials.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
     let placed = || {
         scene
@@ -42,6 +47,27 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     }
     if scene.lights.iter().any(|l| matches!(l, Light::Area(_))) {
         features.push("area_lights".to_string());
+    }
+    if scene
+        .lights
+        .iter()
+        .any(|l| matches!(l, Light::Sun(_) | Light::Point(_) | Light::Spot(_)))
+    {
+        features.push("punctual_lights".to_string());
+    }
+    if placed().any(|m| {
+        m.shading == ShadingModel::BlinnPhong
+            && !is_mirror(&m)
+            && m.specular.max_element() > 0.0
+            && m.shininess > 0.0
+    }) {
+        features.push("glossy".to_string());
+    }
+    if placed().any(|m| is_mirror(&m)) {
+        features.push("mirrors".to_string());
+    }
+    if placed().any(|m| m.shading == ShadingModel::MetallicRoughness) {
+        features.push("metallic_roughness".to_string());
     }
     features
 }

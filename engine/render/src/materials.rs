@@ -30,6 +30,12 @@ pub fn matches(filter: MaterialFilter, m: &Material) -> bool {
     }
 }
 
+/// Whether an MTL material is a mirror (`illum` 3 or 5): the path tracer
+/// reflects its Ks perfectly.
+pub fn is_mirror(m: &Material) -> bool {
+    m.shading == ShadingModel::BlinnPhong && matches!(m.illum, Some(3 | 5))
+}
+
 /// Blinn-Phong parameters of an MTL material: (diffuse, specular, shininess,
 /// ambient reflectance). The ambient reflectance is `Ka`, or `Kd` where `Ka` is
 /// black, as most exporters leave it.
@@ -60,11 +66,9 @@ pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
                 diffuse: diffuse.extend(m.base_color.w),
                 specular: specular.extend(shininess),
                 ambient: ambient.extend(normal_scale),
-                emissive: m.emissive.extend(if matches!(m.illum, Some(3 | 5)) {
-                    MIRROR
-                } else {
-                    BLINN_PHONG
-                }),
+                emissive: m
+                    .emissive
+                    .extend(if is_mirror(m) { MIRROR } else { BLINN_PHONG }),
             }
         }
         ShadingModel::MetallicRoughness => {

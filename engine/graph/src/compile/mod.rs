@@ -132,7 +132,8 @@ pub fn feature_names(ir: &Ir) -> BTreeSet<String> {
         let conditions = pass
             .enabled_if
             .iter()
-            .chain(pass.accesses.iter().flat_map(|a| a.conditions.iter()));
+            .chain(pass.accesses.iter().flat_map(|a| a.conditions.iter()))
+            .chain(pass.defines.iter().flat_map(|d| d.enabled_if.iter()));
         for c in conditions {
             names.insert(c.trim_start_matches('!').to_string());
         }

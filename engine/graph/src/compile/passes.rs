@@ -98,6 +98,11 @@ fn plan_pass(cx: &PassContext, p: IrPassId, i: PassId, barriers: Vec<Barrier>) -
             ));
         }
     }
+    for define in &pass.defines {
+        if super::conditions_hold(&define.enabled_if, &options.features) {
+            defines.insert(define.name.clone());
+        }
+    }
     let render_pass = matches!(pass.kind, PassKind::Raster | PassKind::Fullscreen).then(|| {
         let mut attachments = Vec::new();
         let mut color = Vec::new();
@@ -269,5 +274,24 @@ mod tests {
         let with = plan_of(&text, &["extra"]);
         let b = with.passes.iter().find(|p| p.name == "b").expect("b runs");
         assert_eq!(b.defines, ["HAS_X"]);
+    }
+
+    #[test]
+    fn declared_defines_follow_their_features() {
+        let text = CHAIN.replace(
+            r#"sampled: ["x"], color: [(image: "out")]"#,
+            r#"sampled: ["x"], color: [(image: "out")],
+                 defines: [(name: "ALWAYS"), (name: "WITH_EXTRA", enabled_if: ["extra"]),
+                           (name: "WITHOUT_EXTRA", enabled_if: ["!extra"])]"#,
+        );
+        let b = |features: &[&str]| {
+            let plan = plan_of(&text, features);
+            let b = plan.passes.iter().find(|p| p.name == "b").expect("b runs");
+            b.defines.clone()
+        };
+        assert_eq!(b(&[]), ["ALWAYS", "WITHOUT_EXTRA"]);
+        assert_eq!(b(&["extra"]), ["ALWAYS", "WITH_EXTRA"]);
+        let (_, ir) = super::super::fixture::resolved(&text);
+        assert!(super::super::feature_names(&ir).contains("extra"));
     }
 }

@@ -80,6 +80,8 @@ pub struct IrPass {
     pub raster: RasterState,
     /// Provider uses with their arguments resolved.
     pub derive: Vec<ProviderDecl>,
+    /// Shader defines with the features each needs.
+    pub defines: Vec<crate::schema::DefineDecl>,
 }
 
 /// How many compute work groups, resolved.

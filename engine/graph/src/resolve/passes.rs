@@ -195,9 +195,45 @@ impl Resolver<'_> {
             after,
             enabled_if: decl.enabled_if.clone(),
             raster: self.raster_state(source, index, decl),
+            defines: self.check_defines(source, index, decl),
         };
         self.check_pass_shape(&pass, decl, resources);
         pass
+    }
+
+    /// The pass's defines, each a preprocessor name the engine does not own.
+    fn check_defines(
+        &mut self,
+        source: usize,
+        index: usize,
+        decl: &PassDecl,
+    ) -> Vec<crate::schema::DefineDecl> {
+        for (k, define) in decl.defines.iter().enumerate() {
+            let name = &define.name;
+            let valid = name.starts_with(|c: char| c.is_ascii_uppercase() || c == '_')
+                && name
+                    .chars()
+                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_');
+            let path = pass_path(
+                index,
+                &[Seg::Field("defines"), Seg::Index(k), Seg::Field("name")],
+            );
+            if !valid {
+                self.error(
+                    source,
+                    &path,
+                    format!("define \"{name}\" is not a preprocessor name: use capitals, digits and underscores"),
+                );
+            } else if name.starts_with("HAS_") {
+                self.error(
+                    source,
+                    &path,
+                    format!("define \"{name}\": names starting HAS_ are the engine's, for conditional reads"),
+                )
+                .hint = Some("choose another prefix, e.g. SCENE_".into());
+            }
+        }
+        decl.defines.clone()
     }
 
     /// A pass's declared fixed-function state, with bias parameters resolved;
