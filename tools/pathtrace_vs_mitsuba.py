@@ -149,7 +149,8 @@ def main():
     samples = args.size * args.size * args.spp
     result = subprocess.run(
         [WEFT, "bench", "pathtrace", "--scene", "scenes/cornell.scene", "--size", f"{args.size}x{args.size}",
-         "--spp", str(args.spp), "--reference", reference_path, "--out-dir", args.out, "--json"],
+         "--spp", str(args.spp), "--reference", reference_path, "--out-dir", args.out,
+         "--image", os.path.join(args.out, f"weft_{args.spp}spp.exr"), "--json"],
         cwd=ROOT, check=True, capture_output=True, text=True)
     weft = json.loads(result.stdout.strip().splitlines()[-1])
     run = weft["renders"][-1]

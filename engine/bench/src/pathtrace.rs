@@ -41,10 +41,13 @@ pub struct PathtraceArgs {
     /// measure relative MSE against.
     #[arg(long)]
     reference: Option<PathBuf>,
-    /// Where the CSV, the plot and the last image go (`pathtrace_bench.csv`,
-    /// `pathtrace_convergence.png`, `pathtrace_bench.exr`).
+    /// Where the CSV and the plot go (`pathtrace_bench.csv`,
+    /// `pathtrace_convergence.png`, the plot only with --reference).
     #[arg(long, default_value = "docs")]
     out_dir: PathBuf,
+    /// Also write the last render here (linear EXR).
+    #[arg(long)]
+    image: Option<PathBuf>,
     /// Print the figures as JSON.
     #[arg(long)]
     json: bool,
@@ -178,8 +181,9 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
     let csv_path = args.out_dir.join("pathtrace_bench.csv");
     std::fs::write(&csv_path, csv(&samples))
         .with_context(|| format!("writing {}", csv_path.display()))?;
-    let exr_path = args.out_dir.join("pathtrace_bench.exr");
-    last_image.context("at least one render")?.save(&exr_path)?;
+    if let Some(path) = &args.image {
+        last_image.context("at least one render")?.save(path)?;
+    }
     if reference.is_some() {
         let plot = LinePlot {
             title: format!(
@@ -227,7 +231,7 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
                 "max_depth": args.max_depth,
                 "device": gpu.info().name,
                 "renders": rows,
-                "image": exr_path,
+                "image": args.image,
             })
         );
     } else {
@@ -239,7 +243,7 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
                 s.spp, s.seconds, s.samples_per_second
             );
         }
-        println!("wrote {} and {}", csv_path.display(), exr_path.display());
+        println!("wrote {}", csv_path.display());
     }
     Ok(ExitCode::SUCCESS)
 }
