@@ -30,6 +30,39 @@ layout(std430, set = 1, binding = 11) readonly buffer Emitters {
     uvec4 emitters[];
 };
 
+// Material textures (engine/render/src/trace_textures.rs): every texture is a
+// layer of one array per size class (256, 512, 1024 texels square), sRGB
+// colour arrays at 12-14 and UNORM data arrays at 15-17; per material
+// (base colour slot, metallic-roughness slot, 0, 0), a slot being
+// class << 16 | layer, or 0xffffffff for none.
+layout(set = 1, binding = 12) uniform sampler2DArray trace_colour_256;
+layout(set = 1, binding = 13) uniform sampler2DArray trace_colour_512;
+layout(set = 1, binding = 14) uniform sampler2DArray trace_colour_1024;
+layout(set = 1, binding = 15) uniform sampler2DArray trace_data_256;
+layout(set = 1, binding = 16) uniform sampler2DArray trace_data_512;
+layout(set = 1, binding = 17) uniform sampler2DArray trace_data_1024;
+layout(std430, set = 1, binding = 18) readonly buffer MaterialTextures { uvec4 material_textures[]; };
+
+#define NO_TEXTURE 0xffffffffu
+
+// The texel of a colour (`colour`) or data texture slot at uv, level 0 (the
+// path tracer's jittered samples filter); white for no texture.
+vec4 trace_texel(uint slot, bool colour, vec2 uv) {
+    if (slot == NO_TEXTURE) {
+        return vec4(1.0);
+    }
+    uint size_class = slot >> 16u;
+    vec3 at = vec3(uv, float(slot & 0xffffu));
+    if (colour) {
+        return size_class == 0u ? textureLod(trace_colour_256, at, 0.0)
+            : size_class == 1u  ? textureLod(trace_colour_512, at, 0.0)
+                                : textureLod(trace_colour_1024, at, 0.0);
+    }
+    return size_class == 0u ? textureLod(trace_data_256, at, 0.0)
+        : size_class == 1u  ? textureLod(trace_data_512, at, 0.0)
+                            : textureLod(trace_data_1024, at, 0.0);
+}
+
 // Deepest traversal the stack allows; the builder's trees stay far below it
 // (docs/pathtrace.md: depth 26 on demo.scene).
 #define TRACE_STACK 64

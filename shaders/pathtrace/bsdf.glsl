@@ -3,8 +3,9 @@
 // routines and pdfs. Blinn-Phong is the raster lobe divided by pi, so a
 // punctual light of colour C (irradiance pi C, lights.glsl) shades exactly as
 // the raster path does; GGX metallic-roughness is `cook_torrance` itself; a
-// mirror (MTL illum 3 or 5) reflects Ks perfectly over a Lambert Kd. Textures
-// are not traced yet: every surface shades with a white texel.
+// mirror (MTL illum 3 or 5) reflects Ks perfectly over a Lambert Kd. Base
+// colour textures multiply Kd or the base colour, and metallic-roughness
+// textures the factors, as in the raster path; normal maps are not applied.
 //
 // Code for shading models the scene lacks is compiled out: the includer
 // defines SCENE_GLOSSY (Blinn-Phong with a specular lobe), SCENE_MIRRORS and
@@ -29,12 +30,14 @@ struct Bsdf {
     float p_specular;  // probability that sampling picks the specular lobe
 };
 
-Bsdf bsdf_of(Material m) {
+// The BSDF of material m where its base colour texture reads `texel` and its
+// metallic-roughness texture `mr_texel` (white without textures).
+Bsdf bsdf_of(Material m, vec3 texel, vec4 mr_texel) {
     Bsdf b;
     b.model = m.emissive.w;
     if (b.model == SHADING_METALLIC_ROUGHNESS) {
-        b.base = m.diffuse.rgb;
-        b.metal_rough = metal_rough(m, vec4(1.0));
+        b.base = m.diffuse.rgb * texel;
+        b.metal_rough = metal_rough(m, mr_texel);
         float r = max(b.metal_rough.y, MIN_ROUGHNESS);
         b.alpha = r * r;
         b.specular = mix(vec3(DIELECTRIC_F0), b.base, b.metal_rough.x);
@@ -44,7 +47,7 @@ Bsdf bsdf_of(Material m) {
         b.base = vec3(0.0);
         b.metal_rough = vec2(0.0);
         b.alpha = 1.0;
-        b.diffuse = m.diffuse.rgb;
+        b.diffuse = m.diffuse.rgb * texel;
         b.exponent = m.specular.w;
         bool lobe = b.model == SHADING_MIRROR || b.exponent > 0.0;
         b.specular = lobe ? m.specular.rgb : vec3(0.0);

@@ -7,7 +7,8 @@
 //
 // Only the code for what the scene has is compiled: the graph defines
 // SCENE_AREA_LIGHTS, SCENE_EMISSIVE, SCENE_PUNCTUAL_LIGHTS, SCENE_GLOSSY,
-// SCENE_MIRRORS and SCENE_METALLIC_ROUGHNESS from scene features.
+// SCENE_MIRRORS, SCENE_METALLIC_ROUGHNESS and SCENE_TEXTURES from scene
+// features.
 //
 // Paths: primary rays through uniformly jittered positions in the pixel (a
 // box filter); next-event estimation at every non-mirror vertex, combined
@@ -107,7 +108,12 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         if (depth == params.max_depth) {
             break;
         }
-        Bsdf b = bsdf_of(m);
+#ifdef SCENE_TEXTURES
+        uvec4 slots = material_textures[s.material];
+        Bsdf b = bsdf_of(m, trace_texel(slots.x, true, s.uv).rgb, trace_texel(slots.y, false, s.uv));
+#else
+        Bsdf b = bsdf_of(m, vec3(1.0), vec4(1.0));
+#endif
         vec3 from = leave(s.position, ng);
         vec4 u_pick = rng_next(rng);
         vec4 u_point = rng_next(rng);

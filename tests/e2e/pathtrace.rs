@@ -13,7 +13,8 @@
 //!   (measured 0.54% NEE only, 0.11% BSDF only), 8x8-pixel block luminance
 //!   within 6% (measured 3.6% and 1.8%).
 //! - **Raster agreement.** With direct light only (max_depth 2), the inside of
-//!   a closed box lit by one point light (nothing can shadow anything) matches
+//!   a closed box lit by one point light (nothing can shadow anything; the
+//!   back wall textured, so texture slots, sRGB and UV orientation count) matches
 //!   the forward graph away from the box's edges, where the path tracer's box
 //!   filter and the rasteriser's pixel centres see different things: mean
 //!   relative difference under 0.5%, every pixel under 2% (measured 0.15% and
@@ -261,6 +262,7 @@ fn glowing_box_scene() -> PathBuf {
     box_scene(
         "glowing-box",
         "glow",
+        false,
         "arealight\n{\n\tshape disc\n\tradius 0.4\n\tposition -0.3 -0.2 -0.6\n\tdirection 1 0 1\n\temission 0.5 0.5 1.5\n\ttwo_sided 1\n}\n\
          arealight\n{\n\tshape rect\n\tsize 0.8 0.6\n\tposition 0.5 -0.9 0\n\tdirection 0 1 0\n\temission 2 1.5 1\n}\n",
     )
@@ -329,14 +331,24 @@ fn luminance(c: [f64; 3]) -> f64 {
 
 /// The inside of a closed 2x2x2 box (white walls, a red one on the left, the
 /// ceiling of material `ceiling`: `white` or `glow`, which emits radiance 1 and
-/// reflects nothing) seen from inside, with `lights` (.scene blocks).
-fn box_scene(name: &str, ceiling: &str, lights: &str) -> PathBuf {
+/// reflects nothing) seen from inside, with `lights` (.scene blocks). The
+/// back wall, facing the camera, is white too, or with `poster` white times
+/// a 256 x 256 texture of four coloured quadrants (`map_Kd`).
+fn box_scene(name: &str, ceiling: &str, poster: bool, lights: &str) -> PathBuf {
     let dir = temp_dir(name);
-    let mut obj = String::from("mtllib box.mtl\n");
+    // Four flat quadrants: red high on the left, blue high at the bottom, so
+    // a mirrored u or v shows; flat, so mip filtering and the tracer's box
+    // filter agree away from the quadrants' borders.
+    let quadrants = image::RgbaImage::from_fn(256, 256, |x, y| {
+        let level = |high: bool| if high { 200 } else { 60 };
+        image::Rgba([level(x < 128), 128, level(y >= 128), 255])
+    });
+    quadrants.save(dir.join("poster.png")).expect("png");
+    let mut obj = String::from("mtllib box.mtl\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n");
     // Each face: four corners counter-clockwise seen from inside the box.
     let faces: [(&str, [[f32; 3]; 4]); 6] = [
         (
-            "white",
+            "back",
             [
                 [-1., -1., -1.],
                 [1., -1., -1.],
@@ -386,7 +398,7 @@ fn box_scene(name: &str, ceiling: &str, lights: &str) -> PathBuf {
         let (v, vn) = (i * 4, i + 1);
         writeln!(
             obj,
-            "f {}//{vn} {}//{vn} {}//{vn} {}//{vn}",
+            "f {}/1/{vn} {}/2/{vn} {}/3/{vn} {}/4/{vn}",
             v + 1,
             v + 2,
             v + 3,
@@ -397,8 +409,11 @@ fn box_scene(name: &str, ceiling: &str, lights: &str) -> PathBuf {
     std::fs::write(dir.join("box.obj"), obj).expect("obj");
     std::fs::write(
         dir.join("box.mtl"),
-        "newmtl white\nKd 0.8 0.8 0.8\nKs 0 0 0\nnewmtl red\nKd 0.7 0.1 0.1\nKs 0 0 0\n\
-         newmtl glow\nKd 0 0 0\nKs 0 0 0\nKe 1 1 1\n",
+        format!(
+            "newmtl white\nKd 0.8 0.8 0.8\nKs 0 0 0\nnewmtl red\nKd 0.7 0.1 0.1\nKs 0 0 0\n\
+             newmtl glow\nKd 0 0 0\nKs 0 0 0\nKe 1 1 1\nnewmtl back\nKd 0.8 0.8 0.8\nKs 0 0 0\n{}",
+            if poster { "map_Kd poster.png\n" } else { "" }
+        ),
     )
     .expect("mtl");
     let scene = dir.join("box.scene");
@@ -419,6 +434,7 @@ fn direct_light_matches_the_forward_graph() {
     let scene = box_scene(
         "point-lit-box",
         "white",
+        true,
         "pointlight\n{\n\tposition 0.3 0.4 -0.2\n\tcolor 0.5 0.5 0.4\n\tattenuation 0 0 1\n}\n",
     );
     let traced = render_hdr(

@@ -28,7 +28,7 @@ Bsdf test_bsdf() {
         : vec4(params.specular.rgb, params.exponent);
     m.ambient = vec4(0.0);
     m.emissive = vec4(0.0, 0.0, 0.0, params.model);
-    return bsdf_of(m);
+    return bsdf_of(m, vec3(1.0), vec4(1.0));
 }
 
 // The outgoing direction, in the x-z plane, about the normal +Z.

@@ -1,6 +1,7 @@
 //! `weft bench bvh`: how long the ray tracer's BVH takes to build over a
 //! scene's world-space triangles (the ones the `RayTracing` provider uploads),
-//! and its shape (nodes, leaves, depth).
+//! its shape (nodes, leaves, depth), and the memory of the path tracer's
+//! texture arrays for the scene's materials.
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -29,6 +30,7 @@ struct Row {
     nodes: usize,
     leaves: usize,
     depth: usize,
+    texture_bytes: u64,
 }
 
 /// Runs `weft bench bvh`.
@@ -37,7 +39,19 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
     for path in &args.scenes {
         let scene = weft_scene::load_scene(path)
             .with_context(|| format!("loading scene {}", path.display()))?;
-        let triangles = SceneGeometry::new(&scene).trace_mesh().corners;
+        let geometry = SceneGeometry::new(&scene);
+        let triangles = geometry.trace_mesh().corners;
+        let textures = weft_render::trace_textures::gather(&geometry.materials);
+        for w in &textures.warnings {
+            eprintln!("warning: {}: {w}", path.display());
+        }
+        eprintln!(
+            "{}: texture layers per class {:?} colour, {:?} data",
+            path.display(),
+            textures.colour.each_ref().map(Vec::len),
+            textures.data.each_ref().map(Vec::len)
+        );
+        let texture_bytes = textures.bytes();
         let mut times = Vec::new();
         let mut bvh = None;
         for _ in 0..args.runs {
@@ -54,6 +68,7 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
             nodes: bvh.nodes.len(),
             leaves: bvh.leaf_count(),
             depth: bvh.depth(),
+            texture_bytes,
         });
     }
     print!("{}", table(&rows));
@@ -61,11 +76,17 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
 }
 
 fn table(rows: &[Row]) -> String {
-    let mut out = String::from("| scene | triangles | build (ms, median) | nodes | leaves | depth |\n|---|---|---|---|---|---|\n");
+    let mut out = String::from("| scene | triangles | build (ms, median) | nodes | leaves | depth | texture arrays (MiB) |\n|---|---|---|---|---|---|---|\n");
     for r in rows {
         out.push_str(&format!(
-            "| {} | {} | {:.1} | {} | {} | {} |\n",
-            r.scene, r.triangles, r.build_ms, r.nodes, r.leaves, r.depth
+            "| {} | {} | {:.1} | {} | {} | {} | {:.1} |\n",
+            r.scene,
+            r.triangles,
+            r.build_ms,
+            r.nodes,
+            r.leaves,
+            r.depth,
+            r.texture_bytes as f64 / (1024.0 * 1024.0)
         ));
     }
     out
@@ -84,10 +105,11 @@ mod tests {
             nodes: 7,
             leaves: 4,
             depth: 3,
+            texture_bytes: 3 * 1024 * 1024,
         }];
         assert_eq!(
             table(&rows),
-            "| scene | triangles | build (ms, median) | nodes | leaves | depth |\n|---|---|---|---|---|---|\n| a.scene | 12 | 0.2 | 7 | 4 | 3 |\n"
+            "| scene | triangles | build (ms, median) | nodes | leaves | depth | texture arrays (MiB) |\n|---|---|---|---|---|---|---|\n| a.scene | 12 | 0.2 | 7 | 4 | 3 | 3.0 |\n"
         );
     }
 }

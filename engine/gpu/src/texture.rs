@@ -2,6 +2,8 @@
 //! pixels uploaded once through a staging buffer (colour as sRGB, data such as
 //! metallic-roughness as UNORM), mipmapped by blits and left in
 //! `SHADER_READ_ONLY_OPTIMAL`; [`Rgba8Image::white`] stands in for a missing one.
+//! [`Texture::upload_layers`] makes a 2D array of equally sized layers (the
+//! path tracer's textures, one array per size class).
 
 use crate::buffer::Buffer;
 use crate::context::Gpu;
@@ -45,14 +47,50 @@ pub struct Texture<'g> {
 impl<'g> Texture<'g> {
     /// Uploads `pixels` as an `R8G8B8A8_SRGB` image (colour, `srgb`) or
     /// `R8G8B8A8_UNORM` (data) with a full mip chain (made by linear blits, where
-    /// the format can be filtered) ready for sampling in fragment shaders.
+    /// the format can be filtered) ready for sampling in fragment and compute
+    /// shaders, viewed as a plain 2D image.
     pub fn upload(
         gpu: &'g Gpu,
         name: &str,
         pixels: &Rgba8Image,
         srgb: bool,
     ) -> Result<Self, GpuError> {
+        Self::create(gpu, name, std::slice::from_ref(pixels), srgb, true)
+    }
+
+    /// Uploads equally sized `layers` as one 2D array image (viewed as
+    /// `sampler2DArray`), sRGB or UNORM as [`Texture::upload`], without mips.
+    pub fn upload_layers(
+        gpu: &'g Gpu,
+        name: &str,
+        layers: &[Rgba8Image],
+        srgb: bool,
+    ) -> Result<Self, GpuError> {
+        let first = layers
+            .first()
+            .ok_or_else(|| GpuError::Plan(format!("texture array {name}: no layers to upload")))?;
+        if let Some(odd) = layers
+            .iter()
+            .find(|l| (l.width, l.height) != (first.width, first.height))
+        {
+            return Err(GpuError::Plan(format!(
+                "texture array {name}: a {}x{} layer among {}x{} ones",
+                odd.width, odd.height, first.width, first.height
+            )));
+        }
+        Self::create(gpu, name, layers, srgb, false)
+    }
+
+    fn create(
+        gpu: &'g Gpu,
+        name: &str,
+        layers: &[Rgba8Image],
+        srgb: bool,
+        single: bool,
+    ) -> Result<Self, GpuError> {
         let device = gpu.device();
+        let pixels = &layers[0];
+        let layer_count = layers.len() as u32;
         let format = if srgb {
             vk::Format::R8G8B8A8_SRGB
         } else {
@@ -63,7 +101,7 @@ impl<'g> Texture<'g> {
             height: pixels.height.max(1),
             depth: 1,
         };
-        let levels = if gpu.linear_filter(format.as_raw()) {
+        let levels = if single && gpu.linear_filter(format.as_raw()) {
             mip_levels(extent.width, extent.height)
         } else {
             1
@@ -73,7 +111,7 @@ impl<'g> Texture<'g> {
             .format(format)
             .extent(extent)
             .mip_levels(levels)
-            .array_layers(1)
+            .array_layers(layer_count)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(
@@ -112,24 +150,34 @@ impl<'g> Texture<'g> {
             base_mip_level: 0,
             level_count: levels,
             base_array_layer: 0,
-            layer_count: 1,
+            layer_count,
         };
         let view_info = vk::ImageViewCreateInfo::default()
             .image(image)
-            .view_type(vk::ImageViewType::TYPE_2D)
+            .view_type(if single {
+                vk::ImageViewType::TYPE_2D
+            } else {
+                vk::ImageViewType::TYPE_2D_ARRAY
+            })
             .format(format)
             .subresource_range(range);
         this.view =
             unsafe { device.create_image_view(&view_info, None) }.call("vkCreateImageView")?;
+        let bytes: Vec<u8> = layers.iter().flat_map(|l| l.rgba.iter().copied()).collect();
         let mut staging = Buffer::host(
             gpu,
             &format!("{name} (staging)"),
-            pixels.rgba.len() as u64,
+            bytes.len() as u64,
             vk::BufferUsageFlags::TRANSFER_SRC,
         )?;
-        staging.write(&pixels.rgba)?;
+        staging.write(&bytes)?;
+        let shape = Shape {
+            extent,
+            levels,
+            layers: layer_count,
+        };
         gpu.one_shot(|cmd| {
-            record_upload(device, cmd, staging.buffer, image, extent, levels);
+            record_upload(device, cmd, staging.buffer, image, shape);
             Ok(())
         })?;
         Ok(this)
@@ -157,9 +205,17 @@ pub fn mip_levels(width: u32, height: u32) -> u32 {
     32 - width.max(height).max(1).leading_zeros()
 }
 
+/// An image's size, mip levels and array layers.
+#[derive(Clone, Copy)]
+struct Shape {
+    extent: vk::Extent3D,
+    levels: u32,
+    layers: u32,
+}
+
 fn level_barrier(
     image: vk::Image,
-    level: u32,
+    (level, layers): (u32, u32),
     (src_stage, src_access, old): (vk::PipelineStageFlags2, vk::AccessFlags2, vk::ImageLayout),
     (dst_stage, dst_access, new): (vk::PipelineStageFlags2, vk::AccessFlags2, vk::ImageLayout),
 ) -> vk::ImageMemoryBarrier2<'static> {
@@ -178,7 +234,7 @@ fn level_barrier(
             base_mip_level: level,
             level_count: 1,
             base_array_layer: 0,
-            layer_count: 1,
+            layer_count: layers,
         })
 }
 
@@ -187,16 +243,21 @@ fn barrier(device: &ash::Device, cmd: vk::CommandBuffer, barriers: &[vk::ImageMe
     unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };
 }
 
-/// Copies the staging buffer into level 0, blits each level from the one above,
-/// and leaves every level in `SHADER_READ_ONLY_OPTIMAL` for fragment shaders.
+/// Copies the staging buffer into level 0 of every layer, blits each level
+/// from the one above, and leaves every level in `SHADER_READ_ONLY_OPTIMAL` for
+/// fragment and compute shaders.
 fn record_upload(
     device: &ash::Device,
     cmd: vk::CommandBuffer,
     staging: vk::Buffer,
     image: vk::Image,
-    extent: vk::Extent3D,
-    levels: u32,
+    shape: Shape,
 ) {
+    let Shape {
+        extent,
+        levels,
+        layers: layer_count,
+    } = shape;
     let none = (
         vk::PipelineStageFlags2::NONE,
         vk::AccessFlags2::NONE,
@@ -213,19 +274,19 @@ fn record_upload(
         vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
     );
     let sampled = (
-        vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER,
         vk::AccessFlags2::SHADER_SAMPLED_READ,
         vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
     );
     let to_dst: Vec<_> = (0..levels)
-        .map(|l| level_barrier(image, l, none, written))
+        .map(|l| level_barrier(image, (l, layer_count), none, written))
         .collect();
     barrier(device, cmd, &to_dst);
     let layers = |level| vk::ImageSubresourceLayers {
         aspect_mask: vk::ImageAspectFlags::COLOR,
         mip_level: level,
         base_array_layer: 0,
-        layer_count: 1,
+        layer_count,
     };
     let region = vk::BufferImageCopy::default()
         .image_subresource(layers(0))
@@ -249,7 +310,12 @@ fn record_upload(
         barrier(
             device,
             cmd,
-            &[level_barrier(image, level - 1, written, source)],
+            &[level_barrier(
+                image,
+                (level - 1, layer_count),
+                written,
+                source,
+            )],
         );
         let [sw, sh] = size(level - 1);
         let [dw, dh] = size(level);
@@ -272,13 +338,23 @@ fn record_upload(
         barrier(
             device,
             cmd,
-            &[level_barrier(image, level - 1, source, sampled)],
+            &[level_barrier(
+                image,
+                (level - 1, layer_count),
+                source,
+                sampled,
+            )],
         );
     }
     barrier(
         device,
         cmd,
-        &[level_barrier(image, levels - 1, written, sampled)],
+        &[level_barrier(
+            image,
+            (levels - 1, layer_count),
+            written,
+            sampled,
+        )],
     );
 }
 

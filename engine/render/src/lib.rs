@@ -39,6 +39,7 @@ pub mod shadows;
 pub mod sources;
 pub mod state;
 pub mod texture;
+pub mod trace_textures;
 pub mod volumes;
 pub mod watch;
 

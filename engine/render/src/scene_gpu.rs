@@ -49,6 +49,19 @@ pub const TRIANGLE_MATERIALS_BINDING: u32 = 10;
 /// Binding of the emissive triangles' alias table (`Emitters`,
 /// [`crate::emitters::EmitterTable`]).
 pub const EMITTERS_BINDING: u32 = 11;
+/// First of the path tracer's texture arrays (`trace.glsl`): sRGB colour
+/// layers of each size class of [`crate::trace_textures::CLASSES`] at 12, 13,
+/// 14, UNORM data layers at 15, 16, 17.
+pub const TRACE_TEXTURES_BINDING: u32 = 12;
+/// How many texture arrays the path tracer binds from [`TRACE_TEXTURES_BINDING`] on.
+const TRACE_TEXTURE_ARRAYS: u32 = 2 * crate::trace_textures::CLASSES.len() as u32;
+/// Whether set 1 `binding` is one of the path tracer's texture arrays.
+pub fn is_trace_texture(binding: u32) -> bool {
+    (TRACE_TEXTURES_BINDING..TRACE_TEXTURES_BINDING + TRACE_TEXTURE_ARRAYS).contains(&binding)
+}
+
+/// Binding of each material's texture slots (`MaterialTextures`).
+pub const MATERIAL_TEXTURES_BINDING: u32 = 18;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -83,7 +96,7 @@ pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 5] = [
 /// Set 1 bindings for ray tracing: built only when a compute pass that
 /// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
-pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 7] = [
+pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 14] = [
     (
         TRIANGLES_BINDING,
         DescriptorKind::StorageBuffer,
@@ -118,6 +131,41 @@ pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 7] = [
         EMITTERS_BINDING,
         DescriptorKind::StorageBuffer,
         "the emissive triangles",
+    ),
+    (
+        TRACE_TEXTURES_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the 256-texel colour texture array",
+    ),
+    (
+        TRACE_TEXTURES_BINDING + 1,
+        DescriptorKind::CombinedImageSampler,
+        "the 512-texel colour texture array",
+    ),
+    (
+        TRACE_TEXTURES_BINDING + 2,
+        DescriptorKind::CombinedImageSampler,
+        "the 1024-texel colour texture array",
+    ),
+    (
+        TRACE_TEXTURES_BINDING + 3,
+        DescriptorKind::CombinedImageSampler,
+        "the 256-texel data texture array",
+    ),
+    (
+        TRACE_TEXTURES_BINDING + 4,
+        DescriptorKind::CombinedImageSampler,
+        "the 512-texel data texture array",
+    ),
+    (
+        TRACE_TEXTURES_BINDING + 5,
+        DescriptorKind::CombinedImageSampler,
+        "the 1024-texel data texture array",
+    ),
+    (
+        MATERIAL_TEXTURES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the materials' texture slots",
     ),
 ];
 /// Set 2 as the engine creates it: a material's textures, in the order of its
@@ -182,7 +230,8 @@ fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuE
             ),
             (
                 vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                MATERIAL_SET_BINDINGS.len() as u32 * materials.max(1),
+                MATERIAL_SET_BINDINGS.len() as u32 * materials.max(1)
+                    + TRACE_TEXTURE_ARRAYS * FOREIGN_SETS,
             ),
         ],
     )
@@ -200,6 +249,9 @@ struct TraceBuffers<'g> {
     uvs: Buffer<'g>,
     materials: Buffer<'g>,
     emitters: Buffer<'g>,
+    /// Colour arrays by class, then data arrays by class.
+    textures: Vec<Texture<'g>>,
+    material_textures: Buffer<'g>,
 }
 
 /// Everything the scene shaders read, on the device.
@@ -414,6 +466,18 @@ impl<'g> GpuScene<'g> {
             if let Some(buffer) = self.scene_buffer(b) {
                 writer.buffer(b, kind.vk(), buffer.buffer);
             }
+            let texture = b
+                .checked_sub(TRACE_TEXTURES_BINDING)
+                .and_then(|i| self.trace.as_ref()?.textures.get(i as usize));
+            if let Some(texture) = texture {
+                writer.image(
+                    b,
+                    kind.vk(),
+                    self.sampler.handle(),
+                    texture.view,
+                    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                );
+            }
         }
         writer.write(self.gpu, set);
     }
@@ -443,6 +507,9 @@ impl<'g> GpuScene<'g> {
         let emitters = crate::emitters::EmitterTable::build(&mesh.corners, |t| {
             self.geometry.materials[mesh.materials[t] as usize].emissive
         });
+        let trace_textures = crate::trace_textures::gather(&self.geometry.materials);
+        self.warnings
+            .extend(trace_textures.warnings.iter().cloned());
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         self.trace = Some(TraceBuffers {
             triangles: Buffer::device_local(
@@ -467,6 +534,27 @@ impl<'g> GpuScene<'g> {
                 storage,
             )?,
             emitters: Buffer::device_local(self.gpu, "emitters", &emitters.bytes(), storage)?,
+            textures: trace_textures
+                .colour
+                .iter()
+                .map(|layers| (layers, true))
+                .chain(trace_textures.data.iter().map(|layers| (layers, false)))
+                .map(|(layers, srgb)| {
+                    let white = [Rgba8Image::white()];
+                    let layers = if layers.is_empty() {
+                        &white[..]
+                    } else {
+                        layers
+                    };
+                    Texture::upload_layers(self.gpu, "trace textures", layers, srgb)
+                })
+                .collect::<Result<_, _>>()?,
+            material_textures: Buffer::device_local(
+                self.gpu,
+                "material texture slots",
+                bytes_of(&trace_textures.slots),
+                storage,
+            )?,
         });
         Ok(())
     }
@@ -486,6 +574,7 @@ impl<'g> GpuScene<'g> {
             TRIANGLE_UVS_BINDING => self.trace.as_ref().map(|t| &t.uvs),
             TRIANGLE_MATERIALS_BINDING => self.trace.as_ref().map(|t| &t.materials),
             EMITTERS_BINDING => self.trace.as_ref().map(|t| &t.emitters),
+            MATERIAL_TEXTURES_BINDING => self.trace.as_ref().map(|t| &t.material_textures),
             _ => None,
         }
     }

@@ -8,7 +8,9 @@
 use crate::geometry::VERTEX_ATTRIBUTES;
 use crate::pipelines::MATERIAL_SET;
 use crate::providers::SHADOW_VIEW;
-use crate::scene_gpu::{MATERIAL_SET_BINDINGS, SCENE_SET_BINDINGS, TRACE_SET_BINDINGS};
+use crate::scene_gpu::{
+    is_trace_texture, MATERIAL_SET_BINDINGS, SCENE_SET_BINDINGS, TRACE_SET_BINDINGS,
+};
 use crate::sources::scene_pass_keys;
 use weft_gpu::bind::{
     check_outputs, link_problems, pack_push, resolve_bindings, shape_name, FrameValues,
@@ -62,12 +64,21 @@ pub fn scene_set_problems(
         };
         match table.iter().find(|(b, _, _)| *b == shader.binding) {
             Some((_, kind, what)) if *kind == shader.kind => {
-                let plain_2d = shader.image.is_none_or(|i| {
-                    i.scalar == Some(ScalarKind::Float) && i.two_d && !i.arrayed && !i.multisampled
+                let arrayed = shader.set == SCENE_SET && is_trace_texture(shader.binding);
+                let right_shape = shader.image.is_none_or(|i| {
+                    i.scalar == Some(ScalarKind::Float)
+                        && i.two_d
+                        && i.arrayed == arrayed
+                        && !i.multisampled
                 });
-                if !plain_2d || shader.depth_compare {
+                if !right_shape || shader.depth_compare {
+                    let (glsl, shape) = if arrayed {
+                        ("sampler2DArray", "an array of 2D colour textures")
+                    } else {
+                        ("sampler2D", "a 2D colour texture")
+                    };
                     problems.push(format!(
-                        "shader binding `{}` (set {} binding {}) must be a sampler2D: the engine binds {what} there, a 2D colour texture",
+                        "shader binding `{}` (set {} binding {}) must be a {glsl}: the engine binds {what} there, {shape}",
                         shader.name, shader.set, shader.binding
                     ));
                 }
