@@ -30,6 +30,8 @@ struct Row {
     nodes: usize,
     leaves: usize,
     depth: usize,
+    /// Reading the BVH back from the cache (`weft_render::bvh_cache`), median.
+    cached_ms: f64,
     texture_bytes: u64,
 }
 
@@ -61,6 +63,17 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
         }
         times.sort_by(f64::total_cmp);
         let bvh = bvh.context("at least one build")?;
+        let cache = std::env::temp_dir().join(format!("weft-bench-bvh-{}", std::process::id()));
+        weft_render::bvh_cache::load_or_build(&triangles, Some(&cache));
+        let mut cached = Vec::new();
+        for _ in 0..args.runs {
+            let started = Instant::now();
+            let read = weft_render::bvh_cache::load_or_build(&triangles, Some(&cache));
+            cached.push(started.elapsed().as_secs_f64() * 1e3);
+            anyhow::ensure!(read == bvh, "the cached BVH differs from the built one");
+        }
+        let _ = std::fs::remove_dir_all(&cache);
+        cached.sort_by(f64::total_cmp);
         rows.push(Row {
             scene: path.display().to_string(),
             triangles: triangles.len(),
@@ -68,6 +81,7 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
             nodes: bvh.nodes.len(),
             leaves: bvh.leaf_count(),
             depth: bvh.depth(),
+            cached_ms: cached[cached.len() / 2],
             texture_bytes,
         });
     }
@@ -76,13 +90,14 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
 }
 
 fn table(rows: &[Row]) -> String {
-    let mut out = String::from("| scene | triangles | build (ms, median) | nodes | leaves | depth | texture arrays (MiB) |\n|---|---|---|---|---|---|---|\n");
+    let mut out = String::from("| scene | triangles | build (ms, median) | from the cache (ms, median) | nodes | leaves | depth | texture arrays (MiB) |\n|---|---|---|---|---|---|---|---|\n");
     for r in rows {
         out.push_str(&format!(
-            "| {} | {} | {:.1} | {} | {} | {} | {:.1} |\n",
+            "| {} | {} | {:.1} | {:.1} | {} | {} | {} | {:.1} |\n",
             r.scene,
             r.triangles,
             r.build_ms,
+            r.cached_ms,
             r.nodes,
             r.leaves,
             r.depth,
@@ -105,11 +120,12 @@ mod tests {
             nodes: 7,
             leaves: 4,
             depth: 3,
+            cached_ms: 0.125,
             texture_bytes: 3 * 1024 * 1024,
         }];
         assert_eq!(
             table(&rows),
-            "| scene | triangles | build (ms, median) | nodes | leaves | depth | texture arrays (MiB) |\n|---|---|---|---|---|---|---|\n| a.scene | 12 | 0.2 | 7 | 4 | 3 | 3.0 |\n"
+            "| scene | triangles | build (ms, median) | from the cache (ms, median) | nodes | leaves | depth | texture arrays (MiB) |\n|---|---|---|---|---|---|---|---|\n| a.scene | 12 | 0.2 | 0.1 | 7 | 4 | 3 | 3.0 |\n"
         );
     }
 }

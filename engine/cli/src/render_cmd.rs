@@ -78,6 +78,10 @@ pub struct RenderArgs {
     /// seed renders the same image every run.
     #[arg(long)]
     seed: Option<u32>,
+    /// Do not read or write cached scene data (the ray tracer's BVH, kept in
+    /// $WEFT_CACHE_DIR, else $XDG_CACHE_HOME/weft or ~/.cache/weft).
+    #[arg(long)]
+    no_cache: bool,
     /// Use the first device whose name contains this.
     #[arg(long)]
     device: Option<String>,
@@ -204,6 +208,11 @@ fn settings(args: &RenderArgs, extra_readback: Vec<String>) -> RenderSettings {
             .collect(),
         samples: args.spp,
         time_limit: args.time_limit,
+        cache_dir: if args.no_cache {
+            None
+        } else {
+            weft_scene::cache::user_cache_dir()
+        },
         ..RenderSettings::default()
     }
 }

@@ -47,6 +47,9 @@ pub struct RenderSettings {
     /// Stop before a frame that would end past this many seconds of
     /// rendering (at least one frame is drawn).
     pub time_limit: Option<f64>,
+    /// Where derived scene data is cached between runs (the ray tracer's
+    /// BVH); `None` caches nothing.
+    pub cache_dir: Option<PathBuf>,
 }
 
 impl Default for RenderSettings {
@@ -68,6 +71,7 @@ impl Default for RenderSettings {
             params: BTreeMap::new(),
             samples: None,
             time_limit: None,
+            cache_dir: None,
         }
     }
 }
@@ -194,7 +198,8 @@ pub fn render_with_progress(
     } else {
         settings.frame_time
     };
-    let uploaded = GpuScene::new(gpu, scene)?;
+    let mut uploaded = GpuScene::new(gpu, scene)?;
+    uploaded.cache_bvh_in(settings.cache_dir.clone());
     let warnings = uploaded.warnings.clone();
     let mut frames = FrameLoop::new(gpu, Arc::clone(&plan), uploaded)?;
     let mut record_ms = Vec::with_capacity(count.min(4096) as usize);

@@ -11,6 +11,7 @@
 
 pub mod brdf;
 pub mod bvh;
+pub mod bvh_cache;
 pub mod camera;
 pub mod emitters;
 pub mod error;

@@ -70,8 +70,9 @@ impl<'g> LiveRender<'g> {
         let fail = |e: GpuError| ReloadError::gpu(e, &settings.graph);
         let mut cache = PipelineCache::new().map_err(fail)?;
         check_shaders(&mut cache, &plan, &settings.graph)?;
-        let uploaded =
+        let mut uploaded =
             GpuScene::new(gpu, &scene).map_err(|e| ReloadError::render(e, scene_path))?;
+        uploaded.cache_bvh_in(settings.cache_dir.clone());
         let sources = Sources {
             graph: graph_files(&settings.graph),
             shaders: shader_files(&mut cache, &plan).map_err(fail)?,
@@ -199,8 +200,9 @@ impl<'g> LiveRender<'g> {
         let fail = |e: GpuError| ReloadError::gpu(e, &graph);
         let new_recorder = match &prepared.scene {
             Some(s) => {
-                let uploaded = GpuScene::new(self.gpu, s)
+                let mut uploaded = GpuScene::new(self.gpu, s)
                     .map_err(|e| ReloadError::render(e, &self.scene_path))?;
+                uploaded.cache_bvh_in(prepared.settings.cache_dir.clone());
                 Some(SceneRecorder::new(self.gpu, uploaded).map_err(fail)?)
             }
             None => None,

@@ -283,6 +283,8 @@ pub struct GpuScene<'g> {
     foreign_sets: HashMap<vk::DescriptorSetLayout, vk::DescriptorSet>,
     /// Built on first use by a ray-tracing pass.
     trace: Option<TraceBuffers<'g>>,
+    /// Where the BVH is cached (`crate::bvh_cache`); `None` builds it every time.
+    bvh_cache: Option<PathBuf>,
     source_lights: Vec<weft_scene::Light>,
     bounds: weft_scene::Aabb,
     /// The camera's view volume at the last update, what sun cascades are fitted to.
@@ -408,6 +410,7 @@ impl<'g> GpuScene<'g> {
             foreign_sets: HashMap::new(),
             source_lights: scene.lights.clone(),
             trace: None,
+            bvh_cache: None,
             bounds,
             view_volume: ViewVolume::new(
                 glam::Vec3::ZERO,
@@ -488,7 +491,7 @@ impl<'g> GpuScene<'g> {
             return Ok(());
         }
         let mesh = self.geometry.trace_mesh();
-        let bvh = crate::bvh::Bvh::build(&mesh.corners);
+        let bvh = crate::bvh_cache::load_or_build(&mesh.corners, self.bvh_cache.as_deref());
         let corners: Vec<[f32; 4]> = mesh
             .corners
             .iter()
@@ -577,6 +580,12 @@ impl<'g> GpuScene<'g> {
             MATERIAL_TEXTURES_BINDING => self.trace.as_ref().map(|t| &t.material_textures),
             _ => None,
         }
+    }
+
+    /// Caches the ray tracer's BVH in `dir` (the user's cache folder), so
+    /// the next run over the same geometry reads it instead of building it.
+    pub fn cache_bvh_in(&mut self, dir: Option<PathBuf>) {
+        self.bvh_cache = dir;
     }
 
     /// Set 1 for a pipeline the executor built: allocated from its reflected

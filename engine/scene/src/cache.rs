@@ -54,6 +54,19 @@ impl Stamp {
     }
 }
 
+/// The user's cache folder for weft: `$WEFT_CACHE_DIR`, else
+/// `$XDG_CACHE_HOME/weft`, else `$HOME/.cache/weft`; `None` when none is set.
+pub fn user_cache_dir() -> Option<PathBuf> {
+    let var = |name| {
+        std::env::var_os(name)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    var("WEFT_CACHE_DIR")
+        .or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("weft")))
+        .or_else(|| var("HOME").map(|d| d.join(".cache").join("weft")))
+}
+
 /// The 64-bit FNV-1a hash, to name entries after the model's absolute path.
 fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {

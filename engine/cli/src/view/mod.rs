@@ -119,6 +119,7 @@ pub fn run(args: ViewArgs) -> Result<ExitCode> {
             TimingMode::Off
         },
         readback: false,
+        cache_dir: weft_scene::cache::user_cache_dir(),
         ..RenderSettings::default()
     };
     let outcome = std::thread::scope(|scope| -> Result<Result<()>> {
