@@ -34,7 +34,7 @@ layout(std430, set = 1, binding = 11) readonly buffer Emitters {
 // layer of one array per size class (256, 512, 1024 texels square), sRGB
 // colour arrays at 12-14 and UNORM data arrays at 15-17; per material
 // (base colour slot, metallic-roughness slot, 0, 0), a slot being
-// class << 16 | layer, or 0xffffffff for none.
+// class << 16 | layer, or 0xffffffff for none; the normal map's slot is z.
 layout(set = 1, binding = 12) uniform sampler2DArray trace_colour_256;
 layout(set = 1, binding = 13) uniform sampler2DArray trace_colour_512;
 layout(set = 1, binding = 14) uniform sampler2DArray trace_colour_1024;
@@ -42,6 +42,8 @@ layout(set = 1, binding = 15) uniform sampler2DArray trace_data_256;
 layout(set = 1, binding = 16) uniform sampler2DArray trace_data_512;
 layout(set = 1, binding = 17) uniform sampler2DArray trace_data_1024;
 layout(std430, set = 1, binding = 18) readonly buffer MaterialTextures { uvec4 material_textures[]; };
+// Per corner: unit world tangent, w the bitangent's sign (0 without tangents).
+layout(std430, set = 1, binding = 19) readonly buffer TriangleTangents { vec4 corner_tangents[]; };
 
 #define NO_TEXTURE 0xffffffffu
 
@@ -61,6 +63,21 @@ vec4 trace_texel(uint slot, bool colour, vec2 uv) {
     return size_class == 0u ? textureLod(trace_data_256, at, 0.0)
         : size_class == 1u  ? textureLod(trace_data_512, at, 0.0)
                             : textureLod(trace_data_1024, at, 0.0);
+}
+
+// The shading normal n bent by a tangent-space normal-map texel (glTF
+// convention) with strength `scale`, in the MikkTSpace frame of the
+// interpolated tangent: B = sign * cross(n, T). n itself where the mesh has
+// no tangents.
+vec3 trace_mapped_normal(vec3 n, vec4 tangent, vec3 texel, float scale) {
+    vec3 t = tangent.xyz - n * dot(n, tangent.xyz);
+    if (dot(t, t) <= 1e-20 || tangent.w == 0.0) {
+        return n;
+    }
+    t = normalize(t);
+    vec3 bent = texel * 2.0 - 1.0;
+    bent.xy *= scale;
+    return normalize(mat3(t, cross(n, t) * tangent.w, n) * bent);
 }
 
 // Deepest traversal the stack allows; the builder's trees stay far below it
@@ -191,6 +208,7 @@ struct TraceSurface {
     vec3 geometric_normal;
     vec2 uv;
     uint material;
+    vec4 tangent;  // interpolated, w the bitangent's sign; zero without tangents
 };
 
 // The surface of triangle `tri` where the ray reaches it at distance `t`.
@@ -217,6 +235,9 @@ TraceSurface trace_surface(uint tri, vec3 origin, vec3 dir, float t) {
     s.geometric_normal = normalize(cross(e1, e2));
     s.normal = dot(n, n) > 0.0 ? normalize(n) : s.geometric_normal;
     s.uv = w * corner_uvs[3u * tri] + u * corner_uvs[3u * tri + 1u] + v * corner_uvs[3u * tri + 2u];
+    s.tangent = vec4(w * corner_tangents[3u * tri].xyz + u * corner_tangents[3u * tri + 1u].xyz
+            + v * corner_tangents[3u * tri + 2u].xyz,
+        corner_tangents[3u * tri].w);
     s.material = triangle_materials[tri];
     return s;
 }

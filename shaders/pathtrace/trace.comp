@@ -97,6 +97,12 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         Material m = materials[s.material];
         vec3 wo = -dir;
         vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
+#ifdef SCENE_TEXTURES
+        uvec4 slots = material_textures[s.material];
+        if (slots.z != NO_TEXTURE && m.ambient.w != 0.0) {
+            s.normal = trace_mapped_normal(s.normal, s.tangent, trace_texel(slots.z, false, s.uv).rgb, m.ambient.w);
+        }
+#endif
         vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
 #ifdef SCENE_EMISSIVE
         if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
@@ -109,7 +115,6 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
             break;
         }
 #ifdef SCENE_TEXTURES
-        uvec4 slots = material_textures[s.material];
         Bsdf b = bsdf_of(m, trace_texel(slots.x, true, s.uv).rgb, trace_texel(slots.y, false, s.uv));
 #else
         Bsdf b = bsdf_of(m, vec3(1.0), vec4(1.0));

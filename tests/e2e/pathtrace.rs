@@ -486,3 +486,65 @@ fn direct_light_matches_the_forward_graph() {
     assert!(mean < 0.005, "mean relative difference {mean}");
     assert!(worst < 0.02, "worst relative difference {worst}");
 }
+
+/// A quad facing the camera, Lambert with a constant normal map tilting every
+/// normal towards +u and +v, under a sun from the side: the path tracer's
+/// MikkTSpace frame (baked tangents) must bend the normal the way the raster
+/// path's frame does, or the two disagree by far more than the tolerance
+/// (a flipped u or v changes the cosine from 0.97 to 0.60 or 0.83).
+#[test]
+fn normal_maps_bend_normals_as_the_raster_path_does() {
+    let dir = temp_dir("normal-map");
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([179, 166, 238, 255]))
+        .save(dir.join("tilt.png"))
+        .expect("png");
+    std::fs::write(
+        dir.join("quad.obj"),
+        "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+         vn 0 0 1\nusemtl tilted\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n",
+    )
+    .expect("obj");
+    std::fs::write(
+        dir.join("quad.mtl"),
+        "newmtl tilted\nKd 0.8 0.8 0.8\nKs 0 0 0\nnorm tilt.png\n",
+    )
+    .expect("mtl");
+    let scene = dir.join("quad.scene");
+    std::fs::write(
+        &scene,
+        "model\n{\n\tfile \"quad.obj\"\n}\nsunlight\n{\n\tdirection -0.4 -0.5 -0.77\n\tcolor 1 1 1\n\tambient 0\n}\n\
+         camera\n{\n\tposition 0 0 3\n\ttarget 0 0 0\n\tfov_deg 20\n}\n",
+    )
+    .expect("scene");
+    const SIZE: u32 = 16;
+    let traced = render_hdr(
+        &scene,
+        "pathtrace.ron",
+        SIZE,
+        Some(16),
+        &[("max_depth", 2.0)],
+        &[],
+    );
+    let raster = render_hdr(
+        &scene,
+        "forward.ron",
+        SIZE,
+        None,
+        &[],
+        &["!bloom", "!shadow_casters"],
+    );
+    let centre = |image: &Hdr| block_mean(image, 4..12, 4..12);
+    let (t, r) = (centre(&traced), centre(&raster));
+    let flat = 0.8 * 0.77 / (0.4f64 * 0.4 + 0.5 * 0.5 + 0.77 * 0.77).sqrt();
+    println!("normal map: traced {t:?}, forward {r:?}; unbent the quad would show {flat:.4}");
+    for c in 0..3 {
+        assert!(
+            (t[c] / r[c] - 1.0).abs() < 0.01,
+            "traced {t:?} vs forward {r:?}"
+        );
+    }
+    assert!(
+        (t[0] / flat - 1.0).abs() > 0.1,
+        "the normal map bends the normal: {t:?}"
+    );
+}

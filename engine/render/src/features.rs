@@ -14,7 +14,7 @@ use weft_scene::{Light, Scene};
 /// the models a scene has): `glossy` for a Blinn-Phong material with a
 /// specular lobe (Ks and Ns above 0), `mirrors` for MTL `illum` 3 or 5,
 /// `metallic_roughness` for glTF materials; `textures` when a placed mesh has a
-/// base colour or metallic-roughness texture.
+/// base colour, metallic-roughness or normal texture.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
     let placed = || {
         scene
@@ -70,8 +70,11 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     if placed().any(|m| m.shading == ShadingModel::MetallicRoughness) {
         features.push("metallic_roughness".to_string());
     }
-    if placed().any(|m| m.textures.base_color.is_some() || m.textures.metallic_roughness.is_some())
-    {
+    if placed().any(|m| {
+        m.textures.base_color.is_some()
+            || m.textures.metallic_roughness.is_some()
+            || m.textures.normal.is_some()
+    }) {
         features.push("textures".to_string());
     }
     features

@@ -6,7 +6,7 @@
 use crate::gpu_types::{GpuDraw, GpuVertex};
 use crate::materials;
 use crate::volumes::{self, VolumeMesh};
-use glam::{Mat4, UVec4, Vec2, Vec3};
+use glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::{Material, Scene};
 
@@ -54,6 +54,9 @@ pub struct TraceMesh {
     pub uvs: Vec<[Vec2; 3]>,
     /// Index into [`SceneGeometry::materials`].
     pub materials: Vec<u32>,
+    /// World-space unit tangents at the corners, w the bitangent's sign
+    /// (mirrored instances flip it); zero where the mesh has none.
+    pub tangents: Vec<[Vec4; 3]>,
 }
 
 /// The flattened scene, ready to upload.
@@ -61,6 +64,9 @@ pub struct TraceMesh {
 pub struct SceneGeometry {
     /// Every vertex.
     pub vertices: Vec<GpuVertex>,
+    /// Each vertex's MikkTSpace tangent (w the handedness), zero where its
+    /// mesh has none. Only the ray tracer reads them (normal maps).
+    pub tangents: Vec<Vec4>,
     /// Triangle corners of every mesh, each range relative to its vertex offset.
     pub indices: Vec<u32>,
     /// Draw records (model matrix, normal matrix, material).
@@ -98,6 +104,10 @@ impl SceneGeometry {
                     continue;
                 }
                 let range = g.append(&mesh.positions, &mesh.normals, &mesh.uvs, &mesh.indices);
+                g.tangents.extend(
+                    (0..mesh.positions.len())
+                        .map(|i| mesh.tangents.get(i).copied().unwrap_or(Vec4::ZERO)),
+                );
                 let material = mesh
                     .material
                     .filter(|&i| i < model.materials.len())
@@ -164,7 +174,9 @@ impl SceneGeometry {
             .iter()
             .map(|p| p.try_normalize().unwrap_or(Vec3::Y))
             .collect();
-        self.append(&mesh.positions, &normals, &[], &mesh.indices)
+        let range = self.append(&mesh.positions, &normals, &[], &mesh.indices);
+        self.tangents.resize(self.vertices.len(), Vec4::ZERO);
+        range
     }
 
     /// The draws a pass with `filter` makes, in material order.
@@ -188,7 +200,26 @@ impl SceneGeometry {
             let first = d.range.first_index as usize;
             let indices = &self.indices[first..first + d.range.index_count as usize];
             let vertex = |i: u32| &self.vertices[(d.range.vertex_offset + i as i32) as usize];
+            let tangent = |i: u32| {
+                self.tangents
+                    .get((d.range.vertex_offset + i as i32) as usize)
+                    .copied()
+                    .unwrap_or(Vec4::ZERO)
+            };
+            let handedness = if record.model.determinant() < 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
             for t in indices.chunks_exact(3) {
+                out.tangents.push([t[0], t[1], t[2]].map(|i| {
+                    let v = tangent(i);
+                    record
+                        .model
+                        .transform_vector3(v.truncate())
+                        .normalize_or_zero()
+                        .extend(v.w * handedness)
+                }));
                 let corners = [vertex(t[0]), vertex(t[1]), vertex(t[2])];
                 out.corners
                     .push(corners.map(|v| record.model.transform_point3(Vec3::from(v.position))));

@@ -62,6 +62,9 @@ pub fn is_trace_texture(binding: u32) -> bool {
 
 /// Binding of each material's texture slots (`MaterialTextures`).
 pub const MATERIAL_TEXTURES_BINDING: u32 = 18;
+/// Binding of the corners' world tangents (`TriangleTangents`, a vec4 each,
+/// w the bitangent's sign).
+pub const TRIANGLE_TANGENTS_BINDING: u32 = 19;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -96,7 +99,7 @@ pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 5] = [
 /// Set 1 bindings for ray tracing: built only when a compute pass that
 /// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
-pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 14] = [
+pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 15] = [
     (
         TRIANGLES_BINDING,
         DescriptorKind::StorageBuffer,
@@ -166,6 +169,11 @@ pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 14] = [
         MATERIAL_TEXTURES_BINDING,
         DescriptorKind::StorageBuffer,
         "the materials' texture slots",
+    ),
+    (
+        TRIANGLE_TANGENTS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the corners' tangents",
     ),
 ];
 /// Set 2 as the engine creates it: a material's textures, in the order of its
@@ -246,6 +254,7 @@ struct TraceBuffers<'g> {
     nodes: Buffer<'g>,
     order: Buffer<'g>,
     normals: Buffer<'g>,
+    tangents: Buffer<'g>,
     uvs: Buffer<'g>,
     materials: Buffer<'g>,
     emitters: Buffer<'g>,
@@ -529,6 +538,12 @@ impl<'g> GpuScene<'g> {
                 storage,
             )?,
             normals: Buffer::device_local(self.gpu, "trace normals", bytes_of(&normals), storage)?,
+            tangents: Buffer::device_local(
+                self.gpu,
+                "trace tangents",
+                bytes_of(&mesh.tangents),
+                storage,
+            )?,
             uvs: Buffer::device_local(self.gpu, "trace uvs", bytes_of(&uvs), storage)?,
             materials: Buffer::device_local(
                 self.gpu,
@@ -574,6 +589,7 @@ impl<'g> GpuScene<'g> {
             BVH_NODES_BINDING => self.trace.as_ref().map(|t| &t.nodes),
             BVH_TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.order),
             TRIANGLE_NORMALS_BINDING => self.trace.as_ref().map(|t| &t.normals),
+            TRIANGLE_TANGENTS_BINDING => self.trace.as_ref().map(|t| &t.tangents),
             TRIANGLE_UVS_BINDING => self.trace.as_ref().map(|t| &t.uvs),
             TRIANGLE_MATERIALS_BINDING => self.trace.as_ref().map(|t| &t.materials),
             EMITTERS_BINDING => self.trace.as_ref().map(|t| &t.emitters),

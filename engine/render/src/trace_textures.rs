@@ -1,6 +1,7 @@
 //! Material textures for the path tracer. Compute shaders on lavapipe can
 //! index neither descriptor arrays at run time (no `runtimeDescriptorArray`)
-//! nor sampled images by a non-uniform value, so every texture is resampled
+//! nor sampled images by a non-uniform value, so every texture (base colour,
+//! metallic-roughness, tangent-space normal map) is resampled
 //! to a square size class and becomes a layer of that class's `sampler2DArray`:
 //! one array per class and colour space (sRGB base colours, UNORM
 //! metallic-roughness), bound at set 1, bindings 12 to 17
@@ -32,8 +33,8 @@ pub struct TraceTextures {
     pub colour: [Vec<Rgba8Image>; 3],
     /// Per class: UNORM data layers (metallic-roughness).
     pub data: [Vec<Rgba8Image>; 3],
-    /// Per material: base colour slot, metallic-roughness slot, 0, 0; a slot
-    /// is `class << 16 | layer`, or [`NO_TEXTURE`].
+    /// Per material: base colour slot, metallic-roughness slot, normal-map
+    /// slot, 0; a slot is `class << 16 | layer`, or [`NO_TEXTURE`].
     pub slots: Vec<[u32; 4]>,
     /// Textures that could not be decoded (their materials go untextured).
     pub warnings: Vec<String>,
@@ -88,7 +89,7 @@ fn source_key(source: &TextureSource) -> String {
     }
 }
 
-/// Decodes and places the base colour and metallic-roughness textures of
+/// Decodes and places the base colour, metallic-roughness and normal textures of
 /// `materials`, each distinct source once per colour space.
 pub fn gather(materials: &[Material]) -> TraceTextures {
     let mut out = TraceTextures::default();
@@ -122,7 +123,8 @@ pub fn gather(materials: &[Material]) -> TraceTextures {
     for m in materials {
         let base = slot(m.textures.base_color.as_ref(), true, &mut out);
         let metal_rough = slot(m.textures.metallic_roughness.as_ref(), false, &mut out);
-        out.slots.push([base, metal_rough, 0, 0]);
+        let normal = slot(m.textures.normal.as_ref(), false, &mut out);
+        out.slots.push([base, metal_rough, normal, 0]);
     }
     out
 }

@@ -1,4 +1,10 @@
-//! MikkTSpace tangents for meshes whose material has a normal or bump map.
+//! MikkTSpace tangents for meshes whose material has a normal or bump map,
+//! in glTF's convention: the bitangent is `cross(normal, tangent.xyz) *
+//! tangent.w` and points the way a normal map's green channel does, up in
+//! the image. MikkTSpace runs on weft's UVs, whose origin is the image's top
+//! left (OBJ's v is flipped on import), so its bitangent points down the
+//! image; the sign it reports is negated to match glTF's (whose exporters
+//! compute tangents before flipping v).
 
 use crate::mesh::Mesh;
 use crate::model::Model;
@@ -42,7 +48,7 @@ impl mikktspace::Geometry for Geometry<'_> {
         let i = self.index(face, vert);
         // Vertices shared between faces get the last face's tangent; MikkTSpace gives shared
         // vertices the same frame unless the UV layout splits them.
-        self.tangents[i] = Vec4::from_array(tangent);
+        self.tangents[i] = Vec4::new(tangent[0], tangent[1], tangent[2], -tangent[3]);
     }
 }
 
@@ -107,7 +113,9 @@ mod tests {
         assert!(generate_mesh_tangents(&mut mesh));
         for t in &mesh.tangents {
             assert!(t.truncate().distance(Vec3::X) < 1e-5, "{t}");
-            assert_eq!(t.w.abs(), 1.0);
+            // v = 0 is the image's top, at y = 1: the bitangent cross(N, T) * w
+            // must point up the image, +Y, as glTF's does.
+            assert_eq!(t.w, 1.0, "{t}");
         }
     }
 }
