@@ -26,10 +26,9 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use weft_gpu::Pixels;
 use weft_graph::plan::Extent;
 use weft_graph::schema::ParamValue;
-use weft_render::{render, RenderSettings};
+use weft_render::RenderSettings;
 
 /// Linear RGB per pixel, row by row.
 struct Hdr {
@@ -76,9 +75,6 @@ fn render_hdr(
     params: &[(&str, f64)],
     features: &[&str],
 ) -> Hdr {
-    let scene = weft_scene::load_scene(scene).expect("scene loads");
-    let gpu = weft_tests::gpu();
-    let log = gpu.validation();
     let settings = RenderSettings {
         graph: weft_tests::shipped(graph),
         extent: Extent {
@@ -86,7 +82,6 @@ fn render_hdr(
             height: size,
         },
         features: features.iter().map(|f| f.to_string()).collect(),
-        extra_readback: vec!["hdr".into()],
         params: params
             .iter()
             .map(|(k, v)| (k.to_string(), ParamValue::Number(*v)))
@@ -94,16 +89,10 @@ fn render_hdr(
         samples,
         ..RenderSettings::default()
     };
-    let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
+    let (rendered, values) = weft_tests::render::render_hdr_validated(scene, settings);
     if let Some(spp) = samples {
         assert_eq!(rendered.samples, Some(spp), "the render reached its spp");
     }
-    let (_, hdr) = &rendered.report.readbacks[0];
-    let Pixels::RgbaF32(values) = &hdr.pixels else {
-        panic!("hdr is a float image");
-    };
     Hdr {
         width: size,
         pixels: values.chunks(4).map(|p| [p[0], p[1], p[2]]).collect(),

@@ -10,11 +10,10 @@
 
 use glam::Vec3;
 use std::path::{Path, PathBuf};
-use weft_gpu::Pixels;
 use weft_graph::plan::Extent;
 use weft_render::brdf::{cook_torrance, AreaGeometry};
 use weft_render::lights::area_shape;
-use weft_render::{render, RenderSettings};
+use weft_render::RenderSettings;
 use weft_scene::Light;
 
 /// Image size: odd, so the centre pixel looks straight down the camera axis.
@@ -36,9 +35,6 @@ fn camera_block() -> String {
 
 /// Renders `scene` through `graph` with validation and returns the HDR image as RGBA floats.
 fn render_hdr(scene: &Path, graph: &str) -> Vec<f32> {
-    let scene = weft_scene::load_scene(scene).expect("scene loads");
-    let gpu = weft_tests::gpu();
-    let log = gpu.validation();
     let settings = RenderSettings {
         graph: weft_tests::shipped(graph),
         extent: Extent {
@@ -46,17 +42,9 @@ fn render_hdr(scene: &Path, graph: &str) -> Vec<f32> {
             height: SIZE,
         },
         features: vec!["!bloom".into()],
-        extra_readback: vec!["hdr".into()],
         ..RenderSettings::default()
     };
-    let rendered = render(&gpu, &scene, &settings).expect("renders");
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new(), "{graph}");
-    let (_, hdr) = &rendered.report.readbacks[0];
-    let Pixels::RgbaF32(values) = &hdr.pixels else {
-        panic!("hdr is float");
-    };
-    values.clone()
+    weft_tests::render::render_hdr_validated(scene, settings).1
 }
 
 fn pixel(values: &[f32], x: u32, y: u32) -> Vec3 {

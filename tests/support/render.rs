@@ -158,3 +158,25 @@ pub fn centre_hdr(
     let at = (8 * 16 + 8) * 4;
     [values[at], values[at + 1], values[at + 2], values[at + 3]]
 }
+
+/// Renders `scene` with `settings` and `hdr` read back, on a validating
+/// context; asserts no validation message and returns the render and the
+/// `hdr` image as RGBA floats, row by row.
+pub fn render_hdr_validated(
+    scene: &Path,
+    mut settings: RenderSettings,
+) -> (weft_render::Rendered, Vec<f32>) {
+    let scene = weft_scene::load_scene(scene).expect("scene loads");
+    let gpu = crate::gpu();
+    let log = gpu.validation();
+    settings.extra_readback = vec!["hdr".into()];
+    let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new(), "{}", settings.graph.display());
+    let (_, hdr) = &rendered.report.readbacks[0];
+    let weft_gpu::Pixels::RgbaF32(values) = &hdr.pixels else {
+        panic!("hdr is a float image");
+    };
+    let values = values.clone();
+    (rendered, values)
+}

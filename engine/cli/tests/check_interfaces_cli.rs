@@ -79,12 +79,12 @@ fn line_of(file: &Path, text: &str) -> usize {
 
 #[test]
 fn a_scene_binding_the_engine_does_not_write_is_refused_at_check_and_at_render() {
-    // Binding 19: beyond both the scene's bindings and the ray tracer's (5..10).
+    // Binding 29: beyond both the scene's bindings and the ray tracer's (5..19).
     let copy = Copy::new("set1");
     copy.edit(
         "shaders/include/scene.glsl",
         "set = 1, binding = 3)",
-        "set = 1, binding = 19)",
+        "set = 1, binding = 29)",
     );
     let (code, err) = copy.check("forward.ron");
     assert_eq!(code, Some(1), "{err}");
@@ -95,9 +95,9 @@ fn a_scene_binding_the_engine_does_not_write_is_refused_at_check_and_at_render()
         + (1..lines.len())
             .find(|&i| lines[i - 1].trim() == "Pass(" && lines[i].contains("name: \"forward\","))
             .expect("the forward pass");
-    let glsl_line = line_of(&copy.0.join("shaders/include/scene.glsl"), "binding = 19");
+    let glsl_line = line_of(&copy.0.join("shaders/include/scene.glsl"), "binding = 29");
     let expected = format!(
-        "graphs/forward.ron:{pass_line}:19: error: pass \"forward\": shader binding `Materials` (set 1 binding 19) is not scene data the engine binds; set 1 has 0: the Frame block, 1: the lights, 2: the draw records, 3: the materials, 4: the shadow views (declared at graphs/../shaders/include/scene.glsl:{glsl_line})"
+        "graphs/forward.ron:{pass_line}:19: error: pass \"forward\": shader binding `Materials` (set 1 binding 29) is not scene data the engine binds; set 1 has 0: the Frame block, 1: the lights, 2: the draw records, 3: the materials, 4: the shadow views (declared at graphs/../shaders/include/scene.glsl:{glsl_line})"
     );
     assert!(err.lines().any(|l| l == expected), "{expected}\n{err}");
     // `weft render` refuses it too, located at the pass, instead of a draw
@@ -121,7 +121,7 @@ fn a_scene_binding_the_engine_does_not_write_is_refused_at_check_and_at_render()
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
         err.contains(&format!(
-            "error: graphs/forward.ron:{pass_line}:19: pass `forward`: shader binding `Materials` (set 1 binding 19) is not scene data"
+            "error: graphs/forward.ron:{pass_line}:19: pass `forward`: shader binding `Materials` (set 1 binding 29) is not scene data"
         )),
         "{err}"
     );

@@ -209,7 +209,7 @@ fn plan_with_a_scene_culls_what_the_scene_lacks() {
     );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("dragon.scene: features [shadow_casters]"),
+        stderr.contains("dragon.scene: features [shadow_casters, punctual_lights]"),
         "{stderr}"
     );
     let text = String::from_utf8_lossy(&out.stdout);

@@ -166,14 +166,14 @@ mod tests {
         let missing = dir.join("missing.png");
         c.textures.metallic_roughness = Some(texture(&missing));
         let t = gather(&[a, b, c, Material::default()]);
-        assert_eq!(t.slots[0], [0, NO_TEXTURE, 0, 0]);
-        assert_eq!(t.slots[1], [2 << 16, 0, 0, 0]);
+        assert_eq!(t.slots[0], [0, NO_TEXTURE, NO_TEXTURE, 0]);
+        assert_eq!(t.slots[1], [2 << 16, 0, NO_TEXTURE, 0]);
         assert_eq!(
             t.slots[2],
-            [0, NO_TEXTURE, 0, 0],
+            [0, NO_TEXTURE, NO_TEXTURE, 0],
             "the small colour texture again"
         );
-        assert_eq!(t.slots[3], [NO_TEXTURE, NO_TEXTURE, 0, 0]);
+        assert_eq!(t.slots[3], [NO_TEXTURE, NO_TEXTURE, NO_TEXTURE, 0]);
         assert_eq!(t.colour[0].len(), 1);
         assert_eq!(t.colour[2].len(), 1);
         assert_eq!(t.data[0].len(), 1, "data textures keep their own layers");

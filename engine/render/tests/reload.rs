@@ -373,8 +373,8 @@ fn shader_edits_the_gpu_would_reject_are_refused_before_commit() {
         (
             "shaders/include/scene.glsl",
             "set = 1, binding = 3)",
-            "set = 1, binding = 19)",
-            "pass `forward`: shader binding `Materials` (set 1 binding 19) is not scene data the engine binds",
+            "set = 1, binding = 29)",
+            "pass `forward`: shader binding `Materials` (set 1 binding 29) is not scene data the engine binds",
         ),
         (
             "shaders/tonemap.frag",
