@@ -38,6 +38,8 @@ struct Material {
     vec4 specular;  // Ks, Ns (metallic-roughness: metallic, roughness, 0, 0)
     vec4 ambient;   // ambient reflectance (Ka, or Kd where Ka is black), normal-map scale (0: none)
     vec4 emissive;  // Ke, shading model
+    vec4 transmission;  // path tracer dielectrics: Tf, index of refraction (0: not a dielectric)
+    vec4 reflection;    // path tracer dielectrics: reflection tint (Ks), 0
 };
 
 struct Draw {

@@ -32,6 +32,7 @@
 #include "sampling.glsl"
 #include "bsdf.glsl"
 #include "lights.glsl"
+#include "dielectric.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, rgba32f) uniform image2D accumulation;
@@ -114,6 +115,29 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         if (depth == params.max_depth) {
             break;
         }
+#ifdef SCENE_DIELECTRICS
+        if (m.transmission.w > 0.0) {
+            vec3 n_out = dot(s.normal, s.geometric_normal) < 0.0 ? -s.normal : s.normal;
+            vec3 weight;
+            bool refracted;
+            vec3 next = dielectric_scatter(dir, n_out, m.transmission.w, m.reflection.rgb, m.transmission.rgb,
+                rng_next(rng).x, weight, refracted);
+            // A refracted ray keeps going the way it went through the surface's
+            // plane; a reflected one turns back. Where the shading normal (or
+            // rounding, for refraction grazing the surface) sends the ray to
+            // the wrong side, it is reflected about the geometric normal.
+            if (refracted != (dot(dir, s.geometric_normal) * dot(next, s.geometric_normal) > 0.0)) {
+                next = reflect(dir, s.geometric_normal);
+                weight = m.reflection.rgb;
+            }
+            vec3 side = dot(next, s.geometric_normal) > 0.0 ? s.geometric_normal : -s.geometric_normal;
+            throughput *= weight;
+            origin = leave(s.position, side);
+            dir = next;
+            counted_fully = true;
+            continue;
+        }
+#endif
 #ifdef SCENE_TEXTURES
         Bsdf b = bsdf_of(m, trace_texel(slots.x, true, s.uv).rgb, trace_texel(slots.y, false, s.uv));
 #else

@@ -1,7 +1,7 @@
 //! Scene features a graph's `enabled_if` conditions test: what the scene has,
 //! so passes for things it lacks (spot lights, shadow casters) are culled.
 
-use crate::materials::{is_mirror, matches};
+use crate::materials::{dielectric, is_mirror, matches};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::material::ShadingModel;
 use weft_scene::{Light, Scene};
@@ -13,6 +13,7 @@ use weft_scene::{Light, Scene};
 /// light; and by the shading models placed meshes use (so shaders compile only
 /// the models a scene has): `glossy` for a Blinn-Phong material with a
 /// specular lobe (Ks and Ns above 0), `mirrors` for MTL `illum` 3 or 5,
+/// `dielectrics` for MTL `illum` 4, 6 or 7 (glass),
 /// `metallic_roughness` for glTF materials; `textures` when a placed mesh has a
 /// base colour, metallic-roughness or normal texture.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
@@ -63,6 +64,9 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
             && m.shininess > 0.0
     }) {
         features.push("glossy".to_string());
+    }
+    if placed().any(|m| dielectric(&m).is_some()) {
+        features.push("dielectrics".to_string());
     }
     if placed().any(|m| is_mirror(&m)) {
         features.push("mirrors".to_string());

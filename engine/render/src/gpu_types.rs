@@ -59,6 +59,11 @@ pub struct GpuMaterial {
     pub ambient: Vec4,
     /// Ke, shading model.
     pub emissive: Vec4,
+    /// For the path tracer's smooth dielectrics: the transmission tint (MTL
+    /// `Tf`), and the index of refraction in w; w = 0 for other materials.
+    pub transmission: Vec4,
+    /// The reflection tint of a dielectric (MTL `Ks`), 0.
+    pub reflection: Vec4,
 }
 
 /// The `Frame` uniform block.
@@ -110,7 +115,7 @@ const _: () = {
     assert!(size_of::<GpuVertex>() == 32);
     assert!(size_of::<GpuDraw>() == 144);
     assert!(size_of::<GpuLight>() == 64);
-    assert!(size_of::<GpuMaterial>() == 64);
+    assert!(size_of::<GpuMaterial>() == 96);
     assert!(size_of::<GpuFrame>() == 2 * 64 + 4 * 16);
     assert!(size_of::<GpuShadowsHeader>() == 48);
     assert!(size_of::<GpuShadowView>() == 160);

@@ -30,6 +30,29 @@ pub fn matches(filter: MaterialFilter, m: &Material) -> bool {
     }
 }
 
+/// A smooth dielectric as the path tracer sees it (`shaders/pathtrace/dielectric.glsl`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dielectric {
+    /// Index of refraction of the inside (the outside is air, 1).
+    pub ior: f32,
+    /// Tint of reflected light (MTL `Ks`).
+    pub reflection: Vec3,
+    /// Tint of refracted light, at every crossing (MTL `Tf`).
+    pub transmission: Vec3,
+}
+
+/// The dielectric an MTL material describes: `illum` 4, 6 or 7 (glass,
+/// refraction) with index `Ni`, reflection tint `Ks` and transmission tint
+/// `Tf`. `Ks 1 1 1`, `Tf 1 1 1`, `Ni 1.5`, `illum 7` is clear glass.
+pub fn dielectric(m: &Material) -> Option<Dielectric> {
+    let glass = m.shading == ShadingModel::BlinnPhong && matches!(m.illum, Some(4 | 6 | 7));
+    (glass && m.ior.is_finite() && m.ior > 0.0).then_some(Dielectric {
+        ior: m.ior,
+        reflection: m.specular,
+        transmission: m.transmission_filter,
+    })
+}
+
 /// Whether an MTL material is a mirror (`illum` 3 or 5): the path tracer
 /// reflects its Ks perfectly.
 pub fn is_mirror(m: &Material) -> bool {
@@ -69,6 +92,8 @@ pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
                 emissive: m
                     .emissive
                     .extend(if is_mirror(m) { MIRROR } else { BLINN_PHONG }),
+                transmission: dielectric(m).map_or(Vec4::ZERO, |d| d.transmission.extend(d.ior)),
+                reflection: dielectric(m).map_or(Vec4::ZERO, |d| d.reflection.extend(0.0)),
             }
         }
         ShadingModel::MetallicRoughness => {
@@ -83,6 +108,8 @@ pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
                 specular: factors,
                 ambient: Vec3::ZERO.extend(normal_scale),
                 emissive: m.emissive.extend(METALLIC_ROUGHNESS),
+                transmission: Vec4::ZERO,
+                reflection: Vec4::ZERO,
             }
         }
     }
@@ -160,7 +187,15 @@ mod tests {
                 0.0,
                 0.0,
                 0.0,
-                BLINN_PHONG
+                BLINN_PHONG,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0
             ]
         );
         m.shading = ShadingModel::MetallicRoughness;
@@ -187,11 +222,28 @@ mod tests {
                 2.0,
                 3.0,
                 4.0,
-                METALLIC_ROUGHNESS
+                METALLIC_ROUGHNESS,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0
             ]
         );
         m.roughness = f32::NAN;
         let w = pack_material(&m, true);
         assert_eq!(w.specular.y, 1.0, "NaN roughness falls back to rough");
+        m.shading = ShadingModel::BlinnPhong;
+        m.illum = Some(7);
+        m.ior = 1.33;
+        m.transmission_filter = Vec3::new(0.9, 0.8, 0.7);
+        let glass = pack_material(&m, false);
+        assert_eq!(glass.transmission, Vec4::new(0.9, 0.8, 0.7, 1.33));
+        assert_eq!(glass.reflection, Vec4::new(0.3, 0.3, 0.3, 0.0));
+        m.illum = Some(2);
+        assert_eq!(pack_material(&m, false).transmission, Vec4::ZERO);
     }
 }

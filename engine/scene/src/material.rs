@@ -130,6 +130,8 @@ pub struct Material {
     pub emissive: Vec3,
     /// `Ni` or KHR_materials_ior.
     pub ior: f32,
+    /// MTL `Tf`, the transmission filter: what a refraction lets through.
+    pub transmission_filter: Vec3,
     /// MTL `illum` model, when given.
     pub illum: Option<u8>,
     /// glTF metallic factor (0 for MTL).
@@ -166,6 +168,7 @@ impl Default for Material {
             shininess: 0.0,
             emissive: Vec3::ZERO,
             ior: 1.5,
+            transmission_filter: Vec3::ONE,
             illum: None,
             metallic: 0.0,
             roughness: 1.0,

@@ -203,6 +203,18 @@ pub(crate) fn convert(
         ..Material::default()
     };
     let unknown = |key: &str| m.unknown_param.get(key);
+    if let Some(tf) = unknown("Tf") {
+        let values: Vec<f32> = tf
+            .split_whitespace()
+            .filter_map(|v| v.parse().ok())
+            .collect();
+        out.transmission_filter = match values[..] {
+            [v] => Vec3::splat(v),
+            [r, g, b, ..] => Vec3::new(r, g, b),
+            _ => Vec3::ONE,
+        }
+        .clamp(Vec3::ZERO, Vec3::ONE);
+    }
     out.textures.base_color = texture(dir, m.diffuse_texture.as_ref(), name, mtl, diag, sources);
     out.textures.specular = texture(dir, m.specular_texture.as_ref(), name, mtl, diag, sources);
     out.textures.opacity = texture(dir, m.dissolve_texture.as_ref(), name, mtl, diag, sources);

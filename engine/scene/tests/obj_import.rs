@@ -129,7 +129,7 @@ fn negative_indices_polygons_missing_normals_and_mtl_quirks() {
     std::fs::write(dir.join("tex/d.png"), b"png").expect("write");
     std::fs::write(
         dir.join("m.mtl"),
-        "newmtl a\nKd 0.5 0.25 1\nKs 1 1 1\nKa 0.1 0.1 0.1\nNs 98\nKe 0 1 0\nNi 1.33\nd 1\nTr 1\nillum 7\n\
+        "newmtl a\nKd 0.5 0.25 1\nKs 1 1 1\nKa 0.1 0.1 0.1\nNs 98\nKe 0 1 0\nNi 1.33\nTf 0.9 0.8 0.7\nd 1\nTr 1\nillum 7\n\
          map_Kd tex\\d.png\nmap_bump -bm 0.5 tex/missing.png\nmap_d tex/d.png\n\
          newmtl b\nTr 0.25\n",
     )
@@ -152,6 +152,7 @@ fn negative_indices_polygons_missing_normals_and_mtl_quirks() {
         (Vec3::ONE, Vec3::splat(0.1), Vec3::Y)
     );
     assert_eq!((a.shininess, a.ior, a.illum), (98.0, 1.33, Some(7)));
+    assert_eq!(a.transmission_filter, Vec3::new(0.9, 0.8, 0.7));
     assert!(a.textures.base_color.is_some());
     assert!(a.textures.bump.is_none());
     assert_eq!(a.normal_scale, 0.5);
