@@ -40,6 +40,7 @@ struct Material {
     vec4 emissive;  // Ke, shading model
     vec4 transmission;  // path tracer dielectrics: Tf, index of refraction (0: not a dielectric)
     vec4 reflection;    // path tracer dielectrics: reflection tint (Ks), 0
+    vec4 absorption;    // path tracer dielectrics: Beer-Lambert sigma per world unit, 0
 };
 
 struct Draw {

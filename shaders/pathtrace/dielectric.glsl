@@ -7,7 +7,10 @@
 // (n_from / n_to)^2, the squeeze of solid angle that radiance undergoes
 // crossing the interface (so a closed object's two crossings cancel). Past
 // the critical angle F = 1: total internal reflection. Both are delta
-// events: no NEE, and lights found after them count in full.
+// events: no NEE, and lights found after them count in full. Inside, the
+// path's throughput falls by exp(-sigma t) over each segment of length t
+// (Beer-Lambert, sigma the material's absorption), however many times it
+// reflects internally; trace.comp tracks the medium.
 #ifndef WEFT_PT_DIELECTRIC_GLSL
 #define WEFT_PT_DIELECTRIC_GLSL
 

@@ -79,6 +79,9 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
     vec3 throughput = vec3(1.0);
     float bsdf_pdf = 0.0;
     bool counted_fully = true;  // camera rays and mirror bounces: no MIS
+    // Beer-Lambert coefficient of the medium the ray travels in: a
+    // dielectric's `absorption` after refracting into it, 0 in air.
+    vec3 medium = vec3(0.0);
     for (uint depth = 1u; depth <= params.max_depth; ++depth) {
         vec2 found = trace_closest(origin, dir, 1e30);
         float t = found.x < 0.0 ? 1e30 : found.x;
@@ -93,6 +96,9 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
             radiance += depth > 1u ? throughput * frame.ambient.rgb : vec3(0.0);
             break;
         }
+#ifdef SCENE_DIELECTRICS
+        throughput *= exp(-medium * t);
+#endif
         uint tri = floatBitsToUint(found.y);
         TraceSurface s = trace_surface(tri, origin, dir, t);
         Material m = materials[s.material];
@@ -131,6 +137,10 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
                 weight = m.reflection.rgb;
             }
             vec3 side = dot(next, s.geometric_normal) > 0.0 ? s.geometric_normal : -s.geometric_normal;
+            if (refracted) {
+                bool entering = dot(dir, s.geometric_normal) < 0.0;
+                medium = entering ? m.absorption.rgb : vec3(0.0);
+            }
             throughput *= weight;
             origin = leave(s.position, side);
             dir = next;

@@ -720,3 +720,102 @@ fn glass_of_index_one_is_invisible() {
     );
     assert!(worst_mean < 0.005 && worst_block < 0.05);
 }
+
+/// OBJ text for the box `min`..`max` of material `material`, each face two
+/// triangles wound so that its normal points out of the box.
+fn cuboid(min: [f32; 3], max: [f32; 3], material: &str) -> String {
+    let corner = |i: usize| {
+        glam::Vec3::new(
+            if i & 1 == 0 { min[0] } else { max[0] },
+            if i & 2 == 0 { min[1] } else { max[1] },
+            if i & 4 == 0 { min[2] } else { max[2] },
+        )
+    };
+    let centre = (glam::Vec3::from(min) + glam::Vec3::from(max)) * 0.5;
+    let mut text = format!("usemtl {material}\n");
+    for i in 0..8 {
+        let p = corner(i);
+        writeln!(text, "v {} {} {}", p.x, p.y, p.z).expect("write");
+    }
+    let faces = [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ];
+    for f in faces {
+        let [a, b, c, _] = f.map(corner);
+        let outward = (b - a).cross(c - a).dot(a - centre) > 0.0;
+        let order = if outward { f } else { [f[0], f[3], f[2], f[1]] };
+        for tri in [
+            [order[0], order[1], order[2]],
+            [order[0], order[2], order[3]],
+        ] {
+            writeln!(text, "f {} {} {}", tri[0] + 1, tri[1] + 1, tri[2] + 1).expect("write");
+        }
+    }
+    text
+}
+
+/// Beer–Lambert: a glass slab 1 unit thick (index 1.5, σ = 0.5 per unit,
+/// set by the `.scene` model's `absorption`) seen head-on in the white
+/// furnace. The light leaving it towards the camera is the furnace's
+/// radiance times R_total + T_total, the sums over every number of internal
+/// reflections: with R = ((n - 1)/(n + 1))^2 and τ = exp(-σd),
+/// T_total = (1 - R)^2 τ / (1 - R^2 τ^2) and
+/// R_total = R + (1 - R)^2 R τ^2 / (1 - R^2 τ^2). The centre 8 x 8 pixels
+/// (at most 1.3 degrees off the normal) must average within 0.5% of it.
+#[test]
+fn a_glass_slab_absorbs_as_beer_and_fresnel_say() {
+    let dir = temp_dir("slab");
+    let mut base = 0;
+    std::fs::write(
+        dir.join("enclosure.obj"),
+        format!(
+            "mtllib slab.mtl\n{}",
+            sphere([0.0; 3], 10.0, true, "glow", &mut base)
+        ),
+    )
+    .expect("obj");
+    std::fs::write(
+        dir.join("slab.obj"),
+        format!(
+            "mtllib slab.mtl\n{}",
+            cuboid([-3.0, -3.0, -0.5], [3.0, 3.0, 0.5], "glass")
+        ),
+    )
+    .expect("obj");
+    std::fs::write(
+        dir.join("slab.mtl"),
+        "newmtl glow\nKd 0 0 0\nKs 0 0 0\nKe 1 1 1\nnewmtl glass\nKd 0 0 0\nKs 1 1 1\nTf 1 1 1\nNi 1.5\nillum 7\n",
+    )
+    .expect("mtl");
+    let scene = dir.join("slab.scene");
+    std::fs::write(
+        &scene,
+        "model\n{\n\tfile \"enclosure.obj\"\n}\nmodel\n{\n\tfile \"slab.obj\"\n\tabsorption 0.5\n}\n\
+         camera\n{\n\tposition 0 0 4\n\ttarget 0 0 0\n\tfov_deg 10\n}\n",
+    )
+    .expect("scene");
+    let image = render_hdr(
+        &scene,
+        "pathtrace.ron",
+        32,
+        Some(512),
+        &[("max_depth", 16.0)],
+        &[],
+    );
+    let seen = block_mean(&image, 12..20, 12..20)[0];
+    let r = (0.5f64 / 2.5).powi(2);
+    let tau = (-0.5f64).exp();
+    let denominator = 1.0 - r * r * tau * tau;
+    let expected =
+        (1.0 - r).powi(2) * tau / denominator + r + (1.0 - r).powi(2) * r * tau * tau / denominator;
+    println!("glass slab: {seen:.5} against {expected:.5} (without absorption it would be 1)");
+    assert!(
+        (seen / expected - 1.0).abs() < 0.005,
+        "{seen} vs {expected}"
+    );
+}

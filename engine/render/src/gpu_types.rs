@@ -64,6 +64,8 @@ pub struct GpuMaterial {
     pub transmission: Vec4,
     /// The reflection tint of a dielectric (MTL `Ks`), 0.
     pub reflection: Vec4,
+    /// A dielectric's Beer–Lambert coefficient σ per world unit, 0.
+    pub absorption: Vec4,
 }
 
 /// The `Frame` uniform block.
@@ -115,7 +117,7 @@ const _: () = {
     assert!(size_of::<GpuVertex>() == 32);
     assert!(size_of::<GpuDraw>() == 144);
     assert!(size_of::<GpuLight>() == 64);
-    assert!(size_of::<GpuMaterial>() == 96);
+    assert!(size_of::<GpuMaterial>() == 112);
     assert!(size_of::<GpuFrame>() == 2 * 64 + 4 * 16);
     assert!(size_of::<GpuShadowsHeader>() == 48);
     assert!(size_of::<GpuShadowView>() == 160);

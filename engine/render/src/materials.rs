@@ -39,6 +39,8 @@ pub struct Dielectric {
     pub reflection: Vec3,
     /// Tint of refracted light, at every crossing (MTL `Tf`).
     pub transmission: Vec3,
+    /// Beer–Lambert coefficient σ per world unit inside (`.scene` `absorption`).
+    pub absorption: Vec3,
 }
 
 /// The dielectric an MTL material describes: `illum` 4, 6 or 7 (glass,
@@ -50,6 +52,7 @@ pub fn dielectric(m: &Material) -> Option<Dielectric> {
         ior: m.ior,
         reflection: m.specular,
         transmission: m.transmission_filter,
+        absorption: m.absorption,
     })
 }
 
@@ -94,6 +97,7 @@ pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
                     .extend(if is_mirror(m) { MIRROR } else { BLINN_PHONG }),
                 transmission: dielectric(m).map_or(Vec4::ZERO, |d| d.transmission.extend(d.ior)),
                 reflection: dielectric(m).map_or(Vec4::ZERO, |d| d.reflection.extend(0.0)),
+                absorption: dielectric(m).map_or(Vec4::ZERO, |d| d.absorption.extend(0.0)),
             }
         }
         ShadingModel::MetallicRoughness => {
@@ -110,6 +114,7 @@ pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
                 emissive: m.emissive.extend(METALLIC_ROUGHNESS),
                 transmission: Vec4::ZERO,
                 reflection: Vec4::ZERO,
+                absorption: Vec4::ZERO,
             }
         }
     }
@@ -195,6 +200,10 @@ mod tests {
                 0.0,
                 0.0,
                 0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
                 0.0
             ]
         );
@@ -223,6 +232,10 @@ mod tests {
                 3.0,
                 4.0,
                 METALLIC_ROUGHNESS,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
                 0.0,
                 0.0,
                 0.0,

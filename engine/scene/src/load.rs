@@ -37,6 +37,7 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
                 file: path.to_path_buf(),
                 at: Location::file(path),
                 transform: Mat4::IDENTITY,
+                absorption: None,
             }],
             ..SceneDesc::default()
         }
@@ -117,6 +118,11 @@ fn build(
                 models.len() - 1
             }
         };
+        if let Some(sigma) = placement.absorption {
+            for material in &mut models[index].materials {
+                material.absorption = sigma;
+            }
+        }
         let model = &models[index];
         let m = placement.transform;
         lights.extend(model.lights.iter().map(|l| transform_light(l, &m)));

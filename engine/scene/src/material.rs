@@ -132,6 +132,9 @@ pub struct Material {
     pub ior: f32,
     /// MTL `Tf`, the transmission filter: what a refraction lets through.
     pub transmission_filter: Vec3,
+    /// Beer–Lambert coefficient σ per world unit inside a dielectric (the
+    /// `.scene` model's `absorption`); zero for clear glass.
+    pub absorption: Vec3,
     /// MTL `illum` model, when given.
     pub illum: Option<u8>,
     /// glTF metallic factor (0 for MTL).
@@ -169,6 +172,7 @@ impl Default for Material {
             emissive: Vec3::ZERO,
             ior: 1.5,
             transmission_filter: Vec3::ONE,
+            absorption: Vec3::ZERO,
             illum: None,
             metallic: 0.0,
             roughness: 1.0,

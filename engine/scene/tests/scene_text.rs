@@ -248,3 +248,19 @@ fn report_text_and_json() {
     assert_eq!(json["bounds"]["max"][1], 6.0);
     assert_eq!(json["point_light_radius"]["derived"], 3);
 }
+
+#[test]
+fn model_absorption_is_one_or_three_numbers_of_at_least_zero() {
+    let (d, warnings) = desc("model\n{\n file \"glass.obj\"\n absorption 0.5 0.25 0\n}\n");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(d.models[0].absorption, Some(Vec3::new(0.5, 0.25, 0.0)));
+    let (d, _) = desc("model\n{\n file \"glass.obj\"\n absorption 2\n}\n");
+    assert_eq!(d.models[0].absorption, Some(Vec3::splat(2.0)));
+    let (d, _) = desc("model\n{\n file \"glass.obj\"\n}\n");
+    assert_eq!(d.models[0].absorption, None);
+    let message = error("model\n{\n file \"glass.obj\"\n absorption -1\n}\n");
+    assert_eq!(
+        message,
+        "t.scene:4: 'absorption' expects 1 or 3 finite numbers of at least 0 (per world unit)"
+    );
+}

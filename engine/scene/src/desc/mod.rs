@@ -31,6 +31,9 @@ pub struct Placement {
     pub at: Location,
     /// Model-to-world transform (translate · rotate · scale).
     pub transform: Mat4,
+    /// `absorption r g b`: the Beer–Lambert coefficient σ (per world unit)
+    /// inside the model's dielectric (glass) materials.
+    pub absorption: Option<Vec3>,
 }
 
 /// Everything a `.scene` file (with its includes) declares, before models are loaded.
@@ -231,6 +234,21 @@ fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placeme
         },
         None => Vec3::ONE,
     };
+    let absorption = match props.last("absorption") {
+        Some(p) => match props.numbers(p)?.as_slice() {
+            [s] if s.is_finite() && *s >= 0.0 => Some(Vec3::splat(*s)),
+            [r, g, b] if [r, g, b].iter().all(|v| v.is_finite() && **v >= 0.0) => {
+                Some(Vec3::new(*r, *g, *b))
+            }
+            _ => {
+                return Err(props.error(
+                    p,
+                    "'absorption' expects 1 or 3 finite numbers of at least 0 (per world unit)",
+                ))
+            }
+        },
+        None => None,
+    };
     let Some((name, line)) = file else {
         diag.warn(props.block_at(), "model without a 'file'; skipped");
         return Ok(None);
@@ -239,6 +257,7 @@ fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placeme
         file: resolve(props.file(), &name),
         at: Location::line(props.file(), line),
         transform: Mat4::from_scale_rotation_translation(scale, rot, position),
+        absorption,
     }))
 }
 
