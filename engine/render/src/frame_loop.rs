@@ -9,6 +9,7 @@ use crate::error::RenderError;
 use crate::recorder::SceneRecorder;
 use crate::scene_gpu::GpuScene;
 use std::sync::Arc;
+use weft_gpu::pipeline::{ShaderKey, ShaderModule};
 use weft_gpu::resources::GpuImage;
 use weft_gpu::{FrameOptions, FrameReport, FrameResources, Gpu, GpuError, Renderer, TimingMode};
 use weft_graph::plan::Plan;
@@ -147,18 +148,21 @@ impl<'g> FrameLoop<'g> {
         self.recorder = recorder;
     }
 
-    /// The executor (its pipeline cache takes reloaded shader modules, so
-    /// accumulation starts again).
-    pub fn renderer(&mut self) -> &mut Renderer<'g> {
+    /// Drops every shader and pipeline built from the edited source `changed`,
+    /// in the executor and the scene recorder alike, so the next frame
+    /// rebuilds them; accumulation starts again.
+    pub fn reload_shader(&mut self, changed: &std::path::Path) -> Result<(), GpuError> {
         self.accumulation.reset();
-        &mut self.renderer
+        self.renderer.reload(changed)?;
+        self.recorder.reload(changed)?;
+        Ok(())
     }
 
-    /// The scene recorder (its pipeline cache takes reloaded shader modules, so
-    /// accumulation starts again).
-    pub fn recorder(&mut self) -> &mut SceneRecorder<'g> {
-        self.accumulation.reset();
-        &mut self.recorder
+    /// Hands a shader variant a hot reload already compiled and checked to
+    /// both pipeline caches, so the next frame only builds pipelines.
+    pub fn adopt_shader(&mut self, key: ShaderKey, module: Arc<ShaderModule>) {
+        self.recorder.adopt(key.clone(), Arc::clone(&module));
+        self.renderer.pipelines().adopt(key, module);
     }
 
     /// Samples per pixel the plan's history holds after the last frame drawn:

@@ -88,6 +88,7 @@ pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
     match m.shading {
         ShadingModel::BlinnPhong => {
             let (diffuse, specular, shininess, ambient) = blinn_phong(m);
+            let glass = dielectric(m);
             GpuMaterial {
                 diffuse: diffuse.extend(m.base_color.w),
                 specular: specular.extend(shininess),
@@ -95,9 +96,9 @@ pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
                 emissive: m
                     .emissive
                     .extend(if is_mirror(m) { MIRROR } else { BLINN_PHONG }),
-                transmission: dielectric(m).map_or(Vec4::ZERO, |d| d.transmission.extend(d.ior)),
-                reflection: dielectric(m).map_or(Vec4::ZERO, |d| d.reflection.extend(0.0)),
-                absorption: dielectric(m).map_or(Vec4::ZERO, |d| d.absorption.extend(0.0)),
+                transmission: glass.map_or(Vec4::ZERO, |d| d.transmission.extend(d.ior)),
+                reflection: glass.map_or(Vec4::ZERO, |d| d.reflection.extend(0.0)),
+                absorption: glass.map_or(Vec4::ZERO, |d| d.absorption.extend(0.0)),
             }
         }
         ShadingModel::MetallicRoughness => {

@@ -223,14 +223,10 @@ impl<'g> LiveRender<'g> {
             self.frames.swap_scene(recorder);
         }
         for raw in &rebuild {
-            self.frames.renderer().reload(raw).map_err(fail)?;
-            self.frames.recorder().reload(raw).map_err(fail)?;
+            self.frames.reload_shader(raw).map_err(fail)?;
         }
         for (key, module) in prepared.modules {
-            self.frames
-                .recorder()
-                .adopt(key.clone(), Arc::clone(&module));
-            self.frames.renderer().pipelines().adopt(key, module);
+            self.frames.adopt_shader(key, module);
         }
         if let (Some(plan), Some(resources)) = (prepared.plan, new_resources) {
             self.frames.swap_plan(plan, resources);

@@ -478,9 +478,11 @@ impl<'g> GpuScene<'g> {
             if let Some(buffer) = self.scene_buffer(b) {
                 writer.buffer(b, kind.vk(), buffer.buffer);
             }
-            let texture = b
-                .checked_sub(TRACE_TEXTURES_BINDING)
-                .and_then(|i| self.trace.as_ref()?.textures.get(i as usize));
+            let texture = self
+                .trace
+                .as_ref()
+                .filter(|_| is_trace_texture(b))
+                .and_then(|t| t.textures.get((b - TRACE_TEXTURES_BINDING) as usize));
             if let Some(texture) = texture {
                 writer.image(
                     b,
