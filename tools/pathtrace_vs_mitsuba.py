@@ -12,6 +12,16 @@ reference (and against each other), as a markdown table for docs/pathtrace.md.
     pip install mitsuba
     cargo build --release
     python3 tools/pathtrace_vs_mitsuba.py [--spp 64] [--reference-spp 2048] [--out target/pathtrace-vs-mitsuba]
+        [--ball glass|absorbing|coated]
+
+`--ball` adds scenes/models/glass_sphere.obj (radius 0.3, centre 0 0.3 0.3,
+smooth vertex normals in both renderers) on the box's floor: `glass` is clear
+glass of index 1.5 (Mitsuba's `dielectric`), `absorbing` the same glass
+filled with an absorbing medium, sigma = 2 1 0.5 per unit (the `.scene`
+model's `absorption`; Mitsuba's `homogeneous` medium with albedo 0, and its
+`volpath` integrator), `coated` a Lambert Kd 0.5 0.1 0.1 under a Fresnel coat
+of index 1.5 (MTL `illum 5` with Ks 0.04; Mitsuba's `plastic` with
+`nonlinear`). Both renderers then trace up to 16 segments.
 
 Mitsuba runs the `scalar_rgb` variant on all cores; weft runs on the Vulkan
 device it finds (lavapipe here), through `weft bench pathtrace`.
@@ -35,6 +45,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OBJ = os.path.join(ROOT, "..", "shared", "assets", "cornell", "CornellBox-Original.obj")
 MTL = os.path.join(os.path.dirname(OBJ), "CornellBox-Original.mtl")
 WEFT = os.path.join(ROOT, "target", "release", "weft")
+BALL = os.path.join(ROOT, "scenes", "models", "glass_sphere.obj")
+BALL_CENTRE, BALL_RADIUS = [0.0, 0.3, 0.3], 0.3
+ABSORPTION = [2.0, 1.0, 0.5]
+COATED_KD = [0.5, 0.1, 0.1]
 
 
 def read_materials(path):
@@ -84,11 +98,53 @@ def split_by_material(path, out_dir):
     return files
 
 
-def mitsuba_scene(spp, size, work):
+def max_depth(ball):
+    return 16 if ball else 8
+
+
+def weft_scene(ball, work):
+    """The .scene weft renders: scenes/cornell.scene, or it with the ball."""
+    if not ball:
+        return "scenes/cornell.scene"
+    mtl = os.path.join(work, "ball.mtl")
+    with open(mtl, "w") as f:
+        if ball == "coated":
+            f.write(f"newmtl glass\nKd {' '.join(map(str, COATED_KD))}\nKs 0.04 0.04 0.04\nillum 5\n")
+        else:
+            f.write("newmtl glass\nKd 0 0 0\nKs 1 1 1\nTf 1 1 1\nNi 1.5\nillum 7\n")
+    obj = os.path.join(work, "ball.obj")
+    with open(BALL) as src, open(obj, "w") as dst:
+        dst.write(src.read().replace("mtllib glass_sphere.mtl", "mtllib ball.mtl"))
+    absorption = f"\tabsorption {' '.join(map(str, ABSORPTION))}\n" if ball == "absorbing" else ""
+    path = os.path.join(work, "ball.scene")
+    with open(os.path.join(ROOT, "scenes", "cornell.scene")) as f:
+        cornell = f.read().replace("../../shared", os.path.join(ROOT, "..", "shared"))
+    with open(path, "w") as f:
+        f.write(cornell + f"\nmodel\n{{\n\tfile \"{obj}\"\n\tposition {' '.join(map(str, BALL_CENTRE))}\n"
+                f"\tscale {BALL_RADIUS}\n{absorption}}}\n")
+    return path
+
+
+def mitsuba_ball(ball):
+    """The ball as a Mitsuba shape."""
+    to_world = mi.ScalarTransform4f().translate(BALL_CENTRE) @ mi.ScalarTransform4f().scale(BALL_RADIUS)
+    shape = {"type": "obj", "filename": BALL, "face_normals": False, "to_world": to_world}
+    if ball == "coated":
+        shape["bsdf"] = {"type": "plastic", "int_ior": 1.5, "ext_ior": 1.0, "nonlinear": True,
+                         "diffuse_reflectance": {"type": "rgb", "value": COATED_KD}}
+    else:
+        shape["bsdf"] = {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}
+    if ball == "absorbing":
+        shape["interior"] = {"type": "homogeneous", "albedo": 0.0,
+                             "sigma_t": {"type": "rgb", "value": ABSORPTION}}
+    return shape
+
+
+def mitsuba_scene(spp, size, work, ball=None):
     materials = read_materials(MTL)
     scene = {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": 8, "rr_depth": 5},
+        "integrator": {"type": "volpath" if ball else "path", "max_depth": max_depth(ball), "rr_depth": 5},
         "camera": {
             "type": "perspective",
             "fov": 40.0,
@@ -110,6 +166,8 @@ def mitsuba_scene(spp, size, work):
         if max(m["Ke"]) > 0:
             shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": m["Ke"]}}
         scene[name] = shape
+    if ball:
+        scene["ball"] = mitsuba_ball(ball)
     return mi.load_dict(scene)
 
 
@@ -130,35 +188,39 @@ def main():
     parser.add_argument("--reference-spp", type=int, default=2048)
     parser.add_argument("--size", type=int, default=256)
     parser.add_argument("--out", default=os.path.join(ROOT, "target", "pathtrace-vs-mitsuba"))
+    parser.add_argument("--ball", choices=["glass", "absorbing", "coated"])
     args = parser.parse_args()
+    if args.ball:
+        args.out = os.path.join(args.out, args.ball)
     os.makedirs(args.out, exist_ok=True)
     mi.set_variant("scalar_rgb")
     with tempfile.TemporaryDirectory() as work:
         reference_path = os.path.join(args.out, f"mitsuba_{args.reference_spp}spp.exr")
         if not os.path.exists(reference_path):
             print(f"Mitsuba reference at {args.reference_spp} spp ...", flush=True)
-            scene = mitsuba_scene(args.reference_spp, args.size, work)
+            scene = mitsuba_scene(args.reference_spp, args.size, work, args.ball)
             mi.util.write_bitmap(reference_path, mi.render(scene, spp=args.reference_spp), write_async=False)
-        scene = mitsuba_scene(args.spp, args.size, work)
+        scene = mitsuba_scene(args.spp, args.size, work, args.ball)
         mi.render(scene, spp=1)  # warm up: the first render sets up the thread pool
         started = time.perf_counter()
         image = mi.render(scene, spp=args.spp, seed=1)
         mitsuba_seconds = time.perf_counter() - started
         mitsuba_path = os.path.join(args.out, f"mitsuba_{args.spp}spp.exr")
         mi.util.write_bitmap(mitsuba_path, image, write_async=False)
-    samples = args.size * args.size * args.spp
-    result = subprocess.run(
-        [WEFT, "bench", "pathtrace", "--scene", "scenes/cornell.scene", "--size", f"{args.size}x{args.size}",
-         "--spp", str(args.spp), "--reference", reference_path, "--out-dir", args.out,
-         "--image", os.path.join(args.out, f"weft_{args.spp}spp.exr"), "--json"],
-        cwd=ROOT, check=True, capture_output=True, text=True)
+        samples = args.size * args.size * args.spp
+        result = subprocess.run(
+            [WEFT, "bench", "pathtrace", "--scene", weft_scene(args.ball, work), "--size", f"{args.size}x{args.size}",
+             "--spp", str(args.spp), "--max-depth", str(max_depth(args.ball)), "--reference", reference_path,
+             "--out-dir", args.out, "--image", os.path.join(args.out, f"weft_{args.spp}spp.exr"), "--json"],
+            cwd=ROOT, check=True, capture_output=True, text=True)
     weft = json.loads(result.stdout.strip().splitlines()[-1])
     run = weft["renders"][-1]
     weft_path = weft["image"]
     mitsuba_error = rel_mse(rgb(mitsuba_path), rgb(reference_path))
     between = rel_mse(rgb(weft_path), rgb(mitsuba_path))
     mean = lambda path: list(dr.mean(rgb(path), axis=(0, 1)).array)
-    print(f"\n{args.size}x{args.size}, {args.spp} spp, max_depth 8, on {os.cpu_count()} cores\n")
+    print(f"\n{args.ball or 'Cornell box'}: {args.size}x{args.size}, {args.spp} spp, "
+          f"max_depth {max_depth(args.ball)}, on {os.cpu_count()} cores\n")
     print("| renderer | device | samples/s | rel. MSE vs Mitsuba at "
           f"{args.reference_spp} spp | image mean (RGB) |")
     print("|---|---|---|---|---|")

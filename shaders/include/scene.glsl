@@ -15,9 +15,12 @@
 // Shading models (engine/render/src/materials.rs), in Material.emissive.w.
 #define SHADING_BLINN_PHONG 0.0
 #define SHADING_METALLIC_ROUGHNESS 1.0
-// MTL illum 3 or 5: a perfect mirror of Ks to the path tracer, Blinn-Phong to
+// MTL illum 3: a perfect mirror of Ks to the path tracer, Blinn-Phong to
 // raster passes.
 #define SHADING_MIRROR 2.0
+// MTL illum 5: a Lambert Kd under a smooth dielectric coat (Ks its reflectance
+// at normal incidence) to the path tracer, Blinn-Phong to raster passes.
+#define SHADING_COATED 3.0
 
 // Area lights reuse the fields: position_range = centre, 0; direction_type =
 // local X times the half width (or the disc radius), type; color_exponent =
@@ -38,9 +41,10 @@ struct Material {
     vec4 specular;  // Ks, Ns (metallic-roughness: metallic, roughness, 0, 0)
     vec4 ambient;   // ambient reflectance (Ka, or Kd where Ka is black), normal-map scale (0: none)
     vec4 emissive;  // Ke, shading model
-    vec4 transmission;  // path tracer dielectrics: Tf, index of refraction (0: not a dielectric)
-    vec4 reflection;    // path tracer dielectrics: reflection tint (Ks), 0
+    vec4 transmission;  // path tracer dielectrics: Tf (glTF: base colour), index of refraction
+    vec4 reflection;    // path tracer dielectrics and coats: reflection tint, 0
     vec4 absorption;    // path tracer dielectrics: Beer-Lambert sigma per world unit, 0
+    vec4 optics;        // path tracer: share that is glass, thin shell (1), coat index, coat internal reflectance
 };
 
 struct Draw {

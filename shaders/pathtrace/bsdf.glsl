@@ -3,13 +3,14 @@
 // routines and pdfs. Blinn-Phong is the raster lobe divided by pi, so a
 // punctual light of colour C (irradiance pi C, lights.glsl) shades exactly as
 // the raster path does; GGX metallic-roughness is `cook_torrance` itself; a
-// mirror (MTL illum 3 or 5) reflects Ks perfectly over a Lambert Kd. Base
+// mirror (MTL illum 3) reflects Ks perfectly over a Lambert Kd; a coated
+// diffuse (MTL illum 5) is a Lambert Kd under a smooth dielectric coat. Base
 // colour textures multiply Kd or the base colour, and metallic-roughness
 // textures the factors, as in the raster path; normal maps are not applied.
 //
 // Code for shading models the scene lacks is compiled out: the includer
-// defines SCENE_GLOSSY (Blinn-Phong with a specular lobe), SCENE_MIRRORS and
-// SCENE_METALLIC_ROUGHNESS for the models present (graphs/pathtrace.ron sets
+// defines SCENE_GLOSSY (Blinn-Phong with a specular lobe), SCENE_MIRRORS,
+// SCENE_COATED and SCENE_METALLIC_ROUGHNESS for the models present (graphs/pathtrace.ron sets
 // them from scene features). lavapipe, like a GPU with divergent lanes, runs
 // every side of a branch, so code a scene does not need costs time.
 #ifndef WEFT_PT_BSDF_GLSL
@@ -28,13 +29,49 @@ struct Bsdf {
     vec2 metal_rough;  // GGX metallic and roughness, as the raster path rounds them
     float alpha;       // GGX alpha = roughness^2
     float p_specular;  // probability that sampling picks the specular lobe
+    float coat_ior;    // coated: the coat's index
+    float coat_fdr;    // coated: the coat's internal diffuse reflectance
 };
+
+#ifdef SCENE_COATED
+// The coated diffuse (MTL illum 5), the model of Weidlich & Wilkie's layered
+// "plastic" (as Mitsuba's `plastic` with nonlinear = true). Light meeting the
+// smooth coat at cos_o reflects specularly with the coat's Fresnel reflectance
+// F(cos_o), tinted by Ks / F(0); the rest, 1 - F(cos_o), enters and meets the
+// Lambert base Kd. Of what the base scatters, the coat passes
+// 1 - F(cos_i) towards direction i and sends the share fdr (its internal
+// diffuse reflectance) back down, to be scattered again: the series
+// Kd + Kd fdr Kd + ... = Kd / (1 - Kd fdr). Radiance leaving the coat is
+// spread over a solid angle ior^2 wider than inside. So
+//   f(o, i) = F(cos_o) tint delta(i = mirror(o))
+//           + Kd (1 - F(cos_o)) (1 - F(cos_i)) / (pi ior^2 (1 - Kd fdr)),
+// and with Kd = 1, tint = 1 it reflects exactly everything (the furnace test).
+float coat_fresnel(Bsdf b, float cos_v) {
+    return fresnel_dielectric(clamp(cos_v, 0.0, 1.0), 1.0 / b.coat_ior);
+}
+
+// The probability of sampling the coat's reflection rather than the base,
+// for light leaving along o: each part by its share of the albedo.
+float coat_specular_probability(Bsdf b, float f_o) {
+    float ws = f_o * luminance(b.specular);
+    float wd = (1.0 - f_o) * luminance(b.diffuse);
+    return ws + wd > 0.0 ? ws / (ws + wd) : 1.0;
+}
+
+vec3 coated_diffuse(Bsdf b, float f_o, float cos_i) {
+    float f_i = coat_fresnel(b, cos_i);
+    return b.diffuse * ((1.0 - f_i) * (1.0 - f_o) / (PI * b.coat_ior * b.coat_ior))
+        / (vec3(1.0) - b.diffuse * b.coat_fdr);
+}
+#endif
 
 // The BSDF of material m where its base colour texture reads `texel` and its
 // metallic-roughness texture `mr_texel` (white without textures).
 Bsdf bsdf_of(Material m, vec3 texel, vec4 mr_texel) {
     Bsdf b;
     b.model = m.emissive.w;
+    b.coat_ior = m.optics.z;
+    b.coat_fdr = m.optics.w;
     if (b.model == SHADING_METALLIC_ROUGHNESS) {
         b.base = m.diffuse.rgb * texel;
         b.metal_rough = metal_rough(m, mr_texel);
@@ -51,6 +88,11 @@ Bsdf bsdf_of(Material m, vec3 texel, vec4 mr_texel) {
         b.exponent = m.specular.w;
         bool lobe = b.model == SHADING_MIRROR || b.exponent > 0.0;
         b.specular = lobe ? m.specular.rgb : vec3(0.0);
+#ifdef SCENE_COATED
+        if (b.model == SHADING_COATED) {
+            b.specular = m.reflection.rgb;
+        }
+#endif
     }
     float ws = luminance(b.specular);
     float wd = luminance(b.diffuse);
@@ -72,6 +114,13 @@ vec3 bsdf_eval(Bsdf b, vec3 n, vec3 wo, vec3 wi, out float pdf) {
         return vec3(0.0);
     }
     float p_diffuse = (1.0 - b.p_specular) * cos_i / PI;
+#ifdef SCENE_COATED
+    if (b.model == SHADING_COATED) {
+        float f_o = coat_fresnel(b, dot(n, wo));
+        pdf = (1.0 - coat_specular_probability(b, f_o)) * cos_i / PI;
+        return coated_diffuse(b, f_o, cos_i) * cos_i;
+    }
+#endif
 #ifdef SCENE_MIRRORS
     if (b.model == SHADING_MIRROR) {
         pdf = p_diffuse;
@@ -109,6 +158,23 @@ bool bsdf_sample(Bsdf b, vec3 n, vec3 wo, vec3 u, out vec3 wi, out vec3 weight, 
     delta = false;
     weight = vec3(0.0);
     mat3 frame = basis(n);
+#ifdef SCENE_COATED
+    if (b.model == SHADING_COATED) {
+        float f_o = coat_fresnel(b, dot(n, wo));
+        float p = coat_specular_probability(b, f_o);
+        if (u.z < p) {
+            wi = reflect(-wo, n);
+            weight = b.specular * (f_o / p);
+            pdf = 0.0;
+            delta = true;
+            return true;
+        }
+        wi = frame * sample_cosine(u.xy);
+        vec3 f = bsdf_eval(b, n, wo, wi, pdf);
+        weight = pdf > 0.0 ? f / pdf : vec3(0.0);
+        return pdf > 0.0;
+    }
+#endif
     if (u.z < b.p_specular) {
 #ifdef SCENE_MIRRORS
         if (b.model == SHADING_MIRROR) {

@@ -25,14 +25,22 @@
 // adds nothing); 2 is BSDF sampling only (no NEE towards them). All three
 // converge to the same image (tests/e2e/pathtrace.rs); delta lights always use
 // NEE.
+//
+// Glass: `fresnel` 0 uses Fresnel's exact equations, 1 Schlick's
+// approximation. `nee_through_glass` 1 adds the biased "Snell-bent" NEE of
+// docs/pathtrace.md: a shadow ray that meets glass refracts through it (up to
+// 8 surfaces) and counts if it then meets a light with area, with the sampled
+// light point's value, while BSDF-sampled paths through glass still count:
+// light through glass is counted twice. 0, the default, is unbiased: shadow
+// rays stop at glass and caustics come from BSDF-sampled paths.
 #define NO_DERIVATIVES
 #include "../include/lighting.glsl"
 #include "../include/trace.glsl"
 #include "random.glsl"
 #include "sampling.glsl"
+#include "dielectric.glsl"
 #include "bsdf.glsl"
 #include "lights.glsl"
-#include "dielectric.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, rgba32f) uniform image2D accumulation;
@@ -44,6 +52,8 @@ layout(push_constant) uniform Params {
     uint samples_per_frame;
     uint seed;
     uint sampling;
+    uint fresnel;
+    uint nee_through_glass;
     uint history_frames;
 } params;
 
@@ -73,6 +83,57 @@ bool unoccluded(vec3 origin, vec3 dir, float distance) {
     float t = distance * (1.0 - 1e-3);
     return hit_area_light(origin, dir, t) < 0 && !trace_any(origin, dir, t);
 }
+
+#ifdef SCENE_DIELECTRICS
+// The Snell-bent shadow ray: follows a ray from `origin` along `dir` through up
+// to 8 glass surfaces, refracting at each (weight (1 - F) Tf (n_from/n_to)^2,
+// Beer-Lambert inside); true, with that weight in `through`, when it then
+// meets a light with area. Total internal reflection or an opaque surface
+// ends it.
+bool bent_shadow_ray(vec3 origin, vec3 dir, out vec3 through) {
+    through = vec3(1.0);
+    vec3 medium = vec3(0.0);
+    for (uint crossing = 0u; crossing <= 8u; ++crossing) {
+        vec2 found = trace_closest(origin, dir, 1e30);
+        float t = found.x < 0.0 ? 1e30 : found.x;
+        if (hit_area_light(origin, dir, t) >= 0) {
+            return true;
+        }
+        if (found.x < 0.0) {
+            return false;
+        }
+        through *= exp(-medium * t);
+        TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
+        Material m = materials[s.material];
+#ifdef SCENE_EMISSIVE
+        if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, dir) < 0.0) {
+            return true;
+        }
+#endif
+        if (m.optics.x <= 0.0 || crossing == 8u) {
+            return false;
+        }
+        bool entering = dot(dir, s.geometric_normal) < 0.0;
+        vec3 n = entering ? s.geometric_normal : -s.geometric_normal;
+        float cos_i = min(-dot(dir, n), 1.0);
+        bool schlick = params.fresnel != 0u;
+        if (m.optics.y > 0.0) {
+            through *= m.optics.x * (1.0 - thin_shell_reflectance(cos_i, m.transmission.w, schlick)) * m.transmission.rgb;
+        } else {
+            float eta = entering ? 1.0 / m.transmission.w : m.transmission.w;
+            float sin2_t = eta * eta * max(0.0, 1.0 - cos_i * cos_i);
+            if (sin2_t >= 1.0) {
+                return false;
+            }
+            through *= m.optics.x * (1.0 - fresnel_reflectance(cos_i, eta, schlick)) * (eta * eta) * m.transmission.rgb;
+            dir = normalize(eta * dir + (eta * cos_i - sqrt(1.0 - sin2_t)) * n);
+            medium = entering ? m.absorption.rgb : vec3(0.0);
+        }
+        origin = leave(s.position, -n);
+    }
+    return false;
+}
+#endif
 
 vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
     vec3 radiance = vec3(0.0);
@@ -122,12 +183,19 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
             break;
         }
 #ifdef SCENE_DIELECTRICS
-        if (m.transmission.w > 0.0) {
+        // Glass covers the share optics.x of the surface; the rest is the
+        // opaque shading model below.
+        vec4 u_glass = rng_next(rng);
+        if (u_glass.x < m.optics.x) {
             vec3 n_out = dot(s.normal, s.geometric_normal) < 0.0 ? -s.normal : s.normal;
             vec3 weight;
             bool refracted;
-            vec3 next = dielectric_scatter(dir, n_out, m.transmission.w, m.reflection.rgb, m.transmission.rgb,
-                rng_next(rng).x, weight, refracted);
+            bool schlick = params.fresnel != 0u;
+            vec3 next = m.optics.y > 0.0
+                ? thin_scatter(dir, n_out, m.transmission.w, m.reflection.rgb, m.transmission.rgb, u_glass.y,
+                    schlick, weight, refracted)
+                : dielectric_scatter(dir, n_out, m.transmission.w, m.reflection.rgb, m.transmission.rgb, u_glass.y,
+                    schlick, weight, refracted);
             // A refracted ray keeps going the way it went through the surface's
             // plane; a reflected one turns back. Where the shading normal (or
             // rounding, for refraction grazing the surface) sends the ray to
@@ -135,9 +203,10 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
             if (refracted != (dot(dir, s.geometric_normal) * dot(next, s.geometric_normal) > 0.0)) {
                 next = reflect(dir, s.geometric_normal);
                 weight = m.reflection.rgb;
+                refracted = false;
             }
             vec3 side = dot(next, s.geometric_normal) > 0.0 ? s.geometric_normal : -s.geometric_normal;
-            if (refracted) {
+            if (refracted && m.optics.y == 0.0) {
                 bool entering = dot(dir, s.geometric_normal) < 0.0;
                 medium = entering ? m.absorption.rgb : vec3(0.0);
             }
@@ -167,6 +236,14 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
                     float w = mis ? power_heuristic(ls.pdf, pdf) : 1.0;
                     radiance += throughput * f * ls.value * w;
                 }
+#ifdef SCENE_DIELECTRICS
+                else if (params.nee_through_glass != 0u && ls.pdf > 0.0 && any(greaterThan(f, vec3(0.0)))) {
+                    vec3 through;
+                    if (bent_shadow_ray(from, ls.direction, through)) {
+                        radiance += throughput * f * ls.value * through;
+                    }
+                }
+#endif
             }
         }
         vec4 u = rng_next(rng);

@@ -1,7 +1,7 @@
 //! Scene features a graph's `enabled_if` conditions test: what the scene has,
 //! so passes for things it lacks (spot lights, shadow casters) are culled.
 
-use crate::materials::{dielectric, is_mirror, matches};
+use crate::materials::{coat, dielectric, is_mirror, matches};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::material::ShadingModel;
 use weft_scene::{Light, Scene};
@@ -12,8 +12,9 @@ use weft_scene::{Light, Scene};
 /// there are area lights, `punctual_lights` when there is a sun, point or spot
 /// light; and by the shading models placed meshes use (so shaders compile only
 /// the models a scene has): `glossy` for a Blinn-Phong material with a
-/// specular lobe (Ks and Ns above 0), `mirrors` for MTL `illum` 3 or 5,
-/// `dielectrics` for MTL `illum` 4, 6 or 7 (glass),
+/// specular lobe (Ks and Ns above 0), `mirrors` for MTL `illum` 3,
+/// `coated` for MTL `illum` 5 (a Fresnel coat over Lambert), `dielectrics`
+/// for glass (MTL `illum` 4, 6 or 7, the dissolve rule, glTF transmission),
 /// `metallic_roughness` for glTF materials; `textures` when a placed mesh has a
 /// base colour, metallic-roughness or normal texture.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
@@ -60,6 +61,7 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     if placed().any(|m| {
         m.shading == ShadingModel::BlinnPhong
             && !is_mirror(&m)
+            && coat(&m).is_none()
             && m.specular.max_element() > 0.0
             && m.shininess > 0.0
     }) {
@@ -70,6 +72,9 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     }
     if placed().any(|m| is_mirror(&m)) {
         features.push("mirrors".to_string());
+    }
+    if placed().any(|m| coat(&m).is_some()) {
+        features.push("coated".to_string());
     }
     if placed().any(|m| m.shading == ShadingModel::MetallicRoughness) {
         features.push("metallic_roughness".to_string());

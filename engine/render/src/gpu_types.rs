@@ -62,10 +62,14 @@ pub struct GpuMaterial {
     /// For the path tracer's smooth dielectrics: the transmission tint (MTL
     /// `Tf`), and the index of refraction in w; w = 0 for other materials.
     pub transmission: Vec4,
-    /// The reflection tint of a dielectric (MTL `Ks`), 0.
+    /// The reflection tint of a dielectric (MTL `Ks`) or of a coat, 0.
     pub reflection: Vec4,
     /// A dielectric's Beer–Lambert coefficient σ per world unit, 0.
     pub absorption: Vec4,
+    /// How the path tracer meets the surface: the share that is glass, 1 for
+    /// a thin shell, and for a coated material (`SHADING_COATED`) the coat's
+    /// index and internal diffuse reflectance.
+    pub optics: Vec4,
 }
 
 /// The `Frame` uniform block.
@@ -117,7 +121,7 @@ const _: () = {
     assert!(size_of::<GpuVertex>() == 32);
     assert!(size_of::<GpuDraw>() == 144);
     assert!(size_of::<GpuLight>() == 64);
-    assert!(size_of::<GpuMaterial>() == 112);
+    assert!(size_of::<GpuMaterial>() == 128);
     assert!(size_of::<GpuFrame>() == 2 * 64 + 4 * 16);
     assert!(size_of::<GpuShadowsHeader>() == 48);
     assert!(size_of::<GpuShadowView>() == 160);

@@ -25,6 +25,7 @@ pub mod graph_check;
 pub mod light_scene;
 pub mod lights;
 pub mod materials;
+pub mod optics;
 pub mod pipelines;
 pub mod prepare;
 pub mod providers;

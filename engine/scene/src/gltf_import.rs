@@ -9,7 +9,7 @@ use crate::light::{
     derive_radius, Attenuation, Light, PointLight, RadiusSource, SpotLight, SunLight,
     DEFAULT_LUMINANCE_THRESHOLD,
 };
-use crate::material::{AlphaMode, Material, ShadingModel, TextureRef, TextureSource};
+use crate::material::{AlphaMode, Material, Optics, ShadingModel, TextureRef, TextureSource};
 use crate::mesh::{compute_normals, Mesh};
 use crate::model::Model;
 use crate::source::{read_capped, MAX_MODEL_BYTES};
@@ -370,8 +370,27 @@ fn material(m: &gltf::Material<'_>, images: &[Option<TextureSource>]) -> Materia
         let d = v.attenuation_distance();
         out.attenuation_distance = (d.is_finite() && d > 0.0).then_some(d);
         out.attenuation_color = Vec3::from_array(v.attenuation_color());
+        out.absorption = absorption(out.attenuation_color, out.attenuation_distance);
+    }
+    if out.transmission > 0.0 {
+        out.optics = Optics::Dielectric {
+            fraction: out.transmission.min(1.0),
+            thin: out.thickness <= 0.0,
+        };
     }
     out
+}
+
+/// KHR_materials_volume's Beer–Lambert coefficient σ = −ln(c) / d per world
+/// unit: light that travels `attenuation_distance` d keeps the fraction
+/// `attenuation_color` c. A channel of 0 is taken as 1e-6 (σ finite); no
+/// distance means no absorption.
+fn absorption(color: Vec3, distance: Option<f32>) -> Vec3 {
+    let Some(d) = distance else {
+        return Vec3::ZERO;
+    };
+    let c = color.clamp(Vec3::splat(1e-6), Vec3::ONE);
+    Vec3::new(-c.x.ln(), -c.y.ln(), -c.z.ln()) / d
 }
 
 /// A KHR_lights_punctual light placed by its node (lights shine down the node's -Z).

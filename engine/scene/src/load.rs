@@ -8,6 +8,7 @@ use crate::desc::{read_scene_desc, Placement, SceneDesc};
 use crate::error::{Diagnostics, Location, SceneError};
 use crate::guard::without_panics;
 use crate::light::Light;
+use crate::material::Optics;
 use crate::model::Model;
 use crate::obj::load_obj;
 use crate::scene::{Instance, Scene};
@@ -38,6 +39,8 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
                 at: Location::file(path),
                 transform: Mat4::IDENTITY,
                 absorption: None,
+                ior: None,
+                thin: None,
             }],
             ..SceneDesc::default()
         }
@@ -100,29 +103,39 @@ fn build(
     diag: &mut Diagnostics,
 ) -> Result<Scene, SceneError> {
     let mut models: Vec<Model> = Vec::new();
-    let mut by_file: HashMap<PathBuf, usize> = HashMap::new();
+    // A file is loaded once per distinct set of material overrides.
+    let mut by_file: HashMap<(PathBuf, [u32; 5]), usize> = HashMap::new();
     let mut instances = Vec::new();
     let mut lights = desc.lights;
     let mut cameras = desc.cameras;
     for placement in &desc.models {
-        let key = placement
+        let path = placement
             .file
             .canonicalize()
             .unwrap_or_else(|_| placement.file.clone());
+        let sigma = placement
+            .absorption
+            .map_or([u32::MAX; 3], |s| s.to_array().map(f32::to_bits));
+        let key = (
+            path,
+            [
+                sigma[0],
+                sigma[1],
+                sigma[2],
+                placement.ior.map_or(u32::MAX, f32::to_bits),
+                placement.thin.map_or(2, u32::from),
+            ],
+        );
         let index = match by_file.get(&key) {
             Some(&i) => i,
             None => {
-                let model = load_model(&placement.file, &placement.at, options, diag)?;
+                let mut model = load_model(&placement.file, &placement.at, options, diag)?;
+                override_glass(&mut model, placement);
                 models.push(model);
                 by_file.insert(key, models.len() - 1);
                 models.len() - 1
             }
         };
-        if let Some(sigma) = placement.absorption {
-            for material in &mut models[index].materials {
-                material.absorption = sigma;
-            }
-        }
         let model = &models[index];
         let m = placement.transform;
         lights.extend(model.lights.iter().map(|l| transform_light(l, &m)));
@@ -162,6 +175,26 @@ fn build(
 }
 
 /// Replaces unbounded point-light radii (no falloff) by the scene's diagonal, with a warning.
+/// Applies a `model` block's `absorption`, `ior` and `thin` to the model's
+/// glass (dielectric) materials.
+fn override_glass(model: &mut Model, placement: &Placement) {
+    for material in &mut model.materials {
+        let Optics::Dielectric { fraction, thin } = material.optics else {
+            continue;
+        };
+        material.optics = Optics::Dielectric {
+            fraction,
+            thin: placement.thin.unwrap_or(thin),
+        };
+        if let Some(sigma) = placement.absorption {
+            material.absorption = sigma;
+        }
+        if let Some(ior) = placement.ior {
+            material.ior = ior;
+        }
+    }
+}
+
 fn bound_radii(lights: &mut [Light], bounds: &Aabb, path: &Path, diag: &mut Diagnostics) {
     let extent = bounds.diagonal().max(1.0);
     let mut count = 0;

@@ -15,6 +15,31 @@ pub enum ShadingModel {
     MetallicRoughness,
 }
 
+/// How light leaves or passes a surface in the path tracer, as the importer
+/// read the file (docs: `scenes/FORMAT.md`, "Materials in the path tracer").
+/// Raster graphs shade every kind by its [`ShadingModel`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub enum Optics {
+    /// The shading model's BSDF.
+    #[default]
+    Opaque,
+    /// A perfect mirror reflecting `Ks` over a Lambert `Kd` (MTL `illum 3`).
+    Mirror,
+    /// A Lambert `Kd` base under a smooth dielectric coat whose reflectance at
+    /// normal incidence is `Ks` (MTL `illum 5`, "Fresnel on").
+    Coated,
+    /// A smooth dielectric of index `ior` over `fraction` of the surface (the
+    /// rest is opaque): MTL glass, glTF transmission.
+    Dielectric {
+        /// The share of the surface that is glass: 1 for MTL `illum 4/6/7`,
+        /// `1 - d` for the dissolve rule, glTF's transmission factor.
+        fraction: f32,
+        /// A thin shell: refracts in and straight back out (glTF transmission
+        /// without a volume, or with thickness 0).
+        thin: bool,
+    },
+}
+
 /// How alpha is used, as glTF defines it (MTL dissolve < 1 maps to `Blend`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum AlphaMode {
@@ -137,6 +162,8 @@ pub struct Material {
     pub absorption: Vec3,
     /// MTL `illum` model, when given.
     pub illum: Option<u8>,
+    /// What the path tracer does at the surface.
+    pub optics: Optics,
     /// glTF metallic factor (0 for MTL).
     pub metallic: f32,
     /// glTF roughness factor (for MTL, derived from `Ns` as `sqrt(2 / (Ns + 2))`).
@@ -174,6 +201,7 @@ impl Default for Material {
             transmission_filter: Vec3::ONE,
             absorption: Vec3::ZERO,
             illum: None,
+            optics: Optics::Opaque,
             metallic: 0.0,
             roughness: 1.0,
             transmission: 0.0,

@@ -2,7 +2,7 @@
 //! paths resolved (backslashes included) against the MTL file's folder.
 
 use crate::error::{Diagnostics, Location};
-use crate::material::{AlphaMode, Material, ShadingModel, TextureRef};
+use crate::material::{AlphaMode, Material, Optics, ShadingModel, TextureRef};
 use glam::{Vec3, Vec4};
 use std::path::{Path, PathBuf};
 
@@ -181,6 +181,7 @@ pub(crate) fn convert(
         .unwrap_or(0.0)
         .max(0.0);
     let kd = color(m.diffuse, Vec3::splat(0.8));
+    let ni = m.optical_density.filter(|n| n.is_finite() && *n > 0.0);
     let mut out = Material {
         name: name.to_string(),
         shading: ShadingModel::BlinnPhong,
@@ -189,10 +190,7 @@ pub(crate) fn convert(
         specular: color(m.specular, Vec3::ZERO),
         shininess,
         emissive: color(m.emissive, Vec3::ZERO),
-        ior: m
-            .optical_density
-            .filter(|n| n.is_finite() && *n > 0.0)
-            .unwrap_or(1.5),
+        ior: ni.unwrap_or(1.5),
         illum: m.illumination_model,
         roughness: (2.0 / (shininess + 2.0)).sqrt(),
         alpha_mode: if opacity < 1.0 {
@@ -215,6 +213,9 @@ pub(crate) fn convert(
         }
         .clamp(Vec3::ZERO, Vec3::ONE);
     }
+    out.optics = optics(&out, ni, &mut |message| {
+        diag.warn(Location::file(mtl), format!("material '{name}': {message}"))
+    });
     out.textures.base_color = texture(dir, m.diffuse_texture.as_ref(), name, mtl, diag, sources);
     out.textures.specular = texture(dir, m.specular_texture.as_ref(), name, mtl, diag, sources);
     out.textures.opacity = texture(dir, m.dissolve_texture.as_ref(), name, mtl, diag, sources);
@@ -232,9 +233,124 @@ pub(crate) fn convert(
     out
 }
 
+/// What the path tracer does at an MTL material's surface (`ni`: the `Ni` the
+/// file gives), calling `warn` on combinations that could mean two things.
+/// `illum 3` is a mirror, `illum 5` a coated diffuse, `illum 4/6/7` glass;
+/// any other material with `d < 1` (or `Tr > 0`) and an `Ni` other than 1 is
+/// glass over `1 - d` of its surface.
+fn optics(out: &Material, ni: Option<f32>, warn: &mut dyn FnMut(String)) -> Optics {
+    let opacity = out.base_color.w;
+    match out.illum {
+        Some(3) => Optics::Mirror,
+        Some(5) => Optics::Coated,
+        Some(illum @ (4 | 6 | 7)) => {
+            match ni {
+                None => warn(format!(
+                    "glass (illum {illum}) without 'Ni'; index 1.5 assumed"
+                )),
+                Some(1.0) => warn(format!(
+                    "glass (illum {illum}) with 'Ni 1' bends no light and reflects none: invisible in the path tracer"
+                )),
+                Some(_) => {}
+            }
+            if opacity < 1.0 {
+                warn(format!(
+                    "glass (illum {illum}) with opacity {opacity} ('d'/'Tr'): raster graphs blend it, the path tracer ignores 'd' for glass"
+                ));
+            }
+            if out.transmission_filter == Vec3::ZERO {
+                warn(format!(
+                    "glass (illum {illum}) with 'Tf 0 0 0' lets no light through"
+                ));
+            }
+            Optics::Dielectric {
+                fraction: 1.0,
+                thin: false,
+            }
+        }
+        _ => match ni {
+            Some(n) if opacity < 1.0 && n != 1.0 => {
+                warn(format!(
+                    "opacity {opacity} ('d'/'Tr') with 'Ni {n}' is read as glass over {:.0}% of the surface in the path tracer, while raster graphs blend it; give 'illum 7' to mean glass or 'Ni 1' to mean coverage only",
+                    (1.0 - opacity) * 100.0
+                ));
+                Optics::Dielectric {
+                    fraction: 1.0 - opacity,
+                    thin: false,
+                }
+            }
+            _ => Optics::Opaque,
+        },
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The optics of a material with `illum`, opacity `d`, `Ni` and `Tf`, and the warnings.
+    fn optics_of(illum: Option<u8>, d: f32, ni: Option<f32>, tf: f32) -> (Optics, Vec<String>) {
+        let m = Material {
+            illum,
+            base_color: Vec4::new(0.5, 0.5, 0.5, d),
+            transmission_filter: Vec3::splat(tf),
+            ..Material::default()
+        };
+        let mut warnings = Vec::new();
+        let o = optics(&m, ni, &mut |w| warnings.push(w));
+        (o, warnings)
+    }
+
+    #[test]
+    fn illum_and_dissolve_choose_the_optics() {
+        let glass = |fraction| Optics::Dielectric {
+            fraction,
+            thin: false,
+        };
+        assert_eq!(optics_of(Some(3), 1.0, None, 1.0), (Optics::Mirror, vec![]));
+        assert_eq!(optics_of(Some(5), 1.0, None, 1.0), (Optics::Coated, vec![]));
+        assert_eq!(
+            optics_of(Some(2), 1.0, Some(1.5), 1.0),
+            (Optics::Opaque, vec![])
+        );
+        for illum in [4, 6, 7] {
+            assert_eq!(
+                optics_of(Some(illum), 1.0, Some(1.5), 1.0),
+                (glass(1.0), vec![])
+            );
+        }
+        assert_eq!(
+            optics_of(Some(2), 0.25, Some(1.0), 1.0),
+            (Optics::Opaque, vec![])
+        );
+        assert_eq!(optics_of(None, 0.5, None, 1.0), (Optics::Opaque, vec![]));
+        let (o, w) = optics_of(Some(2), 0.25, Some(1.45), 1.0);
+        assert_eq!(o, glass(0.75));
+        assert_eq!(
+            w,
+            ["opacity 0.25 ('d'/'Tr') with 'Ni 1.45' is read as glass over 75% of the surface in the path tracer, while raster graphs blend it; give 'illum 7' to mean glass or 'Ni 1' to mean coverage only"]
+        );
+    }
+
+    #[test]
+    fn ambiguous_glass_warns() {
+        let warnings = |illum, d, ni, tf| optics_of(Some(illum), d, ni, tf).1;
+        assert_eq!(
+            warnings(7, 1.0, None, 1.0),
+            ["glass (illum 7) without 'Ni'; index 1.5 assumed"]
+        );
+        assert_eq!(
+            warnings(4, 1.0, Some(1.0), 1.0),
+            ["glass (illum 4) with 'Ni 1' bends no light and reflects none: invisible in the path tracer"]
+        );
+        assert_eq!(
+            warnings(6, 0.5, Some(1.5), 0.0),
+            [
+                "glass (illum 6) with opacity 0.5 ('d'/'Tr'): raster graphs blend it, the path tracer ignores 'd' for glass",
+                "glass (illum 6) with 'Tf 0 0 0' lets no light through",
+            ]
+        );
+    }
 
     #[test]
     fn short_colour_statements() {

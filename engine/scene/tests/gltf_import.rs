@@ -6,7 +6,7 @@ mod common;
 use common::asset;
 use glam::{Vec3, Vec4};
 use weft_scene::camera::CameraOrigin;
-use weft_scene::material::{AlphaMode, ShadingModel, TextureSource};
+use weft_scene::material::{AlphaMode, Optics, ShadingModel, TextureSource};
 use weft_scene::{load_scene, Light};
 
 #[test]
@@ -89,6 +89,32 @@ fn transmission_and_volume_extensions() {
         (1.0, 1.0, Some(4.0))
     );
     assert_eq!(m.attenuation_color, Vec3::new(0.1, 0.5, 0.9));
+    // σ = -ln(c) / d: over 4 units the volume keeps (0.1, 0.5, 0.9).
+    let kept = (-m.absorption * 4.0).exp();
+    assert!(
+        (kept - Vec3::new(0.1, 0.5, 0.9)).abs().max_element() < 1e-6,
+        "{kept}"
+    );
+    let solid = Optics::Dielectric {
+        fraction: 1.0,
+        thin: false,
+    };
+    assert_eq!(m.optics, solid);
+    // Without KHR_materials_volume a transmissive material is thin-walled.
+    let sample = mats
+        .iter()
+        .find(|m| m.name == "R1_Sample_1.0")
+        .expect("material");
+    assert_eq!(
+        (sample.optics, sample.absorption),
+        (
+            Optics::Dielectric {
+                fraction: 1.0,
+                thin: true
+            },
+            Vec3::ZERO
+        )
+    );
     let t = mats
         .iter()
         .find(|m| m.name == "R3_ThicknessTex_Mat")
@@ -100,8 +126,8 @@ fn transmission_and_volume_extensions() {
         .find(|m| m.name == "LabelMaterial")
         .expect("material");
     assert_eq!(
-        (plain.transmission, plain.attenuation_distance),
-        (0.0, None)
+        (plain.transmission, plain.attenuation_distance, plain.optics),
+        (0.0, None, Optics::Opaque)
     );
 
     let scene = load_scene(&asset("gltf/rise/TransmissionTest.glb")).expect("loads");

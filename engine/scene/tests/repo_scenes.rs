@@ -29,6 +29,7 @@ fn every_example_scene_loads_without_warnings() {
             "animation.scene",
             "area_lights.scene",
             "cameras.scene",
+            "caustics.scene",
             "cornell.scene",
             "demo.scene",
             "flight_helmet.scene",

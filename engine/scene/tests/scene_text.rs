@@ -264,3 +264,23 @@ fn model_absorption_is_one_or_three_numbers_of_at_least_zero() {
         "t.scene:4: 'absorption' expects 1 or 3 finite numbers of at least 0 (per world unit)"
     );
 }
+
+#[test]
+fn model_ior_and_thin_override_the_glass() {
+    let (d, warnings) = desc("model\n{\n file \"glass.obj\"\n ior 1.33\n thin 1\n}\n");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(
+        (d.models[0].ior, d.models[0].thin),
+        (Some(1.33), Some(true))
+    );
+    let (d, _) = desc("model\n{\n file \"glass.obj\"\n thin 0\n}\n");
+    assert_eq!((d.models[0].ior, d.models[0].thin), (None, Some(false)));
+    assert_eq!(
+        error("model\n{\n file \"glass.obj\"\n ior 0.5\n}\n"),
+        "t.scene:4: 'ior' must be a finite index of refraction of at least 1, found 0.5"
+    );
+    assert_eq!(
+        error("model\n{\n file \"glass.obj\"\n\n thin 2\n}\n"),
+        "t.scene:5: 'thin' must be 0 or 1, found 2"
+    );
+}

@@ -34,6 +34,12 @@ pub struct Placement {
     /// `absorption r g b`: the Beer–Lambert coefficient σ (per world unit)
     /// inside the model's dielectric (glass) materials.
     pub absorption: Option<Vec3>,
+    /// `ior n`: the index of refraction of the model's dielectric (glass)
+    /// materials, replacing the file's.
+    pub ior: Option<f32>,
+    /// `thin 1`: the model's glass is a thin shell (light goes straight
+    /// through); `thin 0`: solid.
+    pub thin: Option<bool>,
 }
 
 /// Everything a `.scene` file (with its includes) declares, before models are loaded.
@@ -249,6 +255,14 @@ fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placeme
         },
         None => None,
     };
+    let ior = props.f32_where(
+        "ior",
+        |n| n.is_finite() && n >= 1.0,
+        "a finite index of refraction of at least 1",
+    )?;
+    let thin = props
+        .f32_where("thin", |v| v == 0.0 || v == 1.0, "0 or 1")?
+        .map(|v| v == 1.0);
     let Some((name, line)) = file else {
         diag.warn(props.block_at(), "model without a 'file'; skipped");
         return Ok(None);
@@ -258,6 +272,8 @@ fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placeme
         at: Location::line(props.file(), line),
         transform: Mat4::from_scale_rotation_translation(scale, rot, position),
         absorption,
+        ior,
+        thin,
     }))
 }
 
