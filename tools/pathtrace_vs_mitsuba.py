@@ -135,8 +135,11 @@ def mitsuba_ball(ball):
     else:
         shape["bsdf"] = {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}
     if ball == "absorbing":
-        shape["interior"] = {"type": "homogeneous", "albedo": 0.0,
-                             "sigma_t": {"type": "rgb", "value": ABSORPTION}}
+        # Mitsuba reads an RGB sigma_t as a reflectance (each channel at most 1): give it
+        # sigma / max(sigma) and the medium's scale max(sigma).
+        peak = max(ABSORPTION)
+        shape["interior"] = {"type": "homogeneous", "albedo": 0.0, "scale": peak,
+                             "sigma_t": {"type": "rgb", "value": [a / peak for a in ABSORPTION]}}
     return shape
 
 
@@ -175,6 +178,14 @@ def rgb(path):
     """An EXR's linear RGB channels (weft writes RGBA)."""
     bitmap = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
     return mi.TensorXf(bitmap)
+
+
+def write_png(exr):
+    """An sRGB PNG beside a linear EXR, for the docs."""
+    png = os.path.splitext(exr)[0] + ".png"
+    bitmap = mi.Bitmap(exr).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.UInt8, srgb_gamma=True)
+    bitmap.write(png)
+    return png
 
 
 def rel_mse(a, b):
@@ -229,6 +240,7 @@ def main():
     print(f"| weft pathtrace.ron | {weft['device']} | {run['samples_per_second']:,.0f} | "
           f"{run['rel_mse']:.4e} | {', '.join(f'{v:.4f}' for v in mean(weft_path))} |")
     print(f"\nrelative MSE between the two {args.spp}-spp images: {between:.4e}")
+    print("images:", ", ".join(write_png(p) for p in (mitsuba_path, weft_path, reference_path)))
     print(f"reference image mean: {', '.join(f'{v:.4f}' for v in mean(reference_path))}")
 
 
