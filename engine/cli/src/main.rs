@@ -1,8 +1,10 @@
 //! The `weft` command.
 
+mod compare_cmd;
 mod graph_cmd;
 mod render_cmd;
 mod scene_cmd;
+mod sweep_cmd;
 mod view;
 mod watch_cmd;
 
@@ -27,6 +29,12 @@ enum Command {
     Scene(scene_cmd::SceneCommand),
     /// Render a scene through a graph to an image.
     Render(render_cmd::RenderArgs),
+    /// Configurations of a scene against a path-traced (or given) reference:
+    /// FLIP, RMSE, PSNR beside time and memory.
+    Compare(compare_cmd::CompareArgs),
+    /// One graph over every combination of parameter values and feature sets
+    /// against one reference: CSV, Pareto plot and frontier table.
+    Sweep(sweep_cmd::SweepArgs),
     /// Benchmarks that write figures and plots (into docs/ by default).
     #[command(subcommand)]
     Bench(weft_bench::BenchCommand),
@@ -52,6 +60,8 @@ fn main() -> ExitCode {
         Command::Graph(cmd) => graph_cmd::run(cmd),
         Command::Scene(cmd) => scene_cmd::run(cmd),
         Command::Render(args) => render_cmd::run(args),
+        Command::Compare(args) => compare_cmd::run(args),
+        Command::Sweep(args) => sweep_cmd::run(args),
         Command::Bench(cmd) => weft_bench::run(cmd),
         Command::View(args) => view::run(args),
     };

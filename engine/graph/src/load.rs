@@ -249,6 +249,13 @@ fn load_file(
             graph.default_features.push(feature.clone());
         }
     }
+    // At the root, `fragment.name` overrides (`--param shadows.resolution=1024`)
+    // reach the parameter `name` of the include whose file stem is `fragment`.
+    let (overrides, mut qualified) = if site.is_none() {
+        split_qualified(graph, source, &parsed.include, overrides)
+    } else {
+        (overrides, BTreeMap::new())
+    };
     let params = resolve_params(graph, source, &parsed.params, overrides, site.as_ref());
     graph.sources[source].params = params;
 
@@ -283,6 +290,9 @@ fn load_file(
                 }
             }
         }
+        if let Some(given) = qualified.remove(&include_stem(Path::new(&include.file))) {
+            child_overrides.extend(given);
+        }
         load_file(
             graph,
             read,
@@ -308,6 +318,58 @@ fn load_file(
             index,
         });
     }
+}
+
+/// The name a fragment's parameters are qualified with: its file stem.
+fn include_stem(file: &Path) -> String {
+    file.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Splits the root's overrides into its own and, by include file stem, those
+/// qualified as `fragment.name`; a qualifier that names no include is an error
+/// with the nearest include's name.
+#[allow(clippy::type_complexity)]
+fn split_qualified(
+    graph: &mut LoadedGraph,
+    source: usize,
+    includes: &[crate::schema::Include],
+    overrides: BTreeMap<String, ParamValue>,
+) -> (
+    BTreeMap<String, ParamValue>,
+    BTreeMap<String, BTreeMap<String, ParamValue>>,
+) {
+    let stems: Vec<String> = includes
+        .iter()
+        .map(|i| include_stem(Path::new(&i.file)))
+        .collect();
+    let mut own = BTreeMap::new();
+    let mut qualified: BTreeMap<String, BTreeMap<String, ParamValue>> = BTreeMap::new();
+    for (name, value) in overrides {
+        let Some((fragment, param)) = name.split_once('.') else {
+            own.insert(name, value);
+            continue;
+        };
+        if stems.iter().any(|s| s == fragment) {
+            qualified
+                .entry(fragment.to_string())
+                .or_default()
+                .insert(param.to_string(), value);
+        } else {
+            let (file, pos) = graph.locate(source, &[Seg::Field("include")]);
+            let graph_file = file_name(&graph.sources[source].file);
+            graph.diagnostics.push(
+                Diagnostic::error(
+                    file,
+                    pos,
+                    format!("parameter \"{name}\": \"{graph_file}\" includes no fragment \"{fragment}\""),
+                )
+                .suggest(fragment, stems.iter().map(String::as_str)),
+            );
+        }
+    }
+    (own, qualified)
 }
 
 /// Applies include-site overrides to a file's declared parameters and resolves

@@ -258,3 +258,56 @@ fn top_level_parameters_can_be_set_when_loading() {
     );
     assert!(errors[0].file.ends_with("forward.ron"));
 }
+
+/// `fragment.name` reaches a parameter of the include whose file stem is
+/// `fragment` (`--param shadows.pcf_radius=3`); a qualifier naming no
+/// include, or a name the fragment lacks, is an error with the nearest name.
+#[test]
+fn fragment_parameters_are_set_by_qualified_names() {
+    use std::collections::BTreeMap;
+    use weft_graph::schema::ParamValue;
+    let path = repo_root().join("graphs/forward.ron");
+    let set =
+        |name: &str, value: f64| BTreeMap::from([(name.to_string(), ParamValue::Number(value))]);
+    let graph = weft_graph::load_with_params(&path, set("bloom.threshold", 4.0));
+    assert!(
+        graph.diagnostics.iter().all(|d| !d.is_error()),
+        "{:?}",
+        graph.diagnostics
+    );
+    let options = CompileOptions {
+        features: graph.features(&["bloom"]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let bright = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "bloom_bright")
+        .expect("bloom_bright pass");
+    assert_eq!(bright.params["threshold"], ParamValue::Number(4.0));
+
+    let errors = |name: &str| {
+        weft_graph::load_with_params(&path, set(name, 1.0))
+            .diagnostics
+            .into_iter()
+            .filter(|d| d.is_error())
+            .map(|d| (d.message, d.hint))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        errors("blom.threshold"),
+        [(
+            "parameter \"blom.threshold\": \"forward.ron\" includes no fragment \"blom\""
+                .to_string(),
+            Some("did you mean \"bloom\"?".to_string())
+        )]
+    );
+    assert_eq!(
+        errors("shadows.pcf_radus"),
+        [(
+            "unknown parameter \"pcf_radus\" for \"shadows.ron\"".to_string(),
+            Some("did you mean \"pcf_radius\"?".to_string())
+        )]
+    );
+}

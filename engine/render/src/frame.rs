@@ -96,6 +96,9 @@ pub struct Rendered {
     pub warnings: Vec<String>,
     /// Samples per pixel the output holds, for a progressive graph.
     pub samples: Option<u64>,
+    /// Per-pass times of every frame (empty lists when timing is off), so
+    /// callers can take medians over frames.
+    pub timings: Vec<Vec<weft_gpu::PassTiming>>,
 }
 
 /// Where a render stands after a frame, for progress displays.
@@ -204,6 +207,7 @@ pub fn render_with_progress(
     let mut frames = FrameLoop::new(gpu, Arc::clone(&plan), uploaded)?;
     let mut record_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut frame_ms = Vec::with_capacity(count.min(4096) as usize);
+    let mut timings = Vec::with_capacity(count.min(4096) as usize);
     let mut last = None;
     let start = std::time::Instant::now();
     for frame in 0..count {
@@ -223,6 +227,7 @@ pub fn render_with_progress(
         })?;
         frame_ms.push(started.elapsed().as_secs_f64() * 1e3);
         record_ms.push(report.record_ms);
+        timings.push(report.timings.clone());
         last = Some(report);
         progress(Progress {
             frames: frame + 1,
@@ -249,5 +254,6 @@ pub fn render_with_progress(
         frame_ms,
         warnings,
         samples,
+        timings,
     })
 }

@@ -1,0 +1,152 @@
+//! The two images compare works on: linear HDR RGB (EXR) and tonemapped
+//! 8-bit sRGB (PNG), with errors that say what was wrong with a file.
+
+use std::path::{Path, PathBuf};
+
+/// Why an image could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    /// The file could not be decoded.
+    #[error("{path}: {message}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// What the decoder said.
+        message: String,
+    },
+    /// The file could not be written.
+    #[error("writing {path}: {message}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// What the encoder said.
+        message: String,
+    },
+    /// Two images that must match in size do not.
+    #[error("{what}: {found_width}x{found_height}, but the reference is {width}x{height} (images are not resampled)")]
+    Size {
+        /// Which image.
+        what: String,
+        /// The reference's size.
+        width: u32,
+        /// The reference's size.
+        height: u32,
+        /// This image's size.
+        found_width: u32,
+        /// This image's size.
+        found_height: u32,
+    },
+}
+
+/// Linear RGB floats, row by row from the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// One RGB triple per pixel.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+/// 8-bit sRGB, row by row from the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SrgbImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// R, G, B bytes per pixel.
+    pub bytes: Vec<u8>,
+}
+
+impl LinearImage {
+    /// Reads an OpenEXR file's RGB channels (alpha, if any, is dropped).
+    pub fn read_exr(path: &Path) -> Result<Self, ImageError> {
+        let read = |message: String| ImageError::Read {
+            path: path.to_path_buf(),
+            message,
+        };
+        let decoded = image::ImageReader::open(path)
+            .map_err(|e| read(e.to_string()))?
+            .with_guessed_format()
+            .map_err(|e| read(e.to_string()))?;
+        if decoded.format() != Some(image::ImageFormat::OpenExr) {
+            return Err(read("not an OpenEXR file".into()));
+        }
+        let rgb = decoded
+            .decode()
+            .map_err(|e| read(format!("not a readable RGB(A) EXR: {e}")))?
+            .into_rgb32f();
+        Ok(Self {
+            width: rgb.width(),
+            height: rgb.height(),
+            pixels: rgb.pixels().map(|p| p.0).collect(),
+        })
+    }
+
+    /// Writes the image as an RGB OpenEXR file.
+    pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
+        let flat: Vec<f32> = self.pixels.iter().flatten().copied().collect();
+        image::Rgb32FImage::from_raw(self.width, self.height, flat)
+            .ok_or_else(|| ImageError::Write {
+                path: path.to_path_buf(),
+                message: "pixel count does not match the size".into(),
+            })?
+            .save_with_format(path, image::ImageFormat::OpenExr)
+            .map_err(|e| ImageError::Write {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            })
+    }
+
+    /// An error unless `other` has this image's size.
+    pub fn check_size(
+        &self,
+        other_width: u32,
+        other_height: u32,
+        what: &str,
+    ) -> Result<(), ImageError> {
+        if (self.width, self.height) == (other_width, other_height) {
+            return Ok(());
+        }
+        Err(ImageError::Size {
+            what: what.to_string(),
+            width: self.width,
+            height: self.height,
+            found_width: other_width,
+            found_height: other_height,
+        })
+    }
+}
+
+impl SrgbImage {
+    /// Writes the image as a PNG file.
+    pub fn write_png(&self, path: &Path) -> Result<(), ImageError> {
+        image::RgbImage::from_raw(self.width, self.height, self.bytes.clone())
+            .ok_or_else(|| ImageError::Write {
+                path: path.to_path_buf(),
+                message: "pixel count does not match the size".into(),
+            })?
+            .save_with_format(path, image::ImageFormat::Png)
+            .map_err(|e| ImageError::Write {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            })
+    }
+}
+
+/// The sRGB encoding of a linear value in [0, 1] (IEC 61966-2-1).
+pub fn linear_to_srgb(x: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// A value in [0, 1] as the nearest byte.
+pub fn to_byte(x: f32) -> u8 {
+    (x.clamp(0.0, 1.0) * 255.0).round() as u8
+}

@@ -1,0 +1,91 @@
+//! Pixel-wise error measures: RMSE and relative MSE on linear HDR (what a
+//! renderer's estimate is judged by), PSNR on the 8-bit tonemapped output
+//! (what a viewer sees).
+
+use crate::image_io::{LinearImage, SrgbImage};
+
+/// Root mean square difference over every pixel and channel.
+pub fn rmse(image: &LinearImage, reference: &LinearImage) -> f64 {
+    let sum: f64 = pairs(image, reference)
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum();
+    (sum / channels(reference)).sqrt()
+}
+
+/// Mean of (a − b)² / (b² + 0.01) over every pixel and channel: squared error
+/// relative to the reference's brightness, 0.01 keeping black pixels finite
+/// (the measure Mitsuba and most rendering papers report).
+pub fn rel_mse(image: &LinearImage, reference: &LinearImage) -> f64 {
+    let sum: f64 = pairs(image, reference)
+        .map(|(a, b)| (a - b) * (a - b) / (b * b + 0.01))
+        .sum();
+    sum / channels(reference)
+}
+
+/// Peak signal-to-noise ratio of 8-bit images in dB: 10 log10(255² / MSE);
+/// infinite for identical images.
+pub fn psnr(image: &SrgbImage, reference: &SrgbImage) -> f64 {
+    let mse = image
+        .bytes
+        .iter()
+        .zip(&reference.bytes)
+        .map(|(&a, &b)| {
+            let d = f64::from(a) - f64::from(b);
+            d * d
+        })
+        .sum::<f64>()
+        / reference.bytes.len().max(1) as f64;
+    10.0 * (255.0 * 255.0 / mse).log10()
+}
+
+fn pairs<'a>(
+    image: &'a LinearImage,
+    reference: &'a LinearImage,
+) -> impl Iterator<Item = (f64, f64)> + 'a {
+    image
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .flat_map(|(a, b)| (0..3).map(move |c| (f64::from(a[c]), f64::from(b[c]))))
+}
+
+fn channels(image: &LinearImage) -> f64 {
+    (image.pixels.len() * 3).max(1) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn linear(values: &[[f32; 3]]) -> LinearImage {
+        LinearImage {
+            width: values.len() as u32,
+            height: 1,
+            pixels: values.to_vec(),
+        }
+    }
+
+    #[test]
+    fn known_differences() {
+        let reference = linear(&[[1.0, 1.0, 1.0], [0.0, 0.0, 0.0]]);
+        let image = linear(&[[1.5, 1.0, 1.0], [0.0, 0.1, 0.0]]);
+        // squared errors 0.25 and 0.01 over 6 channels
+        assert!((rmse(&image, &reference) - (0.26f64 / 6.0).sqrt()).abs() < 1e-7);
+        let expected = (0.25 / 1.01 + 0.01 / 0.01) / 6.0;
+        assert!((rel_mse(&image, &reference) - expected).abs() < 1e-7);
+        assert_eq!(rmse(&reference, &reference), 0.0);
+        let a = SrgbImage {
+            width: 1,
+            height: 1,
+            bytes: vec![10, 20, 30],
+        };
+        let b = SrgbImage {
+            width: 1,
+            height: 1,
+            bytes: vec![10, 20, 33],
+        };
+        // MSE 3 over 3 channels = 3
+        assert!((psnr(&a, &b) - 10.0 * (65025.0f64 / 3.0).log10()).abs() < 1e-9);
+        assert!(psnr(&a, &a).is_infinite());
+    }
+}

@@ -1,0 +1,172 @@
+//! The Pareto frontier of (time, error) points — the settings no other setting
+//! beats on both — and its plot: error against time, every point, the
+//! frontier drawn through its points and labelled.
+
+use crate::image_io::ImageError;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// A measured setting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// What the setting was (`resolution=1024 radius=2`).
+    pub label: String,
+    /// Cost: milliseconds per frame.
+    pub time: f64,
+    /// Error against the reference.
+    pub error: f64,
+}
+
+/// Indices of the points on the frontier, by increasing time: each is
+/// strictly better than every faster point in error, and no point is at
+/// least as good in both with one strictly better. Points with a
+/// non-finite coordinate are never on it.
+pub fn frontier(points: &[Point]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..points.len())
+        .filter(|&i| points[i].time.is_finite() && points[i].error.is_finite())
+        .collect();
+    order.sort_by(|&a, &b| {
+        points[a]
+            .time
+            .total_cmp(&points[b].time)
+            .then(points[a].error.total_cmp(&points[b].error))
+    });
+    let mut best = f64::INFINITY;
+    let mut on = Vec::new();
+    for i in order {
+        if points[i].error < best {
+            best = points[i].error;
+            on.push(i);
+        }
+    }
+    on
+}
+
+/// Writes error against time, every point in grey, the frontier in red with
+/// its labels (axes padded by 10% of their span).
+pub fn write_plot(
+    points: &[Point],
+    title: &str,
+    error_name: &str,
+    path: &Path,
+) -> Result<(), ImageError> {
+    crate::report::ensure_font()?;
+    let fail = |e: &dyn std::fmt::Display| ImageError::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let usable: Vec<&Point> = points
+        .iter()
+        .filter(|p| p.time > 0.0 && p.error > 0.0 && p.time.is_finite() && p.error.is_finite())
+        .collect();
+    if usable.is_empty() {
+        return Err(fail(&"no point with a positive time and error to plot"));
+    }
+    let range = |f: &dyn Fn(&Point) -> f64| {
+        let lo = usable.iter().map(|p| f(p)).fold(f64::INFINITY, f64::min);
+        let hi = usable.iter().map(|p| f(p)).fold(0.0, f64::max);
+        let pad = if hi > lo { 0.1 * (hi - lo) } else { 0.1 * hi };
+        ((lo - pad).max(0.0), hi + pad)
+    };
+    let (t0, t1) = range(&|p| p.time);
+    let (e0, e1) = range(&|p| p.error);
+    let on = frontier(points);
+    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, (crate::report::FAMILY, 22))
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(t0..t1, e0..e1)
+        .map_err(|e| fail(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("frame time (ms)")
+        .y_desc(error_name)
+        .label_style((crate::report::FAMILY, 14))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    chart
+        .draw_series(
+            usable
+                .iter()
+                .map(|p| Circle::new((p.time, p.error), 4, RGBColor(150, 150, 150).filled())),
+        )
+        .map_err(|e| fail(&e))?
+        .label("dominated")
+        .legend(|(x, y)| Circle::new((x, y), 4, RGBColor(150, 150, 150).filled()));
+    let frontier_points: Vec<(f64, f64)> = on
+        .iter()
+        .map(|&i| (points[i].time, points[i].error))
+        .filter(|(t, e)| *t > 0.0 && *e > 0.0)
+        .collect();
+    chart
+        .draw_series(LineSeries::new(
+            frontier_points.clone(),
+            RED.stroke_width(2),
+        ))
+        .map_err(|e| fail(&e))?
+        .label("Pareto frontier")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+    chart
+        .draw_series(
+            frontier_points
+                .iter()
+                .map(|&(t, e)| Circle::new((t, e), 5, RED.filled())),
+        )
+        .map_err(|e| fail(&e))?;
+    chart
+        .draw_series(
+            on.iter()
+                .filter(|&&i| points[i].time > 0.0 && points[i].error > 0.0)
+                .map(|&i| {
+                    EmptyElement::at((points[i].time, points[i].error))
+                        + Text::new(
+                            points[i].label.clone(),
+                            (8, -16),
+                            (crate::report::FAMILY, 13).into_font().color(&BLACK),
+                        )
+                }),
+        )
+        .map_err(|e| fail(&e))?;
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.8))
+        .label_font((crate::report::FAMILY, 14))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    root.present().map_err(|e| fail(&e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(label: &str, time: f64, error: f64) -> Point {
+        Point {
+            label: label.into(),
+            time,
+            error,
+        }
+    }
+
+    #[test]
+    fn the_frontier_of_a_known_set() {
+        let points = [
+            p("a", 10.0, 0.5),
+            p("b", 20.0, 0.3),
+            p("c", 15.0, 0.6), // slower and worse than a
+            p("d", 30.0, 0.3), // ties b's error, slower
+            p("e", 40.0, 0.1),
+            p("f", 5.0, 0.9),
+            p("g", 10.0, 0.7), // ties a's time, worse
+            p("h", f64::NAN, 0.0),
+        ];
+        assert_eq!(frontier(&points), [5, 0, 1, 4]);
+        assert!(frontier(&[]).is_empty());
+        assert_eq!(frontier(&[p("x", 1.0, 1.0), p("y", 1.0, 1.0)]), [0]);
+    }
+}

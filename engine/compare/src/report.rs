@@ -1,0 +1,332 @@
+//! What `weft compare` writes: `report.json` (for scripts), `report.md` and
+//! the stdout table (for people), each FLIP error map with its legend, and a
+//! contact sheet of every image beside its error map.
+
+use crate::flip::FlipResult;
+use crate::image_io::{ImageError, SrgbImage};
+use plotters::prelude::*;
+use plotters::style::{register_font, FontStyle};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// The reference every configuration is measured against.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReferenceInfo {
+    /// The graph that rendered it, or `None` for a given image.
+    pub graph: Option<PathBuf>,
+    /// Its samples per pixel, when rendered.
+    pub spp: Option<u64>,
+    /// Its seed, when rendered.
+    pub seed: Option<u32>,
+    /// Whether it came from the reference cache.
+    pub cached: bool,
+    /// The linear image (the cache entry or the given file).
+    pub image: PathBuf,
+    /// Seconds it took to render (0 when cached or given).
+    pub seconds: f64,
+}
+
+/// One pass's time.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PassTime {
+    /// The pass.
+    pub name: String,
+    /// Median milliseconds over the measured frames.
+    pub ms: f64,
+    /// How it was measured: `gpu` timestamps, or `cpu` wall time of the pass
+    /// submitted alone (where timestamps are meaningless, e.g. compute on
+    /// lavapipe).
+    pub timer: String,
+}
+
+/// One configuration's measurements.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Configuration {
+    /// A short name: the graph's file stem, with a number when repeated.
+    pub name: String,
+    /// The graph file.
+    pub graph: PathBuf,
+    /// The scene features the plan ran with.
+    pub features: Vec<String>,
+    /// Parameters given on the command line.
+    pub params: BTreeMap<String, String>,
+    /// HDR-FLIP of the linear image against the reference.
+    pub flip: f64,
+    /// LDR-FLIP of the tonemapped output against the tonemapped reference.
+    pub flip_ldr: f64,
+    /// RMSE in linear HDR.
+    pub rmse: f64,
+    /// Relative MSE in linear HDR.
+    pub rel_mse: f64,
+    /// PSNR of the tonemapped output in dB.
+    pub psnr: f64,
+    /// Median wall milliseconds per frame after warm-up.
+    pub frame_ms: f64,
+    /// Per-pass times.
+    pub passes: Vec<PassTime>,
+    /// Bytes of transient (graph) images and buffers.
+    pub transient_bytes: u64,
+    /// Bytes of device memory allocated in all.
+    pub device_bytes: u64,
+    /// The files written for it.
+    pub files: Vec<PathBuf>,
+}
+
+/// Everything a compare run measured.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Report {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// The camera.
+    pub camera: String,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// The Vulkan device.
+    pub device: String,
+    /// Frames measured per configuration (after one warm-up frame).
+    pub frames: u32,
+    /// The reference.
+    pub reference: ReferenceInfo,
+    /// The configurations in command-line order.
+    pub configurations: Vec<Configuration>,
+}
+
+impl Report {
+    /// The table of results, as markdown (also what stdout shows).
+    pub fn table(&self) -> String {
+        let mut out = String::from(
+            "| configuration | HDR-FLIP | LDR-FLIP | RMSE | rel. MSE | PSNR (dB) | frame (ms) | transient (MiB) | device (MiB) |\n\
+             |---|---|---|---|---|---|---|---|---|\n",
+        );
+        for c in &self.configurations {
+            out += &format!(
+                "| {} | {:.4} | {:.4} | {:.4e} | {:.4e} | {:.2} | {:.2} | {:.1} | {:.1} |\n",
+                c.name,
+                c.flip,
+                c.flip_ldr,
+                c.rmse,
+                c.rel_mse,
+                c.psnr,
+                c.frame_ms,
+                mib(c.transient_bytes),
+                mib(c.device_bytes)
+            );
+        }
+        out
+    }
+
+    /// `report.md`: what was compared, the table, per-pass times, the images.
+    pub fn markdown(&self) -> String {
+        let reference = match (&self.reference.graph, self.reference.spp) {
+            (Some(graph), Some(spp)) => format!(
+                "{} at {spp} spp, seed {}{}",
+                graph.display(),
+                self.reference.seed.unwrap_or(0),
+                if self.reference.cached {
+                    " (from the reference cache)".to_string()
+                } else {
+                    format!(", rendered in {:.1} s", self.reference.seconds)
+                }
+            ),
+            _ => format!("the image {}", self.reference.image.display()),
+        };
+        let mut out = format!(
+            "# weft compare: {}\n\nCamera \"{}\", {}x{}, on {}; reference: {reference}. Frame times are medians of {} frames after one warm-up frame.\n\n",
+            self.scene.display(),
+            self.camera,
+            self.width,
+            self.height,
+            self.device,
+            self.frames
+        );
+        out += &self.table();
+        out += "\n## Passes\n\n| configuration | pass | ms | timer |\n|---|---|---|---|\n";
+        for c in &self.configurations {
+            for p in &c.passes {
+                out += &format!("| {} | {} | {:.3} | {} |\n", c.name, p.name, p.ms, p.timer);
+            }
+        }
+        out += "\n## Images\n\nEach configuration's output and its HDR-FLIP error map (magma: black 0, yellow 1).\n\n![contact sheet](contact_sheet.png)\n";
+        out
+    }
+}
+
+fn mib(bytes: u64) -> f64 {
+    bytes as f64 / (1024.0 * 1024.0)
+}
+
+/// The family the embedded font is registered under.
+pub(crate) const FAMILY: &str = "sans-serif";
+
+/// Registers the embedded DejaVu Sans, once, so text does not depend on
+/// system fonts.
+pub(crate) fn ensure_font() -> Result<(), ImageError> {
+    static FONT: OnceLock<Result<(), String>> = OnceLock::new();
+    FONT.get_or_init(|| {
+        register_font(FAMILY, FontStyle::Normal, dejavu::sans::regular())
+            .map_err(|_| "the embedded DejaVu Sans is not a usable TrueType font".to_string())
+    })
+    .clone()
+    .map_err(|message| ImageError::Write {
+        path: PathBuf::from("(font)"),
+        message,
+    })
+}
+
+fn drawing_error(path: &Path, e: impl std::fmt::Display) -> ImageError {
+    ImageError::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+/// Height of the legend strip under an error map.
+const LEGEND: u32 = 44;
+
+/// Writes `flip`'s error map in magma with a legend under it: the colour bar
+/// from 0 to 1 and the mean.
+pub fn write_flip_map(flip: &FlipResult, label: &str, path: &Path) -> Result<(), ImageError> {
+    ensure_font()?;
+    let magma = flip.magma();
+    let bar = FlipResult {
+        width: 256,
+        height: 1,
+        map: (0..256).map(|i| i as f32 / 255.0).collect(),
+        mean: 0.0,
+        exposures: None,
+    }
+    .magma();
+    let (w, h) = (magma.width.max(240), magma.height + LEGEND);
+    let mut buffer = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| drawing_error(path, e))?;
+        blit(&root, &magma, 0, 0).map_err(|e| drawing_error(path, e))?;
+        let bar_width = w - 40;
+        for x in 0..bar_width {
+            let i = (x * 255 / (bar_width - 1).max(1)) as usize;
+            let c = RGBColor(bar.bytes[3 * i], bar.bytes[3 * i + 1], bar.bytes[3 * i + 2]);
+            for y in 0..10 {
+                root.draw_pixel((20 + x as i32, (magma.height + 4 + y) as i32), &c)
+                    .map_err(|e| drawing_error(path, e))?;
+            }
+        }
+        let style = (FAMILY, 13).into_font().color(&BLACK);
+        let text_y = (magma.height + 18) as i32;
+        root.draw_text("0", &style, (16, text_y))
+            .map_err(|e| drawing_error(path, e))?;
+        root.draw_text("1", &style, (w as i32 - 24, text_y))
+            .map_err(|e| drawing_error(path, e))?;
+        root.draw_text(
+            &format!("{label}: mean {:.4}", flip.mean),
+            &style,
+            (40, text_y),
+        )
+        .map_err(|e| drawing_error(path, e))?;
+        root.present().map_err(|e| drawing_error(path, e))?;
+    }
+    SrgbImage {
+        width: w,
+        height: h,
+        bytes: buffer,
+    }
+    .write_png(path)
+}
+
+fn blit<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    image: &SrgbImage,
+    x0: u32,
+    y0: u32,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    for y in 0..image.height {
+        for x in 0..image.width {
+            let i = 3 * (y * image.width + x) as usize;
+            let c = RGBColor(image.bytes[i], image.bytes[i + 1], image.bytes[i + 2]);
+            area.draw_pixel(((x0 + x) as i32, (y0 + y) as i32), &c)?;
+        }
+    }
+    Ok(())
+}
+
+/// One column of the contact sheet: a label, the image, and its error map
+/// (none for the reference).
+pub struct SheetColumn<'a> {
+    /// Shown above the image.
+    pub label: String,
+    /// The tonemapped image.
+    pub image: &'a SrgbImage,
+    /// Its error map and mean.
+    pub flip: Option<&'a FlipResult>,
+}
+
+/// Writes every image side by side with its error map under it, labelled, as
+/// one PNG (the images scaled down to at most 320 pixels wide).
+pub fn write_contact_sheet(columns: &[SheetColumn<'_>], path: &Path) -> Result<(), ImageError> {
+    ensure_font()?;
+    let Some(first) = columns.first() else {
+        return Ok(());
+    };
+    let step = first.image.width.div_ceil(320).max(1);
+    let (cw, ch) = (first.image.width / step, first.image.height / step);
+    let label_height = 22;
+    let (w, h) = (
+        columns.len() as u32 * (cw + 8) + 8,
+        label_height * 2 + 2 * ch + 24,
+    );
+    let mut buffer = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| drawing_error(path, e))?;
+        let style = (FAMILY, 14).into_font().color(&BLACK);
+        for (i, column) in columns.iter().enumerate() {
+            let x0 = 8 + i as u32 * (cw + 8);
+            root.draw_text(&column.label, &style, (x0 as i32, 4))
+                .map_err(|e| drawing_error(path, e))?;
+            blit(&root, &downscale(column.image, step), x0, label_height)
+                .map_err(|e| drawing_error(path, e))?;
+            if let Some(flip) = column.flip {
+                let y = label_height + ch + 4;
+                root.draw_text(
+                    &format!("HDR-FLIP {:.4}", flip.mean),
+                    &style,
+                    (x0 as i32, y as i32),
+                )
+                .map_err(|e| drawing_error(path, e))?;
+                blit(&root, &downscale(&flip.magma(), step), x0, y + label_height)
+                    .map_err(|e| drawing_error(path, e))?;
+            }
+        }
+        root.present().map_err(|e| drawing_error(path, e))?;
+    }
+    SrgbImage {
+        width: w,
+        height: h,
+        bytes: buffer,
+    }
+    .write_png(path)
+}
+
+/// Every `step`-th pixel of `image` (nearest, no filtering: error maps stay sharp).
+fn downscale(image: &SrgbImage, step: u32) -> SrgbImage {
+    if step <= 1 {
+        return image.clone();
+    }
+    let (w, h) = (image.width / step, image.height / step);
+    let mut bytes = Vec::with_capacity((w * h * 3) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let i = 3 * ((y * step) * image.width + x * step) as usize;
+            bytes.extend_from_slice(&image.bytes[i..i + 3]);
+        }
+    }
+    SrgbImage {
+        width: w,
+        height: h,
+        bytes,
+    }
+}

@@ -1,0 +1,254 @@
+//! The points of a sweep (the cartesian product of parameter values and
+//! feature sets) and `sweep.csv`, one row per measured point, which makes a
+//! sweep resumable: points already in the file are skipped when it runs
+//! again.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// One setting of a sweep.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub struct SweepPoint {
+    /// Parameter values by name, as given.
+    pub params: BTreeMap<String, String>,
+    /// Feature toggles, space-separated (`bloom !shadows`), empty for none.
+    pub features: String,
+}
+
+impl SweepPoint {
+    /// A short label: `name=value` pairs, then the features.
+    pub fn label(&self) -> String {
+        let mut parts: Vec<String> = self
+            .params
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect();
+        if !self.features.is_empty() {
+            parts.push(format!("[{}]", self.features));
+        }
+        parts.join(" ")
+    }
+}
+
+/// A measured point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepRow {
+    /// The setting.
+    pub point: SweepPoint,
+    /// HDR-FLIP against the reference.
+    pub flip: f64,
+    /// RMSE in linear HDR.
+    pub rmse: f64,
+    /// Median milliseconds per frame.
+    pub frame_ms: f64,
+    /// Device memory allocated, bytes.
+    pub device_bytes: u64,
+}
+
+/// Why `sweep.csv` could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// Reading or writing failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The file belongs to another sweep, or is damaged.
+    #[error("{path}:{line}: {message}")]
+    Format {
+        /// The file.
+        path: String,
+        /// 1-based line.
+        line: usize,
+        /// What was wrong.
+        message: String,
+    },
+}
+
+/// Every point of the product of `params` (name, values) and `feature_sets`
+/// (an empty list means one set with no toggles), in order: the last
+/// parameter varies fastest, feature sets slowest.
+pub fn points(params: &[(String, Vec<String>)], feature_sets: &[String]) -> Vec<SweepPoint> {
+    let sets: Vec<String> = if feature_sets.is_empty() {
+        vec![String::new()]
+    } else {
+        feature_sets.to_vec()
+    };
+    let mut out = Vec::new();
+    for features in &sets {
+        let mut partial = vec![BTreeMap::new()];
+        for (name, values) in params {
+            partial = partial
+                .into_iter()
+                .flat_map(|p: BTreeMap<String, String>| {
+                    values.iter().map(move |v| {
+                        let mut p = p.clone();
+                        p.insert(name.clone(), v.clone());
+                        p
+                    })
+                })
+                .collect();
+        }
+        out.extend(partial.into_iter().map(|params| SweepPoint {
+            params,
+            features: features.clone(),
+        }));
+    }
+    out
+}
+
+/// The CSV header for a sweep over `names`.
+pub fn header(names: &[String]) -> String {
+    let mut columns: Vec<String> = names.to_vec();
+    columns.extend(["features", "flip", "rmse", "frame_ms", "device_bytes"].map(String::from));
+    columns.join(",")
+}
+
+/// One CSV line.
+pub fn line(row: &SweepRow, names: &[String]) -> String {
+    let mut fields: Vec<String> = names
+        .iter()
+        .map(|n| row.point.params.get(n).cloned().unwrap_or_default())
+        .collect();
+    fields.push(row.point.features.clone());
+    fields.push(format!("{:.6}", row.flip));
+    fields.push(format!("{:.6e}", row.rmse));
+    fields.push(format!("{:.3}", row.frame_ms));
+    fields.push(row.device_bytes.to_string());
+    fields.join(",")
+}
+
+/// The rows already in `path` (none when it does not exist). A file whose
+/// header is not this sweep's is an error, not silently mixed in.
+pub fn read(path: &Path, names: &[String]) -> Result<Vec<SweepRow>, SweepError> {
+    let shown = path.display().to_string();
+    let text = match std::fs::read_to_string(path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(source) => {
+            return Err(SweepError::Io {
+                path: shown,
+                source,
+            })
+        }
+    };
+    let mut lines = text.lines().enumerate();
+    let expected = header(names);
+    match lines.next() {
+        Some((_, found)) if found == expected => {}
+        Some((_, found)) => {
+            return Err(SweepError::Format {
+                path: shown,
+                line: 1,
+                message: format!(
+                    "the header is \"{found}\", but this sweep writes \"{expected}\"; use another --out or remove the file"
+                ),
+            })
+        }
+        None => return Ok(Vec::new()),
+    }
+    let mut rows = Vec::new();
+    for (i, text) in lines {
+        let fields: Vec<&str> = text.split(',').collect();
+        let bad = |message: String| SweepError::Format {
+            path: shown.clone(),
+            line: i + 1,
+            message,
+        };
+        if fields.len() != names.len() + 5 {
+            return Err(bad(format!(
+                "{} fields, expected {}",
+                fields.len(),
+                names.len() + 5
+            )));
+        }
+        let number = |s: &str| {
+            s.parse::<f64>()
+                .map_err(|_| bad(format!("\"{s}\" is not a number")))
+        };
+        let n = names.len();
+        rows.push(SweepRow {
+            point: SweepPoint {
+                params: names
+                    .iter()
+                    .cloned()
+                    .zip(fields[..n].iter().map(|s| s.to_string()))
+                    .collect(),
+                features: fields[n].to_string(),
+            },
+            flip: number(fields[n + 1])?,
+            rmse: number(fields[n + 2])?,
+            frame_ms: number(fields[n + 3])?,
+            device_bytes: fields[n + 4]
+                .parse()
+                .map_err(|_| bad(format!("\"{}\" is not a byte count", fields[n + 4])))?,
+        });
+    }
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_are_the_cartesian_product() {
+        let params = vec![
+            ("a".to_string(), vec!["1".to_string(), "2".to_string()]),
+            (
+                "b".to_string(),
+                vec!["x".to_string(), "y".to_string(), "z".to_string()],
+            ),
+        ];
+        let all = points(&params, &["".into(), "bloom".into()]);
+        assert_eq!(all.len(), 12);
+        assert_eq!(all[0].label(), "a=1 b=x");
+        assert_eq!(all[1].label(), "a=1 b=y");
+        assert_eq!(all[6].label(), "a=1 b=x [bloom]");
+        assert_eq!(points(&[], &[]).len(), 1);
+    }
+
+    #[test]
+    fn rows_round_trip_and_a_foreign_file_is_an_error() {
+        let dir = std::env::temp_dir().join(format!("weft-sweep-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let path = dir.join("sweep.csv");
+        let names = vec!["radius".to_string()];
+        assert!(read(&path, &names).expect("missing is empty").is_empty());
+        let row = SweepRow {
+            point: SweepPoint {
+                params: [("radius".to_string(), "3".to_string())].into(),
+                features: "bloom".into(),
+            },
+            flip: 0.125,
+            rmse: 0.0625,
+            frame_ms: 12.5,
+            device_bytes: 1024,
+        };
+        std::fs::write(
+            &path,
+            format!("{}\n{}\n", header(&names), line(&row, &names)),
+        )
+        .expect("write");
+        assert_eq!(read(&path, &names).expect("read"), [row]);
+        let other = vec!["size".to_string()];
+        let error = read(&path, &other).expect_err("another sweep's file");
+        assert!(
+            error
+                .to_string()
+                .contains("sweep.csv:1: the header is \"radius,features"),
+            "{error}"
+        );
+        std::fs::write(&path, format!("{}\n3,bloom,abc,1,2,3\n", header(&names))).expect("write");
+        let error = read(&path, &names).expect_err("damaged");
+        assert!(
+            error
+                .to_string()
+                .ends_with("sweep.csv:2: \"abc\" is not a number"),
+            "{error}"
+        );
+    }
+}
