@@ -56,6 +56,10 @@ pub struct Common {
     /// The reference render's seed.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
+    /// A parameter of the reference graph, NAME=VALUE (`max_depth=2` for
+    /// direct light only); repeatable.
+    #[arg(long = "reference-param", value_parser = crate::render_cmd::parse_param)]
+    pub reference_params: Vec<(String, ParamValue)>,
     /// A linear EXR to use as the reference instead of rendering one; it must
     /// have the size asked for.
     #[arg(long)]
@@ -283,6 +287,7 @@ fn reference(
         return Ok((
             image,
             ReferenceInfo {
+                params: BTreeMap::new(),
                 graph: None,
                 spp: None,
                 seed: None,
@@ -298,16 +303,25 @@ fn reference(
         camera: Some(camera.to_string()),
         features: common.features.clone(),
         samples: Some(common.spp),
-        params: [(
-            "seed".to_string(),
-            ParamValue::Number(f64::from(common.seed)),
-        )]
-        .into(),
+        params: common
+            .reference_params
+            .iter()
+            .cloned()
+            .chain([(
+                "seed".to_string(),
+                ParamValue::Number(f64::from(common.seed)),
+            )])
+            .collect(),
         cache_dir: weft_scene::cache::user_cache_dir(),
         extra_readback: weft_graph::load(&common.reference).readback,
         ..RenderSettings::default()
     };
     let info = |cached, image, seconds| ReferenceInfo {
+        params: common
+            .reference_params
+            .iter()
+            .map(|(k, v)| (k.clone(), param_text(v)))
+            .collect(),
         graph: Some(common.reference.clone()),
         spp: Some(common.spp),
         seed: Some(common.seed),
@@ -369,7 +383,17 @@ fn reference_key(
         height: common.size.height,
         spp: common.spp,
         seed: common.seed,
-        settings: common.features.clone(),
+        settings: common
+            .features
+            .iter()
+            .cloned()
+            .chain(
+                common
+                    .reference_params
+                    .iter()
+                    .map(|(k, v)| format!("{k}={}", param_text(v))),
+            )
+            .collect(),
     })
 }
 

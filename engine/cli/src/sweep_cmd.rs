@@ -65,10 +65,11 @@ fn settings_text(args: &SweepArgs) -> String {
     let reference = match &c.reference_image {
         Some(image) => format!("image {}", image.display()),
         None => format!(
-            "{} at {} spp, seed {}",
+            "{} at {} spp, seed {}, params {:?}",
             c.reference.display(),
             c.spp,
-            c.seed
+            c.seed,
+            c.reference_params
         ),
     };
     format!(
@@ -208,16 +209,17 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
         &args.out.join("pareto.png"),
     )?;
     let mut table = format!(
-        "# weft sweep: {} through {}\n\nPareto frontier of HDR-FLIP against frame time ({} of {} points; the rest are dominated):\n\n| setting | HDR-FLIP | RMSE | frame (ms) | device (MiB) |\n|---|---|---|---|---|\n",
+        "# weft sweep: {} through {}\n\nPareto frontier of HDR-FLIP against frame time ({} of {} points; the rest are dominated):\n\n| # | setting | HDR-FLIP | RMSE | frame (ms) | device (MiB) |\n|---|---|---|---|---|---|\n",
         common.scene.display(),
         args.graph.display(),
         on.len(),
         wanted.len()
     );
-    for &i in &on {
+    for (rank, &i) in on.iter().enumerate() {
         let r = wanted[i];
         table += &format!(
-            "| {} | {:.4} | {:.4e} | {:.2} | {:.1} |\n",
+            "| {} | {} | {:.4} | {:.4e} | {:.2} | {:.1} |\n",
+            rank + 1,
             r.point.label(),
             r.flip,
             r.rmse,
@@ -225,7 +227,7 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
             r.device_bytes as f64 / (1024.0 * 1024.0)
         );
     }
-    table += "\n![error against time](pareto.png)\n";
+    table += "\nThe numbers label the frontier's points in `pareto.png`.\n\n![error against time](pareto.png)\n";
     std::fs::write(args.out.join("sweep.md"), &table)?;
     print!("{table}");
     println!("wrote {}", args.out.display());

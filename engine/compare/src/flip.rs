@@ -89,7 +89,10 @@ pub fn aces(x: f32) -> f32 {
 /// The exposure range HDR-FLIP compares over, from the reference: from the
 /// exposure that maps its brightest pixel to where the tonemapper reaches
 /// 0.85, to the one that maps its median luminance there; and how many
-/// exposures (one per stop, at least 2).
+/// exposures (one per stop, at least 2). Where the reference implementation
+/// would divide by zero — a median luminance of 0, as in a render with a black
+/// background over half the frame, or an all-black image — the median of the
+/// lit pixels is used, or exposure 0; and the range is held to 32 stops.
 pub fn exposure_range(reference: &LinearImage) -> (f32, f32, u32) {
     // The input x at which the tonemapper gives t: a x^2 + b x + c = 0.
     let t = 0.85f32;
@@ -106,11 +109,20 @@ pub fn exposure_range(reference: &LinearImage) -> (f32, f32, u32) {
         .iter()
         .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
         .collect();
-    let y_max = luminance.iter().copied().fold(f32::MIN, f32::max);
+    luminance.retain(|y| y.is_finite());
+    let y_max = luminance.iter().copied().fold(0.0, f32::max);
+    if y_max <= 0.0 {
+        return (0.0, 0.0, 2);
+    }
     let middle = luminance.len() / 2;
-    let (_, median, _) = luminance.select_nth_unstable_by(middle, f32::total_cmp);
+    let mut median = *luminance.select_nth_unstable_by(middle, f32::total_cmp).1;
+    if median <= 0.0 {
+        luminance.retain(|&y| y > 0.0);
+        let middle = luminance.len() / 2;
+        median = *luminance.select_nth_unstable_by(middle, f32::total_cmp).1;
+    }
     let start = (x_max / y_max).log2();
-    let stop = (x_max / *median).log2();
+    let stop = (x_max / median).log2().min(start + 32.0);
     let count = (stop - start).ceil().max(2.0) as u32;
     (start, stop, count)
 }
@@ -202,6 +214,35 @@ mod tests {
             pixels,
         };
         (image(r), image(t))
+    }
+
+    /// A black background over most of the frame, a black image, and a
+    /// NaN pixel give finite exposure ranges.
+    #[test]
+    fn dark_references_give_finite_exposures() {
+        let mut pixels = vec![[0.0f32; 3]; 100];
+        pixels[0] = [1.0, 1.0, 1.0];
+        pixels[1] = [0.25, 0.25, 0.25];
+        pixels[2] = [f32::NAN, 0.0, 0.0];
+        let image = LinearImage {
+            width: 10,
+            height: 10,
+            pixels,
+        };
+        let (start, stop, count) = exposure_range(&image);
+        // the lit median is 1 (of 1 and 0.25, the upper middle); x_max / 1
+        assert!(
+            start.is_finite() && (stop - start).abs() < 1e-6,
+            "{start} {stop}"
+        );
+        assert_eq!(count, 2);
+        let black = LinearImage {
+            width: 2,
+            height: 1,
+            pixels: vec![[0.0; 3]; 2],
+        };
+        assert_eq!(exposure_range(&black), (0.0, 0.0, 2));
+        assert_eq!(hdr_flip(&black, &black).mean, 0.0);
     }
 
     #[test]

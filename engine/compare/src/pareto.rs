@@ -43,7 +43,8 @@ pub fn frontier(points: &[Point]) -> Vec<usize> {
 }
 
 /// Writes error against time, every point in grey, the frontier in red with
-/// its labels (axes padded by 10% of their span).
+/// each of its points numbered 1, 2, ... by increasing time, as the frontier
+/// table lists them (axes padded by 10% of their span).
 pub fn write_plot(
     points: &[Point],
     title: &str,
@@ -119,12 +120,13 @@ pub fn write_plot(
     chart
         .draw_series(
             on.iter()
-                .filter(|&&i| points[i].time > 0.0 && points[i].error > 0.0)
-                .map(|&i| {
+                .enumerate()
+                .filter(|(_, &i)| points[i].time > 0.0 && points[i].error > 0.0)
+                .map(|(rank, &i)| {
                     EmptyElement::at((points[i].time, points[i].error))
                         + Text::new(
-                            points[i].label.clone(),
-                            (8, -16),
+                            (rank + 1).to_string(),
+                            (6, -18),
                             (crate::report::FAMILY, 13).into_font().color(&BLACK),
                         )
                 }),

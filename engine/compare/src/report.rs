@@ -20,6 +20,8 @@ pub struct ReferenceInfo {
     pub spp: Option<u64>,
     /// Its seed, when rendered.
     pub seed: Option<u32>,
+    /// Its graph parameters (`--reference-param`).
+    pub params: BTreeMap<String, String>,
     /// Whether it came from the reference cache.
     pub cached: bool,
     /// The linear image (the cache entry or the given file).
@@ -123,9 +125,14 @@ impl Report {
     pub fn markdown(&self) -> String {
         let reference = match (&self.reference.graph, self.reference.spp) {
             (Some(graph), Some(spp)) => format!(
-                "{} at {spp} spp, seed {}{}",
+                "{} at {spp} spp, seed {}{}{}",
                 graph.display(),
                 self.reference.seed.unwrap_or(0),
+                self.reference
+                    .params
+                    .iter()
+                    .map(|(k, v)| format!(", {k}={v}"))
+                    .collect::<String>(),
                 if self.reference.cached {
                     " (from the reference cache)".to_string()
                 } else {

@@ -37,6 +37,7 @@ fn every_example_scene_loads_without_warnings() {
             "include.scene",
             "many_lights.scene",
             "point_radius.scene",
+            "sun_shadows.scene",
         ]
     );
     for name in names {
