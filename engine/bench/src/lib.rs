@@ -12,6 +12,7 @@ mod lights;
 mod pathtrace;
 mod plot;
 mod shadows;
+mod start;
 
 /// The benchmarks.
 #[derive(Subcommand)]
@@ -26,6 +27,8 @@ pub enum BenchCommand {
     Bvh(crate::bvh::BvhArgs),
     /// Path tracer samples per second, and convergence against a reference image.
     Pathtrace(crate::pathtrace::PathtraceArgs),
+    /// Whole-process `weft render` time, cold (`--no-cache`) against warm.
+    Start(crate::start::StartArgs),
 }
 
 /// Runs `weft bench ...`.
@@ -36,5 +39,6 @@ pub fn run(cmd: BenchCommand) -> Result<ExitCode> {
         BenchCommand::Shadows(args) => crate::shadows::run(args),
         BenchCommand::Bvh(args) => crate::bvh::run(args),
         BenchCommand::Pathtrace(args) => crate::pathtrace::run(args),
+        BenchCommand::Start(args) => crate::start::run(args),
     }
 }

@@ -71,7 +71,9 @@ pub struct Common {
     /// default `cpu` on a software device (lavapipe), `gpu` elsewhere.
     #[arg(long)]
     pub timer: Option<Timer>,
-    /// Render the reference even when the cache has it (and do not store it).
+    /// Read and write no cached data: render the reference even when the
+    /// cache has it (and do not store it), import every model and compile
+    /// every shader again.
     #[arg(long)]
     pub no_cache: bool,
     /// Use the first device whose name contains this.
@@ -432,7 +434,11 @@ impl Session {
     /// Loads the scene, opens the device and gets the reference (`out` is
     /// where an uncached reference is written).
     pub fn open(common: &Common, out: &Path) -> Result<Self> {
-        let scene = weft_scene::load_scene(&common.scene)
+        if common.no_cache {
+            weft_gpu::spirv_cache::set_dir(None);
+        }
+        let cache = weft_scene::cache::user_cache_dir().filter(|_| !common.no_cache);
+        let scene = weft_render::scene_load::load_scene(&common.scene, cache.as_deref())
             .with_context(|| format!("loading {}", common.scene.display()))?;
         let camera = match &common.camera {
             Some(name) => name.clone(),
@@ -541,6 +547,9 @@ impl Session {
     pub fn finish(self, validate: bool) -> ExitCode {
         let log = self.log.clone();
         drop(self);
+        for w in weft_gpu::spirv_cache::take_warnings() {
+            eprintln!("warning: {w}");
+        }
         let counts = log.counts();
         for m in log.messages() {
             eprintln!("validation {:?}: {}: {}", m.severity, m.id, m.text);

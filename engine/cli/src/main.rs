@@ -56,6 +56,9 @@ fn die_quietly_on_closed_pipes() {
 fn main() -> ExitCode {
     die_quietly_on_closed_pipes();
     let cli = Cli::parse();
+    // Compiled shaders are kept in the user cache; commands with --no-cache
+    // turn it off.
+    weft_gpu::spirv_cache::set_dir(weft_scene::cache::user_cache_dir().map(|d| d.join("spirv")));
     let result = match cli.command {
         Command::Graph(cmd) => graph_cmd::run(cmd),
         Command::Scene(cmd) => scene_cmd::run(cmd),

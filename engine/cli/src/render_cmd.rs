@@ -78,7 +78,8 @@ pub struct RenderArgs {
     /// seed renders the same image every run.
     #[arg(long)]
     seed: Option<u32>,
-    /// Do not read or write cached scene data (the ray tracer's BVH, kept in
+    /// Do not read or write cached data (imported models in `models/`,
+    /// compiled shaders in `spirv/` and the ray tracer's BVH, kept in
     /// $WEFT_CACHE_DIR, else $XDG_CACHE_HOME/weft or ~/.cache/weft).
     #[arg(long)]
     no_cache: bool,
@@ -219,6 +220,9 @@ fn settings(args: &RenderArgs, extra_readback: Vec<String>) -> RenderSettings {
 
 /// Runs `weft render`.
 pub fn run(args: RenderArgs) -> Result<ExitCode> {
+    if args.no_cache {
+        weft_gpu::spirv_cache::set_dir(None);
+    }
     let out = args.out.clone().unwrap_or_else(|| default_out(&args.scene));
     let exr = match out.extension().and_then(|e| e.to_str()) {
         Some("png") => false,
@@ -244,7 +248,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             },
         });
     }
-    let scene = weft_scene::load_scene(&args.scene)
+    let scene = weft_render::scene_load::load_scene(&args.scene, settings.cache_dir.as_deref())
         .with_context(|| format!("loading {}", args.scene.display()))?;
     let gpu = Gpu::new(&GpuOptions {
         validation: args.validate,
@@ -293,7 +297,11 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             println!("wrote {} ({name})", path.display());
         }
     }
-    for w in &rendered.warnings {
+    for w in rendered
+        .warnings
+        .iter()
+        .chain(&weft_gpu::spirv_cache::take_warnings())
+    {
         eprintln!("warning: {w}");
     }
     let counts = log.counts();

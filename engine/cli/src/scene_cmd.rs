@@ -15,13 +15,29 @@ pub enum SceneCommand {
         /// Print the summary as JSON.
         #[arg(long)]
         json: bool,
+        /// Import every model again instead of reading the model cache (in
+        /// $WEFT_CACHE_DIR/models, else $XDG_CACHE_HOME/weft/models or
+        /// ~/.cache/weft/models), and write no entry.
+        #[arg(long)]
+        no_cache: bool,
     },
 }
 
 /// Runs a scene subcommand.
 pub fn run(cmd: SceneCommand) -> Result<ExitCode> {
     match cmd {
-        SceneCommand::Check { file, json } => match weft_scene::check_report(&file) {
+        SceneCommand::Check {
+            file,
+            json,
+            no_cache,
+        } => match weft_scene::check_report_with(
+            &file,
+            &weft_scene::LoadOptions {
+                cache_dir: weft_scene::cache::user_cache_dir()
+                    .filter(|_| !no_cache)
+                    .map(|d| d.join("models")),
+            },
+        ) {
             Ok(report) => {
                 if json {
                     println!("{}", serde_json::to_string_pretty(&report)?);

@@ -104,3 +104,45 @@ fn a_scene_error_shows_the_offending_line() {
         "{stderr}"
     );
 }
+
+/// The model cache is used by default (in `$WEFT_CACHE_DIR/models`): the
+/// second check reads the entry the first wrote and reports the same scene,
+/// warnings included; `--no-cache` writes nothing.
+#[test]
+fn check_uses_the_model_cache_unless_told_not_to() {
+    let cache = std::env::temp_dir().join(format!("weft-scene-cli-cache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&cache);
+    let check = |extra: &[&str]| {
+        let mut args = vec![
+            "scene",
+            "check",
+            "../shared/assets/462/scenes/dragon.scene",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let out = Command::new(env!("CARGO_BIN_EXE_weft"))
+            .args(&args)
+            .env("WEFT_CACHE_DIR", &cache)
+            .current_dir(repo())
+            .output()
+            .expect("weft runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let entries = || {
+        std::fs::read_dir(cache.join("models"))
+            .map(|d| d.filter_map(Result::ok).count())
+            .unwrap_or(0)
+    };
+    let uncached = check(&["--no-cache"]);
+    assert_eq!(entries(), 0, "--no-cache wrote an entry");
+    let cold = check(&[]);
+    assert_eq!(entries(), 1, "one model, one entry");
+    let warm = check(&[]);
+    assert_eq!(cold, uncached);
+    assert_eq!(warm, cold, "the cached model reports the same scene");
+}

@@ -26,6 +26,7 @@ pub mod renderpass;
 pub mod resources;
 pub mod samplers;
 pub mod shader;
+pub mod spirv_cache;
 pub mod statistics;
 pub mod swapchain;
 pub mod texture;

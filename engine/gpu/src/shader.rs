@@ -194,17 +194,48 @@ impl ShaderCompiler {
             self.resolve_include(requested, kind, requesting, depth, &dependencies)
         });
         let name = path.to_string_lossy();
+        // With a SPIR-V cache, the preprocessed source (includes expanded)
+        // names the entry; its errors are the compiler's, so they fall
+        // through to the compile below.
+        let key = crate::spirv_cache::dir().and_then(|_| {
+            let expanded = self
+                .compiler
+                .preprocess(source, &name, "main", Some(&options))
+                .ok()?;
+            let mut key = crate::spirv_cache::Key::new();
+            key.field(&[stage as u8]);
+            for define in defines {
+                key.field(define.as_bytes());
+            }
+            key.field(expanded.as_text().as_bytes());
+            Some(key)
+        });
+        if let Some(spirv) = key.as_ref().and_then(|k| crate::spirv_cache::load(k, path)) {
+            drop(options);
+            return Ok(CompiledShader {
+                stage,
+                path: path.to_path_buf(),
+                spirv,
+                dependencies: dependencies.into_inner(),
+            });
+        }
         let result =
             self.compiler
                 .compile_into_spirv(source, stage.kind(), &name, "main", Some(&options));
         drop(options);
         match result {
-            Ok(artifact) => Ok(CompiledShader {
-                stage,
-                path: path.to_path_buf(),
-                spirv: artifact.as_binary().to_vec(),
-                dependencies: dependencies.into_inner(),
-            }),
+            Ok(artifact) => {
+                let spirv = artifact.as_binary().to_vec();
+                if let Some(key) = &key {
+                    crate::spirv_cache::store(key, &spirv);
+                }
+                Ok(CompiledShader {
+                    stage,
+                    path: path.to_path_buf(),
+                    spirv,
+                    dependencies: dependencies.into_inner(),
+                })
+            }
             Err(shaderc::Error::CompilationError(_, text)) => {
                 Err(ShaderError::Compile(parse_diagnostics(&text, path)))
             }

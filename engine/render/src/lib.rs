@@ -36,6 +36,7 @@ pub mod reload_error;
 pub mod reload_worker;
 pub mod scene_gpu;
 pub mod scene_interface;
+pub mod scene_load;
 pub mod shadow_reference;
 pub mod shadows;
 pub mod sources;

@@ -227,7 +227,8 @@ fn prepare_files(
     }
     let new_scene = if scene_changed {
         let loaded =
-            weft_scene::load_scene(&base.scene_path).map_err(|e| ReloadError::scene(&e))?;
+            crate::scene_load::load_scene(&base.scene_path, base.settings.cache_dir.as_deref())
+                .map_err(|e| ReloadError::scene(&e))?;
         Some(Arc::new(loaded))
     } else {
         None

@@ -63,7 +63,8 @@ impl<'g> LiveRender<'g> {
         scene_path: &Path,
         settings: RenderSettings,
     ) -> Result<Self, ReloadError> {
-        let scene = weft_scene::load_scene(scene_path).map_err(|e| ReloadError::scene(&e))?;
+        let scene = crate::scene_load::load_scene(scene_path, settings.cache_dir.as_deref())
+            .map_err(|e| ReloadError::scene(&e))?;
         pick_camera(&scene, &settings).map_err(|e| ReloadError::render(e, scene_path))?;
         let plan = compile_for_scene(gpu, &scene, &settings)
             .map_err(|e| ReloadError::render(e, &settings.graph))?;
@@ -288,7 +289,7 @@ pub fn startup_files(
     let mut files = graph_files(&settings.graph);
     files.insert(normalize(&error.file));
     files.extend(scene_path_files(scene_path));
-    let Ok(scene) = weft_scene::load_scene(scene_path) else {
+    let Ok(scene) = crate::scene_load::load_scene(scene_path, settings.cache_dir.as_deref()) else {
         return files;
     };
     files.extend(scene_files(&scene));
