@@ -191,13 +191,35 @@ fn drawing_error(path: &Path, e: impl std::fmt::Display) -> ImageError {
     }
 }
 
+/// Draws on a white `w` x `h` canvas with `draw` and writes it to `path` as PNG.
+fn draw_png(
+    w: u32,
+    h: u32,
+    path: &Path,
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>) -> Result<(), ImageError>,
+) -> Result<(), ImageError> {
+    ensure_font()?;
+    let mut buffer = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| drawing_error(path, e))?;
+        draw(&root)?;
+        root.present().map_err(|e| drawing_error(path, e))?;
+    }
+    SrgbImage {
+        width: w,
+        height: h,
+        bytes: buffer,
+    }
+    .write_png(path)
+}
+
 /// Height of the legend strip under an error map.
 const LEGEND: u32 = 44;
 
 /// Writes `flip`'s error map in magma with a legend under it: the colour bar
 /// from 0 to 1 and the mean.
 pub fn write_flip_map(flip: &FlipResult, label: &str, path: &Path) -> Result<(), ImageError> {
-    ensure_font()?;
     let magma = flip.magma();
     let bar = FlipResult {
         width: 256,
@@ -208,11 +230,8 @@ pub fn write_flip_map(flip: &FlipResult, label: &str, path: &Path) -> Result<(),
     }
     .magma();
     let (w, h) = (magma.width.max(240), magma.height + LEGEND);
-    let mut buffer = vec![0u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| drawing_error(path, e))?;
-        blit(&root, &magma, 0, 0).map_err(|e| drawing_error(path, e))?;
+    draw_png(w, h, path, |root| {
+        blit(root, &magma, 0, 0).map_err(|e| drawing_error(path, e))?;
         let bar_width = w - 40;
         for x in 0..bar_width {
             let i = (x * 255 / (bar_width - 1).max(1)) as usize;
@@ -224,24 +243,16 @@ pub fn write_flip_map(flip: &FlipResult, label: &str, path: &Path) -> Result<(),
         }
         let style = (FAMILY, 13).into_font().color(&BLACK);
         let text_y = (magma.height + 18) as i32;
-        root.draw_text("0", &style, (16, text_y))
-            .map_err(|e| drawing_error(path, e))?;
-        root.draw_text("1", &style, (w as i32 - 24, text_y))
-            .map_err(|e| drawing_error(path, e))?;
-        root.draw_text(
-            &format!("{label}: mean {:.4}", flip.mean),
-            &style,
-            (40, text_y),
-        )
-        .map_err(|e| drawing_error(path, e))?;
-        root.present().map_err(|e| drawing_error(path, e))?;
-    }
-    SrgbImage {
-        width: w,
-        height: h,
-        bytes: buffer,
-    }
-    .write_png(path)
+        for (text, x) in [
+            ("0".to_string(), 16),
+            ("1".to_string(), w as i32 - 24),
+            (format!("{label}: mean {:.4}", flip.mean), 40),
+        ] {
+            root.draw_text(&text, &style, (x, text_y))
+                .map_err(|e| drawing_error(path, e))?;
+        }
+        Ok(())
+    })
 }
 
 fn blit<DB: DrawingBackend>(
@@ -274,7 +285,6 @@ pub struct SheetColumn<'a> {
 /// Writes every image side by side with its error map under it, labelled, as
 /// one PNG (the images scaled down to at most 320 pixels wide).
 pub fn write_contact_sheet(columns: &[SheetColumn<'_>], path: &Path) -> Result<(), ImageError> {
-    ensure_font()?;
     let Some(first) = columns.first() else {
         return Ok(());
     };
@@ -285,16 +295,13 @@ pub fn write_contact_sheet(columns: &[SheetColumn<'_>], path: &Path) -> Result<(
         columns.len() as u32 * (cw + 8) + 8,
         label_height * 2 + 2 * ch + 24,
     );
-    let mut buffer = vec![0u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| drawing_error(path, e))?;
+    draw_png(w, h, path, |root| {
         let style = (FAMILY, 14).into_font().color(&BLACK);
         for (i, column) in columns.iter().enumerate() {
             let x0 = 8 + i as u32 * (cw + 8);
             root.draw_text(&column.label, &style, (x0 as i32, 4))
                 .map_err(|e| drawing_error(path, e))?;
-            blit(&root, &downscale(column.image, step), x0, label_height)
+            blit(root, &downscale(column.image, step), x0, label_height)
                 .map_err(|e| drawing_error(path, e))?;
             if let Some(flip) = column.flip {
                 let y = label_height + ch + 4;
@@ -304,18 +311,12 @@ pub fn write_contact_sheet(columns: &[SheetColumn<'_>], path: &Path) -> Result<(
                     (x0 as i32, y as i32),
                 )
                 .map_err(|e| drawing_error(path, e))?;
-                blit(&root, &downscale(&flip.magma(), step), x0, y + label_height)
+                blit(root, &downscale(&flip.magma(), step), x0, y + label_height)
                     .map_err(|e| drawing_error(path, e))?;
             }
         }
-        root.present().map_err(|e| drawing_error(path, e))?;
-    }
-    SrgbImage {
-        width: w,
-        height: h,
-        bytes: buffer,
-    }
-    .write_png(path)
+        Ok(())
+    })
 }
 
 /// Every `step`-th pixel of `image` (nearest, no filtering: error maps stay sharp).
