@@ -8,8 +8,9 @@ use crate::plot::{write_png, LinePlot, Series};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
+use weft_compare::rel_mse;
 use weft_gpu::{Gpu, GpuOptions, Pixels};
 use weft_graph::plan::Extent;
 use weft_graph::schema::ParamValue;
@@ -64,29 +65,6 @@ pub struct Sample {
     pub rel_mse: Option<f64>,
 }
 
-/// Relative MSE of `image` against `reference` (RGB triples): the mean over
-/// pixels and channels of (a - b)^2 / (b^2 + 0.01), as in Rousselle et al.
-pub fn rel_mse(image: &[[f32; 3]], reference: &[[f32; 3]]) -> f64 {
-    let sum: f64 = image
-        .iter()
-        .zip(reference)
-        .flat_map(|(a, b)| (0..3).map(move |c| (f64::from(a[c]), f64::from(b[c]))))
-        .map(|(a, b)| (a - b) * (a - b) / (b * b + 0.01))
-        .sum();
-    sum / (3 * image.len().max(1)) as f64
-}
-
-fn read_exr(path: &Path) -> Result<(Extent, Vec<[f32; 3]>)> {
-    let image = image::open(path)
-        .with_context(|| format!("reading {}", path.display()))?
-        .into_rgb32f();
-    let extent = Extent {
-        width: image.width(),
-        height: image.height(),
-    };
-    Ok((extent, image.pixels().map(|p| p.0).collect()))
-}
-
 pub fn csv(samples: &[Sample]) -> String {
     let mut out = String::from("spp,seconds,samples_per_second,rel_mse\n");
     for s in samples {
@@ -106,7 +84,12 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
     }
     let reference = match &args.reference {
         Some(path) => {
-            let (extent, pixels) = read_exr(path)?;
+            let image = weft_compare::LinearImage::read_exr(path)?;
+            let extent = Extent {
+                width: image.width,
+                height: image.height,
+            };
+            let pixels = image.pixels;
             if extent != args.size {
                 bail!(
                     "{} is {}x{}, the render is {}x{}",

@@ -8,6 +8,7 @@ use clap::Args;
 use std::path::PathBuf;
 use std::process::{Command, ExitCode};
 use std::time::Instant;
+use weft_compare::metrics::median;
 
 /// Arguments of `weft bench start`.
 #[derive(Args)]
@@ -23,20 +24,6 @@ pub struct StartArgs {
     /// Runs measured per case (the median is reported).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
     repeats: u32,
-}
-
-/// The median of `values`.
-pub fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n == 0 {
-        return 0.0;
-    }
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
 }
 
 /// Runs `weft bench start`.

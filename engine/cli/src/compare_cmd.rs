@@ -9,6 +9,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_compare::cache::{ReferenceCache, ReferenceKey};
+use weft_compare::metrics::median;
 use weft_compare::report::{
     write_contact_sheet, write_flip_map, Configuration, PassTime, ReferenceInfo, Report,
     SheetColumn,
@@ -199,17 +200,6 @@ fn param_text(value: &ParamValue) -> String {
         ParamValue::Number(n) => n.to_string(),
         ParamValue::Vector(v) => v.iter().map(f64::to_string).collect::<Vec<_>>().join(","),
         ParamValue::Reference(r) => format!("${r}"),
-    }
-}
-
-/// The median of `values` (the mean of the middle two for an even count).
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    match n {
-        0 => 0.0,
-        _ if n % 2 == 1 => values[n / 2],
-        _ => 0.5 * (values[n / 2 - 1] + values[n / 2]),
     }
 }
 
@@ -525,8 +515,8 @@ impl Session {
                 .collect(),
             flip: flip.mean,
             flip_ldr: ldr_flip(&self.reference_ldr, &output).mean,
-            rmse: rmse(&image, &self.reference),
-            rel_mse: rel_mse(&image, &self.reference),
+            rmse: rmse(&image.pixels, &self.reference.pixels),
+            rel_mse: rel_mse(&image.pixels, &self.reference.pixels),
             psnr: psnr(&output, &self.reference_ldr),
             frame_ms: median(&mut frame_ms),
             passes: pass_medians(&rendered),
