@@ -16,10 +16,5 @@ void main() {
     if (!read_surface(s)) {
         discard;
     }
-    Material m = materials[s.material];
-    vec3 c = vec3(0.0);
-    for (uint i = frame.counts.x + frame.counts.y + frame.counts.z; i < frame.counts.w; ++i) {
-        c += shade_light(i, s, m);
-    }
-    color = vec4(c, 0.0);
+    color = vec4(shade_area_lights(s, materials[s.material]), 0.0);
 }

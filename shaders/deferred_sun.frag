@@ -23,9 +23,5 @@ void main() {
         return;
     }
     Material m = materials[s.material];
-    vec3 c = shade_ambient_emissive(s, m, params.emissive_boost);
-    for (uint i = 0u; i < frame.counts.x; ++i) {
-        c += shade_light(i, s, m);
-    }
-    color = vec4(c, 1.0);
+    color = vec4(shade_ambient_emissive(s, m, params.emissive_boost) + shade_suns(s, m), 1.0);
 }

@@ -1,7 +1,9 @@
 #version 450
 // Forward shading: every light evaluated per pixel with the shared lighting
-// code (include/lighting.glsl), plus ambient and emission, into linear HDR;
-// alpha is the material's opacity, which transparent meshes blend with.
+// code (include/lighting.glsl: one loop per light type, only the types and
+// shading models the graph's SCENE_* defines name), plus ambient and emission,
+// into linear HDR; alpha is the material's opacity, which transparent meshes
+// blend with.
 #ifdef HAS_SHADOW_MAP
 layout(set = 0, binding = 0) uniform sampler2DShadow shadow_map;
 #endif
@@ -27,13 +29,12 @@ void main() {
     vec4 texel = texture(base_color, texcoord);
     Material m = materials[material];
     vec2 mr = metal_rough(m, texture(metallic_roughness, texcoord));
-    vec3 bent = texture(normal_map, texcoord).rgb;
-    n = mapped_normal(gl_FrontFacing ? n : -n, world, texcoord, bent, m.ambient.w);
+    n = gl_FrontFacing ? n : -n;
+#ifdef SHADE_NORMAL_MAPS
+    n = mapped_normal(n, world, texcoord, texture(normal_map, texcoord).rgb, m.ambient.w);
+#endif
     Surface s = Surface(world, n, texel.rgb, material, mr);
-    vec3 c = shade_ambient_emissive(s, m, params.emissive_boost);
-    for (uint i = 0u; i < frame.counts.w; ++i) {
-        c += shade_light(i, s, m);
-    }
+    vec3 c = shade_ambient_emissive(s, m, params.emissive_boost) + shade_all_lights(s, m);
     // Alpha matters only where weft-render blends transparent materials.
     color = vec4(c, materials[material].diffuse.a * texel.a);
 }

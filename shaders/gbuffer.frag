@@ -20,8 +20,11 @@ void main() {
     vec3 n = normalize(world_normal);
     albedo = vec4(texture(base_color, texcoord).rgb, 1.0);
     Material m = materials[material];
-    vec3 bent = texture(normal_map, texcoord).rgb;
-    normal = octahedral_encode_half(mapped_normal(gl_FrontFacing ? n : -n, world, texcoord, bent, m.ambient.w));
+    n = gl_FrontFacing ? n : -n;
+#ifdef SHADE_NORMAL_MAPS
+    n = mapped_normal(n, world, texcoord, texture(normal_map, texcoord).rgb, m.ambient.w);
+#endif
+    normal = octahedral_encode_half(n);
     vec2 mr = metal_rough(m, texture(metallic_roughness, texcoord));
     material_out = encode_material(material, mr);
 }

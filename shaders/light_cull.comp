@@ -1,9 +1,11 @@
 #version 450
 // Tiled light culling: one 16x16 workgroup per screen tile finds the nearest and
 // farthest reverse-Z depth of the tile's geometry, bounds it by the six planes of
-// that frustum slab, and lists every point and spot light whose sphere (position,
-// cutoff range) reaches the slab. Background-only tiles get no lights. The CPU
-// mirror of this test is weft_render::tiles (keep the two in step).
+// that frustum slab, and lists every point and spot light whose bounding sphere
+// (light_bounds: the cutoff range for points, the cone's tight sphere for spots)
+// reaches the slab, points and spots in separate parts of the tile's record
+// (include/tiles.glsl). Background-only tiles get no lights. The CPU mirror of
+// this test is weft_testkit::tiles (keep the two in step).
 layout(local_size_x = 16, local_size_y = 16) in;
 
 layout(set = 0, binding = 0) uniform sampler2D depth;
@@ -19,6 +21,8 @@ layout(push_constant) uniform Push { uint max_per_tile; } pc;
 shared uint nearest_bits;
 shared uint farthest_bits;
 shared uint count;
+shared uint points_kept;
+shared uint spots_kept;
 shared vec4 planes[6];
 
 vec3 unproject(vec2 pixel, float d) {
@@ -42,6 +46,8 @@ void main() {
         nearest_bits = 0u;
         farthest_bits = 0x7F800000u;
         count = 0u;
+        points_kept = 0u;
+        spots_kept = 0u;
     }
     memoryBarrierShared();
     barrier();
@@ -87,17 +93,21 @@ void main() {
     if (!empty) {
         // Point and spot records follow the suns; area lights (the last records)
         // are shaded by their own pass.
-        uint end = frame.counts.x + frame.counts.y + frame.counts.z;
+        uint first_spot = frame.counts.x + frame.counts.y;
+        uint end = first_spot + frame.counts.z;
         for (uint i = frame.counts.x + local; i < end; i += 256u) {
-            vec4 sphere = lights[i].position_range;
+            vec4 sphere = light_bounds(i);
             bool touches = true;
             for (int k = 0; k < 6; ++k) {
                 touches = touches && dot(planes[k].xyz, sphere.xyz) + planes[k].w <= sphere.w;
             }
-            if (touches) {
-                uint slot = atomicAdd(count, 1u);
-                if (slot < pc.max_per_tile) {
-                    tile_lights.words[record + 1u + slot] = i;
+            // A slot is reserved first, so points and spots together never
+            // overrun max_per_tile and the two ends never meet.
+            if (touches && atomicAdd(count, 1u) < pc.max_per_tile) {
+                if (i < first_spot) {
+                    tile_lights.words[record + TILE_HEADER + atomicAdd(points_kept, 1u)] = i;
+                } else {
+                    tile_lights.words[record + TILE_HEADER + pc.max_per_tile - 1u - atomicAdd(spots_kept, 1u)] = i;
                 }
             }
         }
@@ -106,6 +116,8 @@ void main() {
     barrier();
     if (local == 0u) {
         tile_lights.words[record] = count;
+        tile_lights.words[record + 1u] = points_kept;
+        tile_lights.words[record + 2u] = spots_kept;
     }
 #ifdef HAS_LIGHT_COUNTS
     if (inside) {

@@ -26,9 +26,9 @@ void main() {
         world = light.position_range.xyz + position * range;
     }
     light_index = gl_InstanceIndex;
-    vec4 clip = frame.view_proj * vec4(world, 1.0);
-    // Depth clamp by hand: parts of a volume beyond the far plane (reverse-Z depth
-    // below 0) keep their screen footprint at depth 0 instead of being clipped away.
-    clip.z = max(clip.z, 0.0);
-    gl_Position = clip;
+    // Parts of a volume beyond the far plane are not clipped away: the passes
+    // that draw volumes clamp depth (raster.depth_clamp), which keeps depth
+    // interpolated exactly across each triangle. Clamping clip-space z here
+    // instead bent that interpolation and cut off the far rim of long spot cones.
+    gl_Position = frame.view_proj * vec4(world, 1.0);
 }

@@ -1,8 +1,9 @@
 #version 450
 // Tiled deferred shading (fullscreen): ambient, emission and every sun as in
 // deferred_sun.frag, then the point and spot lights listed for this pixel's
-// tile by light_cull.comp, each through the same shade_light as forward and
-// deferred; background pixels stay black like forward's clear.
+// tile by light_cull.comp (points and spots kept apart), each type in its own
+// loop through the same shade_point / shade_spot as forward and deferred;
+// background pixels stay black like forward's clear.
 layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
@@ -17,6 +18,12 @@ layout(push_constant) uniform Push {
 } pc;
 #include "include/deferred.glsl"
 #include "include/tiles.glsl"
+// The tile lists are this pass's input: a variant for a feature set without
+// point or spot lights (which `weft graph check --shaders` tries) still reads
+// them, looping over the points (none are listed then).
+#if !defined(SHADE_POINT_LIGHTS) && !defined(SHADE_SPOT_LIGHTS)
+#define SHADE_POINT_LIGHTS
+#endif
 
 layout(location = 0) in vec2 uv;
 layout(location = 0) out vec4 color;
@@ -28,14 +35,21 @@ void main() {
         return;
     }
     Material m = materials[s.material];
-    vec3 c = shade_ambient_emissive(s, m, pc.emissive_boost);
-    for (uint i = 0u; i < frame.counts.x; ++i) {
-        c += shade_light(i, s, m);
-    }
+    vec3 c = shade_ambient_emissive(s, m, pc.emissive_boost) + shade_suns(s, m);
     uint record = tile_record(tile_of(ivec2(gl_FragCoord.xy)), pc.max_per_tile);
-    uint n = min(tile_lights.words[record], pc.max_per_tile);
-    for (uint k = 0u; k < n; ++k) {
-        c += shade_light(tile_lights.words[record + 1u + k], s, m);
+    uint slots = record + TILE_HEADER;
+#ifdef SHADE_POINT_LIGHTS
+    uint points = tile_lights.words[record + 1u];
+    for (uint k = 0u; k < points; ++k) {
+        c += shade_point(tile_lights.words[slots + k], s, m);
     }
+#endif
+#ifdef SHADE_SPOT_LIGHTS
+    uint spots = tile_lights.words[record + 2u];
+    uint last = slots + pc.max_per_tile - 1u;
+    for (uint k = 0u; k < spots; ++k) {
+        c += shade_spot(tile_lights.words[last - k], s, m);
+    }
+#endif
     color = vec4(c, 1.0);
 }

@@ -1,15 +1,67 @@
 // Shading shared by forward and deferred: material decoding, Blinn-Phong for
 // MTL materials, metallic-roughness GGX for glTF materials, and sun / point /
 // spot / area light evaluation with the same cutoffs the light volumes use.
-// Both paths call `shade_light` and `shade_ambient_emissive` with the same
+// Both paths call the per-type `shade_*` functions and `shade_ambient_emissive` with the same
 // inputs (the surface and its material, loaded once per pixel), so they cannot
 // drift apart. engine/render/src/brdf.rs mirrors the BRDFs on the CPU for
 // tests. An includer that defines HAS_SHADOW_MAP must declare
 // `uniform sampler2DShadow shadow_map` before including this file
 // (include/shadows.glsl holds the lookups).
+//
+// Variants: a pass's graph declares `SCENE_SPECIALISED` and then, under the
+// scene's features, `SCENE_SUNS`, `SCENE_POINT_LIGHTS`, `SCENE_SPOT_LIGHTS`,
+// `SCENE_AREA_LIGHTS` (the light types looped over), `SCENE_BLINN_PHONG` and
+// `SCENE_METALLIC_ROUGHNESS` (the shading models compiled) and
+// `SCENE_NORMAL_MAPS`. Code for what the scene lacks is not compiled: GPUs (and
+// lavapipe, which runs both sides of every branch) pay for every light type and
+// model a generic loop contains. A shader compiled without `SCENE_SPECIALISED`
+// shades everything. The `SHADE_*` names below are this file's own, so the
+// includer's `SCENE_*` defines keep their meaning elsewhere (the path tracer).
 #ifndef WEFT_LIGHTING_GLSL
 #define WEFT_LIGHTING_GLSL
 #include "scene.glsl"
+
+#ifdef SCENE_SPECIALISED
+#ifdef SCENE_SUNS
+#define SHADE_SUNS
+#endif
+#ifdef SCENE_POINT_LIGHTS
+#define SHADE_POINT_LIGHTS
+#endif
+#ifdef SCENE_SPOT_LIGHTS
+#define SHADE_SPOT_LIGHTS
+#endif
+#ifdef SCENE_AREA_LIGHTS
+#define SHADE_AREA_LIGHTS
+#endif
+#ifdef SCENE_BLINN_PHONG
+#define SHADE_BLINN_PHONG
+#endif
+#ifdef SCENE_METALLIC_ROUGHNESS
+#define SHADE_METALLIC_ROUGHNESS
+#endif
+#ifdef SCENE_NORMAL_MAPS
+#define SHADE_NORMAL_MAPS
+#endif
+#else
+#define SHADE_SUNS
+#define SHADE_POINT_LIGHTS
+#define SHADE_SPOT_LIGHTS
+#define SHADE_AREA_LIGHTS
+#define SHADE_BLINN_PHONG
+#define SHADE_METALLIC_ROUGHNESS
+#define SHADE_NORMAL_MAPS
+#endif
+// A scene with neither model (no meshes) still compiles one.
+#if !defined(SHADE_METALLIC_ROUGHNESS) && !defined(SHADE_BLINN_PHONG)
+#define SHADE_BLINN_PHONG
+#endif
+// A bound shadow map means a sun or a spot casts shadows: a pass that loops
+// over neither (feature sets `weft graph check --shaders` tries, not scenes)
+// keeps the sun loop, so the map it is given is used.
+#if defined(HAS_SHADOW_MAP) && !defined(SHADE_SUNS) && !defined(SHADE_SPOT_LIGHTS)
+#define SHADE_SUNS
+#endif
 
 const float PI = 3.14159265358979;
 // Roughness is raised to at least this (brdf.rs MIN_ROUGHNESS): a smoother GGX
@@ -46,6 +98,7 @@ vec2 metal_rough(Material m, vec4 texel) {
 // position and UV (dP/du, made orthogonal to n), so meshes need no tangents;
 // it is constant across a triangle and assumes UVs are not mirrored.
 vec3 mapped_normal(vec3 n, vec3 p, vec2 uv, vec3 texel, float scale) {
+#ifdef SHADE_NORMAL_MAPS
     vec3 dpx = dFdx(p);
     vec3 dpy = dFdy(p);
     vec2 dux = dFdx(uv);
@@ -60,6 +113,9 @@ vec3 mapped_normal(vec3 n, vec3 p, vec2 uv, vec3 texel, float scale) {
     vec3 bent = texel * 2.0 - 1.0;
     bent.xy *= scale;
     return normalize(mat3(t, cross(n, t), n) * bent);
+#else
+    return n;
+#endif
 }
 #endif
 
@@ -113,57 +169,79 @@ float attenuate(uint index, float d) {
 #include "shadows.glsl"
 #endif
 
-// Radiance arriving at the surface from light `index` and the unit direction
-// towards it; zero beyond the light's cutoff range or outside a spot's cone. Fields
-// are read from the buffer where they are needed rather than copied up front:
-// lavapipe then loads only what each light type uses (about 20% faster).
-vec3 incoming(uint index, Surface s, out vec3 l) {
-    float type = lights[index].direction_type.w;
-    if (type == LIGHT_SUN) {
-        l = -lights[index].direction_type.xyz;
-        float visible = 1.0;
+// Radiance arriving at the surface from light `index` of each punctual type,
+// and the unit direction towards it; zero beyond the light's cutoff range or
+// outside a spot's cone. Fields are read from the buffer where they are needed
+// rather than copied up front: lavapipe then loads only what each light type
+// uses (about 20% faster).
+vec3 incoming_sun(uint index, Surface s, out vec3 l) {
+    l = -lights[index].direction_type.xyz;
+    float visible = 1.0;
 #ifdef HAS_SHADOW_MAP
-        // Surfaces facing away get no light anyway: skip their shadow lookups.
-        if (index == 0u && dot(s.normal, l) > 0.0) {
-            visible = sun_visibility(s.position, s.normal);
-        }
-#endif
-        return lights[index].color_exponent.rgb * visible;
+    // Surfaces facing away get no light anyway: skip their shadow lookups.
+    if (index == 0u && dot(s.normal, l) > 0.0) {
+        visible = sun_visibility(s.position, s.normal);
     }
+#endif
+    return lights[index].color_exponent.rgb * visible;
+}
+
+vec3 incoming_point(uint index, Surface s, out vec3 l) {
     vec3 to_light = lights[index].position_range.xyz - s.position;
     float d = length(to_light);
     l = to_light / max(d, 1e-6);
-    float range = lights[index].position_range.w;
-    if (type == LIGHT_POINT) {
-        if (d > range) {
-            return vec3(0.0);
-        }
-        return lights[index].color_exponent.rgb * attenuate(index, d);
+    if (d > lights[index].position_range.w) {
+        return vec3(0.0);
     }
-    // Spot: cut off beyond `range` along the axis and outside the cone.
+    return lights[index].color_exponent.rgb * attenuate(index, d);
+}
+
+// Spot: cut off beyond `range` along the axis and outside the cone.
+vec3 incoming_spot(uint index, Surface s, out vec3 l) {
+    vec3 to_light = lights[index].position_range.xyz - s.position;
+    float d = length(to_light);
+    l = to_light / max(d, 1e-6);
     vec3 axis = lights[index].direction_type.xyz;
     float along = dot(-to_light, axis);
     float cosine = dot(-l, axis);
-    if (along > range || cosine < lights[index].attenuation_cos.w) {
+    if (along > lights[index].position_range.w || cosine < lights[index].attenuation_cos.w) {
         return vec3(0.0);
     }
     float spot = lights[index].color_exponent.w > 0.0 ? pow(max(cosine, 0.0), lights[index].color_exponent.w) : 1.0;
 #ifdef HAS_SHADOW_MAP
-    if (type == LIGHT_SPOT_CONE && dot(s.normal, l) > 0.0) {
+    if (lights[index].direction_type.w == LIGHT_SPOT_CONE && dot(s.normal, l) > 0.0) {
         spot *= spot_visibility(index, s.position, s.normal, d);
     }
 #endif
     return lights[index].color_exponent.rgb * spot * attenuate(index, d);
 }
 
-// Light reflected to the camera from `radiance` arriving along `l`, by the
-// material's shading model.
-vec3 reflected(Material m, Surface s, vec3 l, vec3 radiance) {
-    if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
-        vec3 v = normalize(frame.camera_position.xyz - s.position);
-        return radiance * cook_torrance(m.diffuse.rgb * s.texel, s.metal_rough, s.normal, v, l);
+// Any punctual light, by its type (the path tracer samples lights this way).
+vec3 incoming(uint index, Surface s, out vec3 l) {
+    float type = lights[index].direction_type.w;
+    if (type == LIGHT_SUN) {
+        return incoming_sun(index, s, l);
     }
+    if (type == LIGHT_POINT) {
+        return incoming_point(index, s, l);
+    }
+    return incoming_spot(index, s, l);
+}
+
+// Light reflected to the camera from `radiance` arriving along `l`, by the
+// material's shading model (only the models this variant compiles).
+vec3 reflected(Material m, Surface s, vec3 l, vec3 radiance) {
+#ifdef SHADE_METALLIC_ROUGHNESS
+#ifdef SHADE_BLINN_PHONG
+    if (m.emissive.w != SHADING_METALLIC_ROUGHNESS) {
+        return blinn_phong(m, s, l, radiance);
+    }
+#endif
+    vec3 v = normalize(frame.camera_position.xyz - s.position);
+    return radiance * cook_torrance(m.diffuse.rgb * s.texel, s.metal_rough, s.normal, v, l);
+#else
     return blinn_phong(m, s, l, radiance);
+#endif
 }
 
 // Shirley-Chiu concentric map of [-1, 1]^2 onto the unit disc; it preserves
@@ -209,17 +287,67 @@ vec3 shade_area(uint index, Surface s, Material m) {
     return sum * lights[index].color_exponent.rgb;
 }
 
-// One light's contribution to the surface.
-vec3 shade_light(uint index, Surface s, Material m) {
-    if (lights[index].direction_type.w >= LIGHT_AREA_RECT) {
-        return shade_area(index, s, m);
-    }
+// One punctual light's contribution to the surface, by type.
+vec3 shade_sun(uint index, Surface s, Material m) {
     vec3 l;
-    vec3 radiance = incoming(index, s, l);
+    vec3 radiance = incoming_sun(index, s, l);
+    return reflected(m, s, l, radiance);
+}
+
+vec3 shade_point(uint index, Surface s, Material m) {
+    vec3 l;
+    vec3 radiance = incoming_point(index, s, l);
     if (all(equal(radiance, vec3(0.0)))) {
         return vec3(0.0);
     }
     return reflected(m, s, l, radiance);
+}
+
+vec3 shade_spot(uint index, Surface s, Material m) {
+    vec3 l;
+    vec3 radiance = incoming_spot(index, s, l);
+    if (all(equal(radiance, vec3(0.0)))) {
+        return vec3(0.0);
+    }
+    return reflected(m, s, l, radiance);
+}
+
+// Every light of the types this variant shades, one loop per type over the
+// records' ranges (suns, points, spots, areas: engine/render/src/lights.rs).
+vec3 shade_suns(Surface s, Material m) {
+    vec3 c = vec3(0.0);
+#ifdef SHADE_SUNS
+    for (uint i = 0u; i < frame.counts.x; ++i) {
+        c += shade_sun(i, s, m);
+    }
+#endif
+    return c;
+}
+
+vec3 shade_area_lights(Surface s, Material m) {
+    vec3 c = vec3(0.0);
+#ifdef SHADE_AREA_LIGHTS
+    for (uint i = frame.counts.x + frame.counts.y + frame.counts.z; i < frame.counts.w; ++i) {
+        c += shade_area(i, s, m);
+    }
+#endif
+    return c;
+}
+
+vec3 shade_all_lights(Surface s, Material m) {
+    vec3 c = shade_suns(s, m);
+#ifdef SHADE_POINT_LIGHTS
+    for (uint i = frame.counts.x; i < frame.counts.x + frame.counts.y; ++i) {
+        c += shade_point(i, s, m);
+    }
+#endif
+#ifdef SHADE_SPOT_LIGHTS
+    uint first_spot = frame.counts.x + frame.counts.y;
+    for (uint i = first_spot; i < first_spot + frame.counts.z; ++i) {
+        c += shade_spot(i, s, m);
+    }
+#endif
+    return c + shade_area_lights(s, m);
 }
 
 // What the surface shows without any direct light: the suns' ambient on its

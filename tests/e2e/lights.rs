@@ -38,10 +38,8 @@ fn a_thousand_lights_agree_across_forward_deferred_and_tiled() {
     for out in [&forward, &deferred, &tiled] {
         assert_eq!(out.messages, Vec::new());
     }
-    assert_eq!(
-        tiled.passes,
-        ["shadow_sun", "gbuffer", "cull_lights", "shade", "tonemap"]
-    );
+    // Point lights cast no shadows here: no shadow pass.
+    assert_eq!(tiled.passes, ["gbuffer", "cull_lights", "shade", "tonemap"]);
     let fd = agreement(&forward.image, &deferred.image);
     let td = agreement(&tiled.image, &deferred.image);
     eprintln!("forward vs deferred {fd:?}; tiled vs deferred {td:?}");
@@ -78,6 +76,26 @@ const KNOWN_LIGHTS: [([f32; 3], f32); 8] = [
     ([0.0, 3.0, -3.0], 2.0),
 ];
 
+/// Spots of known apex, aim point on the floor, half-angle (degrees) and length,
+/// culled by the sphere around their cone (`tiles::spot_bounds`), not their
+/// length's ball: 10 and 30 degrees use the sphere through apex and rim, 60
+/// the sphere around the rim.
+const KNOWN_SPOTS: [([f32; 3], [f32; 3], f32, f32); 3] = [
+    ([-2.0, 3.0, -1.0], [-2.5, 0.0, -0.5], 10.0, 4.0),
+    ([2.5, 2.0, 2.0], [2.0, 0.0, 2.5], 30.0, 3.0),
+    ([1.0, 1.0, -1.5], [1.0, 0.0, -1.0], 60.0, 1.5),
+];
+
+/// Every light of the known scene as the culling sees it: (centre, radius).
+fn known_bounds() -> Vec<(Vec3, f32)> {
+    let points = KNOWN_LIGHTS.iter().map(|(p, r)| (Vec3::from(*p), *r));
+    let spots = KNOWN_SPOTS.iter().map(|(apex, aim, angle, length)| {
+        let axis = (Vec3::from(*aim) - Vec3::from(*apex)).normalize();
+        tiles::spot_bounds(Vec3::from(*apex), axis, angle.to_radians().cos(), *length)
+    });
+    points.chain(spots).collect()
+}
+
 fn known_scene(dir: &Path) -> PathBuf {
     std::fs::create_dir_all(dir).unwrap();
     std::fs::write(
@@ -89,6 +107,13 @@ fn known_scene(dir: &Path) -> PathBuf {
     for ([x, y, z], r) in KNOWN_LIGHTS {
         text.push_str(&format!(
             "pointlight\n{{\n\tposition {x} {y} {z}\n\tcolor 0.5 0.5 0.5\n\tattenuation 1 0 1\n\tradius {r}\n}}\n"
+        ));
+    }
+    for (apex, aim, angle, length) in KNOWN_SPOTS {
+        let [x, y, z] = apex;
+        let [dx, dy, dz] = (Vec3::from(aim) - Vec3::from(apex)).to_array();
+        text.push_str(&format!(
+            "spotlight\n{{\n\tposition {x} {y} {z}\n\tdirection {dx} {dy} {dz}\n\tcolor 0.5 0.5 0.5\n\tangle {angle}\n\tattenuation 1 0 1\n\tlength {length}\n}}\n"
         ));
     }
     text.push_str("camera \"top\"\n{\n\tposition 0 9 4\n\ttarget 0 0 0\n\tfov_deg 60\n}\n");
@@ -158,7 +183,12 @@ fn the_heat_map_counts_known_lights_per_tile_and_draws_its_legend() {
     let eye = camera::camera_position(camera, 0.0);
     let viewport = Vec2::new(w as f32, h as f32);
     let (tiles_x, tiles_y) = tiles::tile_grid(w, h);
-    let (mut ambiguous, mut most, mut zero) = (0, 0, 0);
+    let (mut ambiguous, mut most, mut zero, mut tighter) = (0, 0, 0, 0);
+    // Each spot's length ball, which culling by the cone improves on.
+    let spot_balls: Vec<(Vec3, f32)> = KNOWN_SPOTS
+        .iter()
+        .map(|(apex, _, _, length)| (Vec3::from(*apex), *length))
+        .collect();
     for ty in 0..tiles_y {
         for tx in 0..tiles_x {
             let (x0, y0) = (tx * 16, ty * 16);
@@ -174,9 +204,9 @@ fn the_heat_map_counts_known_lights_per_tile_and_draws_its_legend() {
             let nearest = depths.iter().copied().fold(f32::MIN, f32::max);
             let farthest = depths.iter().copied().fold(f32::MAX, f32::min);
             let slab = tiles::TileSlab::new(inv, eye, viewport, (tx, ty), nearest, farthest);
-            let margins: Vec<f32> = KNOWN_LIGHTS
+            let margins: Vec<f32> = known_bounds()
                 .iter()
-                .map(|(p, r)| slab.margin(Vec3::from(*p), *r))
+                .map(|(centre, radius)| slab.margin(*centre, *radius))
                 .collect();
             let sure = margins.iter().filter(|m| **m < -1e-3).count() as u32;
             let maybe = margins.iter().filter(|m| **m <= 1e-3).count() as u32;
@@ -188,11 +218,22 @@ fn the_heat_map_counts_known_lights_per_tile_and_draws_its_legend() {
                 (sure..=maybe).contains(&gpu_count),
                 "tile ({tx}, {ty}): GPU {gpu_count}, CPU {sure}..={maybe} (margins {margins:?})"
             );
+            let by_balls = KNOWN_LIGHTS
+                .iter()
+                .map(|(p, r)| (Vec3::from(*p), *r))
+                .chain(spot_balls.iter().copied())
+                .filter(|(centre, radius)| slab.margin(*centre, *radius) < -1e-3)
+                .count() as u32;
+            tighter += u32::from(gpu_count < by_balls);
             most = most.max(gpu_count);
             zero += u32::from(gpu_count == 0);
         }
     }
-    eprintln!("{ambiguous} ambiguous tiles, most lights {most}, {zero} empty tiles");
+    eprintln!(
+        "{ambiguous} ambiguous tiles, most lights {most}, {zero} empty tiles, \
+         {tighter} tiles list fewer lights than the spots' length balls would"
+    );
+    assert!(tighter > 0, "spots are culled by their cones");
     assert!(
         ambiguous * 50 <= tiles_x * tiles_y,
         "{ambiguous} ambiguous tiles"

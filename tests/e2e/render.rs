@@ -165,3 +165,65 @@ fn the_hdr_image_reads_back_as_linear_floats_for_exr() {
     assert!(values.iter().all(|v| v.is_finite() && *v >= 0.0));
     assert!(values.iter().any(|v| *v > 0.1));
 }
+
+/// Every glTF file under the shared assets, as a scene with one sun added to
+/// the file's own lights (KHR_lights_punctual spots and points), framed by the
+/// default camera or the file's first camera.
+fn shared_gltf_files() -> Vec<std::path::PathBuf> {
+    fn walk(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+        let mut entries: Vec<_> = std::fs::read_dir(dir)
+            .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+            .map(|e| e.expect("directory entry").path())
+            .collect();
+        entries.sort();
+        for path in entries {
+            if path.is_dir() {
+                walk(&path, out);
+            } else if matches!(
+                path.extension().and_then(|e| e.to_str()),
+                Some("glb" | "gltf")
+            ) {
+                out.push(path);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    walk(&common::root().join("../shared/assets/gltf"), &mut files);
+    files
+}
+
+#[test]
+fn forward_deferred_and_tiled_agree_on_every_shared_gltf_file() {
+    let files = shared_gltf_files();
+    assert!(files.len() >= 21, "{} glTF files", files.len());
+    let dir = std::env::temp_dir().join(format!("weft-gltf-agree-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut failures = Vec::new();
+    for file in &files {
+        let name = file.file_stem().and_then(|s| s.to_str()).unwrap_or("model");
+        let scene = dir.join(format!("{name}.scene"));
+        std::fs::write(
+            &scene,
+            format!(
+                "model\n{{\n\tfile \"{}\"\n}}\nsunlight\n{{\n\tdirection 0.3 -1 -0.4\n\tcolor 1 1 1\n\tambient 0.05 0.05 0.05\n}}\n",
+                file.display()
+            ),
+        )
+        .unwrap();
+        let [f, d, t] = ["forward.ron", "deferred.ron", "tiled.ron"]
+            .map(|g| render_validated(&scene, &graph(g), 240, 135, &["!bloom"]));
+        for (g, out) in [("forward", &f), ("deferred", &d), ("tiled", &t)] {
+            assert_eq!(out.messages, Vec::new(), "{name} through {g}");
+        }
+        let fd = agreement(&f.image, &d.image);
+        let td = agreement(&t.image, &d.image);
+        eprintln!("{name}: forward vs deferred {fd:?}; tiled vs deferred {td:?}");
+        for (what, a) in [("forward vs deferred", fd), ("tiled vs deferred", td)] {
+            if !(a.mean <= 0.25 && a.p99 <= 1 && a.max <= 8) {
+                failures.push(format!("{name}: {what} {a:?}"));
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(failures.is_empty(), "{failures:#?}");
+}

@@ -336,6 +336,11 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             "culled": rendered.plan.culled.iter().map(|c| &c.name).collect::<Vec<_>>(),
             "output": out,
             "draw_calls": rendered.draw_calls,
+            "culling": rendered.culling.iter().map(|c| serde_json::json!({
+                "view": c.view,
+                "drawn": c.drawn,
+                "culled": c.culled,
+            })).collect::<Vec<_>>(),
             "record_ms": record_ms,
             "frame_ms": frame_ms,
             "timings": timings,
@@ -377,6 +382,14 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
                 " (one frame, includes pipeline builds)"
             }
         );
+        if !rendered.culling.is_empty() {
+            let views: Vec<String> = rendered
+                .culling
+                .iter()
+                .map(|c| format!("{} {} of {}", c.view, c.culled, c.drawn + c.culled))
+                .collect();
+            println!("meshes outside each view, not drawn: {}", views.join("; "));
+        }
         if !rendered.report.timings.is_empty() {
             print!("{}", format_timings(&rendered.report.timings));
         }

@@ -209,7 +209,9 @@ fn plan_with_a_scene_culls_what_the_scene_lacks() {
     );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("dragon.scene: features [shadow_casters, punctual_lights]"),
+        stderr.contains(
+            "dragon.scene: features [shadow_casters, suns, punctual_lights, blinn_phong]"
+        ),
         "{stderr}"
     );
     let text = String::from_utf8_lossy(&out.stdout);
@@ -218,6 +220,13 @@ fn plan_with_a_scene_culls_what_the_scene_lacks() {
         "{text}"
     );
     assert!(text.contains("  0. shadow_sun (Raster)"), "{text}");
+    // The variant key: the sun pass compiles the sun loop and Blinn-Phong only.
+    assert!(
+        text.contains(
+            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS\n"
+        ),
+        "{text}"
+    );
 }
 
 #[test]

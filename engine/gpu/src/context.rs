@@ -35,6 +35,8 @@ pub struct DeviceInfo {
     pub timestamps: bool,
     /// Whether pipeline-statistics queries are available (and enabled).
     pub pipeline_statistics: bool,
+    /// Whether pipelines may clamp depth instead of clipping (`depthClamp`, enabled when offered).
+    pub depth_clamp: bool,
 }
 
 /// The physical device type, in preference order.
@@ -124,13 +126,7 @@ impl Gpu {
         }
         let (physical, info, queue_family) =
             choose_device(guard.instance()?, options.device.as_deref(), presenting)?;
-        let device = create_device(
-            guard.instance()?,
-            physical,
-            queue_family,
-            info.pipeline_statistics,
-            presenting,
-        )?;
+        let device = create_device(guard.instance()?, physical, queue_family, &info, presenting)?;
         let (instance, debug) = guard.release()?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let pool_info = vk::CommandPoolCreateInfo::default()
@@ -523,6 +519,7 @@ fn choose_device(
             timestamp_period: props.limits.timestamp_period,
             timestamps: props_family.timestamp_valid_bits > 0,
             pipeline_statistics: f2.pipeline_statistics_query == vk::TRUE,
+            depth_clamp: f2.depth_clamp == vk::TRUE,
         };
         candidates.push((physical, info, family as u32));
     }
@@ -544,7 +541,7 @@ fn create_device(
     instance: &ash::Instance,
     physical: vk::PhysicalDevice,
     family: u32,
-    pipeline_statistics: bool,
+    info: &DeviceInfo,
     presenting: bool,
 ) -> Result<ash::Device, GpuError> {
     let priorities = [1.0];
@@ -554,7 +551,9 @@ fn create_device(
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .synchronization2(true)
         .maintenance4(true);
-    let core = vk::PhysicalDeviceFeatures::default().pipeline_statistics_query(pipeline_statistics);
+    let core = vk::PhysicalDeviceFeatures::default()
+        .pipeline_statistics_query(info.pipeline_statistics)
+        .depth_clamp(info.depth_clamp);
     let mut features = vk::PhysicalDeviceFeatures2::default()
         .features(core)
         .push_next(&mut f13);

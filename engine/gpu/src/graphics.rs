@@ -44,6 +44,9 @@ pub struct GraphicsState<'a> {
     pub vertex_input: Option<VertexInput<'a>>,
     /// Culled faces.
     pub cull: vk::CullModeFlags,
+    /// Whether fragment depth is clamped to the depth range instead of
+    /// triangles clipped at near and far (needs the `depthClamp` feature).
+    pub depth_clamp: bool,
     /// Constant and slope-scaled depth bias.
     pub depth_bias: Option<(f32, f32)>,
     /// Samples per pixel of the attachments.
@@ -108,6 +111,7 @@ pub fn create_graphics_pipeline(
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
             .cull_mode(state.cull)
+            .depth_clamp_enable(state.depth_clamp)
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .depth_bias_enable(bias)
             .depth_bias_constant_factor(constant)

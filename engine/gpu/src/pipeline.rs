@@ -332,6 +332,7 @@ fn build_graphics(
     let state = crate::graphics::GraphicsState {
         vertex_input: None,
         cull: vk::CullModeFlags::NONE,
+        depth_clamp: false,
         depth_bias: None,
         samples,
         depth: crate::graphics::DepthState::OFF,

@@ -346,6 +346,12 @@ pub struct RasterDecl {
     /// Which faces are culled; without it `None`.
     #[serde(default)]
     pub cull: Option<CullMode>,
+    /// Clamp fragment depth to the depth range instead of clipping triangles
+    /// at the near and far planes (`depthClampEnable`): a light volume that
+    /// reaches past the far plane still covers every surface it lights, and
+    /// its depth stays exact up to the clamp. Without it `false`.
+    #[serde(default)]
+    pub depth_clamp: Option<bool>,
 }
 
 /// A depth comparison (`VkCompareOp`): the fragment passes when
@@ -380,6 +386,8 @@ pub struct RasterState {
     pub depth_bias: Option<(f64, f64)>,
     /// Culled faces.
     pub cull: CullMode,
+    /// Whether fragment depth is clamped instead of triangles clipped at near and far.
+    pub depth_clamp: bool,
 }
 
 /// Shader stages of a pass.

@@ -1,22 +1,27 @@
 //! Scene features a graph's `enabled_if` conditions test: what the scene has,
 //! so passes for things it lacks (spot lights, shadow casters) are culled.
 
+use crate::lights::CONE_MAX_ANGLE;
 use crate::materials::{coat, dielectric, is_mirror, matches};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::material::ShadingModel;
 use weft_scene::{Light, Scene};
 
-/// The features `scene` switches on: `shadow_casters` when a placed mesh casts,
-/// `point_lights` / `spot_lights` when there are such lights, `emissive` when a
+/// The features `scene` switches on: `shadow_casters` when a placed mesh casts
+/// and a light casts shadows (a sun, or a spot narrow enough for a cone),
+/// `suns` / `point_lights` / `spot_lights` when there are such lights, `emissive` when a
 /// placed mesh glows, `transparent` when a placed mesh blends, `area_lights` when
 /// there are area lights, `punctual_lights` when there is a sun, point or spot
 /// light; and by the shading models placed meshes use (so shaders compile only
-/// the models a scene has): `glossy` for a Blinn-Phong material with a
+/// the models a scene has): `blinn_phong` for any material raster passes shade
+/// with Blinn-Phong (MTL materials, mirrors and coats included), `glossy` for a
+/// Blinn-Phong material with a
 /// specular lobe (Ks and Ns above 0), `mirrors` for MTL `illum` 3,
 /// `coated` for MTL `illum` 5 (a Fresnel coat over Lambert), `dielectrics`
 /// for glass (MTL `illum` 4, 6 or 7, the dissolve rule, glTF transmission),
 /// `metallic_roughness` for glTF materials; `textures` when a placed mesh has a
-/// base colour, metallic-roughness or normal texture.
+/// base colour, metallic-roughness or normal texture, `normal_maps` when one
+/// has a normal texture with a non-zero scale.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
     let placed = || {
         scene
@@ -33,7 +38,12 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
             })
     };
     let mut features = Vec::new();
-    if placed().any(|m| matches(MaterialFilter::ShadowCasters, &m)) {
+    let shadowing_light = scene.lights.iter().any(|l| match l {
+        Light::Sun(_) => true,
+        Light::Spot(s) => s.angle <= CONE_MAX_ANGLE,
+        _ => false,
+    });
+    if shadowing_light && placed().any(|m| matches(MaterialFilter::ShadowCasters, &m)) {
         features.push("shadow_casters".to_string());
     }
     if placed().any(|m| matches(MaterialFilter::Emissive, &m)) {
@@ -41,6 +51,9 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     }
     if placed().any(|m| matches(MaterialFilter::Transparent, &m)) {
         features.push("transparent".to_string());
+    }
+    if scene.lights.iter().any(|l| matches!(l, Light::Sun(_))) {
+        features.push("suns".to_string());
     }
     if scene.lights.iter().any(|l| matches!(l, Light::Point(_))) {
         features.push("point_lights".to_string());
@@ -78,6 +91,12 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     }
     if placed().any(|m| m.shading == ShadingModel::MetallicRoughness) {
         features.push("metallic_roughness".to_string());
+    }
+    if placed().any(|m| m.shading != ShadingModel::MetallicRoughness) {
+        features.push("blinn_phong".to_string());
+    }
+    if placed().any(|m| m.textures.normal.is_some() && m.normal_scale != 0.0) {
+        features.push("normal_maps".to_string());
     }
     if placed().any(|m| {
         m.textures.base_color.is_some()

@@ -86,6 +86,8 @@ pub struct Rendered {
     pub camera: String,
     /// Draw calls of the last frame.
     pub draw_calls: u64,
+    /// Meshes each view of the last frame drew and left out (frustum culling).
+    pub culling: Vec<crate::recorder::ViewCulling>,
     /// Host milliseconds per frame spent preparing and recording commands (the
     /// executor's `record_ms`, no GPU wait), one entry per frame.
     pub record_ms: Vec<f64>,
@@ -243,6 +245,7 @@ pub fn render_with_progress(
     let report =
         last.ok_or_else(|| RenderError::Gpu(weft_gpu::GpuError::Plan("no frame".into())))?;
     let draw_calls = frames.draw_calls();
+    let culling = frames.culling().to_vec();
     drop(frames);
     let plan = Arc::try_unwrap(plan).unwrap_or_else(|shared| (*shared).clone());
     Ok(Rendered {
@@ -250,6 +253,7 @@ pub fn render_with_progress(
         report,
         camera: camera.name.clone(),
         draw_calls,
+        culling,
         record_ms,
         frame_ms,
         warnings,

@@ -129,6 +129,11 @@ impl<'g> FrameLoop<'g> {
         self.recorder.draw_calls
     }
 
+    /// Meshes drawn and culled per view in the last frame.
+    pub fn culling(&self) -> &[crate::recorder::ViewCulling] {
+        &self.recorder.culling
+    }
+
     /// Creates a new plan's resources without touching the running one, for a
     /// reload to swap in with [`FrameLoop::swap_plan`] once all of it succeeded.
     pub fn create_resources(&self, plan: &Plan) -> Result<FrameResources<'g>, GpuError> {

@@ -8,7 +8,7 @@ use crate::materials;
 use crate::volumes::{self, VolumeMesh};
 use glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
 use weft_graph::schema::MaterialFilter;
-use weft_scene::{Material, Scene};
+use weft_scene::{Aabb, Material, Scene};
 
 /// The scene vertex's attributes: location, float count and what it holds.
 pub const VERTEX_ATTRIBUTES: [(u32, u32, &str); 3] =
@@ -30,7 +30,7 @@ pub struct MeshRange {
 
 /// One placed mesh: what to draw, its record in the draw buffer (the draw's
 /// `firstInstance`), and its material (index into the scene's material list).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DrawItem {
     /// The mesh's indices and vertices.
     pub range: MeshRange,
@@ -41,6 +41,8 @@ pub struct DrawItem {
     /// Whether the instance's transform mirrors (negative determinant), which
     /// turns its triangles' winding around.
     pub mirrored: bool,
+    /// World-space box around the mesh as placed, for view-frustum culling.
+    pub bounds: Aabb,
 }
 
 /// The scene's triangles as the ray tracer reads them, one entry per triangle.
@@ -112,7 +114,8 @@ impl SceneGeometry {
                     .material
                     .filter(|&i| i < model.materials.len())
                     .map_or(0, |i| material_base[material_base.len() - 1] + i as u32);
-                model_ranges.push(Some((range, material)));
+                let bounds = Aabb::from_points(&mesh.positions);
+                model_ranges.push(Some((range, material, bounds)));
             }
             ranges.push(model_ranges);
         }
@@ -122,7 +125,7 @@ impl SceneGeometry {
             };
             let normal = instance.transform.inverse().transpose();
             let mirrored = instance.transform.determinant() < 0.0;
-            for &(range, material) in model_ranges.iter().flatten() {
+            for &(range, material, bounds) in model_ranges.iter().flatten() {
                 let draw_id = g.draws.len() as u32;
                 g.draw_records.push(GpuDraw {
                     model: instance.transform,
@@ -134,6 +137,7 @@ impl SceneGeometry {
                     draw_id,
                     material,
                     mirrored,
+                    bounds: bounds.transformed(&instance.transform),
                 });
             }
         }

@@ -18,6 +18,7 @@ pub mod error;
 pub mod features;
 pub mod frame;
 pub mod frame_loop;
+pub mod frustum;
 pub mod gaussian;
 pub mod geometry;
 pub mod gpu_types;

@@ -17,7 +17,7 @@ use weft_gpu::graphics::{
 };
 use weft_gpu::pipeline::{PipelineCache, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
-use weft_gpu::GpuError;
+use weft_gpu::{Gpu, GpuError};
 use weft_graph::plan::{Plan, PlanPass};
 use weft_graph::schema::{CompareOp, CullMode};
 
@@ -102,16 +102,23 @@ impl ScenePipelines {
     }
 
     /// The pipeline for `key`, built on first use against the scene's set
-    /// layouts, once its shaders pass the scene interface check for `pass`.
+    /// layouts, once its shaders pass the scene interface check for `pass` and
+    /// the device has the fixed-function features its state asks for.
     pub fn get(
         &mut self,
-        device: &ash::Device,
+        gpu: &Gpu,
         key: &ScenePipelineKey,
         layouts: [vk::DescriptorSetLayout; 2],
         (plan, pass): (&Plan, &PlanPass),
     ) -> Result<Arc<ScenePipeline>, GpuError> {
         if let Some(p) = self.pipelines.get(key) {
             return Ok(Arc::clone(p));
+        }
+        if key.state.depth_clamp && !gpu.info().depth_clamp {
+            return Err(GpuError::Pass {
+                pass: pass.name.clone(),
+                message: "`raster.depth_clamp` needs the device feature depthClamp, which this device lacks".into(),
+            });
         }
         let [scene_layout, material_layout] = layouts;
         let vs = self.shaders.shader(&key.vertex)?;
@@ -129,7 +136,7 @@ impl ScenePipelines {
             });
         }
         let pipeline = build(
-            device,
+            gpu.device(),
             key,
             &vs,
             fs.as_deref(),
@@ -291,6 +298,7 @@ fn create_pipeline(
             CullMode::Front => vk::CullModeFlags::FRONT,
             CullMode::Back => vk::CullModeFlags::BACK,
         },
+        depth_clamp: state.depth_clamp,
         depth_bias: state
             .depth_bias
             .map(|(c, s)| (f32::from_bits(c), f32::from_bits(s))),

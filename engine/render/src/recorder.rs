@@ -3,6 +3,7 @@
 //! material's texture (set 2), then draws the meshes the pass's material filter
 //! selects or one instanced light volume per light.
 
+use crate::frustum::Frustum;
 use crate::geometry::DrawItem;
 use crate::pipelines::{front_face, ScenePipeline, ScenePipelineKey, ScenePipelines, MATERIAL_SET};
 use crate::providers::{self, SHADOW_VIEW};
@@ -11,7 +12,7 @@ use crate::scene_interface::{position_only, scene_set_problems};
 use crate::shadows::ShadowSettings;
 use crate::state::{pass_state, DepthTest, PassState};
 use ash::vk;
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use std::sync::Arc;
 use weft_gpu::bind::{pack_push, resolve_bindings, FrameValues};
 use weft_gpu::commands::Commands;
@@ -74,6 +75,20 @@ pub struct SceneRecorder<'g> {
     frame: FrameValues,
     /// Draw calls recorded in the current frame.
     pub draw_calls: u64,
+    /// Meshes drawn and culled per view in the current frame.
+    pub culling: Vec<ViewCulling>,
+}
+
+/// How many meshes one view drew and how many it left out because their
+/// bounds lie outside its frustum.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ViewCulling {
+    /// The pass, with the shadow view's index for shadow passes (`shadow_sun[2]`).
+    pub view: String,
+    /// Meshes drawn.
+    pub drawn: u64,
+    /// Meshes outside the view.
+    pub culled: u64,
 }
 
 impl<'g> SceneRecorder<'g> {
@@ -96,6 +111,7 @@ impl<'g> SceneRecorder<'g> {
             pool,
             frame: FrameValues::default(),
             draw_calls: 0,
+            culling: Vec::new(),
         })
     }
 
@@ -182,16 +198,40 @@ impl<'g> SceneRecorder<'g> {
 
     /// The draws a filter selects, farthest from the camera first (by the placed
     /// model's origin), the order alpha blending needs.
-    fn back_to_front(&self, filter: MaterialFilter) -> Vec<DrawItem> {
+    /// The draws of `filter` inside the frustum of `clip`, counted under `view`.
+    fn visible(&mut self, view: String, clip: Mat4, filter: MaterialFilter) -> Vec<DrawItem> {
+        let frustum = Frustum::from_clip(clip);
+        let (inside, outside): (Vec<DrawItem>, Vec<DrawItem>) = self
+            .scene
+            .geometry
+            .filtered(filter)
+            .partition(|d| frustum.may_contain(&d.bounds));
+        let (drawn, culled) = (inside.len() as u64, outside.len() as u64);
+        match self.culling.iter_mut().find(|c| c.view == view) {
+            Some(c) => {
+                c.drawn += drawn;
+                c.culled += culled;
+            }
+            None => self.culling.push(ViewCulling {
+                view,
+                drawn,
+                culled,
+            }),
+        }
+        inside
+    }
+
+    /// `draws` sorted farthest from the camera first.
+    fn back_to_front(&self, draws: Vec<DrawItem>) -> Vec<DrawItem> {
         let g = &self.scene.geometry;
         let eye = self.scene.camera_position;
-        let mut draws: Vec<(f32, DrawItem)> = g
-            .filtered(filter)
+        let mut draws: Vec<(f32, DrawItem)> = draws
+            .into_iter()
             .map(|d| {
                 let origin = g
                     .model_matrix(d.draw_id)
                     .map_or(Vec3::ZERO, |m| m.w_axis.truncate());
-                (origin.distance_squared(eye), *d)
+                (origin.distance_squared(eye), d)
             })
             .collect();
         draws.sort_by(|a, b| b.0.total_cmp(&a.0));
@@ -277,7 +317,8 @@ impl SceneRecorder<'_> {
                 },
             });
             commands.push_constants(p.layout, *stages, &bytes);
-            calls += self.draw_meshes(ctx.cmd, p, self.scene.geometry.filtered(filter));
+            let draws = self.visible(format!("{}[{i}]", pass.name), view.clip, filter);
+            calls += self.draw_meshes(ctx.cmd, p, draws.iter());
         }
         Ok(calls)
     }
@@ -289,6 +330,7 @@ impl DrawRecorder for SceneRecorder<'_> {
     fn begin_frame(&mut self) -> Result<(), GpuError> {
         self.pool.reset()?;
         self.draw_calls = 0;
+        self.culling.clear();
         Ok(())
     }
 
@@ -323,14 +365,13 @@ impl DrawRecorder for SceneRecorder<'_> {
             state: pass_state(pass),
             position_only: position_only(pass),
         };
-        let device = self.gpu.device();
         let layouts = [
             self.scene.scene_layout.handle(),
             self.scene.material_layout.handle(),
         ];
         let p = self
             .pipelines
-            .get(device, &key, layouts, (ctx.plan, pass))?;
+            .get(self.gpu, &key, layouts, (ctx.plan, pass))?;
         let graph_set = self.graph_set(ctx, p.graph_layout, &p.interface)?;
         let shadow_atlas = providers::shadow_atlas(pass);
         let mut params = pass.params.clone();
@@ -356,8 +397,12 @@ impl DrawRecorder for SceneRecorder<'_> {
         match draw {
             Draw::Meshes(MaterialFilter::All) if blends_transparency(&key.state) => {
                 // Opaque first, then transparent meshes blended over them, farthest first.
-                calls += self.draw_meshes(ctx.cmd, &p, g.filtered(MaterialFilter::Opaque));
-                let transparent = self.back_to_front(MaterialFilter::Transparent);
+                let camera = self.scene.view_proj;
+                let opaque = self.visible(pass.name.clone(), camera, MaterialFilter::Opaque);
+                calls += self.draw_meshes(ctx.cmd, &p, opaque.iter());
+                let transparent =
+                    self.visible(pass.name.clone(), camera, MaterialFilter::Transparent);
+                let transparent = self.back_to_front(transparent);
                 if !transparent.is_empty() {
                     let blended = ScenePipelineKey {
                         state: transparent_state(&key.state),
@@ -365,14 +410,17 @@ impl DrawRecorder for SceneRecorder<'_> {
                     };
                     let q = self
                         .pipelines
-                        .get(device, &blended, layouts, (ctx.plan, pass))?;
+                        .get(self.gpu, &blended, layouts, (ctx.plan, pass))?;
                     self.bind(ctx.cmd, &q, &bindings);
                     calls += self.draw_meshes(ctx.cmd, &q, transparent.iter());
                 }
             }
             Draw::Meshes(filter) => match &shadow_atlas {
                 Some(settings) => calls += self.draw_shadow_views(ctx, &p, filter, settings)?,
-                None => calls += self.draw_meshes(ctx.cmd, &p, g.filtered(filter)),
+                None => {
+                    let draws = self.visible(pass.name.clone(), self.scene.view_proj, filter);
+                    calls += self.draw_meshes(ctx.cmd, &p, draws.iter());
+                }
             },
             Draw::LightVolumes(kind) => {
                 let lights = &self.scene.light_set;

@@ -300,6 +300,8 @@ pub struct GpuScene<'g> {
     pub view_volume: ViewVolume,
     /// Camera position at the last update, for sorting transparent meshes.
     pub camera_position: glam::Vec3,
+    /// The camera's world-to-clip matrix at the last update, for culling draws.
+    pub view_proj: glam::Mat4,
     /// Light counts by kind (stable over time; animation moves lights only).
     pub light_set: LightSet,
     /// Textures that could not be loaded (their materials use white), and skipped meshes.
@@ -430,6 +432,7 @@ impl<'g> GpuScene<'g> {
                 100.0,
             ),
             camera_position: glam::Vec3::ZERO,
+            view_proj: glam::Mat4::IDENTITY,
             light_set,
             warnings,
         };
@@ -644,6 +647,7 @@ impl<'g> GpuScene<'g> {
         let view_proj = camera::view_projection(camera, time, w / h);
         let eye = camera::camera_position(camera, time);
         self.camera_position = eye;
+        self.view_proj = view_proj;
         let (_, rotation) = camera.pose_at(time);
         self.view_volume =
             ViewVolume::new(eye, rotation, camera.fov_y, w / h, camera.near, camera.far);

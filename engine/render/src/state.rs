@@ -27,6 +27,8 @@ pub struct PassState {
     pub depth: DepthTest,
     /// Face culling.
     pub cull: CullMode,
+    /// Whether fragment depth is clamped instead of clipped at near and far.
+    pub depth_clamp: bool,
     /// Blend per colour attachment.
     pub blends: Vec<BlendCode>,
     /// Constant and slope-scaled depth bias, as `f32` bits.
@@ -42,6 +44,7 @@ pub fn pass_state(pass: &PlanPass) -> PassState {
         return PassState {
             depth: DepthTest::Off,
             cull: raster.cull,
+            depth_clamp: raster.depth_clamp,
             blends: Vec::new(),
             depth_bias: None,
             samples: 1,
@@ -57,6 +60,7 @@ pub fn pass_state(pass: &PlanPass) -> PassState {
     PassState {
         depth,
         cull: raster.cull,
+        depth_clamp: raster.depth_clamp,
         blends: rp
             .color
             .iter()

@@ -1,7 +1,7 @@
 //! The CPU mirror of tiled light culling (`shaders/light_cull.comp`): the
 //! frustum slab of one screen tile between its nearest and farthest reverse-Z
-//! depths, and whether a light's cutoff sphere reaches it. Tests compare the
-//! GPU's per-tile counts with this; keep the two in step.
+//! depths, whether a light's bounding sphere reaches it, and the spot bounds.
+//! Tests compare the GPU's per-tile counts with this; keep the two in step.
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
@@ -97,6 +97,26 @@ impl TileSlab {
     }
 }
 
+/// A sphere (centre, radius) holding everything a spot lights: the part of
+/// the ball of radius `range` around `apex` inside the cone about unit `axis`
+/// with half-angle cosine `cos_half`. Up to 45 degrees the sphere through the
+/// apex and the rim circle (radius `range / (2 cos)`), up to 90 the sphere
+/// around the rim circle (radius `range sin`); wider spots keep the ball.
+/// Mirrors `light_bounds` in `shaders/include/tiles.glsl`.
+pub fn spot_bounds(apex: Vec3, axis: Vec3, cos_half: f32, range: f32) -> (Vec3, f32) {
+    if cos_half <= 0.0 {
+        return (apex, range);
+    }
+    if cos_half >= std::f32::consts::FRAC_1_SQRT_2 {
+        let r = range / (2.0 * cos_half);
+        return (apex + axis * r, r);
+    }
+    (
+        apex + axis * (range * cos_half),
+        range * (1.0 - cos_half * cos_half).sqrt(),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -159,5 +179,42 @@ mod tests {
         assert!(!slab.touches(Vec3::new(2.5, -2.5, -9.5), 0.4));
         let m = slab.margin(Vec3::new(2.5, -2.5, -10.5), 0.4);
         assert!((m - 0.1).abs() < 1e-3, "{m}");
+    }
+
+    #[test]
+    fn spot_bounds_hold_the_lit_sector_and_are_tighter_than_the_range_ball() {
+        let apex = Vec3::new(1.0, 2.0, 3.0);
+        let axis = Vec3::new(0.3, -1.0, 0.2).normalize();
+        let helper = axis.cross(Vec3::X).normalize();
+        let other = axis.cross(helper);
+        let range = 5.0;
+        for degrees in [
+            1.0f32, 10.0, 30.0, 44.9, 45.0, 45.1, 60.0, 89.0, 90.0, 120.0, 180.0,
+        ] {
+            let cos_half = degrees.to_radians().cos();
+            let (centre, radius) = spot_bounds(apex, axis, cos_half, range);
+            assert!(radius <= range * 1.0001, "{degrees}: {radius}");
+            // Points of the lit sector: distances 0..range, angles 0..half, all around.
+            for i in 0..=16 {
+                for j in 0..=16 {
+                    for k in 0..8 {
+                        let d = range * i as f32 / 16.0;
+                        let angle = degrees.min(180.0).to_radians() * j as f32 / 16.0;
+                        let around = std::f32::consts::TAU * k as f32 / 8.0;
+                        let side = helper * around.cos() + other * around.sin();
+                        let p = apex + (axis * angle.cos() + side * angle.sin()) * d;
+                        let outside = p.distance(centre) - radius;
+                        assert!(
+                            outside <= 1e-4 * range,
+                            "{degrees} deg: {p} is {outside} outside"
+                        );
+                    }
+                }
+            }
+        }
+        // A 10-degree spot's sphere has about half the range ball's radius (an eighth of its volume).
+        let (_, narrow) = spot_bounds(apex, axis, 10f32.to_radians().cos(), range);
+        assert!((narrow / range - 1.0 / (2.0 * 10f32.to_radians().cos())).abs() < 1e-6);
+        assert!(narrow < 0.51 * range);
     }
 }

@@ -258,13 +258,16 @@ impl Resolver<'_> {
                 ),
             );
         }
-        let depth_state = raster.depth_compare.is_some() || raster.depth_bias.is_some();
-        if depth_state && decl.depth.is_none() {
-            let field = if raster.depth_compare.is_some() {
-                "depth_compare"
-            } else {
-                "depth_bias"
-            };
+        let depth_field = if raster.depth_compare.is_some() {
+            Some("depth_compare")
+        } else if raster.depth_bias.is_some() {
+            Some("depth_bias")
+        } else if raster.depth_clamp == Some(true) {
+            Some("depth_clamp")
+        } else {
+            None
+        };
+        if let (Some(field), None) = (depth_field, &decl.depth) {
             self.error(
                 source,
                 &at(field),
@@ -281,6 +284,7 @@ impl Resolver<'_> {
             depth_compare: raster.depth_compare,
             depth_bias,
             cull: raster.cull.unwrap_or_default(),
+            depth_clamp: raster.depth_clamp.unwrap_or(false),
         }
     }
 
