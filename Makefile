@@ -1,7 +1,7 @@
 # Entry points: `make demo`, `make test`, `make bench`. Each runs tools/setup first.
 CARGO ?= cargo
 
-.PHONY: setup build demo test bench lint fuzz
+.PHONY: setup build demo test bench lint fuzz ltc-tables
 
 setup:
 	@bash tools/setup
@@ -30,3 +30,7 @@ fuzz: setup
 
 bench: setup
 	$(CARGO) bench --workspace
+
+# Refit the area lights' LTC tables (engine/ltc/tables/ltc_tables.txt; docs/lights.md).
+ltc-tables: setup
+	$(CARGO) run -p weft-ltc --release --bin ltc-fit

@@ -7,6 +7,9 @@ layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
 layout(set = 0, binding = 3) uniform sampler2D depth;
 #include "include/deferred.glsl"
+layout(push_constant) uniform Params {
+    uint area_samples;  // graph parameter: 0 analytic (LTC), n: n x n quadrature
+} params;
 
 layout(location = 0) in vec2 uv;
 layout(location = 0) out vec4 color;
@@ -16,5 +19,5 @@ void main() {
     if (!read_surface(s)) {
         discard;
     }
-    color = vec4(shade_area_lights(s, materials[s.material]), 0.0);
+    color = vec4(shade_area_lights(s, materials[s.material], params.area_samples), 0.0);
 }

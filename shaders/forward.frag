@@ -11,6 +11,7 @@ layout(set = 0, binding = 0) uniform sampler2DShadow shadow_map;
 
 layout(push_constant) uniform Params {
     float emissive_boost;  // graph parameter: scales material emission
+    uint area_samples;     // graph parameter: 0 analytic area lights, n: n x n quadrature
 } params;
 
 layout(set = 2, binding = 0) uniform sampler2D base_color;
@@ -34,7 +35,7 @@ void main() {
     n = mapped_normal(n, world, texcoord, texture(normal_map, texcoord).rgb, m.ambient.w);
 #endif
     Surface s = Surface(world, n, texel.rgb, material, mr);
-    vec3 c = shade_ambient_emissive(s, m, params.emissive_boost) + shade_all_lights(s, m);
+    vec3 c = shade_ambient_emissive(s, m, params.emissive_boost) + shade_all_lights(s, m, params.area_samples);
     // Alpha matters only where weft-render blends transparent materials.
     color = vec4(c, materials[material].diffuse.a * texel.a);
 }

@@ -69,9 +69,6 @@ const float PI = 3.14159265358979;
 const float MIN_ROUGHNESS = 0.045;
 // Reflectance at normal incidence of every non-metal (brdf.rs DIELECTRIC_F0).
 const float DIELECTRIC_F0 = 0.04;
-// Area lights are integrated over AREA_SAMPLES x AREA_SAMPLES equal-area cells
-// (brdf.rs AREA_SAMPLES).
-const int AREA_SAMPLES = 8;
 
 // What shading needs about a surface point.
 struct Surface {
@@ -255,22 +252,24 @@ vec2 concentric(vec2 p) {
     return r * vec2(cos(phi), sin(phi));
 }
 
-// Area light `index`: the rectangle or disc split into AREA_SAMPLES^2 cells of
-// equal area A, each lighting the surface from its centre with irradiance
-// L cos(theta_light) A / (d^2 + A / pi) (a disc of area A seen head-on gives
-// exactly that, so the sum stays finite next to the light). No shadowing.
-vec3 shade_area(uint index, Surface s, Material m) {
+// Area light `index` by quadrature: the rectangle or disc split into
+// `samples`^2 cells of equal area A, each lighting the surface from its centre
+// with irradiance L cos(theta_light) A / (d^2 + A / pi) (a disc of area A seen
+// head-on gives exactly that, so the sum stays finite next to the light). No
+// shadowing. The graph parameter `area_samples` (0: analytic) chooses it;
+// brdf.rs mirrors it at 8 x 8 for tests.
+vec3 shade_area_quadrature(uint index, Surface s, Material m, uint samples) {
     vec3 centre = lights[index].position_range.xyz;
     vec3 x = lights[index].direction_type.xyz;
     vec3 y = lights[index].attenuation_cos.xyz;
     bool disc = lights[index].direction_type.w == LIGHT_AREA_DISC;
     bool two_sided = lights[index].color_exponent.w > 0.5;
     vec3 facing = -normalize(cross(x, y));
-    float cell = (disc ? PI : 4.0) * length(x) * length(y) / float(AREA_SAMPLES * AREA_SAMPLES);
+    float cell = (disc ? PI : 4.0) * length(x) * length(y) / float(samples * samples);
     vec3 sum = vec3(0.0);
-    for (int j = 0; j < AREA_SAMPLES; ++j) {
-        for (int i = 0; i < AREA_SAMPLES; ++i) {
-            vec2 uv = (vec2(i, j) + 0.5) * (2.0 / float(AREA_SAMPLES)) - 1.0;
+    for (uint j = 0u; j < samples; ++j) {
+        for (uint i = 0u; i < samples; ++i) {
+            vec2 uv = (vec2(i, j) + 0.5) * (2.0 / float(samples)) - 1.0;
             if (disc) {
                 uv = concentric(uv);
             }
@@ -286,6 +285,66 @@ vec3 shade_area(uint index, Surface s, Material m) {
     }
     return sum * lights[index].color_exponent.rgb;
 }
+
+#ifdef SHADE_AREA_LIGHTS
+#include "ltc.glsl"
+
+// Area light `index` analytically (include/ltc.glsl). Diffuse: the exact
+// integral of the cosine over the polygon. Highlights: the fitted LTC of the
+// material's lobe (GGX, or Blinn-Phong with the exponent read as roughness
+// (2 / (n + 2))^(1/4)), scaled by the lobe's integral; GGX's Fresnel from the
+// table's Fresnel moment, its diffuse weighted by 1 - F(N.V). No shadowing.
+vec3 shade_area_ltc(uint index, Surface s, Material m) {
+    vec3 centre = lights[index].position_range.xyz - s.position;
+    vec3 x = lights[index].direction_type.xyz;
+    vec3 y = lights[index].attenuation_cos.xyz;
+    bool disc = lights[index].direction_type.w == LIGHT_AREA_DISC;
+    // The light emits towards -(x cross y); a one-sided light seen from behind gives nothing.
+    float side = dot(centre, cross(x, y)) >= 0.0 ? 1.0 : -1.0;
+    if (side < 0.0 && lights[index].color_exponent.w <= 0.5) {
+        return vec3(0.0);
+    }
+    vec3 n = s.normal;
+    vec3 v = normalize(frame.camera_position.xyz - s.position);
+    float ndv = clamp(dot(n, v), 1e-3, 1.0);
+    vec3 t1 = v - n * dot(v, n);
+    vec3 helper = abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+    t1 = dot(t1, t1) > 1e-12 ? normalize(t1) : normalize(cross(n, helper));
+    mat3 local = transpose(mat3(t1, cross(n, t1), n));
+    float diffuse = ltc_integral(local, centre, x, y, disc, side);
+    vec3 result;
+#ifdef SHADE_METALLIC_ROUGHNESS
+#ifdef SHADE_BLINN_PHONG
+    if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
+#endif
+        vec2 scale;
+        mat3 inverse = ltc_lookup(LTC_GGX, max(s.metal_rough.y, MIN_ROUGHNESS), ndv, scale);
+        float highlight = ltc_integral(inverse * local, centre, x, y, disc, side);
+        vec3 base = m.diffuse.rgb * s.texel;
+        vec3 f0 = mix(vec3(DIELECTRIC_F0), base, s.metal_rough.x);
+        vec3 f_view = f0 + (1.0 - f0) * pow(1.0 - ndv, 5.0);
+        result = (1.0 - f_view) * (1.0 - s.metal_rough.x) * base * diffuse
+            + (f0 * scale.x + (1.0 - f0) * scale.y) * highlight;
+#ifdef SHADE_BLINN_PHONG
+    } else {
+#endif
+#endif
+#ifdef SHADE_BLINN_PHONG
+        result = m.diffuse.rgb * s.texel * PI * diffuse;
+        float shininess = m.specular.w;
+        if (shininess > 0.0) {
+            vec2 scale;
+            mat3 inverse = ltc_lookup(LTC_BLINN_PHONG, pow(2.0 / (shininess + 2.0), 0.25), ndv, scale);
+            float highlight = ltc_integral(inverse * local, centre, x, y, disc, side);
+            result += m.specular.rgb * scale.x * highlight;
+        }
+#ifdef SHADE_METALLIC_ROUGHNESS
+    }
+#endif
+#endif
+    return result * lights[index].color_exponent.rgb;
+}
+#endif
 
 // One punctual light's contribution to the surface, by type.
 vec3 shade_sun(uint index, Surface s, Material m) {
@@ -324,17 +383,23 @@ vec3 shade_suns(Surface s, Material m) {
     return c;
 }
 
-vec3 shade_area_lights(Surface s, Material m) {
+// `area_samples` is the graph parameter of that name: 0 integrates analytically
+// (LTC), n > 0 by n x n quadrature.
+vec3 shade_area_lights(Surface s, Material m, uint area_samples) {
     vec3 c = vec3(0.0);
 #ifdef SHADE_AREA_LIGHTS
     for (uint i = frame.counts.x + frame.counts.y + frame.counts.z; i < frame.counts.w; ++i) {
-        c += shade_area(i, s, m);
+        if (area_samples == 0u) {
+            c += shade_area_ltc(i, s, m);
+        } else {
+            c += shade_area_quadrature(i, s, m, area_samples);
+        }
     }
 #endif
     return c;
 }
 
-vec3 shade_all_lights(Surface s, Material m) {
+vec3 shade_all_lights(Surface s, Material m, uint area_samples) {
     vec3 c = shade_suns(s, m);
 #ifdef SHADE_POINT_LIGHTS
     for (uint i = frame.counts.x; i < frame.counts.x + frame.counts.y; ++i) {
@@ -347,7 +412,7 @@ vec3 shade_all_lights(Surface s, Material m) {
         c += shade_spot(i, s, m);
     }
 #endif
-    return c + shade_area_lights(s, m);
+    return c + shade_area_lights(s, m, area_samples);
 }
 
 // What the surface shows without any direct light: the suns' ambient on its

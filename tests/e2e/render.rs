@@ -41,9 +41,19 @@ fn forward_renders_the_demo_scene_cleanly_and_matches_its_golden() {
             "tonemap"
         ]
     );
-    // Nine meshes placed (box parts, dragon, bunny, sphere) drawn by the shading pass
-    // and by the shadow pass once per view (the sun and the spot).
-    assert_eq!(out.draw_calls, 27);
+    // Nine meshes placed (box parts, dragon, bunny, sphere), each drawn by the
+    // shading pass and by the shadow pass once per view (the sun and the spot)
+    // unless it lies outside that view's frustum: the spot's view leaves out
+    // three meshes and the camera one.
+    assert_eq!(
+        out.culling,
+        [
+            ("shadow_sun[0]".to_string(), 9, 0),
+            ("shadow_sun[1]".to_string(), 6, 3),
+            ("forward".to_string(), 8, 1),
+        ]
+    );
+    assert_eq!(out.draw_calls, 23);
     assert_golden(&out.image, "demo_forward_320x180.png");
 }
 

@@ -40,6 +40,8 @@ pub struct Output {
     /// Passes that ran, in order.
     pub passes: Vec<String>,
     pub draw_calls: u64,
+    /// Per view: (name, meshes drawn, meshes culled by the view's frustum).
+    pub culling: Vec<(String, u64, u64)>,
 }
 
 /// Renders `scene` through `graph` at `width`x`height` with validation and
@@ -75,6 +77,11 @@ pub fn render_validated(
             .map(|p| p.name.clone())
             .collect(),
         draw_calls: rendered.draw_calls,
+        culling: rendered
+            .culling
+            .iter()
+            .map(|c| (c.view.clone(), c.drawn, c.culled))
+            .collect(),
     }
 }
 

@@ -65,6 +65,9 @@ pub const MATERIAL_TEXTURES_BINDING: u32 = 18;
 /// Binding of the corners' world tangents (`TriangleTangents`, a vec4 each,
 /// w the bitangent's sign).
 pub const TRIANGLE_TANGENTS_BINDING: u32 = 19;
+/// Binding of the LTC tables analytic area lights read (`LtcTables` in
+/// `shaders/include/ltc.glsl`, [`ltc_table_words`]).
+pub const LTC_TABLES_BINDING: u32 = 20;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -73,7 +76,7 @@ pub const METALLIC_ROUGHNESS_BINDING: u32 = 1;
 pub const NORMAL_BINDING: u32 = 2;
 /// Set 1 as the engine creates and writes it: binding, descriptor kind and
 /// what it holds (for the shader check's messages).
-pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 5] = [
+pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 6] = [
     (
         FRAME_BINDING,
         DescriptorKind::UniformBuffer,
@@ -95,7 +98,27 @@ pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 5] = [
         DescriptorKind::StorageBuffer,
         "the shadow views",
     ),
+    (
+        LTC_TABLES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the area-light LTC tables",
+    ),
 ];
+
+/// The LTC tables as `ltc.glsl` reads them, in vec4s: the GGX inverses, the
+/// GGX (integral, Fresnel moment, 0, 0), then the same for Blinn-Phong.
+pub fn ltc_table_words(tables: &weft_ltc::tables::Tables) -> Vec<f32> {
+    let mut words = Vec::with_capacity(4 * 4 * tables.ggx.len());
+    for table in [&tables.ggx, &tables.blinn_phong] {
+        words.extend(table.iter().flat_map(|e| e.inverse));
+        words.extend(
+            table
+                .iter()
+                .flat_map(|e| [e.magnitude, e.fresnel, 0.0, 0.0]),
+        );
+    }
+    words
+}
 /// Set 1 bindings for ray tracing: built only when a compute pass that
 /// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
@@ -277,6 +300,7 @@ pub struct GpuScene<'g> {
     frame: Buffer<'g>,
     lights: Buffer<'g>,
     shadows: Buffer<'g>,
+    ltc_tables: Buffer<'g>,
     textures: Vec<Texture<'g>>,
     sampler: Sampler<'g>,
     pool: DescriptorPool<'g>,
@@ -398,6 +422,11 @@ impl<'g> GpuScene<'g> {
         )?;
         let mut shadows = Buffer::host(gpu, "shadows", shadows::SHADOWS_BYTES as u64, storage)?;
         shadows.write(&vec![0u8; shadows::SHADOWS_BYTES])?;
+        let tables = weft_ltc::tables::committed()
+            .map_err(|e| GpuError::Plan(format!("the built-in LTC tables: {e}")))?;
+        let words = ltc_table_words(&tables);
+        let mut ltc_tables = Buffer::host(gpu, "ltc_tables", (words.len() * 4) as u64, storage)?;
+        ltc_tables.write(bytes_of(&words))?;
         let sampler = Sampler::linear_repeat(gpu)?;
         let (scene_layout, material_layout) = set_layouts(gpu)?;
         let pool = descriptor_pool(gpu, material_texture.len() as u32)?;
@@ -411,6 +440,7 @@ impl<'g> GpuScene<'g> {
             frame,
             lights,
             shadows,
+            ltc_tables,
             textures,
             sampler,
             pool,
@@ -450,6 +480,7 @@ impl<'g> GpuScene<'g> {
                 DRAWS_BINDING,
                 MATERIALS_BINDING,
                 SHADOWS_BINDING,
+                LTC_TABLES_BINDING,
             ],
         );
         for slots in material_texture {
@@ -590,6 +621,7 @@ impl<'g> GpuScene<'g> {
             DRAWS_BINDING => Some(&self.draws),
             MATERIALS_BINDING => Some(&self.materials),
             SHADOWS_BINDING => Some(&self.shadows),
+            LTC_TABLES_BINDING => Some(&self.ltc_tables),
             TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.triangles),
             BVH_NODES_BINDING => self.trace.as_ref().map(|t| &t.nodes),
             BVH_TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.order),
