@@ -14,6 +14,10 @@ layout(std430, set = 0, binding = 1) writeonly buffer TileLights { uint words[];
 // Debug output (feature light_heatmap): each pixel's tile count, r + 256 g + 65536 b.
 layout(set = 0, binding = 2, rgba8) uniform writeonly image2D light_counts;
 #endif
+#ifdef HAS_LIGHT_COUNT_MAX
+// Debug output (feature light_heatmap): the frame's largest tile count.
+layout(std430, set = 0, binding = 3) buffer LightCountMax { uint value; } light_count_max;
+#endif
 layout(push_constant) uniform Push { uint max_per_tile; } pc;
 
 #include "include/tiles.glsl"
@@ -118,6 +122,9 @@ void main() {
         tile_lights.words[record] = count;
         tile_lights.words[record + 1u] = points_kept;
         tile_lights.words[record + 2u] = spots_kept;
+#ifdef HAS_LIGHT_COUNT_MAX
+        atomicMax(light_count_max.value, count);
+#endif
     }
 #ifdef HAS_LIGHT_COUNTS
     if (inside) {

@@ -1,13 +1,16 @@
 #version 450
 // Debug view (feature light_heatmap): lights per tile over the tonemapped image,
 // blended at 60%, with a legend in the bottom-left corner: an opaque black box
-// holding a colour bar from 0 to `heatmap_max` lights and the labels 0,
-// heatmap_max / 2 and heatmap_max drawn with a built-in 3x5 digit font at 2x.
-// Counts at or above heatmap_max show the bar's top colour. Layout, in pixels
+// holding a colour bar from 0 to the scale's top and the labels 0, top / 2 and
+// top drawn with a built-in 3x5 digit font at 2x. The top is the frame's
+// largest tile count (light_count_max, raised by light_cull.comp), or the
+// `heatmap_max` parameter when it is above 0; counts above it show the bar's
+// top colour. Layout, in pixels
 // from the bottom-left corner of the image: box x 8..8+bar+16, y 8..48; bar
 // x 16..16+bar, 28..40 from the bottom; labels' tops 24 px from the bottom; bar =
 // clamp(width / 4, 64, 256). The render tests check this layout.
 layout(set = 0, binding = 0) uniform sampler2D light_counts;
+layout(std430, set = 0, binding = 1) readonly buffer LightCountMax { uint value; } light_count_max;
 layout(push_constant) uniform Push { uint heatmap_max; } pc;
 
 layout(location = 0) in vec2 uv;
@@ -69,13 +72,14 @@ void main() {
     // From the bottom-left corner.
     ivec2 p = ivec2(frag.x, size.y - 1 - frag.y);
     int bar = clamp(size.x / 4, 64, 256);
-    float top = float(max(pc.heatmap_max, 1u));
+    uint top_count = max(pc.heatmap_max > 0u ? pc.heatmap_max : light_count_max.value, 1u);
+    float top = float(top_count);
     if (p.x >= 8 && p.x < 24 + bar && p.y >= 8 && p.y < 48) {
         vec3 c = vec3(0.0);
         if (p.x >= 16 && p.x < 16 + bar && p.y >= 28 && p.y < 40) {
             c = heat(float(p.x - 16) / float(bar - 1));
         }
-        uint labels[3] = uint[3](0u, pc.heatmap_max / 2u, pc.heatmap_max);
+        uint labels[3] = uint[3](0u, top_count / 2u, top_count);
         for (int i = 0; i < 3; ++i) {
             int width = int(decimal_digits(labels[i])) * 8 - 2;
             int centre = 16 + (bar - 1) * i / 2;

@@ -2,9 +2,13 @@
 //! on (zero messages): a floating box's shadow on a plane lands where the sun's
 //! direction predicts; a lit plane shows no acne at the default bias; widening
 //! PCF never narrows the penumbra; every configuration (forward or deferred,
-//! shadows and bloom on or off) runs cleanly.
+//! shadows and bloom on or off) runs cleanly; a shadow view that did not change
+//! keeps its tile in the persistent shadow map, and the image is exactly what
+//! redrawing every tile gives.
 
 use weft_tests::render as common;
+
+use common::agreement;
 
 use glam::{Vec3, Vec4Swizzles};
 use std::path::{Path, PathBuf};
@@ -344,4 +348,92 @@ fn every_configuration_runs_without_validation_messages() {
             }
         }
     }
+}
+
+/// `graphs/<graph>` rewritten into `dir` to include `shadows` (a path)
+/// instead of the shipped shadow fragment.
+fn graph_including(dir: &Path, graph: &str, shadows: &Path) -> PathBuf {
+    let root = common::root().join("graphs");
+    let text = std::fs::read_to_string(root.join(graph))
+        .expect("graph")
+        .replace(
+            "(file: \"shadows.ron\"",
+            &format!("(file: \"{}\"", shadows.display()),
+        )
+        .replace(
+            "(file: \"bloom.ron\"",
+            &format!("(file: \"{}\"", root.join("bloom.ron").display()),
+        )
+        .replace(
+            "(file: \"gbuffer.ron\"",
+            &format!("(file: \"{}\"", root.join("gbuffer.ron").display()),
+        )
+        .replace(
+            "\"../shaders/",
+            &format!("\"{}/", common::root().join("shaders").display()),
+        );
+    let path = dir.join(graph);
+    std::fs::write(&path, text).expect("graph");
+    path
+}
+
+/// The last of three frames of the demo scene (its spot swivels, the sun and
+/// camera stand still) through `graph`: the image and each view's culling.
+fn three_frames(graph: &Path) -> (image::RgbaImage, Vec<weft_render::recorder::ViewCulling>) {
+    let scene = weft_scene::load_scene(&common::demo_scene()).expect("scene loads");
+    let gpu = weft_tests::gpu();
+    let log = gpu.validation();
+    let settings = RenderSettings {
+        graph: graph.to_path_buf(),
+        extent: Extent {
+            width: 160,
+            height: 90,
+        },
+        frames: 3,
+        features: vec!["!bloom".into()],
+        ..RenderSettings::default()
+    };
+    let rendered = render(&gpu, &scene, &settings).expect("renders");
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+    let image = rendered.report.output.expect("readback").to_rgba8();
+    (image, rendered.culling)
+}
+
+#[test]
+fn an_unchanged_shadow_view_keeps_its_tile_and_the_image_does_not_change() {
+    let dir = std::env::temp_dir().join(format!("weft-kept-tiles-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    // The same shadows, cleared and redrawn every frame.
+    let cleared = dir.join("shadows_cleared.ron");
+    let shipped =
+        std::fs::read_to_string(common::root().join("graphs/shadows.ron")).expect("shadows.ron");
+    let text = shipped
+        .replace(", persistent: true)", ")")
+        .replace("load: Load)", "load: Clear([1.0]))")
+        .replace(
+            "\"../shaders/",
+            &format!("\"{}/", common::root().join("shaders").display()),
+        );
+    assert_ne!(text, shipped, "the shipped fragment keeps tiles");
+    std::fs::write(&cleared, text).expect("write");
+    for graph in ["forward.ron", "deferred.ron"] {
+        let (kept, culling) = three_frames(&common::graph(graph));
+        let shadow_views: Vec<(&str, bool)> = culling
+            .iter()
+            .filter(|c| c.view.starts_with("shadow_sun"))
+            .map(|c| (c.view.as_str(), c.kept))
+            .collect();
+        // The sun's view is unchanged since the last frame and keeps its
+        // tile; the swivelling spot's view is drawn again.
+        assert_eq!(
+            shadow_views,
+            [("shadow_sun[0]", true), ("shadow_sun[1]", false)],
+            "{graph}"
+        );
+        let (redrawn, culling) = three_frames(&graph_including(&dir, graph, &cleared));
+        assert!(culling.iter().all(|c| !c.kept), "{culling:?}");
+        assert_eq!(agreement(&kept, &redrawn).max, 0, "{graph}");
+    }
+    std::fs::remove_dir_all(&dir).expect("clean up");
 }

@@ -340,6 +340,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
                 "view": c.view,
                 "drawn": c.drawn,
                 "culled": c.culled,
+                "kept": c.kept,
             })).collect::<Vec<_>>(),
             "record_ms": record_ms,
             "frame_ms": frame_ms,
@@ -386,7 +387,13 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             let views: Vec<String> = rendered
                 .culling
                 .iter()
-                .map(|c| format!("{} {} of {}", c.view, c.culled, c.drawn + c.culled))
+                .map(|c| {
+                    if c.kept {
+                        format!("{} kept from the last frame", c.view)
+                    } else {
+                        format!("{} {} of {}", c.view, c.culled, c.drawn + c.culled)
+                    }
+                })
                 .collect();
             println!("meshes outside each view, not drawn: {}", views.join("; "));
         }

@@ -81,6 +81,27 @@ impl<'a> Commands<'a> {
         }
     }
 
+    /// Sets the current subpass's depth attachment to `depth` inside `area`,
+    /// within a render pass (`vkCmdClearAttachments`).
+    pub fn clear_depth(&self, area: vk::Rect2D, depth: f32) {
+        let attachment = vk::ClearAttachment {
+            aspect_mask: vk::ImageAspectFlags::DEPTH,
+            color_attachment: 0,
+            clear_value: vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue { depth, stencil: 0 },
+            },
+        };
+        let rect = vk::ClearRect {
+            rect: area,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        unsafe {
+            self.device
+                .cmd_clear_attachments(self.cmd, &[attachment], &[rect])
+        }
+    }
+
     /// An indexed draw of one instance, `first_instance` passed through.
     pub fn draw_indexed(
         &self,

@@ -113,6 +113,11 @@ pub struct ImageDecl {
     /// Persists from the previous frame: reads before this frame's writer see last frame's contents.
     #[serde(default)]
     pub history: bool,
+    /// Kept across frames in memory of its own, but written and read in the
+    /// usual order within a frame: a pass that loads it sees what the
+    /// previous frame left (shadow-map tiles that did not change).
+    #[serde(default)]
+    pub persistent: bool,
 }
 
 fn one_dim() -> Dim {

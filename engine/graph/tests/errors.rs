@@ -461,7 +461,7 @@ const COMPUTE: &str = r#"Graph(
 /// gives them: each case is (base graph, edit, message, text at the location).
 #[test]
 fn out_of_range_values_are_located_errors() {
-    let cases: [(&str, (&str, &str), &str, &str); 18] = [
+    let cases: [(&str, (&str, &str), &str, &str); 19] = [
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([2.0])"#),
             "a depth clear must be in [0, 1], found 2", "Clear([2.0])"),
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([NaN])"#),
@@ -494,6 +494,8 @@ fn out_of_range_values_are_located_errors() {
         (VALID, (r#"            depth: (image: "depth", load: Clear([0.0])),
 "#, "            raster: (depth_clamp: true),\n"),
             "`depth_clamp` needs a depth attachment, and the pass has none", "true)"),
+        (VALID, (r#"format: R8G8B8A8_UNORM)"#, r#"format: R8G8B8A8_UNORM, history: true, persistent: true)"#),
+            "\"albedo\" is both `history` (read before this frame writes it) and `persistent` (written, then read); choose one", "true)"),
         (VALID, (r#"output: "ldr","#, r#"output: "ldr", readback: ["ldr", "albdo"],"#),
             "unknown resource \"albdo\"", r#""albdo"]"#),
         (COMPUTE, ("Output(8, 8)", "Output(0, 16)"),

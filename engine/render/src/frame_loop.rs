@@ -143,6 +143,7 @@ impl<'g> FrameLoop<'g> {
     /// Runs `plan` from the next frame, on `resources` made for it.
     pub fn swap_plan(&mut self, plan: Arc<Plan>, resources: FrameResources<'g>) {
         self.accumulation.reset();
+        self.recorder.forget_shadow_tiles();
         self.resources = resources;
         self.plan = plan;
     }

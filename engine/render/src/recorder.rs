@@ -20,6 +20,7 @@ use weft_gpu::descriptors::{write_graph_set, DescriptorPool};
 use weft_gpu::pipeline::{BlendCode, Pipeline, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, ShaderStage, SCENE_SET};
+use weft_graph::plan::LoadOp;
 use weft_graph::schema::{CompareOp, Draw, LightKind, MaterialFilter, ParamValue};
 
 /// The most light volumes (point spheres, spot cones and spheres) one pass
@@ -77,6 +78,27 @@ pub struct SceneRecorder<'g> {
     pub draw_calls: u64,
     /// Meshes drawn and culled per view in the current frame.
     pub culling: Vec<ViewCulling>,
+    /// Per shadow view, what its atlas tile holds from an earlier frame.
+    shadow_tiles: Vec<Option<ShadowTile>>,
+}
+
+/// What a shadow view drew into its atlas tile: the tile is kept while a
+/// later frame's view is bit-identical (same world-to-clip matrix, same
+/// rectangle) and nothing else changed; [`SceneRecorder::forget_shadow_tiles`]
+/// drops every kept tile (a new plan, scene or shader).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct ShadowTile {
+    clip: [u32; 16],
+    viewport: [u32; 3],
+}
+
+impl ShadowTile {
+    fn of(view: &crate::shadows::ShadowView) -> Self {
+        Self {
+            clip: view.clip.to_cols_array().map(f32::to_bits),
+            viewport: view.viewport,
+        }
+    }
 }
 
 /// How many meshes one view drew and how many it left out because their
@@ -89,6 +111,9 @@ pub struct ViewCulling {
     pub drawn: u64,
     /// Meshes outside the view.
     pub culled: u64,
+    /// Whether the view drew nothing because its shadow-map tile from the
+    /// previous frame still holds (same view, nothing changed).
+    pub kept: bool,
 }
 
 impl<'g> SceneRecorder<'g> {
@@ -112,7 +137,14 @@ impl<'g> SceneRecorder<'g> {
             frame: FrameValues::default(),
             draw_calls: 0,
             culling: Vec::new(),
+            shadow_tiles: Vec::new(),
         })
+    }
+
+    /// Forgets every shadow tile kept from earlier frames, so the next frame
+    /// draws every shadow view (its plan, scene or shaders changed).
+    pub fn forget_shadow_tiles(&mut self) {
+        self.shadow_tiles.clear();
     }
 
     /// Sets the `time`, `frame` and `history_frames` values push constants receive.
@@ -127,12 +159,14 @@ impl<'g> SceneRecorder<'g> {
     /// Returns how many were dropped.
     pub fn reload(&mut self, changed: &std::path::Path) -> Result<usize, GpuError> {
         self.gpu.wait_idle()?;
+        self.forget_shadow_tiles();
         Ok(self.pipelines.invalidate(self.gpu.device(), changed))
     }
 
     /// Takes a shader variant a hot reload already compiled and checked, so the
     /// next frame only builds its pipeline.
     pub fn adopt(&mut self, key: ShaderKey, module: Arc<ShaderModule>) {
+        self.forget_shadow_tiles();
         self.pipelines.adopt(key, module);
     }
 
@@ -216,6 +250,7 @@ impl<'g> SceneRecorder<'g> {
                 view,
                 drawn,
                 culled,
+                kept: false,
             }),
         }
         inside
@@ -296,8 +331,44 @@ impl SceneRecorder<'_> {
             message: "shadow pass without push constants".into(),
         })?;
         let commands = ctx.commands();
+        // A shadow map that loads what the last frame left (a `history` image)
+        // keeps the tiles of views that did not change; one that is cleared
+        // draws every view.
+        let keeps_tiles = pass
+            .render_pass
+            .as_ref()
+            .and_then(|rp| rp.depth.and_then(|d| rp.attachments.get(d)))
+            .is_some_and(|a| a.load == LoadOp::Load);
+        if !keeps_tiles {
+            self.shadow_tiles.clear();
+        }
+        if keeps_tiles && self.shadow_tiles.len() != views.len() {
+            // A new atlas layout (or the first frame): nothing kept, and the
+            // texels between tiles, which filtering at tile edges reads, are
+            // set too, as a cleared map would have them.
+            self.shadow_tiles = vec![None; views.len()];
+            commands.clear_depth(
+                vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent: ctx.extent,
+                },
+                1.0,
+            );
+        }
+        self.shadow_tiles.resize(views.len(), None);
         let mut calls = 0;
         for (i, view) in views.iter().enumerate() {
+            let tile = ShadowTile::of(view);
+            let name = format!("{}[{i}]", pass.name);
+            if keeps_tiles && self.shadow_tiles[i] == Some(tile) {
+                self.culling.push(ViewCulling {
+                    view: name,
+                    drawn: 0,
+                    culled: 0,
+                    kept: true,
+                });
+                continue;
+            }
             let mut params = pass.params.clone();
             params.insert(SHADOW_VIEW.to_string(), ParamValue::Number(i as f64));
             let bytes =
@@ -306,7 +377,7 @@ impl SceneRecorder<'_> {
                     message: problems.join("; "),
                 })?;
             let [x, y, side] = view.viewport;
-            commands.set_viewport_and_scissor(vk::Rect2D {
+            let area = vk::Rect2D {
                 offset: vk::Offset2D {
                     x: x as i32,
                     y: y as i32,
@@ -315,10 +386,16 @@ impl SceneRecorder<'_> {
                     width: side,
                     height: side,
                 },
-            });
+            };
+            commands.set_viewport_and_scissor(area);
+            if keeps_tiles {
+                // The tile holds an older view (or nothing yet): start it afresh.
+                commands.clear_depth(area, 1.0);
+            }
             commands.push_constants(p.layout, *stages, &bytes);
-            let draws = self.visible(format!("{}[{i}]", pass.name), view.clip, filter);
+            let draws = self.visible(name, view.clip, filter);
             calls += self.draw_meshes(ctx.cmd, p, draws.iter());
+            self.shadow_tiles[i] = Some(tile);
         }
         Ok(calls)
     }

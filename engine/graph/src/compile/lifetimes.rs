@@ -90,7 +90,7 @@ impl Timeline {
         let next = touches.partition_point(|t| t.0 <= i);
         match touches.get(next) {
             Some(&(_, p, k)) => uses[p][k].reads_previous || !uses[p][k].discards,
-            None => is_root[r] || ir.resources[r].history,
+            None => is_root[r] || ir.resources[r].kept_across_frames(),
         }
     }
 }
@@ -105,7 +105,7 @@ fn warn_unread(
     warnings: &mut Vec<Diagnostic>,
 ) {
     for (r, res) in ir.resources.iter_enumerated() {
-        if is_root[r] || res.history {
+        if is_root[r] || res.kept_across_frames() {
             continue;
         }
         let touches = &timeline.per_resource[r];

@@ -193,7 +193,7 @@ pub fn order(ir: &Ir, live: &IdVec<IrPassId, bool>, uses: &Uses) -> Result<Order
                 });
             }
         }
-        if resource.history {
+        if resource.kept_across_frames() {
             continue;
         }
         match w.first() {

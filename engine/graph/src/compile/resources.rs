@@ -33,7 +33,7 @@ pub(crate) fn describe(
         let res = &ir.resources[r];
         let residency = if roots.is_root[r] {
             Residency::Output
-        } else if res.history {
+        } else if res.kept_across_frames() {
             Residency::History
         } else {
             Residency::Transient

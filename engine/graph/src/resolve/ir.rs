@@ -26,6 +26,15 @@ pub struct IrResource {
     pub index: usize,
     pub kind: IrKind,
     pub history: bool,
+    /// Kept across frames, written before it is read ([`crate::schema::ImageDecl::persistent`]).
+    pub persistent: bool,
+}
+
+impl IrResource {
+    /// Whether the contents outlive the frame (history or persistent).
+    pub fn kept_across_frames(&self) -> bool {
+        self.history || self.persistent
+    }
 }
 
 /// Image or buffer specifics.

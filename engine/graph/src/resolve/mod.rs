@@ -137,6 +137,7 @@ impl<'a> Resolver<'a> {
                         index: k,
                         kind: IrKind::External,
                         history: false,
+                        persistent: false,
                     });
                     self.resource_index.insert(name, id);
                 } else {

@@ -13,6 +13,16 @@ impl Resolver<'_> {
         let (source, index) = (r.source, r.index);
         match &r.item {
             ResourceDecl::Image(img) => {
+                if img.history && img.persistent {
+                    self.error(
+                        source,
+                        &resource_path(index, &[Seg::Field("persistent")]),
+                        format!(
+                            "\"{}\" is both `history` (read before this frame writes it) and `persistent` (written, then read); choose one",
+                            img.name
+                        ),
+                    );
+                }
                 let Some(format) = format_by_name(&img.format.0) else {
                     let (file, pos) = self
                         .graph
@@ -38,6 +48,7 @@ impl Resolver<'_> {
                         index,
                         kind: IrKind::External,
                         history: img.history,
+                        persistent: img.persistent,
                     };
                 };
                 let size_path = resource_path(index, &[Seg::Field("size")]);
@@ -105,6 +116,7 @@ impl Resolver<'_> {
                         samples,
                     },
                     history: img.history,
+                    persistent: img.persistent,
                 }
             }
             ResourceDecl::Buffer(buf) => {
@@ -152,6 +164,7 @@ impl Resolver<'_> {
                     index,
                     kind: IrKind::Buffer { size },
                     history: buf.history,
+                    persistent: false,
                 }
             }
         }
