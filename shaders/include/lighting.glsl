@@ -34,6 +34,12 @@
 #ifdef SCENE_AREA_LIGHTS
 #define SHADE_AREA_LIGHTS
 #endif
+#ifdef SCENE_RECT_LIGHTS
+#define SHADE_RECT_LIGHTS
+#endif
+#ifdef SCENE_DISC_LIGHTS
+#define SHADE_DISC_LIGHTS
+#endif
 #ifdef SCENE_BLINN_PHONG
 #define SHADE_BLINN_PHONG
 #endif
@@ -48,6 +54,8 @@
 #define SHADE_POINT_LIGHTS
 #define SHADE_SPOT_LIGHTS
 #define SHADE_AREA_LIGHTS
+#define SHADE_RECT_LIGHTS
+#define SHADE_DISC_LIGHTS
 #define SHADE_BLINN_PHONG
 #define SHADE_METALLIC_ROUGHNESS
 #define SHADE_NORMAL_MAPS
@@ -298,7 +306,15 @@ vec3 shade_area_ltc(uint index, Surface s, Material m) {
     vec3 centre = lights[index].position_range.xyz - s.position;
     vec3 x = lights[index].direction_type.xyz;
     vec3 y = lights[index].attenuation_cos.xyz;
+    // Only the shapes the scene has are compiled: lavapipe would run a
+    // 12-gon's corners for every rectangle otherwise.
+#if defined(SHADE_RECT_LIGHTS) && defined(SHADE_DISC_LIGHTS)
     bool disc = lights[index].direction_type.w == LIGHT_AREA_DISC;
+#elif defined(SHADE_DISC_LIGHTS)
+    const bool disc = true;
+#else
+    const bool disc = false;
+#endif
     // The light emits towards -(x cross y); a one-sided light seen from behind gives nothing.
     float side = dot(centre, cross(x, y)) >= 0.0 ? 1.0 : -1.0;
     if (side < 0.0 && lights[index].color_exponent.w <= 0.5) {

@@ -221,7 +221,13 @@ fn number_spans(text: &str) -> Vec<(usize, usize)> {
 /// The shipped files a mutant may edit, relative to the repository root.
 fn mutable_files() -> Vec<PathBuf> {
     let mut files = Vec::new();
-    for dir in ["graphs", "shaders", "shaders/include"] {
+    for dir in [
+        "graphs",
+        "graphs/bench",
+        "shaders",
+        "shaders/include",
+        "shaders/bench",
+    ] {
         let mut found: Vec<PathBuf> = std::fs::read_dir(root().join(dir))
             .expect("read dir")
             .map(|e| e.expect("entry").path())
@@ -278,7 +284,13 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
         .into_iter()
         .filter(|r| {
             let mut text = text_of(r);
-            for fragment in ["shadows.ron", "bloom.ron", "gbuffer.ron"] {
+            for fragment in [
+                "shadows.ron",
+                "bloom.ron",
+                "gbuffer.ron",
+                "bench/mesh_floor.ron",
+                "bench/gbuffer_floor.ron",
+            ] {
                 if text.contains(fragment) {
                     text.push_str(&text_of(fragment));
                 }

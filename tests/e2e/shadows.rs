@@ -85,6 +85,10 @@ fn graph_with(dir: &Path, graph: &str, shadow_params: &str) -> PathBuf {
             &format!("(file: \"{}\"", root.join("gbuffer.ron").display()),
         )
         .replace(
+            "(file: \"bench/",
+            &format!("(file: \"{}/", root.join("bench").display()),
+        )
+        .replace(
             "\"../shaders/",
             &format!("\"{}/", common::root().join("shaders").display()),
         );
@@ -367,6 +371,10 @@ fn graph_including(dir: &Path, graph: &str, shadows: &Path) -> PathBuf {
         .replace(
             "(file: \"gbuffer.ron\"",
             &format!("(file: \"{}\"", root.join("gbuffer.ron").display()),
+        )
+        .replace(
+            "(file: \"bench/",
+            &format!("(file: \"{}/", root.join("bench").display()),
         )
         .replace(
             "\"../shaders/",

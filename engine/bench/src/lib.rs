@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 mod bloom;
 mod bvh;
+mod floors;
 mod lights;
 mod pathtrace;
 mod plot;
@@ -29,6 +30,8 @@ pub enum BenchCommand {
     Pathtrace(crate::pathtrace::PathtraceArgs),
     /// Whole-process `weft render` time, cold (`--no-cache`) against warm.
     Start(crate::start::StartArgs),
+    /// Each pass against its floor in the same frame (constant shading, a G-buffer read).
+    Floors(crate::floors::FloorsArgs),
 }
 
 /// Runs `weft bench ...`.
@@ -40,5 +43,6 @@ pub fn run(cmd: BenchCommand) -> Result<ExitCode> {
         BenchCommand::Bvh(args) => crate::bvh::run(args),
         BenchCommand::Pathtrace(args) => crate::pathtrace::run(args),
         BenchCommand::Start(args) => crate::start::run(args),
+        BenchCommand::Floors(args) => crate::floors::run(args),
     }
 }

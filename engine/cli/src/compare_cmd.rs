@@ -305,7 +305,7 @@ fn reference(
             )])
             .collect(),
         cache_dir: weft_scene::cache::user_cache_dir(),
-        extra_readback: weft_graph::load(&common.reference).readback,
+        extra_readback: weft_graph::load(&common.reference).readback_names(),
         ..RenderSettings::default()
     };
     let info = |cached, image, seconds| ReferenceInfo {
@@ -487,7 +487,7 @@ impl Session {
                 Timer::Gpu => TimingMode::GpuTimestamps,
                 Timer::Cpu => TimingMode::CpuPerPass,
             },
-            extra_readback: weft_graph::load(graph).readback,
+            extra_readback: weft_graph::load(graph).readback_names(),
             cache_dir: weft_scene::cache::user_cache_dir(),
             ..RenderSettings::default()
         };

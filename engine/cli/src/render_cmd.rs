@@ -142,7 +142,7 @@ pub fn parse_time(text: &str) -> Result<f32, String> {
 /// graph's own `readback` list.
 fn readback_names(args: &RenderArgs) -> Vec<String> {
     if args.readback.is_empty() {
-        weft_graph::load(&args.graph).readback
+        weft_graph::load(&args.graph).readback_names()
     } else {
         args.readback.clone()
     }

@@ -20,7 +20,13 @@ impl Copy {
         let dir =
             std::env::temp_dir().join(format!("weft-iface-{}-{name}-{n}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        for sub in ["graphs", "shaders", "shaders/include"] {
+        for sub in [
+            "graphs",
+            "graphs/bench",
+            "shaders",
+            "shaders/include",
+            "shaders/bench",
+        ] {
             std::fs::create_dir_all(dir.join(sub)).expect("temp dir");
             for entry in std::fs::read_dir(repo().join(sub)).expect("read dir") {
                 let path = entry.expect("entry").path();

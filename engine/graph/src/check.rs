@@ -27,6 +27,7 @@ pub fn check(graph: &LoadedGraph) -> Vec<Diagnostic> {
             let label = describe(&names, features);
             let options = CompileOptions {
                 features: features.clone(),
+                readback: graph.readback_names(),
                 ..CompileOptions::default()
             };
             let diagnostics = match compile_ir(graph, &ir, &options) {

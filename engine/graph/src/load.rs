@@ -38,8 +38,9 @@ pub struct LoadedGraph {
     pub passes: Vec<Located<PassDecl>>,
     /// The output image name, from the root file.
     pub output: Option<String>,
-    /// Images tools read back besides the output, from the root file.
-    pub readback: Vec<String>,
+    /// Images tools read back besides the output, from the root file (some
+    /// only under features).
+    pub readback: Vec<crate::schema::ReadDecl>,
     /// How the graph accumulates over frames, from the root file.
     pub progressive: Option<crate::schema::Progressive>,
     /// Human-readable name.
@@ -55,6 +56,13 @@ pub struct LoadedGraph {
 }
 
 impl LoadedGraph {
+    /// The names of the images the graph reads back besides its output, as
+    /// tools ask for them; entries under features the compile does not have
+    /// are dropped by the compiler.
+    pub fn readback_names(&self) -> Vec<String> {
+        self.readback.iter().map(|r| r.name().to_string()).collect()
+    }
+
     /// Where the value at `path` inside `source` is, as a file and position.
     pub fn locate(&self, source: usize, path: &[Seg]) -> (PathBuf, Pos) {
         match self.sources.get(source) {

@@ -39,9 +39,10 @@ pub struct GraphFile {
     pub output: Option<String>,
     /// Images besides the output that tools read back, first the linear
     /// image an `.exr` output is written from (`weft render --out F.exr`);
-    /// `--readback` replaces the list.
+    /// `--readback` replaces the list. An entry may hold only under features:
+    /// `(name: "floor_mesh_color", enabled_if: ["bench_floors"])`.
     #[serde(default)]
-    pub readback: Vec<String>,
+    pub readback: Vec<ReadDecl>,
     /// Marks a graph whose output converges over frames (a path tracer): each
     /// frame adds `samples_per_frame` samples per pixel to its history images,
     /// so tools can render to a sample count and the viewer can show it.

@@ -144,6 +144,8 @@ fn scene_features_cull_passes_and_variants() {
             ("shadow_sun", "enabled_if [shadow_casters] is false"),
             ("bloom_naive_h", "enabled_if [bloom_naive] is false"),
             ("bloom_naive_v", "enabled_if [bloom_naive] is false"),
+            ("floor_meshes", "enabled_if [bench_floors] is false"),
+            ("floor_gbuffer_read", "enabled_if [bench_floors] is false"),
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
             ("area_lights", "enabled_if [area_lights] is false"),

@@ -5,13 +5,13 @@ use crate::lights::CONE_MAX_ANGLE;
 use crate::materials::{coat, dielectric, is_mirror, matches};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::material::ShadingModel;
-use weft_scene::{Light, Scene};
+use weft_scene::{AreaShape, Light, Scene};
 
 /// The features `scene` switches on: `shadow_casters` when a placed mesh casts
 /// and a light casts shadows (a sun, or a spot narrow enough for a cone),
 /// `suns` / `point_lights` / `spot_lights` when there are such lights, `emissive` when a
 /// placed mesh glows, `transparent` when a placed mesh blends, `area_lights` when
-/// there are area lights, `punctual_lights` when there is a sun, point or spot
+/// there are area lights (`rect_lights` / `disc_lights` by shape), `punctual_lights` when there is a sun, point or spot
 /// light; and by the shading models placed meshes use (so shaders compile only
 /// the models a scene has): `blinn_phong` for any material raster passes shade
 /// with Blinn-Phong (MTL materials, mirrors and coats included), `glossy` for a
@@ -63,6 +63,17 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     }
     if scene.lights.iter().any(|l| matches!(l, Light::Area(_))) {
         features.push("area_lights".to_string());
+    }
+    let area_shape = |disc: bool| {
+        scene.lights.iter().any(
+            |l| matches!(l, Light::Area(a) if matches!(a.shape, AreaShape::Disc { .. }) == disc),
+        )
+    };
+    if area_shape(false) {
+        features.push("rect_lights".to_string());
+    }
+    if area_shape(true) {
+        features.push("disc_lights".to_string());
     }
     if scene
         .lights

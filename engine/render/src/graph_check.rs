@@ -31,6 +31,7 @@ pub fn check_graph_and_shaders(graph: &LoadedGraph) -> Result<Vec<Diagnostic>, G
     for features in feature_sets(&names) {
         let options = CompileOptions {
             features,
+            readback: graph.readback_names(),
             ..CompileOptions::default()
         };
         let Ok(mut plan) = prepared.compile(&options) else {

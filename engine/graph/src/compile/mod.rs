@@ -118,6 +118,23 @@ pub fn compile(graph: &LoadedGraph, options: &CompileOptions) -> Result<Plan, Ve
 }
 
 /// Whether every condition (`"name"` on, `"!name"` off) holds.
+/// The images asked for, less those the graph reads back only under
+/// features that do not hold (names the graph does not list are kept).
+fn readback_for(graph: &LoadedGraph, asked: &[String], features: &BTreeSet<String>) -> Vec<String> {
+    asked
+        .iter()
+        .filter(|name| {
+            graph.readback.iter().all(|r| match r {
+                crate::schema::ReadDecl::Conditional(c) if &c.name == *name => {
+                    conditions_hold(&c.enabled_if, features)
+                }
+                _ => true,
+            })
+        })
+        .cloned()
+        .collect()
+}
+
 pub fn conditions_hold(conditions: &[String], features: &BTreeSet<String>) -> bool {
     conditions.iter().all(|c| match c.strip_prefix('!') {
         Some(name) => !features.contains(name),
@@ -173,7 +190,8 @@ pub fn compile_ir(
         )]);
     };
     let ordered = order::order_live(graph, ir, &options.features)?;
-    let roots = cull::roots(graph, ir, output, &options.readback, &ordered)?;
+    let readback = readback_for(graph, &options.readback, &options.features);
+    let roots = cull::roots(graph, ir, output, &readback, &ordered)?;
     let cull::Culled {
         sequence,
         culled,

@@ -206,7 +206,8 @@ impl<'a> Resolver<'a> {
 
     /// Every name in the graph's `readback` list is one of its images.
     fn check_readback(&mut self, resources: &IdVec<IrResourceId, IrResource>) {
-        for (i, name) in self.graph.readback.iter().enumerate() {
+        let names = self.graph.readback_names();
+        for (i, name) in names.iter().enumerate() {
             let path = [Seg::Field("readback"), Seg::Index(i)];
             match self.resource_index.get(name.as_str()) {
                 Some(&r) if matches!(resources[r].kind, IrKind::Buffer { .. }) => {
