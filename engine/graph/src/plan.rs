@@ -179,6 +179,9 @@ pub struct PlanPass {
     pub params: BTreeMap<String, ParamValue>,
     /// Preprocessor defines selecting the shader variant (`HAS_SHADOW_MAP`, ...).
     pub defines: Vec<String>,
+    /// How many define sets the pass's features can give its shaders (the
+    /// variant this plan compiles is one of them), at most 2^12.
+    pub variants: u64,
     /// Barriers recorded before the pass, batched into one `vkCmdPipelineBarrier2`.
     pub barriers: Vec<Barrier>,
     /// The render pass for raster and fullscreen passes.

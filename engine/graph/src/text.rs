@@ -103,8 +103,17 @@ pub fn render(plan: &Plan) -> String {
         if let Some(d) = p.dispatch {
             let _ = writeln!(w, "     dispatch {}x{}x{}", d[0], d[1], d[2]);
         }
-        if !p.defines.is_empty() {
-            let _ = writeln!(w, "     defines {}", p.defines.join(" "));
+        if p.variants > 1 || !p.defines.is_empty() {
+            let _ = writeln!(
+                w,
+                "     defines {} (variant key; 1 of up to {} variants)",
+                if p.defines.is_empty() {
+                    "none".to_string()
+                } else {
+                    p.defines.join(" ")
+                },
+                p.variants
+            );
         }
     }
     if !plan.epilogue.is_empty() {

@@ -461,7 +461,7 @@ const COMPUTE: &str = r#"Graph(
 /// gives them: each case is (base graph, edit, message, text at the location).
 #[test]
 fn out_of_range_values_are_located_errors() {
-    let cases: [(&str, (&str, &str), &str, &str); 19] = [
+    let cases: [(&str, (&str, &str), &str, &str); 20] = [
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([2.0])"#),
             "a depth clear must be in [0, 1], found 2", "Clear([2.0])"),
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([NaN])"#),
@@ -496,6 +496,8 @@ fn out_of_range_values_are_located_errors() {
             "`depth_clamp` needs a depth attachment, and the pass has none", "true)"),
         (VALID, (r#"format: R8G8B8A8_UNORM)"#, r#"format: R8G8B8A8_UNORM, history: true, persistent: true)"#),
             "\"albedo\" is both `history` (read before this frame writes it) and `persistent` (written, then read); choose one", "true)"),
+        (VALID, ("draw: Meshes(Opaque),", r#"draw: Meshes(Opaque), defines: [(name: "D0", enabled_if: ["f0"]), (name: "D1", enabled_if: ["f1"]), (name: "D2", enabled_if: ["f2"]), (name: "D3", enabled_if: ["f3"]), (name: "D4", enabled_if: ["f4"]), (name: "D5", enabled_if: ["f5"]), (name: "D6", enabled_if: ["f6"]), (name: "D7", enabled_if: ["f7"]), (name: "D8", enabled_if: ["f8"]), (name: "D9", enabled_if: ["f9"]), (name: "D10", enabled_if: ["f10"]), (name: "D11", enabled_if: ["f11"]), (name: "D12", enabled_if: ["f12"])],"#),
+            "pass \"gbuffer\" has shader defines decided by 13 features: up to 8192 variants, more than the 4096 a pass may have", "\"gbuffer\""),
         (VALID, (r#"output: "ldr","#, r#"output: "ldr", readback: ["ldr", "albdo"],"#),
             "unknown resource \"albdo\"", r#""albdo"]"#),
         (COMPUTE, ("Output(8, 8)", "Output(0, 16)"),

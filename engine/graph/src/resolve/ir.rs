@@ -101,6 +101,28 @@ pub enum IrDispatch {
     Groups(u32, u32, u32),
 }
 
+impl IrPass {
+    /// How many features decide the pass's shader defines (its conditional
+    /// reads' `HAS_<NAME>` and its declared defines' `enabled_if`): its
+    /// shaders come in at most 2^this variants, one per combination.
+    pub fn variant_bits(&self) -> u32 {
+        let mut features: Vec<&str> = self
+            .accesses
+            .iter()
+            .flat_map(|a| a.conditions.iter())
+            .chain(self.defines.iter().flat_map(|d| d.enabled_if.iter()))
+            .map(|f| f.trim_start_matches('!'))
+            .collect();
+        features.sort_unstable();
+        features.dedup();
+        features.len() as u32
+    }
+}
+
+/// Most shader variants a pass may have: 2^12 = 4,096 define sets (the
+/// shipped forward pass switches 10 defines).
+pub const MAX_VARIANT_BITS: u32 = 12;
+
 /// One use of a resource by a pass.
 #[derive(Debug, Clone)]
 pub struct IrAccess {

@@ -198,6 +198,20 @@ impl Resolver<'_> {
             defines: self.check_defines(source, index, decl),
         };
         self.check_pass_shape(&pass, decl, resources);
+        let bits = pass.variant_bits();
+        if bits > super::ir::MAX_VARIANT_BITS {
+            self.error(
+                source,
+                &pass_path(index, &[Seg::Field("name")]),
+                format!(
+                    "pass \"{}\" has shader defines decided by {bits} features: up to {} variants, more than the {} a pass may have",
+                    pass.name,
+                    1u64 << bits,
+                    1u64 << super::ir::MAX_VARIANT_BITS
+                ),
+            )
+            .hint = Some("key defines that always go together to one feature, or split the pass".into());
+        }
         pass
     }
 
