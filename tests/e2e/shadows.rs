@@ -62,6 +62,28 @@ fn write_scene(dir: &Path, lights: &str, camera: (Vec3, Vec3), box_on: bool) -> 
     path
 }
 
+/// `text` of a shipped graph with its fragment and shader paths made absolute,
+/// so a copy written elsewhere finds them.
+fn absolute_paths(text: &str) -> String {
+    let root = common::root().join("graphs");
+    text.replace(
+        "(file: \"bloom.ron\"",
+        &format!("(file: \"{}\"", root.join("bloom.ron").display()),
+    )
+    .replace(
+        "(file: \"gbuffer.ron\"",
+        &format!("(file: \"{}\"", root.join("gbuffer.ron").display()),
+    )
+    .replace(
+        "(file: \"bench/",
+        &format!("(file: \"{}/", root.join("bench").display()),
+    )
+    .replace(
+        "\"../shaders/",
+        &format!("\"{}/", common::root().join("shaders").display()),
+    )
+}
+
 /// `graphs/<graph>` rewritten into `dir` with shadow parameters overridden.
 fn graph_with(dir: &Path, graph: &str, shadow_params: &str) -> PathBuf {
     let root = common::root().join("graphs");
@@ -75,25 +97,9 @@ fn graph_with(dir: &Path, graph: &str, shadow_params: &str) -> PathBuf {
             "(file: \"shadows.ron\", params: { \"resolution\": 2048 })",
             "(file: \"shadows.ron\")",
         )
-        .replace("(file: \"shadows.ron\")", &include)
-        .replace(
-            "(file: \"bloom.ron\"",
-            &format!("(file: \"{}\"", root.join("bloom.ron").display()),
-        )
-        .replace(
-            "(file: \"gbuffer.ron\"",
-            &format!("(file: \"{}\"", root.join("gbuffer.ron").display()),
-        )
-        .replace(
-            "(file: \"bench/",
-            &format!("(file: \"{}/", root.join("bench").display()),
-        )
-        .replace(
-            "\"../shaders/",
-            &format!("\"{}/", common::root().join("shaders").display()),
-        );
+        .replace("(file: \"shadows.ron\")", &include);
     let path = dir.join(graph);
-    std::fs::write(&path, text).expect("graph");
+    std::fs::write(&path, absolute_paths(&text)).expect("graph");
     path
 }
 
@@ -357,31 +363,14 @@ fn every_configuration_runs_without_validation_messages() {
 /// `graphs/<graph>` rewritten into `dir` to include `shadows` (a path)
 /// instead of the shipped shadow fragment.
 fn graph_including(dir: &Path, graph: &str, shadows: &Path) -> PathBuf {
-    let root = common::root().join("graphs");
-    let text = std::fs::read_to_string(root.join(graph))
+    let text = std::fs::read_to_string(common::root().join("graphs").join(graph))
         .expect("graph")
         .replace(
             "(file: \"shadows.ron\"",
             &format!("(file: \"{}\"", shadows.display()),
-        )
-        .replace(
-            "(file: \"bloom.ron\"",
-            &format!("(file: \"{}\"", root.join("bloom.ron").display()),
-        )
-        .replace(
-            "(file: \"gbuffer.ron\"",
-            &format!("(file: \"{}\"", root.join("gbuffer.ron").display()),
-        )
-        .replace(
-            "(file: \"bench/",
-            &format!("(file: \"{}/", root.join("bench").display()),
-        )
-        .replace(
-            "\"../shaders/",
-            &format!("\"{}/", common::root().join("shaders").display()),
         );
     let path = dir.join(graph);
-    std::fs::write(&path, text).expect("graph");
+    std::fs::write(&path, absolute_paths(&text)).expect("graph");
     path
 }
 

@@ -62,6 +62,25 @@ impl Ltc {
 mod tests {
     use super::*;
 
+    /// The integral of `f` over the sphere by an n x n quadrature in (z, phi).
+    fn over_sphere<T: std::ops::Add<Output = T> + std::ops::Mul<f32, Output = T>>(
+        n: usize,
+        zero: T,
+        f: impl Fn(Vec3) -> T,
+    ) -> T {
+        let cell = 4.0 * PI / (n * n) as f32;
+        let mut sum = zero;
+        for j in 0..n {
+            for i in 0..n {
+                let z = -1.0 + 2.0 * (j as f32 + 0.5) / n as f32;
+                let phi = 2.0 * PI * (i as f32 + 0.5) / n as f32;
+                let s = (1.0 - z * z).sqrt();
+                sum = sum + f(Vec3::new(s * phi.cos(), s * phi.sin(), z)) * cell;
+            }
+        }
+        sum
+    }
+
     #[test]
     fn a_warped_cosine_integrates_to_its_magnitude_and_samples_as_it_evaluates() {
         let m = Mat3::from_cols(
@@ -70,19 +89,8 @@ mod tests {
             Vec3::new(0.3, 0.0, 1.0),
         );
         let ltc = Ltc::new(m, 0.7);
-        // Integral over the sphere by quadrature in (cos, phi).
-        let n = 600;
-        let mut sum = 0.0f64;
-        for j in 0..n {
-            for i in 0..n {
-                let z = -1.0 + 2.0 * (j as f32 + 0.5) / n as f32;
-                let phi = 2.0 * PI * (i as f32 + 0.5) / n as f32;
-                let s = (1.0 - z * z).sqrt();
-                let l = Vec3::new(s * phi.cos(), s * phi.sin(), z);
-                sum += ltc.eval(l) as f64 * (4.0 * PI as f64) / (n * n) as f64;
-            }
-        }
-        assert!((sum - 0.7).abs() < 0.005, "{sum}");
+        let total = over_sphere(600, 0.0f32, |l| ltc.eval(l));
+        assert!((total - 0.7).abs() < 0.005, "{total}");
         // The mean of samples equals the density-weighted mean direction.
         let k = 300;
         let mut mean = Vec3::ZERO;
@@ -92,16 +100,7 @@ mod tests {
             }
         }
         mean /= (k * k) as f32;
-        let mut expected = Vec3::ZERO;
-        for j in 0..n {
-            for i in 0..n {
-                let z = -1.0 + 2.0 * (j as f32 + 0.5) / n as f32;
-                let phi = 2.0 * PI * (i as f32 + 0.5) / n as f32;
-                let s = (1.0 - z * z).sqrt();
-                let l = Vec3::new(s * phi.cos(), s * phi.sin(), z);
-                expected += l * ltc.eval(l) / 0.7 * (4.0 * PI) / (n * n) as f32;
-            }
-        }
+        let expected = over_sphere(600, Vec3::ZERO, |l| l * (ltc.eval(l) / 0.7));
         assert!((mean - expected).length() < 0.01, "{mean} vs {expected}");
     }
 }
