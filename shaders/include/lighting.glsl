@@ -297,11 +297,45 @@ vec3 shade_area_quadrature(uint index, Surface s, Material m, uint samples) {
 #ifdef SHADE_AREA_LIGHTS
 #include "ltc.glsl"
 
+#ifdef SHADE_METALLIC_ROUGHNESS
+// A glTF material under an area light: diffuse weighted by 1 - F(N.V), the
+// GGX highlight from its table, Fresnel from the table's Fresnel moment.
+// `local` takes world directions to the shading frame; `diffuse` is the
+// cosine's integral over the light.
+vec3 area_ltc_metallic_roughness(Surface s, Material m, float ndv, mat3 local, float diffuse,
+                                 vec3 centre, vec3 x, vec3 y, bool disc, float side) {
+    vec2 scale;
+    mat3 inverse = ltc_lookup(LTC_GGX, max(s.metal_rough.y, MIN_ROUGHNESS), ndv, scale);
+    float highlight = ltc_integral(inverse * local, centre, x, y, disc, side);
+    vec3 base = m.diffuse.rgb * s.texel;
+    vec3 f0 = mix(vec3(DIELECTRIC_F0), base, s.metal_rough.x);
+    vec3 f_view = f0 + (1.0 - f0) * pow(1.0 - ndv, 5.0);
+    return (1.0 - f_view) * (1.0 - s.metal_rough.x) * base * diffuse
+        + (f0 * scale.x + (1.0 - f0) * scale.y) * highlight;
+}
+#endif
+
+#ifdef SHADE_BLINN_PHONG
+// A Blinn-Phong material under an area light: Kd times the irradiance, and
+// the highlight from its table with the exponent read as roughness
+// (2 / (n + 2))^(1/4).
+vec3 area_ltc_blinn_phong(Surface s, Material m, float ndv, mat3 local, float diffuse,
+                          vec3 centre, vec3 x, vec3 y, bool disc, float side) {
+    vec3 result = m.diffuse.rgb * s.texel * PI * diffuse;
+    float shininess = m.specular.w;
+    if (shininess > 0.0) {
+        vec2 scale;
+        mat3 inverse = ltc_lookup(LTC_BLINN_PHONG, pow(2.0 / (shininess + 2.0), 0.25), ndv, scale);
+        float highlight = ltc_integral(inverse * local, centre, x, y, disc, side);
+        result += m.specular.rgb * scale.x * highlight;
+    }
+    return result;
+}
+#endif
+
 // Area light `index` analytically (include/ltc.glsl). Diffuse: the exact
 // integral of the cosine over the polygon. Highlights: the fitted LTC of the
-// material's lobe (GGX, or Blinn-Phong with the exponent read as roughness
-// (2 / (n + 2))^(1/4)), scaled by the lobe's integral; GGX's Fresnel from the
-// table's Fresnel moment, its diffuse weighted by 1 - F(N.V). No shadowing.
+// material's lobe, scaled by the lobe's integral. No shadowing.
 vec3 shade_area_ltc(uint index, Surface s, Material m) {
     vec3 centre = lights[index].position_range.xyz - s.position;
     vec3 x = lights[index].direction_type.xyz;
@@ -328,35 +362,14 @@ vec3 shade_area_ltc(uint index, Surface s, Material m) {
     t1 = dot(t1, t1) > 1e-12 ? normalize(t1) : normalize(cross(n, helper));
     mat3 local = transpose(mat3(t1, cross(n, t1), n));
     float diffuse = ltc_integral(local, centre, x, y, disc, side);
-    vec3 result;
-#ifdef SHADE_METALLIC_ROUGHNESS
-#ifdef SHADE_BLINN_PHONG
-    if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
-#endif
-        vec2 scale;
-        mat3 inverse = ltc_lookup(LTC_GGX, max(s.metal_rough.y, MIN_ROUGHNESS), ndv, scale);
-        float highlight = ltc_integral(inverse * local, centre, x, y, disc, side);
-        vec3 base = m.diffuse.rgb * s.texel;
-        vec3 f0 = mix(vec3(DIELECTRIC_F0), base, s.metal_rough.x);
-        vec3 f_view = f0 + (1.0 - f0) * pow(1.0 - ndv, 5.0);
-        result = (1.0 - f_view) * (1.0 - s.metal_rough.x) * base * diffuse
-            + (f0 * scale.x + (1.0 - f0) * scale.y) * highlight;
-#ifdef SHADE_BLINN_PHONG
-    } else {
-#endif
-#endif
-#ifdef SHADE_BLINN_PHONG
-        result = m.diffuse.rgb * s.texel * PI * diffuse;
-        float shininess = m.specular.w;
-        if (shininess > 0.0) {
-            vec2 scale;
-            mat3 inverse = ltc_lookup(LTC_BLINN_PHONG, pow(2.0 / (shininess + 2.0), 0.25), ndv, scale);
-            float highlight = ltc_integral(inverse * local, centre, x, y, disc, side);
-            result += m.specular.rgb * scale.x * highlight;
-        }
-#ifdef SHADE_METALLIC_ROUGHNESS
-    }
-#endif
+#if defined(SHADE_METALLIC_ROUGHNESS) && defined(SHADE_BLINN_PHONG)
+    vec3 result = m.emissive.w == SHADING_METALLIC_ROUGHNESS
+        ? area_ltc_metallic_roughness(s, m, ndv, local, diffuse, centre, x, y, disc, side)
+        : area_ltc_blinn_phong(s, m, ndv, local, diffuse, centre, x, y, disc, side);
+#elif defined(SHADE_METALLIC_ROUGHNESS)
+    vec3 result = area_ltc_metallic_roughness(s, m, ndv, local, diffuse, centre, x, y, disc, side);
+#else
+    vec3 result = area_ltc_blinn_phong(s, m, ndv, local, diffuse, centre, x, y, disc, side);
 #endif
     return result * lights[index].color_exponent.rgb;
 }
@@ -369,22 +382,24 @@ vec3 shade_sun(uint index, Surface s, Material m) {
     return reflected(m, s, l, radiance);
 }
 
-vec3 shade_point(uint index, Surface s, Material m) {
-    vec3 l;
-    vec3 radiance = incoming_point(index, s, l);
+// `reflected`, skipped for lights that do not reach the surface.
+vec3 reflected_if_lit(Material m, Surface s, vec3 l, vec3 radiance) {
     if (all(equal(radiance, vec3(0.0)))) {
         return vec3(0.0);
     }
     return reflected(m, s, l, radiance);
 }
 
+vec3 shade_point(uint index, Surface s, Material m) {
+    vec3 l;
+    vec3 radiance = incoming_point(index, s, l);
+    return reflected_if_lit(m, s, l, radiance);
+}
+
 vec3 shade_spot(uint index, Surface s, Material m) {
     vec3 l;
     vec3 radiance = incoming_spot(index, s, l);
-    if (all(equal(radiance, vec3(0.0)))) {
-        return vec3(0.0);
-    }
-    return reflected(m, s, l, radiance);
+    return reflected_if_lit(m, s, l, radiance);
 }
 
 // Every light of the types this variant shades, one loop per type over the

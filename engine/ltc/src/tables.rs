@@ -112,9 +112,13 @@ pub fn parse(text: &str) -> Result<Tables, ParseError> {
     })
 }
 
-/// The committed tables.
-pub fn committed() -> Result<Tables, ParseError> {
-    parse(TEXT)
+/// The committed tables, read once per process.
+pub fn committed() -> Result<&'static Tables, ParseError> {
+    static TABLES: std::sync::OnceLock<Result<Tables, ParseError>> = std::sync::OnceLock::new();
+    TABLES
+        .get_or_init(|| parse(TEXT))
+        .as_ref()
+        .map_err(Clone::clone)
 }
 
 #[cfg(test)]
@@ -124,7 +128,7 @@ mod tests {
     #[test]
     fn the_text_round_trips_and_the_committed_tables_read() {
         let tables = committed().expect("the committed tables read");
-        assert_eq!(parse(&write(&tables)), Ok(tables));
+        assert_eq!(parse(&write(tables)).as_ref(), Ok(tables));
         assert_eq!(
             parse("table ggx\n1 2 3\n"),
             Err(ParseError("line 2: expected 6 numbers".into()))

@@ -14,8 +14,8 @@ use weft_ltc::{blinn_phong_exponent, column_cos, row_roughness, TABLE_SIZE};
 fn table(name: &str) -> Vec<Entry> {
     let tables = weft_ltc::tables::committed().expect("the committed tables read");
     match name {
-        "LTC_GGX" => tables.ggx,
-        _ => tables.blinn_phong,
+        "LTC_GGX" => tables.ggx.clone(),
+        _ => tables.blinn_phong.clone(),
     }
 }
 

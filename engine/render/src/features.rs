@@ -1,7 +1,7 @@
 //! Scene features a graph's `enabled_if` conditions test: what the scene has,
 //! so passes for things it lacks (spot lights, shadow casters) are culled.
 
-use crate::lights::CONE_MAX_ANGLE;
+use crate::lights::is_cone;
 use crate::materials::{coat, dielectric, is_mirror, matches};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::material::ShadingModel;
@@ -40,7 +40,7 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     let mut features = Vec::new();
     let shadowing_light = scene.lights.iter().any(|l| match l {
         Light::Sun(_) => true,
-        Light::Spot(s) => s.angle <= CONE_MAX_ANGLE,
+        Light::Spot(s) => is_cone(s.angle),
         _ => false,
     });
     if shadowing_light && placed().any(|m| matches(MaterialFilter::ShadowCasters, &m)) {

@@ -25,6 +25,12 @@ pub const AREA_DISC: f32 = 5.0;
 /// Widest half-angle (degrees) drawn as a cone; wider cones would be huge or inverted.
 pub const CONE_MAX_ANGLE: f32 = 70.0;
 
+/// Whether a spot of half-angle `angle` (degrees) is drawn with a cone volume,
+/// and so gets a shadow view; wider spots use a sphere and cast no shadow.
+pub fn is_cone(angle: f32) -> bool {
+    angle <= CONE_MAX_ANGLE
+}
+
 /// The scene's lights packed for the shaders.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LightSet {
@@ -162,7 +168,7 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
     for wide in [false, true] {
         for light in lights {
             let Light::Spot(s) = light else { continue };
-            if (s.angle > CONE_MAX_ANGLE) != wide {
+            if is_cone(s.angle) == wide {
                 continue;
             }
             let range = s

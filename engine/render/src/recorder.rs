@@ -230,8 +230,6 @@ impl<'g> SceneRecorder<'g> {
         calls
     }
 
-    /// The draws a filter selects, farthest from the camera first (by the placed
-    /// model's origin), the order alpha blending needs.
     /// The draws of `filter` inside the frustum of `clip`, counted under `view`.
     fn visible(&mut self, view: String, clip: Mat4, filter: MaterialFilter) -> Vec<DrawItem> {
         let frustum = Frustum::from_clip(clip);
@@ -256,7 +254,8 @@ impl<'g> SceneRecorder<'g> {
         inside
     }
 
-    /// `draws` sorted farthest from the camera first.
+    /// `draws` sorted farthest from the camera first (by the placed model's
+    /// origin), the order alpha blending needs.
     fn back_to_front(&self, draws: Vec<DrawItem>) -> Vec<DrawItem> {
         let g = &self.scene.geometry;
         let eye = self.scene.camera_position;
@@ -331,31 +330,29 @@ impl SceneRecorder<'_> {
             message: "shadow pass without push constants".into(),
         })?;
         let commands = ctx.commands();
-        // A shadow map that loads what the last frame left (a `history` image)
-        // keeps the tiles of views that did not change; one that is cleared
-        // draws every view.
+        // A shadow map that loads what the last frame left (a `persistent`
+        // image) keeps the tiles of views that did not change; one that is
+        // cleared draws every view.
         let keeps_tiles = pass
             .render_pass
             .as_ref()
             .and_then(|rp| rp.depth.and_then(|d| rp.attachments.get(d)))
             .is_some_and(|a| a.load == LoadOp::Load);
-        if !keeps_tiles {
-            self.shadow_tiles.clear();
-        }
-        if keeps_tiles && self.shadow_tiles.len() != views.len() {
-            // A new atlas layout (or the first frame): nothing kept, and the
-            // texels between tiles, which filtering at tile edges reads, are
-            // set too, as a cleared map would have them.
+        if !keeps_tiles || self.shadow_tiles.len() != views.len() {
             self.shadow_tiles = vec![None; views.len()];
-            commands.clear_depth(
-                vk::Rect2D {
-                    offset: vk::Offset2D::default(),
-                    extent: ctx.extent,
-                },
-                1.0,
-            );
+            if keeps_tiles {
+                // A new atlas layout (or the first frame): nothing kept, and
+                // the texels between tiles, which filtering at tile edges
+                // reads, are set too, as a cleared map would have them.
+                commands.clear_depth(
+                    vk::Rect2D {
+                        offset: vk::Offset2D::default(),
+                        extent: ctx.extent,
+                    },
+                    1.0,
+                );
+            }
         }
-        self.shadow_tiles.resize(views.len(), None);
         let mut calls = 0;
         for (i, view) in views.iter().enumerate() {
             let tile = ShadowTile::of(view);

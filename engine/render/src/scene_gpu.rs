@@ -119,6 +119,7 @@ pub fn ltc_table_words(tables: &weft_ltc::tables::Tables) -> Vec<f32> {
     }
     words
 }
+
 /// Set 1 bindings for ray tracing: built only when a compute pass that
 /// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
@@ -424,7 +425,7 @@ impl<'g> GpuScene<'g> {
         shadows.write(&vec![0u8; shadows::SHADOWS_BYTES])?;
         let tables = weft_ltc::tables::committed()
             .map_err(|e| GpuError::Plan(format!("the built-in LTC tables: {e}")))?;
-        let words = ltc_table_words(&tables);
+        let words = ltc_table_words(tables);
         let mut ltc_tables = Buffer::host(gpu, "ltc_tables", (words.len() * 4) as u64, storage)?;
         ltc_tables.write(bytes_of(&words))?;
         let sampler = Sampler::linear_repeat(gpu)?;

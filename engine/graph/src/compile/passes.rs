@@ -213,7 +213,7 @@ fn plan_pass(cx: &PassContext, p: IrPassId, i: PassId, barriers: Vec<Barrier>) -
         dispatch,
         params: pass.params.clone(),
         defines: defines.into_iter().collect(),
-        variants: 1u64 << pass.variant_bits(),
+        variants: crate::resolve::variant_count(pass.variant_bits()),
         barriers,
         render_pass,
         bindings,

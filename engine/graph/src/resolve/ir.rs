@@ -123,6 +123,11 @@ impl IrPass {
 /// shipped forward pass switches 10 defines).
 pub const MAX_VARIANT_BITS: u32 = 12;
 
+/// 2^`bits`, the variants `bits` features can select, saturating past 2^63.
+pub fn variant_count(bits: u32) -> u64 {
+    1u64.checked_shl(bits).unwrap_or(u64::MAX)
+}
+
 /// One use of a resource by a pass.
 #[derive(Debug, Clone)]
 pub struct IrAccess {

@@ -206,8 +206,8 @@ impl Resolver<'_> {
                 format!(
                     "pass \"{}\" has shader defines decided by {bits} features: up to {} variants, more than the {} a pass may have",
                     pass.name,
-                    1u64 << bits,
-                    1u64 << super::ir::MAX_VARIANT_BITS
+                    super::ir::variant_count(bits),
+                    super::ir::variant_count(super::ir::MAX_VARIANT_BITS)
                 ),
             )
             .hint = Some("key defines that always go together to one feature, or split the pass".into());
