@@ -4,8 +4,9 @@
 //! RGB channel differences in 8-bit units: forward vs deferred and tiled vs
 //! deferred each within mean <= 0.25 and 99th percentile <= 1; tiled also
 //! against its golden image. The light heat map (`light_heatmap`) is checked
-//! exactly: per-tile counts read back against the CPU mirror of the culling test
-//! (`weft_testkit::tiles`) on a scene of known lights, and the legend's pixels.
+//! exactly: per-tile counts read back against the CPU mirror of the culling tests
+//! (`weft_testkit::tiles`: the default surface box and 2.5D depth mask, and the
+//! frustum slab) on a scene of known lights, and the legend's pixels.
 
 use weft_tests::render as common;
 
@@ -124,12 +125,17 @@ fn known_scene(dir: &Path) -> PathBuf {
 
 /// The reverse-Z depth of the floor (y = 0) seen through pixel centre `centre`.
 fn floor_depth(view_proj: Mat4, inv: Mat4, viewport: Vec2, centre: Vec2) -> f32 {
+    let hit = floor_point(inv, viewport, centre);
+    let clip = view_proj * hit.extend(1.0);
+    clip.z / clip.w
+}
+
+/// The floor point (y = 0) seen through pixel centre `centre`.
+fn floor_point(inv: Mat4, viewport: Vec2, centre: Vec2) -> Vec3 {
     let near = tiles::unproject(inv, viewport, centre, 1.0);
     let far = tiles::unproject(inv, viewport, centre, 0.5);
     let dir = far - near;
-    let hit = near + dir * (-near.y / dir.y);
-    let clip = view_proj * hit.extend(1.0);
-    clip.z / clip.w
+    near + dir * (-near.y / dir.y)
 }
 
 /// Rows of the 3x5 digits the heat-map legend draws, top first.
@@ -146,44 +152,64 @@ const FONT: [[&str; 5]; 10] = [
     ["###", "#.#", "###", "..#", "###"],
 ];
 
-#[test]
-fn the_heat_map_counts_known_lights_per_tile_and_draws_its_legend() {
+/// Which culling test the tiled graph runs, by its features.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Culling {
+    /// `!tile_box,!tile_depth_mask`: the frustum slab's six planes.
+    Slab,
+    /// The default: the box around the tile's surface points and the 2.5D depth mask.
+    SurfaceBoxAndDepthMask,
+}
+
+/// Slices of slack for rounding differences between the GPU's and the CPU's
+/// eye distances.
+const SLICE_SLACK: f32 = 0.05;
+
+/// Renders the known scene with the heat map under `culling` and checks every
+/// tile's count against the CPU mirror; returns the rendered frame, the
+/// largest tile count and the sum over tiles.
+fn check_tile_counts(culling: Culling) -> (weft_render::Rendered, u32, u32) {
     let (w, h) = (320u32, 180u32);
-    let dir = scratch("heatmap");
+    let dir = scratch(&format!("heatmap-{culling:?}"));
     let path = known_scene(&dir);
     let scene = weft_scene::load_scene(&path).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     let gpu = weft_tests::gpu();
     let log = gpu.validation();
+    let mut features: Vec<String> = vec!["light_heatmap".into(), "!bloom".into()];
+    if culling == Culling::Slab {
+        features.extend(["!tile_box".into(), "!tile_depth_mask".into()]);
+    }
     let settings = RenderSettings {
         graph: graph("tiled.ron"),
         extent: Extent {
             width: w,
             height: h,
         },
-        features: vec!["light_heatmap".into(), "!bloom".into()],
+        features,
         extra_readback: vec!["light_counts".into()],
         ..RenderSettings::default()
     };
     let rendered = render(&gpu, &scene, &settings).unwrap();
     drop(gpu);
     assert_eq!(log.messages(), Vec::new());
-    let counts = &rendered.report.readbacks[0];
-    assert_eq!(counts.0, "light_counts");
+    let counts = rendered.report.readbacks[0].1.to_rgba8();
+    assert_eq!(rendered.report.readbacks[0].0, "light_counts");
     let count_at = |x: u32, y: u32| {
-        let [r, g, b, _] = counts.1.rgba8_at(x, y);
+        let [r, g, b, _] = counts.get_pixel(x, y).0;
         u32::from(r) + 256 * u32::from(g) + 65536 * u32::from(b)
     };
 
-    // The CPU mirror of the culling test, with the floor's depth at the tile's
-    // corner pixel centres as its bounds (depth on a plane is affine on screen).
+    // The CPU mirror of the culling test: the floor's depth at the tile's
+    // corner pixel centres bounds the slab (depth on a plane is affine on
+    // screen); the floor under each pixel centre gives the surface points.
     let camera = &scene.cameras[0];
     let view_proj = camera::view_projection(camera, 0.0, w as f32 / h as f32);
     let inv = view_proj.inverse();
     let eye = camera::camera_position(camera, 0.0);
     let viewport = Vec2::new(w as f32, h as f32);
     let (tiles_x, tiles_y) = tiles::tile_grid(w, h);
-    let (mut ambiguous, mut most, mut zero, mut tighter) = (0, 0, 0, 0);
+    let (mut ambiguous, mut most, mut zero, mut tighter, mut total) = (0, 0, 0, 0, 0);
     // Each spot's length ball, which culling by the cone improves on.
     let spot_balls: Vec<(Vec3, f32)> = KNOWN_SPOTS
         .iter()
@@ -193,56 +219,92 @@ fn the_heat_map_counts_known_lights_per_tile_and_draws_its_legend() {
         for tx in 0..tiles_x {
             let (x0, y0) = (tx * 16, ty * 16);
             let (x1, y1) = ((x0 + 15).min(w - 1), (y0 + 15).min(h - 1));
-            let depths = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| {
-                floor_depth(
-                    view_proj,
-                    inv,
-                    viewport,
-                    Vec2::new(x as f32 + 0.5, y as f32 + 0.5),
-                )
-            });
+            let centre_of = |x: u32, y: u32| Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let depths = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)]
+                .map(|(x, y)| floor_depth(view_proj, inv, viewport, centre_of(x, y)));
             let nearest = depths.iter().copied().fold(f32::MIN, f32::max);
             let farthest = depths.iter().copied().fold(f32::MAX, f32::min);
             let slab = tiles::TileSlab::new(inv, eye, viewport, (tx, ty), nearest, farthest);
-            let margins: Vec<f32> = known_bounds()
-                .iter()
-                .map(|(centre, radius)| slab.margin(*centre, *radius))
+            let points: Vec<Vec3> = (y0..=y1)
+                .flat_map(|y| (x0..=x1).map(move |x| (x, y)))
+                .map(|(x, y)| floor_point(inv, viewport, centre_of(x, y)))
                 .collect();
-            let sure = margins.iter().filter(|m| **m < -1e-3).count() as u32;
-            let maybe = margins.iter().filter(|m| **m <= 1e-3).count() as u32;
+            let surface = tiles::TileSurface::new(&points, eye).unwrap();
+            let (sure_mask, maybe_mask) = (
+                surface.depth_mask(&points, -SLICE_SLACK),
+                surface.depth_mask(&points, SLICE_SLACK),
+            );
+            // (surely listed, maybe listed) for a sphere.
+            let listed = |centre: Vec3, radius: f32| match culling {
+                Culling::Slab => {
+                    let margin = slab.margin(centre, radius);
+                    (margin < -1e-3, margin <= 1e-3)
+                }
+                Culling::SurfaceBoxAndDepthMask => {
+                    let margin = surface.box_margin(centre, radius);
+                    let sure = surface.sphere_slices(centre, radius, -SLICE_SLACK) & sure_mask;
+                    let maybe = surface.sphere_slices(centre, radius, SLICE_SLACK) & maybe_mask;
+                    (margin < -1e-3 && sure != 0, margin <= 1e-3 && maybe != 0)
+                }
+            };
+            let decisions: Vec<(bool, bool)> = known_bounds()
+                .iter()
+                .map(|(centre, radius)| listed(*centre, *radius))
+                .collect();
+            let sure = decisions.iter().filter(|d| d.0).count() as u32;
+            let maybe = decisions.iter().filter(|d| d.1).count() as u32;
             ambiguous += u32::from(sure != maybe);
             // Every pixel of the tile holds the tile's count.
             let gpu_count = count_at(x0, y0);
-            assert_eq!(count_at(x1, y1), gpu_count, "tile ({tx}, {ty})");
+            assert_eq!(count_at(x1, y1), gpu_count, "{culling:?} tile ({tx}, {ty})");
             assert!(
                 (sure..=maybe).contains(&gpu_count),
-                "tile ({tx}, {ty}): GPU {gpu_count}, CPU {sure}..={maybe} (margins {margins:?})"
+                "{culling:?} tile ({tx}, {ty}): GPU {gpu_count}, CPU {sure}..={maybe} ({decisions:?})"
             );
             let by_balls = KNOWN_LIGHTS
                 .iter()
                 .map(|(p, r)| (Vec3::from(*p), *r))
                 .chain(spot_balls.iter().copied())
-                .filter(|(centre, radius)| slab.margin(*centre, *radius) < -1e-3)
+                .filter(|(centre, radius)| listed(*centre, *radius).0)
                 .count() as u32;
             tighter += u32::from(gpu_count < by_balls);
             most = most.max(gpu_count);
+            total += gpu_count;
             zero += u32::from(gpu_count == 0);
         }
     }
     eprintln!(
-        "{ambiguous} ambiguous tiles, most lights {most}, {zero} empty tiles, \
+        "{culling:?}: {ambiguous} ambiguous tiles, most lights {most}, {zero} empty tiles, \
          {tighter} tiles list fewer lights than the spots' length balls would"
     );
-    assert!(tighter > 0, "spots are culled by their cones");
+    assert!(tighter > 0, "{culling:?}: spots are culled by their cones");
     assert!(
         ambiguous * 50 <= tiles_x * tiles_y,
-        "{ambiguous} ambiguous tiles"
+        "{culling:?}: {ambiguous} ambiguous tiles"
     );
     assert!(
         most >= 3,
-        "overlapping lights give tiles with several lights"
+        "{culling:?}: overlapping lights give tiles with several lights"
     );
-    assert!(zero > 0, "tiles far from every light list none");
+    assert!(
+        zero > 0,
+        "{culling:?}: tiles far from every light list none"
+    );
+    (rendered, most, total)
+}
+
+#[test]
+fn the_slab_test_counts_as_its_cpu_mirror_and_lists_more_than_the_surface_tests() {
+    let (_, _, slab) = check_tile_counts(Culling::Slab);
+    let (_, _, surface) = check_tile_counts(Culling::SurfaceBoxAndDepthMask);
+    eprintln!("tile list entries: slab {slab}, surface box and depth mask {surface}");
+    assert!(surface * 4 < slab * 3, "slab {slab}, surface {surface}");
+}
+
+#[test]
+fn the_heat_map_counts_known_lights_per_tile_and_draws_its_legend() {
+    let h = 180u32;
+    let (rendered, most, _) = check_tile_counts(Culling::SurfaceBoxAndDepthMask);
 
     // The legend, bottom-left: a black box, the colour bar, labels 0, max / 2, max.
     let image = rendered.report.output.expect("readback");

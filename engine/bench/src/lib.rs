@@ -14,6 +14,7 @@ mod pathtrace;
 mod plot;
 mod shadows;
 mod start;
+mod tiles;
 
 /// The benchmarks.
 #[derive(Subcommand)]
@@ -32,6 +33,8 @@ pub enum BenchCommand {
     Start(crate::start::StartArgs),
     /// Each pass against its floor in the same frame (constant shading, a G-buffer read).
     Floors(crate::floors::FloorsArgs),
+    /// Tiled light lists: lights listed per pixel and culling cost of each culling test.
+    Tiles(crate::tiles::TilesArgs),
 }
 
 /// Runs `weft bench ...`.
@@ -44,5 +47,6 @@ pub fn run(cmd: BenchCommand) -> Result<ExitCode> {
         BenchCommand::Pathtrace(args) => crate::pathtrace::run(args),
         BenchCommand::Start(args) => crate::start::run(args),
         BenchCommand::Floors(args) => crate::floors::run(args),
+        BenchCommand::Tiles(args) => crate::tiles::run(args),
     }
 }

@@ -1,7 +1,9 @@
 //! The CPU mirror of tiled light culling (`shaders/light_cull.comp`): the
 //! frustum slab of one screen tile between its nearest and farthest reverse-Z
-//! depths, whether a light's bounding sphere reaches it, and the spot bounds.
-//! Tests compare the GPU's per-tile counts with this; keep the two in step.
+//! depths, the box and 2.5D depth mask of its surface points (the graph's
+//! `tile_box` and `tile_depth_mask` features), whether a light's bounding
+//! sphere reaches them, and the spot bounds. Tests compare the GPU's per-tile
+//! counts with this; keep the two in step.
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
@@ -97,6 +99,101 @@ impl TileSlab {
     }
 }
 
+/// Slices of a tile's range of eye distances in the 2.5D depth mask.
+pub const DEPTH_SLICES: u32 = 32;
+
+/// A tile's surface points as the tighter culling tests see them: their
+/// world-space box and, per slice of their range of distances from the eye,
+/// whether a point lies in it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TileSurface {
+    /// Corners of the box around the points.
+    pub min: Vec3,
+    /// See `min`.
+    pub max: Vec3,
+    /// Nearest and farthest eye distance of a point.
+    pub distances: (f32, f32),
+    eye: Vec3,
+    points: usize,
+}
+
+impl TileSurface {
+    /// The box and distance range of `points` seen from `eye`; `None` when
+    /// there are none (a background tile, which lists no light).
+    pub fn new(points: &[Vec3], eye: Vec3) -> Option<Self> {
+        let first = *points.first()?;
+        let (mut min, mut max) = (first, first);
+        let (mut near, mut far) = (f32::INFINITY, 0.0f32);
+        for p in points {
+            min = min.min(*p);
+            max = max.max(*p);
+            let d = p.distance(eye);
+            near = near.min(d);
+            far = far.max(d);
+        }
+        Some(Self {
+            min,
+            max,
+            distances: (near, far),
+            eye,
+            points: points.len(),
+        })
+    }
+
+    /// How far the sphere is from the box, minus its radius: at most zero, the
+    /// box test lists it.
+    pub fn box_margin(&self, centre: Vec3, radius: f32) -> f32 {
+        let gap = (self.min - centre).max(centre - self.max).max(Vec3::ZERO);
+        gap.length() - radius
+    }
+
+    /// Slices per unit of eye distance (one slice for a flat tile).
+    fn slices_per_unit(&self) -> f32 {
+        DEPTH_SLICES as f32 / (self.distances.1 - self.distances.0).max(1e-30)
+    }
+
+    /// The slice (fractional) of eye distance `d`, before rounding down.
+    fn slice(&self, d: f32) -> f32 {
+        (d - self.distances.0) * self.slices_per_unit()
+    }
+
+    /// The depth mask of `points` (the same points `new` was given), with every
+    /// point's slice moved by `slack` slices towards (negative) or away from
+    /// (positive) the slice boundaries: a positive slack marks every slice a
+    /// point may fall in given rounding, a negative one only those it surely does.
+    pub fn depth_mask(&self, points: &[Vec3], slack: f32) -> u32 {
+        debug_assert_eq!(points.len(), self.points);
+        let last = (DEPTH_SLICES - 1) as f32;
+        let mut mask = 0u32;
+        for p in points {
+            let s = self.slice(p.distance(self.eye));
+            let (lo, hi) = ((s - slack).clamp(0.0, last), (s + slack).clamp(0.0, last));
+            let (lo, hi) = (lo.floor() as u32, hi.floor() as u32);
+            if slack >= 0.0 || lo == hi {
+                for k in lo.min(hi)..=hi.max(lo) {
+                    mask |= 1 << k;
+                }
+            }
+        }
+        mask
+    }
+
+    /// The slices a sphere's range of eye distances covers, widened (positive
+    /// `slack`) or narrowed (negative) by `slack` slices at each end; zero when
+    /// the range misses every slice.
+    pub fn sphere_slices(&self, centre: Vec3, radius: f32, slack: f32) -> u32 {
+        let d = centre.distance(self.eye);
+        let first = (self.slice(d - radius) - slack).floor();
+        let last = (self.slice(d + radius) + slack).floor();
+        let top = (DEPTH_SLICES - 1) as f32;
+        if last < 0.0 || first > top || first > last {
+            return 0;
+        }
+        let (first, last) = (first.clamp(0.0, top) as u32, last.clamp(0.0, top) as u32);
+        (u32::MAX >> (31 - last)) & (u32::MAX << first)
+    }
+}
+
 /// A sphere (centre, radius) holding everything a spot lights: the part of
 /// the ball of radius `range` around `apex` inside the cone about unit `axis`
 /// with half-angle cosine `cos_half`. Up to 45 degrees the sphere through the
@@ -179,6 +276,63 @@ mod tests {
         assert!(!slab.touches(Vec3::new(2.5, -2.5, -9.5), 0.4));
         let m = slab.margin(Vec3::new(2.5, -2.5, -10.5), 0.4);
         assert!((m - 0.1).abs() < 1e-3, "{m}");
+    }
+
+    #[test]
+    fn a_surface_box_lists_spheres_that_reach_the_points_box() {
+        let points = [Vec3::new(0.0, 0.0, -10.0), Vec3::new(2.0, 0.0, -12.0)];
+        let surface = TileSurface::new(&points, Vec3::ZERO).unwrap();
+        assert_eq!(
+            (surface.min, surface.max),
+            (points[1].with_x(0.0), points[0].with_x(2.0))
+        );
+        // Above the flat box by 1 unit: radius 1 is on it.
+        assert!((surface.box_margin(Vec3::new(1.0, 1.0, -11.0), 0.9) - 0.1).abs() < 1e-6);
+        assert!(surface.box_margin(Vec3::new(1.0, 1.0, -11.0), 1.1) < 0.0);
+        // Off a corner: distance sqrt(2).
+        let m = surface.box_margin(Vec3::new(3.0, 1.0, -10.0 + 0.0), 0.0);
+        assert!((m - 2f32.sqrt()).abs() < 1e-6, "{m}");
+        assert!(TileSurface::new(&[], Vec3::ZERO).is_none());
+    }
+
+    #[test]
+    fn the_depth_mask_marks_occupied_slices_and_spheres_meet_them() {
+        // Points at eye distances 10, 10.5 and 18 of a range 10..18: slices 0, 2 and 31.
+        let points = [
+            Vec3::new(0.0, 0.0, -10.0),
+            Vec3::new(0.0, 0.0, -10.5),
+            Vec3::new(0.0, 0.0, -18.0),
+        ];
+        let surface = TileSurface::new(&points, Vec3::ZERO).unwrap();
+        assert_eq!(surface.distances, (10.0, 18.0));
+        let mask = surface.depth_mask(&points, 0.0);
+        assert_eq!(mask, 1 | 1 << 2 | 1 << 31);
+        // A sphere between the near points and the far one (distances 12..16)
+        // covers slices 8..=24: empty, so a slab or box test would list it but
+        // the mask does not.
+        let between = surface.sphere_slices(Vec3::new(0.0, 0.0, -14.0), 2.0, 0.0);
+        assert_eq!(between, (u32::MAX >> 7) & (u32::MAX << 8));
+        assert_eq!(between & mask, 0);
+        // Reaching the far point.
+        assert_ne!(
+            surface.sphere_slices(Vec3::new(0.0, 0.0, -19.0), 1.5, 0.0) & mask,
+            0
+        );
+        // Wholly beyond or before the range.
+        assert_eq!(
+            surface.sphere_slices(Vec3::new(0.0, 0.0, -25.0), 1.0, 0.0),
+            0
+        );
+        assert_eq!(
+            surface.sphere_slices(Vec3::new(0.0, 0.0, -5.0), 1.0, 0.0),
+            0
+        );
+        // A point on a slice boundary (10.25 is exactly slice 1) is marked
+        // either side with slack and in neither surely.
+        let edge = [points[0], Vec3::new(0.0, 0.0, -10.25), points[2]];
+        let surface = TileSurface::new(&edge, Vec3::ZERO).unwrap();
+        assert_eq!(surface.depth_mask(&edge, 0.05) & 0b11, 0b11);
+        assert_eq!(surface.depth_mask(&edge, -0.05) & 0b10, 0);
     }
 
     #[test]
