@@ -6,7 +6,9 @@
 
 use weft_tests::render as common;
 
-use common::{agreement, cube_scene, demo_scene, gltf_scene, graph, render_validated};
+use common::{
+    absolute_paths, agreement, cube_scene, demo_scene, gltf_scene, graph, render_validated,
+};
 use weft_testkit::{check_golden, Tolerance};
 
 /// Golden tolerance: lavapipe is deterministic on one machine; the slack covers
@@ -236,4 +238,87 @@ fn forward_deferred_and_tiled_agree_on_every_shared_gltf_file() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// A floor from an OBJ file (Blinn-Phong) under DamagedHelmet (glTF,
+/// metallic-roughness), a sun and a point light.
+fn mixed_models_scene(dir: &std::path::Path) -> std::path::PathBuf {
+    std::fs::create_dir_all(dir).expect("scratch dir");
+    let root = common::root();
+    let text = format!(
+        "model\n{{\n\tfile \"{}\"\n}}\n\
+         model\n{{\n\tfile \"{}\"\n\tposition 0 1 0\n}}\n\
+         sunlight\n{{\n\tdirection 0.3 -1 0.2\n\tcolor 0.8 0.8 0.8\n}}\n\
+         pointlight\n{{\n\tposition 1 2 2\n\tcolor 2 2 2\n\tattenuation 1 0 1\n}}\n\
+         camera \"view\"\n{{\n\tposition 0 2 4\n\ttarget 0 1 0\n\tfov_deg 50\n}}\n",
+        root.join("scenes/models/floor.obj").display(),
+        root.join("../shared/assets/gltf/rise/DamagedHelmet.glb")
+            .display(),
+    );
+    let path = dir.join("mixed.scene");
+    std::fs::write(&path, text).expect("scene");
+    path
+}
+
+#[test]
+fn draws_are_grouped_by_shading_model_with_one_variant_each_and_the_image_unchanged() {
+    let dir = std::env::temp_dir().join(format!("weft-mixed-models-{}", std::process::id()));
+    let scene = mixed_models_scene(&dir);
+    // The same graph without `draws:`: one variant with both models, chosen per pixel.
+    let text = std::fs::read_to_string(graph("forward.ron")).expect("forward.ron");
+    let ungrouped_text = text
+        .replace(", draws: BlinnPhong", "")
+        .replace(", draws: MetallicRoughness", "");
+    assert_ne!(ungrouped_text, text, "forward.ron groups its draws");
+    let ungrouped = dir.join("forward_ungrouped.ron");
+    std::fs::write(&ungrouped, absolute_paths(&ungrouped_text)).expect("graph");
+
+    let loaded = weft_scene::load_scene(&scene).expect("scene loads");
+    let features = weft_render::scene_features(&loaded);
+    let plan_of = |path: &std::path::Path| {
+        let options = weft_graph::CompileOptions {
+            features: features.iter().cloned().collect(),
+            ..weft_graph::CompileOptions::default()
+        };
+        weft_graph::compile(&weft_graph::load(path), &options).expect("compiles")
+    };
+    let plan = plan_of(&graph("forward.ron"));
+    let pass = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "forward")
+        .expect("forward pass");
+    let variants = weft_render::sources::scene_pass_variants(pass);
+    assert_eq!(variants.len(), 2, "one variant per shading model");
+    let fragment_defines: Vec<&Vec<String>> = variants.iter().map(|v| &v[1].defines).collect();
+    let has = |defines: &Vec<String>, name: &str| defines.iter().any(|d| d == name);
+    assert!(has(fragment_defines[0], "SCENE_BLINN_PHONG"));
+    assert!(!has(fragment_defines[0], "SCENE_METALLIC_ROUGHNESS"));
+    assert!(has(fragment_defines[1], "SCENE_METALLIC_ROUGHNESS"));
+    assert!(!has(fragment_defines[1], "SCENE_BLINN_PHONG"));
+    let text = weft_graph::text::render(&plan);
+    assert!(
+        text.contains("mesh draws grouped by shading model, one variant each: BlinnPhong +SCENE_BLINN_PHONG, MetallicRoughness +SCENE_METALLIC_ROUGHNESS"),
+        "{text}"
+    );
+    let plain = plan_of(&ungrouped);
+    let pass = plain
+        .passes
+        .iter()
+        .find(|p| p.name == "forward")
+        .expect("forward pass");
+    assert_eq!(weft_render::sources::scene_pass_variants(pass).len(), 1);
+
+    let grouped = render_validated(&scene, &graph("forward.ron"), 160, 90, &["!bloom"]);
+    let single = render_validated(&scene, &ungrouped, 160, 90, &["!bloom"]);
+    std::fs::remove_dir_all(&dir).expect("scratch dir removed");
+    assert_eq!(grouped.messages, Vec::new());
+    assert_eq!(single.messages, Vec::new());
+    assert_eq!(grouped.draw_calls, single.draw_calls);
+    let a = agreement(&grouped.image, &single.image);
+    eprintln!("grouped vs one variant: {a:?}");
+    assert!(a.max <= 1, "{a:?}");
+    // Both models are on screen: not a comparison of two empty frames.
+    let lit = grouped.image.pixels().filter(|p| p.0[0] > 16).count();
+    assert!(lit > 160 * 90 / 4, "{lit} lit pixels");
 }

@@ -8,7 +8,7 @@
 
 use weft_tests::render as common;
 
-use common::agreement;
+use common::{absolute_paths, agreement};
 
 use glam::{Vec3, Vec4Swizzles};
 use std::path::{Path, PathBuf};
@@ -60,28 +60,6 @@ fn write_scene(dir: &Path, lights: &str, camera: (Vec3, Vec3), box_on: bool) -> 
     let path = dir.join("plane.scene");
     std::fs::write(&path, scene).expect("scene");
     path
-}
-
-/// `text` of a shipped graph with its fragment and shader paths made absolute,
-/// so a copy written elsewhere finds them.
-fn absolute_paths(text: &str) -> String {
-    let root = common::root().join("graphs");
-    text.replace(
-        "(file: \"bloom.ron\"",
-        &format!("(file: \"{}\"", root.join("bloom.ron").display()),
-    )
-    .replace(
-        "(file: \"gbuffer.ron\"",
-        &format!("(file: \"{}\"", root.join("gbuffer.ron").display()),
-    )
-    .replace(
-        "(file: \"bench/",
-        &format!("(file: \"{}/", root.join("bench").display()),
-    )
-    .replace(
-        "\"../shaders/",
-        &format!("\"{}/", common::root().join("shaders").display()),
-    )
 }
 
 /// `graphs/<graph>` rewritten into `dir` with shadow parameters overridden.

@@ -32,6 +32,27 @@ pub fn graph(name: &str) -> PathBuf {
     root().join("graphs").join(name)
 }
 
+/// `text` of a shipped graph with its fragment and shader paths made absolute,
+/// so a copy written elsewhere finds them.
+pub fn absolute_paths(text: &str) -> String {
+    let graphs = root().join("graphs");
+    let mut text = text.to_string();
+    for fragment in ["bloom.ron", "gbuffer.ron", "shadows.ron"] {
+        text = text.replace(
+            &format!("(file: \"{fragment}\""),
+            &format!("(file: \"{}\"", graphs.join(fragment).display()),
+        );
+    }
+    text.replace(
+        "(file: \"bench/",
+        &format!("(file: \"{}/", graphs.join("bench").display()),
+    )
+    .replace(
+        "\"../shaders/",
+        &format!("\"{}/", root().join("shaders").display()),
+    )
+}
+
 /// What one validated render produced.
 pub struct Output {
     pub image: RgbaImage,

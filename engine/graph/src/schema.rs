@@ -286,6 +286,19 @@ pub struct DefineDecl {
     /// Features that must all hold (`"name"`) or not hold (`"!name"`).
     #[serde(default)]
     pub enabled_if: Vec<String>,
+    /// Set only for the pass's mesh draws whose material uses this shading
+    /// model: the pass's draws are grouped by model, one shader variant each.
+    #[serde(default)]
+    pub draws: Option<ShadingModel>,
+}
+
+/// A material's shading model, as mesh draws are grouped by it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Deserialize, Serialize)]
+pub enum ShadingModel {
+    /// MTL materials: diffuse, specular and shininess (mirrors and coats too).
+    BlinnPhong,
+    /// glTF materials: base colour, metallic and roughness.
+    MetallicRoughness,
 }
 
 /// A use of a named value provider: its name and arguments (numbers, vectors,

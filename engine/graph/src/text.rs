@@ -115,6 +115,21 @@ pub fn render(plan: &Plan) -> String {
                 p.variants
             );
         }
+        if p.groups_by_model() {
+            let mut groups: Vec<String> = Vec::new();
+            for (model, define) in &p.model_defines {
+                let label = format!("{model:?}");
+                match groups.iter_mut().find(|g| g.starts_with(&label)) {
+                    Some(g) => g.push_str(&format!(" {define}")),
+                    None => groups.push(format!("{label} +{define}")),
+                }
+            }
+            let _ = writeln!(
+                w,
+                "     mesh draws grouped by shading model, one variant each: {}",
+                groups.join(", ")
+            );
+        }
     }
     if !plan.epilogue.is_empty() {
         let _ = writeln!(w, "\nepilogue:");

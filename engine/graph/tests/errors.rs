@@ -573,3 +573,26 @@ fn a_define_must_be_a_preprocessor_name_the_engine_does_not_own() {
     );
     assert!(errors(&graph("SCENE_MIRRORS")).is_empty());
 }
+
+#[test]
+fn a_define_for_one_shading_model_needs_a_pass_that_draws_meshes() {
+    let on_meshes = VALID.replace(
+        r#"draw: Meshes(Opaque),"#,
+        "draw: Meshes(Opaque),\n            defines: [(name: \"SCENE_PBR\", draws: MetallicRoughness)],",
+    );
+    assert!(errors(&on_meshes).is_empty());
+    let text = VALID.replace(
+        r#"color: [(image: "ldr")],"#,
+        "color: [(image: \"ldr\")],\n            defines: [(name: \"SCENE_PBR\", draws: MetallicRoughness)],",
+    );
+    let d = only_error(&text);
+    assert_eq!(
+        d.message,
+        "define \"SCENE_PBR\": `draws` groups a pass's mesh draws by shading model, and pass `resolve` draws no meshes"
+    );
+    assert!(text_at(&text, &d).starts_with("MetallicRoughness"), "{d:?}");
+    assert_eq!(
+        d.hint.as_deref(),
+        Some("remove `draws`, or give the pass `draw: Meshes(...)`")
+    );
+}

@@ -237,6 +237,7 @@ mod tests {
             dispatch: None,
             params: BTreeMap::new(),
             defines: Vec::new(),
+            model_defines: Vec::new(),
             variants: 1,
             barriers: Vec::new(),
             render_pass: None,

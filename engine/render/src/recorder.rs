@@ -13,6 +13,7 @@ use crate::shadows::ShadowSettings;
 use crate::state::{pass_state, DepthTest, PassState};
 use ash::vk;
 use glam::{Mat4, Vec3};
+use std::collections::BTreeMap;
 use std::sync::Arc;
 use weft_gpu::bind::{pack_push, resolve_bindings, FrameValues};
 use weft_gpu::commands::Commands;
@@ -21,7 +22,7 @@ use weft_gpu::pipeline::{BlendCode, Pipeline, ShaderKey, ShaderModule};
 use weft_gpu::reflect::PipelineInterface;
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, ShaderStage, SCENE_SET};
 use weft_graph::plan::LoadOp;
-use weft_graph::schema::{CompareOp, Draw, LightKind, MaterialFilter, ParamValue};
+use weft_graph::schema::{CompareOp, Draw, LightKind, MaterialFilter, ParamValue, ShadingModel};
 
 /// The most light volumes (point spheres, spot cones and spheres) one pass
 /// draws: 65,536 volumes of 320 triangles already take seconds a frame on a
@@ -254,6 +255,95 @@ impl<'g> SceneRecorder<'g> {
         inside
     }
 
+    /// The pipeline for `key` with the pass's graph set and push constants
+    /// (`params` packed into the pipeline's push block).
+    fn ready(
+        &mut self,
+        ctx: &RasterContext<'_>,
+        key: &ScenePipelineKey,
+        layouts: [vk::DescriptorSetLayout; 2],
+        params: &BTreeMap<String, ParamValue>,
+    ) -> Result<(Arc<ScenePipeline>, PassBindings), GpuError> {
+        let pass = ctx.pass();
+        let p = self
+            .pipelines
+            .get(self.gpu, key, layouts, (ctx.plan, pass))?;
+        let graph_set = self.graph_set(ctx, p.graph_layout, &p.interface)?;
+        let push = match &p.interface.push {
+            Some((block, stages)) => {
+                let frame = FrameValues {
+                    extent: [ctx.extent.width, ctx.extent.height],
+                    ..self.frame
+                };
+                let bytes =
+                    pack_push(block, params, &frame).map_err(|problems| GpuError::Pass {
+                        pass: pass.name.clone(),
+                        message: problems.join("; "),
+                    })?;
+                Some((*stages, bytes))
+            }
+            None => None,
+        };
+        Ok((p, PassBindings { graph_set, push }))
+    }
+
+    /// Draws `draws` with the pass's variant; with `by_model`, in runs of one
+    /// shading model, each run with the variant the pass declares for that
+    /// model (`PlanPass::defines_for`), opaque-safe order kept: callers pass
+    /// blended draws already sorted, and the runs follow that order.
+    fn draw_variants(
+        &mut self,
+        ctx: &RasterContext<'_>,
+        key: &ScenePipelineKey,
+        layouts: [vk::DescriptorSetLayout; 2],
+        params: &BTreeMap<String, ParamValue>,
+        mut draws: Vec<DrawItem>,
+        by_model: bool,
+    ) -> Result<u64, GpuError> {
+        if !by_model {
+            let (p, bindings) = self.ready(ctx, key, layouts, params)?;
+            self.bind(ctx.cmd, &p, &bindings);
+            return Ok(self.draw_meshes(ctx.cmd, &p, draws.iter()));
+        }
+        if !blends_transparency(&key.state) {
+            // Depth-tested opaque draws may go in any order: one run per model.
+            draws.sort_by_key(|d| self.model_of(d));
+        }
+        let models: Vec<ShadingModel> = draws.iter().map(|d| self.model_of(d)).collect();
+        let mut calls = 0;
+        let mut start = 0;
+        while start < draws.len() {
+            let model = models[start];
+            let end = start + models[start..].iter().take_while(|m| **m == model).count();
+            let defines = ctx.pass().defines_for(model);
+            let variant = |shader: &ShaderKey| ShaderKey {
+                defines: defines.clone(),
+                ..shader.clone()
+            };
+            let for_model = ScenePipelineKey {
+                vertex: variant(&key.vertex),
+                fragment: key.fragment.as_ref().map(variant),
+                ..key.clone()
+            };
+            let (p, bindings) = self.ready(ctx, &for_model, layouts, params)?;
+            self.bind(ctx.cmd, &p, &bindings);
+            calls += self.draw_meshes(ctx.cmd, &p, draws[start..end].iter());
+            start = end;
+        }
+        Ok(calls)
+    }
+
+    /// The shading model of a draw's material, as passes group draws by it.
+    fn model_of(&self, d: &DrawItem) -> ShadingModel {
+        let material = self.scene.geometry.materials.get(d.material as usize);
+        match material.map(|m| m.shading) {
+            Some(weft_scene::material::ShadingModel::MetallicRoughness) => {
+                ShadingModel::MetallicRoughness
+            }
+            _ => ShadingModel::BlinnPhong,
+        }
+    }
+
     /// `draws` sorted farthest from the camera first (by the placed model's
     /// origin), the order alpha blending needs.
     fn back_to_front(&self, draws: Vec<DrawItem>) -> Vec<DrawItem> {
@@ -443,37 +533,19 @@ impl DrawRecorder for SceneRecorder<'_> {
             self.scene.scene_layout.handle(),
             self.scene.material_layout.handle(),
         ];
-        let p = self
-            .pipelines
-            .get(self.gpu, &key, layouts, (ctx.plan, pass))?;
-        let graph_set = self.graph_set(ctx, p.graph_layout, &p.interface)?;
         let shadow_atlas = providers::shadow_atlas(pass);
         let mut params = pass.params.clone();
         if shadow_atlas.is_some() {
             params.insert(SHADOW_VIEW.to_string(), ParamValue::Number(0.0));
         }
-        let push = match &p.interface.push {
-            Some((block, stages)) => {
-                let frame = FrameValues {
-                    extent: [ctx.extent.width, ctx.extent.height],
-                    ..self.frame
-                };
-                let bytes = pack_push(block, &params, &frame)
-                    .map_err(|problems| fail(problems.join("; ")))?;
-                Some((*stages, bytes))
-            }
-            None => None,
-        };
-        let bindings = PassBindings { graph_set, push };
-        self.bind(ctx.cmd, &p, &bindings);
-        let g = &self.scene.geometry;
+        let by_model = pass.groups_by_model() && shadow_atlas.is_none();
         let mut calls = 0u64;
         match draw {
             Draw::Meshes(MaterialFilter::All) if blends_transparency(&key.state) => {
                 // Opaque first, then transparent meshes blended over them, farthest first.
                 let camera = self.scene.view_proj;
                 let opaque = self.visible(pass.name.clone(), camera, MaterialFilter::Opaque);
-                calls += self.draw_meshes(ctx.cmd, &p, opaque.iter());
+                calls += self.draw_variants(ctx, &key, layouts, &params, opaque, by_model)?;
                 let transparent =
                     self.visible(pass.name.clone(), camera, MaterialFilter::Transparent);
                 let transparent = self.back_to_front(transparent);
@@ -482,21 +554,25 @@ impl DrawRecorder for SceneRecorder<'_> {
                         state: transparent_state(&key.state),
                         ..key.clone()
                     };
-                    let q = self
-                        .pipelines
-                        .get(self.gpu, &blended, layouts, (ctx.plan, pass))?;
-                    self.bind(ctx.cmd, &q, &bindings);
-                    calls += self.draw_meshes(ctx.cmd, &q, transparent.iter());
+                    calls +=
+                        self.draw_variants(ctx, &blended, layouts, &params, transparent, by_model)?;
                 }
             }
             Draw::Meshes(filter) => match &shadow_atlas {
-                Some(settings) => calls += self.draw_shadow_views(ctx, &p, filter, settings)?,
+                Some(settings) => {
+                    let (p, bindings) = self.ready(ctx, &key, layouts, &params)?;
+                    self.bind(ctx.cmd, &p, &bindings);
+                    calls += self.draw_shadow_views(ctx, &p, filter, settings)?;
+                }
                 None => {
                     let draws = self.visible(pass.name.clone(), self.scene.view_proj, filter);
-                    calls += self.draw_meshes(ctx.cmd, &p, draws.iter());
+                    calls += self.draw_variants(ctx, &key, layouts, &params, draws, by_model)?;
                 }
             },
             Draw::LightVolumes(kind) => {
+                let (p, bindings) = self.ready(ctx, &key, layouts, &params)?;
+                self.bind(ctx.cmd, &p, &bindings);
+                let g = &self.scene.geometry;
                 let lights = &self.scene.light_set;
                 let groups = match kind {
                     LightKind::Point => vec![(g.sphere, lights.points, lights.first_point())],

@@ -11,7 +11,7 @@ use crate::providers::SHADOW_VIEW;
 use crate::scene_gpu::{
     is_trace_texture, MATERIAL_SET_BINDINGS, SCENE_SET_BINDINGS, TRACE_SET_BINDINGS,
 };
-use crate::sources::scene_pass_keys;
+use crate::sources::scene_pass_variants;
 use weft_gpu::bind::{
     check_outputs, link_problems, pack_push, resolve_bindings, shape_name, FrameValues,
 };
@@ -234,13 +234,18 @@ fn scene_pass_shaders(
     if pass.shaders.vertex.is_none() {
         return Ok(vec!["needs a vertex shader".into()]);
     }
-    let keys = scene_pass_keys(pass);
-    let vs = cache.shader(&keys[0])?;
-    let fs = keys.get(1).map(|k| cache.shader(k)).transpose()?;
-    let problems =
-        scene_pass_problems(plan, pass, &vs.interface, fs.as_ref().map(|f| &f.interface));
-    Ok(problems
-        .into_iter()
-        .map(|m| with_declaration(cache, &keys, m))
-        .collect())
+    let mut found = Vec::new();
+    for keys in scene_pass_variants(pass) {
+        let vs = cache.shader(&keys[0])?;
+        let fs = keys.get(1).map(|k| cache.shader(k)).transpose()?;
+        let problems =
+            scene_pass_problems(plan, pass, &vs.interface, fs.as_ref().map(|f| &f.interface));
+        for m in problems {
+            let located = with_declaration(cache, &keys, m);
+            if !found.contains(&located) {
+                found.push(located);
+            }
+        }
+    }
+    Ok(found)
 }

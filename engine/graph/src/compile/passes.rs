@@ -98,11 +98,18 @@ fn plan_pass(cx: &PassContext, p: IrPassId, i: PassId, barriers: Vec<Barrier>) -
             ));
         }
     }
+    let mut model_defines = Vec::new();
     for define in &pass.defines {
         if super::conditions_hold(&define.enabled_if, &options.features) {
-            defines.insert(define.name.clone());
+            match define.draws {
+                Some(model) => model_defines.push((model, define.name.clone())),
+                None => {
+                    defines.insert(define.name.clone());
+                }
+            }
         }
     }
+    model_defines.sort();
     let render_pass = matches!(pass.kind, PassKind::Raster | PassKind::Fullscreen).then(|| {
         let mut attachments = Vec::new();
         let mut color = Vec::new();
@@ -213,6 +220,7 @@ fn plan_pass(cx: &PassContext, p: IrPassId, i: PassId, barriers: Vec<Barrier>) -
         dispatch,
         params: pass.params.clone(),
         defines: defines.into_iter().collect(),
+        model_defines,
         variants: crate::resolve::variant_count(pass.variant_bits()),
         barriers,
         render_pass,
@@ -228,6 +236,7 @@ mod tests {
     use super::super::fixture::CHAIN;
     use super::super::tests::plan_of;
     use super::*;
+    use crate::schema::ShadingModel;
 
     #[test]
     fn stores_are_kept_only_for_contents_read_later() {
@@ -294,5 +303,38 @@ mod tests {
         assert_eq!(b(&["extra"]), ["ALWAYS", "WITH_EXTRA"]);
         let (_, ir) = super::super::fixture::resolved(&text);
         assert!(super::super::feature_names(&ir).contains("extra"));
+    }
+
+    #[test]
+    fn model_defines_group_mesh_draws_by_shading_model() {
+        let text = CHAIN
+            .replace(
+                r#"Pass(name: "b", kind: Fullscreen, shaders: (fragment: "b.frag"),"#,
+                r#"Pass(name: "b", kind: Raster, shaders: (vertex: "b.vert", fragment: "b.frag"),
+                 draw: Meshes(All),"#,
+            )
+            .replace(
+                r#"sampled: ["x"], color: [(image: "out")]"#,
+                r#"sampled: ["x"], color: [(image: "out")],
+                 defines: [(name: "ALWAYS"),
+                           (name: "PHONG", enabled_if: ["phong"], draws: BlinnPhong),
+                           (name: "PBR", draws: MetallicRoughness)]"#,
+            );
+        let plan = plan_of(&text, &["phong"]);
+        let b = plan.passes.iter().find(|p| p.name == "b").expect("b runs");
+        assert_eq!(b.defines, ["ALWAYS"]);
+        assert!(b.groups_by_model());
+        assert_eq!(b.defines_for(ShadingModel::BlinnPhong), ["ALWAYS", "PHONG"]);
+        assert_eq!(
+            b.defines_for(ShadingModel::MetallicRoughness),
+            ["ALWAYS", "PBR"]
+        );
+        let plan = plan_of(&text, &[]);
+        let b = plan.passes.iter().find(|p| p.name == "b").expect("b runs");
+        assert_eq!(
+            b.model_defines,
+            [(ShadingModel::MetallicRoughness, "PBR".to_string())]
+        );
+        assert_eq!(b.defines_for(ShadingModel::BlinnPhong), ["ALWAYS"]);
     }
 }

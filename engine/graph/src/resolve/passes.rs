@@ -7,7 +7,8 @@ use crate::id::{IdVec, IrResourceId};
 use crate::load::Located;
 use crate::plan::ShaderFiles;
 use crate::schema::{
-    AttachmentDecl, Dispatch, ParamValue, PassDecl, PassKind, ProviderDecl, RasterState, ReadDecl,
+    AttachmentDecl, Dispatch, Draw, ParamValue, PassDecl, PassKind, ProviderDecl, RasterState,
+    ReadDecl,
 };
 use crate::spans::Seg;
 use std::collections::BTreeMap;
@@ -245,6 +246,21 @@ impl Resolver<'_> {
                     format!("define \"{name}\": names starting HAS_ are the engine's, for conditional reads"),
                 )
                 .hint = Some("choose another prefix, e.g. SCENE_".into());
+            }
+            if define.draws.is_some() && !matches!(decl.draw, Some(Draw::Meshes(_))) {
+                let path = pass_path(
+                    index,
+                    &[Seg::Field("defines"), Seg::Index(k), Seg::Field("draws")],
+                );
+                self.error(
+                    source,
+                    &path,
+                    format!(
+                        "define \"{name}\": `draws` groups a pass's mesh draws by shading model, and pass `{}` draws no meshes",
+                        decl.name
+                    ),
+                )
+                .hint = Some("remove `draws`, or give the pass `draw: Meshes(...)`".into());
             }
         }
         decl.defines.clone()
