@@ -44,6 +44,7 @@ pub mod rng;
 pub mod scene;
 pub mod source;
 mod syntax;
+pub mod tangent_frame;
 pub mod tangents;
 mod uri;
 
