@@ -22,6 +22,7 @@ layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 world_normal;
 layout(location = 2) in vec2 texcoord;
 layout(location = 3) flat in uint material;
+layout(location = 4) in vec4 world_tangent;
 
 layout(location = 0) out vec4 color;
 
@@ -30,9 +31,12 @@ void main() {
     vec4 texel = texture(base_color, texcoord);
     Material m = materials[material];
     vec2 mr = metal_rough(m, texture(metallic_roughness, texcoord));
+    // Seen from behind, the normal turns round and, for the bitangent to
+    // stay put, so does the handedness.
+    vec4 tangent = gl_FrontFacing ? world_tangent : vec4(world_tangent.xyz, -world_tangent.w);
     n = gl_FrontFacing ? n : -n;
 #ifdef SHADE_NORMAL_MAPS
-    n = mapped_normal(n, world, texcoord, texture(normal_map, texcoord).rgb, m.ambient.w);
+    n = mapped_normal(n, tangent, world, texcoord, texture(normal_map, texcoord).rgb, m.ambient.w);
 #endif
     Surface s = Surface(world, n, texel.rgb, material, mr);
     vec3 c = shade_ambient_emissive(s, m, params.emissive_boost) + shade_all_lights(s, m, params.area_samples);

@@ -11,6 +11,7 @@ layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 world_normal;
 layout(location = 2) in vec2 texcoord;
 layout(location = 3) flat in uint material;
+layout(location = 4) in vec4 world_tangent;
 
 layout(location = 0) out vec4 albedo;
 layout(location = 1) out vec2 normal;
@@ -20,9 +21,12 @@ void main() {
     vec3 n = normalize(world_normal);
     albedo = vec4(texture(base_color, texcoord).rgb, 1.0);
     Material m = materials[material];
+    // Seen from behind, the normal turns round and, for the bitangent to
+    // stay put, so does the handedness.
+    vec4 tangent = gl_FrontFacing ? world_tangent : vec4(world_tangent.xyz, -world_tangent.w);
     n = gl_FrontFacing ? n : -n;
 #ifdef SHADE_NORMAL_MAPS
-    n = mapped_normal(n, world, texcoord, texture(normal_map, texcoord).rgb, m.ambient.w);
+    n = mapped_normal(n, tangent, world, texcoord, texture(normal_map, texcoord).rgb, m.ambient.w);
 #endif
     normal = octahedral_encode_half(n);
     vec2 mr = metal_rough(m, texture(metallic_roughness, texcoord));

@@ -94,16 +94,16 @@ vec2 metal_rough(Material m, vec4 texel) {
     return round(clamp(m.specular.xy * texel.bg, 0.0, 1.0) * 255.0) / 255.0;
 }
 
-// Compute shaders (which have no derivatives) define NO_DERIVATIVES before
-// including this file and go without `mapped_normal`.
-#ifndef NO_DERIVATIVES
 // The normal `n` bent by a tangent-space normal-map texel (glTF convention:
-// +X along increasing u, +Y up in the image) with strength `scale`; 0 leaves
-// `n` as it is. The tangent frame comes from screen-space derivatives of the
-// position and UV (dP/du, made orthogonal to n), so meshes need no tangents;
-// it is constant across a triangle and assumes UVs are not mirrored.
-vec3 mapped_normal(vec3 n, vec3 p, vec2 uv, vec3 texel, float scale) {
-#ifdef SHADE_NORMAL_MAPS
+// +X along the tangent, +Y along the bitangent, up in the image) with strength
+// `scale`; 0 leaves `n` as it is. `tangent` is the interpolated vertex
+// tangent (w the handedness: bitangent = cross(n, tangent) * w), made
+// orthogonal to `n` here. With SCREEN_SPACE_TANGENTS (graph feature
+// `screen_space_tangents`, for comparison) the frame comes instead from
+// screen-space derivatives of the position and UV, as before baked tangents:
+// constant across a triangle, and wrong where UVs are mirrored.
+#ifdef SCREEN_SPACE_TANGENTS
+vec3 mapped_normal(vec3 n, vec4 tangent, vec3 p, vec2 uv, vec3 texel, float scale) {
     vec3 dpx = dFdx(p);
     vec3 dpy = dFdy(p);
     vec2 dux = dFdx(uv);
@@ -118,9 +118,17 @@ vec3 mapped_normal(vec3 n, vec3 p, vec2 uv, vec3 texel, float scale) {
     vec3 bent = texel * 2.0 - 1.0;
     bent.xy *= scale;
     return normalize(mat3(t, cross(n, t), n) * bent);
+}
 #else
-    return n;
-#endif
+vec3 mapped_normal(vec3 n, vec4 tangent, vec3 p, vec2 uv, vec3 texel, float scale) {
+    vec3 t = tangent.xyz - n * dot(n, tangent.xyz);
+    if (scale == 0.0 || dot(t, t) <= 1e-20) {
+        return n;
+    }
+    t = normalize(t);
+    vec3 bent = texel * 2.0 - 1.0;
+    bent.xy *= scale;
+    return normalize(mat3(t, cross(n, t) * tangent.w, n) * bent);
 }
 #endif
 

@@ -51,6 +51,7 @@ struct Draw {
     mat4 model;
     mat4 normal;     // inverse transpose of model
     uvec4 material;  // x: index into materials
+    vec4 uv_box;     // the mesh's UVs: xy smallest, zw size (vertex UVs are fractions of it)
 };
 
 layout(set = 1, binding = 0) uniform Frame {

@@ -33,7 +33,6 @@
 // light point's value, while BSDF-sampled paths through glass still count:
 // light through glass is counted twice. 0, the default, is unbiased: shadow
 // rays stop at glass and caustics come from BSDF-sampled paths.
-#define NO_DERIVATIVES
 #include "../include/lighting.glsl"
 #include "../include/trace.glsl"
 #include "random.glsl"

@@ -14,6 +14,7 @@ mod pathtrace;
 mod plot;
 mod shadows;
 mod start;
+mod tangents;
 mod tiles;
 
 /// The benchmarks.
@@ -35,6 +36,8 @@ pub enum BenchCommand {
     Floors(crate::floors::FloorsArgs),
     /// Tiled light lists: lights listed per pixel and culling cost of each culling test.
     Tiles(crate::tiles::TilesArgs),
+    /// Packed vertex tangent frames of real models against their float frames.
+    Tangents(crate::tangents::TangentsArgs),
 }
 
 /// Runs `weft bench ...`.
@@ -48,5 +51,6 @@ pub fn run(cmd: BenchCommand) -> Result<ExitCode> {
         BenchCommand::Start(args) => crate::start::run(args),
         BenchCommand::Floors(args) => crate::floors::run(args),
         BenchCommand::Tiles(args) => crate::tiles::run(args),
+        BenchCommand::Tangents(args) => crate::tangents::run(args),
     }
 }

@@ -30,34 +30,47 @@ pub fn run(cmd: SceneCommand) -> Result<ExitCode> {
             file,
             json,
             no_cache,
-        } => match weft_scene::check_report_with(
-            &file,
-            &weft_scene::LoadOptions {
+        } => {
+            let options = weft_scene::LoadOptions {
                 cache_dir: weft_scene::cache::user_cache_dir()
                     .filter(|_| !no_cache)
                     .map(|d| d.join("models")),
-            },
-        ) {
-            Ok(report) => {
-                if json {
-                    println!("{}", serde_json::to_string_pretty(&report)?);
-                } else {
-                    print!("{report}");
-                }
-                Ok(ExitCode::SUCCESS)
-            }
-            Err(err) => {
-                if json {
-                    let value = serde_json::json!({ "error": err });
-                    println!("{}", serde_json::to_string_pretty(&value)?);
-                } else {
-                    eprintln!("error: {err}");
-                    if let Some(snippet) = weft_diagnostic::source_snippet(&err.diagnostic()) {
-                        eprint!("{snippet}");
+            };
+            match weft_scene::check_report_with(&file, &options) {
+                Ok(report) => {
+                    // The scene loaded once already, so this read is from the cache.
+                    let scene = weft_scene::load_scene_with(&file, &options)?;
+                    let vertices = weft_render::geometry::SceneGeometry::new(&scene)
+                        .vertices
+                        .len() as u64;
+                    let vertex_bytes = u64::from(weft_render::geometry::VERTEX_BYTES);
+                    if json {
+                        let mut value = serde_json::to_value(&report)?;
+                        value["vertex_bytes"] = vertex_bytes.into();
+                        value["vertex_buffer_bytes"] = (vertices * vertex_bytes).into();
+                        println!("{}", serde_json::to_string_pretty(&value)?);
+                    } else {
+                        print!("{report}");
+                        println!(
+                            "  vertex buffer: {vertices} vertices x {vertex_bytes} bytes = {:.2} MiB (light volumes included)",
+                            (vertices * vertex_bytes) as f64 / (1024.0 * 1024.0)
+                        );
                     }
+                    Ok(ExitCode::SUCCESS)
                 }
-                Ok(ExitCode::FAILURE)
+                Err(err) => {
+                    if json {
+                        let value = serde_json::json!({ "error": err });
+                        println!("{}", serde_json::to_string_pretty(&value)?);
+                    } else {
+                        eprintln!("error: {err}");
+                        if let Some(snippet) = weft_diagnostic::source_snippet(&err.diagnostic()) {
+                            eprint!("{snippet}");
+                        }
+                    }
+                    Ok(ExitCode::FAILURE)
+                }
             }
-        },
+        }
     }
 }

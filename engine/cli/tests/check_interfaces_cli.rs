@@ -176,7 +176,7 @@ fn scene_pass_shaders_are_compiled_and_their_interfaces_compared() {
     assert_refused(
         "forward.ron",
         &[("shaders/mesh.vert", "layout(location = 2) in vec2 uv;", "layout(location = 4) in vec2 uv;")],
-        "pass \"forward\": vertex input `uv` at location 4 is not supplied; this pass's vertices have 0: position, 1: normal, 2: UV (declared at graphs/../shaders/mesh.vert:8)",
+        "pass \"forward\": vertex input `uv` at location 4 is not supplied; this pass's vertices have 0: position, 1: packed tangent frame, 2: UV (declared at graphs/../shaders/mesh.vert:13)",
     );
 }
 

@@ -46,6 +46,13 @@ fn check_json_has_counts() {
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     assert_eq!(json["lights"]["sun"], 1);
     assert!(json["triangles"].as_u64().expect("triangles") > 100_000);
+    // 20-byte vertices: every vertex of the demo's models and the two light-volume meshes.
+    assert_eq!(json["vertex_bytes"], 20);
+    let scene = weft_scene::load_scene(&repo().join("scenes/demo.scene")).expect("demo loads");
+    let vertices = weft_render::geometry::SceneGeometry::new(&scene)
+        .vertices
+        .len() as u64;
+    assert_eq!(json["vertex_buffer_bytes"].as_u64(), Some(vertices * 20));
 }
 
 #[test]

@@ -53,24 +53,50 @@ pub fn check(graph: &LoadedGraph) -> Vec<Diagnostic> {
 }
 
 /// The feature sets `check` compiles a graph under: every combination of up
-/// to ten features, else none, all and each alone.
+/// to ten features; beyond that none, all, each alone and each pair, and
+/// all but each one and all but each pair, so every interaction of two
+/// features is tried both ways.
 pub fn feature_sets(names: &[String]) -> Vec<BTreeSet<String>> {
     if names.len() <= EXHAUSTIVE_FEATURES {
-        (0u32..1 << names.len())
-            .map(|mask| {
-                names
-                    .iter()
-                    .enumerate()
-                    .filter(|(i, _)| mask & (1 << i) != 0)
-                    .map(|(_, n)| n.clone())
-                    .collect()
-            })
-            .collect()
-    } else {
-        let mut sets = vec![BTreeSet::new(), names.iter().cloned().collect()];
-        sets.extend(names.iter().map(|n| BTreeSet::from([n.clone()])));
-        sets
+        return every_combination(names);
     }
+    let all: BTreeSet<String> = names.iter().cloned().collect();
+    let mut sets = vec![BTreeSet::new(), all.clone()];
+    for (i, a) in names.iter().enumerate() {
+        sets.push(BTreeSet::from([a.clone()]));
+        sets.push(&all - &BTreeSet::from([a.clone()]));
+        for b in &names[i + 1..] {
+            let pair = BTreeSet::from([a.clone(), b.clone()]);
+            sets.push(&all - &pair);
+            sets.push(pair);
+        }
+    }
+    sets
+}
+
+/// The feature sets shader checks compile variants under (each set is a
+/// shader compile per pass whose defines it changes): every combination of up
+/// to ten features, else none, all and each alone.
+pub fn variant_sets(names: &[String]) -> Vec<BTreeSet<String>> {
+    if names.len() <= EXHAUSTIVE_FEATURES {
+        return every_combination(names);
+    }
+    let mut sets = vec![BTreeSet::new(), names.iter().cloned().collect()];
+    sets.extend(names.iter().map(|n| BTreeSet::from([n.clone()])));
+    sets
+}
+
+fn every_combination(names: &[String]) -> Vec<BTreeSet<String>> {
+    (0u32..1 << names.len())
+        .map(|mask| {
+            names
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| mask & (1 << i) != 0)
+                .map(|(_, n)| n.clone())
+                .collect()
+        })
+        .collect()
 }
 
 fn describe(names: &[String], on: &BTreeSet<String>) -> String {
@@ -85,4 +111,37 @@ fn describe(names: &[String], on: &BTreeSet<String>) -> String {
         })
         .collect();
     format!("[{}]", parts.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(n: usize) -> Vec<String> {
+        (0..n).map(|i| format!("f{i}")).collect()
+    }
+
+    #[test]
+    fn up_to_ten_features_every_combination_is_tried() {
+        assert_eq!(feature_sets(&names(10)).len(), 1024);
+        assert_eq!(variant_sets(&names(3)).len(), 8);
+    }
+
+    #[test]
+    fn beyond_ten_every_pair_is_tried_on_and_off() {
+        let n = names(12);
+        let sets = feature_sets(&n);
+        // None, all, 12 singles and their complements, 66 pairs and theirs.
+        assert_eq!(sets.len(), 2 + 2 * 12 + 2 * 66);
+        let all: BTreeSet<String> = n.iter().cloned().collect();
+        for a in &n {
+            for b in &n {
+                let pair = BTreeSet::from([a.clone(), b.clone()]);
+                assert!(sets.contains(&pair), "{pair:?}");
+                assert!(sets.contains(&(&all - &pair)), "all but {pair:?}");
+            }
+        }
+        // Shader variants stay at none, all and each alone.
+        assert_eq!(variant_sets(&n).len(), 2 + 12);
+    }
 }

@@ -8,14 +8,82 @@ use crate::materials;
 use crate::volumes::{self, VolumeMesh};
 use glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
 use weft_graph::schema::MaterialFilter;
-use weft_scene::{Aabb, Material, Scene};
+use weft_scene::tangent_frame::{self, TangentFrame};
+use weft_scene::{Aabb, Material, Mesh, Scene};
 
 /// The scene vertex's attributes: location, float count and what it holds.
-pub const VERTEX_ATTRIBUTES: [(u32, u32, &str); 3] =
-    [(0, 3, "position"), (1, 3, "normal"), (2, 2, "UV")];
+pub const VERTEX_ATTRIBUTES: [VertexAttribute; 3] = [
+    VertexAttribute {
+        location: 0,
+        offset: 0,
+        format: VertexFormat::Float3,
+        what: "position",
+    },
+    VertexAttribute {
+        location: 1,
+        offset: 12,
+        format: VertexFormat::Uint,
+        what: "packed tangent frame",
+    },
+    VertexAttribute {
+        location: 2,
+        offset: 16,
+        format: VertexFormat::Unorm16x2,
+        what: "UV",
+    },
+];
 
-/// Bytes per vertex: position (3 floats), normal (3), uv (2).
+/// Bytes per vertex: position (3 floats), tangent frame (32 bits), UV (2 × 16 bits).
 pub const VERTEX_BYTES: u32 = std::mem::size_of::<GpuVertex>() as u32;
+
+/// One attribute of the shared vertex buffer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct VertexAttribute {
+    /// `layout(location = ...)` in the vertex shader.
+    pub location: u32,
+    /// Bytes from the vertex's start.
+    pub offset: u32,
+    /// How it is stored.
+    pub format: VertexFormat,
+    /// What it holds, for messages.
+    pub what: &'static str,
+}
+
+/// How a vertex attribute is stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VertexFormat {
+    /// Three 32-bit floats (a `vec3` input).
+    Float3,
+    /// One 32-bit unsigned integer (a `uint` input).
+    Uint,
+    /// Two 16-bit unsigned normalized values (a `vec2` input in [0, 1]).
+    Unorm16x2,
+}
+
+/// The box around `uvs` as (smallest, size), the mapping [`quantize_uv`]
+/// stores UVs against; zero for a mesh without UVs. Non-finite UVs are left out.
+pub fn uv_box(uvs: &[Vec2]) -> (Vec2, Vec2) {
+    let finite = || uvs.iter().filter(|uv| uv.is_finite());
+    let lo = finite().fold(Vec2::splat(f32::INFINITY), |a, b| a.min(*b));
+    let hi = finite().fold(Vec2::splat(f32::NEG_INFINITY), |a, b| a.max(*b));
+    if lo.x > hi.x {
+        return (Vec2::ZERO, Vec2::ZERO);
+    }
+    (lo, hi - lo)
+}
+
+/// `uv` as 16-bit fractions of the box `(lo, size)`: the error is at most half
+/// of `size / 65535` per component (a non-finite UV becomes the box's corner).
+pub fn quantize_uv(uv: Vec2, (lo, size): (Vec2, Vec2)) -> [u16; 2] {
+    let fraction = |x: f32, lo: f32, size: f32| {
+        if size > 0.0 && x.is_finite() {
+            (((x - lo) / size).clamp(0.0, 1.0) * 65535.0).round() as u16
+        } else {
+            0
+        }
+    };
+    [fraction(uv.x, lo.x, size.x), fraction(uv.y, lo.y, size.y)]
+}
 
 /// Where a mesh lies in the shared arrays.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -64,10 +132,14 @@ pub struct TraceMesh {
 /// The flattened scene, ready to upload.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SceneGeometry {
-    /// Every vertex.
+    /// Every vertex, packed for the GPU.
     pub vertices: Vec<GpuVertex>,
+    /// Each vertex's unit normal, as imported (the ray tracer reads these).
+    pub normals: Vec<Vec3>,
+    /// Each vertex's UV, as imported (the ray tracer reads these).
+    pub uvs: Vec<Vec2>,
     /// Each vertex's MikkTSpace tangent (w the handedness), zero where its
-    /// mesh has none. Only the ray tracer reads them (normal maps).
+    /// mesh has none, as imported (the ray tracer reads these).
     pub tangents: Vec<Vec4>,
     /// Triangle corners of every mesh, each range relative to its vertex offset.
     pub indices: Vec<u32>,
@@ -105,17 +177,15 @@ impl SceneGeometry {
                     model_ranges.push(None);
                     continue;
                 }
-                let range = g.append(&mesh.positions, &mesh.normals, &mesh.uvs, &mesh.indices);
-                g.tangents.extend(
-                    (0..mesh.positions.len())
-                        .map(|i| mesh.tangents.get(i).copied().unwrap_or(Vec4::ZERO)),
-                );
+                let uv_box = uv_box(&mesh.uvs);
+                let range = g.append(mesh, uv_box);
                 let material = mesh
                     .material
                     .filter(|&i| i < model.materials.len())
                     .map_or(0, |i| material_base[material_base.len() - 1] + i as u32);
                 let bounds = Aabb::from_points(&mesh.positions);
-                model_ranges.push(Some((range, material, bounds)));
+                let uv_box = Vec4::new(uv_box.0.x, uv_box.0.y, uv_box.1.x, uv_box.1.y);
+                model_ranges.push(Some((range, material, bounds, uv_box)));
             }
             ranges.push(model_ranges);
         }
@@ -125,12 +195,13 @@ impl SceneGeometry {
             };
             let normal = instance.transform.inverse().transpose();
             let mirrored = instance.transform.determinant() < 0.0;
-            for &(range, material, bounds) in model_ranges.iter().flatten() {
+            for &(range, material, bounds, uv_box) in model_ranges.iter().flatten() {
                 let draw_id = g.draws.len() as u32;
                 g.draw_records.push(GpuDraw {
                     model: instance.transform,
                     normal,
                     material: UVec4::new(material, 0, 0, 0),
+                    uv_box,
                 });
                 g.draws.push(DrawItem {
                     range,
@@ -147,12 +218,29 @@ impl SceneGeometry {
         g
     }
 
-    fn append(
+    /// Appends a mesh's vertices (frames packed, UVs against `uv_box`) and indices.
+    fn append(&mut self, mesh: &Mesh, uv_box: (Vec2, Vec2)) -> MeshRange {
+        let tangents: Vec<Vec4> = (0..mesh.positions.len())
+            .map(|i| mesh.tangents.get(i).copied().unwrap_or(Vec4::ZERO))
+            .collect();
+        self.append_arrays(
+            &mesh.positions,
+            &mesh.normals,
+            &mesh.uvs,
+            &tangents,
+            &mesh.indices,
+            uv_box,
+        )
+    }
+
+    fn append_arrays(
         &mut self,
         positions: &[Vec3],
         normals: &[Vec3],
         uvs: &[Vec2],
+        tangents: &[Vec4],
         indices: &[u32],
+        uv_box: (Vec2, Vec2),
     ) -> MeshRange {
         let range = MeshRange {
             first_index: self.indices.len() as u32,
@@ -162,11 +250,16 @@ impl SceneGeometry {
         for (i, p) in positions.iter().enumerate() {
             let n = normals.get(i).copied().unwrap_or(Vec3::Y);
             let uv = uvs.get(i).copied().unwrap_or(Vec2::ZERO);
+            let t = tangents.get(i).copied().filter(|t| *t != Vec4::ZERO);
+            let frame = TangentFrame::new(n, t);
             self.vertices.push(GpuVertex {
                 position: p.to_array(),
-                normal: n.to_array(),
-                uv: uv.to_array(),
+                frame: tangent_frame::pack(&frame),
+                uv: quantize_uv(uv, uv_box),
             });
+            self.normals.push(n);
+            self.uvs.push(uv);
+            self.tangents.push(t.unwrap_or(Vec4::ZERO));
         }
         self.indices.extend_from_slice(indices);
         range
@@ -178,9 +271,14 @@ impl SceneGeometry {
             .iter()
             .map(|p| p.try_normalize().unwrap_or(Vec3::Y))
             .collect();
-        let range = self.append(&mesh.positions, &normals, &[], &mesh.indices);
-        self.tangents.resize(self.vertices.len(), Vec4::ZERO);
-        range
+        self.append_arrays(
+            &mesh.positions,
+            &normals,
+            &[],
+            &[],
+            &mesh.indices,
+            (Vec2::ZERO, Vec2::ZERO),
+        )
     }
 
     /// The draws a pass with `filter` makes, in material order.
@@ -203,7 +301,7 @@ impl SceneGeometry {
             };
             let first = d.range.first_index as usize;
             let indices = &self.indices[first..first + d.range.index_count as usize];
-            let vertex = |i: u32| &self.vertices[(d.range.vertex_offset + i as i32) as usize];
+            let vertex = |i: u32| (d.range.vertex_offset + i as i32) as usize;
             let tangent = |i: u32| {
                 self.tangents
                     .get((d.range.vertex_offset + i as i32) as usize)
@@ -225,15 +323,18 @@ impl SceneGeometry {
                         .extend(v.w * handedness)
                 }));
                 let corners = [vertex(t[0]), vertex(t[1]), vertex(t[2])];
-                out.corners
-                    .push(corners.map(|v| record.model.transform_point3(Vec3::from(v.position))));
+                out.corners.push(corners.map(|v| {
+                    record
+                        .model
+                        .transform_point3(Vec3::from(self.vertices[v].position))
+                }));
                 out.normals.push(corners.map(|v| {
                     record
                         .normal
-                        .transform_vector3(Vec3::from(v.normal))
+                        .transform_vector3(self.normals[v])
                         .normalize_or_zero()
                 }));
-                out.uvs.push(corners.map(|v| Vec2::from(v.uv)));
+                out.uvs.push(corners.map(|v| self.uvs[v]));
                 out.materials.push(d.material);
             }
         }

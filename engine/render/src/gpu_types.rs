@@ -3,22 +3,25 @@
 //! `shaders/include/scene.glsl` and `shadows.glsl`. The compiler lays the
 //! bytes out, so no offset is kept by hand; each struct's size is asserted
 //! against the std430/std140 size its GLSL twin has. Every member is a vec4,
-//! mat4 or uvec4 (or, for the vertex, tightly packed floats), so the two
+//! mat4 or uvec4 (or, for the vertex, tightly packed attributes), so the two
 //! layouts agree and there is no padding.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec4, Vec4};
 
-/// One vertex of the shared vertex buffer (`layout(location = 0..2)` inputs).
+/// One vertex of the shared vertex buffer (`layout(location = 0..2)` inputs,
+/// `crate::geometry::VERTEX_ATTRIBUTES`): 20 bytes.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuVertex {
     /// Model-space position.
     pub position: [f32; 3],
-    /// Model-space normal.
-    pub normal: [f32; 3],
-    /// Texture coordinates.
-    pub uv: [f32; 2],
+    /// The tangent frame (normal, tangent, handedness) packed by
+    /// `weft_scene::tangent_frame::pack`, decoded in the vertex shader.
+    pub frame: u32,
+    /// Texture coordinates as 16-bit fractions of the mesh's UV box (the
+    /// draw record's `uv_box` maps them back).
+    pub uv: [u16; 2],
 }
 
 /// `struct Draw`: one placed mesh.
@@ -31,6 +34,9 @@ pub struct GpuDraw {
     pub normal: Mat4,
     /// x: index into the materials.
     pub material: UVec4,
+    /// The mesh's UV box: xy its smallest UV, zw its size; a vertex's UV is
+    /// `xy + zw * uv` with `uv` its 16-bit fractions.
+    pub uv_box: Vec4,
 }
 
 /// `struct Light`. Area lights reuse the fields (see `scene.glsl`).
@@ -118,8 +124,8 @@ pub struct GpuShadowView {
 
 const _: () = {
     use std::mem::size_of;
-    assert!(size_of::<GpuVertex>() == 32);
-    assert!(size_of::<GpuDraw>() == 144);
+    assert!(size_of::<GpuVertex>() == 20);
+    assert!(size_of::<GpuDraw>() == 160);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMaterial>() == 128);
     assert!(size_of::<GpuFrame>() == 2 * 64 + 4 * 16);
@@ -152,9 +158,23 @@ mod tests {
             model: Mat4::from_translation(glam::Vec3::new(9.0, 8.0, 7.0)),
             normal: Mat4::IDENTITY,
             material: UVec4::new(5, 0, 0, 0),
+            uv_box: Vec4::new(0.25, 0.5, 2.0, 4.0),
         };
         let words: &[u32] = bytemuck::cast_slice(std::slice::from_ref(&draw));
         assert_eq!(f32::from_bits(words[12]), 9.0, "column-major translation");
         assert_eq!(words[32], 5, "material index after two mat4s");
+        assert_eq!(f32::from_bits(words[38]), 2.0, "uv_box after the material");
+        let vertex = GpuVertex {
+            position: [1.0, 2.0, 3.0],
+            frame: 0xDEAD_BEEF,
+            uv: [7, 65535],
+        };
+        let bytes = bytemuck::bytes_of(&vertex);
+        assert_eq!(
+            bytes[12..16],
+            0xDEAD_BEEFu32.to_le_bytes(),
+            "frame at offset 12"
+        );
+        assert_eq!(bytes[16..20], [7, 0, 255, 255], "UV at offset 16");
     }
 }

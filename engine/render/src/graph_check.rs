@@ -6,7 +6,7 @@
 use crate::scene_interface::check_plan_shaders;
 use weft_gpu::pipeline::PipelineCache;
 use weft_gpu::{GpuError, ShaderProblem};
-use weft_graph::check::feature_sets;
+use weft_graph::check::variant_sets;
 use weft_graph::compile::feature_names;
 use weft_graph::{CompileOptions, Diagnostic, LoadedGraph, Prepared};
 
@@ -28,7 +28,7 @@ pub fn check_graph_and_shaders(graph: &LoadedGraph) -> Result<Vec<Diagnostic>, G
     };
     let names: Vec<String> = feature_names(prepared.ir()).into_iter().collect();
     let mut cache = PipelineCache::new()?;
-    for features in feature_sets(&names) {
+    for features in variant_sets(&names) {
         let options = CompileOptions {
             features,
             readback: graph.readback_names(),

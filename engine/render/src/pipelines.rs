@@ -3,7 +3,7 @@
 //! reflection (graph resources), set 1 and 2 from the scene, push constants
 //! from reflection, and the fixed-function state the plan implies.
 
-use crate::geometry::{VERTEX_ATTRIBUTES, VERTEX_BYTES};
+use crate::geometry::{VertexFormat, VERTEX_ATTRIBUTES, VERTEX_BYTES};
 use crate::scene_interface::scene_pass_problems;
 use crate::state::{DepthTest, PassState};
 use ash::vk;
@@ -264,19 +264,15 @@ fn create_pipeline(
     fs: Option<&ShaderModule>,
     layout: vk::PipelineLayout,
 ) -> Result<vk::Pipeline, GpuError> {
-    let mut offset = 0;
-    let all = VERTEX_ATTRIBUTES.map(|(location, floats, _)| {
-        let attribute = vk::VertexInputAttributeDescription {
-            location,
-            binding: 0,
-            format: match floats {
-                2 => vk::Format::R32G32_SFLOAT,
-                _ => vk::Format::R32G32B32_SFLOAT,
-            },
-            offset,
-        };
-        offset += floats * 4;
-        attribute
+    let all = VERTEX_ATTRIBUTES.map(|a| vk::VertexInputAttributeDescription {
+        location: a.location,
+        binding: 0,
+        format: match a.format {
+            VertexFormat::Float3 => vk::Format::R32G32B32_SFLOAT,
+            VertexFormat::Uint => vk::Format::R32_UINT,
+            VertexFormat::Unorm16x2 => vk::Format::R16G16_UNORM,
+        },
+        offset: a.offset,
     });
     let attributes = if key.position_only {
         &all[..1]

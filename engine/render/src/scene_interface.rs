@@ -5,7 +5,7 @@
 //! binding 19 is refused with its pass's location instead of reading an
 //! unbound descriptor on the GPU.
 
-use crate::geometry::VERTEX_ATTRIBUTES;
+use crate::geometry::{VertexFormat, VERTEX_ATTRIBUTES};
 use crate::pipelines::MATERIAL_SET;
 use crate::providers::SHADOW_VIEW;
 use crate::scene_gpu::{
@@ -109,6 +109,15 @@ fn slot_list<'a>(slots: impl Iterator<Item = (u32, &'a str)>) -> String {
         .join(", ")
 }
 
+/// The shader input type a vertex attribute's format gives.
+fn shader_shape(format: VertexFormat) -> (ScalarKind, u32) {
+    match format {
+        VertexFormat::Float3 => (ScalarKind::Float, 3),
+        VertexFormat::Uint => (ScalarKind::Uint, 1),
+        VertexFormat::Unorm16x2 => (ScalarKind::Float, 2),
+    }
+}
+
 /// Vertex attributes the shader reads that the scene's vertex buffer does
 /// not supply, or supplies with another type.
 fn vertex_input_problems(vs: &ShaderInterface, position_only: bool) -> Vec<String> {
@@ -120,19 +129,26 @@ fn vertex_input_problems(vs: &ShaderInterface, position_only: bool) -> Vec<Strin
     vs.inputs
         .iter()
         .filter_map(|input| {
-            let found = supplied.iter().find(|(l, _, _)| *l == input.location);
+            let found = supplied.iter().find(|a| a.location == input.location);
             match (found, input.shape) {
-                (Some((_, n, _)), Some((ScalarKind::Float, m))) if m <= *n => None,
-                (Some((l, n, what)), _) => Some(format!(
-                    "vertex input `{}` at location {l} is {}, but the scene supplies the {what} as {n} floats",
+                (Some(a), Some((kind, m)))
+                    if kind == shader_shape(a.format).0 && m <= shader_shape(a.format).1 =>
+                {
+                    None
+                }
+                (Some(a), _) => Some(format!(
+                    "vertex input `{}` at location {} is {}, but the scene supplies the {} as {}",
                     input.name,
-                    shape_name(input.shape)
+                    a.location,
+                    shape_name(input.shape),
+                    a.what,
+                    shape_name(Some(shader_shape(a.format)))
                 )),
                 (None, _) => Some(format!(
                     "vertex input `{}` at location {} is not supplied; this pass's vertices have {}",
                     input.name,
                     input.location,
-                    slot_list(supplied.iter().map(|(l, _, what)| (*l, *what)))
+                    slot_list(supplied.iter().map(|a| (a.location, a.what)))
                 )),
             }
         })

@@ -6,7 +6,7 @@
 //!   coordinates on a [`OCT_SIDE`]×[`OCT_SIDE`] grid, the tangent as an angle
 //!   in [`ANGLE_STEPS`] steps around the normal (measured from a basis the
 //!   normal alone determines, [`normal_basis`]), and the handedness, combined
-//!   in mixed radix so that 1550² × 893 × 2 codes fill 99.9% of the 2³²
+//!   in mixed radix so that 1549² × 895 × 2 codes fill 99.999% of the 2³²
 //!   a `u32` holds. Normal and angle are rounded to the code with the least
 //!   error among the nearest candidates.
 //! - [`pack_quaternion`]: "smallest three" — the rotation taking the
@@ -22,10 +22,12 @@
 
 use glam::{Quat, Vec2, Vec3, Vec4};
 
-/// Octahedral grid points per side.
-pub const OCT_SIDE: u32 = 1550;
+/// Octahedral grid points per side: odd, so that 0 and ±1 are grid
+/// coordinates and the six axis directions decode exactly (a flat floor's
+/// normal stays exactly up).
+pub const OCT_SIDE: u32 = 1549;
 /// Steps of the tangent angle around the normal.
-pub const ANGLE_STEPS: u32 = 893;
+pub const ANGLE_STEPS: u32 = 895;
 
 /// An orthonormal tangent frame with handedness.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,7 +84,7 @@ impl TangentFrame {
 /// continuous except where n.z changes sign (Duff et al. 2017, "Building an
 /// orthonormal basis, revisited").
 pub fn normal_basis(n: Vec3) -> (Vec3, Vec3) {
-    let sign = 1.0f32.copysign(n.z);
+    let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;
     (
@@ -106,8 +108,8 @@ fn octahedral(n: Vec3) -> Vec2 {
 fn from_octahedral(p: Vec2) -> Vec3 {
     let z = 1.0 - p.x.abs() - p.y.abs();
     let fold = (-z).max(0.0);
-    let x = p.x - fold.copysign(p.x);
-    let y = p.y - fold.copysign(p.y);
+    let x = p.x + if p.x >= 0.0 { -fold } else { fold };
+    let y = p.y + if p.y >= 0.0 { -fold } else { fold };
     Vec3::new(x, y, z).normalize()
 }
 
@@ -156,7 +158,10 @@ pub fn pack(frame: &TangentFrame) -> u32 {
     let steps = phi.rem_euclid(std::f32::consts::TAU) / std::f32::consts::TAU * ANGLE_STEPS as f32;
     let mut angle = steps.round() as u32 % ANGLE_STEPS;
     // Rounding the angle in f32 can land one step off at the boundary.
-    for candidate in [(angle + ANGLE_STEPS - 1) % ANGLE_STEPS, (angle + 1) % ANGLE_STEPS] {
+    for candidate in [
+        (angle + ANGLE_STEPS - 1) % ANGLE_STEPS,
+        (angle + 1) % ANGLE_STEPS,
+    ] {
         if tangent_at(normal, candidate).dot(frame.tangent)
             > tangent_at(normal, angle).dot(frame.tangent)
         {
@@ -347,7 +352,10 @@ mod tests {
             for v in [decoded.normal, decoded.tangent, decoded.bitangent()] {
                 assert!((v.length() - 1.0).abs() < 1e-5, "unit length: {f:?}");
             }
-            assert!(decoded.normal.dot(decoded.tangent).abs() < 1e-5, "orthogonal: {f:?}");
+            assert!(
+                decoded.normal.dot(decoded.tangent).abs() < 1e-5,
+                "orthogonal: {f:?}"
+            );
             s.add(frame_error(&f, &decoded));
         }
         s
@@ -402,9 +410,15 @@ mod tests {
     fn degenerate_input_gets_a_valid_frame() {
         let cases = [
             (Vec3::ZERO, None),
-            (Vec3::new(0.0, 0.0, -1.0), Some(Vec4::new(0.0, 0.0, 1.0, 1.0))),
+            (
+                Vec3::new(0.0, 0.0, -1.0),
+                Some(Vec4::new(0.0, 0.0, 1.0, 1.0)),
+            ),
             (Vec3::X, Some(Vec4::ZERO)),
-            (Vec3::new(f32::NAN, 0.0, 1.0), Some(Vec4::new(1.0, 0.0, 0.0, -1.0))),
+            (
+                Vec3::new(f32::NAN, 0.0, 1.0),
+                Some(Vec4::new(1.0, 0.0, 0.0, -1.0)),
+            ),
             (Vec3::Y * 1e-30, Some(Vec4::new(1.0, 1.0, 0.0, -1.0))),
         ];
         for (normal, tangent) in cases {
@@ -423,8 +437,21 @@ mod tests {
     }
 
     #[test]
+    fn axis_normals_decode_exactly() {
+        for n in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
+            let f = TangentFrame::new(n, None);
+            assert_eq!(unpack(pack(&f)).normal, n);
+        }
+    }
+
+    #[test]
     fn the_normal_basis_is_orthonormal_on_both_hemispheres() {
-        for n in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(1.0, 2.0, -3.0).normalize()] {
+        for n in [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::X,
+            Vec3::new(1.0, 2.0, -3.0).normalize(),
+        ] {
             let (b1, b2) = normal_basis(n);
             assert!((b1.length() - 1.0).abs() < 1e-6 && (b2.length() - 1.0).abs() < 1e-6);
             assert!(b1.dot(n).abs() < 1e-6 && b2.dot(n).abs() < 1e-6 && b1.dot(b2).abs() < 1e-6);

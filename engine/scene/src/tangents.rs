@@ -203,7 +203,11 @@ mod tests {
                 let t = mesh.tangents[i as usize];
                 // Mirrored: the tangent turns round and the handedness flips,
                 // so the bitangent still points up the image.
-                let (expected, w) = if right { (-Vec3::X, -1.0) } else { (Vec3::X, 1.0) };
+                let (expected, w) = if right {
+                    (-Vec3::X, -1.0)
+                } else {
+                    (Vec3::X, 1.0)
+                };
                 assert!(t.truncate().distance(expected) < 1e-5, "{t} in {tri:?}");
                 assert_eq!(t.w, w, "{t}");
             }
