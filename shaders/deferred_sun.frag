@@ -8,6 +8,10 @@ layout(set = 0, binding = 3) uniform sampler2D depth;
 #ifdef HAS_SHADOW_MAP
 layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
 #endif
+#ifdef HAS_GBUFFER_EMISSION
+// The emissive texture's sample (rgb) and the occlusion texture's (a).
+layout(set = 0, binding = 5) uniform sampler2D gbuffer_emission;
+#endif
 #include "include/deferred.glsl"
 layout(push_constant) uniform Params {
     float emissive_boost;  // graph parameter: scales material emission
@@ -23,5 +27,10 @@ void main() {
         return;
     }
     Material m = materials[s.material];
-    color = vec4(shade_ambient_emissive(s, m, params.emissive_boost) + shade_suns(s, m), 1.0);
+    vec4 emission_occlusion = vec4(1.0);
+#ifdef HAS_GBUFFER_EMISSION
+    emission_occlusion = texelFetch(gbuffer_emission, ivec2(gl_FragCoord.xy), 0);
+#endif
+    vec3 ambient = shade_ambient_emissive(s, m, params.emissive_boost, emission_occlusion.rgb, emission_occlusion.a);
+    color = vec4(ambient + shade_suns(s, m), 1.0);
 }

@@ -17,6 +17,10 @@ layout(push_constant) uniform Params {
 layout(set = 2, binding = 0) uniform sampler2D base_color;
 layout(set = 2, binding = 1) uniform sampler2D metallic_roughness;
 layout(set = 2, binding = 2) uniform sampler2D normal_map;
+#ifdef SCENE_EMISSION_OCCLUSION_MAPS
+layout(set = 2, binding = 3) uniform sampler2D emissive_map;
+layout(set = 2, binding = 4) uniform sampler2D occlusion_map;
+#endif
 
 layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 world_normal;
@@ -39,7 +43,15 @@ void main() {
     n = mapped_normal(n, tangent, world, texcoord, texture(normal_map, texcoord).rgb, m.ambient.w);
 #endif
     Surface s = Surface(world, n, texel.rgb, material, mr);
-    vec3 c = shade_ambient_emissive(s, m, params.emissive_boost) + shade_all_lights(s, m, params.area_samples);
+#ifdef SCENE_EMISSION_OCCLUSION_MAPS
+    vec3 emission_texel = texture(emissive_map, texcoord).rgb;
+    float occlusion = texture(occlusion_map, texcoord).r;
+#else
+    vec3 emission_texel = vec3(1.0);
+    float occlusion = 1.0;
+#endif
+    vec3 c = shade_ambient_emissive(s, m, params.emissive_boost, emission_texel, occlusion)
+        + shade_all_lights(s, m, params.area_samples);
     // Alpha matters only where weft-render blends transparent materials.
     color = vec4(c, materials[material].diffuse.a * texel.a);
 }

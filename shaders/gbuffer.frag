@@ -1,11 +1,16 @@
 #version 450
 // Deferred geometry pass: what lighting needs, in the compact encoding of
-// include/gbuffer.glsl (12 bytes per pixel plus depth).
+// include/gbuffer.glsl (12 bytes per pixel plus depth; 16 when the scene has
+// emissive or occlusion textures, whose samples go to gbuffer_emission).
 #include "include/gbuffer.glsl"
 
 layout(set = 2, binding = 0) uniform sampler2D base_color;
 layout(set = 2, binding = 1) uniform sampler2D metallic_roughness;
 layout(set = 2, binding = 2) uniform sampler2D normal_map;
+#ifdef HAS_GBUFFER_EMISSION
+layout(set = 2, binding = 3) uniform sampler2D emissive_map;
+layout(set = 2, binding = 4) uniform sampler2D occlusion_map;
+#endif
 
 layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 world_normal;
@@ -16,6 +21,11 @@ layout(location = 4) in vec4 world_tangent;
 layout(location = 0) out vec4 albedo;
 layout(location = 1) out vec2 normal;
 layout(location = 2) out vec4 material_out;
+#ifdef HAS_GBUFFER_EMISSION
+// The emissive texture's sample (rgb, sRGB-encoded by the target) and the
+// occlusion texture's (a), for the lighting passes' ambient and emission.
+layout(location = 3) out vec4 emission_out;
+#endif
 
 void main() {
     vec3 n = normalize(world_normal);
@@ -31,4 +41,7 @@ void main() {
     normal = octahedral_encode_half(n);
     vec2 mr = metal_rough(m, texture(metallic_roughness, texcoord));
     material_out = encode_material(material, mr);
+#ifdef HAS_GBUFFER_EMISSION
+    emission_out = vec4(texture(emissive_map, texcoord).rgb, texture(occlusion_map, texcoord).r);
+#endif
 }

@@ -11,7 +11,11 @@ layout(set = 0, binding = 3) uniform sampler2D depth;
 #ifdef HAS_SHADOW_MAP
 layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
 #endif
-layout(std430, set = 0, binding = 5) readonly buffer TileLights { uint words[]; } tile_lights;
+#ifdef HAS_GBUFFER_EMISSION
+// The emissive texture's sample (rgb) and the occlusion texture's (a).
+layout(set = 0, binding = 5) uniform sampler2D gbuffer_emission;
+#endif
+layout(std430, set = 0, binding = 6) readonly buffer TileLights { uint words[]; } tile_lights;
 layout(push_constant) uniform Push {
     uint max_per_tile;
     float emissive_boost;
@@ -35,7 +39,12 @@ void main() {
         return;
     }
     Material m = materials[s.material];
-    vec3 c = shade_ambient_emissive(s, m, pc.emissive_boost) + shade_suns(s, m);
+    vec4 emission_occlusion = vec4(1.0);
+#ifdef HAS_GBUFFER_EMISSION
+    emission_occlusion = texelFetch(gbuffer_emission, ivec2(gl_FragCoord.xy), 0);
+#endif
+    vec3 c = shade_ambient_emissive(s, m, pc.emissive_boost, emission_occlusion.rgb, emission_occlusion.a)
+        + shade_suns(s, m);
     uint record = tile_record(tile_of(ivec2(gl_FragCoord.xy)), pc.max_per_tile);
     uint slots = record + TILE_HEADER;
 #ifdef SHADE_POINT_LIGHTS

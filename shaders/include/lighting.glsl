@@ -459,15 +459,18 @@ vec3 shade_all_lights(Surface s, Material m, uint area_samples) {
 // parameter of that name, so glowing materials can be pushed over the bloom
 // threshold). Blinn-Phong: Ka (or Kd) times the texture; metallic-roughness:
 // the diffuse colour plus F0, the response to uniform surroundings without the
-// GGX terms' angular detail.
-vec3 shade_ambient_emissive(Surface s, Material m, float emissive_boost) {
+// GGX terms' angular detail. `emission_texel` is the emissive texture's sample
+// (MTL map_Ke, glTF emissiveTexture; 1 without one) and `occlusion` the
+// occlusion texture's (glTF occlusionTexture, red; 1 without one), which
+// darkens the ambient term only.
+vec3 shade_ambient_emissive(Surface s, Material m, float emissive_boost, vec3 emission_texel, float occlusion) {
     vec3 reflectance = m.ambient.rgb * s.texel;
     if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
         vec3 base = m.diffuse.rgb * s.texel;
         float metallic = s.metal_rough.x;
         reflectance = base * (1.0 - metallic) + mix(vec3(DIELECTRIC_F0), base, metallic);
     }
-    return frame.ambient.rgb * reflectance + m.emissive.rgb * emissive_boost;
+    return frame.ambient.rgb * reflectance * occlusion + m.emissive.rgb * emission_texel * emissive_boost;
 }
 
 #endif

@@ -34,3 +34,76 @@ fn emissive_boost_scales_emission_alone_in_every_graph() {
         );
     }
 }
+
+/// DamagedHelmet facing the camera under `sun` (a `.scene` light block).
+fn helmet_scene(dir: &std::path::Path, sun: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).expect("scratch folder");
+    let model = common::root().join("../shared/assets/gltf/rise/DamagedHelmet.glb");
+    let path = dir.join("helmet.scene");
+    std::fs::write(
+        &path,
+        format!(
+            "model\n{{\n\tfile \"{}\"\n}}\n{sun}\
+             camera \"front\"\n{{\n\tposition 0 0 3\n\ttarget 0 0 0\n\tfov_deg 45\n}}\n",
+            model.display()
+        ),
+    )
+    .expect("scene written");
+    path
+}
+
+#[test]
+fn emissive_and_occlusion_textures_apply_alike_in_every_graph() {
+    let dir = TempDir(std::env::temp_dir().join(format!("weft-helmet-{}", std::process::id())));
+    // Emission alone (a black sun adds nothing), then ambient alone.
+    let cases = [
+        (
+            "emission",
+            "sunlight\n{\n\tdirection 0 -1 0\n\tcolor 0 0 0\n}\n",
+        ),
+        (
+            "ambient",
+            "sunlight\n{\n\tdirection 0 -1 0\n\tcolor 0 0 0\n\tambient 0.5 0.5 0.5\n}\n",
+        ),
+    ];
+    let mut forward_images = Vec::new();
+    for (what, sun) in cases {
+        let scene = helmet_scene(&dir.0, sun);
+        let outputs: Vec<_> = ["forward.ron", "deferred.ron", "tiled.ron"]
+            .iter()
+            .map(|g| common::render_validated(&scene, &common::graph(g), 320, 320, &["!bloom"]))
+            .collect();
+        for out in &outputs {
+            assert_eq!(out.messages, Vec::new(), "{what}");
+        }
+        assert!(
+            outputs[1].passes.contains(&"gbuffer".to_string()),
+            "{:?}",
+            outputs[1].passes
+        );
+        for (name, out) in [("forward", &outputs[0]), ("tiled", &outputs[2])] {
+            let a = common::agreement(&out.image, &outputs[1].image);
+            eprintln!("{what}: {name} vs deferred {a:?}");
+            assert!(
+                a.mean <= 0.25 && a.p99 <= 1 && a.max <= 8,
+                "{what}: {name} {a:?}"
+            );
+        }
+        forward_images.push(outputs[0].image.clone());
+    }
+    // The emissive factor is white: untextured, every helmet pixel glowed
+    // white. Textured, only the lamps and the visor's display do. The helmet's
+    // pixels are those the ambient light reaches.
+    let [emission, ambient] = &forward_images[..] else {
+        unreachable!("two cases")
+    };
+    let helmet = ambient.pixels().filter(|p| p.0[..3] != [0, 0, 0]).count();
+    let glowing = emission
+        .pixels()
+        .filter(|p| p.0[..3].iter().any(|c| *c > 128))
+        .count();
+    eprintln!("{glowing} of {helmet} helmet pixels glow");
+    assert!(helmet > 320 * 320 / 5, "{helmet}");
+    assert!(glowing * 10 < helmet, "{glowing} of {helmet}");
+    assert!(glowing > 0, "the lamps glow");
+}

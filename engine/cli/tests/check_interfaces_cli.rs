@@ -158,7 +158,7 @@ fn scene_pass_shaders_are_compiled_and_their_interfaces_compared() {
     assert_refused(
         "forward.ron",
         &[("shaders/forward.frag", "layout(location = 2) in vec2 texcoord;", "layout(location = 5) in vec2 texcoord;")],
-        "pass \"forward\": fragment input `texcoord` at location 5 is not written by the vertex shader (declared at graphs/../shaders/forward.frag:23)",
+        "pass \"forward\": fragment input `texcoord` at location 5 is not written by the vertex shader (declared at graphs/../shaders/forward.frag:27)",
     );
     assert_refused(
         "forward.ron",

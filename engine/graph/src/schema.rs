@@ -436,6 +436,11 @@ pub struct AttachmentDecl {
     /// Depth attachment used for testing only (no depth writes), so it can be sampled too.
     #[serde(default)]
     pub read_only: bool,
+    /// Features that must all hold for a colour attachment to be attached
+    /// (the shaders then see `HAS_<IMAGE>`); conditional attachments come
+    /// after every unconditional one, so fragment output locations stay put.
+    #[serde(default)]
+    pub enabled_if: Vec<String>,
 }
 
 /// What happens to an attachment's contents when a pass begins.

@@ -596,3 +596,31 @@ fn a_define_for_one_shading_model_needs_a_pass_that_draws_meshes() {
         Some("remove `draws`, or give the pass `draw: Meshes(...)`")
     );
 }
+
+#[test]
+fn conditional_colour_attachments_come_last_and_depth_is_never_conditional() {
+    let text = VALID.replace(
+        r#"color: [(image: "albedo", load: Clear([0.0, 0.0, 0.0, 1.0]))],"#,
+        r#"color: [(image: "ldr", enabled_if: ["x"]), (image: "albedo", load: Clear([0.0, 0.0, 0.0, 1.0]))],"#,
+    );
+    let d = only_error(&text);
+    assert_eq!(
+        d.message,
+        "colour attachment \"albedo\" follows the conditional attachment \"ldr\": its fragment output location would depend on features"
+    );
+    assert!(text_at(&text, &d).starts_with("\"albedo\""), "{d:?}");
+    assert_eq!(
+        d.hint.as_deref(),
+        Some("list conditional colour attachments last")
+    );
+    let text = VALID.replace(
+        r#"depth: (image: "depth", load: Clear([0.0])),"#,
+        r#"depth: (image: "depth", load: Clear([0.0]), enabled_if: ["x"]),"#,
+    );
+    let d = only_error(&text);
+    assert_eq!(
+        d.message,
+        "a depth attachment cannot be conditional: make the pass conditional instead"
+    );
+    assert!(text_at(&text, &d).starts_with("[\"x\"]"), "{d:?}");
+}

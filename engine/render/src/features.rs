@@ -21,7 +21,8 @@ use weft_scene::{AreaShape, Light, Scene};
 /// for glass (MTL `illum` 4, 6 or 7, the dissolve rule, glTF transmission),
 /// `metallic_roughness` for glTF materials; `textures` when a placed mesh has a
 /// base colour, metallic-roughness or normal texture, `normal_maps` when one
-/// has a normal texture with a non-zero scale.
+/// has a normal texture with a non-zero scale, `emission_occlusion_maps` when
+/// one has an emissive or occlusion texture.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
     let placed = || {
         scene
@@ -105,6 +106,9 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     }
     if placed().any(|m| m.shading != ShadingModel::MetallicRoughness) {
         features.push("blinn_phong".to_string());
+    }
+    if placed().any(|m| m.textures.emissive.is_some() || m.textures.occlusion.is_some()) {
+        features.push("emission_occlusion_maps".to_string());
     }
     if placed().any(|m| m.textures.normal.is_some() && m.normal_scale != 0.0) {
         features.push("normal_maps".to_string());

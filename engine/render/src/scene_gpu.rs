@@ -74,6 +74,10 @@ pub const BASE_COLOR_BINDING: u32 = 0;
 pub const METALLIC_ROUGHNESS_BINDING: u32 = 1;
 /// Set 2 binding of a material's tangent-space normal map (UNORM).
 pub const NORMAL_BINDING: u32 = 2;
+/// Set 2 binding of the emissive texture (sRGB; white when the material has none).
+pub const EMISSIVE_BINDING: u32 = 3;
+/// Set 2 binding of the occlusion texture (its red channel; white when none).
+pub const OCCLUSION_BINDING: u32 = 4;
 /// Set 1 as the engine creates and writes it: binding, descriptor kind and
 /// what it holds (for the shader check's messages).
 pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 6] = [
@@ -202,7 +206,7 @@ pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 15] = [
 ];
 /// Set 2 as the engine creates it: a material's textures, in the order of its
 /// texture slots.
-pub const MATERIAL_SET_BINDINGS: [(u32, DescriptorKind, &str); 3] = [
+pub const MATERIAL_SET_BINDINGS: [(u32, DescriptorKind, &str); 5] = [
     (
         BASE_COLOR_BINDING,
         DescriptorKind::CombinedImageSampler,
@@ -217,6 +221,16 @@ pub const MATERIAL_SET_BINDINGS: [(u32, DescriptorKind, &str); 3] = [
         NORMAL_BINDING,
         DescriptorKind::CombinedImageSampler,
         "the normal map",
+    ),
+    (
+        EMISSIVE_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the emissive texture",
+    ),
+    (
+        OCCLUSION_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the occlusion texture",
     ),
 ];
 /// Bytes of the `Frame` uniform block.
@@ -399,8 +413,10 @@ impl<'g> GpuScene<'g> {
             let base = slot(m.textures.base_color.as_ref(), true)?;
             let metal_rough = slot(m.textures.metallic_roughness.as_ref(), false)?;
             let normal = slot(m.textures.normal.as_ref(), false)?;
+            let emissive = slot(m.textures.emissive.as_ref(), true)?;
+            let occlusion = slot(m.textures.occlusion.as_ref(), false)?;
             material_records.push(pack_material(m, normal != 0));
-            material_texture.push([base, metal_rough, normal]);
+            material_texture.push([base, metal_rough, normal, emissive, occlusion]);
         }
         let materials =
             Buffer::device_local(gpu, "scene materials", bytes_of(&material_records), storage)?;
@@ -471,7 +487,7 @@ impl<'g> GpuScene<'g> {
         Ok(this)
     }
 
-    fn create_sets(&mut self, material_texture: &[[usize; 3]]) -> Result<(), GpuError> {
+    fn create_sets(&mut self, material_texture: &[[usize; 5]]) -> Result<(), GpuError> {
         self.scene_set = self.pool.allocate(self.scene_layout.handle())?;
         self.write_scene_set(
             self.scene_set,

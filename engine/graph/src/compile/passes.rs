@@ -98,6 +98,14 @@ fn plan_pass(cx: &PassContext, p: IrPassId, i: PassId, barriers: Vec<Barrier>) -
             ));
         }
     }
+    for access in active_accesses() {
+        if matches!(access.usage, Usage::Color { .. }) && !access.conditions.is_empty() {
+            defines.insert(format!(
+                "HAS_{}",
+                ir.resources[access.resource].name.to_ascii_uppercase()
+            ));
+        }
+    }
     let mut model_defines = Vec::new();
     for define in &pass.defines {
         if super::conditions_hold(&define.enabled_if, &options.features) {
@@ -303,6 +311,41 @@ mod tests {
         assert_eq!(b(&["extra"]), ["ALWAYS", "WITH_EXTRA"]);
         let (_, ir) = super::super::fixture::resolved(&text);
         assert!(super::super::feature_names(&ir).contains("extra"));
+    }
+
+    #[test]
+    fn a_conditional_colour_attachment_is_attached_only_when_its_features_hold() {
+        let text = CHAIN
+            .replace(
+                r#"color: [(image: "x", load: Clear([0.0, 0.0, 0.0, 0.0]))]),"#,
+                r#"color: [(image: "x", load: Clear([0.0, 0.0, 0.0, 0.0])),
+                         (image: "tint", enabled_if: ["extra"])]),"#,
+            )
+            .replace(
+                r#"Image(name: "out", format: R8G8B8A8_UNORM),"#,
+                r#"Image(name: "out", format: R8G8B8A8_UNORM),
+            Image(name: "tint", format: R8G8B8A8_UNORM),"#,
+            )
+            .replace(
+                r#"sampled: ["x"], color: [(image: "out")]"#,
+                r#"sampled: ["x", (name: "tint", enabled_if: ["extra"])], color: [(image: "out")]"#,
+            );
+        let a = |features: &[&str]| {
+            let plan = plan_of(&text, features);
+            let a = plan
+                .passes
+                .iter()
+                .find(|p| p.name == "a")
+                .expect("a runs")
+                .clone();
+            a
+        };
+        let plain = a(&[]);
+        assert_eq!(plain.render_pass.as_ref().map(|rp| rp.color.len()), Some(1));
+        assert!(plain.defines.is_empty());
+        let extra = a(&["extra"]);
+        assert_eq!(extra.render_pass.as_ref().map(|rp| rp.color.len()), Some(2));
+        assert_eq!(extra.defines, ["HAS_TINT"]);
     }
 
     #[test]

@@ -67,6 +67,7 @@ impl Resolver<'_> {
         let (source, index) = (p.source, p.index);
         let decl = &p.item;
         let mut accesses = Vec::new();
+        let mut conditional_before = None;
         for (i, a) in decl.color.iter().enumerate() {
             let path = pass_path(
                 index,
@@ -75,9 +76,33 @@ impl Resolver<'_> {
             if let Some(r) = self.lookup(source, &path, &a.image) {
                 accesses.push(attachment_access(r, a, false, "color", Some(i)));
             }
+            match (&conditional_before, a.enabled_if.is_empty()) {
+                (None, false) => conditional_before = Some(a.image.clone()),
+                (Some(earlier), true) => {
+                    self.error(
+                        source,
+                        &path,
+                        format!(
+                            "colour attachment \"{}\" follows the conditional attachment \"{earlier}\": its fragment output location would depend on features",
+                            a.image
+                        ),
+                    )
+                    .hint = Some("list conditional colour attachments last".into());
+                }
+                _ => {}
+            }
         }
         if let Some(a) = &decl.depth {
             let path = pass_path(index, &[Seg::Field("depth"), Seg::Field("image")]);
+            if !a.enabled_if.is_empty() {
+                let at = pass_path(index, &[Seg::Field("depth"), Seg::Field("enabled_if")]);
+                self.error(
+                    source,
+                    &at,
+                    "a depth attachment cannot be conditional: make the pass conditional instead"
+                        .to_string(),
+                );
+            }
             if let Some(r) = self.lookup(source, &path, &a.image) {
                 accesses.push(attachment_access(r, a, true, "depth", None));
             }
@@ -370,7 +395,7 @@ fn attachment_access(
     IrAccess {
         resource,
         usage,
-        conditions: Vec::new(),
+        conditions: a.enabled_if.clone(),
         field,
         item,
     }
