@@ -32,5 +32,5 @@ void main() {
     emission_occlusion = texelFetch(gbuffer_emission, ivec2(gl_FragCoord.xy), 0);
 #endif
     vec3 ambient = shade_ambient_emissive(s, m, params.emissive_boost, emission_occlusion.rgb, emission_occlusion.a);
-    color = vec4(ambient + shade_suns(s, m), 1.0);
+    color = vec4(hdr_output(ambient + shade_suns(s, m)), 1.0);
 }

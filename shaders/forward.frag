@@ -53,5 +53,5 @@ void main() {
     vec3 c = shade_ambient_emissive(s, m, params.emissive_boost, emission_texel, occlusion)
         + shade_all_lights(s, m, params.area_samples);
     // Alpha matters only where weft-render blends transparent materials.
-    color = vec4(c, materials[material].diffuse.a * texel.a);
+    color = vec4(hdr_output(c), materials[material].diffuse.a * texel.a);
 }

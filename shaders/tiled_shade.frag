@@ -60,5 +60,5 @@ void main() {
         c += shade_spot(tile_lights.words[last - k], s, m);
     }
 #endif
-    color = vec4(c, 1.0);
+    color = vec4(hdr_output(c), 1.0);
 }

@@ -18,6 +18,8 @@ void main() {
 #ifdef HAS_BLOOM
     c += texture(bloom, uv).rgb;
 #endif
+    // NaN shows black and inf white rather than NaN spreading through c / (1 + c).
     c *= params.exposure;
+    c = min(mix(c, vec3(0.0), isnan(c)), vec3(1.0e30));
     color = vec4(c / (1.0 + c), 1.0);
 }

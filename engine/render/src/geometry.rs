@@ -155,6 +155,10 @@ pub struct SceneGeometry {
     pub cone: MeshRange,
     /// Meshes left out because their arrays disagree, as `model file: mesh name`.
     pub skipped: Vec<String>,
+    /// Triangles left out because a corner's position is not finite, as
+    /// `model file: mesh name: count` (`sanitize`: a NaN or infinite vertex
+    /// would otherwise reach the rasterizer).
+    pub non_finite: Vec<String>,
 }
 
 impl SceneGeometry {
@@ -178,12 +182,25 @@ impl SceneGeometry {
                     continue;
                 }
                 let uv_box = uv_box(&mesh.uvs);
-                let range = g.append(mesh, uv_box);
+                let (range, dropped) = g.append(mesh, uv_box);
+                if dropped > 0 {
+                    g.non_finite.push(format!(
+                        "{}: {}: {dropped}",
+                        model.path.display(),
+                        mesh.name
+                    ));
+                }
                 let material = mesh
                     .material
                     .filter(|&i| i < model.materials.len())
                     .map_or(0, |i| material_base[material_base.len() - 1] + i as u32);
-                let bounds = Aabb::from_points(&mesh.positions);
+                let finite: Vec<Vec3> = mesh
+                    .positions
+                    .iter()
+                    .copied()
+                    .filter(|p| p.is_finite())
+                    .collect();
+                let bounds = Aabb::from_points(&finite);
                 let uv_box = Vec4::new(uv_box.0.x, uv_box.0.y, uv_box.1.x, uv_box.1.y);
                 model_ranges.push(Some((range, material, bounds, uv_box)));
             }
@@ -218,19 +235,35 @@ impl SceneGeometry {
         g
     }
 
-    /// Appends a mesh's vertices (frames packed, UVs against `uv_box`) and indices.
-    fn append(&mut self, mesh: &Mesh, uv_box: (Vec2, Vec2)) -> MeshRange {
+    /// Appends a mesh's vertices (frames packed, UVs against `uv_box`) and its
+    /// triangles whose corners all have finite positions; returns the range
+    /// and how many triangles were left out.
+    fn append(&mut self, mesh: &Mesh, uv_box: (Vec2, Vec2)) -> (MeshRange, usize) {
         let tangents: Vec<Vec4> = (0..mesh.positions.len())
             .map(|i| mesh.tangents.get(i).copied().unwrap_or(Vec4::ZERO))
             .collect();
-        self.append_arrays(
+        let finite = |i: &u32| {
+            mesh.positions
+                .get(*i as usize)
+                .is_some_and(|p| p.is_finite())
+        };
+        let indices: Vec<u32> = mesh
+            .indices
+            .chunks_exact(3)
+            .filter(|t| t.iter().all(finite))
+            .flatten()
+            .copied()
+            .collect();
+        let dropped = (mesh.indices.len() - indices.len()) / 3;
+        let range = self.append_arrays(
             &mesh.positions,
             &mesh.normals,
             &mesh.uvs,
             &tangents,
-            &mesh.indices,
+            &indices,
             uv_box,
-        )
+        );
+        (range, dropped)
     }
 
     fn append_arrays(

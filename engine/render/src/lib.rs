@@ -35,6 +35,7 @@ pub mod recorder;
 pub mod reload;
 pub mod reload_error;
 pub mod reload_worker;
+pub mod sanitize;
 pub mod scene_gpu;
 pub mod scene_interface;
 pub mod scene_load;

@@ -4,6 +4,7 @@
 
 use crate::brdf::AreaGeometry;
 use crate::gpu_types::GpuLight;
+use crate::sanitize;
 use glam::{Vec3, Vec4};
 use weft_scene::light::{derive_radius, DEFAULT_LUMINANCE_THRESHOLD};
 use weft_scene::{Aabb, AreaLight, AreaShape, Attenuation, Light};
@@ -105,14 +106,28 @@ struct Record {
 }
 
 impl Record {
-    fn pack(&self, records: &mut Vec<GpuLight>) {
+    /// Appends the record, its colour and falloff made finite and bounded
+    /// (`sanitize`); a light whose position, direction or range is not finite
+    /// lights nothing and is left out (false).
+    fn pack(&self, records: &mut Vec<GpuLight>) -> bool {
+        if !(self.position.is_finite() && self.direction.is_finite() && self.range.is_finite()) {
+            return false;
+        }
         let a = &self.attenuation;
+        let falloff = |x: f32| sanitize::bounded(x, sanitize::RADIANCE_MAX);
         records.push(GpuLight {
             position_range: self.position.extend(self.range),
             direction_type: self.direction.extend(self.kind),
-            color_exponent: self.color.extend(self.exponent),
-            attenuation_cos: Vec4::new(a.constant, a.linear, a.quadratic, self.cos_cutoff),
+            color_exponent: sanitize::radiance(self.color)
+                .extend(sanitize::bounded(self.exponent, sanitize::RADIANCE_MAX)),
+            attenuation_cos: Vec4::new(
+                falloff(a.constant),
+                falloff(a.linear),
+                falloff(a.quadratic),
+                self.cos_cutoff,
+            ),
         });
+        true
     }
 }
 
@@ -138,9 +153,9 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
                 attenuation: Attenuation::NONE,
                 cos_cutoff: -1.0,
             }
-            .pack(&mut set.records);
-            set.suns += 1;
-            set.ambient += s.ambient;
+            .pack(&mut set.records)
+            .then(|| set.suns += 1);
+            set.ambient += sanitize::radiance(s.ambient);
             set.sun_direction.get_or_insert(dir);
         }
     }
@@ -161,8 +176,8 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
                 attenuation: p.attenuation,
                 cos_cutoff: -1.0,
             }
-            .pack(&mut set.records);
-            set.points += 1;
+            .pack(&mut set.records)
+            .then(|| set.points += 1);
         }
     }
     for wide in [false, true] {
@@ -177,7 +192,12 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
                 .unwrap_or_else(|| cutoff_range(s.color, &s.attenuation, fallback));
             let dir = s.direction.try_normalize().unwrap_or(Vec3::NEG_Y);
             let kind = if wide { SPOT_SPHERE } else { SPOT_CONE };
-            let cos_cutoff = s.angle.clamp(0.0, 180.0).to_radians().cos();
+            // A NaN angle lights nothing rather than everything.
+            let cos_cutoff = if s.angle.is_nan() {
+                1.0
+            } else {
+                s.angle.clamp(0.0, 180.0).to_radians().cos()
+            };
             Record {
                 position: s.position,
                 range,
@@ -188,12 +208,14 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
                 attenuation: s.attenuation,
                 cos_cutoff,
             }
-            .pack(&mut set.records);
-            if wide {
-                set.spot_spheres += 1;
-            } else {
-                set.spot_cones += 1;
-            }
+            .pack(&mut set.records)
+            .then(|| {
+                if wide {
+                    set.spot_spheres += 1;
+                } else {
+                    set.spot_cones += 1;
+                }
+            });
         }
     }
     for light in lights {
@@ -207,8 +229,8 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
 }
 
 /// An area light as the shaders see it (centre, half-extent axes: local X and Y
-/// scaled by the half size or the radius), or `None` when it has no area or a
-/// field is not finite.
+/// scaled by the half size or the radius), or `None` when it has no area or its
+/// placement is not finite (its emission is bounded when packed, `sanitize`).
 pub fn area_shape(a: &AreaLight) -> Option<AreaGeometry> {
     let (disc, half_x, half_y) = match a.shape {
         AreaShape::Rect { width, height } => (false, width * 0.5, height * 0.5),
@@ -222,7 +244,7 @@ pub fn area_shape(a: &AreaLight) -> Option<AreaGeometry> {
         disc,
         two_sided: a.two_sided,
     };
-    let finite = [shape.centre, shape.x, shape.y, a.emission]
+    let finite = [shape.centre, shape.x, shape.y]
         .iter()
         .all(|v| v.is_finite());
     (half_x > 0.0 && half_y > 0.0 && finite).then_some(shape)
@@ -239,7 +261,11 @@ fn pack_area(a: &AreaLight, records: &mut Vec<GpuLight>) -> bool {
         direction_type: shape
             .x
             .extend(if shape.disc { AREA_DISC } else { AREA_RECT }),
-        color_exponent: a.emission.extend(if shape.two_sided { 1.0 } else { 0.0 }),
+        color_exponent: sanitize::radiance(a.emission).extend(if shape.two_sided {
+            1.0
+        } else {
+            0.0
+        }),
         attenuation_cos: shape.y.extend(0.0),
     });
     true

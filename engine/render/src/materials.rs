@@ -4,6 +4,7 @@
 
 use crate::gpu_types::GpuMaterial;
 use crate::optics::Coat;
+use crate::sanitize;
 use glam::{Vec3, Vec4};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::material::{AlphaMode, Optics, ShadingModel};
@@ -135,10 +136,11 @@ pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
                 BLINN_PHONG
             };
             GpuMaterial {
-                diffuse: diffuse.extend(m.base_color.w),
-                specular: specular.extend(shininess),
-                ambient: ambient.extend(normal_scale),
-                emissive: m.emissive.extend(model),
+                diffuse: sanitize::radiance(diffuse).extend(sanitize::bounded(m.base_color.w, 1.0)),
+                specular: sanitize::radiance(specular)
+                    .extend(sanitize::bounded(shininess, sanitize::RADIANCE_MAX)),
+                ambient: sanitize::radiance(ambient).extend(normal_scale),
+                emissive: sanitize::radiance(m.emissive).extend(model),
                 transmission,
                 reflection: coat.map_or(reflection, |c| c.tint.extend(0.0)),
                 absorption,
@@ -159,10 +161,10 @@ pub fn pack_material(m: &Material, normal_mapped: bool) -> GpuMaterial {
             };
             let factors = Vec4::new(metallic, finite_unit(m.roughness, 1.0), 0.0, 0.0);
             GpuMaterial {
-                diffuse: m.base_color,
+                diffuse: sanitize::colour_alpha(m.base_color),
                 specular: factors,
                 ambient: Vec3::ZERO.extend(normal_scale),
-                emissive: m.emissive.extend(METALLIC_ROUGHNESS),
+                emissive: sanitize::radiance(m.emissive).extend(METALLIC_ROUGHNESS),
                 transmission,
                 reflection,
                 absorption,

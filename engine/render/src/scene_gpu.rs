@@ -355,6 +355,12 @@ impl<'g> GpuScene<'g> {
             .skipped
             .iter()
             .map(|m| format!("mesh skipped (inconsistent arrays): {m}"))
+            .chain(
+                geometry
+                    .non_finite
+                    .iter()
+                    .map(|m| format!("triangles with a non-finite vertex left out: {m}")),
+            )
             .collect();
         if geometry.draws.len() > u32::MAX as usize / 2 {
             return Err(RenderError::TooLarge(format!(
@@ -570,7 +576,7 @@ impl<'g> GpuScene<'g> {
             .flat_map(|t| t.map(|uv| uv.to_array()))
             .collect();
         let emitters = crate::emitters::EmitterTable::build(&mesh.corners, |t| {
-            self.geometry.materials[mesh.materials[t] as usize].emissive
+            crate::sanitize::radiance(self.geometry.materials[mesh.materials[t] as usize].emissive)
         });
         let trace_textures = crate::trace_textures::gather(&self.geometry.materials);
         self.warnings

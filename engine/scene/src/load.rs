@@ -148,10 +148,12 @@ fn build(
             c.orientation = rotation;
             c
         }));
+        let placed = model.bounds.transformed(&m);
+        warn_if_far(&placed, &placement.at, diag);
         instances.push(Instance {
             model: index,
             transform: m,
-            bounds: model.bounds.transformed(&m),
+            bounds: placed,
         });
     }
     let bounds = instances
@@ -174,7 +176,28 @@ fn build(
     })
 }
 
-/// Replaces unbounded point-light radii (no falloff) by the scene's diagonal, with a warning.
+/// Largest distance from the origin, per axis, that keeps a scene within
+/// 1e6 units across; beyond it float32 positions step by 1/32 unit or more.
+const PRECISE_REACH: f32 = 5e5;
+
+/// Warns, at the `model` block, when the placed model reaches past
+/// [`PRECISE_REACH`] from the origin (docs/stability.md).
+fn warn_if_far(placed: &Aabb, at: &Location, diag: &mut Diagnostics) {
+    if placed.is_empty() {
+        return;
+    }
+    let reach = placed.min.abs().max(placed.max.abs()).max_element();
+    if reach > PRECISE_REACH {
+        let step = reach.next_up() - reach;
+        diag.warn(
+            at.clone(),
+            format!(
+                "this model reaches {reach:e} units from the origin: the scene spans more than 1e6 units, where float32 positions step by {step:.2} units; move the scene towards the origin"
+            ),
+        );
+    }
+}
+
 /// Applies a `model` block's `absorption`, `ior` and `thin` to the model's
 /// glass (dielectric) materials.
 fn override_glass(model: &mut Model, placement: &Placement) {

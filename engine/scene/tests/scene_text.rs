@@ -284,3 +284,37 @@ fn model_ior_and_thin_override_the_glass() {
         "t.scene:5: 'thin' must be 0 or 1, found 2"
     );
 }
+
+#[test]
+fn values_that_lose_precision_are_warned_about_at_their_line() {
+    let (_, warnings) = desc(
+        "pointlight\n{\n position 0 1 0\n color 1e30 1 1\n}\n\
+         arealight\n{\n shape rect\n size 1 1\n emission 70000 0 0\n}\n\
+         spotlight\n{\n color 2 2 2\n}\n",
+    );
+    assert_eq!(
+        warnings,
+        vec![
+            "t.scene:4: 'color' 1000000000000000000000000000000 is beyond the half-float range (65504) of HDR images: the lit surfaces saturate; each pass clamps what it writes at 8192",
+            "t.scene:10: 'emission' 70000 is beyond the half-float range (65504) of HDR images: the lit surfaces saturate; each pass clamps what it writes at 8192",
+        ]
+    );
+}
+
+#[test]
+fn a_model_placed_a_million_units_out_is_warned_about_at_its_block() {
+    let dir = temp_dir("far");
+    std::fs::write(dir.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let scene = dir.join("far.scene");
+    std::fs::write(
+        &scene,
+        "model\n{\n file \"tri.obj\"\n}\nmodel\n{\n file \"tri.obj\"\n position 2e6 0 0\n}\n",
+    )
+    .unwrap();
+    let loaded = load_scene(&scene).unwrap();
+    let warnings = short_warnings(&loaded.warnings);
+    assert_eq!(
+        warnings,
+        vec!["far.scene:7: this model reaches 2.000001e6 units from the origin: the scene spans more than 1e6 units, where float32 positions step by 0.12 units; move the scene towards the origin"]
+    );
+}

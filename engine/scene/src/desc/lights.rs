@@ -13,6 +13,26 @@ use crate::rng::Rng;
 use crate::syntax::Prop;
 use glam::{Quat, Vec3};
 
+/// The largest value an RGBA16F HDR image holds.
+const HALF_MAX: f32 = 65504.0;
+
+/// Warns at `name`'s line when a colour or emission channel is beyond the
+/// half-float range HDR images hold (the renderer clamps what each pass
+/// writes, docs/stability.md).
+fn warn_if_beyond_half(props: &mut Props<'_>, name: &str, value: Vec3, diag: &mut Diagnostics) {
+    if let Some(p) = props.last(name) {
+        if value.max_element() > HALF_MAX {
+            diag.warn(
+                Location::line(props.file(), p.line),
+                format!(
+                    "'{name}' {} is beyond the half-float range (65504) of HDR images: the lit surfaces saturate; each pass clamps what it writes at 8192",
+                    value.max_element()
+                ),
+            );
+        }
+    }
+}
+
 /// A `sunlight` block.
 pub(super) fn sunlight(
     props: &mut Props<'_>,
@@ -20,6 +40,7 @@ pub(super) fn sunlight(
 ) -> Result<SunLight, SceneError> {
     let direction = props.direction("direction")?.unwrap_or(Vec3::NEG_Y);
     let color = props.vec3("color")?.unwrap_or(Vec3::ONE);
+    warn_if_beyond_half(props, "color", color, diag);
     let ambient = match props.last("ambient") {
         Some(p) => match props.numbers(p)?.as_slice() {
             [a] => color * *a,
@@ -147,10 +168,12 @@ pub(super) fn spotlight(
             "within 0..180 degrees",
         )?
         .unwrap_or(45.0);
+    let color = props.vec3("color")?.unwrap_or(Vec3::ONE);
+    warn_if_beyond_half(props, "color", color, diag);
     Ok(SpotLight {
         position,
         direction,
-        color: props.vec3("color")?.unwrap_or(Vec3::ONE),
+        color,
         exponent: props.f32("exponent")?.unwrap_or(1.0),
         angle,
         inner_angle: props.f32("inner_angle")?,
@@ -202,8 +225,12 @@ fn radius(
 }
 
 /// A `pointlight` block.
-pub(super) fn pointlight(props: &mut Props<'_>) -> Result<PointLight, SceneError> {
+pub(super) fn pointlight(
+    props: &mut Props<'_>,
+    diag: &mut Diagnostics,
+) -> Result<PointLight, SceneError> {
     let color = props.vec3("color")?.unwrap_or(Vec3::ONE);
+    warn_if_beyond_half(props, "color", color, diag);
     let att = attenuation(props)?.unwrap_or(Attenuation::NONE);
     let threshold = positive(props, "threshold")?.unwrap_or(DEFAULT_LUMINANCE_THRESHOLD);
     let (radius, radius_source) = radius(positive(props, "radius")?, color, &att, threshold);
@@ -224,7 +251,10 @@ fn positive(props: &mut Props<'_>, name: &str) -> Result<Option<f32>, SceneError
 }
 
 /// An `arealight` block: `shape rect` with `size W H`, or `shape disc` with `radius R`.
-pub(super) fn arealight(props: &mut Props<'_>) -> Result<AreaLight, SceneError> {
+pub(super) fn arealight(
+    props: &mut Props<'_>,
+    diag: &mut Diagnostics,
+) -> Result<AreaLight, SceneError> {
     let (shape_name, shape_line) = props
         .text("shape")?
         .unwrap_or_else(|| ("rect".to_string(), props.block_at().line.unwrap_or(1)));
@@ -257,11 +287,13 @@ pub(super) fn arealight(props: &mut Props<'_>) -> Result<AreaLight, SceneError> 
         Some(v) => v != 0.0,
         None => false,
     };
+    let emission = props.vec3("emission")?.unwrap_or(Vec3::ONE);
+    warn_if_beyond_half(props, "emission", emission, diag);
     Ok(AreaLight {
         shape,
         position,
         orientation,
-        emission: props.vec3("emission")?.unwrap_or(Vec3::ONE),
+        emission,
         two_sided,
     })
 }

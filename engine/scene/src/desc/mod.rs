@@ -147,8 +147,10 @@ fn block_into(
         }
         "sunlight" => desc.lights.push(Light::Sun(sunlight(&mut props, diag)?)),
         "spotlight" => desc.lights.push(Light::Spot(spotlight(&mut props, diag)?)),
-        "pointlight" => desc.lights.push(Light::Point(pointlight(&mut props)?)),
-        "arealight" => desc.lights.push(Light::Area(arealight(&mut props)?)),
+        "pointlight" => desc
+            .lights
+            .push(Light::Point(pointlight(&mut props, diag)?)),
+        "arealight" => desc.lights.push(Light::Area(arealight(&mut props, diag)?)),
         "pointlights" => desc
             .lights
             .extend(generate(&mut props)?.into_iter().map(Light::Point)),
