@@ -261,3 +261,167 @@ fn a_nan_or_infinite_input_changes_nothing_beyond_itself() {
         }
     }
 }
+
+/// `base` with its lights replaced by `lights`.
+fn with_lights(base: &Scene, lights: Vec<Light>) -> Scene {
+    let mut scene = base.clone();
+    scene.lights = lights;
+    scene
+}
+
+#[test]
+fn degenerate_lights_stay_finite_and_the_graphs_agree() {
+    let dir = Scratch::new("lights");
+    let base = weft_scene::load_scene(&write_scene(&dir.0, &lights_of("1 1 1"), BOX_CORNER, GREY))
+        .expect("scene loads");
+    let find = |pick: fn(&Light) -> bool| {
+        base.lights
+            .iter()
+            .find(|l| pick(l))
+            .cloned()
+            .expect("the scene has the light")
+    };
+    let sun = find(|l| matches!(l, Light::Sun(_)));
+    let Light::Point(point) = find(|l| matches!(l, Light::Point(_))) else {
+        unreachable!()
+    };
+    let Light::Area(area) = find(|l| matches!(l, Light::Area(_))) else {
+        unreachable!()
+    };
+    let spot = |angle: f32| {
+        Light::Spot(weft_scene::light::SpotLight {
+            position: Vec3::new(0.0, 2.0, 1.0),
+            direction: Vec3::NEG_Y,
+            color: Vec3::splat(3.0),
+            exponent: 1.0,
+            angle,
+            inner_angle: None,
+            length: Some(4.0),
+            attenuation: point.attenuation,
+            swivel: None,
+        })
+    };
+    let point_with = |f: &dyn Fn(&mut weft_scene::PointLight)| {
+        let mut p = point.clone();
+        f(&mut p);
+        Light::Point(p)
+    };
+    let area_with = |f: &dyn Fn(&mut weft_scene::AreaLight)| {
+        let mut a = area.clone();
+        f(&mut a);
+        Light::Area(a)
+    };
+    let cases: Vec<(&str, Vec<Light>)> = vec![
+        ("no lights", vec![]),
+        (
+            "point radius 1e-30",
+            vec![sun.clone(), point_with(&|p| p.radius = 1e-30)],
+        ),
+        (
+            "point attenuation 0 0 0",
+            vec![
+                sun.clone(),
+                point_with(&|p| {
+                    p.attenuation = weft_scene::Attenuation {
+                        constant: 0.0,
+                        linear: 0.0,
+                        quadratic: 0.0,
+                    }
+                }),
+            ],
+        ),
+        (
+            "point on the floor",
+            vec![
+                sun.clone(),
+                point_with(&|p| p.position = Vec3::new(1.0, 0.0, 1.0)),
+            ],
+        ),
+        (
+            "area 1e-30 across",
+            vec![
+                sun.clone(),
+                area_with(&|a| {
+                    a.shape = weft_scene::AreaShape::Rect {
+                        width: 1e-30,
+                        height: 1e-30,
+                    }
+                }),
+            ],
+        ),
+        (
+            "area of zero size",
+            vec![
+                sun.clone(),
+                area_with(&|a| {
+                    a.shape = weft_scene::AreaShape::Disc { radius: 0.0 };
+                }),
+            ],
+        ),
+        (
+            "area on the floor",
+            vec![
+                sun.clone(),
+                area_with(&|a| a.position = Vec3::new(-1.0, 0.0, 0.0)),
+            ],
+        ),
+        ("spot angle 0", vec![sun.clone(), spot(0.0)]),
+        ("spot angle 180", vec![sun.clone(), spot(180.0)]),
+    ];
+    for (what, lights) in cases {
+        let images = render_all(&with_lights(&base, lights), what);
+        for (g, image) in [(GRAPHS[0], &images[0]), (GRAPHS[2], &images[2])] {
+            let a = agreement(image, &images[1]);
+            eprintln!("{what}: {g} vs deferred {a:?}");
+            assert!(
+                a.mean <= 0.25 && a.p99 <= 1,
+                "{what}: {g} vs deferred {a:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_hundred_thousand_lights_shade_tiled_and_light_volumes_refuse_them_with_a_reason() {
+    let dir = Scratch::new("many");
+    let base = weft_scene::load_scene(&write_scene(&dir.0, &lights_of("1 1 1"), BOX_CORNER, GREY))
+        .expect("scene loads");
+    let Some(Light::Point(point)) = base.lights.iter().find(|l| matches!(l, Light::Point(_)))
+    else {
+        panic!("the scene has a point light")
+    };
+    let lights: Vec<Light> = (0..100_000)
+        .map(|i| {
+            let (x, z) = ((i % 316) as f32 / 316.0, (i / 316) as f32 / 316.0);
+            Light::Point(weft_scene::PointLight {
+                position: Vec3::new(x * 6.0 - 3.0, 0.02, z * 6.0 - 3.0),
+                color: Vec3::splat(0.05),
+                radius: 0.05,
+                ..point.clone()
+            })
+        })
+        .collect();
+    let scene = with_lights(&base, lights);
+    let (_, hdr) = render_both(&scene, "tiled.ron");
+    assert_finite_and_bounded(&hdr, "tiled, 100,000 lights");
+    let lit = hdr.chunks_exact(4).filter(|p| p[0] > 0.0).count();
+    assert!(lit > 96 * 64 / 4, "the floor is lit: {lit} pixels");
+    let gpu = weft_tests::gpu();
+    let settings = RenderSettings {
+        graph: common::graph("deferred.ron"),
+        extent: Extent {
+            width: 96,
+            height: 64,
+        },
+        ..RenderSettings::default()
+    };
+    let err = match render(&gpu, &scene, &settings) {
+        Ok(_) => panic!("light volumes accepted 100,000 lights"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("100000 light volumes exceed the 65536 a frame draws this way")
+            && err.contains("graphs/tiled.ron"),
+        "{err}"
+    );
+}

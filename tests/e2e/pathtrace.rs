@@ -154,6 +154,12 @@ fn temp_dir(name: &str) -> PathBuf {
 /// A furnace: a unit sphere of material `object` (MTL statements) inside a
 /// sphere of radius 10 that emits radiance 1 inward and reflects nothing.
 fn furnace_scene(name: &str, object: &str) -> PathBuf {
+    furnace_scene_with(name, object, "")
+}
+
+/// [`furnace_scene`] with further statements in the model block
+/// (`absorption`, say).
+fn furnace_scene_with(name: &str, object: &str, model: &str) -> PathBuf {
     let dir = temp_dir(name);
     let mut base = 0;
     let mut obj = String::from("mtllib furnace.mtl\n");
@@ -168,7 +174,7 @@ fn furnace_scene(name: &str, object: &str) -> PathBuf {
     let scene = dir.join("furnace.scene");
     std::fs::write(
         &scene,
-        "model\n{\n\tfile \"furnace.obj\"\n}\ncamera\n{\n\tposition 0 0 4\n\ttarget 0 0 0\n\tfov_deg 40\n}\n",
+        format!("model\n{{\n\tfile \"furnace.obj\"\n{model}}}\ncamera\n{{\n\tposition 0 0 4\n\ttarget 0 0 0\n\tfov_deg 40\n}}\n"),
     )
     .expect("scene");
     scene
@@ -190,9 +196,30 @@ fn furnace_with(
     samples: u64,
     params: &[(&str, f64)],
 ) -> f32 {
-    const SIZE: u32 = 32;
     let scene = furnace_scene(name, object);
-    let image = render_hdr(&scene, "pathtrace.ron", SIZE, Some(samples), params, &[]);
+    furnace_checked(
+        name,
+        &scene,
+        object_value,
+        [tolerance, 1e-3],
+        samples,
+        params,
+    )
+}
+
+/// Renders the furnace `scene` and checks it as [`furnace`] says, each pixel
+/// within `tolerance[0]` of its value and the object's mean within the
+/// relative `tolerance[1]`.
+fn furnace_checked(
+    name: &str,
+    scene: &Path,
+    object_value: f32,
+    [tolerance, mean_tolerance]: [f32; 2],
+    samples: u64,
+    params: &[(&str, f64)],
+) -> f32 {
+    const SIZE: u32 = 32;
+    let image = render_hdr(scene, "pathtrace.ron", SIZE, Some(samples), params, &[]);
     let tan = (20.0f32).to_radians().tan();
     let mut worst = 0.0f32;
     let mut checked = [0u32; 2];
@@ -232,7 +259,7 @@ fn furnace_with(
     let bias = (mean / f64::from(object_value) - 1.0).abs();
     println!("{name}: worst pixel error {worst:.4} over {checked:?} object/enclosure pixels; object mean {mean:.5}");
     assert!(
-        bias < 1e-3,
+        bias < f64::from(mean_tolerance),
         "{name}: the object's mean is {mean}, not {object_value}"
     );
     worst
@@ -659,6 +686,139 @@ fn furnace_clear_glass_neither_gains_nor_loses_energy() {
     let glass = "Kd 0 0 0\nKs 1 1 1\nTf 1 1 1\nNi 1.5\nillum 7";
     let worst = furnace_with("glass", glass, 1.0, 1e-2, 128, &params);
     println!("clear glass in the furnace: worst pixel error {worst:.2e}");
+}
+
+/// The furnace's pixels split by what the centre ray meets.
+struct FurnacePixels {
+    /// Every pixel that sees only the object, with its impact parameter b
+    /// (the centre ray's distance from the sphere's centre).
+    object: Vec<(f64, [f32; 3])>,
+    /// Every pixel that sees only the enclosure (b > 1.15).
+    enclosure: Vec<[f32; 3]>,
+}
+
+/// Splits a furnace image: object pixels are those of b < `object_below`.
+fn furnace_pixels(image: &Hdr, size: u32, object_below: f32) -> FurnacePixels {
+    let tan = (20.0f32).to_radians().tan();
+    let (mut object, mut enclosure) = (Vec::new(), Vec::new());
+    for y in 0..size {
+        for x in 0..size {
+            let ndc = [
+                (x as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+                (y as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+            ];
+            let dir = glam::Vec3::new(ndc[0] * tan, ndc[1] * tan, -1.0).normalize();
+            let b = glam::Vec3::new(0.0, 0.0, 4.0).cross(dir).length();
+            if b < object_below {
+                object.push((f64::from(b), image.at(x, y)));
+            } else if b > 1.15 {
+                enclosure.push(image.at(x, y));
+            }
+        }
+    }
+    FurnacePixels { object, enclosure }
+}
+
+/// Clear glass at the ends of its index range (issue 19): barely denser than
+/// air (1.0001: the Fresnel terms near their 0/0 limits), diamond (2.42) and
+/// 3.0. Every path that leaves the sphere carries weight exactly 1, so no
+/// pixel may exceed 1 (held to 1e-5: energy is never gained) and the
+/// enclosure is exactly 1. What falls short of 1 is paths still inside after
+/// 100 segments: on the faceted sphere total internal reflection between
+/// flat faces traps paths, more often the higher the index (internal
+/// reflectance 0.17 at 2.42 and 0.25 at 3 head-on, so more bounces). Measured
+/// at 128 spp: index 1.0001 exactly 1 everywhere; 2.42 object mean 0.9942,
+/// worst pixel 0.906; 3.0 mean 0.9904, worst 0.906. Held to: mean above
+/// 0.985, every pixel above 0.85.
+#[test]
+fn furnace_glass_at_extreme_indices_never_gains_energy() {
+    const SIZE: u32 = 32;
+    let params = [("max_depth", 100.0), ("rr_depth", 100.0)];
+    for ior in [1.0001, 2.42, 3.0] {
+        let glass = format!("Kd 0 0 0\nKs 1 1 1\nTf 1 1 1\nNi {ior}\nillum 7");
+        let scene = furnace_scene(&format!("glass-{ior}"), &glass);
+        let image = render_hdr(&scene, "pathtrace.ron", SIZE, Some(128), &params, &[]);
+        let FurnacePixels { object, enclosure } = furnace_pixels(&image, SIZE, 0.85);
+        assert!(object.len() > 200 && enclosure.len() > 100);
+        for value in enclosure.iter().flatten() {
+            assert!(
+                (value - 1.0).abs() <= 1e-5,
+                "index {ior}: enclosure {value}"
+            );
+        }
+        let values: Vec<f32> = object.iter().flat_map(|(_, p)| *p).collect();
+        let (lowest, highest) = values
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+        let mean = values.iter().map(|v| f64::from(*v)).sum::<f64>() / values.len() as f64;
+        println!("index {ior}: object mean {mean:.5}, pixels {lowest:.4} to {highest:.6}");
+        assert!(
+            values.iter().all(|v| v.is_finite()),
+            "index {ior}: not finite"
+        );
+        assert!(
+            highest <= 1.0 + 1e-5,
+            "index {ior}: a pixel gained energy: {highest}"
+        );
+        if ior < 1.001 {
+            assert!(lowest >= 1.0 - 1e-5, "index {ior}: {lowest}");
+        } else {
+            assert!(
+                mean > 0.985 && lowest > 0.85,
+                "index {ior}: mean {mean}, lowest {lowest}"
+            );
+        }
+    }
+}
+
+/// Glass that absorbs whatever enters it (σ = 1e6 per unit: e^-σd is 0
+/// within microns) shows only its Fresnel reflection of the furnace. The path
+/// tracer picks reflection with probability F, so at N spp a pixel is k/N
+/// with k binomial: the pixel whose centre ray passes the centre at distance
+/// b is held to F(asin b) at index 1.5 within 5 standard deviations plus
+/// 0.01 for the faceted normals (within 3.75 degrees of the smooth sphere's)
+/// and the pixel's footprint, and the mean over those pixels within 3% of
+/// the mean of F. Measured at 1,024 spp over b < 0.8: mean 0.04615 against
+/// 0.04596 (0.4%), worst pixel 2.9 standard deviations.
+/// Every pixel is finite, and with `absorption 0` the same glass is clear: 1
+/// everywhere, as without the statement.
+#[test]
+fn furnace_glass_absorbing_everything_shows_only_its_reflection() {
+    const SIZE: u32 = 32;
+    const SAMPLES: u64 = 1024;
+    let glass = "Kd 0 0 0\nKs 1 1 1\nTf 1 1 1\nNi 1.5\nillum 7";
+    let scene = furnace_scene_with("opaque-glass", glass, "\tabsorption 1e6\n");
+    let params = [("max_depth", 8.0)];
+    let image = render_hdr(&scene, "pathtrace.ron", SIZE, Some(SAMPLES), &params, &[]);
+    let object = furnace_pixels(&image, SIZE, 0.8).object;
+    assert!(object.len() > 200, "{}", object.len());
+    let (mut measured, mut expected, mut worst_sigmas) = (0.0f64, 0.0f64, 0.0f64);
+    for (b, pixel) in &object {
+        let (reflected, _) = fresnel_by_angles((1.0 - b * b).sqrt(), 1.0, 1.5);
+        let sigma = (reflected * (1.0 - reflected) / SAMPLES as f64).sqrt();
+        for c in pixel {
+            let error = (f64::from(*c) - reflected).abs();
+            worst_sigmas = worst_sigmas.max(error / sigma);
+            assert!(
+                c.is_finite() && error <= 5.0 * sigma + 0.01,
+                "b {b:.3}: {c}, F = {reflected:.4}, sigma {sigma:.4}"
+            );
+        }
+        measured += f64::from(pixel[0]);
+        expected += reflected;
+    }
+    let ratio = measured / expected;
+    println!(
+        "absorption 1e6: object mean {:.5} against mean F {:.5} (ratio {ratio:.4}); worst pixel {worst_sigmas:.1} sigma",
+        measured / object.len() as f64,
+        expected / object.len() as f64
+    );
+    assert!((ratio - 1.0).abs() < 0.03, "ratio {ratio}");
+    assert!(image.pixels.iter().flatten().all(|c| c.is_finite()));
+    let scene = furnace_scene_with("clear-glass-zero-absorption", glass, "\tabsorption 0\n");
+    let params = [("max_depth", 100.0), ("rr_depth", 100.0)];
+    let worst = furnace_checked("absorption 0", &scene, 1.0, [1e-2, 1e-3], 128, &params);
+    println!("absorption 0: worst pixel error {worst:.2e}");
 }
 
 /// A glass sphere of index 1 is invisible: the glowing box with it inside

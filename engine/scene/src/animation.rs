@@ -1,9 +1,17 @@
 //! Light animation evaluated at a time: point lights circling, spotlights swivelling, the sun
 //! turning. Pure functions of (light, index, time, seed), so every frame is reproducible.
+//! Phases are reduced to one period in f64 before any f32 trigonometry, so a
+//! time of 1e9 seconds (or a negative one) gives the same pose as the same
+//! point in the first period, not f32 noise (docs/stability.md).
 
 use crate::light::{Light, PointLight, SpotLight, SunLight};
 use crate::rng::Rng;
 use glam::{Quat, Vec3};
+
+/// `rate × time` reduced to [0, `period`), computed in f64.
+fn wrapped(rate: f32, time: f32, period: f64) -> f32 {
+    (f64::from(rate) * f64::from(time)).rem_euclid(period) as f32
+}
 
 /// Where point light number `index` is at `time` seconds: on a horizontal circle of radius
 /// `amplitude` around its position, at `velocity` radians per second, with a start phase and
@@ -15,7 +23,7 @@ pub fn point_position_at(light: &PointLight, index: usize, time: f32, seed: u64)
     let mut rng = Rng::new(seed ^ (index as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
     let phase = rng.range(0.0, std::f32::consts::TAU);
     let sense = if rng.next_u64() & 1 == 0 { 1.0 } else { -1.0 };
-    let angle = phase + sense * light.velocity * time;
+    let angle = phase + sense * wrapped(light.velocity, time, std::f64::consts::TAU);
     // Start on the circle at the phase, so the offset at t=0 is zero.
     let start = Vec3::new(phase.cos(), 0.0, phase.sin());
     let now = Vec3::new(angle.cos(), 0.0, angle.sin());
@@ -28,7 +36,7 @@ pub fn spot_direction_at(light: &SpotLight, time: f32) -> Vec3 {
         return light.direction;
     };
     let s = if sw.period > 0.0 {
-        0.5 - 0.5 * (std::f32::consts::TAU * time / sw.period).cos()
+        0.5 - 0.5 * (std::f32::consts::TAU * wrapped(1.0 / sw.period, time, 1.0)).cos()
     } else {
         0.0
     };
@@ -43,8 +51,10 @@ pub fn spot_direction_at(light: &SpotLight, time: f32) -> Vec3 {
 pub fn sun_direction_at(light: &SunLight, time: f32) -> Vec3 {
     match light.motion {
         Some(m) => {
-            Quat::from_axis_angle(m.axis, (m.degrees_per_second * time).to_radians())
-                * light.direction
+            Quat::from_axis_angle(
+                m.axis,
+                wrapped(m.degrees_per_second, time, 360.0).to_radians(),
+            ) * light.direction
         }
         None => light.direction,
     }
@@ -139,5 +149,67 @@ mod tests {
             }),
         };
         assert!(sun_direction_at(&sun, 1.0).distance(Vec3::NEG_Z) < 1e-6);
+    }
+
+    #[test]
+    fn poses_at_huge_and_negative_times_are_finite_and_periodic() {
+        // At 1 rad/s the point light's pose at any time is its pose at that
+        // time reduced modulo 2π (reduced here in f64, as the code does); a
+        // spot swivelling every 4 s and a sun turning 90 degrees a second are
+        // back where they started at 1e9 s and at -8 s (whole periods, exact
+        // in f32).
+        let p = point(1.0);
+        for t in [1e9f32, -8.0, 12345.678] {
+            let reduced = f64::from(t).rem_euclid(std::f64::consts::TAU) as f32;
+            let at = point_position_at(&p, 3, t, 9);
+            assert!(at.is_finite(), "{t}");
+            let expected = point_position_at(&p, 3, reduced, 9);
+            assert!(
+                at.distance(expected) < 1e-4,
+                "point at {t}: {at}, expected {expected}"
+            );
+        }
+        let spot = SpotLight {
+            position: Vec3::ZERO,
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            exponent: 1.0,
+            angle: 30.0,
+            inner_angle: None,
+            length: None,
+            attenuation: Attenuation::NONE,
+            swivel: Some(Swivel {
+                from: Vec3::NEG_Y,
+                to: Vec3::X,
+                period: 4.0,
+            }),
+        };
+        let sun = SunLight {
+            direction: Vec3::X,
+            color: Vec3::ONE,
+            ambient: Vec3::ZERO,
+            motion: Some(SunMotion {
+                axis: Vec3::Y,
+                degrees_per_second: 90.0,
+            }),
+        };
+        for t in [1e9f32, -8.0] {
+            assert!(
+                spot_direction_at(&spot, t).distance(Vec3::NEG_Y) < 1e-5,
+                "spot at {t}"
+            );
+            assert!(
+                sun_direction_at(&sun, t).distance(Vec3::X) < 1e-5,
+                "sun at {t}"
+            );
+        }
+        assert!(spot_direction_at(&spot, 1e9 + 128.0 + 2.0).is_finite());
+        assert!(spot_direction_at(&spot, -6.0).distance(Vec3::X) < 1e-5);
+        // Every pose is finite at any time, the extremes of f32 included.
+        for t in [f32::MAX, f32::MIN, 1e-30, 0.0] {
+            assert!(point_position_at(&p, 1, t, 2).is_finite(), "{t}");
+            assert!(spot_direction_at(&spot, t).is_finite(), "{t}");
+            assert!(sun_direction_at(&sun, t).is_finite(), "{t}");
+        }
     }
 }
