@@ -37,6 +37,9 @@ pub struct DeviceInfo {
     pub pipeline_statistics: bool,
     /// Whether pipelines may clamp depth instead of clipping (`depthClamp`, enabled when offered).
     pub depth_clamp: bool,
+    /// The largest width or height of a 2D image (`maxImageDimension2D`):
+    /// plans with a larger image are refused before any is created.
+    pub max_image_dimension: u32,
 }
 
 /// The physical device type, in preference order.
@@ -520,6 +523,7 @@ fn choose_device(
             timestamps: props_family.timestamp_valid_bits > 0,
             pipeline_statistics: f2.pipeline_statistics_query == vk::TRUE,
             depth_clamp: f2.depth_clamp == vk::TRUE,
+            max_image_dimension: props.limits.max_image_dimension2_d,
         };
         candidates.push((physical, info, family as u32));
     }

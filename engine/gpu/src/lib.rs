@@ -40,7 +40,7 @@ pub use error::{GpuError, VkCall};
 pub use executor::{FrameOptions, FrameReport, Renderer};
 pub use present::{PresentSource, Presented, Presenter};
 pub use readback::{Pixels, Readback};
-pub use resources::{image_requirements, memory_requirements, FrameResources};
+pub use resources::{image_requirements, memory_requirements, oversized_images, FrameResources};
 pub use shader::{CompiledShader, ShaderCompiler, ShaderDiagnostic, ShaderError, ShaderStage};
 pub use statistics::PassStatistics;
 pub use swapchain::Swapchain;

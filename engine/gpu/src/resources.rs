@@ -79,9 +79,37 @@ pub fn image_requirements(gpu: &Gpu, desc: &ImageDesc) -> MemoryRequirements {
     }
 }
 
-/// `image_requirements` as the closure `weft_graph::CompileOptions::memory` takes.
+/// `image_requirements` as the closure `weft_graph::CompileOptions::memory`
+/// takes. An image larger than the device allows is not asked of the device
+/// (that would be invalid usage) but estimated; [`oversized_images`] then
+/// refuses the plan.
 pub fn memory_requirements(gpu: &Gpu) -> impl Fn(&ImageDesc) -> MemoryRequirements + '_ {
-    move |desc| image_requirements(gpu, desc)
+    move |desc| {
+        if fits(gpu, desc) {
+            image_requirements(gpu, desc)
+        } else {
+            weft_graph::estimate_requirements(desc)
+        }
+    }
+}
+
+fn fits(gpu: &Gpu, desc: &ImageDesc) -> bool {
+    let max = gpu.info().max_image_dimension;
+    desc.extent.width <= max && desc.extent.height <= max
+}
+
+/// The plan's images wider or taller than the device's
+/// `maxImageDimension2D`: their names and extents.
+pub fn oversized_images(gpu: &Gpu, plan: &Plan) -> Vec<(String, [u32; 2])> {
+    plan.resources
+        .iter()
+        .filter_map(|r| match &r.desc {
+            ResourceDesc::Image(desc) if !fits(gpu, desc) => {
+                Some((r.name.clone(), [desc.extent.width, desc.extent.height]))
+            }
+            _ => None,
+        })
+        .collect()
 }
 
 fn image_info(desc: &ImageDesc, output: bool) -> vk::ImageCreateInfo<'static> {

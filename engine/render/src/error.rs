@@ -47,6 +47,18 @@ pub enum RenderError {
     /// The scene has more of something than the GPU layouts can index.
     #[error("scene too large: {0}")]
     TooLarge(String),
+    /// The plan has an image larger than the device can create.
+    #[error("image `{image}` would be {}x{}; {device} allows at most {max} texels per side (maxImageDimension2D): render smaller or lower the graph parameter that sizes it", size[0], size[1])]
+    ImageTooLarge {
+        /// The graph's resource name.
+        image: String,
+        /// Its width and height for this render.
+        size: [u32; 2],
+        /// The device's limit.
+        max: u32,
+        /// The device's name.
+        device: String,
+    },
 }
 
 impl RenderError {
@@ -71,7 +83,9 @@ impl RenderError {
             .with_hint(
                 "declare `progressive: (samples_per_frame: ...)`, as graphs/pathtrace.ron does",
             )],
-            Self::Gpu(_) | Self::Camera { .. } | Self::TooLarge(_) => Vec::new(),
+            Self::Gpu(_) | Self::Camera { .. } | Self::TooLarge(_) | Self::ImageTooLarge { .. } => {
+                Vec::new()
+            }
         }
     }
 

@@ -145,7 +145,16 @@ pub fn compile_for_scene(
         memory: &memory,
         readback: settings.extra_readback.clone(),
     };
-    crate::providers::compile(&loaded, &options).map_err(RenderError::Graph)
+    let plan = crate::providers::compile(&loaded, &options).map_err(RenderError::Graph)?;
+    if let Some((image, size)) = weft_gpu::oversized_images(gpu, &plan).into_iter().next() {
+        return Err(RenderError::ImageTooLarge {
+            image,
+            size,
+            max: gpu.info().max_image_dimension,
+            device: gpu.info().name.clone(),
+        });
+    }
+    Ok(plan)
 }
 
 /// Renders `scene` through the graph in `settings`.
