@@ -172,16 +172,18 @@ fn build(
         cameras,
         bounds,
         declared_bounds: desc.bounding_box,
+        origin: desc.origin,
         warnings: std::mem::take(&mut diag.warnings),
     })
 }
 
-/// Largest distance from the origin, per axis, that keeps a scene within
-/// 1e6 units across; beyond it float32 positions step by 1/32 unit or more.
+/// Largest distance from the scene's origin ([`Scene::origin`]), per axis,
+/// that keeps a scene within 1e6 units across; beyond it float32 positions
+/// step by 1/32 unit or more.
 const PRECISE_REACH: f32 = 5e5;
 
 /// Warns, at the `model` block, when the placed model reaches past
-/// [`PRECISE_REACH`] from the origin (docs/stability.md).
+/// [`PRECISE_REACH`] from the scene's origin (docs/stability.md).
 fn warn_if_far(placed: &Aabb, at: &Location, diag: &mut Diagnostics) {
     if placed.is_empty() {
         return;
@@ -192,7 +194,7 @@ fn warn_if_far(placed: &Aabb, at: &Location, diag: &mut Diagnostics) {
         diag.warn(
             at.clone(),
             format!(
-                "this model reaches {reach:e} units from the origin: the scene spans more than 1e6 units, where float32 positions step by {step:.2} units; move the scene towards the origin"
+                "this model reaches {reach:e} units from the scene's origin (its first camera, else its first position): the scene spans more than 1e6 units, where float32 positions step by {step:.2} units; keep what is drawn within 5e5 units of the first camera"
             ),
         );
     }

@@ -3,7 +3,7 @@
 
 use crate::error::{Diagnostics, Location, SceneError};
 use crate::syntax::{Block, Prop, Value};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::path::Path;
 
 /// Reads one block's properties and remembers which were used.
@@ -11,15 +11,18 @@ pub(crate) struct Props<'a> {
     block: &'a Block,
     file: &'a Path,
     used: Vec<bool>,
+    /// The scene's origin: positions are stored relative to it.
+    origin: DVec3,
 }
 
 impl<'a> Props<'a> {
-    /// Starts reading `block` from `file`.
-    pub(crate) fn new(block: &'a Block, file: &'a Path) -> Self {
+    /// Starts reading `block` from `file`, positions relative to `origin`.
+    pub(crate) fn new(block: &'a Block, file: &'a Path, origin: DVec3) -> Self {
         Self {
             block,
             file,
             used: vec![false; block.props.len()],
+            origin,
         }
     }
 
@@ -57,6 +60,11 @@ impl<'a> Props<'a> {
 
     /// The property's fields as numbers, whatever their count.
     pub(crate) fn numbers(&self, prop: &Prop) -> Result<Vec<f32>, SceneError> {
+        Ok(self.wide(prop)?.into_iter().map(|n| n as f32).collect())
+    }
+
+    /// The property's fields as the f64 numbers the file gives.
+    fn wide(&self, prop: &Prop) -> Result<Vec<f64>, SceneError> {
         prop.values
             .iter()
             .map(|v| match v {
@@ -109,6 +117,34 @@ impl<'a> Props<'a> {
             Ok(Some(v))
         } else {
             Err(self.error(p, format!("'{name}' must be {expected}, found {v}")))
+        }
+    }
+
+    /// The point given by three numbers of `prop` from `first` on, relative
+    /// to the origin: subtracted in f64, so a position far from zero keeps
+    /// its precision near the origin (docs/stability.md).
+    pub(crate) fn point_at(&self, prop: &Prop, first: usize) -> Result<Vec3, SceneError> {
+        let v = self.wide(prop)?;
+        let p = DVec3::new(v[first], v[first + 1], v[first + 2]);
+        Ok((p - self.origin).as_vec3())
+    }
+
+    /// The last `name` as a point relative to the origin, or the world point
+    /// `default` (relative to the origin too) when it is not given.
+    pub(crate) fn point_or(&mut self, name: &str, default: DVec3) -> Result<Vec3, SceneError> {
+        Ok(self
+            .point(name)?
+            .unwrap_or_else(|| (default - self.origin).as_vec3()))
+    }
+
+    /// The last `name` as a point (three numbers) relative to the origin.
+    pub(crate) fn point(&mut self, name: &str) -> Result<Option<Vec3>, SceneError> {
+        match self.last(name) {
+            Some(p) => {
+                self.exactly(p, 3)?;
+                Ok(Some(self.point_at(p, 0)?))
+            }
+            None => Ok(None),
         }
     }
 

@@ -81,6 +81,9 @@ pub struct SceneReport {
     pub cameras: Vec<String>,
     /// World bounds of the geometry, `None` when there is none.
     pub bounds: Option<Aabb>,
+    /// The point the loaded positions are relative to (`Scene::origin`):
+    /// zero unless the scene's first camera is 512 units or more from zero.
+    pub origin: [f64; 3],
     /// Warnings, in the order found.
     pub warnings: Vec<Warning>,
 }
@@ -178,7 +181,11 @@ impl SceneReport {
             lights,
             point_light_radius,
             cameras: scene.cameras.iter().map(|c| c.name.clone()).collect(),
-            bounds: (!scene.bounds.is_empty()).then_some(scene.bounds),
+            bounds: (!scene.bounds.is_empty()).then(|| Aabb {
+                min: (scene.bounds.min.as_dvec3() + scene.origin).as_vec3(),
+                max: (scene.bounds.max.as_dvec3() + scene.origin).as_vec3(),
+            }),
+            origin: scene.origin.to_array(),
             warnings: scene.warnings.clone(),
         }
     }
@@ -234,6 +241,10 @@ impl fmt::Display for SceneReport {
                 b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
             )?,
             None => writeln!(f, "  bounds: empty")?,
+        }
+        if self.origin != [0.0; 3] {
+            let [x, y, z] = self.origin;
+            writeln!(f, "  positions stored relative to ({x}, {y}, {z})")?;
         }
         writeln!(f, "  warnings: {}", self.warnings.len())?;
         for w in &self.warnings {

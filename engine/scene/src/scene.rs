@@ -38,6 +38,11 @@ pub struct Scene {
     pub bounds: Aabb,
     /// The `boundingbox` block, when the scene declares one.
     pub declared_bounds: Option<Aabb>,
+    /// The world point every position here is relative to (near the first
+    /// camera, see `desc::origin_of`; zero for scenes near zero): world =
+    /// origin + stored position.
+    /// Renderers never need it; reports that print world coordinates do.
+    pub origin: glam::DVec3,
     /// What the loader accepted but reported.
     pub warnings: Vec<Warning>,
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Value {
     /// A finite number.
-    Num(f32),
+    Num(f64),
     /// A quoted string.
     Str(String),
     /// An unquoted word that is not a number.
@@ -123,7 +123,7 @@ fn value_of(token: &Token<'_>, file: &Path, line: usize) -> Result<Value, SceneE
             format!("number '{text}' is not a finite 32-bit float"),
         ));
     }
-    Ok(Value::Num(parsed as f32))
+    Ok(Value::Num(parsed))
 }
 
 /// A block whose `{` has not been seen yet, or whose properties are being read.

@@ -315,6 +315,39 @@ fn a_model_placed_a_million_units_out_is_warned_about_at_its_block() {
     let warnings = short_warnings(&loaded.warnings);
     assert_eq!(
         warnings,
-        vec!["far.scene:7: this model reaches 2.000001e6 units from the origin: the scene spans more than 1e6 units, where float32 positions step by 0.12 units; move the scene towards the origin"]
+        vec!["far.scene:3: this model reaches 1.999872e6 units from the scene's origin (its first camera, else its first position): the scene spans more than 1e6 units, where float32 positions step by 0.12 units; keep what is drawn within 5e5 units of the first camera"]
     );
+    assert_eq!(loaded.origin, glam::DVec3::new(1999872.0, 0.0, 0.0));
+}
+
+/// Positions are read in f64 and stored relative to the first camera's
+/// position snapped to a 1024-unit grid: a scene ten million units out keeps
+/// quarter units (float32 steps by 1 unit there).
+#[test]
+fn positions_far_from_zero_are_stored_relative_to_the_first_camera_in_full_precision() {
+    let dir = temp_dir("relative");
+    std::fs::write(dir.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let scene = dir.join("relative.scene");
+    std::fs::write(
+        &scene,
+        "model\n{\n file \"tri.obj\"\n position 10000001.75 -0.25 3\n}\n\
+         pointlight\n{\n position 10000000.5 2.25 0\n attenuation 1 0 1\n}\n\
+         camera\n{\n position 10000000.25 1.5 5\n target 10000000.25 1.5 0\n}\n",
+    )
+    .unwrap();
+    let loaded = load_scene(&scene).unwrap();
+    assert_eq!(loaded.origin, glam::DVec3::new(10000384.0, 0.0, 0.0));
+    assert_eq!(
+        loaded.cameras[0].position,
+        glam::Vec3::new(-383.75, 1.5, 5.0)
+    );
+    assert_eq!(
+        loaded.instances[0].transform.w_axis.truncate(),
+        glam::Vec3::new(-382.25, -0.25, 3.0)
+    );
+    let weft_scene::Light::Point(light) = &loaded.lights[0] else {
+        panic!("a point light");
+    };
+    assert_eq!(light.position, glam::Vec3::new(-383.5, 2.25, 0.0));
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
 }

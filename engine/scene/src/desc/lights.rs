@@ -11,7 +11,7 @@ use crate::light::{
 use crate::props::Props;
 use crate::rng::Rng;
 use crate::syntax::Prop;
-use glam::{Quat, Vec3};
+use glam::{DVec3, Quat, Vec3};
 
 /// The largest value an RGBA16F HDR image holds.
 const HALF_MAX: f32 = 65504.0;
@@ -91,7 +91,7 @@ pub(super) fn spotlight(
     props: &mut Props<'_>,
     diag: &mut Diagnostics,
 ) -> Result<SpotLight, SceneError> {
-    let position = props.vec3("position")?.unwrap_or(Vec3::ZERO);
+    let position = props.point_or("position", DVec3::ZERO)?;
     let given = props.direction("direction")?;
     let oriented = match props.last("orientation") {
         Some(p) => {
@@ -235,7 +235,7 @@ pub(super) fn pointlight(
     let threshold = positive(props, "threshold")?.unwrap_or(DEFAULT_LUMINANCE_THRESHOLD);
     let (radius, radius_source) = radius(positive(props, "radius")?, color, &att, threshold);
     Ok(PointLight {
-        position: props.vec3("position")?.unwrap_or(Vec3::ZERO),
+        position: props.point_or("position", DVec3::ZERO)?,
         color,
         velocity: props.f32("velocity")?.unwrap_or(0.0),
         amplitude: props.f32("amplitude")?.unwrap_or(1.0),
@@ -274,7 +274,7 @@ pub(super) fn arealight(
             ));
         }
     };
-    let position = props.vec3("position")?.unwrap_or(Vec3::ZERO);
+    let position = props.point_or("position", DVec3::ZERO)?;
     let orientation = match (props.last("orientation"), props.direction("direction")?) {
         (Some(p), None) => rotation(props, p)?,
         (None, Some(d)) => look_at_rotation(Vec3::ZERO, d),
@@ -308,8 +308,8 @@ pub(super) fn generate(props: &mut Props<'_>) -> Result<Vec<PointLight>, SceneEr
         )?
         .unwrap_or(0.0);
     let seed = props.f32("seed")?.unwrap_or(0.0);
-    let min = props.vec3("min")?.unwrap_or(Vec3::splat(-1.0));
-    let max = props.vec3("max")?.unwrap_or(Vec3::splat(1.0));
+    let min = props.point_or("min", DVec3::splat(-1.0))?;
+    let max = props.point_or("max", DVec3::ONE)?;
     let color_min = props.vec3("color_min")?.unwrap_or(Vec3::ONE);
     let color_max = props.vec3("color_max")?.unwrap_or(color_min);
     let radius_range = positive_pair(props, "radius", Order::Increasing)?;

@@ -7,8 +7,8 @@ use crate::error::{Diagnostics, Location, SceneError};
 use crate::light::Light;
 use crate::props::Props;
 use crate::source::{read_text, MAX_SCENE_BYTES};
-use crate::syntax::{parse, Block, Item, Prop};
-use glam::{EulerRot, Mat4, Quat, Vec3};
+use crate::syntax::{parse, Block, Item, Prop, Value};
+use glam::{DVec3, EulerRot, Mat4, Quat, Vec3};
 use std::path::{Path, PathBuf};
 
 mod lights;
@@ -53,11 +53,17 @@ pub struct SceneDesc {
     pub cameras: Vec<Camera>,
     /// A `boundingbox` block, when present.
     pub bounding_box: Option<Aabb>,
+    /// The world point every position above is relative to ([`origin_of`]).
+    pub origin: DVec3,
 }
 
 /// Reads a `.scene` file and its includes.
 pub fn read_scene_desc(path: &Path, diag: &mut Diagnostics) -> Result<SceneDesc, SceneError> {
-    let mut desc = SceneDesc::default();
+    let text = read_text(path, &Location::file(path), MAX_SCENE_BYTES)?;
+    let mut desc = SceneDesc {
+        origin: origin_of(&text, path),
+        ..SceneDesc::default()
+    };
     let mut stack = Vec::new();
     read_into(path, &Location::file(path), &mut desc, &mut stack, diag)?;
     Ok(desc)
@@ -69,10 +75,56 @@ pub fn scene_desc_from_str(
     path: &Path,
     diag: &mut Diagnostics,
 ) -> Result<SceneDesc, SceneError> {
-    let mut desc = SceneDesc::default();
+    let mut desc = SceneDesc {
+        origin: origin_of(text, path),
+        ..SceneDesc::default()
+    };
     let mut stack = vec![path.to_path_buf()];
     interpret(text, path, &mut desc, &mut stack, diag)?;
     Ok(desc)
+}
+
+/// The grid the origin snaps to: a scene within half of it from zero is
+/// stored as written.
+pub const ORIGIN_GRID: f64 = 1024.0;
+
+/// The world point a scene's positions are stored relative to: the first
+/// camera's `position` (or its first `key`'s) in the top-level file, else the
+/// first `position` of any block there, else zero; rounded to the nearest
+/// multiple of [`ORIGIN_GRID`], so scenes within 512 units of zero keep
+/// their coordinates. Positions are read in f64 and the origin subtracted
+/// before they become f32, so a scene placed far from zero keeps near its
+/// camera the precision it has near zero (docs/stability.md, "Far from the
+/// origin").
+pub fn origin_of(text: &str, path: &Path) -> DVec3 {
+    let mut scratch = Diagnostics::default();
+    let Ok(items) = parse(text, path, &mut scratch) else {
+        return DVec3::ZERO;
+    };
+    let point = |values: &[Value]| match values {
+        [Value::Num(x), Value::Num(y), Value::Num(z), ..] => Some(DVec3::new(*x, *y, *z)),
+        _ => None,
+    };
+    let position = |block: &Block| {
+        block.props.iter().find_map(|p| match p.name.as_str() {
+            "position" => point(&p.values),
+            "key" => point(p.values.get(1..).unwrap_or(&[])),
+            _ => None,
+        })
+    };
+    let blocks: Vec<&Block> = items
+        .iter()
+        .filter_map(|item| match item {
+            Item::Block(b) => Some(b),
+            Item::Include { .. } => None,
+        })
+        .collect();
+    blocks
+        .iter()
+        .filter(|b| b.kind == "camera")
+        .find_map(|b| position(b))
+        .or_else(|| blocks.iter().find_map(|b| position(b)))
+        .map_or(DVec3::ZERO, |p| (p / ORIGIN_GRID).round() * ORIGIN_GRID)
 }
 
 /// Reads one file into `desc`; `stack` holds the files being included, to stop cycles.
@@ -137,7 +189,7 @@ fn block_into(
     desc: &mut SceneDesc,
     diag: &mut Diagnostics,
 ) -> Result<(), SceneError> {
-    let mut props = Props::new(block, file);
+    let mut props = Props::new(block, file, desc.origin);
     let first_warning = diag.warnings.len();
     match block.kind.as_str() {
         "model" => {
@@ -160,8 +212,8 @@ fn block_into(
                 .push(camera(&mut props, block.label.clone(), index)?);
         }
         "boundingbox" => {
-            let min = props.vec3("min")?.unwrap_or(Vec3::ZERO);
-            let max = props.vec3("max")?.unwrap_or(Vec3::ZERO);
+            let min = props.point_or("min", DVec3::ZERO)?;
+            let max = props.point_or("max", DVec3::ZERO)?;
             desc.bounding_box = Some(Aabb::from_points(&[min, max]));
         }
         other => {
@@ -221,7 +273,7 @@ fn warn_angle_axis(props: &Props<'_>, prop: &Prop, diag: &mut Diagnostics) {
 /// A `model` block; `None` (with a warning) when it names no file.
 fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placement>, SceneError> {
     let file = props.text("file")?;
-    let position = props.vec3("position")?.unwrap_or(Vec3::ZERO);
+    let position = props.point_or("position", DVec3::ZERO)?;
     let rot = match props.last("orientation") {
         Some(p) => {
             warn_angle_axis(props, p, diag);
@@ -285,8 +337,8 @@ fn camera(
     label: Option<String>,
     index: usize,
 ) -> Result<Camera, SceneError> {
-    let position = props.vec3("position")?.unwrap_or(Vec3::ZERO);
-    let target = props.vec3("target")?;
+    let position = props.point_or("position", DVec3::ZERO)?;
+    let target = props.point("target")?;
     let orientation = match (props.last("orientation"), target) {
         (Some(p), None) => rotation(props, p)?,
         (None, Some(t)) => look_at_rotation(position, t),
@@ -323,11 +375,11 @@ fn camera(
     let mut path = Vec::new();
     for p in props.all("key") {
         let v = props.exactly(p, 7)?;
-        let key_position = Vec3::new(v[1], v[2], v[3]);
+        let key_position = props.point_at(p, 1)?;
         path.push(CameraKey {
             time: v[0],
             position: key_position,
-            orientation: look_at_rotation(key_position, Vec3::new(v[4], v[5], v[6])),
+            orientation: look_at_rotation(key_position, props.point_at(p, 4)?),
         });
         if path.len() > 1 && path[path.len() - 2].time >= v[0] {
             return Err(props.error(p, "camera 'key' times must increase"));
