@@ -220,42 +220,25 @@ fn furnace_checked(
 ) -> f32 {
     const SIZE: u32 = 32;
     let image = render_hdr(scene, "pathtrace.ron", SIZE, Some(samples), params, &[]);
-    let tan = (20.0f32).to_radians().tan();
+    let FurnacePixels { object, enclosure } = furnace_pixels(&image, SIZE, 0.85);
+    let checked = [object.len(), enclosure.len()];
+    assert!(checked[0] > 200 && checked[1] > 100, "{checked:?}");
     let mut worst = 0.0f32;
-    let mut checked = [0u32; 2];
-    let mut object_sum = 0.0f64;
-    for y in 0..SIZE {
-        for x in 0..SIZE {
-            // The pixel centre's ray from (0, 0, 4): its distance from the
-            // sphere's centre says which surface the pixel sees.
-            let ndc = [
-                (x as f32 + 0.5) / SIZE as f32 * 2.0 - 1.0,
-                (y as f32 + 0.5) / SIZE as f32 * 2.0 - 1.0,
-            ];
-            let dir = glam::Vec3::new(ndc[0] * tan, ndc[1] * tan, -1.0).normalize();
-            let miss = glam::Vec3::new(0.0, 0.0, 4.0).cross(dir).length();
-            let expected = if miss < 0.85 {
-                checked[0] += 1;
-                object_sum += f64::from(image.at(x, y)[0]);
-                object_value
-            } else if miss > 1.15 {
-                checked[1] += 1;
-                1.0
-            } else {
-                continue;
-            };
-            for c in image.at(x, y) {
-                let error = (c - expected).abs();
-                worst = worst.max(error);
-                assert!(
-                    error <= tolerance,
-                    "{name}: pixel ({x}, {y}) is {c}, expected {expected} +- {tolerance}"
-                );
-            }
+    let expected = object
+        .iter()
+        .map(|(b, pixel)| (*b, object_value, pixel))
+        .chain(enclosure.iter().map(|pixel| (f64::INFINITY, 1.0, pixel)));
+    for (b, expected, pixel) in expected {
+        for c in pixel {
+            let error = (c - expected).abs();
+            worst = worst.max(error);
+            assert!(
+                error <= tolerance,
+                "{name}: the pixel whose ray passes the centre at {b:.3} is {c}, expected {expected} +- {tolerance}"
+            );
         }
     }
-    assert!(checked[0] > 200 && checked[1] > 100, "{checked:?}");
-    let mean = object_sum / f64::from(checked[0]);
+    let mean = object.iter().map(|(_, p)| f64::from(p[0])).sum::<f64>() / checked[0] as f64;
     let bias = (mean / f64::from(object_value) - 1.0).abs();
     println!("{name}: worst pixel error {worst:.4} over {checked:?} object/enclosure pixels; object mean {mean:.5}");
     assert!(

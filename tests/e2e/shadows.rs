@@ -171,6 +171,38 @@ fn column(image: &[f32], x: usize) -> Vec<f32> {
 const SUN: Vec3 = Vec3::new(-2.0, -1.0, 0.0);
 const TOP: (Vec3, Vec3) = (Vec3::new(-3.0, 10.0, 0.0), Vec3::new(-3.0, 0.0, 0.0));
 
+/// The box shadow's four edges on the row and the column through its
+/// centre, each as (edge, measured pixel, predicted pixel): where the image
+/// crosses half the lit value (the sun along [`SUN`]) against the projection
+/// of the edge's world point.
+fn box_shadow_edges(scene: &Path, image: &[f32]) -> Vec<(Vec3, f32, f32)> {
+    let lit = 1.0 / 5f32.sqrt();
+    let centre = project(scene, Vec3::new(-3.0, 0.0, 0.0));
+    let (cx, cy) = (centre.x as usize, centre.y as usize);
+    assert!(
+        image[cy * SIZE as usize + cx] < 0.01,
+        "the centre is in shadow"
+    );
+    [
+        (Vec3::new(-4.5, 0.0, 0.0), true),
+        (Vec3::new(-1.5, 0.0, 0.0), true),
+        (Vec3::new(-3.0, 0.0, -0.5), false),
+        (Vec3::new(-3.0, 0.0, 0.5), false),
+    ]
+    .into_iter()
+    .map(|(edge, along_row)| {
+        let p = project(scene, edge);
+        let (line, from, predicted) = if along_row {
+            (row(image, cy), cx, p.x - 0.5)
+        } else {
+            (column(image, cx), cy, p.y - 0.5)
+        };
+        let step = if predicted > from as f32 { 1 } else { -1 };
+        (edge, crossing(&line, from, step, lit * 0.5), predicted)
+    })
+    .collect()
+}
+
 #[test]
 fn a_box_shadow_lands_where_the_sun_direction_predicts() {
     let dir = std::env::temp_dir().join("weft-shadows-analytic");
@@ -178,29 +210,7 @@ fn a_box_shadow_lands_where_the_sun_direction_predicts() {
     for (graph, cascades) in [("forward.ron", 1), ("deferred.ron", 1), ("forward.ron", 3)] {
         let g = graph_with(&dir, graph, &format!("\"cascades\": {cascades}"));
         let image = render_hdr(&scene, &g);
-        let lit = 1.0 / 5f32.sqrt();
-        let centre = project(&scene, Vec3::new(-3.0, 0.0, 0.0));
-        let (cx, cy) = (centre.x as usize, centre.y as usize);
-        assert!(
-            image[cy * SIZE as usize + cx] < 0.01,
-            "{graph}, {cascades} cascade(s): the centre is in shadow"
-        );
-        // Edges along the row and the column through the shadow's centre.
-        let edges = [
-            (Vec3::new(-4.5, 0.0, 0.0), true),
-            (Vec3::new(-1.5, 0.0, 0.0), true),
-            (Vec3::new(-3.0, 0.0, -0.5), false),
-            (Vec3::new(-3.0, 0.0, 0.5), false),
-        ];
-        for (edge, along_row) in edges {
-            let p = project(&scene, edge);
-            let (line, from, predicted) = if along_row {
-                (row(&image, cy), cx, p.x - 0.5)
-            } else {
-                (column(&image, cx), cy, p.y - 0.5)
-            };
-            let step = if predicted > from as f32 { 1 } else { -1 };
-            let measured = crossing(&line, from, step, lit * 0.5);
+        for (edge, measured, predicted) in box_shadow_edges(&scene, &image) {
             eprintln!(
                 "{graph}, {cascades} cascade(s): edge {edge}: measured {measured:.2} px, predicted {predicted:.2} px"
             );
@@ -230,51 +240,33 @@ fn shadows_in_a_scene_1e4_units_across_keep_their_place_with_cascades() {
         let loaded = weft_scene::load_scene(&scene).expect("scene loads");
         let inv = weft_render::camera::view_projection(&loaded.cameras[0], 0.0, 1.0).inverse();
         let lit = 1.0 / 5f32.sqrt();
-        {
-            let g = graph_with(&dir, "forward.ron", &format!("\"cascades\": {cascades}"));
-            let image = render_hdr(&scene, &g);
-            let centre = project(&scene, Vec3::new(-3.0, 0.0, 0.0));
-            let (cx, cy) = (centre.x as usize, centre.y as usize);
-            let mut worst = 0.0f32;
-            for (edge, along_row) in [
-                (Vec3::new(-4.5, 0.0, 0.0), true),
-                (Vec3::new(-1.5, 0.0, 0.0), true),
-                (Vec3::new(-3.0, 0.0, -0.5), false),
-                (Vec3::new(-3.0, 0.0, 0.5), false),
-            ] {
-                let p = project(&scene, edge);
-                let (line, from, predicted) = if along_row {
-                    (row(&image, cy), cx, p.x - 0.5)
-                } else {
-                    (column(&image, cx), cy, p.y - 0.5)
-                };
-                let step = if predicted > from as f32 { 1 } else { -1 };
-                let measured = crossing(&line, from, step, lit * 0.5);
-                println!("{cascades} cascade(s): edge {edge}: measured {measured:.2} px, predicted {predicted:.2} px");
-                worst = worst.max((measured - predicted).abs());
-            }
-            // Plane pixels 2 units or more outside the shadow (x -4.5..-1.5,
-            // z -0.5..0.5), beyond any penumbra, and clear of the box itself.
-            let outside: Vec<f32> = (0..SIZE * SIZE)
-                .filter(|i| {
-                    plane_hit(&inv, i % SIZE, i / SIZE).is_some_and(|p| {
-                        !(-6.5..=2.0).contains(&p.x) || !(-2.5..=2.5).contains(&p.z)
-                    })
-                })
-                .map(|i| image[i as usize])
-                .collect();
-            let darkened = outside.iter().filter(|v| **v < lit * 0.99).count();
-            println!(
+        let g = graph_with(&dir, "forward.ron", &format!("\"cascades\": {cascades}"));
+        let image = render_hdr(&scene, &g);
+        let mut worst = 0.0f32;
+        for (edge, measured, predicted) in box_shadow_edges(&scene, &image) {
+            println!("{cascades} cascade(s): edge {edge}: measured {measured:.2} px, predicted {predicted:.2} px");
+            worst = worst.max((measured - predicted).abs());
+        }
+        // Plane pixels 2 units or more outside the shadow (x -4.5..-1.5,
+        // z -0.5..0.5), beyond any penumbra, and clear of the box itself.
+        let outside: Vec<f32> = (0..SIZE * SIZE)
+            .filter(|i| {
+                plane_hit(&inv, i % SIZE, i / SIZE)
+                    .is_some_and(|p| !(-6.5..=2.0).contains(&p.x) || !(-2.5..=2.5).contains(&p.z))
+            })
+            .map(|i| image[i as usize])
+            .collect();
+        let darkened = outside.iter().filter(|v| **v < lit * 0.99).count();
+        println!(
             "plane {half} either side, {cascades} cascade(s): worst edge {worst:.2} px; {darkened} of {} lit plane pixels darkened",
             outside.len()
         );
-            if cascades == 4 && half > 10.0 {
-                assert!(worst <= 2.5, "edges {worst} px from the prediction");
-                assert!(
-                    (darkened as f64) < 0.001 * outside.len() as f64,
-                    "acne: {darkened}"
-                );
-            }
+        if cascades == 4 && half > 10.0 {
+            assert!(worst <= 2.5, "edges {worst} px from the prediction");
+            assert!(
+                (darkened as f64) < 0.001 * outside.len() as f64,
+                "acne: {darkened}"
+            );
         }
     }
 }

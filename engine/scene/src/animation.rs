@@ -119,9 +119,9 @@ mod tests {
         assert_eq!(point_position_at(&point(0.0), 0, 5.0, 1), p.position);
     }
 
-    #[test]
-    fn swivel_and_sun_motion() {
-        let spot = SpotLight {
+    /// A spot at the origin swivelling from straight down to +X and back every 4 s.
+    fn swivelling_spot() -> SpotLight {
+        SpotLight {
             position: Vec3::ZERO,
             direction: Vec3::NEG_Y,
             color: Vec3::ONE,
@@ -135,7 +135,12 @@ mod tests {
                 to: Vec3::X,
                 period: 4.0,
             }),
-        };
+        }
+    }
+
+    #[test]
+    fn swivel_and_sun_motion() {
+        let spot = swivelling_spot();
         assert!(spot_direction_at(&spot, 0.0).distance(Vec3::NEG_Y) < 1e-6);
         assert!(spot_direction_at(&spot, 2.0).distance(Vec3::X) < 1e-6);
         assert!(spot_direction_at(&spot, 4.0).distance(Vec3::NEG_Y) < 1e-6);
@@ -169,21 +174,7 @@ mod tests {
                 "point at {t}: {at}, expected {expected}"
             );
         }
-        let spot = SpotLight {
-            position: Vec3::ZERO,
-            direction: Vec3::NEG_Y,
-            color: Vec3::ONE,
-            exponent: 1.0,
-            angle: 30.0,
-            inner_angle: None,
-            length: None,
-            attenuation: Attenuation::NONE,
-            swivel: Some(Swivel {
-                from: Vec3::NEG_Y,
-                to: Vec3::X,
-                period: 4.0,
-            }),
-        };
+        let spot = swivelling_spot();
         let sun = SunLight {
             direction: Vec3::X,
             color: Vec3::ONE,
