@@ -7,6 +7,7 @@ layout(set = 0, binding = 0) uniform sampler2D hdr;
 layout(push_constant) uniform Params {
     float threshold;
 } params;
+#include "include/hdr.glsl"
 
 layout(location = 0) in vec2 uv;
 layout(location = 0) out vec4 color;
@@ -14,8 +15,7 @@ layout(location = 0) out vec4 color;
 void main() {
     // A non-finite input never enters the blur, which would spread it over
     // the whole kernel: NaN counts as 0, anything above RGBA16F's range as its top.
-    vec3 c = texture(hdr, uv).rgb;
-    c = clamp(mix(c, vec3(0.0), isnan(c)), vec3(0.0), vec3(65504.0));
+    vec3 c = finite_clamped(texture(hdr, uv).rgb, 65504.0);
     float peak = max(c.r, max(c.g, c.b));
     float keep = peak > params.threshold ? (peak - params.threshold) / peak : 0.0;
     color = vec4(c * keep, 1.0);

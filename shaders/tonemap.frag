@@ -9,6 +9,7 @@ layout(set = 0, binding = 1) uniform sampler2D bloom;
 layout(push_constant) uniform Params {
     float exposure;
 } params;
+#include "include/hdr.glsl"
 
 layout(location = 0) in vec2 uv;
 layout(location = 0) out vec4 color;
@@ -20,6 +21,6 @@ void main() {
 #endif
     // NaN shows black and inf white rather than NaN spreading through c / (1 + c).
     c *= params.exposure;
-    c = min(mix(c, vec3(0.0), isnan(c)), vec3(1.0e30));
+    c = finite_clamped(c, 1.0e30);
     color = vec4(c / (1.0 + c), 1.0);
 }

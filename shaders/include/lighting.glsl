@@ -20,6 +20,7 @@
 #ifndef WEFT_LIGHTING_GLSL
 #define WEFT_LIGHTING_GLSL
 #include "scene.glsl"
+#include "hdr.glsl"
 
 #ifdef SCENE_SPECIALISED
 #ifdef SCENE_SUNS
@@ -463,18 +464,6 @@ vec3 shade_all_lights(Surface s, Material m, uint area_samples) {
 // (MTL map_Ke, glTF emissiveTexture; 1 without one) and `occlusion` the
 // occlusion texture's (glTF occlusionTexture, red; 1 without one), which
 // darkens the ambient term only.
-// The most one pass writes to an RGBA16F HDR channel: the graphs add at most
-// seven passes into one image (deferred: sun, points, spots, areas,
-// transparent), so a sum stays below the format's 65504 and never becomes
-// inf. weft_render::sanitize::HDR_PASS_MAX mirrors it.
-#define HDR_PASS_MAX 8192.0
-
-// `c` made safe to write to an HDR target: NaN becomes 0, negatives 0, and
-// anything above HDR_PASS_MAX (inf included) HDR_PASS_MAX.
-vec3 hdr_output(vec3 c) {
-    return clamp(mix(c, vec3(0.0), isnan(c)), vec3(0.0), vec3(HDR_PASS_MAX));
-}
-
 vec3 shade_ambient_emissive(Surface s, Material m, float emissive_boost, vec3 emission_texel, float occlusion) {
     vec3 reflectance = m.ambient.rgb * s.texel;
     if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {

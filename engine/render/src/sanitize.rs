@@ -10,7 +10,7 @@ use glam::{Vec3, Vec4};
 pub const RADIANCE_MAX: f32 = 1e30;
 
 /// The most one pass writes to an RGBA16F HDR channel (`HDR_PASS_MAX` in
-/// `shaders/include/lighting.glsl`): seven additive passes stay below the
+/// `shaders/include/hdr.glsl`): seven additive passes stay below the
 /// format's 65504.
 pub const HDR_PASS_MAX: f32 = 8192.0;
 

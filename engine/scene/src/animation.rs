@@ -138,13 +138,9 @@ mod tests {
         }
     }
 
-    #[test]
-    fn swivel_and_sun_motion() {
-        let spot = swivelling_spot();
-        assert!(spot_direction_at(&spot, 0.0).distance(Vec3::NEG_Y) < 1e-6);
-        assert!(spot_direction_at(&spot, 2.0).distance(Vec3::X) < 1e-6);
-        assert!(spot_direction_at(&spot, 4.0).distance(Vec3::NEG_Y) < 1e-6);
-        let sun = SunLight {
+    /// A sun along +X turning about +Y at 90 degrees a second.
+    fn turning_sun() -> SunLight {
+        SunLight {
             direction: Vec3::X,
             color: Vec3::ONE,
             ambient: Vec3::ZERO,
@@ -152,7 +148,16 @@ mod tests {
                 axis: Vec3::Y,
                 degrees_per_second: 90.0,
             }),
-        };
+        }
+    }
+
+    #[test]
+    fn swivel_and_sun_motion() {
+        let spot = swivelling_spot();
+        assert!(spot_direction_at(&spot, 0.0).distance(Vec3::NEG_Y) < 1e-6);
+        assert!(spot_direction_at(&spot, 2.0).distance(Vec3::X) < 1e-6);
+        assert!(spot_direction_at(&spot, 4.0).distance(Vec3::NEG_Y) < 1e-6);
+        let sun = turning_sun();
         assert!(sun_direction_at(&sun, 1.0).distance(Vec3::NEG_Z) < 1e-6);
     }
 
@@ -175,15 +180,7 @@ mod tests {
             );
         }
         let spot = swivelling_spot();
-        let sun = SunLight {
-            direction: Vec3::X,
-            color: Vec3::ONE,
-            ambient: Vec3::ZERO,
-            motion: Some(SunMotion {
-                axis: Vec3::Y,
-                degrees_per_second: 90.0,
-            }),
-        };
+        let sun = turning_sun();
         for t in [1e9f32, -8.0] {
             assert!(
                 spot_direction_at(&spot, t).distance(Vec3::NEG_Y) < 1e-5,

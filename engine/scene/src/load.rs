@@ -220,6 +220,7 @@ fn override_glass(model: &mut Model, placement: &Placement) {
     }
 }
 
+/// Replaces unbounded point-light radii (no falloff) by the scene's diagonal, with a warning.
 fn bound_radii(lights: &mut [Light], bounds: &Aabb, path: &Path, diag: &mut Diagnostics) {
     let extent = bounds.diagonal().max(1.0);
     let mut count = 0;

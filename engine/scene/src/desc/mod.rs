@@ -59,11 +59,7 @@ pub struct SceneDesc {
 
 /// Reads a `.scene` file and its includes.
 pub fn read_scene_desc(path: &Path, diag: &mut Diagnostics) -> Result<SceneDesc, SceneError> {
-    let text = read_text(path, &Location::file(path), MAX_SCENE_BYTES)?;
-    let mut desc = SceneDesc {
-        origin: origin_of(&text, path),
-        ..SceneDesc::default()
-    };
+    let mut desc = SceneDesc::default();
     let mut stack = Vec::new();
     read_into(path, &Location::file(path), &mut desc, &mut stack, diag)?;
     Ok(desc)
@@ -75,10 +71,7 @@ pub fn scene_desc_from_str(
     path: &Path,
     diag: &mut Diagnostics,
 ) -> Result<SceneDesc, SceneError> {
-    let mut desc = SceneDesc {
-        origin: origin_of(text, path),
-        ..SceneDesc::default()
-    };
+    let mut desc = SceneDesc::default();
     let mut stack = vec![path.to_path_buf()];
     interpret(text, path, &mut desc, &mut stack, diag)?;
     Ok(desc)
@@ -88,19 +81,15 @@ pub fn scene_desc_from_str(
 /// stored as written.
 pub const ORIGIN_GRID: f64 = 1024.0;
 
-/// The world point a scene's positions are stored relative to: the first
-/// camera's `position` (or its first `key`'s) in the top-level file, else the
-/// first `position` of any block there, else zero; rounded to the nearest
+/// The world point a scene's positions are stored relative to, from the
+/// top-level file's `items`: the first camera's `position` (or its first
+/// `key`'s), else the first `position` of any block, else zero; rounded to the nearest
 /// multiple of [`ORIGIN_GRID`], so scenes within 512 units of zero keep
 /// their coordinates. Positions are read in f64 and the origin subtracted
 /// before they become f32, so a scene placed far from zero keeps near its
 /// camera the precision it has near zero (docs/stability.md, "Far from the
 /// origin").
-pub fn origin_of(text: &str, path: &Path) -> DVec3 {
-    let mut scratch = Diagnostics::default();
-    let Ok(items) = parse(text, path, &mut scratch) else {
-        return DVec3::ZERO;
-    };
+pub(crate) fn origin_of(items: &[Item]) -> DVec3 {
     let point = |values: &[Value]| match values {
         [Value::Num(x), Value::Num(y), Value::Num(z), ..] => Some(DVec3::new(*x, *y, *z)),
         _ => None,
@@ -155,7 +144,8 @@ fn read_into(
     result
 }
 
-/// Interprets the text of one file.
+/// Interprets the text of one file; the top-level one (the only file on
+/// `stack`) also sets the scene's origin before any position is read.
 fn interpret(
     text: &str,
     path: &Path,
@@ -163,7 +153,11 @@ fn interpret(
     stack: &mut Vec<PathBuf>,
     diag: &mut Diagnostics,
 ) -> Result<(), SceneError> {
-    for item in parse(text, path, diag)? {
+    let items = parse(text, path, diag)?;
+    if stack.len() == 1 {
+        desc.origin = origin_of(&items);
+    }
+    for item in items {
         match item {
             Item::Include { path: name, line } => {
                 let target = resolve(path, &name);
