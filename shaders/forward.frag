@@ -8,6 +8,16 @@
 layout(set = 0, binding = 0) uniform sampler2DShadow shadow_map;
 #endif
 #include "include/lighting.glsl"
+#ifdef HAS_VIEW_OVERSHADING
+// Debug view `overshading` (graphs/debug_views.ron): every invocation adds one
+// to its pixel. Storage writes
+// would otherwise turn early depth tests off; the pass's real depth state
+// and early tests stay as they are without the view.
+layout(early_fragment_tests) in;
+layout(set = 0, binding = 6, r32ui) uniform uimage2D view_overshading;
+layout(std430, set = 0, binding = 7) buffer ViewOvershadingTotals { uint words[4]; } view_overshading_totals;
+#include "include/view_counts.glsl"
+#endif
 
 layout(push_constant) uniform Params {
     float emissive_boost;  // graph parameter: scales material emission
@@ -31,6 +41,9 @@ layout(location = 4) in vec4 world_tangent;
 layout(location = 0) out vec4 color;
 
 void main() {
+#ifdef HAS_VIEW_OVERSHADING
+    COUNT_INVOCATION(view_overshading, view_overshading_totals.words[0]);
+#endif
     vec3 n = normalize(world_normal);
     vec4 texel = texture(base_color, texcoord);
     Material m = materials[material];

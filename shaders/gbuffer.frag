@@ -3,6 +3,16 @@
 // include/gbuffer.glsl (12 bytes per pixel plus depth; 16 when the scene has
 // emissive or occlusion textures, whose samples go to gbuffer_emission).
 #include "include/gbuffer.glsl"
+#ifdef HAS_VIEW_OVERSHADING
+// Debug view `overshading` (graphs/debug_views.ron): every invocation adds one
+// to its pixel. Storage writes
+// would otherwise turn early depth tests off; the pass's real depth state
+// and early tests stay as they are without the view.
+layout(early_fragment_tests) in;
+layout(set = 0, binding = 6, r32ui) uniform uimage2D view_overshading;
+layout(std430, set = 0, binding = 7) buffer ViewOvershadingTotals { uint words[4]; } view_overshading_totals;
+#include "include/view_counts.glsl"
+#endif
 
 layout(set = 2, binding = 0) uniform sampler2D base_color;
 layout(set = 2, binding = 1) uniform sampler2D metallic_roughness;
@@ -28,6 +38,9 @@ layout(location = 3) out vec4 emission_out;
 #endif
 
 void main() {
+#ifdef HAS_VIEW_OVERSHADING
+    COUNT_INVOCATION(view_overshading, view_overshading_totals.words[0]);
+#endif
     vec3 n = normalize(world_normal);
     albedo = vec4(texture(base_color, texcoord).rgb, 1.0);
     Material m = materials[material];

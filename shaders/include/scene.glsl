@@ -50,7 +50,7 @@ struct Material {
 struct Draw {
     mat4 model;
     mat4 normal;     // inverse transpose of model
-    uvec4 material;  // x: index into materials
+    uvec4 material;  // x: index into materials; y: first index, z: vertex offset (mesh_data.glsl)
     vec4 uv_box;     // the mesh's UVs: xy smallest, zw size (vertex UVs are fractions of it)
 };
 

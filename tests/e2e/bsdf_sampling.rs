@@ -151,7 +151,7 @@ fn run(case: &Case) -> (Vec<f32>, Vec<f32>) {
     assert_eq!(log.messages(), Vec::new());
     let floats = |pixels: &Pixels| match pixels {
         Pixels::RgbaF32(v) => v.clone(),
-        Pixels::Rgba8(_) => panic!("float images"),
+        _ => panic!("RGBA float images"),
     };
     let samples = floats(&rendered.report.output.expect("samples").pixels);
     let density = floats(&rendered.report.readbacks[0].1.pixels);

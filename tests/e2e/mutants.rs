@@ -288,6 +288,7 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
                 "shadows.ron",
                 "bloom.ron",
                 "gbuffer.ron",
+                "debug_views.ron",
                 "bench/mesh_floor.ron",
                 "bench/gbuffer_floor.ron",
             ] {

@@ -64,7 +64,7 @@ fn traced_pixels_match_the_cpu(scene: &std::path::Path, textured: bool) {
             .1;
         match &readback.pixels {
             Pixels::RgbaF32(texels) => texels,
-            Pixels::Rgba8(_) => panic!("{name} is a float image"),
+            _ => panic!("{name} is an RGBA float image"),
         }
     };
     let (surfaces, rays) = (image("surface"), image("ray"));

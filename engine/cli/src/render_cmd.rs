@@ -345,6 +345,11 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             "record_ms": record_ms,
             "frame_ms": frame_ms,
             "timings": timings,
+            "statistics": rendered.report.statistics,
+            "views": weft_render::view_summary::plan_views(&rendered.plan, &rendered.report.readbacks)
+                .into_iter()
+                .map(|(name, summary)| (name, serde_json::json!(summary)))
+                .collect::<serde_json::Map<String, serde_json::Value>>(),
             "transient_bytes": rendered.report.transient_bytes,
             "device_memory_bytes": rendered.report.memory.allocated_bytes,
             "validation": {

@@ -37,6 +37,13 @@ pub struct DeviceInfo {
     pub pipeline_statistics: bool,
     /// Whether pipelines may clamp depth instead of clipping (`depthClamp`, enabled when offered).
     pub depth_clamp: bool,
+    /// Whether fragment shaders may write storage images and buffers and use
+    /// atomics (`fragmentStoresAndAtomics`, enabled when offered): debug views
+    /// count invocations this way.
+    pub fragment_stores: bool,
+    /// Whether fragment shaders may read `gl_PrimitiveID` (`geometryShader`,
+    /// enabled when offered, for that alone): the mesh-density view.
+    pub primitive_id: bool,
     /// The largest width or height of a 2D image (`maxImageDimension2D`):
     /// plans with a larger image are refused before any is created.
     pub max_image_dimension: u32,
@@ -523,6 +530,8 @@ fn choose_device(
             timestamps: props_family.timestamp_valid_bits > 0,
             pipeline_statistics: f2.pipeline_statistics_query == vk::TRUE,
             depth_clamp: f2.depth_clamp == vk::TRUE,
+            fragment_stores: f2.fragment_stores_and_atomics == vk::TRUE,
+            primitive_id: f2.geometry_shader == vk::TRUE,
             max_image_dimension: props.limits.max_image_dimension2_d,
         };
         candidates.push((physical, info, family as u32));
@@ -557,7 +566,9 @@ fn create_device(
         .maintenance4(true);
     let core = vk::PhysicalDeviceFeatures::default()
         .pipeline_statistics_query(info.pipeline_statistics)
-        .depth_clamp(info.depth_clamp);
+        .depth_clamp(info.depth_clamp)
+        .fragment_stores_and_atomics(info.fragment_stores)
+        .geometry_shader(info.primitive_id);
     let mut features = vk::PhysicalDeviceFeatures2::default()
         .features(core)
         .push_next(&mut f13);

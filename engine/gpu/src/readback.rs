@@ -10,6 +10,33 @@ pub enum Pixels {
     Rgba8(Vec<u8>),
     /// Linear floats (from 16- or 32-bit float formats).
     RgbaF32(Vec<f32>),
+    /// One unsigned integer per pixel (`R32_UINT`: counts).
+    CountU32(Vec<u32>),
+    /// One float per pixel (`R32_SFLOAT`: measures).
+    ValueF32(Vec<f32>),
+}
+
+impl Pixels {
+    /// One value per pixel, as f64, for single-channel images (counts and
+    /// measures); `None` for colour images.
+    pub fn values(&self) -> Option<Vec<f64>> {
+        match self {
+            Pixels::CountU32(v) => Some(v.iter().map(|&c| f64::from(c)).collect()),
+            Pixels::ValueF32(v) => Some(v.iter().map(|&c| f64::from(c)).collect()),
+            Pixels::Rgba8(_) | Pixels::RgbaF32(_) => None,
+        }
+    }
+
+    /// RGBA floats, a single channel replicated into red, green and blue.
+    fn rgba_f32(&self) -> Option<Vec<f32>> {
+        let grey = |v: f32| [v, v, v, 1.0];
+        match self {
+            Pixels::RgbaF32(v) => Some(v.clone()),
+            Pixels::CountU32(v) => Some(v.iter().flat_map(|&c| grey(c as f32)).collect()),
+            Pixels::ValueF32(v) => Some(v.iter().flat_map(|&c| grey(c)).collect()),
+            Pixels::Rgba8(_) => None,
+        }
+    }
 }
 
 /// An image read back from the device.
@@ -50,6 +77,7 @@ pub fn texel_bytes(format: &str) -> Option<u32> {
         "R8G8B8A8_UNORM" | "R8G8B8A8_SRGB" | "B8G8R8A8_UNORM" | "B8G8R8A8_SRGB" => Some(4),
         "R16G16B16A16_SFLOAT" => Some(8),
         "R32G32B32A32_SFLOAT" => Some(16),
+        "R32_UINT" | "R32_SFLOAT" => Some(4),
         _ => None,
     }
 }
@@ -71,6 +99,18 @@ pub fn decode(format: &str, bytes: &[u8]) -> Result<Pixels, ReadbackError> {
                 .collect(),
         )),
         "R32G32B32A32_SFLOAT" => Ok(Pixels::RgbaF32(
+            bytes
+                .chunks_exact(4)
+                .map(|f| f32::from_le_bytes([f[0], f[1], f[2], f[3]]))
+                .collect(),
+        )),
+        "R32_UINT" => Ok(Pixels::CountU32(
+            bytes
+                .chunks_exact(4)
+                .map(|f| u32::from_le_bytes([f[0], f[1], f[2], f[3]]))
+                .collect(),
+        )),
+        "R32_SFLOAT" => Ok(Pixels::ValueF32(
             bytes
                 .chunks_exact(4)
                 .map(|f| f32::from_le_bytes([f[0], f[1], f[2], f[3]]))
@@ -105,12 +145,13 @@ pub fn srgb_to_linear(x: f32) -> f32 {
 impl Readback {
     /// 8-bit RGBA: stored bytes, or floats clamped to [0, 1] and rounded.
     pub fn to_rgba8(&self) -> image::RgbaImage {
-        let data = match &self.pixels {
-            Pixels::Rgba8(v) => v.clone(),
-            Pixels::RgbaF32(v) => v
+        let data = match (&self.pixels, self.pixels.rgba_f32()) {
+            (Pixels::Rgba8(v), _) => v.clone(),
+            (_, Some(v)) => v
                 .iter()
                 .map(|&f| (f.clamp(0.0, 1.0) * 255.0).round() as u8)
                 .collect(),
+            (_, None) => Vec::new(),
         };
         image::RgbaImage::from_raw(self.width, self.height, data)
             .unwrap_or_else(|| image::RgbaImage::new(self.width, self.height))
@@ -126,7 +167,9 @@ impl Readback {
     pub fn to_rgba_f32(&self) -> image::Rgba32FImage {
         let srgb = self.format.ends_with("_SRGB");
         let data = match &self.pixels {
-            Pixels::RgbaF32(v) => v.clone(),
+            Pixels::RgbaF32(_) | Pixels::CountU32(_) | Pixels::ValueF32(_) => {
+                self.pixels.rgba_f32().unwrap_or_default()
+            }
             Pixels::Rgba8(v) => v
                 .iter()
                 .enumerate()

@@ -154,7 +154,8 @@ impl ShaderInterface {
             path: shader.path.clone(),
             message,
         };
-        let entry = reflect_main(shader, false)?;
+        let mut entry = reflect_main(shader, false)?;
+        entry.vars.extend(atomic_images(shader, &entry.vars)?);
         let mut bindings = Vec::new();
         let mut push = None;
         let mut outputs = Vec::new();
@@ -254,6 +255,60 @@ fn is_depth_sampler(ty: &Type) -> bool {
         Type::CombinedImageSampler(t) => t.sampled_image_ty.is_depth == Some(true),
         _ => false,
     }
+}
+
+/// Storage images the code uses only through image atomics
+/// (`OpImageTexelPointer`), which spirq's static-use analysis does not see:
+/// their descriptors from the reflection of every resource, less those in
+/// `used` already.
+fn atomic_images(shader: &CompiledShader, used: &[Variable]) -> Result<Vec<Variable>, ShaderError> {
+    let atomics = texel_pointer_bindings(&shader.spirv);
+    if atomics.is_empty() {
+        return Ok(Vec::new());
+    }
+    let bound = |v: &Variable| match v {
+        Variable::Descriptor { desc_bind, .. } => Some((desc_bind.set(), desc_bind.bind())),
+        _ => None,
+    };
+    let seen: Vec<(u32, u32)> = used.iter().filter_map(bound).collect();
+    Ok(reflect_main(shader, true)?
+        .vars
+        .into_iter()
+        .filter(|v| bound(v).is_some_and(|b| atomics.contains(&b) && !seen.contains(&b)))
+        .collect())
+}
+
+/// (set, binding) of every variable an `OpImageTexelPointer` points into.
+fn texel_pointer_bindings(words: &[u32]) -> Vec<(u32, u32)> {
+    const OP_DECORATE: u32 = 71;
+    const OP_IMAGE_TEXEL_POINTER: u32 = 60;
+    const DECORATION_BINDING: u32 = 33;
+    const DECORATION_DESCRIPTOR_SET: u32 = 34;
+    let mut sets = std::collections::HashMap::new();
+    let mut bindings = std::collections::HashMap::new();
+    let mut images = Vec::new();
+    // Instructions start after the five-word header; each gives its word count.
+    let mut at = 5;
+    while at < words.len() {
+        let count = (words[at] >> 16) as usize;
+        let opcode = words[at] & 0xffff;
+        let operands = &words[(at + 1).min(words.len())..(at + count.max(1)).min(words.len())];
+        match (opcode, operands) {
+            (OP_DECORATE, [target, DECORATION_DESCRIPTOR_SET, value, ..]) => {
+                sets.insert(*target, *value);
+            }
+            (OP_DECORATE, [target, DECORATION_BINDING, value, ..]) => {
+                bindings.insert(*target, *value);
+            }
+            (OP_IMAGE_TEXEL_POINTER, [_, _, image, ..]) => images.push(*image),
+            _ => {}
+        }
+        at += count.max(1);
+    }
+    images
+        .iter()
+        .filter_map(|id| Some((*sets.get(id)?, *bindings.get(id)?)))
+        .collect()
 }
 
 /// The `main` entry point, with only the resources its code uses or with all.

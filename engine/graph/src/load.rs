@@ -43,6 +43,8 @@ pub struct LoadedGraph {
     pub readback: Vec<crate::schema::ReadDecl>,
     /// How the graph accumulates over frames, from the root file.
     pub progressive: Option<crate::schema::Progressive>,
+    /// Summarised views from the graph and its fragments, with their source.
+    pub views: Vec<(usize, crate::schema::ViewDecl)>,
     /// Human-readable name.
     pub name: String,
     /// Toggles declared on by default by the graph and its fragments.
@@ -252,6 +254,9 @@ fn load_file(
         );
     }
 
+    graph
+        .views
+        .extend(parsed.views.iter().map(|v| (source, v.clone())));
     for feature in &parsed.features {
         if !graph.default_features.contains(feature) {
             graph.default_features.push(feature.clone());

@@ -42,6 +42,17 @@ impl std::str::FromStr for Extent {
     }
 }
 
+/// A summarised view in a plan (see [`crate::schema::GraphFile::views`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct PlanView {
+    /// The summary's key.
+    pub name: String,
+    /// The image summarised; also in [`Plan::readback`].
+    pub image: ResourceId,
+    /// `share_above` counts pixels above this value.
+    pub threshold: f64,
+}
+
 /// A compiled graph, ready to execute for one output size and feature set.
 #[derive(Debug, Clone, Serialize)]
 pub struct Plan {
@@ -65,6 +76,8 @@ pub struct Plan {
     /// For a progressive graph (`progressive` in the file), the samples per
     /// pixel each frame adds to its history.
     pub samples_per_frame: Option<u32>,
+    /// The views whose features hold: images read back and summarised per pixel.
+    pub views: Vec<PlanView>,
     /// Where transient images live.
     pub memory: MemoryPlan,
     /// Barriers after the last pass: the output to `TRANSFER_SRC_OPTIMAL` for presenting or

@@ -48,6 +48,27 @@ pub struct GraphFile {
     /// so tools can render to a sample count and the viewer can show it.
     #[serde(default)]
     pub progressive: Option<Progressive>,
+    /// Per-pixel counts or measures that tools summarise (`weft render
+    /// --json` prints a `views` object: mean, median, p95, max, histogram,
+    /// share above a threshold). Fragments may declare them; each is read
+    /// back when its features hold.
+    #[serde(default)]
+    pub views: Vec<ViewDecl>,
+}
+
+/// A debug view's summarised image (see [`GraphFile::views`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ViewDecl {
+    /// The key in the `views` summary (the feature that turns the view on, by convention).
+    pub name: String,
+    /// A single-channel image (`R32_UINT` counts or `R32_SFLOAT` measures).
+    pub image: String,
+    /// `share_above` is the share of covered pixels whose value exceeds this.
+    pub threshold: f64,
+    /// Features that must hold for the view to be summarised.
+    #[serde(default)]
+    pub enabled_if: Vec<String>,
 }
 
 /// How a progressive graph accumulates (see [`GraphFile::progressive`]).

@@ -217,7 +217,12 @@ impl SceneGeometry {
                 g.draw_records.push(GpuDraw {
                     model: instance.transform,
                     normal,
-                    material: UVec4::new(material, 0, 0, 0),
+                    material: UVec4::new(
+                        material,
+                        range.first_index,
+                        range.vertex_offset as u32,
+                        0,
+                    ),
                     uv_box,
                 });
                 g.draws.push(DrawItem {

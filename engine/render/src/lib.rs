@@ -45,6 +45,7 @@ pub mod sources;
 pub mod state;
 pub mod texture;
 pub mod trace_textures;
+pub mod view_summary;
 pub mod volumes;
 pub mod watch;
 

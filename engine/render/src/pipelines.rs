@@ -35,9 +35,6 @@ pub struct ScenePipelineKey {
     pub render_pass: vk::RenderPass,
     /// Depth, culling, blending and bias.
     pub state: PassState,
-    /// Whether the vertex shader reads only the position (location 0): depth-only
-    /// passes and light volumes; mesh shading reads normal and UV too.
-    pub position_only: bool,
 }
 
 /// A built scene pipeline.
@@ -274,11 +271,12 @@ fn create_pipeline(
         },
         offset: a.offset,
     });
-    let attributes = if key.position_only {
-        &all[..1]
-    } else {
-        &all[..]
-    };
+    // The attributes the vertex shader reads (a subset of the vertex, which
+    // the shader check guarantees): unread ones would only draw warnings.
+    let attributes: Vec<vk::VertexInputAttributeDescription> = all
+        .into_iter()
+        .filter(|a| vs.interface.inputs.iter().any(|i| i.location == a.location))
+        .collect();
     let state = &key.state;
     // Every projection flips Y for Vulkan's downward framebuffer Y, which keeps
     // counter-clockwise model triangles counter-clockwise in Vulkan's convention;
@@ -287,7 +285,7 @@ fn create_pipeline(
     let graphics = GraphicsState {
         vertex_input: Some(VertexInput {
             stride: VERTEX_BYTES,
-            attributes,
+            attributes: &attributes,
         }),
         cull: match state.cull {
             CullMode::None => vk::CullModeFlags::NONE,

@@ -342,6 +342,7 @@ mod tests {
             output: weft_graph::id::ResourceId::new(0),
             readback: Vec::new(),
             samples_per_frame: None,
+            views: Vec::new(),
             memory: Default::default(),
             epilogue: Vec::new(),
             warnings: Vec::new(),

@@ -8,7 +8,7 @@ use crate::geometry::DrawItem;
 use crate::pipelines::{front_face, ScenePipeline, ScenePipelineKey, ScenePipelines, MATERIAL_SET};
 use crate::providers::{self, SHADOW_VIEW};
 use crate::scene_gpu::GpuScene;
-use crate::scene_interface::{position_only, scene_set_problems};
+use crate::scene_interface::scene_set_problems;
 use crate::shadows::ShadowSettings;
 use crate::state::{pass_state, DepthTest, PassState};
 use ash::vk;
@@ -527,7 +527,6 @@ impl DrawRecorder for SceneRecorder<'_> {
                 .map(|f| shader(f, ShaderStage::Fragment)),
             render_pass: ctx.render_pass,
             state: pass_state(pass),
-            position_only: position_only(pass),
         };
         let layouts = [
             self.scene.scene_layout.handle(),

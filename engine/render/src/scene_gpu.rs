@@ -68,6 +68,11 @@ pub const TRIANGLE_TANGENTS_BINDING: u32 = 19;
 /// Binding of the LTC tables analytic area lights read (`LtcTables` in
 /// `shaders/include/ltc.glsl`, [`ltc_table_words`]).
 pub const LTC_TABLES_BINDING: u32 = 20;
+/// Binding of the vertex buffer as 32-bit words (`Vertices` in
+/// `shaders/include/mesh_data.glsl`), for shaders that fetch whole triangles.
+pub const VERTICES_BINDING: u32 = 21;
+/// Binding of the index buffer (`Indices` in `shaders/include/mesh_data.glsl`).
+pub const INDICES_BINDING: u32 = 22;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -80,7 +85,7 @@ pub const EMISSIVE_BINDING: u32 = 3;
 pub const OCCLUSION_BINDING: u32 = 4;
 /// Set 1 as the engine creates and writes it: binding, descriptor kind and
 /// what it holds (for the shader check's messages).
-pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 6] = [
+pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 8] = [
     (
         FRAME_BINDING,
         DescriptorKind::UniformBuffer,
@@ -106,6 +111,16 @@ pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 6] = [
         LTC_TABLES_BINDING,
         DescriptorKind::StorageBuffer,
         "the area-light LTC tables",
+    ),
+    (
+        VERTICES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the vertices",
+    ),
+    (
+        INDICES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the indices",
     ),
 ];
 
@@ -373,7 +388,7 @@ impl<'g> GpuScene<'g> {
             gpu,
             "scene vertices",
             bytes_of(&geometry.vertices),
-            vk::BufferUsageFlags::VERTEX_BUFFER,
+            vk::BufferUsageFlags::VERTEX_BUFFER | storage,
         )?;
         let index_bytes: Vec<u8> = geometry
             .indices
@@ -384,7 +399,7 @@ impl<'g> GpuScene<'g> {
             gpu,
             "scene indices",
             &index_bytes,
-            vk::BufferUsageFlags::INDEX_BUFFER,
+            vk::BufferUsageFlags::INDEX_BUFFER | storage,
         )?;
         let draws = Buffer::device_local(
             gpu,
@@ -504,6 +519,8 @@ impl<'g> GpuScene<'g> {
                 MATERIALS_BINDING,
                 SHADOWS_BINDING,
                 LTC_TABLES_BINDING,
+                VERTICES_BINDING,
+                INDICES_BINDING,
             ],
         );
         for slots in material_texture {
@@ -645,6 +662,8 @@ impl<'g> GpuScene<'g> {
             MATERIALS_BINDING => Some(&self.materials),
             SHADOWS_BINDING => Some(&self.shadows),
             LTC_TABLES_BINDING => Some(&self.ltc_tables),
+            VERTICES_BINDING => Some(&self.vertices),
+            INDICES_BINDING => Some(&self.indices),
             TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.triangles),
             BVH_NODES_BINDING => self.trace.as_ref().map(|t| &t.nodes),
             BVH_TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.order),

@@ -16,8 +16,8 @@ pub(crate) mod sync;
 use crate::diagnostic::Diagnostic;
 use crate::id::IrPassId;
 use crate::load::LoadedGraph;
-use crate::plan::{Extent, ImageDesc, Plan};
-use crate::resolve::{resolve, Ir};
+use crate::plan::{Extent, ImageDesc, Plan, PlanView};
+use crate::resolve::{resolve, Ir, IrView};
 use crate::spans::{Pos, Seg};
 use memory::MemoryRequirements;
 use std::collections::BTreeSet;
@@ -190,7 +190,18 @@ pub fn compile_ir(
         )]);
     };
     let ordered = order::order_live(graph, ir, &options.features)?;
-    let readback = readback_for(graph, &options.readback, &options.features);
+    let active_views: Vec<&IrView> = ir
+        .views
+        .iter()
+        .filter(|v| conditions_hold(&v.enabled_if, &options.features))
+        .collect();
+    let mut readback = readback_for(graph, &options.readback, &options.features);
+    for view in &active_views {
+        let name = &ir.resources[view.image].name;
+        if !readback.contains(name) {
+            readback.push(name.clone());
+        }
+    }
     let roots = cull::roots(graph, ir, output, &readback, &ordered)?;
     let cull::Culled {
         sequence,
@@ -235,6 +246,14 @@ pub fn compile_ir(
             .map(|&r| lifetimes.plan_index(r))
             .collect(),
         samples_per_frame: ir.samples_per_frame,
+        views: active_views
+            .iter()
+            .map(|v| PlanView {
+                name: v.name.clone(),
+                image: lifetimes.plan_index(v.image),
+                threshold: v.threshold,
+            })
+            .collect(),
         resources,
         passes,
         culled,

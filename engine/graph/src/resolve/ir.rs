@@ -16,6 +16,17 @@ pub struct Ir {
     pub output: Option<IrResourceId>,
     /// Samples per pixel each frame adds, for a progressive graph.
     pub samples_per_frame: Option<u32>,
+    /// Summarised views ([`crate::schema::GraphFile::views`]).
+    pub views: Vec<IrView>,
+}
+
+/// A resolved summarised view.
+#[derive(Debug, Clone)]
+pub struct IrView {
+    pub name: String,
+    pub image: IrResourceId,
+    pub threshold: f64,
+    pub enabled_if: Vec<String>,
 }
 
 /// A resolved resource.
@@ -119,9 +130,12 @@ impl IrPass {
     }
 }
 
-/// Most shader variants a pass may have: 2^12 = 4,096 define sets (the
-/// shipped forward pass switches 10 defines).
-pub const MAX_VARIANT_BITS: u32 = 12;
+/// Most shader variants a pass may have: 2^13 = 8,192 define sets. The
+/// shipped forward pass is decided by 13 features (11 scene features, shadow
+/// casters and the overshading view). Variants are compiled on demand, only
+/// for the feature sets a scene selects, so the cap bounds the key space of a
+/// pass, not the work done.
+pub const MAX_VARIANT_BITS: u32 = 13;
 
 /// 2^`bits`, the variants `bits` features can select, saturating past 2^63.
 pub fn variant_count(bits: u32) -> u64 {

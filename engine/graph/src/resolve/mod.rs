@@ -28,6 +28,9 @@ type SizeAtProbe = Option<(Extent, u32)>;
 
 /// Output sizes at which attachment sizes are compared, so that sizes which only
 /// coincide at one output size are still reported.
+/// The formats a summarised view may read: counts and measures, one channel.
+pub const VIEW_FORMATS: [&str; 2] = ["R32_UINT", "R32_SFLOAT"];
+
 const PROBE_SIZES: [Extent; 3] = [
     Extent {
         width: 1920,
@@ -156,11 +159,13 @@ impl<'a> Resolver<'a> {
         let output = self.resolve_output(&resources);
         self.check_readback(&resources);
         let samples_per_frame = self.resolve_progressive();
+        let views = self.resolve_views(&resources);
         let ir = Ir {
             resources,
             passes,
             output,
             samples_per_frame,
+            views,
         };
         self.check_usages(&ir);
         self.check_extents(&ir);
@@ -202,6 +207,83 @@ impl<'a> Resolver<'a> {
             "samples_per_frame",
             MAX_SAMPLES_PER_FRAME,
         ))
+    }
+
+    /// Each view names a single-channel `R32_UINT` or `R32_SFLOAT` image the
+    /// summary can read, under a name no other view takes.
+    fn resolve_views(&mut self, resources: &IdVec<IrResourceId, IrResource>) -> Vec<IrView> {
+        let mut views: Vec<IrView> = Vec::new();
+        for (k, (source, decl)) in self.graph.views.iter().enumerate() {
+            let index = self.graph.views[..k]
+                .iter()
+                .filter(|(s, _)| s == source)
+                .count();
+            let path = |field| [Seg::Field("views"), Seg::Index(index), Seg::Field(field)];
+            if views.iter().any(|v| v.name == decl.name) {
+                self.error(
+                    *source,
+                    &path("name"),
+                    format!("view \"{}\" is declared twice", decl.name),
+                );
+                continue;
+            }
+            if !decl.threshold.is_finite() {
+                self.error(
+                    *source,
+                    &path("threshold"),
+                    format!(
+                        "threshold must be a finite number, found {}",
+                        decl.threshold
+                    ),
+                );
+                continue;
+            }
+            let Some(&image) = self.resource_index.get(decl.image.as_str()) else {
+                let names = self.resource_names();
+                self.error(
+                    *source,
+                    &path("image"),
+                    format!("unknown resource \"{}\"", decl.image),
+                )
+                .hint = crate::diagnostic::nearest(&decl.image, names)
+                    .map(|n| format!("did you mean \"{n}\"?"));
+                continue;
+            };
+            match &resources[image].kind {
+                IrKind::Image { format, .. } if VIEW_FORMATS.contains(&format.name) => {
+                    views.push(IrView {
+                        name: decl.name.clone(),
+                        image,
+                        threshold: decl.threshold,
+                        enabled_if: decl.enabled_if.clone(),
+                    });
+                }
+                IrKind::Image { format, .. } => {
+                    self.error(
+                        *source,
+                        &path("image"),
+                        format!(
+                            "view \"{}\" reads image \"{}\" of format {}; views summarise {}",
+                            decl.name,
+                            decl.image,
+                            format.name,
+                            VIEW_FORMATS.join(" or ")
+                        ),
+                    );
+                }
+                _ => {
+                    self.error(
+                        *source,
+                        &path("image"),
+                        format!(
+                            "view \"{}\" names \"{}\", which is not an image",
+                            decl.name, decl.image
+                        ),
+                    );
+                }
+            }
+        }
+        views
     }
 
     /// Every name in the graph's `readback` list is one of its images.

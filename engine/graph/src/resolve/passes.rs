@@ -150,6 +150,9 @@ impl Resolver<'_> {
         for (i, name) in decl.after.iter().enumerate() {
             match self.pass_index.get(name.as_str()) {
                 Some(&target) => after.push(target),
+                // A fragment checked alone may order itself after its
+                // includer's passes, as it may read its includer's resources.
+                None if self.graph.is_fragment => {}
                 None => {
                     let names: Vec<&str> = self
                         .graph
