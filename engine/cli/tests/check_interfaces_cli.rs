@@ -103,7 +103,7 @@ fn a_scene_binding_the_engine_does_not_write_is_refused_at_check_and_at_render()
             .expect("the forward pass");
     let glsl_line = line_of(&copy.0.join("shaders/include/scene.glsl"), "binding = 29");
     let expected = format!(
-        "graphs/forward.ron:{pass_line}:19: error: pass \"forward\": shader binding `Materials` (set 1 binding 29) is not scene data the engine binds; set 1 has 0: the Frame block, 1: the lights, 2: the draw records, 3: the materials, 4: the shadow views, 20: the area-light LTC tables (declared at graphs/../shaders/include/scene.glsl:{glsl_line})"
+        "graphs/forward.ron:{pass_line}:19: error: pass \"forward\": shader binding `Materials` (set 1 binding 29) is not scene data the engine binds; set 1 has 0: the Frame block, 1: the lights, 2: the draw records, 3: the materials, 4: the shadow views, 20: the area-light LTC tables, 21: the vertices, 22: the indices (declared at graphs/../shaders/include/scene.glsl:{glsl_line})"
     );
     assert!(err.lines().any(|l| l == expected), "{expected}\n{err}");
     // `weft render` refuses it too, located at the pass, instead of a draw
@@ -158,7 +158,7 @@ fn scene_pass_shaders_are_compiled_and_their_interfaces_compared() {
     assert_refused(
         "forward.ron",
         &[("shaders/forward.frag", "layout(location = 2) in vec2 texcoord;", "layout(location = 5) in vec2 texcoord;")],
-        "pass \"forward\": fragment input `texcoord` at location 5 is not written by the vertex shader (declared at graphs/../shaders/forward.frag:27)",
+        "pass \"forward\": fragment input `texcoord` at location 5 is not written by the vertex shader (declared at graphs/../shaders/forward.frag:37)",
     );
     assert_refused(
         "forward.ron",

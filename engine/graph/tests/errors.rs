@@ -461,7 +461,7 @@ const COMPUTE: &str = r#"Graph(
 /// gives them: each case is (base graph, edit, message, text at the location).
 #[test]
 fn out_of_range_values_are_located_errors() {
-    let cases: [(&str, (&str, &str), &str, &str); 20] = [
+    let cases: [(&str, (&str, &str), &str, &str); 22] = [
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([2.0])"#),
             "a depth clear must be in [0, 1], found 2", "Clear([2.0])"),
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([NaN])"#),
