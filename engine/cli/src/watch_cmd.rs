@@ -146,6 +146,9 @@ fn reload(
 fn write_frame(live: &mut LiveRender<'_>, out: &Path, image: Option<&str>) -> Result<f64> {
     let started = Instant::now();
     let report = live.frame()?;
+    if let Some(error) = live.take_script_error() {
+        eprintln!("error: {error} (the lights of the last good step kept)");
+    }
     let frame_ms = started.elapsed().as_secs_f64() * 1e3;
     let picked = image
         .and_then(|name| report.readbacks.iter().find(|(n, _)| n == name))

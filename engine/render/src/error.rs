@@ -47,6 +47,9 @@ pub enum RenderError {
     /// The scene has more of something than the GPU layouts can index.
     #[error("scene too large: {0}")]
     TooLarge(String),
+    /// The scene's script failed (at load or in `update`), located in the script.
+    #[error(transparent)]
+    Script(#[from] weft_scene::SceneError),
     /// The plan has an image larger than the device can create.
     #[error("image `{image}` would be {}x{}; {device} allows at most {max} texels per side (maxImageDimension2D): render smaller or lower the graph parameter that sizes it", size[0], size[1])]
     ImageTooLarge {
@@ -75,6 +78,7 @@ impl RenderError {
                 vec![Diagnostic::error(&at.file, at.pos, error.to_string())]
             }
             Self::Texture { path, message } => vec![Diagnostic::in_file(path, None, message)],
+            Self::Script(error) => vec![error.diagnostic()],
             Self::NotProgressive { graph } => vec![Diagnostic::in_file(
                 graph,
                 None,

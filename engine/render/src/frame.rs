@@ -236,6 +236,9 @@ pub fn render_with_progress(
             timing: settings.timing,
             readback: settings.readback && final_frame,
         })?;
+        if let Some(error) = frames.take_script_error() {
+            return Err(RenderError::Script(error));
+        }
         frame_ms.push(started.elapsed().as_secs_f64() * 1e3);
         record_ms.push(report.record_ms);
         timings.push(report.timings.clone());

@@ -114,6 +114,12 @@ impl<'g> FrameLoop<'g> {
             .map_err(|e| RenderError::at_pass(e, &self.plan))
     }
 
+    /// The scene script's error from `update`, if one failed since the last
+    /// call; the frames kept the lights of the last good step.
+    pub fn take_script_error(&mut self) -> Option<weft_scene::SceneError> {
+        self.recorder.scene.take_script_error()
+    }
+
     /// The plan that runs.
     pub fn plan(&self) -> &Arc<Plan> {
         &self.plan

@@ -155,6 +155,12 @@ impl<'g> LiveRender<'g> {
         })
     }
 
+    /// The scene script's error from `update`, if one failed since the last
+    /// call: the frames go on with the lights of the last good step.
+    pub fn take_script_error(&mut self) -> Option<weft_scene::SceneError> {
+        self.frames.take_script_error()
+    }
+
     fn base(&self) -> ReloadBase {
         ReloadBase {
             version: self.version,

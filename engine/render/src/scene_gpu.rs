@@ -349,6 +349,14 @@ pub struct GpuScene<'g> {
     /// Where the BVH is cached (`crate::bvh_cache`); `None` builds it every time.
     bvh_cache: Option<PathBuf>,
     source_lights: Vec<weft_scene::Light>,
+    /// The scene's script, which sets the lights per frame instead of the
+    /// `.scene` motions when it has `fn update`.
+    script: Option<weft_scene::script::ScriptRuntime>,
+    /// The script's last error in `update`; the frame kept the lights of the
+    /// last good step. Taken by [`GpuScene::take_script_error`].
+    script_error: Option<weft_scene::SceneError>,
+    /// The lights of the last frame the script computed.
+    script_lights: Vec<weft_scene::Light>,
     bounds: weft_scene::Aabb,
     /// The camera's view volume at the last update, what sun cascades are fitted to.
     pub view_volume: ViewVolume,
@@ -488,6 +496,18 @@ impl<'g> GpuScene<'g> {
             material_sets: Vec::new(),
             foreign_sets: HashMap::new(),
             source_lights: scene.lights.clone(),
+            script: match &scene.script {
+                Some(script) => Some(weft_scene::script::ScriptRuntime::new(
+                    script,
+                    &scene.path,
+                    &scene.lights,
+                    scene.origin,
+                    &weft_scene::script::Limits::default(),
+                )?),
+                None => None,
+            },
+            script_error: None,
+            script_lights: scene.lights.clone(),
             trace: None,
             bvh_cache: None,
             bounds,
@@ -725,10 +745,7 @@ impl<'g> GpuScene<'g> {
         let (_, rotation) = camera.pose_at(time);
         self.view_volume =
             ViewVolume::new(eye, rotation, camera.fov_y, w / h, camera.near, camera.far);
-        let lights = pack_lights(
-            &weft_scene::animation::lights_at(&self.source_lights, time, 0),
-            &self.bounds,
-        );
+        let lights = pack_lights(&self.lights_at(time), &self.bounds);
         let frame = GpuFrame {
             view_proj,
             inv_view_proj: view_proj.inverse(),
@@ -755,6 +772,27 @@ impl<'g> GpuScene<'g> {
 }
 
 impl GpuScene<'_> {
+    /// The lights at `time`: the script's, when it animates them (the last
+    /// good step's if `update` fails, with the error kept for
+    /// [`GpuScene::take_script_error`]), else the `.scene` motions'.
+    fn lights_at(&mut self, time: f32) -> Vec<weft_scene::Light> {
+        match self.script.as_mut().filter(|s| s.animates()) {
+            Some(script) => {
+                match script.lights_at(f64::from(time)) {
+                    Ok(lights) => self.script_lights = lights,
+                    Err(e) => self.script_error = Some(e),
+                }
+                self.script_lights.clone()
+            }
+            None => weft_scene::animation::lights_at(&self.source_lights, time, 0),
+        }
+    }
+
+    /// The scene script's error from the last frames, if `update` failed.
+    pub fn take_script_error(&mut self) -> Option<weft_scene::SceneError> {
+        self.script_error.take()
+    }
+
     /// Fits this frame's shadow views for a `atlas_size` squared shadow map with
     /// `settings` (after [`GpuScene::update`]) and writes the record the shaders
     /// read; returns the views, to draw one by one. The device must not be

@@ -138,8 +138,13 @@ pub fn scene_path_files(path: &Path) -> BTreeSet<PathBuf> {
     files
 }
 
-/// Adds `path` and, recursively, the files its `include` lines name.
+/// Adds `path` and, recursively, the files its `include` lines name, and
+/// the script a `script` line names. A `.rhai` scene is a file of its own.
 fn scene_includes(path: &Path, depth: usize, files: &mut BTreeSet<PathBuf>) {
+    if path.extension().is_some_and(|e| e == "rhai") {
+        files.insert(normalize(path));
+        return;
+    }
     if !files.insert(normalize(path)) || depth >= MAX_SCENE_INCLUDE_DEPTH {
         return;
     }
@@ -151,7 +156,11 @@ fn scene_includes(path: &Path, depth: usize, files: &mut BTreeSet<PathBuf>) {
     };
     let base = path.parent().unwrap_or(Path::new(""));
     for line in text.lines() {
-        let Some(rest) = line.trim().strip_prefix("include") else {
+        let line = line.trim();
+        let Some(rest) = line
+            .strip_prefix("include")
+            .or_else(|| line.strip_prefix("script"))
+        else {
             continue;
         };
         let name = rest.trim();

@@ -12,6 +12,9 @@ pub struct Location {
     pub file: PathBuf,
     /// The 1-based line, or `None` when the problem concerns the whole file.
     pub line: Option<usize>,
+    /// The 1-based column, where the source gives one (scripts).
+    #[serde(default)]
+    pub column: Option<usize>,
 }
 
 impl Location {
@@ -20,6 +23,7 @@ impl Location {
         Self {
             file: file.to_path_buf(),
             line: Some(line),
+            column: None,
         }
     }
 
@@ -28,15 +32,26 @@ impl Location {
         Self {
             file: file.to_path_buf(),
             line: None,
+            column: None,
+        }
+    }
+
+    /// A location at one line and column of a file.
+    pub fn column(file: &Path, line: usize, column: usize) -> Self {
+        Self {
+            file: file.to_path_buf(),
+            line: Some(line),
+            column: Some(column),
         }
     }
 }
 
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(line) => write!(f, "{}:{}", self.file.display(), line),
-            None => write!(f, "{}", self.file.display()),
+        match (self.line, self.column) {
+            (Some(line), Some(column)) => write!(f, "{}:{line}:{column}", self.file.display()),
+            (Some(line), None) => write!(f, "{}:{line}", self.file.display()),
+            (None, _) => write!(f, "{}", self.file.display()),
         }
     }
 }

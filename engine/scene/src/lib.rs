@@ -42,6 +42,7 @@ mod props;
 pub mod report;
 pub mod rng;
 pub mod scene;
+pub mod script;
 pub mod source;
 mod syntax;
 pub mod tangent_frame;

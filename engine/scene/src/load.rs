@@ -12,6 +12,7 @@ use crate::material::Optics;
 use crate::model::Model;
 use crate::obj::load_obj;
 use crate::scene::{Instance, Scene};
+use crate::script::{Limits, ScriptRef};
 use crate::tangents::generate_model_tangents;
 use glam::Mat4;
 use std::collections::HashMap;
@@ -24,7 +25,8 @@ pub struct LoadOptions {
     pub cache_dir: Option<PathBuf>,
 }
 
-/// Loads a `.scene` file, or an `.obj`, `.gltf` or `.glb` file as a scene with one model.
+/// Loads a `.scene` file, a `.rhai` scene script, or an `.obj`, `.gltf` or
+/// `.glb` file as a scene with one model.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
     load_scene_with(path, &LoadOptions::default())
 }
@@ -44,9 +46,31 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
             }],
             ..SceneDesc::default()
         }
+    } else if extension(path) == "rhai" {
+        SceneDesc {
+            script: Some(ScriptRef {
+                path: path.to_path_buf(),
+                at: Location::file(path),
+                first_light: 0,
+            }),
+            ..SceneDesc::default()
+        }
     } else {
         read_scene_desc(path, &mut diag)?
     };
+    let mut desc = desc;
+    if let Some(script) = desc.script.as_mut() {
+        // The script's objects follow every object of the file.
+        script.first_light = desc.lights.len();
+        let script = script.clone();
+        if !script.path.is_file() {
+            return Err(SceneError::Syntax {
+                at: script.at.clone(),
+                message: format!("script {} not found", script.path.display()),
+            });
+        }
+        crate::script::run_load(&script, path, &mut desc, &mut diag, &Limits::default())?;
+    }
     build(path, desc, options, &mut diag)
 }
 
@@ -173,6 +197,7 @@ fn build(
         bounds,
         declared_bounds: desc.bounding_box,
         origin: desc.origin,
+        script: desc.script,
         warnings: std::mem::take(&mut diag.warnings),
     })
 }

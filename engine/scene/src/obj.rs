@@ -132,6 +132,7 @@ fn load_mtl_text(
                 at: Location {
                     file: file.to_path_buf(),
                     line: locate_mtl_error(text.as_bytes()),
+                    column: None,
                 },
                 message: format!("material library does not parse ({e}); default material used"),
             });

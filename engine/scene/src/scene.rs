@@ -43,6 +43,9 @@ pub struct Scene {
     /// origin + stored position.
     /// Renderers never need it; reports that print world coordinates do.
     pub origin: glam::DVec3,
+    /// The Rhai script that added to the scene and animates it per frame
+    /// ([`crate::script`]), if any.
+    pub script: Option<crate::script::ScriptRef>,
     /// What the loader accepted but reported.
     pub warnings: Vec<Warning>,
 }

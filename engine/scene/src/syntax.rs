@@ -62,6 +62,13 @@ pub(crate) enum Item {
         /// Its line.
         line: usize,
     },
+    /// `script "file.rhai"`: a Rhai script that adds to the scene and animates it.
+    Script {
+        /// The path as written.
+        path: String,
+        /// Its line.
+        line: usize,
+    },
 }
 
 /// A token of one line.
@@ -210,7 +217,7 @@ pub(crate) fn parse(
     }
 }
 
-/// Handles a line outside any block: an object header or an include.
+/// Handles a line outside any block: an object header, an include or a script.
 fn top_level(
     tokens: &[Token<'_>],
     file: &Path,
@@ -247,6 +254,22 @@ fn top_level(
                 Ok(State::Top)
             }
             _ => Err(SceneError::syntax(file, line, "expected include \"FILE\"")),
+        };
+    }
+    if kind == "script" {
+        return match tokens {
+            [_, Token::Quoted(path)] => {
+                items.push(Item::Script {
+                    path: (*path).to_string(),
+                    line,
+                });
+                Ok(State::Top)
+            }
+            _ => Err(SceneError::syntax(
+                file,
+                line,
+                "expected script \"FILE.rhai\"",
+            )),
         };
     }
     let (label, opened) = match &tokens[1..] {

@@ -55,6 +55,8 @@ pub struct SceneDesc {
     pub bounding_box: Option<Aabb>,
     /// The world point every position above is relative to ([`origin_of`]).
     pub origin: DVec3,
+    /// The scene's script (`script "file.rhai"`, or the `.rhai` scene itself).
+    pub script: Option<crate::script::ScriptRef>,
 }
 
 /// Reads a `.scene` file and its includes.
@@ -105,7 +107,7 @@ pub(crate) fn origin_of(items: &[Item]) -> DVec3 {
         .iter()
         .filter_map(|item| match item {
             Item::Block(b) => Some(b),
-            Item::Include { .. } => None,
+            Item::Include { .. } | Item::Script { .. } => None,
         })
         .collect();
     blocks
@@ -164,6 +166,46 @@ fn interpret(
                 read_into(&target, &Location::line(path, line), desc, stack, diag)?;
             }
             Item::Block(block) => block_into(&block, path, desc, diag)?,
+            Item::Script { path: name, line } => {
+                let at = Location::line(path, line);
+                if let Some(first) = &desc.script {
+                    return Err(SceneError::Syntax {
+                        at,
+                        message: format!(
+                            "a scene has one script, and {} is already named",
+                            first.path.display()
+                        ),
+                    });
+                }
+                desc.script = Some(crate::script::ScriptRef {
+                    path: resolve(path, &name),
+                    at,
+                    first_light: 0,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Adds the object blocks of `text` (no includes or scripts) to `desc`, with
+/// positions relative to `desc.origin`: how a script's calls become objects.
+pub(crate) fn blocks_into(
+    text: &str,
+    file: &Path,
+    desc: &mut SceneDesc,
+    diag: &mut Diagnostics,
+) -> Result<(), SceneError> {
+    for item in parse(text, file, diag)? {
+        match item {
+            Item::Block(block) => block_into(&block, file, desc, diag)?,
+            Item::Include { line, .. } | Item::Script { line, .. } => {
+                return Err(SceneError::syntax(
+                    file,
+                    line,
+                    "only objects may be added here",
+                ))
+            }
         }
     }
     Ok(())

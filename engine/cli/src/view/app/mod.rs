@@ -359,6 +359,9 @@ impl<'g> Viewer<'g> {
             ..self.lens.clone()
         };
         let report = self.live.draw(&camera, self.time, self.frames, false)?;
+        if let Some(error) = self.live.take_script_error() {
+            eprintln!("error: {error} (the lights of the last good step kept)");
+        }
         let output = self.live.output()?;
         let source = PresentSource {
             image: output.image,
