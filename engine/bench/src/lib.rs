@@ -12,6 +12,7 @@ mod floors;
 mod lights;
 mod pathtrace;
 mod plot;
+mod script;
 mod shadows;
 mod start;
 mod tangents;
@@ -38,6 +39,8 @@ pub enum BenchCommand {
     Tiles(crate::tiles::TilesArgs),
     /// Packed vertex tangent frames of real models against their float frames.
     Tangents(crate::tangents::TangentsArgs),
+    /// Scene scripts: the per-frame cost of `update` and of uploading what it changed.
+    Script(crate::script::ScriptArgs),
 }
 
 /// Runs `weft bench ...`.
@@ -52,5 +55,6 @@ pub fn run(cmd: BenchCommand) -> Result<ExitCode> {
         BenchCommand::Floors(args) => crate::floors::run(args),
         BenchCommand::Tiles(args) => crate::tiles::run(args),
         BenchCommand::Tangents(args) => crate::tangents::run(args),
+        BenchCommand::Script(args) => crate::script::run(args),
     }
 }

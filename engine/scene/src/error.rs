@@ -12,8 +12,9 @@ pub struct Location {
     pub file: PathBuf,
     /// The 1-based line, or `None` when the problem concerns the whole file.
     pub line: Option<usize>,
-    /// The 1-based column, where the source gives one (scripts).
-    #[serde(default)]
+    /// The 1-based column, where the source gives one (scripts); shown in
+    /// messages, not stored (the model cache's format stays as it is).
+    #[serde(skip)]
     pub column: Option<usize>,
 }
 

@@ -266,12 +266,16 @@ fn light_index(
         })
 }
 
+/// Three numbers (integers or floats) as a finite vector.
 fn vec3(
     ctx: &NativeCallContext,
-    x: FLOAT,
-    y: FLOAT,
-    z: FLOAT,
+    x: &Dynamic,
+    y: &Dynamic,
+    z: &Dynamic,
 ) -> Result<DVec3, Box<EvalAltResult>> {
+    let (Some(x), Some(y), Some(z)) = (number(x), number(y), number(z)) else {
+        return Err(fail(ctx, "expected three numbers"));
+    };
     let v = DVec3::new(x, y, z);
     if v.is_finite() {
         Ok(v)
@@ -312,9 +316,15 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
     let st = state.clone();
     engine.register_fn("rand", move || FLOAT::from(lock(&st).rng.next_f32()));
     let st = state.clone();
-    engine.register_fn("rand_range", move |lo: FLOAT, hi: FLOAT| {
-        lo + (hi - lo) * FLOAT::from(lock(&st).rng.next_f32())
-    });
+    engine.register_fn(
+        "rand_range",
+        move |ctx: NativeCallContext, lo: Dynamic, hi: Dynamic| {
+            let (Some(lo), Some(hi)) = (number(&lo), number(&hi)) else {
+                return Err(fail(&ctx, "rand_range expects two numbers"));
+            };
+            Ok::<FLOAT, Box<EvalAltResult>>(lo + (hi - lo) * FLOAT::from(lock(&st).rng.next_f32()))
+        },
+    );
     let st = state.clone();
     engine.register_fn("light_count", move || {
         let s = lock(&st);
@@ -340,8 +350,8 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
     let st = state.clone();
     engine.register_fn(
         "set_light_position",
-        move |ctx: NativeCallContext, i: INT, x: FLOAT, y: FLOAT, z: FLOAT| {
-            let p = (vec3(&ctx, x, y, z)? - origin).as_vec3();
+        move |ctx: NativeCallContext, i: INT, x: Dynamic, y: Dynamic, z: Dynamic| {
+            let p = (vec3(&ctx, &x, &y, &z)? - origin).as_vec3();
             let mut s = lock(&st);
             let i = light_index(&ctx, &s, i)?;
             match &mut s.lights[i] {
@@ -361,8 +371,8 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
     let st = state.clone();
     engine.register_fn(
         "set_light_direction",
-        move |ctx: NativeCallContext, i: INT, x: FLOAT, y: FLOAT, z: FLOAT| {
-            let d = vec3(&ctx, x, y, z)?.as_vec3();
+        move |ctx: NativeCallContext, i: INT, x: Dynamic, y: Dynamic, z: Dynamic| {
+            let d = vec3(&ctx, &x, &y, &z)?.as_vec3();
             let Some(d) = d.try_normalize() else {
                 return Err(fail(&ctx, "a light's direction must not be zero"));
             };
@@ -384,10 +394,10 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
     let st = state.clone();
     engine.register_fn(
         "set_light_color",
-        move |ctx: NativeCallContext, i: INT, r: FLOAT, g: FLOAT, b: FLOAT| {
-            let c = vec3(&ctx, r, g, b)?.as_vec3();
+        move |ctx: NativeCallContext, i: INT, r: Dynamic, g: Dynamic, b: Dynamic| {
+            let c = vec3(&ctx, &r, &g, &b)?.as_vec3();
             if c.min_element() < 0.0 {
-                return Err(fail(&ctx, format!("colour ({r}, {g}, {b}) is negative")));
+                return Err(fail(&ctx, format!("colour {c} is negative")));
             }
             let mut s = lock(&st);
             let i = light_index(&ctx, &s, i)?;
@@ -648,4 +658,291 @@ fn switched_off(light: &Light) -> Light {
         Light::Area(l) => l.emission = Vec3::ZERO,
     }
     off
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::PointLight;
+
+    /// A folder of its own under the temp folder, with `files` written in it.
+    fn folder(name: &str, files: &[(&str, &str)]) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("weft-script-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        for (file, text) in files {
+            let path = dir.join(file);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(path, text).unwrap();
+        }
+        dir
+    }
+
+    fn script_ref(path: &Path) -> ScriptRef {
+        ScriptRef {
+            path: path.to_path_buf(),
+            at: Location::file(path),
+            first_light: 0,
+        }
+    }
+
+    /// Runs a `.rhai` scene's load with `limits`.
+    fn load(dir: &Path, limits: &Limits) -> Result<SceneDesc, SceneError> {
+        let path = dir.join("scene.rhai");
+        let mut desc = SceneDesc::default();
+        run_load(
+            &script_ref(&path),
+            &path,
+            &mut desc,
+            &mut Diagnostics::default(),
+            limits,
+        )?;
+        Ok(desc)
+    }
+
+    fn point(light: &Light) -> &PointLight {
+        match light {
+            Light::Point(p) => p,
+            other => panic!("not a point light: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn objects_a_script_adds_are_the_scene_files_objects() {
+        let dir = folder(
+            "objects",
+            &[(
+                "scene.rhai",
+                r#"
+                point_light(#{ position: [1, 2, 3], color: [0.5, 0.25, 1], radius: 4 });
+                spot_light(#{ position: [0, 5, 0], direction: [0, -1, 0], angle: 30 });
+                sun_light(#{ direction: [0, -1, 0], ambient: 0.1 });
+                area_light(#{ position: [0, 4, 0], size: [1, 2] });
+                model("box.obj", #{ position: [1, 0, 0], scale: 2 });
+                camera("top", #{ position: [0, 9, 0.1], target: [0, 0, 0] });
+                "#,
+            )],
+        );
+        let from_script = load(&dir, &Limits::default()).unwrap();
+        let text = "pointlight\n{\n\tposition 1 2 3\n\tcolor 0.5 0.25 1\n\tradius 4\n}\n\
+            spotlight\n{\n\tposition 0 5 0\n\tdirection 0 -1 0\n\tangle 30\n}\n\
+            sunlight\n{\n\tdirection 0 -1 0\n\tambient 0.1\n}\n\
+            arealight\n{\n\tposition 0 4 0\n\tsize 1 2\n}\n\
+            model\n{\n\tfile \"box.obj\"\n\tposition 1 0 0\n\tscale 2\n}\n\
+            camera \"top\"\n{\n\tposition 0 9 0.1\n\ttarget 0 0 0\n}\n";
+        let from_file =
+            crate::scene_desc_from_str(text, &dir.join("scene.rhai"), &mut Diagnostics::default())
+                .unwrap();
+        assert_eq!(from_script.lights, from_file.lights);
+        assert_eq!(from_script.cameras, from_file.cameras);
+        assert_eq!(from_script.models.len(), 1);
+        assert_eq!(from_script.models[0].file, dir.join("box.obj"));
+        assert_eq!(
+            from_script.models[0].transform,
+            from_file.models[0].transform
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn updates_are_fixed_steps_so_a_time_gives_the_same_lights_however_it_is_reached() {
+        let dir = folder(
+            "steps",
+            &[(
+                "scene.rhai",
+                r#"
+                point_light(#{ position: [0, 0, 0], color: [1, 1, 1] });
+                fn init() { #{ steps: 0 } }
+                fn update(t, dt) {
+                    this.steps += 1;
+                    let p = light_position(0);
+                    set_light_position(0, p[0] + dt, t, this.steps);
+                    set_light_on(0, this.steps % 2 == 0);
+                }
+                "#,
+            )],
+        );
+        let path = dir.join("scene.rhai");
+        let desc = load(&dir, &Limits::default()).unwrap();
+        let runtime = || {
+            ScriptRuntime::new(
+                &script_ref(&path),
+                &path,
+                &desc.lights,
+                DVec3::ZERO,
+                &Limits::default(),
+            )
+            .unwrap()
+        };
+        let mut a = runtime();
+        assert!(a.animates());
+        // 0.5 s = 30 steps of 1/60 s: x = 30 / 60, y = t of the last step, z = steps.
+        let at_half = a.lights_at(0.5).unwrap();
+        let p = point(&at_half[0]);
+        assert!(
+            (p.position - Vec3::new(0.5, 0.5, 30.0)).abs().max_element() < 1e-5,
+            "{p:?}"
+        );
+        assert_eq!(p.color, Vec3::ONE, "step 30 is even: on");
+        // Reached through other frame times, or again after going back: the same.
+        let mut b = runtime();
+        for t in [0.1, 0.25, 0.4999, 0.5] {
+            b.lights_at(t).unwrap();
+        }
+        assert_eq!(b.lights_at(0.5).unwrap(), at_half);
+        a.lights_at(3.0).unwrap();
+        assert_eq!(a.lights_at(0.5).unwrap(), at_half, "going back starts over");
+        // Step 31 is odd: off, with zero colour.
+        assert_eq!(
+            point(&a.lights_at(31.0 / 60.0 + 1e-9).unwrap()[0]).color,
+            Vec3::ZERO
+        );
+        assert_eq!(point(&a.lights_at(0.0).unwrap()[0]).position, Vec3::ZERO);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The error a script body gets under `limits`, with its location.
+    fn load_error(name: &str, body: &str, limits: &Limits) -> String {
+        let dir = folder(name, &[("scene.rhai", body)]);
+        let error = load(&dir, limits)
+            .map(|_| ())
+            .expect_err(&format!("{name} refused"))
+            .to_string();
+        std::fs::remove_dir_all(&dir).unwrap();
+        error.replace(&dir.join("scene.rhai").display().to_string(), "scene.rhai")
+    }
+
+    #[test]
+    fn each_limit_stops_a_script_with_a_located_error() {
+        let small = Limits {
+            operations: 10_000,
+            call_depth: 8,
+            expression_depth: 16,
+            string_bytes: 64,
+            array_len: 16,
+            map_len: 4,
+        };
+        let cases = [
+            (
+                "loop",
+                "let x = 0;\nloop { x += 1; }",
+                "scene.rhai:2:",
+                "Too many operations",
+            ),
+            (
+                "depth",
+                "fn f(n) { f(n + 1) }\nf(0);",
+                "scene.rhai:2:",
+                "Stack overflow",
+            ),
+            (
+                "string",
+                "let s = \"\";\nfor i in 0..100 { s += \"x\"; }",
+                "scene.rhai:2:",
+                "Length of string",
+            ),
+            (
+                "array",
+                "let a = [];\nfor i in 0..100 { a.push(i); }",
+                "scene.rhai:2:",
+                "Size of array",
+            ),
+            (
+                "map",
+                "let m = #{ a: 1, b: 2, c: 3 };\nm.mixin(#{ d: 4, e: 5, f: 6 });",
+                "scene.rhai:2:",
+                "Size of object map",
+            ),
+            (
+                "expression",
+                &format!("let x = {}1{};", "(".repeat(40), ")".repeat(40)),
+                "scene.rhai:1:",
+                "Expression exceeds maximum complexity",
+            ),
+        ];
+        for (name, body, at, message) in cases {
+            let error = load_error(name, body, &small);
+            assert!(error.starts_with(at), "{name}: {error}");
+            assert!(error.contains(message), "{name}: {error}");
+        }
+    }
+
+    #[test]
+    fn runtime_errors_and_misuse_are_located_at_file_line_and_column() {
+        let limits = Limits::default();
+        let error = load_error(
+            "missing",
+            "let x = 1;\n  point_light(#{ position: [1, 2] });",
+            &limits,
+        );
+        assert!(
+            error.starts_with("scene.rhai:2:3: pointlight: "),
+            "the .scene reader's own message, at the call: {error}"
+        );
+        assert!(error.contains("position"), "{error}");
+        let error = load_error("update-only", "set_light_on(0, false);", &limits);
+        assert_eq!(
+            error,
+            "scene.rhai:1:1: lights are changed in init or update, after the scene has loaded"
+        );
+        let error = load_error("syntax", "let x = ;", &limits);
+        assert!(error.starts_with("scene.rhai:1:9: "), "{error}");
+        let dir = folder(
+            "adds-late",
+            &[(
+                "scene.rhai",
+                "fn update(t, dt) {\n    point_light(#{});\n}\n",
+            )],
+        );
+        let path = dir.join("scene.rhai");
+        let mut runtime =
+            ScriptRuntime::new(&script_ref(&path), &path, &[], DVec3::ZERO, &limits).unwrap();
+        let error = runtime.lights_at(1.0).expect_err("refused").to_string();
+        assert_eq!(
+            error,
+            format!(
+                "{}:2:5: pointlight objects are added while the scene loads, not in init or update",
+                path.display()
+            )
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn imports_reach_only_scripts_under_the_scenes_folder() {
+        let dir = folder(
+            "imports",
+            &[
+                (
+                    "scene.rhai",
+                    "import \"lib/colours\" as c;\npoint_light(#{ color: c::warm() });",
+                ),
+                ("lib/colours.rhai", "fn warm() { [1.0, 0.5, 0.25] }"),
+            ],
+        );
+        let desc = load(&dir, &Limits::default()).unwrap();
+        assert_eq!(point(&desc.lights[0]).color, Vec3::new(1.0, 0.5, 0.25));
+        std::fs::write(dir.join("scene.rhai"), "import \"../outside\" as o;").unwrap();
+        std::fs::write(dir.join("../outside.rhai"), "fn f() { 1 }").unwrap();
+        let error = load(&dir, &Limits::default())
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            error.contains("import \"../outside\": scripts may import only scripts under"),
+            "{error}"
+        );
+        std::fs::remove_file(dir.join("../outside.rhai")).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn scripts_have_no_file_access_and_no_clock() {
+        for (name, body) in [
+            ("open", "open_file(\"/etc/passwd\");"),
+            ("clock", "let t = timestamp();"),
+        ] {
+            let error = load_error(name, body, &Limits::default());
+            assert!(error.contains("Function not found"), "{name}: {error}");
+        }
+    }
 }

@@ -164,13 +164,11 @@ fn negative_indices_polygons_missing_normals_and_mtl_quirks() {
     assert_eq!(
         warnings,
         vec![
-            "p.obj: material library unusable (".to_string()
-                + &format!(
-                    "{}: missing file {}",
-                    dir.join("p.obj").display(),
-                    dir.join("gone.mtl").display()
-                )
-                + "); default material used",
+            format!(
+                "p.obj: material library unusable ({}: missing file {}); default material used",
+                dir.join("p.obj").display(),
+                dir.join("gone.mtl").display()
+            ),
             "m.mtl: material 'a': 'd 1' and 'Tr 1' disagree (d should be 1 - Tr); 'd' is used"
                 .to_string(),
             format!(

@@ -20,7 +20,7 @@ fn every_example_scene_loads_without_warnings() {
         .expect("scenes/")
         .filter_map(|e| e.ok())
         .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".scene"))
+        .filter(|n| n.ends_with(".scene") || n.ends_with(".rhai"))
         .collect();
     names.sort();
     assert_eq!(
@@ -31,13 +31,17 @@ fn every_example_scene_loads_without_warnings() {
             "cameras.scene",
             "caustics.scene",
             "cornell.scene",
+            "day_cycle.scene",
             "demo.scene",
             "flight_helmet.scene",
+            "flocking.rhai",
             "gltf.scene",
+            "grid.rhai",
             "include.scene",
             "many_lights.scene",
             "point_radius.scene",
             "sun_shadows.scene",
+            "swinging_spots.rhai",
         ]
     );
     for name in names {

@@ -1,0 +1,112 @@
+//! `weft bench script`: what a scene script costs per frame. For 100, 1,000
+//! and 10,000 point lights that a script moves every frame (each on its own
+//! circle, the common case of scripted light animation), the time of the
+//! script's `update` step (with the lights copied out), and of the whole
+//! per-frame scene update that uploads them (`GpuScene::update`: the
+//! script's step, packing the lights and writing the light buffer).
+
+use anyhow::{Context, Result};
+use clap::Args;
+use std::process::ExitCode;
+use std::time::Instant;
+use weft_gpu::{Gpu, GpuOptions};
+use weft_render::scene_gpu::GpuScene;
+use weft_scene::script::{Limits, ScriptRuntime, STEP};
+
+/// Arguments of `weft bench script`.
+#[derive(Args)]
+pub struct ScriptArgs {
+    /// Light counts to measure.
+    #[arg(long, value_delimiter = ',', default_value = "100,1000,10000")]
+    lights: Vec<u32>,
+    /// Frames measured per count (one update step each), after 10 warm-up frames.
+    #[arg(long, default_value_t = 120)]
+    frames: u32,
+    /// Vulkan device to use (name substring); the first suitable one by default.
+    #[arg(long)]
+    device: Option<String>,
+}
+
+/// A script with `n` point lights that its `update` moves on circles.
+fn script_text(n: u32) -> String {
+    format!(
+        r#"fn lights() {{ {n} }}
+for i in 0..lights() {{
+    point_light(#{{ position: [i % 100, 1, i / 100], color: [1, 1, 1], radius: 2 }});
+}}
+fn update(t, dt) {{
+    for i in 0..lights() {{
+        let a = t + i * 0.1;
+        set_light_position(i, i % 100 + 0.5 * a.cos(), 1, i / 100 + 0.5 * a.sin());
+    }}
+}}
+"#
+    )
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Runs the benchmark and prints a table.
+pub fn run(args: ScriptArgs) -> Result<ExitCode> {
+    let gpu = Gpu::new(&GpuOptions {
+        validation: false,
+        device: args.device.clone(),
+    })?;
+    println!(
+        "device: {}; median over {} frames of one 1/60 s step each",
+        gpu.info().name,
+        args.frames
+    );
+    println!("| lights | script update (ms) | per-frame scene update with upload (ms) | light buffer (KiB) |");
+    println!("|---:|---:|---:|---:|");
+    let dir = std::env::temp_dir().join(format!("weft-bench-script-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    for &n in &args.lights {
+        let path = dir.join(format!("lights{n}.rhai"));
+        std::fs::write(&path, script_text(n))?;
+        let scene =
+            weft_scene::load_scene(&path).with_context(|| format!("loading {}", path.display()))?;
+        let script = scene.script.clone().context("the scene has its script")?;
+        let mut runtime = ScriptRuntime::new(
+            &script,
+            &scene.path,
+            &scene.lights,
+            scene.origin,
+            &Limits::default(),
+        )?;
+        let mut script_ms = Vec::new();
+        for frame in 0..args.frames + 10 {
+            let t = f64::from(frame + 1) * STEP;
+            let started = Instant::now();
+            runtime.lights_at(t)?;
+            if frame >= 10 {
+                script_ms.push(started.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        let mut gpu_scene = GpuScene::new(&gpu, &scene)?;
+        let camera = scene.cameras[0].clone();
+        let mut update_ms = Vec::new();
+        for frame in 0..args.frames + 10 {
+            let t = (f64::from(frame + 1) * STEP) as f32;
+            let started = Instant::now();
+            gpu_scene.update(&camera, t, [1280, 720])?;
+            if frame >= 10 {
+                update_ms.push(started.elapsed().as_secs_f64() * 1e3);
+            }
+            if let Some(e) = gpu_scene.take_script_error() {
+                return Err(e.into());
+            }
+        }
+        println!(
+            "| {n} | {:.3} | {:.3} | {:.1} |",
+            median(script_ms),
+            median(update_ms),
+            f64::from(n) * 64.0 / 1024.0
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(ExitCode::SUCCESS)
+}
