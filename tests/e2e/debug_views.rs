@@ -30,6 +30,18 @@ fn scratch(name: &str) -> PathBuf {
 
 const CAMERA: &str = "camera\n{\n\tposition 0 0 0\n\ttarget 0 0 -1\n\tfov_deg 90\n}\n";
 
+/// Writes `NAME.obj` with `obj` and `NAME.scene` placing it under a sun,
+/// seen by the test camera; returns the scene.
+fn write_scene(dir: &Path, name: &str, obj: &str) -> PathBuf {
+    std::fs::write(dir.join(format!("{name}.obj")), obj).unwrap();
+    let text = format!(
+        "model\n{{\n\tfile \"{name}.obj\"\n}}\nsunlight\n{{\n\tdirection 0 0 -1\n\tcolor 1 1 1\n}}\n{CAMERA}"
+    );
+    let path = dir.join(format!("{name}.scene"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
 /// Quads facing the camera at z = -2, -3, ..., each far wider than the view,
 /// nearest first (`front_to_back`) or farthest first, in one mesh so the
 /// draw order is the file's order.
@@ -49,13 +61,7 @@ fn stacked_scene(dir: &Path, front_to_back: bool) -> PathBuf {
             4 * k + 4
         ));
     }
-    std::fs::write(dir.join("quads.obj"), obj).unwrap();
-    let text = format!(
-        "model\n{{\n\tfile \"quads.obj\"\n}}\nsunlight\n{{\n\tdirection 0 0 -1\n\tcolor 1 1 1\n}}\n{CAMERA}"
-    );
-    let path = dir.join("stacked.scene");
-    std::fs::write(&path, text).unwrap();
-    path
+    write_scene(dir, "stacked", &obj)
 }
 
 /// A plane at z = -4 that fills the view, cut into a grid of squares of
@@ -88,13 +94,7 @@ fn grid_scene(dir: &Path, cell: u32) -> PathBuf {
             ));
         }
     }
-    std::fs::write(dir.join("grid.obj"), obj).unwrap();
-    let text = format!(
-        "model\n{{\n\tfile \"grid.obj\"\n}}\nsunlight\n{{\n\tdirection 0 0 -1\n\tcolor 1 1 1\n}}\n{CAMERA}"
-    );
-    let path = dir.join("grid.scene");
-    std::fs::write(&path, text).unwrap();
-    path
+    write_scene(dir, "grid", &obj)
 }
 
 /// Renders `scene` through `graph_name` with `features` (bloom off) under
@@ -283,20 +283,6 @@ fn a_regular_grid_has_the_density_of_its_triangles_areas() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// Rows of the 3x5 glyphs the legend draws, top first: 0-9.
-const FONT: [[&str; 5]; 10] = [
-    ["###", "#.#", "#.#", "#.#", "###"],
-    [".#.", "##.", ".#.", ".#.", "###"],
-    ["###", "..#", "###", "#..", "###"],
-    ["###", "..#", "###", "..#", "###"],
-    ["#.#", "#.#", "###", "..#", "..#"],
-    ["###", "#..", "###", "..#", "###"],
-    ["###", "#..", "###", "#.#", "###"],
-    ["###", "..#", "..#", "..#", "..#"],
-    ["###", "#.#", "###", "#.#", "###"],
-    ["###", "#.#", "###", "..#", "###"],
-];
-
 #[test]
 fn the_legend_shows_the_scale_with_its_numbers_and_the_view_its_colours() {
     let dir = scratch("legend");
@@ -309,47 +295,14 @@ fn the_legend_shows_the_scale_with_its_numbers_and_the_view_its_colours() {
     let image = rendered.report.output.as_ref().expect("readback");
     let at = |x: i32, y: i32| image.rgba8_at(x as u32, SIZE - 1 - y as u32);
     let bar = 64; // clamp(width / 4, 64, 256)
-    assert_eq!(at(12, 44), [0, 0, 0, 255], "legend box");
-    // Viridis' first and last colours, as published (sRGB bytes), within rounding.
-    let close = |p: [u8; 4], q: [u8; 3]| (0..3).all(|c| p[c].abs_diff(q[c]) <= 1);
-    assert!(close(at(16, 34), [68, 1, 84]), "bar start {:?}", at(16, 34));
+                  // Every pixel outside the legend is the count's colour: 3 of a top of 3.
     assert!(
-        close(at(16 + bar - 1, 34), [253, 231, 37]),
-        "bar end {:?}",
-        at(16 + bar - 1, 34)
-    );
-    // Every pixel outside the legend is the count's colour: 3 of a top of 3.
-    assert!(
-        close(at(100, 100), [253, 231, 37]),
+        weft_tests::legend::close(at(100, 100), weft_tests::legend::VIRIDIS_END),
         "view {:?}",
         at(100, 100)
     );
     // The scale is the frame's largest count: labels 0, 1, 3.
-    for (i, label) in [0u32, 1, 3].into_iter().enumerate() {
-        let text = label.to_string();
-        let width = text.len() as i32 * 8 - 2;
-        let centre = 16 + (bar - 1) * i as i32 / 2;
-        let left = (centre - width / 2).clamp(10, 22 + bar - width);
-        for (k, digit) in text.bytes().enumerate() {
-            let glyph = FONT[usize::from(digit - b'0')];
-            for row in 0..10 {
-                for col in 0..8 {
-                    let lit =
-                        col < 6 && glyph[row as usize / 2].as_bytes()[col as usize / 2] == b'#';
-                    let expected = if lit {
-                        [255, 255, 255, 255]
-                    } else {
-                        [0, 0, 0, 255]
-                    };
-                    assert_eq!(
-                        at(left + k as i32 * 8 + col, 24 - row),
-                        expected,
-                        "label {label} digit {k} row {row} col {col}"
-                    );
-                }
-            }
-        }
-    }
+    weft_tests::legend::assert_legend(at, bar, [0, 1, 3]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

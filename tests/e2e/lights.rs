@@ -138,20 +138,6 @@ fn floor_point(inv: Mat4, viewport: Vec2, centre: Vec2) -> Vec3 {
     near + dir * (-near.y / dir.y)
 }
 
-/// Rows of the 3x5 digits the heat-map legend draws, top first.
-const FONT: [[&str; 5]; 10] = [
-    ["###", "#.#", "#.#", "#.#", "###"],
-    [".#.", "##.", ".#.", ".#.", "###"],
-    ["###", "..#", "###", "#..", "###"],
-    ["###", "..#", "###", "..#", "###"],
-    ["#.#", "#.#", "###", "..#", "..#"],
-    ["###", "#..", "###", "..#", "###"],
-    ["###", "#..", "###", "#.#", "###"],
-    ["###", "..#", "..#", "..#", "..#"],
-    ["###", "#.#", "###", "#.#", "###"],
-    ["###", "#.#", "###", "..#", "###"],
-];
-
 /// Which culling test the tiled graph runs, by its features.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Culling {
@@ -310,40 +296,6 @@ fn the_heat_map_counts_known_lights_per_tile_and_draws_its_legend() {
     let image = rendered.report.output.expect("readback");
     let at = |x: i32, y: i32| image.rgba8_at(x as u32, h - 1 - y as u32);
     let bar = 80; // clamp(width / 4, 64, 256)
-    assert_eq!(at(12, 44), [0, 0, 0, 255], "legend box");
-    // The debug views' sequential map (viridis): its first and last colours
-    // as published, sRGB bytes, within rounding.
-    let close = |p: [u8; 4], q: [u8; 3]| (0..3).all(|c| p[c].abs_diff(q[c]) <= 1);
-    assert!(close(at(16, 34), [68, 1, 84]), "bar start {:?}", at(16, 34));
-    assert!(
-        close(at(16 + bar - 1, 34), [253, 231, 37]),
-        "bar end {:?}",
-        at(16 + bar - 1, 34)
-    );
-    // The scale is the frame's largest tile count.
-    for (i, label) in [0u32, most / 2, most].into_iter().enumerate() {
-        let text = label.to_string();
-        let width = text.len() as i32 * 8 - 2;
-        let centre = 16 + (bar - 1) * i as i32 / 2;
-        let left = (centre - width / 2).clamp(10, 22 + bar - width);
-        for (k, digit) in text.bytes().enumerate() {
-            let glyph = FONT[usize::from(digit - b'0')];
-            for row in 0..10 {
-                for col in 0..8 {
-                    let lit =
-                        col < 6 && glyph[row as usize / 2].as_bytes()[col as usize / 2] == b'#';
-                    let pixel = at(left + k as i32 * 8 + col, 24 - row);
-                    let expected = if lit {
-                        [255, 255, 255, 255]
-                    } else {
-                        [0, 0, 0, 255]
-                    };
-                    assert_eq!(
-                        pixel, expected,
-                        "label {label} digit {k} row {row} col {col}"
-                    );
-                }
-            }
-        }
-    }
+                  // The scale is the frame's largest tile count.
+    weft_tests::legend::assert_legend(at, bar, [0, most / 2, most]);
 }

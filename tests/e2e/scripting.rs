@@ -17,6 +17,16 @@ const EXAMPLES: [&str; 4] = [
     "scenes/grid.rhai",
 ];
 
+/// Settings for `graph_name` at a size and time.
+fn settings(graph_name: &str, width: u32, height: u32, time: f32) -> RenderSettings {
+    RenderSettings {
+        graph: graph(graph_name),
+        extent: Extent { width, height },
+        time,
+        ..RenderSettings::default()
+    }
+}
+
 /// The image of `scene` at `time` through `graph_name`, under validation
 /// (asserting zero messages).
 fn image_at(scene: &Path, graph_name: &str, time: f32) -> image::RgbaImage {
@@ -24,14 +34,8 @@ fn image_at(scene: &Path, graph_name: &str, time: f32) -> image::RgbaImage {
     let gpu = weft_tests::gpu();
     let log = gpu.validation();
     let settings = RenderSettings {
-        graph: graph(graph_name),
-        extent: Extent {
-            width: 160,
-            height: 90,
-        },
-        time,
         features: vec!["!bloom".into()],
-        ..RenderSettings::default()
+        ..settings(graph_name, 160, 90, time)
     };
     let rendered =
         render(&gpu, &loaded, &settings).unwrap_or_else(|e| panic!("{}: {e}", scene.display()));
@@ -82,15 +86,7 @@ fn a_failing_update_is_a_located_render_error() {
     .unwrap();
     let loaded = weft_scene::load_scene(&scene).expect("loads: the error is per frame");
     let gpu = weft_tests::gpu();
-    let settings = RenderSettings {
-        graph: graph("forward.ron"),
-        extent: Extent {
-            width: 32,
-            height: 18,
-        },
-        time: 1.0,
-        ..RenderSettings::default()
-    };
+    let settings = settings("forward.ron", 32, 18, 1.0);
     let error = render(&gpu, &loaded, &settings)
         .err()
         .expect("refused")
@@ -100,4 +96,23 @@ fn a_failing_update_is_a_located_render_error() {
         format!("{}:3:5: colour [1, 1, -1] is negative", scene.display())
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn lights_a_script_adds_decide_the_passes_like_a_files_lights() {
+    let scene = weft_scene::load_scene(&root().join("scenes/swinging_spots.rhai")).expect("loads");
+    let gpu = weft_tests::gpu();
+    let settings = settings("deferred.ron", 32, 18, 0.0);
+    let rendered = render(&gpu, &scene, &settings).expect("renders");
+    let passes: Vec<&str> = rendered
+        .plan
+        .passes
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect();
+    assert!(passes.contains(&"spot_lights"), "{passes:?}");
+    assert!(
+        !passes.contains(&"point_lights"),
+        "the script adds no point light: {passes:?}"
+    );
 }

@@ -3,7 +3,9 @@
 //! circle, the common case of scripted light animation), the time of the
 //! script's `update` step (with the lights copied out), and of the whole
 //! per-frame scene update that uploads them (`GpuScene::update`: the
-//! script's step, packing the lights and writing the light buffer).
+//! script's step, packing the lights and writing the light buffer), and of
+//! that update for the same lights without a script (the upload alone:
+//! packing and writing).
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -49,6 +51,26 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// `GpuScene::update` per frame for `scene`, one 1/60 s step each, after 10
+/// warm-up frames.
+fn scene_update_ms(gpu: &Gpu, scene: &weft_scene::Scene, frames: u32) -> Result<Vec<f64>> {
+    let mut gpu_scene = GpuScene::new(gpu, scene)?;
+    let camera = scene.cameras[0].clone();
+    let mut ms = Vec::new();
+    for frame in 0..frames + 10 {
+        let t = (f64::from(frame + 1) * STEP) as f32;
+        let started = Instant::now();
+        gpu_scene.update(&camera, t, [1280, 720])?;
+        if frame >= 10 {
+            ms.push(started.elapsed().as_secs_f64() * 1e3);
+        }
+        if let Some(e) = gpu_scene.take_script_error() {
+            return Err(e.into());
+        }
+    }
+    Ok(ms)
+}
+
 /// Runs the benchmark and prints a table.
 pub fn run(args: ScriptArgs) -> Result<ExitCode> {
     let gpu = Gpu::new(&GpuOptions {
@@ -60,8 +82,8 @@ pub fn run(args: ScriptArgs) -> Result<ExitCode> {
         gpu.info().name,
         args.frames
     );
-    println!("| lights | script update (ms) | per-frame scene update with upload (ms) | light buffer (KiB) |");
-    println!("|---:|---:|---:|---:|");
+    println!("| lights | script update (ms) | scene update with upload (ms) | upload alone (ms) | light buffer (KiB) |");
+    println!("|---:|---:|---:|---:|---:|");
     let dir = std::env::temp_dir().join(format!("weft-bench-script-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     for &n in &args.lights {
@@ -86,24 +108,17 @@ pub fn run(args: ScriptArgs) -> Result<ExitCode> {
                 script_ms.push(started.elapsed().as_secs_f64() * 1e3);
             }
         }
-        let mut gpu_scene = GpuScene::new(&gpu, &scene)?;
-        let camera = scene.cameras[0].clone();
-        let mut update_ms = Vec::new();
-        for frame in 0..args.frames + 10 {
-            let t = (f64::from(frame + 1) * STEP) as f32;
-            let started = Instant::now();
-            gpu_scene.update(&camera, t, [1280, 720])?;
-            if frame >= 10 {
-                update_ms.push(started.elapsed().as_secs_f64() * 1e3);
-            }
-            if let Some(e) = gpu_scene.take_script_error() {
-                return Err(e.into());
-            }
-        }
+        let update_ms = scene_update_ms(&gpu, &scene, args.frames)?;
+        let still = weft_scene::Scene {
+            script: None,
+            ..scene.clone()
+        };
+        let upload_ms = scene_update_ms(&gpu, &still, args.frames)?;
         println!(
-            "| {n} | {:.3} | {:.3} | {:.1} |",
+            "| {n} | {:.3} | {:.3} | {:.3} | {:.1} |",
             median(script_ms),
             median(update_ms),
+            median(upload_ms),
             f64::from(n) * 64.0 / 1024.0
         );
     }
