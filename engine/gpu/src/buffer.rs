@@ -122,6 +122,13 @@ impl<'g> Buffer<'g> {
 
     /// Copies `bytes` to the start of a host-visible buffer.
     pub fn write(&mut self, bytes: &[u8]) -> Result<(), GpuError> {
+        self.write_at(0, bytes)
+    }
+
+    /// Copies `bytes` into a host-visible buffer at byte `offset`: a range
+    /// update, for data of which only a part changed.
+    pub fn write_at(&mut self, offset: usize, bytes: &[u8]) -> Result<(), GpuError> {
+        let size = self.size;
         let slice = self
             .allocation
             .as_mut()
@@ -130,12 +137,13 @@ impl<'g> Buffer<'g> {
                 what: "a scene buffer".into(),
                 message: "buffer is not host-visible".into(),
             })?;
-        let dst = slice
-            .get_mut(..bytes.len())
-            .ok_or_else(|| GpuError::Allocation {
-                what: "a scene buffer".into(),
-                message: format!("{} bytes do not fit in {}", bytes.len(), self.size),
-            })?;
+        let dst =
+            slice
+                .get_mut(offset..offset + bytes.len())
+                .ok_or_else(|| GpuError::Allocation {
+                    what: "a scene buffer".into(),
+                    message: format!("{} bytes at {offset} do not fit in {size}", bytes.len()),
+                })?;
         dst.copy_from_slice(bytes);
         Ok(())
     }

@@ -5,7 +5,7 @@
 use crate::camera;
 use crate::error::RenderError;
 use crate::geometry::SceneGeometry;
-use crate::gpu_types::{bytes_of, GpuFrame, GpuMaterial};
+use crate::gpu_types::{bytes_of, GpuFrame, GpuLight, GpuMaterial};
 use crate::lights::{pack_lights, LightSet, LIGHT_BYTES};
 use crate::materials::pack_material;
 use crate::shadows::{self, ShadowSettings, ShadowView, ViewVolume};
@@ -460,12 +460,16 @@ impl<'g> GpuScene<'g> {
             &weft_scene::animation::lights_at(&scene.lights, 0.0, 0),
             &bounds,
         );
-        let lights = Buffer::host(
+        let mut lights = Buffer::host(
             gpu,
             "lights",
             (light_set.len() as usize * LIGHT_BYTES) as u64,
             storage,
         )?;
+        // `update` writes only the records that change from these.
+        if !light_set.records.is_empty() {
+            lights.write(bytes_of(&light_set.records))?;
+        }
         let mut shadows = Buffer::host(gpu, "shadows", shadows::SHADOWS_BYTES as u64, storage)?;
         shadows.write(&vec![0u8; shadows::SHADOWS_BYTES])?;
         let tables = weft_ltc::tables::committed()
@@ -760,8 +764,10 @@ impl<'g> GpuScene<'g> {
             viewport: Vec4::new(w, h, 1.0 / w, 1.0 / h),
         };
         self.frame.write(bytes_of(&[frame]))?;
-        if !lights.is_empty() {
-            self.lights.write(bytes_of(&lights.records))?;
+        if let Some(changed) = changed_records(&self.light_set.records, &lights.records) {
+            let offset = changed.start * std::mem::size_of::<GpuLight>();
+            self.lights
+                .write_at(offset, bytes_of(&lights.records[changed]))?;
         }
         let mut inputs = std::collections::hash_map::DefaultHasher::new();
         std::hash::Hash::hash(bytes_of(&[frame]), &mut inputs);
@@ -814,6 +820,20 @@ impl GpuScene<'_> {
     }
 }
 
+/// The records of `new` that differ from `old` (the light buffer's
+/// contents), as one range to write; all of them when the counts differ,
+/// none when nothing changed: what moved or changed colour is all that is
+/// written each frame.
+fn changed_records(old: &[GpuLight], new: &[GpuLight]) -> Option<std::ops::Range<usize>> {
+    if old.len() != new.len() {
+        return (!new.is_empty()).then_some(0..new.len());
+    }
+    let same = |i: &usize| bytes_of(&old[*i..*i + 1]) == bytes_of(&new[*i..*i + 1]);
+    let first = (0..new.len()).find(|i| !same(i))?;
+    let last = (0..new.len()).rev().find(|i| !same(i))?;
+    Some(first..last + 1)
+}
+
 fn source_key(source: &TextureSource) -> String {
     match source {
         TextureSource::File(p) => PathBuf::from(p).display().to_string(),
@@ -826,5 +846,43 @@ impl Drop for GpuScene<'_> {
     /// the device must have finished with them first.
     fn drop(&mut self) {
         let _ = self.gpu.wait_idle();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bytemuck::Zeroable;
+    use glam::Vec4;
+
+    fn at(x: f32) -> GpuLight {
+        GpuLight {
+            position_range: Vec4::new(x, 0.0, 0.0, 1.0),
+            ..GpuLight::zeroed()
+        }
+    }
+
+    #[test]
+    fn only_the_span_of_changed_light_records_is_written() {
+        let old: Vec<GpuLight> = (0..6).map(|i| at(i as f32)).collect();
+        assert_eq!(changed_records(&old, &old), None, "nothing changed");
+        let mut new = old.clone();
+        new[2] = at(20.0);
+        new[4] = at(40.0);
+        assert_eq!(changed_records(&old, &new), Some(2..5));
+        new.truncate(3);
+        assert_eq!(
+            changed_records(&old, &new),
+            Some(0..3),
+            "another count: all"
+        );
+        assert_eq!(
+            changed_records(&old, &[]),
+            None,
+            "no lights: nothing to write"
+        );
+        // NaN records compare by their bits: an unchanged NaN is not rewritten.
+        let nan = vec![at(f32::NAN)];
+        assert_eq!(changed_records(&nan, &nan), None);
     }
 }

@@ -123,6 +123,10 @@ pub fn shader_files(
 pub fn scene_files(scene: &Scene) -> BTreeSet<PathBuf> {
     let mut files = BTreeSet::new();
     scene_includes(&scene.path, 0, &mut files);
+    if let Some(script) = &scene.script {
+        files.insert(normalize(&script.path));
+        files.extend(script.imports.iter().map(|p| normalize(p)));
+    }
     for model in &scene.models {
         files.insert(normalize(&model.path));
         files.extend(model.sources.iter().map(|p| normalize(p)));

@@ -52,6 +52,7 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
                 path: path.to_path_buf(),
                 at: Location::file(path),
                 first_light: 0,
+                imports: Vec::new(),
             }),
             ..SceneDesc::default()
         }
@@ -59,17 +60,17 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
         read_scene_desc(path, &mut diag)?
     };
     let mut desc = desc;
-    if let Some(script) = desc.script.as_mut() {
+    if let Some(mut script) = desc.script.take() {
         // The script's objects follow every object of the file.
         script.first_light = desc.lights.len();
-        let script = script.clone();
         if !script.path.is_file() {
             return Err(SceneError::Syntax {
                 at: script.at.clone(),
                 message: format!("script {} not found", script.path.display()),
             });
         }
-        crate::script::run_load(&script, path, &mut desc, &mut diag, &Limits::default())?;
+        crate::script::run_load(&mut script, path, &mut desc, &mut diag, &Limits::default())?;
+        desc.script = Some(script);
     }
     build(path, desc, options, &mut diag)
 }

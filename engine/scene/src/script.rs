@@ -43,6 +43,8 @@ pub struct ScriptRef {
     pub at: Location,
     /// Lights the scene declared before the script's.
     pub first_light: usize,
+    /// The scripts it imported while loading, so they are watched too.
+    pub imports: Vec<PathBuf>,
 }
 
 /// Seconds per update step.
@@ -135,10 +137,11 @@ fn position_at(script: &Path, position: Position) -> Location {
     }
 }
 
-/// `import` for scripts under one folder only.
+/// `import` for scripts under one folder only; records what it read.
 struct FolderResolver {
     root: PathBuf,
     files: FileModuleResolver,
+    read: Arc<Mutex<Vec<PathBuf>>>,
 }
 
 impl ModuleResolver for FolderResolver {
@@ -151,7 +154,12 @@ impl ModuleResolver for FolderResolver {
     ) -> Result<RhaiShared<Module>, Box<EvalAltResult>> {
         let file = self.root.join(format!("{path}.rhai"));
         let inside = file.canonicalize().is_ok_and(|f| f.starts_with(&self.root));
-        if !inside {
+        if inside {
+            let mut read = self.read.lock().unwrap_or_else(|p| p.into_inner());
+            if !read.contains(&file) {
+                read.push(file.clone());
+            }
+        } else {
             return Err(EvalAltResult::ErrorRuntime(
                 format!(
                     "import \"{path}\": scripts may import only scripts under {}",
@@ -422,7 +430,13 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
     );
 }
 
-fn engine_for(script: &Path, state: &Shared, origin: DVec3, limits: &Limits) -> Engine {
+fn engine_for(
+    script: &Path,
+    state: &Shared,
+    origin: DVec3,
+    limits: &Limits,
+    imports: &Arc<Mutex<Vec<PathBuf>>>,
+) -> Engine {
     let mut engine = Engine::new();
     engine
         .set_max_operations(limits.operations)
@@ -439,6 +453,7 @@ fn engine_for(script: &Path, state: &Shared, origin: DVec3, limits: &Limits) -> 
     engine.set_module_resolver(FolderResolver {
         files: FileModuleResolver::new_with_path(&root),
         root,
+        read: imports.clone(),
     });
     engine.on_print(|_| {});
     engine.on_debug(|_, _, _| {});
@@ -458,14 +473,14 @@ fn compile(engine: &Engine, script: &Path) -> Result<AST, SceneError> {
 /// Runs `script`'s top level, adding its objects to `desc` (after those
 /// already there); records the script as the scene's.
 pub fn run_load(
-    script: &ScriptRef,
+    script_ref: &mut ScriptRef,
     scene_file: &Path,
     desc: &mut SceneDesc,
     diag: &mut Diagnostics,
     limits: &Limits,
 ) -> Result<(), SceneError> {
-    let script_ref = script;
-    let script = script_ref.path.as_path();
+    let path = script_ref.path.clone();
+    let script = path.as_path();
     let state: Shared = Arc::new(Mutex::new(State {
         scene: scene_file.to_path_buf(),
         desc: SceneDesc {
@@ -479,11 +494,13 @@ pub fn run_load(
         on: Vec::new(),
         loading: true,
     }));
-    let engine = engine_for(script, &state, desc.origin, limits);
+    let imports = Arc::new(Mutex::new(Vec::new()));
+    let engine = engine_for(script, &state, desc.origin, limits, &imports);
     let ast = compile(&engine, script)?;
     engine
         .run_ast_with_scope(&mut Scope::new(), &ast)
         .map_err(|e| located(script, &e))?;
+    script_ref.imports = std::mem::take(&mut *imports.lock().unwrap_or_else(|p| p.into_inner()));
     let mut s = lock(&state);
     let added = std::mem::take(&mut s.desc);
     desc.models.extend(added.models);
@@ -537,7 +554,7 @@ impl ScriptRuntime {
             on: vec![true; lights.len()],
             loading: true,
         }));
-        let engine = engine_for(script, &state, origin, limits);
+        let engine = engine_for(script, &state, origin, limits, &Arc::default());
         let ast = compile(&engine, script)?;
         engine
             .run_ast_with_scope(&mut Scope::new(), &ast)
@@ -683,6 +700,7 @@ mod tests {
             path: path.to_path_buf(),
             at: Location::file(path),
             first_light: 0,
+            imports: Vec::new(),
         }
     }
 
@@ -690,13 +708,9 @@ mod tests {
     fn load(dir: &Path, limits: &Limits) -> Result<SceneDesc, SceneError> {
         let path = dir.join("scene.rhai");
         let mut desc = SceneDesc::default();
-        run_load(
-            &script_ref(&path),
-            &path,
-            &mut desc,
-            &mut Diagnostics::default(),
-            limits,
-        )?;
+        let mut script = script_ref(&path);
+        run_load(&mut script, &path, &mut desc, &mut Diagnostics::default(), limits)?;
+        desc.script = Some(script);
         Ok(desc)
     }
 
@@ -922,6 +936,11 @@ mod tests {
         );
         let desc = load(&dir, &Limits::default()).unwrap();
         assert_eq!(point(&desc.lights[0]).color, Vec3::new(1.0, 0.5, 0.25));
+        assert_eq!(
+            desc.script.unwrap().imports,
+            [dir.canonicalize().unwrap().join("lib/colours.rhai")],
+            "imports are recorded, to be watched"
+        );
         std::fs::write(dir.join("scene.rhai"), "import \"../outside\" as o;").unwrap();
         std::fs::write(dir.join("../outside.rhai"), "fn f() { 1 }").unwrap();
         let error = load(&dir, &Limits::default())

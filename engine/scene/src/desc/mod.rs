@@ -181,6 +181,7 @@ fn interpret(
                     path: resolve(path, &name),
                     at,
                     first_light: 0,
+                    imports: Vec::new(),
                 });
             }
         }
