@@ -709,7 +709,13 @@ mod tests {
         let path = dir.join("scene.rhai");
         let mut desc = SceneDesc::default();
         let mut script = script_ref(&path);
-        run_load(&mut script, &path, &mut desc, &mut Diagnostics::default(), limits)?;
+        run_load(
+            &mut script,
+            &path,
+            &mut desc,
+            &mut Diagnostics::default(),
+            limits,
+        )?;
         desc.script = Some(script);
         Ok(desc)
     }
