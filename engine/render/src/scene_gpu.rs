@@ -749,7 +749,8 @@ impl<'g> GpuScene<'g> {
         let (_, rotation) = camera.pose_at(time);
         self.view_volume =
             ViewVolume::new(eye, rotation, camera.fov_y, w / h, camera.near, camera.far);
-        let lights = pack_lights(&self.lights_at(time), &self.bounds);
+        let bounds = self.bounds;
+        let lights = pack_lights(&self.lights_at(time), &bounds);
         let frame = GpuFrame {
             view_proj,
             inv_view_proj: view_proj.inverse(),
@@ -781,16 +782,16 @@ impl GpuScene<'_> {
     /// The lights at `time`: the script's, when it animates them (the last
     /// good step's if `update` fails, with the error kept for
     /// [`GpuScene::take_script_error`]), else the `.scene` motions'.
-    fn lights_at(&mut self, time: f32) -> Vec<weft_scene::Light> {
+    fn lights_at(&mut self, time: f32) -> std::borrow::Cow<'_, [weft_scene::Light]> {
         match self.script.as_mut().filter(|s| s.animates()) {
             Some(script) => {
                 match script.lights_at(f64::from(time)) {
                     Ok(lights) => self.script_lights = lights,
                     Err(e) => self.script_error = Some(e),
                 }
-                self.script_lights.clone()
+                std::borrow::Cow::Borrowed(&self.script_lights)
             }
-            None => weft_scene::animation::lights_at(&self.source_lights, time, 0),
+            None => weft_scene::animation::lights_at(&self.source_lights, time, 0).into(),
         }
     }
 
