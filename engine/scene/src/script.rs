@@ -346,13 +346,13 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
     engine.register_fn("light_position", move |ctx: NativeCallContext, i: INT| {
         let s = lock(&st);
         let i = light_index(&ctx, &s, i)?;
-        let p = match &s.lights[i] {
-            Light::Point(l) => l.position,
-            Light::Spot(l) => l.position,
-            Light::Area(l) => l.position,
-            Light::Sun(l) => l.direction,
+        // Positions are stored relative to the scene's origin; a sun's direction is not a point.
+        let world = match &s.lights[i] {
+            Light::Point(l) => origin + l.position.as_dvec3(),
+            Light::Spot(l) => origin + l.position.as_dvec3(),
+            Light::Area(l) => origin + l.position.as_dvec3(),
+            Light::Sun(l) => l.direction.as_dvec3(),
         };
-        let world = origin + p.as_dvec3();
         Ok::<Array, Box<EvalAltResult>>(vec![world.x.into(), world.y.into(), world.z.into()])
     });
     let st = state.clone();
