@@ -116,3 +116,118 @@ fn lights_a_script_adds_decide_the_passes_like_a_files_lights() {
         "the script adds no point light: {passes:?}"
     );
 }
+
+/// A floor quad (grey) and a unit cube, with the cube also in red.
+const FLOOR_OBJ: &str =
+    "mtllib grey.mtl\nusemtl grey\nv -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\nf 1 3 2\nf 1 4 3\n";
+const CUBE_FACES: &str = "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n\
+    v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n\
+    f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 5 8\nf 1 8 4\n\
+    f 2 3 7\nf 2 7 6\nf 1 2 6\nf 1 6 5\nf 4 8 7\nf 4 7 3\n";
+const LIGHTS: &str = "pointlight\n{\n\tposition 2 4 2\n\tcolor 1 1 1\n\tradius 20\n}\n\
+    sunlight\n{\n\tdirection -0.3 -1 -0.4\n\tcolor 0.5 0.5 0.5\n}\n";
+
+/// The folder of the placement tests: the models, a script that moves the
+/// cube and the camera each step (to x = 1.25, turned 90 degrees, at step
+/// 90 = 1.5 s), and the files that place them there.
+fn placement_scenes() -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("weft-placements-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let files = [
+        ("grey.mtl", "newmtl grey\nKd 0.5 0.5 0.5\n".to_string()),
+        ("red.mtl", "newmtl red\nKd 0.9 0.2 0.1\n".to_string()),
+        ("floor.obj", FLOOR_OBJ.to_string()),
+        ("cube.obj", format!("mtllib grey.mtl\nusemtl grey\n{CUBE_FACES}")),
+        ("cube_red.obj", format!("mtllib red.mtl\nusemtl red\n{CUBE_FACES}")),
+        (
+            "moved.rhai",
+            r#"model("floor.obj", #{});
+model("cube.obj", #{ color: [0.9, 0.2, 0.1] });
+camera("main", #{ position: [0, 3, 6], target: [0, 0, 0] });
+point_light(#{ position: [2, 4, 2], color: [1, 1, 1], radius: 20 });
+sun_light(#{ direction: [-0.3, -1, -0.4], color: [0.5, 0.5, 0.5] });
+fn init() { #{ n: 0 } }
+fn update(t, dt) {
+    this.n += 1;
+    let x = (this.n - 80).to_float() * 0.125;
+    set_model_transform(1, #{ position: [x, 0.5, 0], orientation: [0, this.n, 0] });
+    set_camera("main", #{ position: [x, 3, 6], target: [x, 0.5, 0] });
+}
+"#
+            .to_string(),
+        ),
+        (
+            "placed.scene",
+            format!(
+                "model\n{{\n\tfile \"floor.obj\"\n}}\n\
+                 model\n{{\n\tfile \"cube.obj\"\n\tposition 1.25 0.5 0\n\torientation 0 90 0\n\tcolor 0.9 0.2 0.1\n}}\n\
+                 camera \"main\"\n{{\n\tposition 1.25 3 6\n\ttarget 1.25 0.5 0\n}}\n{LIGHTS}"
+            ),
+        ),
+        (
+            "placed_red.scene",
+            format!(
+                "model\n{{\n\tfile \"floor.obj\"\n}}\n\
+                 model\n{{\n\tfile \"cube_red.obj\"\n\tposition 1.25 0.5 0\n\torientation 0 90 0\n}}\n\
+                 camera \"main\"\n{{\n\tposition 1.25 3 6\n\ttarget 1.25 0.5 0\n}}\n{LIGHTS}"
+            ),
+        ),
+    ];
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    dir
+}
+
+/// The last of `frames` frames of `scene` from `time`, half a second apart,
+/// through `graph_name`, under validation (asserting zero messages).
+fn last_frame(scene: &Path, graph_name: &str, time: f32, frames: u32) -> image::RgbaImage {
+    let loaded = weft_scene::load_scene(scene).expect("scene loads");
+    let gpu = weft_tests::gpu();
+    let log = gpu.validation();
+    let settings = RenderSettings {
+        features: vec!["!bloom".into()],
+        frames,
+        frame_time: 0.5,
+        ..settings(graph_name, 96, 64, time)
+    };
+    let rendered =
+        render(&gpu, &loaded, &settings).unwrap_or_else(|e| panic!("{}: {e}", scene.display()));
+    drop(gpu);
+    assert_eq!(
+        log.messages(),
+        Vec::new(),
+        "{} {graph_name}",
+        scene.display()
+    );
+    rendered.report.output.expect("readback").to_rgba8()
+}
+
+#[test]
+fn a_script_moving_a_placement_and_the_camera_draws_what_a_file_placing_them_there_draws() {
+    let dir = placement_scenes();
+    for graph_name in ["forward.ron", "deferred.ron", "pathtrace.ron"] {
+        // Frame 0 at 1 s (step 60), frame 1 at 1.5 s (step 90): the second
+        // frame rewrites the draw records (and rebuilds the ray tracer's BVH).
+        let moved = last_frame(&dir.join("moved.rhai"), graph_name, 1.0, 2);
+        let placed = last_frame(&dir.join("placed.scene"), graph_name, 0.0, 1);
+        assert!(moved == placed, "{graph_name}: the same image");
+        let before = last_frame(&dir.join("moved.rhai"), graph_name, 1.0, 1);
+        let changed = before
+            .pixels()
+            .zip(placed.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(
+            changed > 500,
+            "{graph_name}: the cube and camera moved: {changed} pixels"
+        );
+    }
+    let red = last_frame(&dir.join("placed_red.scene"), "forward.ron", 0.0, 1);
+    let overridden = last_frame(&dir.join("placed.scene"), "forward.ron", 0.0, 1);
+    assert!(
+        red == overridden,
+        "a grey cube placed with `color 0.9 0.2 0.1` is the red cube"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

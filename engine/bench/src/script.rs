@@ -92,18 +92,12 @@ pub fn run(args: ScriptArgs) -> Result<ExitCode> {
         let scene =
             weft_scene::load_scene(&path).with_context(|| format!("loading {}", path.display()))?;
         let script = scene.script.clone().context("the scene has its script")?;
-        let mut runtime = ScriptRuntime::new(
-            &script,
-            &scene.path,
-            &scene.lights,
-            scene.origin,
-            &Limits::default(),
-        )?;
+        let mut runtime = ScriptRuntime::new(&script, &scene, &Limits::default())?;
         let mut script_ms = Vec::new();
         for frame in 0..args.frames + 10 {
             let t = f64::from(frame + 1) * STEP;
             let started = Instant::now();
-            runtime.lights_at(t)?;
+            runtime.frame_at(t)?;
             if frame >= 10 {
                 script_ms.push(started.elapsed().as_secs_f64() * 1e3);
             }

@@ -28,13 +28,16 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
         scene
             .instances
             .iter()
-            .filter_map(|i| scene.models.get(i.model))
-            .flat_map(|m| {
+            .filter_map(|i| Some((scene.models.get(i.model)?, i.material)))
+            .flat_map(|(m, overrides)| {
                 m.meshes.iter().map(move |mesh| {
-                    mesh.material
-                        .and_then(|i| m.materials.get(i))
-                        .cloned()
-                        .unwrap_or_default()
+                    overrides.apply(
+                        &mesh
+                            .material
+                            .and_then(|i| m.materials.get(i))
+                            .cloned()
+                            .unwrap_or_default(),
+                    )
                 })
             })
     };

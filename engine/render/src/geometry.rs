@@ -7,6 +7,7 @@ use crate::gpu_types::{GpuDraw, GpuVertex};
 use crate::materials;
 use crate::volumes::{self, VolumeMesh};
 use glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
+use std::collections::HashMap;
 use weft_graph::schema::MaterialFilter;
 use weft_scene::tangent_frame::{self, TangentFrame};
 use weft_scene::{Aabb, Material, Mesh, Scene};
@@ -147,6 +148,11 @@ pub struct SceneGeometry {
     pub draw_records: Vec<GpuDraw>,
     /// Draws sorted by material.
     pub draws: Vec<DrawItem>,
+    /// Per scene instance, its draw records (ids), so a moved instance
+    /// rewrites only those ([`SceneGeometry::place_instance`]).
+    pub instance_draws: Vec<std::ops::Range<u32>>,
+    /// Per draw id, the mesh's model-space box and where the draw sits in `draws`.
+    draw_places: Vec<(Aabb, usize)>,
     /// Every material, index 0 being the default for meshes without one.
     pub materials: Vec<Material>,
     /// The point-light volume (see [`crate::volumes::sphere`]).
@@ -206,13 +212,29 @@ impl SceneGeometry {
             }
             ranges.push(model_ranges);
         }
+        // Overridden materials are copies appended once per (material, override).
+        let mut overridden: HashMap<(u32, [u32; 8]), u32> = HashMap::new();
+        let mut local_bounds = Vec::new();
         for instance in &scene.instances {
+            let first = g.draw_records.len() as u32;
             let Some(model_ranges) = ranges.get(instance.model) else {
+                g.instance_draws.push(first..first);
                 continue;
             };
             let normal = instance.transform.inverse().transpose();
             let mirrored = instance.transform.determinant() < 0.0;
             for &(range, material, bounds, uv_box) in model_ranges.iter().flatten() {
+                let material = if instance.material.is_empty() {
+                    material
+                } else {
+                    *overridden
+                        .entry((material, instance.material.key()))
+                        .or_insert_with(|| {
+                            let copy = instance.material.apply(&g.materials[material as usize]);
+                            g.materials.push(copy);
+                            g.materials.len() as u32 - 1
+                        })
+                };
                 let draw_id = g.draws.len() as u32;
                 g.draw_records.push(GpuDraw {
                     model: instance.transform,
@@ -232,12 +254,46 @@ impl SceneGeometry {
                     mirrored,
                     bounds: bounds.transformed(&instance.transform),
                 });
+                local_bounds.push(bounds);
             }
+            g.instance_draws.push(first..g.draw_records.len() as u32);
         }
         g.draws.sort_by_key(|d| (d.material, d.draw_id));
+        g.draw_places = local_bounds.into_iter().map(|b| (b, 0)).collect();
+        for (slot, d) in g.draws.iter().enumerate() {
+            g.draw_places[d.draw_id as usize].1 = slot;
+        }
         g.sphere = g.append_volume(&volumes::sphere());
         g.cone = g.append_volume(&volumes::cone());
         g
+    }
+
+    /// Moves scene instance `instance` to `transform`: its draw records and
+    /// their world boxes; returns the draw ids rewritten (empty for an
+    /// instance that has none).
+    pub fn place_instance(&mut self, instance: usize, transform: Mat4) -> std::ops::Range<u32> {
+        let Some(ids) = self.instance_draws.get(instance).cloned() else {
+            return 0..0;
+        };
+        let normal = transform.inverse().transpose();
+        let mirrored = transform.determinant() < 0.0;
+        for id in ids.clone() {
+            let record = &mut self.draw_records[id as usize];
+            record.model = transform;
+            record.normal = normal;
+            let (local, slot) = self.draw_places[id as usize];
+            let draw = &mut self.draws[slot];
+            draw.bounds = local.transformed(&transform);
+            draw.mirrored = mirrored;
+        }
+        ids
+    }
+
+    /// The box around every draw as placed now.
+    pub fn placed_bounds(&self) -> Aabb {
+        self.draws
+            .iter()
+            .fold(Aabb::EMPTY, |b, d| b.union(&d.bounds))
     }
 
     /// Appends a mesh's vertices (frames packed, UVs against `uv_box`) and its

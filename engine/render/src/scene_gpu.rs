@@ -342,8 +342,8 @@ pub struct GpuScene<'g> {
     pub scene_set: vk::DescriptorSet,
     /// Set 2 per material.
     pub material_sets: Vec<vk::DescriptorSet>,
-    /// Set 1 for layouts the executor built from reflection.
-    foreign_sets: HashMap<vk::DescriptorSetLayout, vk::DescriptorSet>,
+    /// Set 1 for layouts the executor built from reflection, with the bindings written.
+    foreign_sets: HashMap<vk::DescriptorSetLayout, (vk::DescriptorSet, Vec<u32>)>,
     /// Built on first use by a ray-tracing pass.
     trace: Option<TraceBuffers<'g>>,
     /// Where the BVH is cached (`crate::bvh_cache`); `None` builds it every time.
@@ -355,8 +355,14 @@ pub struct GpuScene<'g> {
     /// The script's last error in `update`; the frame kept the lights of the
     /// last good step. Taken by [`GpuScene::take_script_error`].
     script_error: Option<weft_scene::SceneError>,
-    /// The lights of the last frame the script computed.
-    script_lights: Vec<weft_scene::Light>,
+    /// What the script left for the last frame it computed.
+    script_frame: weft_scene::script::ScriptFrame,
+    /// Each scene instance's transform as the draw records hold it.
+    transforms: Vec<glam::Mat4>,
+    /// The scene's `boundingbox`, which moving placements do not change.
+    declared_bounds: Option<weft_scene::Aabb>,
+    /// Whether the script has moved a placement since the scene loaded.
+    moved: bool,
     bounds: weft_scene::Aabb,
     /// The camera's view volume at the last update, what sun cascades are fitted to.
     pub view_volume: ViewVolume,
@@ -409,12 +415,33 @@ impl<'g> GpuScene<'g> {
             &index_bytes,
             vk::BufferUsageFlags::INDEX_BUFFER | storage,
         )?;
-        let draws = Buffer::device_local(
-            gpu,
-            "scene draws",
-            bytes_of(&geometry.draw_records),
-            storage,
-        )?;
+        let script = match &scene.script {
+            Some(script) => Some(weft_scene::script::ScriptRuntime::new(
+                script,
+                scene,
+                &weft_scene::script::Limits::default(),
+            )?),
+            None => None,
+        };
+        // A script that animates may move placements: their draw records are
+        // then rewritten in place each frame.
+        let draws = if script.as_ref().is_some_and(|s| s.animates()) {
+            let mut draws = Buffer::host(
+                gpu,
+                "scene draws",
+                std::mem::size_of_val(geometry.draw_records.as_slice()).max(1) as u64,
+                storage,
+            )?;
+            draws.write(bytes_of(&geometry.draw_records))?;
+            draws
+        } else {
+            Buffer::device_local(
+                gpu,
+                "scene draws",
+                bytes_of(&geometry.draw_records),
+                storage,
+            )?
+        };
         let mut textures = vec![Texture::upload(gpu, "white", &Rgba8Image::white(), true)?];
         let mut by_source: HashMap<(String, bool), usize> = HashMap::new();
         let mut material_texture = Vec::with_capacity(geometry.materials.len());
@@ -500,18 +527,16 @@ impl<'g> GpuScene<'g> {
             material_sets: Vec::new(),
             foreign_sets: HashMap::new(),
             source_lights: scene.lights.clone(),
-            script: match &scene.script {
-                Some(script) => Some(weft_scene::script::ScriptRuntime::new(
-                    script,
-                    &scene.path,
-                    &scene.lights,
-                    scene.origin,
-                    &weft_scene::script::Limits::default(),
-                )?),
-                None => None,
-            },
+            script,
             script_error: None,
-            script_lights: scene.lights.clone(),
+            script_frame: weft_scene::script::ScriptFrame {
+                lights: scene.lights.clone(),
+                transforms: scene.instances.iter().map(|i| i.transform).collect(),
+                cameras: Vec::new(),
+            },
+            transforms: scene.instances.iter().map(|i| i.transform).collect(),
+            declared_bounds: scene.declared_bounds,
+            moved: false,
             trace: None,
             bvh_cache: None,
             bounds,
@@ -600,7 +625,9 @@ impl<'g> GpuScene<'g> {
             return Ok(());
         }
         let mesh = self.geometry.trace_mesh();
-        let bvh = crate::bvh_cache::load_or_build(&mesh.corners, self.bvh_cache.as_deref());
+        // Placements a script moves give new geometry each frame: not cached.
+        let cache = self.bvh_cache.as_deref().filter(|_| !self.moved);
+        let bvh = crate::bvh_cache::load_or_build(&mesh.corners, cache);
         let corners: Vec<[f32; 4]> = mesh
             .corners
             .iter()
@@ -715,8 +742,8 @@ impl<'g> GpuScene<'g> {
         layout: vk::DescriptorSetLayout,
         bindings: impl FnOnce() -> Result<Vec<u32>, GpuError>,
     ) -> Result<vk::DescriptorSet, GpuError> {
-        if let Some(&set) = self.foreign_sets.get(&layout) {
-            return Ok(set);
+        if let Some((set, _)) = self.foreign_sets.get(&layout) {
+            return Ok(*set);
         }
         let bindings = bindings()?;
         if TRACE_SET_BINDINGS
@@ -727,7 +754,7 @@ impl<'g> GpuScene<'g> {
         }
         let set = self.pool.allocate(layout)?;
         self.write_scene_set(set, &bindings);
-        self.foreign_sets.insert(layout, set);
+        self.foreign_sets.insert(layout, (set, bindings));
         Ok(set)
     }
 
@@ -741,6 +768,15 @@ impl<'g> GpuScene<'g> {
         time: f32,
         extent: [u32; 2],
     ) -> Result<u64, GpuError> {
+        self.run_script(time);
+        self.place_instances()?;
+        let scripted = self
+            .script_frame
+            .cameras
+            .iter()
+            .find(|c| c.name == camera.name)
+            .cloned();
+        let camera = scripted.as_ref().unwrap_or(camera);
         let [w, h] = [extent[0].max(1) as f32, extent[1].max(1) as f32];
         let view_proj = camera::view_projection(camera, time, w / h);
         let eye = camera::camera_position(camera, time);
@@ -773,26 +809,90 @@ impl<'g> GpuScene<'g> {
         let mut inputs = std::collections::hash_map::DefaultHasher::new();
         std::hash::Hash::hash(bytes_of(&[frame]), &mut inputs);
         std::hash::Hash::hash(bytes_of(&lights.records), &mut inputs);
+        std::hash::Hash::hash(bytes_of(&self.transforms), &mut inputs);
         self.light_set = lights;
         Ok(std::hash::Hasher::finish(&inputs))
     }
 }
 
 impl GpuScene<'_> {
-    /// The lights at `time`: the script's, when it animates them (the last
-    /// good step's if `update` fails, with the error kept for
-    /// [`GpuScene::take_script_error`]), else the `.scene` motions'.
-    fn lights_at(&mut self, time: f32) -> std::borrow::Cow<'_, [weft_scene::Light]> {
-        match self.script.as_mut().filter(|s| s.animates()) {
-            Some(script) => {
-                match script.lights_at(f64::from(time)) {
-                    Ok(lights) => self.script_lights = lights,
-                    Err(e) => self.script_error = Some(e),
-                }
-                std::borrow::Cow::Borrowed(&self.script_lights)
+    /// Runs the script, when it animates, up to `time`; on an error keeps
+    /// the last good step's frame, with the error for
+    /// [`GpuScene::take_script_error`].
+    fn run_script(&mut self, time: f32) {
+        if let Some(script) = self.script.as_mut().filter(|s| s.animates()) {
+            match script.frame_at(f64::from(time)) {
+                Ok(frame) => self.script_frame = frame,
+                Err(e) => self.script_error = Some(e),
             }
-            None => weft_scene::animation::lights_at(&self.source_lights, time, 0).into(),
         }
+    }
+
+    /// The lights at `time`: the script's, when it animates them, else the
+    /// `.scene` motions'.
+    fn lights_at(&self, time: f32) -> std::borrow::Cow<'_, [weft_scene::Light]> {
+        if self.script.as_ref().is_some_and(|s| s.animates()) {
+            std::borrow::Cow::Borrowed(&self.script_frame.lights)
+        } else {
+            weft_scene::animation::lights_at(&self.source_lights, time, 0).into()
+        }
+    }
+
+    /// Moves the placements the script moved: their draw records rewritten
+    /// in place as one range, the scene's box refitted (unless declared),
+    /// and the ray tracer's triangles and BVH rebuilt if a pass traces.
+    fn place_instances(&mut self) -> Result<(), GpuError> {
+        if !self.script.as_ref().is_some_and(|s| s.animates()) {
+            return Ok(());
+        }
+        let mut changed: Option<std::ops::Range<u32>> = None;
+        for (i, (new, old)) in self
+            .script_frame
+            .transforms
+            .iter()
+            .zip(self.transforms.iter_mut())
+            .enumerate()
+        {
+            if new == old {
+                continue;
+            }
+            *old = *new;
+            let ids = self.geometry.place_instance(i, *new);
+            if ids.is_empty() {
+                continue;
+            }
+            changed = Some(match changed {
+                Some(c) => c.start.min(ids.start)..c.end.max(ids.end),
+                None => ids,
+            });
+        }
+        let Some(ids) = changed else {
+            return Ok(());
+        };
+        self.moved = true;
+        let records = &self.geometry.draw_records[ids.start as usize..ids.end as usize];
+        self.draws.write_at(
+            ids.start as usize * std::mem::size_of::<crate::gpu_types::GpuDraw>(),
+            bytes_of(records),
+        )?;
+        if self.declared_bounds.is_none() {
+            self.bounds = self.geometry.placed_bounds();
+        }
+        if self.trace.is_some() {
+            self.trace = None;
+            self.ensure_trace_buffers()?;
+            let sets: Vec<(vk::DescriptorSet, Vec<u32>)> =
+                self.foreign_sets.values().cloned().collect();
+            for (set, bindings) in sets {
+                if TRACE_SET_BINDINGS
+                    .iter()
+                    .any(|(b, _, _)| bindings.contains(b))
+                {
+                    self.write_scene_set(set, &bindings);
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The scene script's error from the last frames, if `update` failed.

@@ -43,6 +43,7 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
                 absorption: None,
                 ior: None,
                 thin: None,
+                material: Default::default(),
             }],
             ..SceneDesc::default()
         }
@@ -52,6 +53,7 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
                 path: path.to_path_buf(),
                 at: Location::file(path),
                 first_light: 0,
+                first_model: 0,
                 imports: Vec::new(),
             }),
             ..SceneDesc::default()
@@ -60,6 +62,7 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
         read_scene_desc(path, &mut diag)?
     };
     let mut desc = desc;
+    let mut preloaded = HashMap::new();
     if let Some(mut script) = desc.script.take() {
         // The script's objects follow every object of the file.
         script.first_light = desc.lights.len();
@@ -69,10 +72,16 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
                 message: format!("script {} not found", script.path.display()),
             });
         }
-        crate::script::run_load(&mut script, path, &mut desc, &mut diag, &Limits::default())?;
+        preloaded = crate::script::run_load(
+            &mut script,
+            path,
+            &mut desc,
+            &mut diag,
+            (options, &Limits::default()),
+        )?;
         desc.script = Some(script);
     }
-    build(path, desc, options, &mut diag)
+    build(path, desc, (options, preloaded), &mut diag)
 }
 
 /// Whether the path names a model file rather than a scene file.
@@ -120,11 +129,12 @@ pub fn load_model(
     })
 }
 
-/// Turns a description into a scene.
+/// Turns a description into a scene; `preloaded` holds model files already
+/// read (by canonical path).
 fn build(
     path: &Path,
     desc: SceneDesc,
-    options: &LoadOptions,
+    (options, preloaded): (&LoadOptions, HashMap<PathBuf, Model>),
     diag: &mut Diagnostics,
 ) -> Result<Scene, SceneError> {
     let mut models: Vec<Model> = Vec::new();
@@ -142,7 +152,7 @@ fn build(
             .absorption
             .map_or([u32::MAX; 3], |s| s.to_array().map(f32::to_bits));
         let key = (
-            path,
+            path.clone(),
             [
                 sigma[0],
                 sigma[1],
@@ -154,7 +164,10 @@ fn build(
         let index = match by_file.get(&key) {
             Some(&i) => i,
             None => {
-                let mut model = load_model(&placement.file, &placement.at, options, diag)?;
+                let mut model = match preloaded.get(&path) {
+                    Some(model) => model.clone(),
+                    None => load_model(&placement.file, &placement.at, options, diag)?,
+                };
                 override_glass(&mut model, placement);
                 models.push(model);
                 by_file.insert(key, models.len() - 1);
@@ -179,6 +192,7 @@ fn build(
             model: index,
             transform: m,
             bounds: placed,
+            material: placement.material,
         });
     }
     let bounds = instances

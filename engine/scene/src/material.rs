@@ -186,6 +186,66 @@ pub struct Material {
     pub textures: MaterialTextures,
 }
 
+/// A `model` block's replacements for the factors of every material of that
+/// placement (scenes/FORMAT.md, "Material overrides"); textures stay and are
+/// multiplied by the new factors as before. Placements of one file share its
+/// geometry whatever their overrides.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MaterialOverride {
+    /// `color r g b`: the diffuse or base colour (alpha kept).
+    pub color: Option<Vec3>,
+    /// `emission r g b`: the emitted radiance.
+    pub emission: Option<Vec3>,
+    /// `roughness r` in [0, 1]; makes the material metallic-roughness.
+    pub roughness: Option<f32>,
+    /// `metallic m` in [0, 1]; makes the material metallic-roughness.
+    pub metallic: Option<f32>,
+}
+
+impl MaterialOverride {
+    /// Whether it replaces nothing.
+    pub fn is_empty(&self) -> bool {
+        *self == Self::default()
+    }
+
+    /// `material` with the factors replaced. Setting roughness or metallic on
+    /// a Blinn-Phong (MTL) material turns it metallic-roughness: its diffuse
+    /// colour becomes the base colour, roughness defaults to the one derived
+    /// from `Ns`, and metallic to 0.
+    pub fn apply(&self, material: &Material) -> Material {
+        let mut m = material.clone();
+        if let Some(c) = self.color {
+            m.base_color = c.extend(m.base_color.w);
+        }
+        if let Some(e) = self.emission {
+            m.emissive = e;
+        }
+        if self.roughness.is_some() || self.metallic.is_some() {
+            m.shading = ShadingModel::MetallicRoughness;
+            m.roughness = self.roughness.unwrap_or(m.roughness);
+            m.metallic = self.metallic.unwrap_or(m.metallic);
+        }
+        m
+    }
+
+    /// The override's exact bits, to tell overrides apart as map keys.
+    pub fn key(&self) -> [u32; 8] {
+        let bits = |v: Option<Vec3>| v.map_or([u32::MAX; 3], |v| v.to_array().map(f32::to_bits));
+        let [r, g, b] = bits(self.color);
+        let [er, eg, eb] = bits(self.emission);
+        [
+            r,
+            g,
+            b,
+            er,
+            eg,
+            eb,
+            self.roughness.map_or(u32::MAX, f32::to_bits),
+            self.metallic.map_or(u32::MAX, f32::to_bits),
+        ]
+    }
+}
+
 impl Default for Material {
     /// The material for meshes without one: mid grey, rough, opaque.
     fn default() -> Self {

@@ -5,6 +5,7 @@ use crate::bounds::Aabb;
 use crate::camera::Camera;
 use crate::error::Warning;
 use crate::light::Light;
+use crate::material::MaterialOverride;
 use crate::model::Model;
 use glam::Mat4;
 use std::path::PathBuf;
@@ -18,6 +19,8 @@ pub struct Instance {
     pub transform: Mat4,
     /// World-space box around the placed model.
     pub bounds: Aabb,
+    /// Factors that replace the model's for this placement only.
+    pub material: MaterialOverride,
 }
 
 /// A loaded scene.

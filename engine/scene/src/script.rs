@@ -7,7 +7,11 @@
 //! becomes an object block read by the `.scene` reader itself, so a script
 //! and a file mean the same thing and are validated the same way.
 //!
-//! Per frame, `fn update(t, dt)` moves, recolours and switches lights. Time
+//! At load a script may also read the bounds of the models placed so far
+//! (`scene_bounds()`, which loads them; the scene reuses what it loaded).
+//!
+//! Per frame, `fn update(t, dt)` moves, recolours and switches lights, moves
+//! model placements and cameras ([`ScriptFrame`]). Time
 //! advances in fixed steps of [`STEP`] from 0, so the lights at time `t` are
 //! the same on every run and every machine, however the frames fell: `weft
 //! render --time T` is deterministic and golden-testable. `fn init()`, when
@@ -20,16 +24,22 @@
 //! ([`Limits`]). A script that breaks a limit, loops forever or fails gets a
 //! located error (file:line:column).
 
+use crate::bounds::Aabb;
+use crate::camera::Camera;
 use crate::desc::{blocks_into, SceneDesc};
 use crate::error::{Diagnostics, Location, SceneError};
 use crate::light::Light;
+use crate::load::{load_model, LoadOptions};
+use crate::model::Model;
 use crate::rng::Rng;
-use glam::{DVec3, Vec3};
+use crate::scene::Scene;
+use glam::{DVec3, Mat4, Vec3};
 use rhai::module_resolvers::FileModuleResolver;
 use rhai::{
     Array, CallFnOptions, Dynamic, Engine, EvalAltResult, Map, Module, ModuleResolver,
     NativeCallContext, Position, Scope, Shared as RhaiShared, AST, FLOAT, INT,
 };
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -43,6 +53,8 @@ pub struct ScriptRef {
     pub at: Location,
     /// Lights the scene declared before the script's.
     pub first_light: usize,
+    /// Model placements the scene declared before the script's.
+    pub first_model: usize,
     /// The scripts it imported while loading, so they are watched too.
     pub imports: Vec<PathBuf>,
 }
@@ -92,14 +104,94 @@ struct State {
     desc: SceneDesc,
     /// Lights the scene had before the script's, so a light's index counts every light.
     lights_before: usize,
+    /// The scene's placements before the script's (file, transform), for bounds
+    /// and so a placement's index counts every placement.
+    models_before: Vec<(PathBuf, Mat4)>,
     /// Problems the `.scene` reader reported for added objects.
     diag: Diagnostics,
     rng: Rng,
+    /// How model files are loaded for `scene_bounds`.
+    options: LoadOptions,
+    /// Model files `scene_bounds` loaded, by canonical path, for the scene to reuse.
+    models: HashMap<PathBuf, Model>,
+    /// Each model file's bounds, by canonical path.
+    model_bounds: HashMap<PathBuf, Aabb>,
+    /// After the load: the loaded scene's bounds (relative to the origin).
+    scene_bounds: Aabb,
     /// Per frame: the scene's lights as the script leaves them, and which are on.
     lights: Vec<Light>,
     on: Vec<bool>,
+    /// Per frame: each placement's model-to-world transform (relative to the origin).
+    transforms: Vec<Mat4>,
+    /// Per frame: the scene's cameras, and which the script has set.
+    cameras: Vec<Camera>,
+    camera_set: Vec<bool>,
     /// Whether objects may be added (the load) or lights changed (init, update).
     loading: bool,
+}
+
+impl State {
+    /// The state for loading `scene_file`'s script, with nothing per frame yet.
+    fn loading(
+        script_ref: &ScriptRef,
+        scene_file: &Path,
+        origin: DVec3,
+        options: &LoadOptions,
+    ) -> Self {
+        Self {
+            scene: scene_file.to_path_buf(),
+            desc: SceneDesc {
+                origin,
+                ..SceneDesc::default()
+            },
+            lights_before: script_ref.first_light,
+            models_before: Vec::new(),
+            diag: Diagnostics::default(),
+            rng: Rng::new(0),
+            options: options.clone(),
+            models: HashMap::new(),
+            model_bounds: HashMap::new(),
+            scene_bounds: Aabb::EMPTY,
+            lights: Vec::new(),
+            on: Vec::new(),
+            transforms: Vec::new(),
+            cameras: Vec::new(),
+            camera_set: Vec::new(),
+            loading: true,
+        }
+    }
+
+    /// The bounds (relative to the origin) of every model placed so far,
+    /// loading model files not yet read.
+    fn placed_bounds(&mut self) -> Result<Aabb, SceneError> {
+        let placed: Vec<(PathBuf, Mat4, Location)> = self
+            .models_before
+            .iter()
+            .map(|(file, m)| (file.clone(), *m, Location::file(file)))
+            .chain(
+                self.desc
+                    .models
+                    .iter()
+                    .map(|p| (p.file.clone(), p.transform, p.at.clone())),
+            )
+            .collect();
+        let mut bounds = Aabb::EMPTY;
+        for (file, transform, at) in placed {
+            let key = file.canonicalize().unwrap_or_else(|_| file.clone());
+            let local = match self.model_bounds.get(&key) {
+                Some(b) => *b,
+                None => {
+                    let model = load_model(&file, &at, &self.options, &mut self.diag)?;
+                    let b = model.bounds;
+                    self.model_bounds.insert(key.clone(), b);
+                    self.models.insert(key, model);
+                    b
+                }
+            };
+            bounds = bounds.union(&local.transformed(&transform));
+        }
+        Ok(bounds)
+    }
 }
 
 type Shared = Arc<Mutex<State>>;
@@ -227,8 +319,8 @@ fn block_text(kind: &str, label: Option<&str>, props: &Map) -> Result<String, St
     Ok(text)
 }
 
-/// Adds one object through the `.scene` reader; returns the new light's index
-/// over every light of the scene, for lights.
+/// Adds one object through the `.scene` reader; returns the new object's
+/// index over every object of its kind in the scene, for lights and models.
 fn add_object(
     ctx: &NativeCallContext,
     state: &Shared,
@@ -248,7 +340,62 @@ fn add_object(
     let State { desc, diag, .. } = &mut *s;
     blocks_into(&text, &scene, desc, diag)
         .map_err(|e| fail(ctx, format!("{kind}: {}", e.message())))?;
-    Ok((s.lights_before + s.desc.lights.len()) as INT - 1)
+    let count = match kind {
+        "model" => s.models_before.len() + s.desc.models.len(),
+        _ => s.lights_before + s.desc.lights.len(),
+    };
+    Ok(count as INT - 1)
+}
+
+/// The object of `kind` that `props` describe, read by the `.scene` reader
+/// (so a per-frame pose means what the same block in a file means), from
+/// the properties in `allowed` only.
+fn read_object(
+    ctx: &NativeCallContext,
+    s: &State,
+    function: &str,
+    (kind, label): (&str, Option<&str>),
+    props: &Map,
+    allowed: &[&str],
+) -> Result<SceneDesc, Box<EvalAltResult>> {
+    if let Some(key) = props.keys().find(|k| !allowed.contains(&k.as_str())) {
+        return Err(fail(
+            ctx,
+            format!("{function} takes {}; not '{key}'", allowed.join(", ")),
+        ));
+    }
+    let mut props = props.clone();
+    if kind == "model" {
+        props.insert("file".into(), "-".into());
+    }
+    let text = block_text(kind, label, &props).map_err(|m| fail(ctx, m))?;
+    let mut desc = SceneDesc {
+        origin: s.desc.origin,
+        ..SceneDesc::default()
+    };
+    blocks_into(&text, &s.scene, &mut desc, &mut Diagnostics::default())
+        .map_err(|e| fail(ctx, format!("{function}: {}", e.message())))?;
+    Ok(desc)
+}
+
+/// The index of the `what` that `index` refers to (of `count`), for the
+/// per-frame functions.
+fn frame_index(
+    ctx: &NativeCallContext,
+    s: &State,
+    (what, count): (&str, usize),
+    index: INT,
+) -> Result<usize, Box<EvalAltResult>> {
+    if s.loading {
+        return Err(fail(
+            ctx,
+            format!("{what}s are changed in init or update, after the scene has loaded"),
+        ));
+    }
+    usize::try_from(index)
+        .ok()
+        .filter(|&i| i < count)
+        .ok_or_else(|| fail(ctx, format!("no {what} {index}: the scene has {count}")))
 }
 
 /// The light `index` refers to, for the per-frame functions.
@@ -257,21 +404,12 @@ fn light_index(
     s: &State,
     index: INT,
 ) -> Result<usize, Box<EvalAltResult>> {
-    if s.loading {
-        return Err(fail(
-            ctx,
-            "lights are changed in init or update, after the scene has loaded",
-        ));
-    }
-    usize::try_from(index)
-        .ok()
-        .filter(|&i| i < s.lights.len())
-        .ok_or_else(|| {
-            fail(
-                ctx,
-                format!("no light {index}: the scene has {}", s.lights.len()),
-            )
-        })
+    frame_index(ctx, s, ("light", s.lights.len()), index)
+}
+
+/// `v` as a script array of three floats.
+fn array3(v: DVec3) -> Array {
+    vec![v.x.into(), v.y.into(), v.z.into()]
 }
 
 /// Three numbers (integers or floats) as a finite vector.
@@ -311,9 +449,11 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
         move |ctx: NativeCallContext, file: &str, props: Map| {
             let mut props = props;
             props.insert("file".into(), file.into());
-            add_object(&ctx, &st, "model", None, &props).map(|_| ())
+            add_object(&ctx, &st, "model", None, &props)
         },
     );
+    register_models(engine, state, origin);
+    register_cameras(engine, state);
     let st = state.clone();
     engine.register_fn(
         "camera",
@@ -430,6 +570,114 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
     );
 }
 
+/// The functions on model placements: their count and bounds, and per frame
+/// their transforms.
+fn register_models(engine: &mut Engine, state: &Shared, origin: DVec3) {
+    let st = state.clone();
+    engine.register_fn("model_count", move || {
+        let s = lock(&st);
+        (if s.loading {
+            s.models_before.len() + s.desc.models.len()
+        } else {
+            s.transforms.len()
+        }) as INT
+    });
+    let st = state.clone();
+    engine.register_fn("scene_bounds", move |ctx: NativeCallContext| {
+        let mut s = lock(&st);
+        let bounds = if s.loading {
+            s.placed_bounds()
+                .map_err(|e| fail(&ctx, format!("scene_bounds: {e}")))?
+        } else {
+            s.scene_bounds
+        };
+        if bounds.is_empty() {
+            return Err(fail(&ctx, "scene_bounds: no model is placed yet"));
+        }
+        let mut map = Map::new();
+        map.insert("min".into(), array3(origin + bounds.min.as_dvec3()).into());
+        map.insert("max".into(), array3(origin + bounds.max.as_dvec3()).into());
+        Ok::<Map, Box<EvalAltResult>>(map)
+    });
+    let st = state.clone();
+    engine.register_fn("model_position", move |ctx: NativeCallContext, i: INT| {
+        let s = lock(&st);
+        let i = frame_index(&ctx, &s, ("model", s.transforms.len()), i)?;
+        let p = s.transforms[i].w_axis.truncate().as_dvec3();
+        Ok::<Array, Box<EvalAltResult>>(array3(origin + p))
+    });
+    let st = state.clone();
+    engine.register_fn(
+        "set_model_transform",
+        move |ctx: NativeCallContext, i: INT, props: Map| {
+            let mut s = lock(&st);
+            let i = frame_index(&ctx, &s, ("model", s.transforms.len()), i)?;
+            let desc = read_object(
+                &ctx,
+                &s,
+                "set_model_transform",
+                ("model", None),
+                &props,
+                &["position", "orientation", "scale"],
+            )?;
+            let transform = desc.models[0].transform;
+            if !transform.is_finite() {
+                return Err(fail(
+                    &ctx,
+                    "set_model_transform: the transform is not finite",
+                ));
+            }
+            s.transforms[i] = transform;
+            Ok::<(), Box<EvalAltResult>>(())
+        },
+    );
+}
+
+/// `set_camera`: a camera's pose (and field of view) per frame.
+fn register_cameras(engine: &mut Engine, state: &Shared) {
+    let st = state.clone();
+    engine.register_fn(
+        "set_camera",
+        move |ctx: NativeCallContext, name: &str, props: Map| {
+            let mut s = lock(&st);
+            if s.loading {
+                return Err(fail(
+                    &ctx,
+                    "cameras are moved in init or update; at load, add them with camera(name, #{...})",
+                ));
+            }
+            let Some(i) = s.cameras.iter().position(|c| c.name == name) else {
+                let names: Vec<&str> = s.cameras.iter().map(|c| c.name.as_str()).collect();
+                return Err(fail(
+                    &ctx,
+                    format!("no camera '{name}': the scene has {}", names.join(", ")),
+                ));
+            };
+            if !props.contains_key("position") {
+                return Err(fail(&ctx, "set_camera needs a 'position'"));
+            }
+            let desc = read_object(
+                &ctx,
+                &s,
+                "set_camera",
+                ("camera", Some(name)),
+                &props,
+                &["position", "target", "orientation", "fov", "fov_deg"],
+            )?;
+            let set = &desc.cameras[0];
+            let camera = &mut s.cameras[i];
+            camera.position = set.position;
+            camera.orientation = set.orientation;
+            if props.contains_key("fov") || props.contains_key("fov_deg") {
+                camera.fov_y = set.fov_y;
+            }
+            camera.path.clear();
+            s.camera_set[i] = true;
+            Ok::<(), Box<EvalAltResult>>(())
+        },
+    );
+}
+
 fn engine_for(
     script: &Path,
     state: &Shared,
@@ -471,29 +719,25 @@ fn compile(engine: &Engine, script: &Path) -> Result<AST, SceneError> {
 }
 
 /// Runs `script`'s top level, adding its objects to `desc` (after those
-/// already there); records the script as the scene's.
+/// already there); records the script as the scene's. Returns the model
+/// files `scene_bounds` loaded, by canonical path, for the scene to reuse.
 pub fn run_load(
     script_ref: &mut ScriptRef,
     scene_file: &Path,
     desc: &mut SceneDesc,
     diag: &mut Diagnostics,
-    limits: &Limits,
-) -> Result<(), SceneError> {
+    (options, limits): (&LoadOptions, &Limits),
+) -> Result<HashMap<PathBuf, Model>, SceneError> {
     let path = script_ref.path.clone();
     let script = path.as_path();
-    let state: Shared = Arc::new(Mutex::new(State {
-        scene: scene_file.to_path_buf(),
-        desc: SceneDesc {
-            origin: desc.origin,
-            ..SceneDesc::default()
-        },
-        lights_before: script_ref.first_light,
-        diag: Diagnostics::default(),
-        rng: Rng::new(0),
-        lights: Vec::new(),
-        on: Vec::new(),
-        loading: true,
-    }));
+    script_ref.first_model = desc.models.len();
+    let mut loading = State::loading(script_ref, scene_file, desc.origin, options);
+    loading.models_before = desc
+        .models
+        .iter()
+        .map(|p| (p.file.clone(), p.transform))
+        .collect();
+    let state: Shared = Arc::new(Mutex::new(loading));
     let imports = Arc::new(Mutex::new(Vec::new()));
     let engine = engine_for(script, &state, desc.origin, limits, &imports);
     let ast = compile(&engine, script)?;
@@ -510,17 +754,35 @@ pub fn run_load(
         desc.bounding_box = added.bounding_box;
     }
     diag.warnings.append(&mut s.diag.warnings);
-    Ok(())
+    Ok(std::mem::take(&mut s.models))
 }
 
-/// A loaded scene's script, running per frame: the lights at a time.
+/// What a script's `update` leaves for a frame.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ScriptFrame {
+    /// Every light of the scene (those switched off with zero colour).
+    pub lights: Vec<Light>,
+    /// Every placement's model-to-world transform, relative to the origin.
+    pub transforms: Vec<Mat4>,
+    /// The cameras the script has set since time 0, with their paths cleared.
+    pub cameras: Vec<Camera>,
+}
+
+/// The per-frame objects as the scene loaded them, to start over from.
+struct Loaded {
+    lights: Vec<Light>,
+    transforms: Vec<Mat4>,
+    cameras: Vec<Camera>,
+}
+
+/// A loaded scene's script, running per frame: the lights, placements and
+/// cameras at a time.
 pub struct ScriptRuntime {
     script: PathBuf,
     engine: Engine,
     ast: AST,
     state: Shared,
-    /// The scene's lights as loaded, to start over from.
-    loaded: Vec<Light>,
+    loaded: Loaded,
     has_init: bool,
     has_update: bool,
     /// `init`'s value, seen by `update` as `this`.
@@ -530,30 +792,32 @@ pub struct ScriptRuntime {
 }
 
 impl ScriptRuntime {
-    /// The runtime for `scene`'s script, with the scene's lights as loaded
+    /// The runtime for `scene`'s script, with the scene's objects as loaded
     /// (the script's own included): runs the load again for the script's
-    /// random state, then `init`.
-    pub fn new(
-        script_ref: &ScriptRef,
-        scene_file: &Path,
-        lights: &[Light],
-        origin: DVec3,
-        limits: &Limits,
-    ) -> Result<Self, SceneError> {
+    /// random state (reading bounds from the loaded models), then `init`.
+    pub fn new(script_ref: &ScriptRef, scene: &Scene, limits: &Limits) -> Result<Self, SceneError> {
         let script = script_ref.path.as_path();
-        let state: Shared = Arc::new(Mutex::new(State {
-            scene: scene_file.to_path_buf(),
-            desc: SceneDesc {
-                origin,
-                ..SceneDesc::default()
-            },
-            lights_before: script_ref.first_light,
-            diag: Diagnostics::default(),
-            rng: Rng::new(0),
-            lights: lights.to_vec(),
-            on: vec![true; lights.len()],
-            loading: true,
-        }));
+        let origin = scene.origin;
+        let canonical = |p: &Path| p.canonicalize().unwrap_or_else(|_| p.to_path_buf());
+        let mut loading = State::loading(script_ref, &scene.path, origin, &LoadOptions::default());
+        loading.models_before = scene
+            .instances
+            .iter()
+            .take(script_ref.first_model)
+            .filter_map(|i| Some((scene.models.get(i.model)?.path.clone(), i.transform)))
+            .collect();
+        loading.model_bounds = scene
+            .models
+            .iter()
+            .map(|m| (canonical(&m.path), m.bounds))
+            .collect();
+        loading.scene_bounds = scene.bounds;
+        let loaded = Loaded {
+            lights: scene.lights.clone(),
+            transforms: scene.instances.iter().map(|i| i.transform).collect(),
+            cameras: scene.cameras.clone(),
+        };
+        let state: Shared = Arc::new(Mutex::new(loading));
         let engine = engine_for(script, &state, origin, limits, &Arc::default());
         let ast = compile(&engine, script)?;
         engine
@@ -571,7 +835,7 @@ impl ScriptRuntime {
             engine,
             ast,
             state,
-            loaded: lights.to_vec(),
+            loaded,
             this: Dynamic::UNIT,
             steps: 0,
         };
@@ -579,12 +843,15 @@ impl ScriptRuntime {
         Ok(runtime)
     }
 
-    /// Back to time 0: the loaded lights, all on, and `init` run again.
+    /// Back to time 0: the loaded objects, lights all on, and `init` run again.
     fn restart(&mut self) -> Result<(), SceneError> {
         {
             let mut s = lock(&self.state);
-            s.lights = self.loaded.clone();
-            s.on = vec![true; self.loaded.len()];
+            s.lights = self.loaded.lights.clone();
+            s.on = vec![true; self.loaded.lights.len()];
+            s.transforms = self.loaded.transforms.clone();
+            s.cameras = self.loaded.cameras.clone();
+            s.camera_set = vec![false; self.loaded.cameras.len()];
         }
         self.steps = 0;
         self.this = if self.has_init {
@@ -608,11 +875,11 @@ impl ScriptRuntime {
         self.has_update
     }
 
-    /// The lights at `time`: `update` run in steps of [`STEP`] from 0 up to
+    /// The scene at `time`: `update` run in steps of [`STEP`] from 0 up to
     /// `time` (from the last step taken when time only moved forward). Lights
     /// switched off come back with zero colour. On an error the runtime
     /// starts over at the next call.
-    pub fn lights_at(&mut self, time: f64) -> Result<Vec<Light>, SceneError> {
+    pub fn frame_at(&mut self, time: f64) -> Result<ScriptFrame, SceneError> {
         let target = if time.is_finite() && time > 0.0 {
             (time / STEP).floor() as u64
         } else {
@@ -648,17 +915,28 @@ impl ScriptRuntime {
             }
         }
         let s = lock(&self.state);
-        Ok(s.lights
-            .iter()
-            .zip(&s.on)
-            .map(|(light, &on)| {
-                if on {
-                    light.clone()
-                } else {
-                    switched_off(light)
-                }
-            })
-            .collect())
+        Ok(ScriptFrame {
+            lights: s
+                .lights
+                .iter()
+                .zip(&s.on)
+                .map(|(light, &on)| {
+                    if on {
+                        light.clone()
+                    } else {
+                        switched_off(light)
+                    }
+                })
+                .collect(),
+            transforms: s.transforms.clone(),
+            cameras: s
+                .cameras
+                .iter()
+                .zip(&s.camera_set)
+                .filter(|(_, &set)| set)
+                .map(|(c, _)| c.clone())
+                .collect(),
+        })
     }
 }
 
@@ -700,8 +978,15 @@ mod tests {
             path: path.to_path_buf(),
             at: Location::file(path),
             first_light: 0,
+            first_model: 0,
             imports: Vec::new(),
         }
+    }
+
+    /// The runtime of the `.rhai` scene at `path`, loaded as a scene.
+    fn runtime(path: &Path) -> ScriptRuntime {
+        let scene = crate::load_scene(path).unwrap();
+        ScriptRuntime::new(scene.script.as_ref().unwrap(), &scene, &Limits::default()).unwrap()
     }
 
     /// Runs a `.rhai` scene's load with `limits`.
@@ -714,7 +999,7 @@ mod tests {
             &path,
             &mut desc,
             &mut Diagnostics::default(),
-            limits,
+            (&LoadOptions::default(), limits),
         )?;
         desc.script = Some(script);
         Ok(desc)
@@ -783,21 +1068,11 @@ mod tests {
             )],
         );
         let path = dir.join("scene.rhai");
-        let desc = load(&dir, &Limits::default()).unwrap();
-        let runtime = || {
-            ScriptRuntime::new(
-                &script_ref(&path),
-                &path,
-                &desc.lights,
-                DVec3::ZERO,
-                &Limits::default(),
-            )
-            .unwrap()
-        };
+        let runtime = || runtime(&path);
         let mut a = runtime();
         assert!(a.animates());
         // 0.5 s = 30 steps of 1/60 s: x = 30 / 60, y = t of the last step, z = steps.
-        let at_half = a.lights_at(0.5).unwrap();
+        let at_half = a.frame_at(0.5).unwrap().lights;
         let p = point(&at_half[0]);
         assert!(
             (p.position - Vec3::new(0.5, 0.5, 30.0)).abs().max_element() < 1e-5,
@@ -807,17 +1082,24 @@ mod tests {
         // Reached through other frame times, or again after going back: the same.
         let mut b = runtime();
         for t in [0.1, 0.25, 0.4999, 0.5] {
-            b.lights_at(t).unwrap();
+            b.frame_at(t).unwrap();
         }
-        assert_eq!(b.lights_at(0.5).unwrap(), at_half);
-        a.lights_at(3.0).unwrap();
-        assert_eq!(a.lights_at(0.5).unwrap(), at_half, "going back starts over");
+        assert_eq!(b.frame_at(0.5).unwrap().lights, at_half);
+        a.frame_at(3.0).unwrap();
+        assert_eq!(
+            a.frame_at(0.5).unwrap().lights,
+            at_half,
+            "going back starts over"
+        );
         // Step 31 is odd: off, with zero colour.
         assert_eq!(
-            point(&a.lights_at(31.0 / 60.0 + 1e-9).unwrap()[0]).color,
+            point(&a.frame_at(31.0 / 60.0 + 1e-9).unwrap().lights[0]).color,
             Vec3::ZERO
         );
-        assert_eq!(point(&a.lights_at(0.0).unwrap()[0]).position, Vec3::ZERO);
+        assert_eq!(
+            point(&a.frame_at(0.0).unwrap().lights[0]).position,
+            Vec3::ZERO
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -915,9 +1197,8 @@ mod tests {
             )],
         );
         let path = dir.join("scene.rhai");
-        let mut runtime =
-            ScriptRuntime::new(&script_ref(&path), &path, &[], DVec3::ZERO, &limits).unwrap();
-        let error = runtime.lights_at(1.0).expect_err("refused").to_string();
+        let mut runtime = runtime(&path);
+        let error = runtime.frame_at(1.0).expect_err("refused").to_string();
         assert_eq!(
             error,
             format!(
@@ -969,5 +1250,130 @@ mod tests {
             let error = load_error(name, body, &Limits::default());
             assert!(error.contains("Function not found"), "{name}: {error}");
         }
+    }
+
+    /// A one-triangle OBJ spanning (0, 0, 0)..(1, 1, 0).
+    const TRIANGLE: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
+    #[test]
+    fn scene_bounds_at_load_are_those_of_the_models_placed_so_far() {
+        let dir = folder(
+            "bounds",
+            &[
+                ("tri.obj", TRIANGLE),
+                (
+                    "scene.rhai",
+                    r#"
+                    let i = model("tri.obj", #{ position: [10, 0, 0], scale: 2 });
+                    let b = scene_bounds();
+                    point_light(#{ position: b.max, radius: 1 });
+                    point_light(#{ position: b.min, radius: 1 });
+                    let j = model("tri.obj", #{ position: [-4, 0, 0] });
+                    point_light(#{ position: scene_bounds().min, radius: i + j });
+                    "#,
+                ),
+            ],
+        );
+        let scene = crate::load_scene(&dir.join("scene.rhai")).unwrap();
+        let positions: Vec<Vec3> = scene.lights.iter().map(|l| point(l).position).collect();
+        assert_eq!(
+            positions,
+            [
+                Vec3::new(12.0, 2.0, 0.0),
+                Vec3::new(10.0, 0.0, 0.0),
+                Vec3::new(-4.0, 0.0, 0.0)
+            ]
+        );
+        assert_eq!(
+            point(&scene.lights[2]).radius,
+            1.0,
+            "model() gives indices 0 and 1"
+        );
+        assert_eq!(scene.models.len(), 1, "the file is loaded once");
+        std::fs::write(dir.join("scene.rhai"), "let b = scene_bounds();").unwrap();
+        let error = crate::load_scene(&dir.join("scene.rhai"))
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            error.ends_with("scene.rhai:1:9: scene_bounds: no model is placed yet"),
+            "{error}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn update_moves_placements_and_cameras_as_the_same_blocks_in_a_file_would_place_them() {
+        let dir = folder(
+            "placements",
+            &[
+                ("tri.obj", TRIANGLE),
+                (
+                    "scene.rhai",
+                    r#"
+                    model("tri.obj", #{ color: [1, 0, 0], roughness: 0.25 });
+                    model("tri.obj", #{});
+                    camera("top", #{ position: [0, 9, 0.1], target: [0, 0, 0], fov_deg: 30 });
+                    fn update(t, dt) {
+                        set_model_transform(1, #{ position: [t, 2, 0], orientation: [0, 90, 0], scale: [1, 2, 3] });
+                        let p = model_position(1);
+                        set_camera("top", #{ position: [p[0], 5, 5], target: p });
+                    }
+                    "#,
+                ),
+            ],
+        );
+        let path = dir.join("scene.rhai");
+        let scene = crate::load_scene(&path).unwrap();
+        assert_eq!(
+            scene.instances[0].material,
+            crate::material::MaterialOverride {
+                color: Some(Vec3::new(1.0, 0.0, 0.0)),
+                roughness: Some(0.25),
+                ..Default::default()
+            }
+        );
+        assert!(scene.instances[1].material.is_empty());
+        let frame = runtime(&path).frame_at(0.5).unwrap();
+        let file = "model\n{\n\tfile \"tri.obj\"\n\tposition 0.5 2 0\n\torientation 0 90 0\n\tscale 1 2 3\n}\n\
+            camera \"top\"\n{\n\tposition 0.5 5 5\n\ttarget 0.5 2 0\n\tfov_deg 30\n}\n";
+        let desc = crate::scene_desc_from_str(file, &path, &mut Diagnostics::default()).unwrap();
+        assert_eq!(
+            frame.transforms[0], scene.instances[0].transform,
+            "not moved"
+        );
+        assert_eq!(frame.transforms[1], desc.models[0].transform);
+        assert_eq!(frame.cameras.len(), 1, "the camera the script set");
+        let (set, file) = (&frame.cameras[0], &desc.cameras[0]);
+        assert_eq!(
+            (set.position, set.orientation, set.fov_y),
+            (file.position, file.orientation, file.fov_y),
+            "the field of view kept"
+        );
+        let error = |body: &str| {
+            std::fs::write(&path, format!("camera(\"top\", #{{}});\nmodel(\"tri.obj\", #{{}});\nfn update(t, dt) {{\n    {body}\n}}\n")).unwrap();
+            runtime(&path)
+                .frame_at(1.0)
+                .expect_err("refused")
+                .to_string()
+                .replace(&path.display().to_string(), "scene.rhai")
+        };
+        assert_eq!(
+            error("set_model_transform(0, #{ color: [1, 0, 0] });"),
+            "scene.rhai:4:5: set_model_transform takes position, orientation, scale; not 'color'"
+        );
+        assert_eq!(
+            error("set_model_transform(1, #{});"),
+            "scene.rhai:4:5: no model 1: the scene has 1"
+        );
+        assert_eq!(
+            error("set_camera(\"side\", #{ position: [0, 0, 0] });"),
+            "scene.rhai:4:5: no camera 'side': the scene has top"
+        );
+        assert!(
+            error("set_model_transform(0, #{ scale: [1, 2] });")
+                .starts_with("scene.rhai:4:5: set_model_transform: "),
+            "the .scene reader's message"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -5,6 +5,7 @@ use crate::bounds::Aabb;
 use crate::camera::{look_at_rotation, Camera, CameraKey, CameraOrigin, DEFAULT_FOV_Y};
 use crate::error::{Diagnostics, Location, SceneError};
 use crate::light::Light;
+use crate::material::MaterialOverride;
 use crate::props::Props;
 use crate::source::{read_text, MAX_SCENE_BYTES};
 use crate::syntax::{parse, Block, Item, Prop, Value};
@@ -40,6 +41,9 @@ pub struct Placement {
     /// `thin 1`: the model's glass is a thin shell (light goes straight
     /// through); `thin 0`: solid.
     pub thin: Option<bool>,
+    /// `color`, `emission`, `roughness`, `metallic`: factors replaced for
+    /// this placement's materials.
+    pub material: MaterialOverride,
 }
 
 /// Everything a `.scene` file (with its includes) declares, before models are loaded.
@@ -181,6 +185,7 @@ fn interpret(
                     path: resolve(path, &name),
                     at,
                     first_light: 0,
+                    first_model: 0,
                     imports: Vec::new(),
                 });
             }
@@ -354,6 +359,7 @@ fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placeme
     let thin = props
         .f32_where("thin", |v| v == 0.0 || v == 1.0, "0 or 1")?
         .map(|v| v == 1.0);
+    let material = material_override(props)?;
     let Some((name, line)) = file else {
         diag.warn(props.block_at(), "model without a 'file'; skipped");
         return Ok(None);
@@ -365,7 +371,36 @@ fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placeme
         absorption,
         ior,
         thin,
+        material,
     }))
+}
+
+/// A `model` block's material overrides: colours of three finite numbers of
+/// at least 0, roughness and metallic in [0, 1].
+fn material_override(props: &mut Props<'_>) -> Result<MaterialOverride, SceneError> {
+    let mut colour = |name: &str| -> Result<Option<Vec3>, SceneError> {
+        let Some(p) = props.last(name) else {
+            return Ok(None);
+        };
+        let v = Vec3::from_slice(&props.exactly(p, 3)?);
+        if v.is_finite() && v.min_element() >= 0.0 {
+            Ok(Some(v))
+        } else {
+            Err(props.error(
+                p,
+                format!("'{name}' must be 3 finite numbers of at least 0, found {v}"),
+            ))
+        }
+    };
+    let color = colour("color")?;
+    let emission = colour("emission")?;
+    let unit = |v: f32| (0.0..=1.0).contains(&v);
+    Ok(MaterialOverride {
+        color,
+        emission,
+        roughness: props.f32_where("roughness", unit, "in [0, 1]")?,
+        metallic: props.f32_where("metallic", unit, "in [0, 1]")?,
+    })
 }
 
 /// A `camera` block; `index` names unlabelled cameras `camera0`, `camera1`, ...
