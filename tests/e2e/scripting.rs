@@ -124,12 +124,13 @@ const CUBE_FACES: &str = "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -
     v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n\
     f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 5 8\nf 1 8 4\n\
     f 2 3 7\nf 2 7 6\nf 1 2 6\nf 1 6 5\nf 4 8 7\nf 4 7 3\n";
-const LIGHTS: &str = "pointlight\n{\n\tposition 2 4 2\n\tcolor 1 1 1\n\tradius 20\n}\n\
-    sunlight\n{\n\tdirection -0.3 -1 -0.4\n\tcolor 0.5 0.5 0.5\n}\n";
+/// The script's lights where it leaves them at step 90.
+const LIGHTS: &str = "pointlight\n{\n\tposition 2 4 1.25\n\tcolor 1 1 1\n\tradius 20\n}\n\
+    sunlight\n{\n\tdirection -0.3 -1 -0.3125\n\tcolor 0.5 0.5 0.5\n}\n";
 
 /// The folder of the placement tests: the models, a script that moves the
-/// cube and the camera each step (to x = 1.25, turned 90 degrees, at step
-/// 90 = 1.5 s), and the files that place them there.
+/// cube, the camera and the lights each step (the cube to x = 1.25, turned
+/// 90 degrees, at step 90 = 1.5 s), and the files that place them there.
 fn placement_scenes() -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("weft-placements-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -152,6 +153,8 @@ fn update(t, dt) {
     let x = (this.n - 80).to_float() * 0.125;
     set_model_transform(1, #{ position: [x, 0.5, 0], orientation: [0, this.n, 0] });
     set_camera("main", #{ position: [x, 3, 6], target: [x, 0.5, 0] });
+    set_light_position(0, 2, 4, x);
+    set_light_direction(1, -0.3, -1, -0.25 * x);
 }
 "#
             .to_string(),
@@ -204,11 +207,13 @@ fn last_frame(scene: &Path, graph_name: &str, time: f32, frames: u32) -> image::
 }
 
 #[test]
-fn a_script_moving_a_placement_and_the_camera_draws_what_a_file_placing_them_there_draws() {
+fn a_script_moving_a_placement_the_camera_and_the_lights_draws_what_a_file_placing_them_there_draws(
+) {
     let dir = placement_scenes();
     for graph_name in ["forward.ron", "deferred.ron", "pathtrace.ron"] {
         // Frame 0 at 1 s (step 60), frame 1 at 1.5 s (step 90): the second
-        // frame rewrites the draw records (and rebuilds the ray tracer's BVH).
+        // frame rewrites the draw records (and rebuilds the ray tracer's BVH),
+        // and the sun's shadow map follows both the cube and the sun.
         let moved = last_frame(&dir.join("moved.rhai"), graph_name, 1.0, 2);
         let placed = last_frame(&dir.join("placed.scene"), graph_name, 0.0, 1);
         assert!(moved == placed, "{graph_name}: the same image");

@@ -5,7 +5,10 @@
 //! per-frame scene update that uploads them (`GpuScene::update`: the
 //! script's step, packing the lights and writing the light buffer), and of
 //! that update for the same lights without a script (the upload alone:
-//! packing and writing).
+//! packing and writing). Then the same for 100 and 1,000 model placements
+//! (a 12-triangle cube each) that a script moves every frame: the script's
+//! step, the whole scene update (draw records rewritten in place), and the
+//! rewrite alone (placing the records and writing the changed range).
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -21,6 +24,9 @@ pub struct ScriptArgs {
     /// Light counts to measure.
     #[arg(long, value_delimiter = ',', default_value = "100,1000,10000")]
     lights: Vec<u32>,
+    /// Placement counts to measure.
+    #[arg(long, value_delimiter = ',', default_value = "100,1000")]
+    placements: Vec<u32>,
     /// Frames measured per count (one update step each), after 10 warm-up frames.
     #[arg(long, default_value_t = 120)]
     frames: u32,
@@ -40,6 +46,33 @@ fn update(t, dt) {{
     for i in 0..lights() {{
         let a = t + i * 0.1;
         set_light_position(i, i % 100 + 0.5 * a.cos(), 1, i / 100 + 0.5 * a.sin());
+    }}
+}}
+"#
+    )
+}
+
+/// A unit cube (12 triangles).
+const CUBE: &str = "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n\
+    v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n\
+    f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 5 8\nf 1 8 4\n\
+    f 2 3 7\nf 2 7 6\nf 1 2 6\nf 1 6 5\nf 4 8 7\nf 4 7 3\n";
+
+/// A script with `n` cubes that its `update` moves up and down and turns.
+fn placements_text(n: u32) -> String {
+    format!(
+        r#"fn cubes() {{ {n} }}
+point_light(#{{ position: [50, 10, 50], color: [1, 1, 1], radius: 200 }});
+for i in 0..cubes() {{
+    model("cube.obj", #{{ position: [i % 100, 0, i / 100], scale: 0.4 }});
+}}
+fn update(t, dt) {{
+    for i in 0..cubes() {{
+        set_model_transform(i, #{{
+            position: [i % 100, 0.5 * (t + i * 0.1).sin(), i / 100],
+            orientation: [0, 40 * t, 0],
+            scale: 0.4,
+        }});
     }}
 }}
 "#
@@ -67,6 +100,43 @@ fn scene_update_ms(gpu: &Gpu, scene: &weft_scene::Scene, frames: u32) -> Result<
         if let Some(e) = gpu_scene.take_script_error() {
             return Err(e.into());
         }
+    }
+    Ok(ms)
+}
+
+/// Placing every instance at each frame's transforms and writing the draw
+/// records' range to a host-visible buffer, as `GpuScene::update` does for
+/// moved placements, timed per frame.
+fn rewrite_ms(
+    gpu: &Gpu,
+    scene: &weft_scene::Scene,
+    frames: &[Vec<glam::Mat4>],
+) -> Result<Vec<f64>> {
+    let mut geometry = weft_render::geometry::SceneGeometry::new(scene);
+    let bytes = bytemuck::cast_slice::<_, u8>(&geometry.draw_records).to_vec();
+    let mut buffer = weft_gpu::buffer::Buffer::host(
+        gpu,
+        "draw records",
+        bytes.len() as u64,
+        ash::vk::BufferUsageFlags::STORAGE_BUFFER,
+    )?;
+    buffer.write(&bytes)?;
+    let mut ms = Vec::with_capacity(frames.len());
+    for transforms in frames {
+        let started = Instant::now();
+        let mut changed = u32::MAX..0;
+        for (i, t) in transforms.iter().enumerate() {
+            let ids = geometry.place_instance(i, *t);
+            changed = changed.start.min(ids.start)..changed.end.max(ids.end);
+        }
+        if !changed.is_empty() {
+            let records = &geometry.draw_records[changed.start as usize..changed.end as usize];
+            buffer.write_at(
+                changed.start as usize * std::mem::size_of::<weft_render::gpu_types::GpuDraw>(),
+                bytemuck::cast_slice(records),
+            )?;
+        }
+        ms.push(started.elapsed().as_secs_f64() * 1e3);
     }
     Ok(ms)
 }
@@ -114,6 +184,38 @@ pub fn run(args: ScriptArgs) -> Result<ExitCode> {
             median(update_ms),
             median(upload_ms),
             f64::from(n) * 64.0 / 1024.0
+        );
+    }
+    println!();
+    println!("| placements | script update (ms) | scene update with rewrite (ms) | rewrite alone (ms) | draw records (KiB) |");
+    println!("|---:|---:|---:|---:|---:|");
+    std::fs::write(dir.join("cube.obj"), CUBE)?;
+    for &n in &args.placements {
+        let path = dir.join(format!("placements{n}.rhai"));
+        std::fs::write(&path, placements_text(n))?;
+        let scene =
+            weft_scene::load_scene(&path).with_context(|| format!("loading {}", path.display()))?;
+        let script = scene.script.clone().context("the scene has its script")?;
+        let mut runtime = ScriptRuntime::new(&script, &scene, &Limits::default())?;
+        let mut script_ms = Vec::new();
+        let mut frames = Vec::new();
+        for frame in 0..args.frames + 10 {
+            let t = f64::from(frame + 1) * STEP;
+            let started = Instant::now();
+            let placed = runtime.frame_at(t)?;
+            if frame >= 10 {
+                script_ms.push(started.elapsed().as_secs_f64() * 1e3);
+                frames.push(placed.transforms);
+            }
+        }
+        let update_ms = scene_update_ms(&gpu, &scene, args.frames)?;
+        let rewrite_ms = rewrite_ms(&gpu, &scene, &frames)?;
+        println!(
+            "| {n} | {:.3} | {:.3} | {:.3} | {:.1} |",
+            median(script_ms),
+            median(update_ms),
+            median(rewrite_ms),
+            f64::from(n) * 160.0 / 1024.0
         );
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -364,11 +364,7 @@ fn read_object(
             format!("{function} takes {}; not '{key}'", allowed.join(", ")),
         ));
     }
-    let mut props = props.clone();
-    if kind == "model" {
-        props.insert("file".into(), "-".into());
-    }
-    let text = block_text(kind, label, &props).map_err(|m| fail(ctx, m))?;
+    let text = block_text(kind, label, props).map_err(|m| fail(ctx, m))?;
     let mut desc = SceneDesc {
         origin: s.desc.origin,
         ..SceneDesc::default()
@@ -376,6 +372,60 @@ fn read_object(
     blocks_into(&text, &s.scene, &mut desc, &mut Diagnostics::default())
         .map_err(|e| fail(ctx, format!("{function}: {}", e.message())))?;
     Ok(desc)
+}
+
+/// A script value's numbers (one number, or an array of numbers), for the
+/// property `name`.
+fn numbers_of(name: &str, value: &Dynamic) -> Result<Vec<f32>, String> {
+    let wrong = || format!("'{name}' must be a number or an array of numbers");
+    if let Some(n) = number(value) {
+        return Ok(vec![n as f32]);
+    }
+    let array = value.read_lock::<Array>().ok_or_else(wrong)?;
+    array
+        .iter()
+        .map(|v| number(v).map(|n| n as f32).ok_or_else(wrong))
+        .collect()
+}
+
+/// The model-to-world transform (relative to `origin`) of a `model` block
+/// with these `position`, `orientation` and `scale`, built as the `.scene`
+/// reader builds it (the same rotation and scale rules) without going
+/// through its text: `set_model_transform` runs per placement per step.
+fn placement_transform(props: &Map, origin: DVec3) -> Result<Mat4, String> {
+    let mut position = -origin;
+    let mut rotation = glam::Quat::IDENTITY;
+    let mut scale = Vec3::ONE;
+    for (name, value) in props {
+        match name.as_str() {
+            "position" => {
+                let p: Vec<f64> = match value.read_lock::<Array>() {
+                    Some(a) => a.iter().filter_map(number).collect(),
+                    None => Vec::new(),
+                };
+                let [x, y, z] = p[..] else {
+                    return Err(format!(
+                        "'position' expects an array of 3 numbers, found {value}"
+                    ));
+                };
+                position = DVec3::new(x, y, z) - origin;
+            }
+            "orientation" => {
+                rotation = crate::desc::rotation_from("orientation", &numbers_of(name, value)?)?
+            }
+            "scale" => scale = crate::desc::scale_from(&numbers_of(name, value)?)?,
+            other => {
+                return Err(format!(
+                    "'{other}' is not a transform property (position, orientation, scale)"
+                ))
+            }
+        }
+    }
+    Ok(Mat4::from_scale_rotation_translation(
+        scale,
+        rotation,
+        position.as_vec3(),
+    ))
 }
 
 /// The index of the `what` that `index` refers to (of `count`), for the
@@ -612,15 +662,8 @@ fn register_models(engine: &mut Engine, state: &Shared, origin: DVec3) {
         move |ctx: NativeCallContext, i: INT, props: Map| {
             let mut s = lock(&st);
             let i = frame_index(&ctx, &s, ("model", s.transforms.len()), i)?;
-            let desc = read_object(
-                &ctx,
-                &s,
-                "set_model_transform",
-                ("model", None),
-                &props,
-                &["position", "orientation", "scale"],
-            )?;
-            let transform = desc.models[0].transform;
+            let transform = placement_transform(&props, origin)
+                .map_err(|m| fail(&ctx, format!("set_model_transform: {m}")))?;
             if !transform.is_finite() {
                 return Err(fail(
                     &ctx,
@@ -1359,7 +1402,7 @@ mod tests {
         };
         assert_eq!(
             error("set_model_transform(0, #{ color: [1, 0, 0] });"),
-            "scene.rhai:4:5: set_model_transform takes position, orientation, scale; not 'color'"
+            "scene.rhai:4:5: set_model_transform: 'color' is not a transform property (position, orientation, scale)"
         );
         assert_eq!(
             error("set_model_transform(1, #{});"),

@@ -5,6 +5,7 @@ mod common;
 use common::{short_warnings, temp_dir};
 use glam::Vec3;
 use std::path::Path;
+use weft_scene::material::MaterialOverride;
 use weft_scene::{load_scene, scene_desc_from_str, Diagnostics, Light, SceneDesc, SceneReport};
 
 fn desc(text: &str) -> (SceneDesc, Vec<String>) {
@@ -282,6 +283,79 @@ fn model_ior_and_thin_override_the_glass() {
     assert_eq!(
         error("model\n{\n file \"glass.obj\"\n\n thin 2\n}\n"),
         "t.scene:5: 'thin' must be 0 or 1, found 2"
+    );
+}
+
+#[test]
+fn model_material_overrides_are_read_and_checked_at_their_line() {
+    let (d, warnings) = desc(
+        "model\n{\n file \"a.obj\"\n color 1 0.5 0\n emission 0 0 2\n roughness 0.25\n metallic 1\n}\n",
+    );
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(
+        d.models[0].material,
+        MaterialOverride {
+            color: Some(Vec3::new(1.0, 0.5, 0.0)),
+            emission: Some(Vec3::new(0.0, 0.0, 2.0)),
+            roughness: Some(0.25),
+            metallic: Some(1.0),
+        }
+    );
+    let (d, _) = desc("model\n{\n file \"a.obj\"\n}\n");
+    assert!(d.models[0].material.is_empty());
+    for (property, message) in [
+        (
+            "color -1 0 0",
+            "'color' must be 3 finite numbers of at least 0, found [-1, 0, 0]",
+        ),
+        ("color 1 0", "'color' expects 3 numbers, found 2"),
+        (
+            "emission 1 inf 0",
+            "'emission' expects numbers, found 'inf'",
+        ),
+        (
+            "emission 1e39 0 0",
+            "number '1e39' is not a finite 32-bit float",
+        ),
+        ("roughness 1.5", "'roughness' must be in [0, 1], found 1.5"),
+        ("metallic -0.1", "'metallic' must be in [0, 1], found -0.1"),
+    ] {
+        assert_eq!(
+            error(&format!("model\n{{\n file \"a.obj\"\n\n {property}\n}}\n")),
+            format!("t.scene:5: {message}")
+        );
+    }
+}
+
+#[test]
+fn a_material_override_replaces_factors_and_turns_mtl_materials_metallic_roughness() {
+    use weft_scene::material::ShadingModel;
+    let mtl = weft_scene::Material {
+        base_color: glam::Vec4::new(0.5, 0.5, 0.5, 0.75),
+        roughness: 0.4,
+        ..Default::default()
+    };
+    let coloured = MaterialOverride {
+        color: Some(Vec3::new(1.0, 0.0, 0.0)),
+        ..Default::default()
+    }
+    .apply(&mtl);
+    assert_eq!(
+        coloured.base_color,
+        glam::Vec4::new(1.0, 0.0, 0.0, 0.75),
+        "alpha kept"
+    );
+    assert_eq!(coloured.shading, ShadingModel::BlinnPhong);
+    let metal = MaterialOverride {
+        metallic: Some(1.0),
+        ..Default::default()
+    }
+    .apply(&mtl);
+    assert_eq!(metal.shading, ShadingModel::MetallicRoughness);
+    assert_eq!(
+        (metal.metallic, metal.roughness),
+        (1.0, 0.4),
+        "roughness from Ns kept"
     );
 }
 

@@ -274,8 +274,12 @@ fn block_into(
 /// A rotation from 3 values (pitch, yaw, roll in degrees, applied roll then pitch then yaw)
 /// or 4 values (angle in radians, then axis: the 15-462 reference loader's reading).
 fn rotation(props: &Props<'_>, prop: &Prop) -> Result<Quat, SceneError> {
-    let v = props.numbers(prop)?;
-    match v.as_slice() {
+    rotation_from(&prop.name, &props.numbers(prop)?).map_err(|m| props.error(prop, m))
+}
+
+/// [`rotation`] from the values of a property called `name`.
+pub(crate) fn rotation_from(name: &str, v: &[f32]) -> Result<Quat, String> {
+    match v {
         [pitch, yaw, roll] => Ok(Quat::from_euler(
             EulerRot::YXZ,
             yaw.to_radians(),
@@ -285,16 +289,24 @@ fn rotation(props: &Props<'_>, prop: &Prop) -> Result<Quat, SceneError> {
         [angle, x, y, z] => {
             let axis = Vec3::new(*x, *y, *z)
                 .try_normalize()
-                .ok_or_else(|| props.error(prop, format!("'{}' has a zero rotation axis", prop.name)))?;
+                .ok_or_else(|| format!("'{name}' has a zero rotation axis"))?;
             Ok(Quat::from_axis_angle(axis, *angle))
         }
-        _ => Err(props.error(
-            prop,
-            format!(
-                "'{}' expects 3 numbers (pitch yaw roll, degrees) or 4 (angle in radians, axis x y z), found {}",
-                prop.name,
-                v.len()
-            ),
+        _ => Err(format!(
+            "'{name}' expects 3 numbers (pitch yaw roll, degrees) or 4 (angle in radians, axis x y z), found {}",
+            v.len()
+        )),
+    }
+}
+
+/// A `model` block's `scale`: one uniform factor or x y z.
+pub(crate) fn scale_from(v: &[f32]) -> Result<Vec3, String> {
+    match v {
+        [s] => Ok(Vec3::splat(*s)),
+        [x, y, z] => Ok(Vec3::new(*x, *y, *z)),
+        other => Err(format!(
+            "'scale' expects 1 or 3 numbers, found {}",
+            other.len()
         )),
     }
 }
@@ -324,16 +336,7 @@ fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placeme
         None => Quat::IDENTITY,
     };
     let scale = match props.last("scale") {
-        Some(p) => match props.numbers(p)?.as_slice() {
-            [s] => Vec3::splat(*s),
-            [x, y, z] => Vec3::new(*x, *y, *z),
-            other => {
-                return Err(props.error(
-                    p,
-                    format!("'scale' expects 1 or 3 numbers, found {}", other.len()),
-                ))
-            }
-        },
+        Some(p) => scale_from(&props.numbers(p)?).map_err(|m| props.error(p, m))?,
         None => Vec3::ONE,
     };
     let absorption = match props.last("absorption") {
