@@ -124,15 +124,16 @@ fn rewrite_ms(
     let mut ms = Vec::with_capacity(frames.len());
     for transforms in frames {
         let started = Instant::now();
-        let mut changed = u32::MAX..0;
+        let (mut first, mut end) = (u32::MAX, 0);
         for (i, t) in transforms.iter().enumerate() {
             let ids = geometry.place_instance(i, *t);
-            changed = changed.start.min(ids.start)..changed.end.max(ids.end);
+            first = first.min(ids.start);
+            end = end.max(ids.end);
         }
-        if !changed.is_empty() {
-            let records = &geometry.draw_records[changed.start as usize..changed.end as usize];
+        if first < end {
+            let records = &geometry.draw_records[first as usize..end as usize];
             buffer.write_at(
-                changed.start as usize * std::mem::size_of::<weft_render::gpu_types::GpuDraw>(),
+                first as usize * std::mem::size_of::<weft_render::gpu_types::GpuDraw>(),
                 bytemuck::cast_slice(records),
             )?;
         }
