@@ -128,11 +128,11 @@ const CUBE_FACES: &str = "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -
 const LIGHTS: &str = "pointlight\n{\n\tposition 2 4 1.25\n\tcolor 1 1 1\n\tradius 20\n}\n\
     sunlight\n{\n\tdirection -0.3 -1 -0.3125\n\tcolor 0.5 0.5 0.5\n}\n";
 
-/// The folder of the placement tests: the models, a script that moves the
+/// A folder of its own for `test`: the models, a script that moves the
 /// cube, the camera and the lights each step (the cube to x = 1.25, turned
 /// 90 degrees, at step 90 = 1.5 s), and the files that place them there.
-fn placement_scenes() -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("weft-placements-{}", std::process::id()));
+fn placement_scenes(test: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("weft-{test}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let files = [
         ("grey.mtl", "newmtl grey\nKd 0.5 0.5 0.5\n".to_string()),
@@ -166,6 +166,28 @@ fn update(t, dt) {
                  model\n{{\n\tfile \"cube.obj\"\n\tposition 1.25 0.5 0\n\torientation 0 90 0\n\tcolor 0.9 0.2 0.1\n}}\n\
                  camera \"main\"\n{{\n\tposition 1.25 3 6\n\ttarget 1.25 0.5 0\n}}\n{LIGHTS}"
             ),
+        ),
+        (
+            "mixed.rhai",
+            r#"model("floor.obj", #{});
+model("cube.obj", #{ position: [0, 0.5, 0] });
+camera("main", #{ position: [0, 3, 6], target: [0, 0, 0] });
+point_light(#{ position: [2, 1, 0], color: [1, 0.5, 0.2], radius: 6, velocity: 2, amplitude: 1.5 });
+point_light(#{ position: [-2, 1, 0], color: [0.2, 0.5, 1], radius: 6, velocity: 2, amplitude: 1.5 });
+fn update(t, dt) {
+    if t > 1.0 { set_light_position(1, -2, 1, 2); }
+}
+"#
+            .to_string(),
+        ),
+        (
+            "mixed.scene",
+            "model\n{\n\tfile \"floor.obj\"\n}\n\
+             model\n{\n\tfile \"cube.obj\"\n\tposition 0 0.5 0\n}\n\
+             camera \"main\"\n{\n\tposition 0 3 6\n\ttarget 0 0 0\n}\n\
+             pointlight\n{\n\tposition 2 1 0\n\tcolor 1 0.5 0.2\n\tradius 6\n\tvelocity 2\n\tamplitude 1.5\n}\n\
+             pointlight\n{\n\tposition -2 1 2\n\tcolor 0.2 0.5 1\n\tradius 6\n}\n"
+                .to_string(),
         ),
         (
             "placed_red.scene",
@@ -209,7 +231,7 @@ fn last_frame(scene: &Path, graph_name: &str, time: f32, frames: u32) -> image::
 #[test]
 fn a_script_moving_a_placement_the_camera_and_the_lights_draws_what_a_file_placing_them_there_draws(
 ) {
-    let dir = placement_scenes();
+    let dir = placement_scenes("placements");
     for graph_name in ["forward.ron", "deferred.ron", "pathtrace.ron"] {
         // Frame 0 at 1 s (step 60), frame 1 at 1.5 s (step 90): the second
         // frame rewrites the draw records (and rebuilds the ray tracer's BVH),
@@ -234,5 +256,23 @@ fn a_script_moving_a_placement_the_camera_and_the_lights_draws_what_a_file_placi
         red == overridden,
         "a grey cube placed with `color 0.9 0.2 0.1` is the red cube"
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn lights_the_script_leaves_alone_keep_their_scene_motions() {
+    let dir = placement_scenes("motions");
+    // Light 0 circles by its `velocity` in both; light 1, moved by the
+    // script after 1 s, stands where the file puts it.
+    let scripted = last_frame(&dir.join("mixed.rhai"), "forward.ron", 1.5, 1);
+    let file = last_frame(&dir.join("mixed.scene"), "forward.ron", 1.5, 1);
+    assert!(scripted == file, "the same lights at 1.5 s");
+    let start = last_frame(&dir.join("mixed.rhai"), "forward.ron", 0.0, 1);
+    let changed = start
+        .pixels()
+        .zip(scripted.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(changed > 500, "the lights moved: {changed} pixels");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -5,7 +5,9 @@
 //! per-frame scene update that uploads them (`GpuScene::update`: the
 //! script's step, packing the lights and writing the light buffer), and of
 //! that update for the same lights without a script (the upload alone:
-//! packing and writing). Then the same for 100 and 1,000 model placements
+//! packing and writing), and the scene update when the script declares the
+//! same circles at load as `.scene` motions instead of moving the lights
+//! itself. Then the same for 100 and 1,000 model placements
 //! (a 12-triangle cube each) that a script moves every frame: the script's
 //! step, the whole scene update (draw records rewritten in place), and the
 //! rewrite alone (placing the records and writing the changed range).
@@ -48,6 +50,20 @@ fn update(t, dt) {{
         set_light_position(i, i % 100 + 0.5 * a.cos(), 1, i / 100 + 0.5 * a.sin());
     }}
 }}
+"#
+    )
+}
+
+/// The same circles as [`script_text`] declared at load as `.scene` motions
+/// (`velocity`, `amplitude`), with an `update` that changes no light: the
+/// renderer moves them, the script runs no per-light code.
+fn declared_text(n: u32) -> String {
+    format!(
+        r#"fn lights() {{ {n} }}
+for i in 0..lights() {{
+    point_light(#{{ position: [i % 100, 1, i / 100], color: [1, 1, 1], radius: 2, velocity: 1, amplitude: 0.5 }});
+}}
+fn update(t, dt) {{ }}
 "#
     )
 }
@@ -153,8 +169,8 @@ pub fn run(args: ScriptArgs) -> Result<ExitCode> {
         gpu.info().name,
         args.frames
     );
-    println!("| lights | script update (ms) | scene update with upload (ms) | upload alone (ms) | light buffer (KiB) |");
-    println!("|---:|---:|---:|---:|---:|");
+    println!("| lights | script update (ms) | scene update with upload (ms) | upload alone (ms) | declared motions: scene update (ms) | light buffer (KiB) |");
+    println!("|---:|---:|---:|---:|---:|---:|");
     let dir = std::env::temp_dir().join(format!("weft-bench-script-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     for &n in &args.lights {
@@ -179,11 +195,17 @@ pub fn run(args: ScriptArgs) -> Result<ExitCode> {
             ..scene.clone()
         };
         let upload_ms = scene_update_ms(&gpu, &still, args.frames)?;
+        let declared = dir.join(format!("declared{n}.rhai"));
+        std::fs::write(&declared, declared_text(n))?;
+        let declared = weft_scene::load_scene(&declared)
+            .with_context(|| format!("loading {}", declared.display()))?;
+        let declared_ms = scene_update_ms(&gpu, &declared, args.frames)?;
         println!(
-            "| {n} | {:.3} | {:.3} | {:.3} | {:.1} |",
+            "| {n} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} |",
             median(script_ms),
             median(update_ms),
             median(upload_ms),
+            median(declared_ms),
             f64::from(n) * 64.0 / 1024.0
         );
     }

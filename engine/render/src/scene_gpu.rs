@@ -531,6 +531,7 @@ impl<'g> GpuScene<'g> {
             script_error: None,
             script_frame: weft_scene::script::ScriptFrame {
                 lights: scene.lights.clone(),
+                touched: vec![false; scene.lights.len()],
                 transforms: scene.instances.iter().map(|i| i.transform).collect(),
                 cameras: Vec::new(),
             },
@@ -828,14 +829,22 @@ impl GpuScene<'_> {
         }
     }
 
-    /// The lights at `time`: the script's, when it animates them, else the
-    /// `.scene` motions'.
-    fn lights_at(&self, time: f32) -> std::borrow::Cow<'_, [weft_scene::Light]> {
+    /// The lights at `time`: the `.scene` motions', with the lights the
+    /// script has changed as it left them.
+    fn lights_at(&self, time: f32) -> Vec<weft_scene::Light> {
+        let mut lights = weft_scene::animation::lights_at(&self.source_lights, time, 0);
         if self.script.as_ref().is_some_and(|s| s.animates()) {
-            std::borrow::Cow::Borrowed(&self.script_frame.lights)
-        } else {
-            weft_scene::animation::lights_at(&self.source_lights, time, 0).into()
+            let frame = &self.script_frame;
+            for ((light, scripted), _) in lights
+                .iter_mut()
+                .zip(&frame.lights)
+                .zip(&frame.touched)
+                .filter(|(_, &touched)| touched)
+            {
+                light.clone_from(scripted);
+            }
         }
+        lights
     }
 
     /// Moves the placements the script moved: their draw records rewritten

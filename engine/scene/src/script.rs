@@ -118,9 +118,11 @@ struct State {
     model_bounds: HashMap<PathBuf, Aabb>,
     /// After the load: the loaded scene's bounds (relative to the origin).
     scene_bounds: Aabb,
-    /// Per frame: the scene's lights as the script leaves them, and which are on.
+    /// Per frame: the scene's lights as the script leaves them, which are
+    /// on, and which it has changed (the others keep their `.scene` motions).
     lights: Vec<Light>,
     on: Vec<bool>,
+    touched: Vec<bool>,
     /// Per frame: each placement's model-to-world transform (relative to the origin).
     transforms: Vec<Mat4>,
     /// Per frame: the scene's cameras, and which the script has set.
@@ -154,6 +156,7 @@ impl State {
             scene_bounds: Aabb::EMPTY,
             lights: Vec::new(),
             on: Vec::new(),
+            touched: Vec::new(),
             transforms: Vec::new(),
             cameras: Vec::new(),
             camera_set: Vec::new(),
@@ -552,6 +555,7 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
             let p = (vec3(&ctx, &x, &y, &z)? - origin).as_vec3();
             let mut s = lock(&st);
             let i = light_index(&ctx, &s, i)?;
+            s.touched[i] = true;
             match &mut s.lights[i] {
                 Light::Point(l) => l.position = p,
                 Light::Spot(l) => l.position = p,
@@ -576,6 +580,7 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
             };
             let mut s = lock(&st);
             let i = light_index(&ctx, &s, i)?;
+            s.touched[i] = true;
             match &mut s.lights[i] {
                 Light::Sun(l) => l.direction = d,
                 Light::Spot(l) => l.direction = d,
@@ -599,6 +604,7 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
             }
             let mut s = lock(&st);
             let i = light_index(&ctx, &s, i)?;
+            s.touched[i] = true;
             match &mut s.lights[i] {
                 Light::Sun(l) => l.color = c,
                 Light::Spot(l) => l.color = c,
@@ -614,6 +620,7 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
         move |ctx: NativeCallContext, i: INT, on: bool| {
             let mut s = lock(&st);
             let i = light_index(&ctx, &s, i)?;
+            s.touched[i] = true;
             s.on[i] = on;
             Ok::<(), Box<EvalAltResult>>(())
         },
@@ -805,6 +812,10 @@ pub fn run_load(
 pub struct ScriptFrame {
     /// Every light of the scene (those switched off with zero colour).
     pub lights: Vec<Light>,
+    /// Per light, whether the script has changed it since time 0; a light
+    /// it has not changed keeps its `.scene` motion (`velocity`, `swivel`,
+    /// `motion`), which the renderer evaluates.
+    pub touched: Vec<bool>,
     /// Every placement's model-to-world transform, relative to the origin.
     pub transforms: Vec<Mat4>,
     /// The cameras the script has set since time 0, with their paths cleared.
@@ -892,6 +903,7 @@ impl ScriptRuntime {
             let mut s = lock(&self.state);
             s.lights = self.loaded.lights.clone();
             s.on = vec![true; self.loaded.lights.len()];
+            s.touched = vec![false; self.loaded.lights.len()];
             s.transforms = self.loaded.transforms.clone();
             s.cameras = self.loaded.cameras.clone();
             s.camera_set = vec![false; self.loaded.cameras.len()];
@@ -971,6 +983,7 @@ impl ScriptRuntime {
                     }
                 })
                 .collect(),
+            touched: s.touched.clone(),
             transforms: s.transforms.clone(),
             cameras: s
                 .cameras
