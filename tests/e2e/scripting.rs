@@ -190,6 +190,28 @@ fn update(t, dt) {
                 .to_string(),
         ),
         (
+            "caster.rhai",
+            r#"model("floor.obj", #{});
+model("cube.obj", #{ position: [-1, 0.5, 0] });
+camera("main", #{ position: [0, 3, 6], target: [0, 0, 0] });
+sun_light(#{ direction: [-0.3, -1, -0.4], color: [0.5, 0.5, 0.5] });
+spot_light(#{ position: [2.5, 3, -2.5], direction: [0, -1, 0], angle: 20, color: [1, 1, 1] });
+fn update(t, dt) {
+    if t > 1.2 { set_model_transform(1, #{ position: [1, 0.5, 0] }); }
+}
+"#
+            .to_string(),
+        ),
+        (
+            "caster.scene",
+            "model\n{\n\tfile \"floor.obj\"\n}\n\
+             model\n{\n\tfile \"cube.obj\"\n\tposition 1 0.5 0\n}\n\
+             camera \"main\"\n{\n\tposition 0 3 6\n\ttarget 0 0 0\n}\n\
+             sunlight\n{\n\tdirection -0.3 -1 -0.4\n\tcolor 0.5 0.5 0.5\n}\n\
+             spotlight\n{\n\tposition 2.5 3 -2.5\n\tdirection 0 -1 0\n\tangle 20\n\tcolor 1 1 1\n}\n"
+                .to_string(),
+        ),
+        (
             "placed_red.scene",
             format!(
                 "model\n{{\n\tfile \"floor.obj\"\n}}\n\
@@ -274,5 +296,49 @@ fn lights_the_script_leaves_alone_keep_their_scene_motions() {
         .filter(|(a, b)| a != b)
         .count();
     assert!(changed > 500, "the lights moved: {changed} pixels");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_moved_caster_redraws_exactly_the_shadow_views_it_meets() {
+    let dir = placement_scenes("casters");
+    let render_frames = |scene: &str, time: f32, frames: u32| {
+        let loaded = weft_scene::load_scene(&dir.join(scene)).expect("scene loads");
+        let gpu = weft_tests::gpu();
+        let log = gpu.validation();
+        let settings = RenderSettings {
+            features: vec!["!bloom".into()],
+            frames,
+            frame_time: 0.5,
+            ..settings("forward.ron", 96, 64, time)
+        };
+        let rendered = render(&gpu, &loaded, &settings).expect("renders");
+        drop(gpu);
+        assert_eq!(log.messages(), Vec::new(), "{scene}");
+        let kept: Vec<bool> = rendered
+            .culling
+            .iter()
+            .filter(|c| c.view.starts_with("shadow"))
+            .map(|c| c.kept)
+            .collect();
+        (rendered.report.output.expect("readback").to_rgba8(), kept)
+    };
+    // Frame 0 at 1 s draws both views; the cube moves before frame 1 at
+    // 1.5 s, inside the sun's view and outside the spot's; the sun and the
+    // scene's bounds stay as they were, so the sun's view is bit-identical.
+    let (moved, kept) = render_frames("caster.rhai", 1.0, 2);
+    assert_eq!(
+        kept,
+        [false, true],
+        "the sun's tile redrawn, the spot's kept"
+    );
+    let (placed, _) = render_frames("caster.scene", 0.0, 1);
+    assert!(moved == placed, "the shadow follows the cube");
+    let (_, kept) = render_frames("caster.rhai", 1.5, 2);
+    assert_eq!(
+        kept,
+        [true, true],
+        "nothing moved from 1.5 s to 2 s: both kept"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

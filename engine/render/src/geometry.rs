@@ -289,6 +289,15 @@ impl SceneGeometry {
         ids
     }
 
+    /// The world boxes of scene instance `instance`'s draws as placed now.
+    pub fn instance_boxes(&self, instance: usize) -> impl Iterator<Item = Aabb> + '_ {
+        self.instance_draws
+            .get(instance)
+            .cloned()
+            .unwrap_or(0..0)
+            .map(|id| self.draws[self.draw_places[id as usize].1].bounds)
+    }
+
     /// The box around every draw as placed now.
     pub fn placed_bounds(&self) -> Aabb {
         self.draws

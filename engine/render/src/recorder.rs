@@ -85,8 +85,9 @@ pub struct SceneRecorder<'g> {
 
 /// What a shadow view drew into its atlas tile: the tile is kept while a
 /// later frame's view is bit-identical (same world-to-clip matrix, same
-/// rectangle) and nothing else changed; [`SceneRecorder::forget_shadow_tiles`]
-/// drops every kept tile (a new plan, scene or shader).
+/// rectangle) and no placement moved into or out of it (a moved light changes
+/// its views' matrices); [`SceneRecorder::forget_shadow_tiles`] drops every
+/// kept tile (a new plan, scene or shader).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct ShadowTile {
     clip: [u32; 16],
@@ -447,7 +448,14 @@ impl SceneRecorder<'_> {
         for (i, view) in views.iter().enumerate() {
             let tile = ShadowTile::of(view);
             let name = format!("{}[{i}]", pass.name);
-            if keeps_tiles && self.shadow_tiles[i] == Some(tile) {
+            // A placement that moved into or out of the view stales its tile.
+            let frustum = crate::frustum::Frustum::from_clip(view.clip);
+            let casters_moved = self
+                .scene
+                .moved_boxes()
+                .iter()
+                .any(|b| frustum.may_contain(b));
+            if keeps_tiles && self.shadow_tiles[i] == Some(tile) && !casters_moved {
                 self.culling.push(ViewCulling {
                     view: name,
                     drawn: 0,

@@ -363,6 +363,9 @@ pub struct GpuScene<'g> {
     declared_bounds: Option<weft_scene::Aabb>,
     /// Whether the script has moved a placement since the scene loaded.
     moved: bool,
+    /// The world boxes, before and after, of the draws moved by the last
+    /// update: the shadow views they meet are redrawn.
+    moved_boxes: Vec<weft_scene::Aabb>,
     bounds: weft_scene::Aabb,
     /// The camera's view volume at the last update, what sun cascades are fitted to.
     pub view_volume: ViewVolume,
@@ -538,6 +541,7 @@ impl<'g> GpuScene<'g> {
             transforms: scene.instances.iter().map(|i| i.transform).collect(),
             declared_bounds: scene.declared_bounds,
             moved: false,
+            moved_boxes: Vec::new(),
             trace: None,
             bvh_cache: None,
             bounds,
@@ -851,6 +855,7 @@ impl GpuScene<'_> {
     /// in place as one range, the scene's box refitted (unless declared),
     /// and the ray tracer's triangles and BVH rebuilt if a pass traces.
     fn place_instances(&mut self) -> Result<(), GpuError> {
+        self.moved_boxes.clear();
         if !self.script.as_ref().is_some_and(|s| s.animates()) {
             return Ok(());
         }
@@ -866,7 +871,9 @@ impl GpuScene<'_> {
                 continue;
             }
             *old = *new;
+            self.moved_boxes.extend(self.geometry.instance_boxes(i));
             let ids = self.geometry.place_instance(i, *new);
+            self.moved_boxes.extend(self.geometry.instance_boxes(i));
             if ids.is_empty() {
                 continue;
             }
@@ -902,6 +909,12 @@ impl GpuScene<'_> {
             }
         }
         Ok(())
+    }
+
+    /// Where the draws the last [`GpuScene::update`] moved were and are now
+    /// (world boxes): a kept shadow tile whose view meets one is stale.
+    pub fn moved_boxes(&self) -> &[weft_scene::Aabb] {
+        &self.moved_boxes
     }
 
     /// The scene script's error from the last frames, if `update` failed.
