@@ -130,7 +130,8 @@ const LIGHTS: &str = "pointlight\n{\n\tposition 2 4 1.25\n\tcolor 1 1 1\n\tradiu
 
 /// A folder of its own for `test`: the models, a script that moves the
 /// cube, the camera and the lights each step (the cube to x = 1.25, turned
-/// 90 degrees, at step 90 = 1.5 s), and the files that place them there.
+/// 90 degrees, at step 90 = 1.5 s) and turns the green cube red from step
+/// 85, and the files that place them there.
 fn placement_scenes(test: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("weft-{test}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -143,7 +144,7 @@ fn placement_scenes(test: &str) -> std::path::PathBuf {
         (
             "moved.rhai",
             r#"model("floor.obj", #{});
-model("cube.obj", #{ color: [0.9, 0.2, 0.1] });
+model("cube.obj", #{ color: [0.2, 0.9, 0.1] });
 camera("main", #{ position: [0, 3, 6], target: [0, 0, 0] });
 point_light(#{ position: [2, 4, 2], color: [1, 1, 1], radius: 20 });
 sun_light(#{ direction: [-0.3, -1, -0.4], color: [0.5, 0.5, 0.5] });
@@ -155,6 +156,7 @@ fn update(t, dt) {
     set_camera("main", #{ position: [x, 3, 6], target: [x, 0.5, 0] });
     set_light_position(0, 2, 4, x);
     set_light_direction(1, -0.3, -1, -0.25 * x);
+    if this.n >= 85 { set_model_color(1, 0.9, 0.2, 0.1); }
 }
 "#
             .to_string(),
@@ -251,7 +253,7 @@ fn last_frame(scene: &Path, graph_name: &str, time: f32, frames: u32) -> image::
 }
 
 #[test]
-fn a_script_moving_a_placement_the_camera_and_the_lights_draws_what_a_file_placing_them_there_draws(
+fn a_script_moving_and_recolouring_a_placement_and_moving_the_camera_and_lights_draws_what_a_file_placing_them_there_draws(
 ) {
     let dir = placement_scenes("placements");
     for graph_name in ["forward.ron", "deferred.ron", "pathtrace.ron"] {

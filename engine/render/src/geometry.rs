@@ -153,6 +153,10 @@ pub struct SceneGeometry {
     pub instance_draws: Vec<std::ops::Range<u32>>,
     /// Per draw id, the mesh's model-space box and where the draw sits in `draws`.
     draw_places: Vec<(Aabb, usize)>,
+    /// Per scene instance, with [`SceneGeometry::with_own_materials`]: its
+    /// own material copies, each with the model material it copies (so a
+    /// script can recolour one instance).
+    pub instance_materials: Vec<Vec<(u32, u32)>>,
     /// Every material, index 0 being the default for meshes without one.
     pub materials: Vec<Material>,
     /// The point-light volume (see [`crate::volumes::sphere`]).
@@ -170,6 +174,17 @@ pub struct SceneGeometry {
 impl SceneGeometry {
     /// Flattens `scene`.
     pub fn new(scene: &Scene) -> Self {
+        Self::flatten(scene, false)
+    }
+
+    /// Flattens `scene` with every instance drawing its own copies of its
+    /// materials (listed in `instance_materials`), so each can be recoloured
+    /// alone; the geometry is shared as before.
+    pub fn with_own_materials(scene: &Scene) -> Self {
+        Self::flatten(scene, true)
+    }
+
+    fn flatten(scene: &Scene, own_materials: bool) -> Self {
         let mut g = SceneGeometry {
             materials: vec![Material::default()],
             ..Self::default()
@@ -212,11 +227,14 @@ impl SceneGeometry {
             }
             ranges.push(model_ranges);
         }
-        // Overridden materials are copies appended once per (material, override).
-        let mut overridden: HashMap<(u32, [u32; 8]), u32> = HashMap::new();
+        // Overridden materials are copies appended once per (material,
+        // override), or per (material, instance) with own materials.
+        let mut overridden: HashMap<(u32, [u32; 8], usize), u32> = HashMap::new();
         let mut local_bounds = Vec::new();
-        for instance in &scene.instances {
+        for (index, instance) in scene.instances.iter().enumerate() {
             let first = g.draw_records.len() as u32;
+            let owner = if own_materials { index } else { usize::MAX };
+            g.instance_materials.push(Vec::new());
             let Some(model_ranges) = ranges.get(instance.model) else {
                 g.instance_draws.push(first..first);
                 continue;
@@ -224,15 +242,19 @@ impl SceneGeometry {
             let normal = instance.transform.inverse().transpose();
             let mirrored = instance.transform.determinant() < 0.0;
             for &(range, material, bounds, uv_box) in model_ranges.iter().flatten() {
-                let material = if instance.material.is_empty() {
+                let material = if instance.material.is_empty() && !own_materials {
                     material
                 } else {
                     *overridden
-                        .entry((material, instance.material.key()))
+                        .entry((material, instance.material.key(), owner))
                         .or_insert_with(|| {
                             let copy = instance.material.apply(&g.materials[material as usize]);
                             g.materials.push(copy);
-                            g.materials.len() as u32 - 1
+                            let copy = g.materials.len() as u32 - 1;
+                            if own_materials {
+                                g.instance_materials[index].push((copy, material));
+                            }
+                            copy
                         })
                 };
                 let draw_id = g.draws.len() as u32;

@@ -359,6 +359,10 @@ pub struct GpuScene<'g> {
     script_frame: weft_scene::script::ScriptFrame,
     /// Each scene instance's transform as the draw records hold it.
     transforms: Vec<glam::Mat4>,
+    /// Each scene instance's material overrides as the material records hold them.
+    overrides: Vec<weft_scene::material::MaterialOverride>,
+    /// Per material, whether it has a normal map (how its record is packed).
+    normal_mapped: Vec<bool>,
     /// The scene's `boundingbox`, which moving placements do not change.
     declared_bounds: Option<weft_scene::Aabb>,
     /// Whether the script has moved a placement since the scene loaded.
@@ -382,7 +386,23 @@ pub struct GpuScene<'g> {
 impl<'g> GpuScene<'g> {
     /// Uploads `scene`.
     pub fn new(gpu: &'g Gpu, scene: &Scene) -> Result<Self, RenderError> {
-        let geometry = SceneGeometry::new(scene);
+        let script = match &scene.script {
+            Some(script) => Some(weft_scene::script::ScriptRuntime::new(
+                script,
+                scene,
+                &weft_scene::script::Limits::default(),
+            )?),
+            None => None,
+        };
+        // A script that animates may move and recolour placements: each then
+        // draws its own material copies, and the draw records and materials
+        // are rewritten in place each frame.
+        let animates = script.as_ref().is_some_and(|s| s.animates());
+        let geometry = if animates {
+            SceneGeometry::with_own_materials(scene)
+        } else {
+            SceneGeometry::new(scene)
+        };
         let mut warnings: Vec<String> = geometry
             .skipped
             .iter()
@@ -418,33 +438,12 @@ impl<'g> GpuScene<'g> {
             &index_bytes,
             vk::BufferUsageFlags::INDEX_BUFFER | storage,
         )?;
-        let script = match &scene.script {
-            Some(script) => Some(weft_scene::script::ScriptRuntime::new(
-                script,
-                scene,
-                &weft_scene::script::Limits::default(),
-            )?),
-            None => None,
-        };
-        // A script that animates may move placements: their draw records are
-        // then rewritten in place each frame.
-        let draws = if script.as_ref().is_some_and(|s| s.animates()) {
-            let mut draws = Buffer::host(
-                gpu,
-                "scene draws",
-                std::mem::size_of_val(geometry.draw_records.as_slice()).max(1) as u64,
-                storage,
-            )?;
-            draws.write(bytes_of(&geometry.draw_records))?;
-            draws
-        } else {
-            Buffer::device_local(
-                gpu,
-                "scene draws",
-                bytes_of(&geometry.draw_records),
-                storage,
-            )?
-        };
+        let draws = rewritable(
+            gpu,
+            "scene draws",
+            bytes_of(&geometry.draw_records),
+            animates,
+        )?;
         let mut textures = vec![Texture::upload(gpu, "white", &Rgba8Image::white(), true)?];
         let mut by_source: HashMap<(String, bool), usize> = HashMap::new();
         let mut material_texture = Vec::with_capacity(geometry.materials.len());
@@ -477,8 +476,13 @@ impl<'g> GpuScene<'g> {
             material_records.push(pack_material(m, normal != 0));
             material_texture.push([base, metal_rough, normal, emissive, occlusion]);
         }
-        let materials =
-            Buffer::device_local(gpu, "scene materials", bytes_of(&material_records), storage)?;
+        let materials = rewritable(
+            gpu,
+            "scene materials",
+            bytes_of(&material_records),
+            animates,
+        )?;
+        let normal_mapped = material_texture.iter().map(|slots| slots[2] != 0).collect();
         let frame = Buffer::host(
             gpu,
             "frame",
@@ -536,9 +540,12 @@ impl<'g> GpuScene<'g> {
                 lights: scene.lights.clone(),
                 touched: vec![false; scene.lights.len()],
                 transforms: scene.instances.iter().map(|i| i.transform).collect(),
+                colors: scene.instances.iter().map(|i| i.material.color).collect(),
                 cameras: Vec::new(),
             },
             transforms: scene.instances.iter().map(|i| i.transform).collect(),
+            overrides: scene.instances.iter().map(|i| i.material).collect(),
+            normal_mapped,
             declared_bounds: scene.declared_bounds,
             moved: false,
             moved_boxes: Vec::new(),
@@ -775,6 +782,7 @@ impl<'g> GpuScene<'g> {
     ) -> Result<u64, GpuError> {
         self.run_script(time);
         self.place_instances()?;
+        self.recolour_instances()?;
         let scripted = self
             .script_frame
             .cameras
@@ -911,6 +919,47 @@ impl GpuScene<'_> {
         Ok(())
     }
 
+    /// Repacks the material copies of the placements the script recoloured
+    /// and writes them as one range of the material buffer.
+    fn recolour_instances(&mut self) -> Result<(), GpuError> {
+        if !self.script.as_ref().is_some_and(|s| s.animates()) {
+            return Ok(());
+        }
+        let mut changed: Option<(u32, u32)> = None;
+        for (i, (colour, overrides)) in self
+            .script_frame
+            .colors
+            .iter()
+            .zip(self.overrides.iter_mut())
+            .enumerate()
+        {
+            if *colour == overrides.color {
+                continue;
+            }
+            overrides.color = *colour;
+            for &(copy, original) in &self.geometry.instance_materials[i] {
+                let material = overrides.apply(&self.geometry.materials[original as usize]);
+                self.geometry.materials[copy as usize] = material;
+                changed = Some(changed.map_or((copy, copy), |(a, b)| (a.min(copy), b.max(copy))));
+            }
+        }
+        let Some((first, last)) = changed else {
+            return Ok(());
+        };
+        let records: Vec<GpuMaterial> = (first..=last)
+            .map(|m| {
+                pack_material(
+                    &self.geometry.materials[m as usize],
+                    self.normal_mapped[m as usize],
+                )
+            })
+            .collect();
+        self.materials.write_at(
+            first as usize * std::mem::size_of::<GpuMaterial>(),
+            bytes_of(&records),
+        )
+    }
+
     /// Where the draws the last [`GpuScene::update`] moved were and are now
     /// (world boxes): a kept shadow tile whose view meets one is stale.
     pub fn moved_boxes(&self) -> &[weft_scene::Aabb] {
@@ -940,6 +989,24 @@ impl GpuScene<'_> {
         );
         self.shadows.write(&frame.pack(settings))?;
         Ok(frame.views)
+    }
+}
+
+/// A storage buffer holding `bytes`: host-visible when it is `rewritten`
+/// per frame (in ranges), else device-local.
+fn rewritable<'g>(
+    gpu: &'g Gpu,
+    name: &str,
+    bytes: &[u8],
+    rewritten: bool,
+) -> Result<Buffer<'g>, GpuError> {
+    let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+    if rewritten {
+        let mut buffer = Buffer::host(gpu, name, bytes.len().max(1) as u64, storage)?;
+        buffer.write(bytes)?;
+        Ok(buffer)
+    } else {
+        Buffer::device_local(gpu, name, bytes, storage)
     }
 }
 

@@ -123,8 +123,10 @@ struct State {
     lights: Vec<Light>,
     on: Vec<bool>,
     touched: Vec<bool>,
-    /// Per frame: each placement's model-to-world transform (relative to the origin).
+    /// Per frame: each placement's model-to-world transform (relative to the
+    /// origin) and its colour override.
     transforms: Vec<Mat4>,
+    colors: Vec<Option<Vec3>>,
     /// Per frame: the scene's cameras, and which the script has set.
     cameras: Vec<Camera>,
     camera_set: Vec<bool>,
@@ -158,6 +160,7 @@ impl State {
             on: Vec::new(),
             touched: Vec::new(),
             transforms: Vec::new(),
+            colors: Vec::new(),
             cameras: Vec::new(),
             camera_set: Vec::new(),
             loading: true,
@@ -506,6 +509,7 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
         },
     );
     register_models(engine, state, origin);
+    register_model_colors(engine, state);
     register_cameras(engine, state);
     let st = state.clone();
     engine.register_fn(
@@ -683,6 +687,24 @@ fn register_models(engine: &mut Engine, state: &Shared, origin: DVec3) {
     );
 }
 
+/// `set_model_color`: a placement's colour override per frame.
+fn register_model_colors(engine: &mut Engine, state: &Shared) {
+    let st = state.clone();
+    engine.register_fn(
+        "set_model_color",
+        move |ctx: NativeCallContext, i: INT, r: Dynamic, g: Dynamic, b: Dynamic| {
+            let c = vec3(&ctx, &r, &g, &b)?.as_vec3();
+            if c.min_element() < 0.0 {
+                return Err(fail(&ctx, format!("colour {c} is negative")));
+            }
+            let mut s = lock(&st);
+            let i = frame_index(&ctx, &s, ("model", s.colors.len()), i)?;
+            s.colors[i] = Some(c);
+            Ok::<(), Box<EvalAltResult>>(())
+        },
+    );
+}
+
 /// `set_camera`: a camera's pose (and field of view) per frame.
 fn register_cameras(engine: &mut Engine, state: &Shared) {
     let st = state.clone();
@@ -818,6 +840,9 @@ pub struct ScriptFrame {
     pub touched: Vec<bool>,
     /// Every placement's model-to-world transform, relative to the origin.
     pub transforms: Vec<Mat4>,
+    /// Every placement's colour override (`color`), as loaded or as the
+    /// script set it.
+    pub colors: Vec<Option<Vec3>>,
     /// The cameras the script has set since time 0, with their paths cleared.
     pub cameras: Vec<Camera>,
 }
@@ -826,6 +851,7 @@ pub struct ScriptFrame {
 struct Loaded {
     lights: Vec<Light>,
     transforms: Vec<Mat4>,
+    colors: Vec<Option<Vec3>>,
     cameras: Vec<Camera>,
 }
 
@@ -869,6 +895,7 @@ impl ScriptRuntime {
         let loaded = Loaded {
             lights: scene.lights.clone(),
             transforms: scene.instances.iter().map(|i| i.transform).collect(),
+            colors: scene.instances.iter().map(|i| i.material.color).collect(),
             cameras: scene.cameras.clone(),
         };
         let state: Shared = Arc::new(Mutex::new(loading));
@@ -905,6 +932,7 @@ impl ScriptRuntime {
             s.on = vec![true; self.loaded.lights.len()];
             s.touched = vec![false; self.loaded.lights.len()];
             s.transforms = self.loaded.transforms.clone();
+            s.colors = self.loaded.colors.clone();
             s.cameras = self.loaded.cameras.clone();
             s.camera_set = vec![false; self.loaded.cameras.len()];
         }
@@ -985,6 +1013,7 @@ impl ScriptRuntime {
                 .collect(),
             touched: s.touched.clone(),
             transforms: s.transforms.clone(),
+            colors: s.colors.clone(),
             cameras: s
                 .cameras
                 .iter()
