@@ -8,7 +8,7 @@ use weft_tests::render as common;
 use common::{graph, root};
 use std::path::Path;
 use weft_graph::plan::Extent;
-use weft_render::{render, RenderSettings};
+use weft_render::{render, RenderSettings, Rendered};
 
 const EXAMPLES: [&str; 4] = [
     "scenes/flocking.rhai",
@@ -27,15 +27,22 @@ fn settings(graph_name: &str, width: u32, height: u32, time: f32) -> RenderSetti
     }
 }
 
-/// The image of `scene` at `time` through `graph_name`, under validation
-/// (asserting zero messages).
-fn image_at(scene: &Path, graph_name: &str, time: f32) -> image::RgbaImage {
+/// `frames` frames of `scene` at `width`×`height` from `time`, half a second
+/// apart, through `graph_name`, under validation (asserting zero messages).
+fn rendered(
+    scene: &Path,
+    graph_name: &str,
+    [width, height]: [u32; 2],
+    (time, frames): (f32, u32),
+) -> Rendered {
     let loaded = weft_scene::load_scene(scene).expect("scene loads");
     let gpu = weft_tests::gpu();
     let log = gpu.validation();
     let settings = RenderSettings {
         features: vec!["!bloom".into()],
-        ..settings(graph_name, 160, 90, time)
+        frames,
+        frame_time: 0.5,
+        ..settings(graph_name, width, height, time)
     };
     let rendered =
         render(&gpu, &loaded, &settings).unwrap_or_else(|e| panic!("{}: {e}", scene.display()));
@@ -46,7 +53,17 @@ fn image_at(scene: &Path, graph_name: &str, time: f32) -> image::RgbaImage {
         "{} {graph_name}",
         scene.display()
     );
+    rendered
+}
+
+/// The last frame's image.
+fn image_of(rendered: Rendered) -> image::RgbaImage {
     rendered.report.output.expect("readback").to_rgba8()
+}
+
+/// The image of `scene` at `time` through `graph_name` at 160×90.
+fn image_at(scene: &Path, graph_name: &str, time: f32) -> image::RgbaImage {
+    image_of(rendered(scene, graph_name, [160, 90], (time, 1)))
 }
 
 #[test]
@@ -229,27 +246,9 @@ fn update(t, dt) {
 }
 
 /// The last of `frames` frames of `scene` from `time`, half a second apart,
-/// through `graph_name`, under validation (asserting zero messages).
+/// through `graph_name` at 96×64.
 fn last_frame(scene: &Path, graph_name: &str, time: f32, frames: u32) -> image::RgbaImage {
-    let loaded = weft_scene::load_scene(scene).expect("scene loads");
-    let gpu = weft_tests::gpu();
-    let log = gpu.validation();
-    let settings = RenderSettings {
-        features: vec!["!bloom".into()],
-        frames,
-        frame_time: 0.5,
-        ..settings(graph_name, 96, 64, time)
-    };
-    let rendered =
-        render(&gpu, &loaded, &settings).unwrap_or_else(|e| panic!("{}: {e}", scene.display()));
-    drop(gpu);
-    assert_eq!(
-        log.messages(),
-        Vec::new(),
-        "{} {graph_name}",
-        scene.display()
-    );
-    rendered.report.output.expect("readback").to_rgba8()
+    image_of(rendered(scene, graph_name, [96, 64], (time, frames)))
 }
 
 #[test]
@@ -305,25 +304,14 @@ fn lights_the_script_leaves_alone_keep_their_scene_motions() {
 fn a_moved_caster_redraws_exactly_the_shadow_views_it_meets() {
     let dir = placement_scenes("casters");
     let render_frames = |scene: &str, time: f32, frames: u32| {
-        let loaded = weft_scene::load_scene(&dir.join(scene)).expect("scene loads");
-        let gpu = weft_tests::gpu();
-        let log = gpu.validation();
-        let settings = RenderSettings {
-            features: vec!["!bloom".into()],
-            frames,
-            frame_time: 0.5,
-            ..settings("forward.ron", 96, 64, time)
-        };
-        let rendered = render(&gpu, &loaded, &settings).expect("renders");
-        drop(gpu);
-        assert_eq!(log.messages(), Vec::new(), "{scene}");
+        let rendered = rendered(&dir.join(scene), "forward.ron", [96, 64], (time, frames));
         let kept: Vec<bool> = rendered
             .culling
             .iter()
             .filter(|c| c.view.starts_with("shadow"))
             .map(|c| c.kept)
             .collect();
-        (rendered.report.output.expect("readback").to_rgba8(), kept)
+        (image_of(rendered), kept)
     };
     // Frame 0 at 1 s draws both views; the cube moves before frame 1 at
     // 1.5 s, inside the sun's view and outside the spot's; the sun and the

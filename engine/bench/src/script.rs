@@ -18,7 +18,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 use weft_gpu::{Gpu, GpuOptions};
 use weft_render::scene_gpu::GpuScene;
-use weft_scene::script::{Limits, ScriptRuntime, STEP};
+use weft_scene::script::{Limits, ScriptFrame, ScriptRuntime, STEP};
 
 /// Arguments of `weft bench script`.
 #[derive(Args)]
@@ -158,6 +158,30 @@ fn rewrite_ms(
     Ok(ms)
 }
 
+/// The scene of the script `text`, written to `path`.
+fn scene_from(path: &std::path::Path, text: &str) -> Result<weft_scene::Scene> {
+    std::fs::write(path, text)?;
+    weft_scene::load_scene(path).with_context(|| format!("loading {}", path.display()))
+}
+
+/// The script's step per frame, one 1/60 s step each, after 10 warm-up
+/// frames: the times, and what each measured step left.
+fn script_steps(scene: &weft_scene::Scene, frames: u32) -> Result<(Vec<f64>, Vec<ScriptFrame>)> {
+    let script = scene.script.as_ref().context("the scene has its script")?;
+    let mut runtime = ScriptRuntime::new(script, scene, &Limits::default())?;
+    let (mut ms, mut left) = (Vec::new(), Vec::new());
+    for frame in 0..frames + 10 {
+        let t = f64::from(frame + 1) * STEP;
+        let started = Instant::now();
+        let stepped = runtime.frame_at(t)?;
+        if frame >= 10 {
+            ms.push(started.elapsed().as_secs_f64() * 1e3);
+            left.push(stepped);
+        }
+    }
+    Ok((ms, left))
+}
+
 /// Runs the benchmark and prints a table.
 pub fn run(args: ScriptArgs) -> Result<ExitCode> {
     let gpu = Gpu::new(&GpuOptions {
@@ -174,31 +198,15 @@ pub fn run(args: ScriptArgs) -> Result<ExitCode> {
     let dir = std::env::temp_dir().join(format!("weft-bench-script-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     for &n in &args.lights {
-        let path = dir.join(format!("lights{n}.rhai"));
-        std::fs::write(&path, script_text(n))?;
-        let scene =
-            weft_scene::load_scene(&path).with_context(|| format!("loading {}", path.display()))?;
-        let script = scene.script.clone().context("the scene has its script")?;
-        let mut runtime = ScriptRuntime::new(&script, &scene, &Limits::default())?;
-        let mut script_ms = Vec::new();
-        for frame in 0..args.frames + 10 {
-            let t = f64::from(frame + 1) * STEP;
-            let started = Instant::now();
-            runtime.frame_at(t)?;
-            if frame >= 10 {
-                script_ms.push(started.elapsed().as_secs_f64() * 1e3);
-            }
-        }
+        let scene = scene_from(&dir.join(format!("lights{n}.rhai")), &script_text(n))?;
+        let (script_ms, _) = script_steps(&scene, args.frames)?;
         let update_ms = scene_update_ms(&gpu, &scene, args.frames)?;
         let still = weft_scene::Scene {
             script: None,
             ..scene.clone()
         };
         let upload_ms = scene_update_ms(&gpu, &still, args.frames)?;
-        let declared = dir.join(format!("declared{n}.rhai"));
-        std::fs::write(&declared, declared_text(n))?;
-        let declared = weft_scene::load_scene(&declared)
-            .with_context(|| format!("loading {}", declared.display()))?;
+        let declared = scene_from(&dir.join(format!("declared{n}.rhai")), &declared_text(n))?;
         let declared_ms = scene_update_ms(&gpu, &declared, args.frames)?;
         println!(
             "| {n} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} |",
@@ -214,23 +222,12 @@ pub fn run(args: ScriptArgs) -> Result<ExitCode> {
     println!("|---:|---:|---:|---:|---:|");
     std::fs::write(dir.join("cube.obj"), CUBE)?;
     for &n in &args.placements {
-        let path = dir.join(format!("placements{n}.rhai"));
-        std::fs::write(&path, placements_text(n))?;
-        let scene =
-            weft_scene::load_scene(&path).with_context(|| format!("loading {}", path.display()))?;
-        let script = scene.script.clone().context("the scene has its script")?;
-        let mut runtime = ScriptRuntime::new(&script, &scene, &Limits::default())?;
-        let mut script_ms = Vec::new();
-        let mut frames = Vec::new();
-        for frame in 0..args.frames + 10 {
-            let t = f64::from(frame + 1) * STEP;
-            let started = Instant::now();
-            let placed = runtime.frame_at(t)?;
-            if frame >= 10 {
-                script_ms.push(started.elapsed().as_secs_f64() * 1e3);
-                frames.push(placed.transforms);
-            }
-        }
+        let scene = scene_from(
+            &dir.join(format!("placements{n}.rhai")),
+            &placements_text(n),
+        )?;
+        let (script_ms, frames) = script_steps(&scene, args.frames)?;
+        let frames: Vec<Vec<glam::Mat4>> = frames.into_iter().map(|f| f.transforms).collect();
         let update_ms = scene_update_ms(&gpu, &scene, args.frames)?;
         let rewrite_ms = rewrite_ms(&gpu, &scene, &frames)?;
         println!(

@@ -829,6 +829,11 @@ impl<'g> GpuScene<'g> {
 }
 
 impl GpuScene<'_> {
+    /// Whether the scene's script has `update`, which moves things per frame.
+    fn script_animates(&self) -> bool {
+        self.script.as_ref().is_some_and(|s| s.animates())
+    }
+
     /// Runs the script, when it animates, up to `time`; on an error keeps
     /// the last good step's frame, with the error for
     /// [`GpuScene::take_script_error`].
@@ -845,7 +850,7 @@ impl GpuScene<'_> {
     /// script has changed as it left them.
     fn lights_at(&self, time: f32) -> Vec<weft_scene::Light> {
         let mut lights = weft_scene::animation::lights_at(&self.source_lights, time, 0);
-        if self.script.as_ref().is_some_and(|s| s.animates()) {
+        if self.script_animates() {
             let frame = &self.script_frame;
             for ((light, scripted), _) in lights
                 .iter_mut()
@@ -864,7 +869,7 @@ impl GpuScene<'_> {
     /// and the ray tracer's triangles and BVH rebuilt if a pass traces.
     fn place_instances(&mut self) -> Result<(), GpuError> {
         self.moved_boxes.clear();
-        if !self.script.as_ref().is_some_and(|s| s.animates()) {
+        if !self.script_animates() {
             return Ok(());
         }
         let mut changed: Option<std::ops::Range<u32>> = None;
@@ -922,7 +927,7 @@ impl GpuScene<'_> {
     /// Repacks the material copies of the placements the script recoloured
     /// and writes them as one range of the material buffer.
     fn recolour_instances(&mut self) -> Result<(), GpuError> {
-        if !self.script.as_ref().is_some_and(|s| s.animates()) {
+        if !self.script_animates() {
             return Ok(());
         }
         let mut changed: Option<(u32, u32)> = None;

@@ -486,6 +486,20 @@ fn vec3(
     }
 }
 
+/// Three numbers as a colour: finite and not negative.
+fn colour(
+    ctx: &NativeCallContext,
+    r: &Dynamic,
+    g: &Dynamic,
+    b: &Dynamic,
+) -> Result<Vec3, Box<EvalAltResult>> {
+    let c = vec3(ctx, r, g, b)?.as_vec3();
+    if c.min_element() < 0.0 {
+        return Err(fail(ctx, format!("colour {c} is negative")));
+    }
+    Ok(c)
+}
+
 /// Registers every function scripts may call.
 fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
     for (name, kind) in [
@@ -602,10 +616,7 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
     engine.register_fn(
         "set_light_color",
         move |ctx: NativeCallContext, i: INT, r: Dynamic, g: Dynamic, b: Dynamic| {
-            let c = vec3(&ctx, &r, &g, &b)?.as_vec3();
-            if c.min_element() < 0.0 {
-                return Err(fail(&ctx, format!("colour {c} is negative")));
-            }
+            let c = colour(&ctx, &r, &g, &b)?;
             let mut s = lock(&st);
             let i = light_index(&ctx, &s, i)?;
             s.touched[i] = true;
@@ -693,10 +704,7 @@ fn register_model_colors(engine: &mut Engine, state: &Shared) {
     engine.register_fn(
         "set_model_color",
         move |ctx: NativeCallContext, i: INT, r: Dynamic, g: Dynamic, b: Dynamic| {
-            let c = vec3(&ctx, &r, &g, &b)?.as_vec3();
-            if c.min_element() < 0.0 {
-                return Err(fail(&ctx, format!("colour {c} is negative")));
-            }
+            let c = colour(&ctx, &r, &g, &b)?;
             let mut s = lock(&st);
             let i = frame_index(&ctx, &s, ("model", s.colors.len()), i)?;
             s.colors[i] = Some(c);
@@ -1402,6 +1410,7 @@ mod tests {
                         set_model_transform(1, #{ position: [t, 2, 0], orientation: [0, 90, 0], scale: [1, 2, 3] });
                         let p = model_position(1);
                         set_camera("top", #{ position: [p[0], 5, 5], target: p });
+                        set_model_color(1, 0, 1, 0.5);
                     }
                     "#,
                 ),
@@ -1426,6 +1435,14 @@ mod tests {
             frame.transforms[0], scene.instances[0].transform,
             "not moved"
         );
+        assert_eq!(
+            frame.colors,
+            [
+                Some(Vec3::new(1.0, 0.0, 0.0)),
+                Some(Vec3::new(0.0, 1.0, 0.5))
+            ],
+            "the load's override, and the colour set per frame"
+        );
         assert_eq!(frame.transforms[1], desc.models[0].transform);
         assert_eq!(frame.cameras.len(), 1, "the camera the script set");
         let (set, file) = (&frame.cameras[0], &desc.cameras[0]);
@@ -1449,6 +1466,10 @@ mod tests {
         assert_eq!(
             error("set_model_transform(1, #{});"),
             "scene.rhai:4:5: no model 1: the scene has 1"
+        );
+        assert_eq!(
+            error("set_model_color(0, 1, -1, 0);"),
+            "scene.rhai:4:5: colour [1, -1, 0] is negative"
         );
         assert_eq!(
             error("set_camera(\"side\", #{ position: [0, 0, 0] });"),
