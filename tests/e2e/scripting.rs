@@ -332,3 +332,22 @@ fn a_moved_caster_redraws_exactly_the_shadow_views_it_meets() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_grid_example_at_two_seconds_matches_its_golden() {
+    // Placements moved and recoloured and the camera swung by the script,
+    // over material overrides from its load: a regression check of the
+    // whole path (tolerance as for the other goldens, tests/e2e/render.rs).
+    let image = image_at(&root().join("scenes/grid.rhai"), "forward.ron", 2.0);
+    let tolerance = weft_testkit::Tolerance {
+        per_channel: 12,
+        mean: 0.5,
+    };
+    if let Err(e) = weft_testkit::check_golden(
+        &image,
+        &weft_tests::golden("grid_script_forward_160x90.png"),
+        &tolerance,
+    ) {
+        panic!("{e}");
+    }
+}
