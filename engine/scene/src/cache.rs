@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::time::UNIX_EPOCH;
 
 /// Bumped whenever the encoding or the importers' output changes; older entries are ignored.
-pub const CACHE_FORMAT_VERSION: u32 = 8;
+pub const CACHE_FORMAT_VERSION: u32 = 9;
 
 /// The first bytes of every entry.
 const MAGIC: [u8; 8] = *b"WEFTMDL\0";

@@ -72,20 +72,68 @@ fn texture(
         );
         return None;
     }
-    let path = dir.join(name.replace('\\', "/"));
-    sources.push(path.clone());
-    if !path.is_file() {
+    let named = dir.join(name.replace('\\', "/"));
+    sources.push(named.clone());
+    let path = if named.is_file() {
+        named
+    } else if let Some(found) = find_ignoring_case(&named) {
+        // MTL files written on case-insensitive file systems (Sponza's among them).
+        diag.warn(
+            Location::file(mtl),
+            format!(
+                "material '{material}': texture {} found as {} (the case differs)",
+                named.display(),
+                found.display()
+            ),
+        );
+        sources.push(found.clone());
+        found
+    } else {
         diag.warn(
             Location::file(mtl),
             format!(
                 "material '{material}': texture {} not found; left out",
-                path.display()
+                named.display()
             ),
         );
         return None;
-    }
+    };
     let path = std::path::absolute(&path).unwrap_or(path);
     Some(TextureRef::file(path))
+}
+
+/// The file `path` names when its components are matched without regard to
+/// ASCII case, if exactly one file matches at each step; for MTL files
+/// written where names are case-insensitive.
+fn find_ignoring_case(path: &Path) -> Option<PathBuf> {
+    let mut found = PathBuf::new();
+    for component in path.components() {
+        let exact = found.join(component);
+        if exact.exists() {
+            found = exact;
+            continue;
+        }
+        let wanted = component.as_os_str().to_str()?;
+        let mut matches = std::fs::read_dir(if found.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            &found
+        })
+        .ok()?
+        .filter_map(|entry| entry.ok())
+        .filter(|entry| {
+            entry
+                .file_name()
+                .to_str()
+                .is_some_and(|n| n.eq_ignore_ascii_case(wanted))
+        });
+        let first = matches.next()?;
+        if matches.next().is_some() {
+            return None;
+        }
+        found.push(first.file_name());
+    }
+    found.is_file().then_some(found)
 }
 
 /// Clamps a value that must lie in [0, 1], treating NaN as `fallback`.

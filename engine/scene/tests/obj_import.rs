@@ -180,6 +180,53 @@ fn negative_indices_polygons_missing_normals_and_mtl_quirks() {
 }
 
 #[test]
+fn a_texture_whose_name_differs_in_case_is_found_with_a_warning() {
+    let dir = temp_dir("obj-case");
+    std::fs::create_dir_all(dir.join("Textures")).expect("dir");
+    std::fs::write(dir.join("Textures/Brick.PNG"), b"png").expect("write");
+    std::fs::write(dir.join("Textures/twin.png"), b"png").expect("write");
+    std::fs::write(dir.join("Textures/TWIN.png"), b"png").expect("write");
+    std::fs::write(
+        dir.join("m.mtl"),
+        "newmtl a\nmap_Kd textures\\brick.png\nnewmtl b\nmap_Kd textures/Twin.png\n",
+    )
+    .expect("write");
+    std::fs::write(
+        dir.join("t.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\n",
+    )
+    .expect("write");
+    let (model, warnings) = load(&dir.join("t.obj"));
+    let tex = model.materials[0]
+        .textures
+        .base_color
+        .as_ref()
+        .expect("found");
+    let weft_scene::material::TextureSource::File(path) = &tex.source else {
+        panic!("file texture")
+    };
+    assert!(path.ends_with("Textures/Brick.PNG"), "{}", path.display());
+    assert!(
+        model.materials[1].textures.base_color.is_none(),
+        "two files match Twin.png but for case: neither is guessed"
+    );
+    assert_eq!(
+        warnings,
+        [
+            format!(
+                "m.mtl: material 'a': texture {} found as {} (the case differs)",
+                dir.join("textures/brick.png").display(),
+                dir.join("Textures/Brick.PNG").display()
+            ),
+            format!(
+                "m.mtl: material 'b': texture {} not found; left out",
+                dir.join("textures/Twin.png").display()
+            ),
+        ]
+    );
+}
+
+#[test]
 fn malformed_obj_is_a_located_error() {
     let dir = temp_dir("obj-bad");
     let cases = [
