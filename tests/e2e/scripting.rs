@@ -231,6 +231,19 @@ fn update(t, dt) {
                 .to_string(),
         ),
         (
+            "recoloured.rhai",
+            r#"model("floor.obj", #{});
+model("cube.obj", #{ position: [1.25, 0.5, 0], orientation: [0, 90, 0], color: [0.2, 0.9, 0.1] });
+camera("main", #{ position: [1.25, 3, 6], target: [1.25, 0.5, 0] });
+point_light(#{ position: [2, 4, 1.25], color: [1, 1, 1], radius: 20 });
+sun_light(#{ direction: [-0.3, -1, -0.3125], color: [0.5, 0.5, 0.5] });
+fn update(t, dt) {
+    if t > 1.2 { set_model_color(1, 0.9, 0.2, 0.1); }
+}
+"#
+            .to_string(),
+        ),
+        (
             "placed_red.scene",
             format!(
                 "model\n{{\n\tfile \"floor.obj\"\n}}\n\
@@ -350,4 +363,16 @@ fn the_grid_example_at_two_seconds_matches_its_golden() {
     ) {
         panic!("{e}");
     }
+}
+
+#[test]
+fn a_recolour_alone_restarts_the_path_tracers_accumulation() {
+    let dir = placement_scenes("recolour");
+    // Frame 0 at 1 s traces the green cube; only its colour changes before
+    // frame 1, which must start the running mean again: the red cube's first
+    // frame, not a blend of the two.
+    let recoloured = last_frame(&dir.join("recoloured.rhai"), "pathtrace.ron", 1.0, 2);
+    let red = last_frame(&dir.join("placed.scene"), "pathtrace.ron", 0.0, 1);
+    assert!(recoloured == red, "the accumulation started again");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -772,8 +772,8 @@ impl<'g> GpuScene<'g> {
 
     /// Writes the camera and the lights as they are at `time` for a target of `extent`;
     /// call it before each frame (the previous frame must have finished).
-    /// Returns a hash of what it uploaded (camera and lights), so callers can
-    /// tell whether two frames see the same inputs.
+    /// Returns a hash of what it uploaded (camera, lights, placements and their
+    /// colours), so callers can tell whether two frames see the same inputs.
     pub fn update(
         &mut self,
         camera: &Camera,
@@ -823,6 +823,9 @@ impl<'g> GpuScene<'g> {
         std::hash::Hash::hash(bytes_of(&[frame]), &mut inputs);
         std::hash::Hash::hash(bytes_of(&lights.records), &mut inputs);
         std::hash::Hash::hash(bytes_of(&self.transforms), &mut inputs);
+        for overrides in &self.overrides {
+            std::hash::Hash::hash(&overrides.key(), &mut inputs);
+        }
         self.light_set = lights;
         Ok(std::hash::Hasher::finish(&inputs))
     }
