@@ -61,6 +61,11 @@ fn image_of(rendered: Rendered) -> image::RgbaImage {
     rendered.report.output.expect("readback").to_rgba8()
 }
 
+/// How many pixels of `a` and `b` differ.
+fn pixels_differing(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
+    a.pixels().zip(b.pixels()).filter(|(a, b)| a != b).count()
+}
+
 /// The image of `scene` at `time` through `graph_name` at 160×90.
 fn image_at(scene: &Path, graph_name: &str, time: f32) -> image::RgbaImage {
     image_of(rendered(scene, graph_name, [160, 90], (time, 1)))
@@ -83,11 +88,7 @@ fn a_time_gives_the_same_image_every_run_and_the_script_moves_it() {
     let again = image_at(&scene, "forward.ron", 2.0);
     assert!(first == again, "the same time, the same image");
     let start = image_at(&scene, "forward.ron", 0.0);
-    let changed = first
-        .pixels()
-        .zip(start.pixels())
-        .filter(|(a, b)| a != b)
-        .count();
+    let changed = pixels_differing(&first, &start);
     assert!(changed > 100, "the flock moved: {changed} pixels changed");
 }
 
@@ -276,11 +277,7 @@ fn a_script_moving_and_recolouring_a_placement_and_moving_the_camera_and_lights_
         let placed = last_frame(&dir.join("placed.scene"), graph_name, 0.0, 1);
         assert!(moved == placed, "{graph_name}: the same image");
         let before = last_frame(&dir.join("moved.rhai"), graph_name, 1.0, 1);
-        let changed = before
-            .pixels()
-            .zip(placed.pixels())
-            .filter(|(a, b)| a != b)
-            .count();
+        let changed = pixels_differing(&before, &placed);
         assert!(
             changed > 500,
             "{graph_name}: the cube and camera moved: {changed} pixels"
@@ -304,11 +301,7 @@ fn lights_the_script_leaves_alone_keep_their_scene_motions() {
     let file = last_frame(&dir.join("mixed.scene"), "forward.ron", 1.5, 1);
     assert!(scripted == file, "the same lights at 1.5 s");
     let start = last_frame(&dir.join("mixed.rhai"), "forward.ron", 0.0, 1);
-    let changed = start
-        .pixels()
-        .zip(scripted.pixels())
-        .filter(|(a, b)| a != b)
-        .count();
+    let changed = pixels_differing(&start, &scripted);
     assert!(changed > 500, "the lights moved: {changed} pixels");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -120,9 +120,9 @@ fn scene_update_ms(gpu: &Gpu, scene: &weft_scene::Scene, frames: u32) -> Result<
     Ok(ms)
 }
 
-/// Placing every instance at each frame's transforms and writing the draw
-/// records' range to a host-visible buffer, as `GpuScene::update` does for
-/// moved placements, timed per frame.
+/// Placing the instances at each frame's transforms
+/// (`SceneGeometry::place_instances`, as `GpuScene::update` calls it) and
+/// writing the draw records' range to a host-visible buffer, timed per frame.
 fn rewrite_ms(
     gpu: &Gpu,
     scene: &weft_scene::Scene,
@@ -137,19 +137,16 @@ fn rewrite_ms(
         ash::vk::BufferUsageFlags::STORAGE_BUFFER,
     )?;
     buffer.write(&bytes)?;
+    let mut placed: Vec<glam::Mat4> = scene.instances.iter().map(|i| i.transform).collect();
+    let mut moved = Vec::new();
     let mut ms = Vec::with_capacity(frames.len());
     for transforms in frames {
         let started = Instant::now();
-        let (mut first, mut end) = (u32::MAX, 0);
-        for (i, t) in transforms.iter().enumerate() {
-            let ids = geometry.place_instance(i, *t);
-            first = first.min(ids.start);
-            end = end.max(ids.end);
-        }
-        if first < end {
-            let records = &geometry.draw_records[first as usize..end as usize];
+        moved.clear();
+        if let Some(ids) = geometry.place_instances(transforms, &mut placed, &mut moved) {
+            let records = &geometry.draw_records[ids.start as usize..ids.end as usize];
             buffer.write_at(
-                first as usize * std::mem::size_of::<weft_render::gpu_types::GpuDraw>(),
+                ids.start as usize * std::mem::size_of::<weft_render::gpu_types::GpuDraw>(),
                 bytemuck::cast_slice(records),
             )?;
         }

@@ -149,7 +149,7 @@ pub struct SceneGeometry {
     /// Draws sorted by material.
     pub draws: Vec<DrawItem>,
     /// Per scene instance, its draw records (ids), so a moved instance
-    /// rewrites only those ([`SceneGeometry::place_instance`]).
+    /// rewrites only those ([`SceneGeometry::place_instances`]).
     pub instance_draws: Vec<std::ops::Range<u32>>,
     /// Per draw id, the mesh's model-space box and where the draw sits in `draws`.
     draw_places: Vec<(Aabb, usize)>,
@@ -290,34 +290,52 @@ impl SceneGeometry {
         g
     }
 
-    /// Moves scene instance `instance` to `transform`: its draw records and
-    /// their world boxes; returns the draw ids rewritten (empty for an
-    /// instance that has none).
-    pub fn place_instance(&mut self, instance: usize, transform: Mat4) -> std::ops::Range<u32> {
-        let Some(ids) = self.instance_draws.get(instance).cloned() else {
-            return 0..0;
-        };
-        let normal = transform.inverse().transpose();
-        let mirrored = transform.determinant() < 0.0;
-        for id in ids.clone() {
-            let record = &mut self.draw_records[id as usize];
-            record.model = transform;
-            record.normal = normal;
-            let (local, slot) = self.draw_places[id as usize];
-            let draw = &mut self.draws[slot];
-            draw.bounds = local.transformed(&transform);
-            draw.mirrored = mirrored;
+    /// Moves every scene instance whose transform in `transforms` differs
+    /// from the one in `placed` (which is updated to match): its draw records
+    /// and their world boxes. Pushes the moved draws' world boxes, before and
+    /// after, onto `moved`, and returns the draw ids rewritten as one range
+    /// (`None` when nothing moved), the span of the draw buffer to write.
+    pub fn place_instances(
+        &mut self,
+        transforms: &[Mat4],
+        placed: &mut [Mat4],
+        moved: &mut Vec<Aabb>,
+    ) -> Option<std::ops::Range<u32>> {
+        let mut changed: Option<std::ops::Range<u32>> = None;
+        for (instance, (new, old)) in transforms.iter().zip(placed.iter_mut()).enumerate() {
+            if new == old {
+                continue;
+            }
+            *old = *new;
+            let Some(ids) = self.instance_draws.get(instance).cloned() else {
+                continue;
+            };
+            moved.extend(self.boxes(ids.clone()));
+            let normal = new.inverse().transpose();
+            let mirrored = new.determinant() < 0.0;
+            for id in ids.clone() {
+                let record = &mut self.draw_records[id as usize];
+                record.model = *new;
+                record.normal = normal;
+                let (local, slot) = self.draw_places[id as usize];
+                let draw = &mut self.draws[slot];
+                draw.bounds = local.transformed(new);
+                draw.mirrored = mirrored;
+            }
+            moved.extend(self.boxes(ids.clone()));
+            if !ids.is_empty() {
+                changed = Some(match changed {
+                    Some(c) => c.start.min(ids.start)..c.end.max(ids.end),
+                    None => ids,
+                });
+            }
         }
-        ids
+        changed
     }
 
-    /// The world boxes of scene instance `instance`'s draws as placed now.
-    pub fn instance_boxes(&self, instance: usize) -> impl Iterator<Item = Aabb> + '_ {
-        self.instance_draws
-            .get(instance)
-            .cloned()
-            .unwrap_or(0..0)
-            .map(|id| self.draws[self.draw_places[id as usize].1].bounds)
+    /// The world boxes of the draws `ids` as placed now.
+    fn boxes(&self, ids: std::ops::Range<u32>) -> impl Iterator<Item = Aabb> + '_ {
+        ids.map(|id| self.draws[self.draw_places[id as usize].1].bounds)
     }
 
     /// The box around every draw as placed now.

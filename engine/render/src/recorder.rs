@@ -449,13 +449,14 @@ impl SceneRecorder<'_> {
             let tile = ShadowTile::of(view);
             let name = format!("{}[{i}]", pass.name);
             // A placement that moved into or out of the view stales its tile.
-            let frustum = crate::frustum::Frustum::from_clip(view.clip);
-            let casters_moved = self
-                .scene
-                .moved_boxes()
-                .iter()
-                .any(|b| frustum.may_contain(b));
-            if keeps_tiles && self.shadow_tiles[i] == Some(tile) && !casters_moved {
+            let casters_moved = || {
+                let frustum = crate::frustum::Frustum::from_clip(view.clip);
+                self.scene
+                    .moved_boxes()
+                    .iter()
+                    .any(|b| frustum.may_contain(b))
+            };
+            if keeps_tiles && self.shadow_tiles[i] == Some(tile) && !casters_moved() {
                 self.culling.push(ViewCulling {
                     view: name,
                     drawn: 0,

@@ -852,19 +852,13 @@ impl GpuScene<'_> {
     /// The lights at `time`: the `.scene` motions', with the lights the
     /// script has changed as it left them.
     fn lights_at(&self, time: f32) -> Vec<weft_scene::Light> {
-        let mut lights = weft_scene::animation::lights_at(&self.source_lights, time, 0);
-        if self.script_animates() {
-            let frame = &self.script_frame;
-            for ((light, scripted), _) in lights
-                .iter_mut()
-                .zip(&frame.lights)
-                .zip(&frame.touched)
-                .filter(|(_, &touched)| touched)
-            {
-                light.clone_from(scripted);
-            }
-        }
-        lights
+        let frame = &self.script_frame;
+        let animates = self.script_animates();
+        weft_scene::animation::lights_at_with(&self.source_lights, time, 0, |i| {
+            (animates && frame.touched.get(i) == Some(&true))
+                .then(|| frame.lights.get(i))
+                .flatten()
+        })
     }
 
     /// Moves the placements the script moved: their draw records rewritten
@@ -875,30 +869,11 @@ impl GpuScene<'_> {
         if !self.script_animates() {
             return Ok(());
         }
-        let mut changed: Option<std::ops::Range<u32>> = None;
-        for (i, (new, old)) in self
-            .script_frame
-            .transforms
-            .iter()
-            .zip(self.transforms.iter_mut())
-            .enumerate()
-        {
-            if new == old {
-                continue;
-            }
-            *old = *new;
-            self.moved_boxes.extend(self.geometry.instance_boxes(i));
-            let ids = self.geometry.place_instance(i, *new);
-            self.moved_boxes.extend(self.geometry.instance_boxes(i));
-            if ids.is_empty() {
-                continue;
-            }
-            changed = Some(match changed {
-                Some(c) => c.start.min(ids.start)..c.end.max(ids.end),
-                None => ids,
-            });
-        }
-        let Some(ids) = changed else {
+        let Some(ids) = self.geometry.place_instances(
+            &self.script_frame.transforms,
+            &mut self.transforms,
+            &mut self.moved_boxes,
+        ) else {
             return Ok(());
         };
         self.moved = true;

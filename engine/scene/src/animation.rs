@@ -63,27 +63,48 @@ pub fn sun_direction_at(light: &SunLight, time: f32) -> Vec3 {
 /// Every light as it is at `time` for animation seed `seed`; point lights are numbered in
 /// list order among point lights.
 pub fn lights_at(lights: &[Light], time: f32, seed: u64) -> Vec<Light> {
+    lights_at_with(lights, time, seed, |_| None)
+}
+
+/// [`lights_at`], with `fixed(i)` standing in for light `i` where it gives
+/// one (a light a scene script has changed): that light is taken as it is,
+/// not animated. Point lights are still numbered over every point light.
+pub fn lights_at_with<'f>(
+    lights: &[Light],
+    time: f32,
+    seed: u64,
+    fixed: impl Fn(usize) -> Option<&'f Light>,
+) -> Vec<Light> {
     let mut point_index = 0;
     lights
         .iter()
-        .map(|light| match light {
-            Light::Point(p) => {
-                let mut moved = p.clone();
-                moved.position = point_position_at(p, point_index, time, seed);
+        .enumerate()
+        .map(|(i, light)| {
+            let index = point_index;
+            if matches!(light, Light::Point(_)) {
                 point_index += 1;
-                Light::Point(moved)
             }
-            Light::Spot(s) => {
-                let mut turned = s.clone();
-                turned.direction = spot_direction_at(s, time);
-                Light::Spot(turned)
+            if let Some(kept) = fixed(i) {
+                return kept.clone();
             }
-            Light::Sun(s) => {
-                let mut turned = s.clone();
-                turned.direction = sun_direction_at(s, time);
-                Light::Sun(turned)
+            match light {
+                Light::Point(p) => {
+                    let mut moved = p.clone();
+                    moved.position = point_position_at(p, index, time, seed);
+                    Light::Point(moved)
+                }
+                Light::Spot(s) => {
+                    let mut turned = s.clone();
+                    turned.direction = spot_direction_at(s, time);
+                    Light::Spot(turned)
+                }
+                Light::Sun(s) => {
+                    let mut turned = s.clone();
+                    turned.direction = sun_direction_at(s, time);
+                    Light::Sun(turned)
+                }
+                Light::Area(a) => Light::Area(a.clone()),
             }
-            Light::Area(a) => Light::Area(a.clone()),
         })
         .collect()
 }

@@ -564,7 +564,7 @@ fn register(engine: &mut Engine, state: &Shared, origin: DVec3) {
             Light::Area(l) => origin + l.position.as_dvec3(),
             Light::Sun(l) => l.direction.as_dvec3(),
         };
-        Ok::<Array, Box<EvalAltResult>>(vec![world.x.into(), world.y.into(), world.z.into()])
+        Ok::<Array, Box<EvalAltResult>>(array3(world))
     });
     let st = state.clone();
     engine.register_fn(
