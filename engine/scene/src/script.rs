@@ -789,6 +789,37 @@ fn engine_for(
     engine
 }
 
+/// Runs the script's top level, then checks the variables it leaves against
+/// the size limits. Rhai 1.27 checks a map's size when `m.k = v` adds a key
+/// but not when `m[k] = v` does, so a map can outgrow its limit by indexing.
+fn run_top_level(engine: &Engine, ast: &AST, script: &Path) -> Result<(), SceneError> {
+    let mut scope = Scope::new();
+    engine
+        .run_ast_with_scope(&mut scope, ast)
+        .map_err(|e| located(script, &e))?;
+    for (name, _, value) in scope.iter_raw() {
+        within_limits(engine, script, value, &format!("variable `{name}`"))?;
+    }
+    Ok(())
+}
+
+/// `value` checked against the string, array and map size limits. The
+/// state kept between `update` calls is checked after each call, so indexing
+/// cannot grow it past a limit frame by frame.
+fn within_limits(
+    engine: &Engine,
+    script: &Path,
+    value: &Dynamic,
+    what: &str,
+) -> Result<(), SceneError> {
+    engine
+        .ensure_data_size_within_limits(value)
+        .map_err(|e| SceneError::Syntax {
+            at: Location::file(script),
+            message: format!("{what}: {e}"),
+        })
+}
+
 fn compile(engine: &Engine, script: &Path) -> Result<AST, SceneError> {
     let at = Location::file(script);
     let text = crate::source::read_text(script, &at, crate::source::MAX_SCENE_BYTES)?;
@@ -821,9 +852,7 @@ pub fn run_load(
     let imports = Arc::new(Mutex::new(Vec::new()));
     let engine = engine_for(script, &state, desc.origin, limits, &imports);
     let ast = compile(&engine, script)?;
-    engine
-        .run_ast_with_scope(&mut Scope::new(), &ast)
-        .map_err(|e| located(script, &e))?;
+    run_top_level(&engine, &ast, script)?;
     script_ref.imports = std::mem::take(&mut *imports.lock().unwrap_or_else(|p| p.into_inner()));
     let mut s = lock(&state);
     let added = std::mem::take(&mut s.desc);
@@ -909,9 +938,7 @@ impl ScriptRuntime {
         let state: Shared = Arc::new(Mutex::new(loading));
         let engine = engine_for(script, &state, origin, limits, &Arc::default());
         let ast = compile(&engine, script)?;
-        engine
-            .run_ast_with_scope(&mut Scope::new(), &ast)
-            .map_err(|e| located(script, &e))?;
+        run_top_level(&engine, &ast, script)?;
         lock(&state).loading = false;
         let has = |name: &str, params: usize| {
             ast.iter_functions()
@@ -958,7 +985,12 @@ impl ScriptRuntime {
         } else {
             Dynamic::UNIT
         };
-        Ok(())
+        within_limits(
+            &self.engine,
+            &self.script,
+            &self.this,
+            "the state `init` returned",
+        )
     }
 
     /// Whether the script animates anything (has `fn update(t, dt)`).
@@ -1000,9 +1032,17 @@ impl ScriptRuntime {
                 "update",
                 (t, STEP),
             );
-            if let Err(e) = result {
+            let checked = result.map_err(|e| located(&self.script, &e)).and_then(|_| {
+                within_limits(
+                    &self.engine,
+                    &self.script,
+                    &self.this,
+                    &format!("the state (`this`) after update at t = {t:.3} s"),
+                )
+            });
+            if let Err(e) = checked {
                 self.steps = u64::MAX;
-                return Err(located(&self.script, &e));
+                return Err(e);
             }
         }
         let s = lock(&self.state);
@@ -1260,6 +1300,50 @@ mod tests {
             assert!(error.starts_with(at), "{name}: {error}");
             assert!(error.contains(message), "{name}: {error}");
         }
+    }
+
+    #[test]
+    fn maps_grown_by_indexing_are_held_to_the_size_limit() {
+        let small = Limits {
+            map_len: 4,
+            ..Limits::default()
+        };
+        let error = load_error(
+            "map-index",
+            "let m = #{};\nfor i in 0..10 { m[\"k\" + i] = i; }",
+            &small,
+        );
+        assert_eq!(
+            error,
+            "scene.rhai: variable `m`: Size of object map too large"
+        );
+        let dir = folder(
+            "map-state",
+            &[(
+                "scene.rhai",
+                "fn init() { #{ m: #{} } }\nfn update(t, dt) { this.m[\"k\" + t] = t; }\n",
+            )],
+        );
+        let path = dir.join("scene.rhai");
+        let scene = crate::load_scene(&path).unwrap();
+        let mut runtime =
+            ScriptRuntime::new(scene.script.as_ref().unwrap(), &scene, &small).unwrap();
+        // Rhai counts nested maps' entries together: `m` and three keys are four.
+        runtime
+            .frame_at(3.5 * STEP)
+            .expect("four entries are within the limit");
+        let error = runtime
+            .frame_at(4.5 * STEP)
+            .expect_err("a fifth entry")
+            .to_string();
+        assert_eq!(
+            error,
+            format!(
+                "{}: the state (`this`) after update at t = 0.067 s: Size of object map too large",
+                path.display()
+            )
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
