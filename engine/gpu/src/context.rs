@@ -2,6 +2,7 @@
 //! validation), the chosen physical device, a device with synchronization2 and
 //! maintenance4, one queue, a command pool and the memory allocator.
 
+use crate::capabilities::ShaderSupport;
 use crate::error::{GpuError, VkCall};
 use crate::validation::{self, ValidationCounts, ValidationLog};
 use ash::vk;
@@ -41,9 +42,11 @@ pub struct DeviceInfo {
     /// atomics (`fragmentStoresAndAtomics`, enabled when offered): debug views
     /// count invocations this way.
     pub fragment_stores: bool,
-    /// Whether fragment shaders may read `gl_PrimitiveID` (`geometryShader`,
-    /// enabled when offered, for that alone): the mesh-density view.
-    pub primitive_id: bool,
+    /// The optional shader capabilities offered, each enabled when offered
+    /// (`geometryShader` for `gl_PrimitiveID` in the mesh-density view, wider
+    /// and narrower number types, subgroup operations): pipelines whose
+    /// shaders need more are refused with the missing feature named.
+    pub shaders: ShaderSupport,
     /// The largest width or height of a 2D image (`maxImageDimension2D`):
     /// plans with a larger image are refused before any is created.
     pub max_image_dimension: u32,
@@ -531,7 +534,7 @@ fn choose_device(
             pipeline_statistics: f2.pipeline_statistics_query == vk::TRUE,
             depth_clamp: f2.depth_clamp == vk::TRUE,
             fragment_stores: f2.fragment_stores_and_atomics == vk::TRUE,
-            primitive_id: f2.geometry_shader == vk::TRUE,
+            shaders: ShaderSupport::query(instance, physical),
             max_image_dimension: props.limits.max_image_dimension2_d,
         };
         candidates.push((physical, info, family as u32));
@@ -564,13 +567,21 @@ fn create_device(
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .synchronization2(true)
         .maintenance4(true);
+    let shaders = &info.shaders;
+    let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
+        .shader_float16(shaders.float16)
+        .shader_int8(shaders.int8);
     let core = vk::PhysicalDeviceFeatures::default()
         .pipeline_statistics_query(info.pipeline_statistics)
         .depth_clamp(info.depth_clamp)
         .fragment_stores_and_atomics(info.fragment_stores)
-        .geometry_shader(info.primitive_id);
+        .geometry_shader(shaders.geometry)
+        .shader_float64(shaders.float64)
+        .shader_int64(shaders.int64)
+        .shader_int16(shaders.int16);
     let mut features = vk::PhysicalDeviceFeatures2::default()
         .features(core)
+        .push_next(&mut f12)
         .push_next(&mut f13);
     let extensions = if presenting {
         vec![ash::khr::swapchain::NAME.as_ptr()]

@@ -5,6 +5,7 @@
 
 pub mod bind;
 pub mod buffer;
+pub mod capabilities;
 pub mod check;
 pub mod commands;
 pub mod context;
@@ -33,6 +34,7 @@ pub mod texture;
 pub mod timing;
 pub mod validation;
 
+pub use capabilities::ShaderSupport;
 pub use check::{check_shaders, ShaderProblem};
 pub use context::{DeviceInfo, DeviceKind, Gpu, GpuOptions, MemoryReport};
 pub use draw::{DrawRecorder, NoDraws, RasterContext, SCENE_SET};

@@ -124,6 +124,12 @@ impl ScenePipelines {
             .as_ref()
             .map(|k| self.shaders.shader(k))
             .transpose()?;
+        let info = gpu.info();
+        let compiled: Vec<_> = std::iter::once(&vs)
+            .chain(&fs)
+            .map(|m| &m.compiled)
+            .collect();
+        info.shaders.check(&info.name, &pass.name, &compiled)?;
         let problems =
             scene_pass_problems(plan, pass, &vs.interface, fs.as_ref().map(|f| &f.interface));
         if !problems.is_empty() {

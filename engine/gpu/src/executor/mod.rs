@@ -164,6 +164,14 @@ impl<'g> Renderer<'g> {
             return Ok(None);
         };
         let interface = self.pipelines.interface(&shaders.keys())?;
+        let modules = shaders
+            .keys()
+            .into_iter()
+            .map(|key| self.pipelines.shader(key))
+            .collect::<Result<Vec<_>, _>>()?;
+        let compiled: Vec<_> = modules.iter().map(|m| &m.compiled).collect();
+        let info = self.gpu.info();
+        info.shaders.check(&info.name, &pass.name, &compiled)?;
         let bindings =
             check::pass_problems(plan, pass, &shaders, &interface).map_err(|problems| {
                 GpuError::Mismatch {
