@@ -876,3 +876,46 @@ fn blinn_phong_exponents_from_1_to_1e6_at_grazing_angles_stay_finite() {
         }
     }
 }
+
+/// The animated scene at `time` in forward, 160×90, under validation.
+fn animated_at(scene: &Scene, time: f64) -> RgbaImage {
+    let gpu = weft_tests::gpu();
+    let log = gpu.validation();
+    let settings = RenderSettings {
+        graph: common::graph("forward.ron"),
+        extent: Extent {
+            width: 160,
+            height: 90,
+        },
+        time,
+        features: vec!["!bloom".into()],
+        extra_readback: vec!["hdr".into()],
+        ..RenderSettings::default()
+    };
+    let rendered = render(&gpu, scene, &settings).expect("renders");
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new(), "at {time} s");
+    let Pixels::RgbaF32(values) = &rendered.report.readbacks[0].1.pixels else {
+        panic!("hdr is a float image");
+    };
+    assert_finite_and_bounded(values, &format!("at {time} s"));
+    rendered.report.output.expect("readback").to_rgba8()
+}
+
+/// The scene clock is f64 (issue 19, time): at a billion seconds, where f32
+/// seconds are 64 apart, two frames 1/60 s apart still see the lights move,
+/// as two frames at the start do. In f32 they were the same image.
+#[test]
+fn frames_a_sixtieth_of_a_second_apart_differ_at_a_billion_seconds() {
+    let scene =
+        weft_scene::load_scene(&common::root().join("scenes/animation.scene")).expect("loads");
+    for start in [0.0, 1e9] {
+        let a = animated_at(&scene, start);
+        let b = animated_at(&scene, start + 1.0 / 60.0);
+        let moved = a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count();
+        assert!(
+            moved > 0,
+            "nothing moved between {start} s and 1/60 s later"
+        );
+    }
+}

@@ -18,7 +18,7 @@ const EXAMPLES: [&str; 4] = [
 ];
 
 /// Settings for `graph_name` at a size and time.
-fn settings(graph_name: &str, width: u32, height: u32, time: f32) -> RenderSettings {
+fn settings(graph_name: &str, width: u32, height: u32, time: f64) -> RenderSettings {
     RenderSettings {
         graph: graph(graph_name),
         extent: Extent { width, height },
@@ -33,7 +33,7 @@ fn rendered(
     scene: &Path,
     graph_name: &str,
     [width, height]: [u32; 2],
-    (time, frames): (f32, u32),
+    (time, frames): (f64, u32),
 ) -> Rendered {
     let loaded = weft_scene::load_scene(scene).expect("scene loads");
     let gpu = weft_tests::gpu();
@@ -67,7 +67,7 @@ fn pixels_differing(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
 }
 
 /// The image of `scene` at `time` through `graph_name` at 160×90.
-fn image_at(scene: &Path, graph_name: &str, time: f32) -> image::RgbaImage {
+fn image_at(scene: &Path, graph_name: &str, time: f64) -> image::RgbaImage {
     image_of(rendered(scene, graph_name, [160, 90], (time, 1)))
 }
 
@@ -261,7 +261,7 @@ fn update(t, dt) {
 
 /// The last of `frames` frames of `scene` from `time`, half a second apart,
 /// through `graph_name` at 96×64.
-fn last_frame(scene: &Path, graph_name: &str, time: f32, frames: u32) -> image::RgbaImage {
+fn last_frame(scene: &Path, graph_name: &str, time: f64, frames: u32) -> image::RgbaImage {
     image_of(rendered(scene, graph_name, [96, 64], (time, frames)))
 }
 
@@ -309,7 +309,7 @@ fn lights_the_script_leaves_alone_keep_their_scene_motions() {
 #[test]
 fn a_moved_caster_redraws_exactly_the_shadow_views_it_meets() {
     let dir = placement_scenes("casters");
-    let render_frames = |scene: &str, time: f32, frames: u32| {
+    let render_frames = |scene: &str, time: f64, frames: u32| {
         let rendered = rendered(&dir.join(scene), "forward.ron", [96, 64], (time, frames));
         let kept: Vec<bool> = rendered
             .culling

@@ -107,7 +107,7 @@ fn scene_update_ms(gpu: &Gpu, scene: &weft_scene::Scene, frames: u32) -> Result<
     let camera = scene.cameras[0].clone();
     let mut ms = Vec::new();
     for frame in 0..frames + 10 {
-        let t = (f64::from(frame + 1) * STEP) as f32;
+        let t = f64::from(frame + 1) * STEP;
         let started = Instant::now();
         gpu_scene.update(&camera, t, [1280, 720])?;
         if frame >= 10 {

@@ -35,7 +35,7 @@ pub struct RenderArgs {
     frames: u32,
     /// Scene time in seconds at the first frame (frames are 1/60 s apart).
     #[arg(long, default_value_t = 0.0, value_parser = parse_time)]
-    time: f32,
+    time: f64,
     /// Camera name; the scene's first camera by default.
     #[arg(long)]
     camera: Option<String>,
@@ -128,8 +128,8 @@ pub(crate) fn parse_param(text: &str) -> Result<(String, ParamValue), String> {
 
 /// A scene time in seconds: a finite number (NaN or infinity would make every
 /// animated light and camera vanish).
-pub fn parse_time(text: &str) -> Result<f32, String> {
-    match text.trim().parse::<f32>() {
+pub fn parse_time(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
         Ok(t) if t.is_finite() => Ok(t),
         Ok(_) => Err(format!(
             "time must be a finite number of seconds, found \"{text}\""

@@ -222,3 +222,128 @@ fn merged_stages_give_set_layout_bindings_and_push_ranges() {
     assert_eq!(merged.set_count(), 1);
     assert!(merged.set_layout_bindings(1).is_empty());
 }
+
+/// Optional capabilities a module declares, and the features they need
+/// (`weft_gpu::capabilities`). Here rather than beside the code: the unit
+/// tests share one process-wide SPIR-V cache folder with its own test.
+mod capabilities {
+    use super::*;
+    use ash::vk;
+    use spirv::Capability;
+    use weft_gpu::capabilities::declared;
+    use weft_gpu::{CompiledShader, ShaderSupport};
+
+    fn compiled(source: &str, name: &str, stage: ShaderStage) -> CompiledShader {
+        compiler()
+            .compile_source(source, Path::new(name), stage, &[])
+            .unwrap()
+    }
+
+    /// A compute shader with a subgroup reduction and a 64-bit integer.
+    const REDUCE: &str = "#version 450
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+layout(local_size_x = 64) in;
+layout(set = 0, binding = 0) buffer Values { uint64_t total; float v[]; };
+void main() {
+    v[gl_GlobalInvocationID.x] = subgroupMax(v[gl_GlobalInvocationID.x]);
+    total += uint64_t(1);
+}
+";
+
+    /// A fragment shader reading `gl_PrimitiveID`, as the mesh-density view does.
+    const PRIMITIVE: &str = "#version 450
+layout(location = 0) out vec4 colour;
+void main() { colour = vec4(float(gl_PrimitiveID)); }
+";
+
+    fn everything() -> ShaderSupport {
+        ShaderSupport {
+            geometry: true,
+            float64: true,
+            int64: true,
+            int16: true,
+            float16: true,
+            int8: true,
+            subgroup_stages: vk::ShaderStageFlags::ALL,
+            subgroup_operations: vk::SubgroupFeatureFlags::from_raw(0xff),
+        }
+    }
+
+    #[test]
+    fn a_module_declares_the_capabilities_its_source_uses() {
+        let reduce = compiled(REDUCE, "reduce.comp", ShaderStage::Compute);
+        let found = declared(&reduce.spirv);
+        for wanted in [
+            Capability::Shader,
+            Capability::Int64,
+            Capability::GroupNonUniform,
+            Capability::GroupNonUniformArithmetic,
+        ] {
+            assert!(found.contains(&wanted), "{wanted:?} in {found:?}");
+        }
+        let primitive = compiled(PRIMITIVE, "primitive.frag", ShaderStage::Fragment);
+        assert_eq!(
+            declared(&primitive.spirv),
+            [Capability::Shader, Capability::Geometry]
+        );
+        assert_eq!(declared(&[]), []);
+        // The five header words alone declare nothing.
+        assert_eq!(declared(&reduce.spirv[..5]), []);
+    }
+
+    #[test]
+    fn each_missing_feature_is_named() {
+        let reduce = compiled(REDUCE, "reduce.comp", ShaderStage::Compute);
+        let primitive = compiled(PRIMITIVE, "primitive.frag", ShaderStage::Fragment);
+        let all = everything();
+        assert_eq!(all.unmet(&reduce), Vec::<String>::new());
+        assert_eq!(all.unmet(&primitive), Vec::<String>::new());
+        assert_eq!(
+            ShaderSupport::core().unmet(&primitive),
+            ["gl_PrimitiveID or geometry-stage built-ins (the `geometryShader` feature)"]
+        );
+        assert_eq!(
+            ShaderSupport::core().unmet(&reduce),
+            [
+                "64-bit integers (the `shaderInt64` feature)",
+                "subgroup operations in compute shaders (`supportedStages` lacks COMPUTE)",
+            ]
+        );
+        let fragment_only = ShaderSupport {
+            subgroup_stages: vk::ShaderStageFlags::FRAGMENT,
+            ..all
+        };
+        assert_eq!(
+            fragment_only.unmet(&reduce),
+            ["subgroup operations in compute shaders (`supportedStages` lacks COMPUTE)"]
+        );
+        let basic_only = ShaderSupport {
+            subgroup_operations: vk::SubgroupFeatureFlags::BASIC,
+            ..all
+        };
+        assert_eq!(
+            basic_only.unmet(&reduce),
+            ["subgroup arithmetic operations (`supportedOperations` lacks ARITHMETIC)"]
+        );
+    }
+
+    #[test]
+    fn a_pass_is_refused_naming_its_shader_the_need_and_the_device() {
+        let reduce = compiled(REDUCE, "shaders/reduce.comp", ShaderStage::Compute);
+        let primitive = compiled(PRIMITIVE, "shaders/primitive.frag", ShaderStage::Fragment);
+        let no_int64 = ShaderSupport {
+            int64: false,
+            ..everything()
+        };
+        assert!(no_int64.check("gpu", "p", &[&primitive]).is_ok());
+        let error = no_int64
+            .check("gpu", "reduce", &[&primitive, &reduce])
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            error,
+            "pass `reduce`: shaders/reduce.comp needs 64-bit integers (the `shaderInt64` feature), which the device `gpu` does not offer"
+        );
+    }
+}

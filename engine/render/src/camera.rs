@@ -13,12 +13,12 @@ pub fn reverse_z_projection(fov_y: f32, aspect: f32, near: f32, far: f32) -> Mat
 }
 
 /// World-to-clip for `camera` at `time` seen through a viewport of `aspect` = width / height.
-pub fn view_projection(camera: &Camera, time: f32, aspect: f32) -> Mat4 {
+pub fn view_projection(camera: &Camera, time: f64, aspect: f32) -> Mat4 {
     reverse_z_projection(camera.fov_y, aspect, camera.near, camera.far) * camera.view_at(time)
 }
 
 /// World position of the camera at `time`.
-pub fn camera_position(camera: &Camera, time: f32) -> Vec3 {
+pub fn camera_position(camera: &Camera, time: f64) -> Vec3 {
     camera.pose_at(time).0
 }
 

@@ -25,9 +25,9 @@ pub struct RenderSettings {
     /// Frames to run; the last one is reported.
     pub frames: u32,
     /// Seconds at the first frame.
-    pub time: f32,
+    pub time: f64,
     /// Seconds between frames.
-    pub frame_time: f32,
+    pub frame_time: f64,
     /// Camera name; the scene's first camera when `None`.
     pub camera: Option<String>,
     /// Toggles as on the command line (`name`, `!name`), applied after scene features.
@@ -231,7 +231,7 @@ pub fn render_with_progress(
         let started = std::time::Instant::now();
         let report = frames.draw(&FrameRequest {
             camera,
-            time: settings.time + frame as f32 * frame_time,
+            time: settings.time + f64::from(frame) * frame_time,
             frame,
             timing: settings.timing,
             readback: settings.readback && final_frame,

@@ -60,8 +60,9 @@ impl Accumulation {
 pub struct FrameRequest<'c> {
     /// The camera to look through (animated to `time`).
     pub camera: &'c Camera,
-    /// Scene time in seconds.
-    pub time: f32,
+    /// Scene time in seconds: f64, so frames 1/60 s apart stay apart at any
+    /// time a scene runs to. Shaders receive it as f32.
+    pub time: f64,
     /// Frame number.
     pub frame: u32,
     /// How per-pass times are measured.
@@ -95,12 +96,13 @@ impl<'g> FrameLoop<'g> {
             .scene
             .update(request.camera, request.time, extent)?;
         let history_frames = self.accumulation.next(inputs);
+        let shader_time = request.time as f32;
         self.recorder
-            .set_frame(request.time, request.frame, history_frames);
+            .set_frame(shader_time, request.frame, history_frames);
         let options = FrameOptions {
             timing: request.timing,
             readback: request.readback,
-            time: request.time,
+            time: shader_time,
             frame: request.frame,
             history_frames,
         };

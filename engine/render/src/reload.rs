@@ -142,7 +142,7 @@ impl<'g> LiveRender<'g> {
     pub fn draw(
         &mut self,
         camera: &Camera,
-        time: f32,
+        time: f64,
         frame: u32,
         readback: bool,
     ) -> Result<FrameReport, RenderError> {

@@ -777,7 +777,7 @@ impl<'g> GpuScene<'g> {
     pub fn update(
         &mut self,
         camera: &Camera,
-        time: f32,
+        time: f64,
         extent: [u32; 2],
     ) -> Result<u64, GpuError> {
         self.run_script(time);
@@ -840,9 +840,9 @@ impl GpuScene<'_> {
     /// Runs the script, when it animates, up to `time`; on an error keeps
     /// the last good step's frame, with the error for
     /// [`GpuScene::take_script_error`].
-    fn run_script(&mut self, time: f32) {
+    fn run_script(&mut self, time: f64) {
         if let Some(script) = self.script.as_mut().filter(|s| s.animates()) {
-            match script.frame_at(f64::from(time)) {
+            match script.frame_at(time) {
                 Ok(frame) => self.script_frame = frame,
                 Err(e) => self.script_error = Some(e),
             }
@@ -851,7 +851,7 @@ impl GpuScene<'_> {
 
     /// The lights at `time`: the `.scene` motions', with the lights the
     /// script has changed as it left them.
-    fn lights_at(&self, time: f32) -> Vec<weft_scene::Light> {
+    fn lights_at(&self, time: f64) -> Vec<weft_scene::Light> {
         let frame = &self.script_frame;
         let animates = self.script_animates();
         weft_scene::animation::lights_at_with(&self.source_lights, time, 0, |i| {

@@ -1,22 +1,29 @@
 //! Light animation evaluated at a time: point lights circling, spotlights swivelling, the sun
 //! turning. Pure functions of (light, index, time, seed), so every frame is reproducible.
-//! Phases are reduced to one period in f64 before any f32 trigonometry, so a
-//! time of 1e9 seconds (or a negative one) gives the same pose as the same
-//! point in the first period, not f32 noise (docs/stability.md).
+//! Time is f64 seconds, and phases are reduced to one period in f64 before
+//! any f32 trigonometry, so a time of 1e9 seconds (or a negative one) gives
+//! the same pose as the same point in the first period, not f32 noise, and
+//! frames 1/60 s apart at 1e9 s still differ (docs/stability.md).
 
 use crate::light::{Light, PointLight, SpotLight, SunLight};
 use crate::rng::Rng;
 use glam::{Quat, Vec3};
 
-/// `rate × time` reduced to [0, `period`), computed in f64.
-fn wrapped(rate: f32, time: f32, period: f64) -> f32 {
-    (f64::from(rate) * f64::from(time)).rem_euclid(period) as f32
+/// `rate × time` reduced to [0, `period`), computed in f64; 0 where the
+/// product overflows f64 (no phase is left to keep there).
+fn wrapped(rate: f32, time: f64, period: f64) -> f32 {
+    let phase = f64::from(rate) * time;
+    if phase.is_finite() {
+        phase.rem_euclid(period) as f32
+    } else {
+        0.0
+    }
 }
 
 /// Where point light number `index` is at `time` seconds: on a horizontal circle of radius
 /// `amplitude` around its position, at `velocity` radians per second, with a start phase and
 /// a turning sense drawn from `seed` and `index`.
-pub fn point_position_at(light: &PointLight, index: usize, time: f32, seed: u64) -> Vec3 {
+pub fn point_position_at(light: &PointLight, index: usize, time: f64, seed: u64) -> Vec3 {
     if light.velocity == 0.0 || light.amplitude == 0.0 {
         return light.position;
     }
@@ -31,7 +38,7 @@ pub fn point_position_at(light: &PointLight, index: usize, time: f32, seed: u64)
 }
 
 /// The spotlight's direction at `time`: eased back and forth between the swivel directions.
-pub fn spot_direction_at(light: &SpotLight, time: f32) -> Vec3 {
+pub fn spot_direction_at(light: &SpotLight, time: f64) -> Vec3 {
     let Some(sw) = light.swivel else {
         return light.direction;
     };
@@ -48,7 +55,7 @@ pub fn spot_direction_at(light: &SpotLight, time: f32) -> Vec3 {
 }
 
 /// The sun's direction at `time`, turned about its motion axis.
-pub fn sun_direction_at(light: &SunLight, time: f32) -> Vec3 {
+pub fn sun_direction_at(light: &SunLight, time: f64) -> Vec3 {
     match light.motion {
         Some(m) => {
             Quat::from_axis_angle(
@@ -62,7 +69,7 @@ pub fn sun_direction_at(light: &SunLight, time: f32) -> Vec3 {
 
 /// Every light as it is at `time` for animation seed `seed`; point lights are numbered in
 /// list order among point lights.
-pub fn lights_at(lights: &[Light], time: f32, seed: u64) -> Vec<Light> {
+pub fn lights_at(lights: &[Light], time: f64, seed: u64) -> Vec<Light> {
     lights_at_with(lights, time, seed, |_| None)
 }
 
@@ -71,7 +78,7 @@ pub fn lights_at(lights: &[Light], time: f32, seed: u64) -> Vec<Light> {
 /// not animated. Point lights are still numbered over every point light.
 pub fn lights_at_with<'f>(
     lights: &[Light],
-    time: f32,
+    time: f64,
     seed: u64,
     fixed: impl Fn(usize) -> Option<&'f Light>,
 ) -> Vec<Light> {
@@ -135,7 +142,7 @@ mod tests {
         assert_ne!(a, point_position_at(&p, 3, 1.5, 10));
         assert_eq!(a.y, 2.0);
         // Full turn after 2π seconds at 1 rad/s.
-        let back = point_position_at(&p, 3, std::f32::consts::TAU, 9);
+        let back = point_position_at(&p, 3, std::f64::consts::TAU, 9);
         assert!(back.distance(p.position) < 1e-4);
         assert_eq!(point_position_at(&point(0.0), 0, 5.0, 1), p.position);
     }
@@ -188,10 +195,10 @@ mod tests {
         // time reduced modulo 2π (reduced here in f64, as the code does); a
         // spot swivelling every 4 s and a sun turning 90 degrees a second are
         // back where they started at 1e9 s and at -8 s (whole periods, exact
-        // in f32).
+        // in f64).
         let p = point(1.0);
-        for t in [1e9f32, -8.0, 12345.678] {
-            let reduced = f64::from(t).rem_euclid(std::f64::consts::TAU) as f32;
+        for t in [1e9, -8.0, 12345.678] {
+            let reduced = f64::rem_euclid(t, std::f64::consts::TAU);
             let at = point_position_at(&p, 3, t, 9);
             assert!(at.is_finite(), "{t}");
             let expected = point_position_at(&p, 3, reduced, 9);
@@ -202,7 +209,7 @@ mod tests {
         }
         let spot = swivelling_spot();
         let sun = turning_sun();
-        for t in [1e9f32, -8.0] {
+        for t in [1e9, -8.0] {
             assert!(
                 spot_direction_at(&spot, t).distance(Vec3::NEG_Y) < 1e-5,
                 "spot at {t}"
@@ -214,11 +221,42 @@ mod tests {
         }
         assert!(spot_direction_at(&spot, 1e9 + 128.0 + 2.0).is_finite());
         assert!(spot_direction_at(&spot, -6.0).distance(Vec3::X) < 1e-5);
-        // Every pose is finite at any time, the extremes of f32 included.
-        for t in [f32::MAX, f32::MIN, 1e-30, 0.0] {
+        // Every pose is finite at any time, the extremes of f64 included.
+        for t in [f64::MAX, f64::MIN, 1e-300, 0.0] {
             assert!(point_position_at(&p, 1, t, 2).is_finite(), "{t}");
             assert!(spot_direction_at(&spot, t).is_finite(), "{t}");
             assert!(sun_direction_at(&sun, t).is_finite(), "{t}");
         }
+    }
+
+    #[test]
+    fn frames_a_sixtieth_of_a_second_apart_differ_at_a_billion_seconds() {
+        // In f32, 1e9 and 1e9 + 1/60 are the same number; the clock is f64.
+        assert_eq!(1e9f32, 1e9f32 + 1.0 / 60.0);
+        let sun = turning_sun();
+        let frame = 1.0 / 60.0;
+        for start in [0.0, 1e9] {
+            let turned = sun_direction_at(&sun, start + frame);
+            // 90 degrees a second: 1.5 degrees from +X towards -Z.
+            let expected = Quat::from_rotation_y(1.5f32.to_radians()) * Vec3::X;
+            assert!(
+                turned.distance(expected) < 1e-5,
+                "sun at {start} + 1/60 s: {turned}, expected {expected}"
+            );
+        }
+        let spot = swivelling_spot();
+        assert_ne!(
+            spot_direction_at(&spot, 1e9 + 1.0),
+            spot_direction_at(&spot, 1e9 + 1.0 + frame)
+        );
+        let p = point(1.0);
+        let a = point_position_at(&p, 0, 1e9, 4);
+        let b = point_position_at(&p, 0, 1e9 + frame, 4);
+        // 1/60 rad along a circle of radius 2.
+        assert!(
+            (a.distance(b) - 2.0 / 60.0).abs() < 1e-4,
+            "{}",
+            a.distance(b)
+        );
     }
 }

@@ -61,21 +61,21 @@ impl Camera {
 
     /// Position and orientation at `time` seconds: the path interpolated (linear position,
     /// slerped rotation), clamped to its ends; the still pose when there is no path.
-    pub fn pose_at(&self, time: f32) -> (Vec3, Quat) {
+    pub fn pose_at(&self, time: f64) -> (Vec3, Quat) {
         let (Some(first), Some(last)) = (self.path.first(), self.path.last()) else {
             return (self.position, self.orientation);
         };
-        if time <= first.time {
+        if time <= f64::from(first.time) {
             return (first.position, first.orientation);
         }
-        if time >= last.time {
+        if time >= f64::from(last.time) {
             return (last.position, last.orientation);
         }
-        let next = self.path.partition_point(|k| k.time <= time);
+        let next = self.path.partition_point(|k| f64::from(k.time) <= time);
         let (a, b) = (&self.path[next - 1], &self.path[next]);
-        let span = b.time - a.time;
+        let span = f64::from(b.time) - f64::from(a.time);
         let s = if span > 0.0 {
-            (time - a.time) / span
+            ((time - f64::from(a.time)) / span) as f32
         } else {
             1.0
         };
@@ -92,7 +92,7 @@ impl Camera {
     }
 
     /// The world-to-view matrix at `time`.
-    pub fn view_at(&self, time: f32) -> Mat4 {
+    pub fn view_at(&self, time: f64) -> Mat4 {
         let (p, q) = self.pose_at(time);
         Mat4::from_rotation_translation(q, p).inverse()
     }

@@ -52,7 +52,7 @@ pub struct ViewArgs {
     camera: Option<String>,
     /// Scene time in seconds at the start.
     #[arg(long, default_value_t = 0.0, value_parser = crate::render_cmd::parse_time)]
-    time: f32,
+    time: f64,
     /// Start with scene time stopped (Space resumes).
     #[arg(long)]
     paused: bool,

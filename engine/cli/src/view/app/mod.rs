@@ -61,7 +61,7 @@ pub struct Viewer<'g> {
     dragging: bool,
     cursor: Option<(f64, f64)>,
     drag: Vec2,
-    time: f32,
+    time: f64,
     paused: bool,
     last_frame: Option<Instant>,
     frames: u32,
@@ -349,7 +349,7 @@ impl<'g> Viewer<'g> {
         let input = self.input(dt);
         self.camera.update(&input, dt);
         if !self.paused {
-            self.time += dt;
+            self.time += f64::from(dt);
         }
         let camera = Camera {
             name: "fly".into(),
