@@ -1,8 +1,9 @@
 #version 450
 // Debug view `light_count` (graphs/debug_views.ron): for each pixel with a
 // surface, the point and spot lights that reach it, by the tests the lighting
-// code applies (include/lighting.glsl: within a point light's cutoff range;
-// within a spot's range along its axis and inside its cone). Suns and area
+// code applies (`point_reaches` and `spot_reaches` in include/lighting.glsl:
+// within a point light's cutoff range; within a spot's range along its axis
+// and inside its cone). Suns and area
 // lights reach every surface in front of them and are not counted. The
 // forward and deferred paths shade exactly these lights at the pixel.
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -24,17 +25,14 @@ void main() {
         vec3 position = position_from_depth(vec2(p) + 0.5, d);
         uint first_point = frame.counts.x;
         for (uint i = first_point; i < first_point + frame.counts.y; ++i) {
-            vec3 to_light = lights[i].position_range.xyz - position;
-            n += length(to_light) > lights[i].position_range.w ? 0u : 1u;
+            float d = length(lights[i].position_range.xyz - position);
+            n += point_reaches(i, d) ? 1u : 0u;
         }
         uint first_spot = first_point + frame.counts.y;
         for (uint i = first_spot; i < first_spot + frame.counts.z; ++i) {
             vec3 to_light = lights[i].position_range.xyz - position;
-            vec3 axis = lights[i].direction_type.xyz;
-            float cosine = dot(-to_light / max(length(to_light), 1e-6), axis);
-            bool reached = dot(-to_light, axis) <= lights[i].position_range.w
-                && cosine >= lights[i].attenuation_cos.w;
-            n += reached ? 1u : 0u;
+            vec3 l = to_light / max(length(to_light), 1e-6);
+            n += spot_reaches(i, to_light, l) ? 1u : 0u;
         }
     }
     imageStore(view_light_count, p, uvec4(n));

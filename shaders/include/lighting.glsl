@@ -200,11 +200,25 @@ vec3 incoming_sun(uint index, Surface s, out vec3 l) {
     return lights[index].color_exponent.rgb * visible;
 }
 
+// Whether point light `index` reaches a surface `d` away: within its cutoff
+// range. The light_count view counts lights by this test and the next.
+bool point_reaches(uint index, float d) {
+    return !(d > lights[index].position_range.w);
+}
+
+// Whether spot `index` reaches a surface `to_light` away from it (`l` is the
+// unit direction towards it): within `range` along the axis and inside the cone.
+bool spot_reaches(uint index, vec3 to_light, vec3 l) {
+    vec3 axis = lights[index].direction_type.xyz;
+    return !(dot(-to_light, axis) > lights[index].position_range.w
+        || dot(-l, axis) < lights[index].attenuation_cos.w);
+}
+
 vec3 incoming_point(uint index, Surface s, out vec3 l) {
     vec3 to_light = lights[index].position_range.xyz - s.position;
     float d = length(to_light);
     l = to_light / max(d, 1e-6);
-    if (d > lights[index].position_range.w) {
+    if (!point_reaches(index, d)) {
         return vec3(0.0);
     }
     return lights[index].color_exponent.rgb * attenuate(index, d);
@@ -215,12 +229,10 @@ vec3 incoming_spot(uint index, Surface s, out vec3 l) {
     vec3 to_light = lights[index].position_range.xyz - s.position;
     float d = length(to_light);
     l = to_light / max(d, 1e-6);
-    vec3 axis = lights[index].direction_type.xyz;
-    float along = dot(-to_light, axis);
-    float cosine = dot(-l, axis);
-    if (along > lights[index].position_range.w || cosine < lights[index].attenuation_cos.w) {
+    if (!spot_reaches(index, to_light, l)) {
         return vec3(0.0);
     }
+    float cosine = dot(-l, lights[index].direction_type.xyz);
     float spot = lights[index].color_exponent.w > 0.0 ? pow(max(cosine, 0.0), lights[index].color_exponent.w) : 1.0;
 #ifdef HAS_SHADOW_MAP
     if (lights[index].direction_type.w == LIGHT_SPOT_CONE && dot(s.normal, l) > 0.0) {
