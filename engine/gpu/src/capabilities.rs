@@ -87,6 +87,18 @@ impl ShaderSupport {
         unmet
     }
 
+    /// Why the device (`device`, by name) cannot run `shader`, when it cannot:
+    /// every feature it lacks ("needs ..., which the device ... does not offer").
+    pub fn refusal(&self, device: &str, shader: &CompiledShader) -> Option<String> {
+        let unmet = self.unmet(shader);
+        (!unmet.is_empty()).then(|| {
+            format!(
+                "needs {}, which the device `{device}` does not offer",
+                unmet.join(" and ")
+            )
+        })
+    }
+
     /// An error for `pass` naming each of its `shaders` that needs what the
     /// device (`device`, by name) lacks.
     pub fn check(
@@ -98,14 +110,8 @@ impl ShaderSupport {
         let problems: Vec<String> = shaders
             .iter()
             .filter_map(|shader| {
-                let unmet = self.unmet(shader);
-                (!unmet.is_empty()).then(|| {
-                    format!(
-                        "{} needs {}, which the device `{device}` does not offer",
-                        shader.path.display(),
-                        unmet.join(" and ")
-                    )
-                })
+                let refusal = self.refusal(device, shader)?;
+                Some(format!("{} {refusal}", shader.path.display()))
             })
             .collect();
         if problems.is_empty() {

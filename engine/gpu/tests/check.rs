@@ -97,3 +97,47 @@ fn reload_drops_pipelines_built_from_a_changed_file() {
     drop(renderer);
     common::assert_no_validation_messages(gpu);
 }
+
+/// A pass whose shader needs a feature the device lacks is refused by name
+/// before any shader module is created: no validation message, no crash.
+/// lavapipe offers no clustered subgroup operations; a device that does
+/// renders the pass.
+#[test]
+fn a_shader_needing_a_feature_the_device_lacks_is_refused_naming_it() {
+    use ash::vk::{ShaderStageFlags, SubgroupFeatureFlags};
+    let gpu = common::gpu();
+    let plan = common::compile(&gpu, &common::graph("clustered.ron"), 4, 4);
+    let mut renderer = Renderer::new(&gpu).expect("renderer");
+    let mut resources = renderer.create_resources(&plan).expect("resources");
+    let result = renderer.execute(
+        &plan,
+        &mut resources,
+        &mut NoDraws,
+        &FrameOptions::default(),
+    );
+    let device = gpu.info();
+    let offered = device
+        .shaders
+        .subgroup_stages
+        .contains(ShaderStageFlags::FRAGMENT)
+        && device
+            .shaders
+            .subgroup_operations
+            .contains(SubgroupFeatureFlags::CLUSTERED);
+    if offered {
+        result.expect("the device offers clustered subgroup operations");
+    } else {
+        let err = result.expect_err("refused");
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "pass `clustered`: {} needs subgroup clustered operations (`supportedOperations` lacks CLUSTERED), which the device `{}` does not offer",
+                common::graph("shaders/clustered.frag").display(),
+                device.name
+            )
+        );
+    }
+    drop(resources);
+    drop(renderer);
+    common::assert_no_validation_messages(gpu);
+}

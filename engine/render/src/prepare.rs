@@ -130,15 +130,24 @@ pub(crate) fn pick_camera<'s>(
 /// Compiles and checks every shader the plan runs (and its agreement with the
 /// graph) through `checker`, without building pipelines.
 pub(crate) fn check_shaders(
+    gpu: &Gpu,
     checker: &mut PipelineCache,
     plan: &Plan,
     graph: &Path,
 ) -> Result<(), ReloadError> {
     let keys = plan_shader_keys(plan).map_err(|e| ReloadError::gpu(e, graph))?;
+    let device = gpu.info();
     for key in &keys {
-        checker
+        let module = checker
             .shader(key)
             .map_err(|e| ReloadError::gpu(e, &key.path))?;
+        if let Some(refusal) = device.shaders.refusal(&device.name, &module.compiled) {
+            return Err(ReloadError::new(
+                &crate::sources::normalize(&key.path),
+                None,
+                &refusal,
+            ));
+        }
     }
     let problems = crate::scene_interface::check_plan_shaders(checker, plan);
     match problems.first() {
@@ -243,7 +252,7 @@ fn prepare_files(
         None
     };
     let plan = new_plan.as_deref().unwrap_or(&base.plan);
-    check_shaders(&mut checker.cache, plan, graph)?;
+    check_shaders(gpu, &mut checker.cache, plan, graph)?;
     let sources = Sources {
         graph: if graph_changed {
             graph_files(graph)
@@ -283,7 +292,7 @@ fn prepare_settings(
         compile_for_scene(gpu, &base.scene, settings).map_err(|e| ReloadError::render(e, graph))?;
     let fail = |e: GpuError| ReloadError::gpu(e, graph);
     let mut cache = PipelineCache::new().map_err(fail)?;
-    check_shaders(&mut cache, &plan, graph)?;
+    check_shaders(gpu, &mut cache, &plan, graph)?;
     let sources = Sources {
         graph: graph_files(graph),
         shaders: shader_files(&mut cache, &plan).map_err(fail)?,

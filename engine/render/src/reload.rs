@@ -70,7 +70,7 @@ impl<'g> LiveRender<'g> {
             .map_err(|e| ReloadError::render(e, &settings.graph))?;
         let fail = |e: GpuError| ReloadError::gpu(e, &settings.graph);
         let mut cache = PipelineCache::new().map_err(fail)?;
-        check_shaders(&mut cache, &plan, &settings.graph)?;
+        check_shaders(gpu, &mut cache, &plan, &settings.graph)?;
         let mut uploaded =
             GpuScene::new(gpu, &scene).map_err(|e| ReloadError::render(e, scene_path))?;
         uploaded.cache_bvh_in(settings.cache_dir.clone());

@@ -10,6 +10,7 @@ fn repo_root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
+use ash::vk::{ShaderStageFlags, SubgroupFeatureFlags};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -404,6 +405,44 @@ fn shader_edits_the_gpu_would_reject_are_refused_before_commit() {
         std::fs::write(&path, original).expect("restore");
         live.apply(&BTreeSet::from([normalize(&path)]))
             .expect("the restored file reloads");
+    }
+    // A shader that needs a feature the device lacks is refused at the shader
+    // before any module is created. lavapipe offers no clustered subgroup
+    // operations; a device that does takes the edit.
+    let path = dir.join("shaders/tonemap.frag");
+    edit(
+        &path,
+        "#version 450",
+        "#version 450\n#extension GL_KHR_shader_subgroup_clustered : require",
+    );
+    edit(
+        &path,
+        "texture(hdr, uv).rgb",
+        "texture(hdr, uv).rgb * (subgroupClusteredAdd(1.0, 1u))",
+    );
+    let device = gpu.info();
+    let offered = device
+        .shaders
+        .subgroup_stages
+        .contains(ShaderStageFlags::FRAGMENT)
+        && device
+            .shaders
+            .subgroup_operations
+            .contains(SubgroupFeatureFlags::CLUSTERED);
+    let applied = live.apply(&BTreeSet::from([normalize(&path)]));
+    if offered {
+        applied.expect("the device offers clustered subgroup operations");
+    } else {
+        let err = applied.expect_err("refused");
+        assert_eq!(err.file, path, "{err}");
+        assert_eq!(
+            err.message,
+            format!(
+                "needs subgroup clustered operations (`supportedOperations` lacks CLUSTERED), which the device `{}` does not offer",
+                device.name
+            )
+        );
+        assert_eq!(pixels(&mut live), first, "the live version keeps rendering");
     }
     drop(live);
     assert_eq!(gpu.validation().messages(), Vec::new());
