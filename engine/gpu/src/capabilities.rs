@@ -124,6 +124,12 @@ impl ShaderSupport {
         }
     }
 
+    /// Whether `stage` may use the subgroup operations of class `operation`.
+    pub fn offers_subgroup(&self, stage: ShaderStage, operation: vk::SubgroupFeatureFlags) -> bool {
+        self.subgroup_stages.contains(stage_flag(stage))
+            && self.subgroup_operations.contains(operation)
+    }
+
     /// Why `capability` cannot be used in `stage`, when it cannot.
     fn lacks(&self, capability: Capability, stage: ShaderStage) -> Option<String> {
         let feature = |offered: bool, what: &str, feature: &str| {

@@ -104,7 +104,8 @@ fn reload_drops_pipelines_built_from_a_changed_file() {
 /// renders the pass.
 #[test]
 fn a_shader_needing_a_feature_the_device_lacks_is_refused_naming_it() {
-    use ash::vk::{ShaderStageFlags, SubgroupFeatureFlags};
+    use ash::vk::SubgroupFeatureFlags;
+    use weft_gpu::ShaderStage;
     let gpu = common::gpu();
     let plan = common::compile(&gpu, &common::graph("clustered.ron"), 4, 4);
     let mut renderer = Renderer::new(&gpu).expect("renderer");
@@ -118,12 +119,7 @@ fn a_shader_needing_a_feature_the_device_lacks_is_refused_naming_it() {
     let device = gpu.info();
     let offered = device
         .shaders
-        .subgroup_stages
-        .contains(ShaderStageFlags::FRAGMENT)
-        && device
-            .shaders
-            .subgroup_operations
-            .contains(SubgroupFeatureFlags::CLUSTERED);
+        .offers_subgroup(ShaderStage::Fragment, SubgroupFeatureFlags::CLUSTERED);
     if offered {
         result.expect("the device offers clustered subgroup operations");
     } else {

@@ -318,6 +318,11 @@ void main() { colour = vec4(float(gl_PrimitiveID)); }
             fragment_only.unmet(&reduce),
             ["subgroup operations in compute shaders (`supportedStages` lacks COMPUTE)"]
         );
+        assert!(fragment_only
+            .offers_subgroup(ShaderStage::Fragment, vk::SubgroupFeatureFlags::ARITHMETIC));
+        assert!(
+            !fragment_only.offers_subgroup(ShaderStage::Compute, vk::SubgroupFeatureFlags::BASIC)
+        );
         let basic_only = ShaderSupport {
             subgroup_operations: vk::SubgroupFeatureFlags::BASIC,
             ..all

@@ -10,11 +10,11 @@ fn repo_root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-use ash::vk::{ShaderStageFlags, SubgroupFeatureFlags};
+use ash::vk::SubgroupFeatureFlags;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-use weft_gpu::{Gpu, GpuOptions};
+use weft_gpu::{Gpu, GpuOptions, ShaderStage};
 use weft_graph::plan::Extent;
 use weft_render::reload_worker::Prepared;
 use weft_render::sources::normalize;
@@ -423,12 +423,7 @@ fn shader_edits_the_gpu_would_reject_are_refused_before_commit() {
     let device = gpu.info();
     let offered = device
         .shaders
-        .subgroup_stages
-        .contains(ShaderStageFlags::FRAGMENT)
-        && device
-            .shaders
-            .subgroup_operations
-            .contains(SubgroupFeatureFlags::CLUSTERED);
+        .offers_subgroup(ShaderStage::Fragment, SubgroupFeatureFlags::CLUSTERED);
     let applied = live.apply(&BTreeSet::from([normalize(&path)]));
     if offered {
         applied.expect("the device offers clustered subgroup operations");
