@@ -427,36 +427,46 @@ fn a_hundred_thousand_lights_shade_tiled_and_light_volumes_refuse_them_with_a_re
     );
 }
 
-/// `scene` through `graph` at `width` x `height` with bloom off and the graph
-/// parameters `params`, on a validating context (zero messages asserted): the
-/// tonemapped image, and the HDR image checked finite and bounded.
+/// `scene` rendered with `settings`, bloom off and the HDR image read back,
+/// on a validating context (zero messages asserted): the tonemapped image,
+/// and the HDR image checked finite and bounded. `what` names the render in
+/// failure messages.
+fn render_checked(scene: &Scene, settings: RenderSettings, what: &str) -> RgbaImage {
+    let settings = RenderSettings {
+        features: vec!["!bloom".into()],
+        extra_readback: vec!["hdr".into()],
+        ..settings
+    };
+    let gpu = weft_tests::gpu();
+    let log = gpu.validation();
+    let rendered = render(&gpu, scene, &settings).expect("renders");
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new(), "{what}");
+    let Pixels::RgbaF32(values) = &rendered.report.readbacks[0].1.pixels else {
+        panic!("hdr is a float image");
+    };
+    assert_finite_and_bounded(values, what);
+    rendered.report.output.expect("readback").to_rgba8()
+}
+
+/// `scene` through `graph` at `width` x `height` with the graph parameters
+/// `params`, checked as [`render_checked`] checks it.
 fn render_sized(
     scene: &Scene,
     graph: &str,
     [width, height]: [u32; 2],
     params: &[(&str, f64)],
 ) -> RgbaImage {
-    let gpu = weft_tests::gpu();
-    let log = gpu.validation();
     let settings = RenderSettings {
         graph: common::graph(graph),
         extent: Extent { width, height },
-        features: vec!["!bloom".into()],
-        extra_readback: vec!["hdr".into()],
         params: params
             .iter()
             .map(|(k, v)| (k.to_string(), weft_graph::schema::ParamValue::Number(*v)))
             .collect(),
         ..RenderSettings::default()
     };
-    let rendered = render(&gpu, scene, &settings).expect("renders");
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new(), "{graph} at {width}x{height}");
-    let Pixels::RgbaF32(values) = &rendered.report.readbacks[0].1.pixels else {
-        panic!("hdr is a float image");
-    };
-    assert_finite_and_bounded(values, &format!("{graph} at {width}x{height}"));
-    rendered.report.output.expect("readback").to_rgba8()
+    render_checked(scene, settings, &format!("{graph} at {width}x{height}"))
 }
 
 /// Outputs of one pixel, one column and one row (issue 19, sizes). The field
@@ -877,10 +887,9 @@ fn blinn_phong_exponents_from_1_to_1e6_at_grazing_angles_stay_finite() {
     }
 }
 
-/// The animated scene at `time` in forward, 160×90, under validation.
+/// The animated scene at `time` in forward, 160×90, checked as
+/// [`render_checked`] checks it.
 fn animated_at(scene: &Scene, time: f64) -> RgbaImage {
-    let gpu = weft_tests::gpu();
-    let log = gpu.validation();
     let settings = RenderSettings {
         graph: common::graph("forward.ron"),
         extent: Extent {
@@ -888,18 +897,9 @@ fn animated_at(scene: &Scene, time: f64) -> RgbaImage {
             height: 90,
         },
         time,
-        features: vec!["!bloom".into()],
-        extra_readback: vec!["hdr".into()],
         ..RenderSettings::default()
     };
-    let rendered = render(&gpu, scene, &settings).expect("renders");
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new(), "at {time} s");
-    let Pixels::RgbaF32(values) = &rendered.report.readbacks[0].1.pixels else {
-        panic!("hdr is a float image");
-    };
-    assert_finite_and_bounded(values, &format!("at {time} s"));
-    rendered.report.output.expect("readback").to_rgba8()
+    render_checked(scene, settings, &format!("at {time} s"))
 }
 
 /// The scene clock is f64 (issue 19, time): at a billion seconds, where f32

@@ -59,21 +59,6 @@ fn unknown_device_name_lists_what_exists() {
         .starts_with("no suitable Vulkan 1.3 device matching \"no-such-gpu-xyz\""));
 }
 
-/// A compute shader using optional features: 64-bit and 16-bit integers,
-/// 16-bit floats and a subgroup reduction.
-const OPTIONAL_FEATURES: &str = "#version 450
-#extension GL_KHR_shader_subgroup_arithmetic : require
-#extension GL_EXT_shader_explicit_arithmetic_types : require
-layout(local_size_x = 64) in;
-layout(set = 0, binding = 0) buffer Values { uint64_t total; float v[]; };
-void main() {
-    float16_t half_value = float16_t(v[gl_GlobalInvocationID.x]);
-    int16_t small = int16_t(gl_LocalInvocationIndex);
-    v[gl_GlobalInvocationID.x] = subgroupMax(float(half_value) + float(small));
-    total += uint64_t(1);
-}
-";
-
 #[test]
 fn optional_shader_features_are_enabled_when_the_device_offers_them() {
     use weft_gpu::pipeline::{PipelineCache, PipelineKey, ShaderKey};
@@ -83,17 +68,14 @@ fn optional_shader_features_are_enabled_when_the_device_offers_them() {
         device: None,
     })
     .expect("a Vulkan 1.3 device");
-    let dir = std::env::temp_dir().join(format!("weft-optional-features-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("optional.comp");
-    std::fs::write(&path, OPTIONAL_FEATURES).unwrap();
     let key = ShaderKey {
-        path,
+        path: std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/shaders/optional_features.comp"),
         stage: ShaderStage::Compute,
         defines: Vec::new(),
     };
-    let mut cache = PipelineCache::new().unwrap();
-    let shader = cache.shader(&key).unwrap();
+    let mut cache = PipelineCache::new().expect("shaderc");
+    let shader = cache.shader(&key).expect("the fixture compiles");
     let unmet = gpu.info().shaders.unmet(&shader.compiled);
     if gpu.info().kind == DeviceKind::Cpu {
         // lavapipe offers all of them (docs/architecture.md, "Optional device features").
@@ -105,7 +87,6 @@ fn optional_shader_features_are_enabled_when_the_device_offers_them() {
             .expect("a pipeline from the offered features");
     }
     cache.destroy(gpu.device());
-    std::fs::remove_dir_all(&dir).unwrap();
     let log = gpu.validation();
     drop(gpu);
     assert_eq!(log.messages(), Vec::new());
