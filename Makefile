@@ -25,8 +25,9 @@ test: lint
 FUZZ_CASES ?= 20000
 MUTANTS ?= 2000
 fuzz: setup
-	WEFT_FUZZ_CASES=$(FUZZ_CASES) $(CARGO) test -p weft-scene -p weft-graph --test fuzz -- --nocapture
-	WEFT_MUTANTS=$(MUTANTS) $(CARGO) test -p weft-tests --test mutants -- --nocapture
+	WEFT_FUZZ_CASES=$(FUZZ_CASES) $(CARGO) test -p weft-scene --test scene -- --nocapture fuzz::
+	WEFT_FUZZ_CASES=$(FUZZ_CASES) $(CARGO) test -p weft-graph --test graph -- --nocapture fuzz::
+	WEFT_MUTANTS=$(MUTANTS) $(CARGO) test -p weft-tests --test e2e -- --nocapture mutants::
 
 bench: setup
 	$(CARGO) bench --workspace

@@ -68,7 +68,7 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
         let mut cached = Vec::new();
         for _ in 0..args.runs {
             let started = Instant::now();
-            let read = weft_render::bvh_cache::load_or_build(&triangles, Some(&cache));
+            let (read, _) = weft_render::bvh_cache::load_or_build(&triangles, Some(&cache));
             cached.push(started.elapsed().as_secs_f64() * 1e3);
             anyhow::ensure!(read == bvh, "the cached BVH differs from the built one");
         }

@@ -268,6 +268,7 @@ fn reference(
     let Extent { width, height } = common.size;
     if let Some(path) = &common.reference_image {
         let image = LinearImage::read_exr(path)?;
+        image.check_radiance(path)?;
         if (image.width, image.height) != (width, height) {
             bail!(
                 "--reference-image {} is {}x{}, but --size asks for {width}x{height} (images are not resampled)",
@@ -328,23 +329,27 @@ fn reference(
         Some(_) => Some(reference_key(common, gpu, scene, camera, &settings)?.digest()?),
         None => None,
     };
+    // The reference the report links to is always an EXR in the output folder;
+    // the cache keeps its own framed copy.
+    let path = out.join("reference.exr");
     if let (Some(cache), Some(digest)) = (&cache, &digest) {
-        if let Some(image) = cache.load(digest, width, height) {
-            return Ok((image, info(true, cache.path(digest), 0.0)));
+        match cache.load(digest, width, height) {
+            Ok(Some(image)) => {
+                image.write_exr(&path)?;
+                return Ok((image, info(true, path, 0.0)));
+            }
+            Ok(None) => {}
+            Err(damaged) => eprintln!("warning: {damaged}"),
         }
     }
     let started = std::time::Instant::now();
     let rendered = render(gpu, scene, &settings, "reference")?;
     let image = linear(first_readback(&rendered, &common.reference)?);
     let seconds = started.elapsed().as_secs_f64();
-    let path = match (&cache, &digest) {
-        (Some(cache), Some(digest)) => cache.store(digest, &image)?,
-        _ => {
-            let path = out.join("reference.exr");
-            image.write_exr(&path)?;
-            path
-        }
-    };
+    if let (Some(cache), Some(digest)) = (&cache, &digest) {
+        cache.store(digest, &image)?;
+    }
+    image.write_exr(&path)?;
     Ok((image, info(false, path, seconds)))
 }
 

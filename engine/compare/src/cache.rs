@@ -1,11 +1,12 @@
 //! The reference cache: a path-traced reference is slow, so it is kept as an
 //! EXR under the user cache (`$WEFT_CACHE_DIR`, else
 //! `$XDG_CACHE_HOME/weft` or `~/.cache/weft`, beside the scene and BVH
-//! caches) in `references/KEY.exr`. The key hashes everything the image
+//! caches) in `references/KEY.weftref`, an OpenEXR file framed by
+//! [`weft_io::entry`] (the key and a checksum). The key hashes everything the image
 //! depends on: the content of every file (scene, models, materials,
 //! textures, graph, shaders), the camera, size, samples, seed, parameters
-//! and features. An entry that cannot be read, or has the wrong size, is a
-//! miss and is rendered again.
+//! and features. An entry that is damaged, stored for another key or of the
+//! wrong size is a miss with a warning and is rendered again.
 
 use crate::image_io::{ImageError, LinearImage};
 use std::path::{Path, PathBuf};
@@ -40,20 +41,12 @@ pub enum CacheError {
         /// Why.
         source: std::io::Error,
     },
-    /// The cache folder could not be made.
-    #[error("creating the reference cache {path}: {source}")]
-    Folder {
-        /// The folder.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// The entry could not be written.
+    /// The entry could not be encoded.
     #[error(transparent)]
-    Write(#[from] ImageError),
-    /// The written entry could not be moved into place.
+    Encode(#[from] ImageError),
+    /// The entry could not be written.
     #[error("storing {path}: {source}")]
-    Rename {
+    Write {
         /// The entry.
         path: PathBuf,
         /// Why.
@@ -61,41 +54,21 @@ pub enum CacheError {
     },
 }
 
-/// 64-bit FNV-1a, stable across builds and platforms (unlike std's hasher).
-struct Fnv(u64);
-
-impl Fnv {
-    fn new() -> Self {
-        Self(0xcbf2_9ce4_8422_2325)
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 ^= u64::from(b);
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    }
-
-    /// Writes a length first, so that adjacent fields cannot run together.
-    fn field(&mut self, bytes: &[u8]) {
-        self.write(&(bytes.len() as u64).to_le_bytes());
-        self.write(bytes);
-    }
-}
-
 impl ReferenceKey {
-    /// The key as 16 hex digits.
+    /// The key as 32 hex digits ([`weft_io::hash`]); files are read through
+    /// weft's one reader (regular files only).
     pub fn digest(&self) -> Result<String, CacheError> {
-        let mut h = Fnv::new();
-        h.field(b"weft reference 1");
+        let mut h = weft_io::hash::Hasher::new();
+        h.field(b"weft reference 2");
         let mut files = self.files.clone();
         files.sort();
         files.dedup();
         for path in &files {
-            let bytes = std::fs::read(path).map_err(|source| CacheError::Read {
-                path: path.clone(),
-                source,
-            })?;
+            let bytes =
+                weft_io::read_capped(path, MAX_INPUT_BYTES).map_err(|e| CacheError::Read {
+                    path: path.clone(),
+                    source: e.into_io(),
+                })?;
             h.field(path.to_string_lossy().as_bytes());
             h.field(&bytes);
         }
@@ -107,9 +80,22 @@ impl ReferenceKey {
         for s in &self.settings {
             h.field(s.as_bytes());
         }
-        Ok(format!("{:016x}", h.0))
+        Ok(weft_io::hash::hex(h.finish()))
     }
 }
+
+/// The largest input file hashed into a key (models and textures included).
+const MAX_INPUT_BYTES: u64 = 2 << 30;
+
+/// The entry kind of references ([`weft_io::entry`]): the payload is the
+/// reference as an OpenEXR file.
+const KIND: weft_io::entry::Kind = weft_io::entry::Kind {
+    name: "ref",
+    version: 1,
+};
+
+/// The largest entry read (a 16384×16384 RGB float EXR is 3 GiB).
+const MAX_ENTRY_BYTES: u64 = 4 << 30;
 
 /// The folder of cached references.
 #[derive(Debug, Clone, PartialEq)]
@@ -127,31 +113,50 @@ impl ReferenceCache {
 
     /// Where the entry for `digest` lives.
     pub fn path(&self, digest: &str) -> PathBuf {
-        self.dir.join(format!("{digest}.exr"))
+        self.dir.join(format!("{digest}.weftref"))
     }
 
-    /// The cached image for `digest` when there is a readable one of this size.
-    pub fn load(&self, digest: &str, width: u32, height: u32) -> Option<LinearImage> {
-        LinearImage::read_exr(&self.path(digest))
-            .ok()
-            .filter(|image| (image.width, image.height) == (width, height))
+    /// The cached image for `digest` when there is a sound entry of this
+    /// size; `Err` says why an entry that is there was not used (damaged,
+    /// stored for another key, not a regular file, another size).
+    pub fn load(
+        &self,
+        digest: &str,
+        width: u32,
+        height: u32,
+    ) -> Result<Option<LinearImage>, String> {
+        let path = self.path(digest);
+        let damaged = |why: String| {
+            format!(
+                "the cached reference {} is damaged ({why}); rendered again",
+                path.display()
+            )
+        };
+        let exr = match weft_io::entry::read(&path, KIND, digest.as_bytes(), MAX_ENTRY_BYTES) {
+            Ok(Some(exr)) => exr,
+            Ok(None) => return Ok(None),
+            Err(damage) => return Err(damaged(damage.to_string())),
+        };
+        let image = LinearImage::decode_exr(&exr, &path).map_err(|e| damaged(e.to_string()))?;
+        if (image.width, image.height) != (width, height) {
+            return Err(damaged(format!(
+                "it is {}x{}, not {width}x{height}",
+                image.width, image.height
+            )));
+        }
+        Ok(Some(image))
     }
 
     /// Stores `image` for `digest`, written aside and renamed into place so a
-    /// reader never sees half a file.
+    /// reader never sees half an entry and concurrent writers never mix theirs.
     pub fn store(&self, digest: &str, image: &LinearImage) -> Result<PathBuf, CacheError> {
-        std::fs::create_dir_all(&self.dir).map_err(|source| CacheError::Folder {
-            path: self.dir.clone(),
-            source,
-        })?;
         let path = self.path(digest);
-        let partial = self
-            .dir
-            .join(format!("{digest}.{}.partial.exr", std::process::id()));
-        image.write_exr(&partial)?;
-        std::fs::rename(&partial, &path).map_err(|source| CacheError::Rename {
-            path: path.clone(),
-            source,
+        let exr = image.encode_exr(&path)?;
+        weft_io::entry::write(&path, KIND, digest.as_bytes(), &exr).map_err(|source| {
+            CacheError::Write {
+                path: path.clone(),
+                source,
+            }
         })?;
         Ok(path)
     }
@@ -226,11 +231,37 @@ mod tests {
             height: 1,
             pixels: vec![[0.5, 1.0, 2.0], [0.0, 0.25, 8.0]],
         };
-        assert_eq!(cache.load("abc", 2, 1), None);
+        assert_eq!(cache.load("abc", 2, 1), Ok(None));
         cache.store("abc", &image).expect("store");
-        assert_eq!(cache.load("abc", 2, 1), Some(image));
-        assert_eq!(cache.load("abc", 3, 1), None, "wrong size");
+        assert_eq!(cache.load("abc", 2, 1), Ok(Some(image.clone())));
+        let wrong = cache.load("abc", 3, 1).expect_err("wrong size");
+        assert!(wrong.contains("it is 2x1, not 3x1"), "{wrong}");
+        let good = std::fs::read(cache.path("abc")).expect("entry");
         std::fs::write(cache.path("abc"), b"not an exr").expect("corrupt");
-        assert_eq!(cache.load("abc", 2, 1), None);
+        let junk = cache.load("abc", 2, 1).expect_err("junk");
+        assert!(junk.contains("not a weft cache entry"), "{junk}");
+        let mut flipped = good.clone();
+        let last = flipped.len() - 1;
+        flipped[last] ^= 0x10;
+        std::fs::write(cache.path("abc"), &flipped).expect("flip");
+        assert!(cache
+            .load("abc", 2, 1)
+            .expect_err("flip")
+            .contains("checksum"));
+        // Another key's entry under this name: refused, never served.
+        cache.store("def", &image).expect("store");
+        std::fs::copy(cache.path("def"), cache.path("abc")).expect("swap");
+        assert!(cache
+            .load("abc", 2, 1)
+            .expect_err("swapped")
+            .contains("stored for another input"));
+        std::fs::remove_file(cache.path("abc")).expect("rm");
+        std::os::unix::fs::symlink("/dev/zero", cache.path("abc")).expect("link");
+        assert!(cache
+            .load("abc", 2, 1)
+            .expect_err("device")
+            .contains("it is a device"));
+        cache.store("abc", &image).expect("a link is replaced");
+        assert_eq!(cache.load("abc", 2, 1), Ok(Some(image)));
     }
 }

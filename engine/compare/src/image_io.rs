@@ -3,6 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
+/// The largest EXR file read (a 16384×16384 RGBA float image is 4 GiB).
+const MAX_EXR_BYTES: u64 = 4 << 30;
+
 /// Why an image could not be read or written.
 #[derive(Debug, thiserror::Error)]
 pub enum ImageError {
@@ -21,6 +24,20 @@ pub enum ImageError {
         path: PathBuf,
         /// What the encoder said.
         message: String,
+    },
+    /// An image that should hold radiance holds non-finite or negative values.
+    #[error("{path}: {count} pixel(s) are not finite, non-negative radiance; the first is at ({x}, {y}): {value:?}")]
+    Radiance {
+        /// The file.
+        path: PathBuf,
+        /// How many pixels have a non-finite or negative channel.
+        count: usize,
+        /// The first such pixel's column.
+        x: u32,
+        /// The first such pixel's row.
+        y: u32,
+        /// Its value.
+        value: [f32; 3],
     },
     /// Two images that must match in size do not.
     #[error("{what}: {found_width}x{found_height}, but the reference is {width}x{height} (images are not resampled)")]
@@ -61,14 +78,23 @@ pub struct SrgbImage {
 }
 
 impl LinearImage {
-    /// Reads an OpenEXR file's RGB channels (alpha, if any, is dropped).
+    /// Reads an OpenEXR file's RGB channels (alpha, if any, is dropped)
+    /// through weft's one reader: a FIFO or device is refused, never waited on.
     pub fn read_exr(path: &Path) -> Result<Self, ImageError> {
+        let bytes = weft_io::read_capped(path, MAX_EXR_BYTES).map_err(|e| ImageError::Read {
+            path: path.to_path_buf(),
+            message: e.reason(),
+        })?;
+        Self::decode_exr(&bytes, path)
+    }
+
+    /// Decodes OpenEXR bytes; `path` names them in errors.
+    pub fn decode_exr(bytes: &[u8], path: &Path) -> Result<Self, ImageError> {
         let read = |message: String| ImageError::Read {
             path: path.to_path_buf(),
             message,
         };
-        let decoded = image::ImageReader::open(path)
-            .map_err(|e| read(e.to_string()))?
+        let decoded = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| read(e.to_string()))?;
         if decoded.format() != Some(image::ImageFormat::OpenExr) {
@@ -85,19 +111,47 @@ impl LinearImage {
         })
     }
 
+    /// The image as the bytes of an RGB OpenEXR file; `path` names it in errors.
+    pub fn encode_exr(&self, path: &Path) -> Result<Vec<u8>, ImageError> {
+        let write = |message: String| ImageError::Write {
+            path: path.to_path_buf(),
+            message,
+        };
+        let flat: Vec<f32> = self.pixels.iter().flatten().copied().collect();
+        let image = image::Rgb32FImage::from_raw(self.width, self.height, flat)
+            .ok_or_else(|| write("pixel count does not match the size".into()))?;
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        image
+            .write_to(&mut bytes, image::ImageFormat::OpenExr)
+            .map_err(|e| write(e.to_string()))?;
+        Ok(bytes.into_inner())
+    }
+
+    /// An error unless every channel of every pixel is finite and not
+    /// negative, as radiance is: it names how many pixels are not, and the
+    /// first (row by row from the top).
+    pub fn check_radiance(&self, path: &Path) -> Result<(), ImageError> {
+        let bad = |p: &[f32; 3]| p.iter().any(|c| !c.is_finite() || *c < 0.0);
+        let count = self.pixels.iter().filter(|p| bad(p)).count();
+        match self.pixels.iter().position(bad) {
+            None => Ok(()),
+            Some(first) => Err(ImageError::Radiance {
+                path: path.to_path_buf(),
+                count,
+                x: first as u32 % self.width.max(1),
+                y: first as u32 / self.width.max(1),
+                value: self.pixels[first],
+            }),
+        }
+    }
+
     /// Writes the image as an RGB OpenEXR file.
     pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
-        let flat: Vec<f32> = self.pixels.iter().flatten().copied().collect();
-        image::Rgb32FImage::from_raw(self.width, self.height, flat)
-            .ok_or_else(|| ImageError::Write {
-                path: path.to_path_buf(),
-                message: "pixel count does not match the size".into(),
-            })?
-            .save_with_format(path, image::ImageFormat::OpenExr)
-            .map_err(|e| ImageError::Write {
-                path: path.to_path_buf(),
-                message: e.to_string(),
-            })
+        let bytes = self.encode_exr(path)?;
+        std::fs::write(path, bytes).map_err(|e| ImageError::Write {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })
     }
 
     /// An error unless `other` has this image's size.

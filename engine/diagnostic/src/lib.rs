@@ -158,22 +158,16 @@ pub fn nearest<'a>(wrong: &str, candidates: impl IntoIterator<Item = &'a str>) -
 /// The diagnostics for people: each one's header (`file:line:col: error:
 /// message`, the grep-friendly form editors jump to), its hint and notes, then
 /// the offending source line with a caret under the position, as rustc shows
-/// it. A file that cannot be read, or a position past its end, prints the
-/// header alone.
+/// it. The line comes from the text weft read ([`weft_io::sources`]); the
+/// file is never read again, so a file weft did not read as text (or whose
+/// content must not be echoed), or a position past its end, prints the header
+/// alone.
 pub fn render(diagnostics: &[Diagnostic]) -> String {
-    let mut sources: Vec<(PathBuf, Option<String>)> = Vec::new();
     let mut out = String::new();
     for d in diagnostics {
         out.push_str(&d.to_string());
         out.push('\n');
-        let text = match sources.iter().position(|(p, _)| *p == d.file) {
-            Some(i) => sources[i].1.as_deref(),
-            None => {
-                sources.push((d.file.clone(), std::fs::read_to_string(&d.file).ok()));
-                sources.last().and_then(|(_, t)| t.as_deref())
-            }
-        };
-        if let Some(snippet) = text.and_then(|t| snippet(t, d.pos)) {
+        if let Some(snippet) = source_snippet(d) {
             out.push_str(&snippet);
         }
     }
@@ -181,10 +175,10 @@ pub fn render(diagnostics: &[Diagnostic]) -> String {
 }
 
 /// The source line a diagnostic points at, with its caret line (see [`render`]),
-/// for callers that print the header themselves; `None` when the file cannot
-/// be read or the diagnostic has no line.
+/// for callers that print the header themselves; `None` when weft did not
+/// read the file as text or the diagnostic has no line.
 pub fn source_snippet(d: &Diagnostic) -> Option<String> {
-    let text = std::fs::read_to_string(&d.file).ok()?;
+    let text = weft_io::sources::text_of(&d.file)?;
     snippet(&text, d.pos)
 }
 
@@ -269,6 +263,7 @@ mod tests {
         std::fs::create_dir_all(&dir).expect("dir");
         let file = dir.join("g.ron");
         std::fs::write(&file, "Graph(\n    output: \"hdx\",\n)\n").expect("write");
+        weft_io::read_text(&file, 1 << 20).expect("read as weft reads it");
         let d = Diagnostic::error(&file, Pos { line: 2, col: 13 }, "unknown resource \"hdx\"")
             .with_hint("did you mean \"hdr\"?");
         let text = render(&[d, Diagnostic::in_file(&file, None, "whole file")]);
@@ -280,6 +275,18 @@ mod tests {
                 "{name}:2:13: error: unknown resource \"hdx\"\n  hint: did you mean \"hdr\"?\n   |\n 2 |     output: \"hdx\",\n   |             ^^^^^\n{name}: error: whole file\n"
             )
         );
+    }
+
+    #[test]
+    fn render_never_reads_a_file_weft_did_not_read() {
+        let dir = std::env::temp_dir().join(format!("weft-diag-unread-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let file = dir.join("g.ron");
+        std::fs::write(&file, "Graph(\n)\n").expect("write");
+        let d = Diagnostic::error(&file, Pos { line: 1, col: 1 }, "broken");
+        let text = render(&[d]);
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(text, format!("{}:1:1: error: broken\n", file.display()));
     }
 
     #[test]

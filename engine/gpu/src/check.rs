@@ -157,7 +157,7 @@ const SHADER_VARIABLE_MESSAGES: [&str; 4] = [
 /// The 1-based line of `file` that declares `name`: a `layout(...)` line, or
 /// a block or variable declaration, naming it as a whole word.
 fn declaration_line(file: &std::path::Path, name: &str) -> Option<usize> {
-    let text = std::fs::read_to_string(file).ok()?;
+    let text = weft_io::sources::text_of(file)?;
     let is_word = |line: &str| {
         line.split(|c: char| !(c.is_alphanumeric() || c == '_'))
             .any(|w| w == name)

@@ -163,9 +163,11 @@ impl ShaderCompiler {
         stage: ShaderStage,
         defines: &[String],
     ) -> Result<CompiledShader, ShaderError> {
-        let source = std::fs::read_to_string(path).map_err(|e| ShaderError::Read {
-            path: path.to_path_buf(),
-            message: e.to_string(),
+        let source = weft_io::read_text(path, weft_io::read::MAX_TEXT_BYTES).map_err(|e| {
+            ShaderError::Read {
+                path: path.to_path_buf(),
+                message: e.reason(),
+            }
         })?;
         self.compile_source(&source, path, stage, defines)
     }
@@ -272,8 +274,8 @@ impl ShaderCompiler {
         let Some(found) = candidates.into_iter().find(|c| c.is_file()) else {
             return Err(format!("cannot find include file `{requested}`"));
         };
-        let content = std::fs::read_to_string(&found)
-            .map_err(|e| format!("cannot read `{}`: {e}", found.display()))?;
+        let content = weft_io::read_text(&found, weft_io::read::MAX_TEXT_BYTES)
+            .map_err(|e| format!("cannot read `{}`: {}", found.display(), e.reason()))?;
         dependencies.borrow_mut().insert(found.clone());
         Ok(shaderc::ResolvedInclude {
             resolved_name: found.to_string_lossy().into_owned(),

@@ -3,8 +3,9 @@
 //! depends on: the preprocessed source (every `#include` expanded, so an
 //! edit to any included file changes it), the stage, the defines, the
 //! target environment, shaderc's SPIR-V version and this crate's version.
-//! An entry that is not valid SPIR-V is rebuilt with a warning, never
-//! trusted. The binary chooses the folder once at start (`weft` uses
+//! An entry carries that hash whole and a checksum of its SPIR-V
+//! ([`weft_io::entry`]): a damaged, swapped or foreign entry is rebuilt with a
+//! warning, never trusted. The binary chooses the folder once at start (`weft` uses
 //! `$WEFT_CACHE_DIR/spirv`, else `$XDG_CACHE_HOME/weft/spirv` or
 //! `~/.cache/weft/spirv`, and `--no-cache` turns it off); by default nothing
 //! is cached.
@@ -59,12 +60,23 @@ fn warn(message: String) {
     }
 }
 
-/// 64-bit FNV-1a over length-prefixed fields.
-pub(crate) struct Key(u64);
+/// The entry kind of SPIR-V in the cache ([`weft_io::entry`]).
+const KIND: weft_io::entry::Kind = weft_io::entry::Kind {
+    name: "spirv",
+    version: 2,
+};
+
+/// The largest entry read: a compiled shader is far smaller.
+const MAX_ENTRY_BYTES: u64 = 64 << 20;
+
+/// The hash of everything a shader's SPIR-V depends on ([`weft_io::hash`]),
+/// over length-prefixed fields. The entry is named after it and stores it
+/// whole, so an entry moved onto another's name is noticed.
+pub(crate) struct Key(weft_io::hash::Hasher);
 
 impl Key {
     pub(crate) fn new() -> Self {
-        let mut key = Self(0xcbf2_9ce4_8422_2325);
+        let mut key = Self(weft_io::hash::Hasher::new());
         key.field(FORMAT.as_bytes());
         key.field(env!("CARGO_PKG_VERSION").as_bytes());
         let (major, minor) = shaderc::get_spirv_version();
@@ -74,35 +86,45 @@ impl Key {
     }
 
     pub(crate) fn field(&mut self, bytes: &[u8]) {
-        for &b in (bytes.len() as u64).to_le_bytes().iter().chain(bytes) {
-            self.0 ^= u64::from(b);
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
-        }
+        self.0.field(bytes);
+    }
+
+    fn digest(&self) -> u128 {
+        self.0.finish()
     }
 
     fn path(&self, dir: &Path) -> PathBuf {
-        dir.join(format!("{:016x}.spv", self.0))
+        dir.join(format!("{}.spv", weft_io::hash::hex(self.digest())))
     }
 }
 
-/// The cached SPIR-V for `key`, when there is a valid entry. A damaged one
-/// (not whole words, or not starting with SPIR-V's magic number) is
-/// reported and ignored.
+/// The cached SPIR-V for `key`, when there is a sound entry. One that is
+/// damaged (truncated, flipped bits, stored for another key, not a regular
+/// file) or whose payload is not SPIR-V is reported and ignored; the caller
+/// compiles again and [`store`] replaces it.
 pub(crate) fn load(key: &Key, shader: &Path) -> Option<Vec<u32>> {
     let dir = dir()?;
     let path = key.path(&dir);
-    let bytes = std::fs::read(&path).ok()?;
+    let damaged = |why: String| {
+        warn(format!(
+            "the cached SPIR-V of {} ({}) is damaged ({why}); compiled again",
+            shader.display(),
+            path.display()
+        ));
+        None
+    };
+    let bytes =
+        match weft_io::entry::read(&path, KIND, &key.digest().to_le_bytes(), MAX_ENTRY_BYTES) {
+            Ok(Some(bytes)) => bytes,
+            Ok(None) => return None,
+            Err(damage) => return damaged(damage.to_string()),
+        };
     let words: Vec<u32> = bytes
         .chunks_exact(4)
         .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
         .collect();
     if bytes.len() % 4 != 0 || words.len() < 5 || words[0] != MAGIC {
-        warn(format!(
-            "the cached SPIR-V of {} ({}) is damaged; compiled again",
-            shader.display(),
-            path.display()
-        ));
-        return None;
+        return damaged("its payload is not SPIR-V".into());
     }
     Some(words)
 }
@@ -114,12 +136,8 @@ pub(crate) fn store(key: &Key, spirv: &[u32]) {
         return;
     };
     let path = key.path(&dir);
-    let partial = path.with_extension(format!("partial{}", std::process::id()));
     let bytes: Vec<u8> = spirv.iter().flat_map(|w| w.to_le_bytes()).collect();
-    let written = std::fs::create_dir_all(&dir)
-        .and_then(|()| std::fs::write(&partial, &bytes))
-        .and_then(|()| std::fs::rename(&partial, &path));
-    if let Err(e) = written {
+    if let Err(e) = weft_io::entry::write(&path, KIND, &key.digest().to_le_bytes(), &bytes) {
         warn(format!(
             "cannot write the SPIR-V cache {}: {e}",
             path.display()
@@ -168,23 +186,96 @@ mod tests {
         assert_eq!(warm, cold, "same SPIR-V and the same dependencies");
         assert!(warm.dependencies.contains(&include));
 
-        // A damaged entry is compiled again, with a warning, and replaced.
-        std::fs::write(&entries()[0], b"not spir-v").expect("damage");
-        let rebuilt = compiler
+        // Each kind of damage is compiled again, with one warning naming it,
+        // and the entry replaced by a sound one.
+        let good = std::fs::read(&entries()[0]).expect("entry");
+        let mut flipped = good.clone();
+        let last = flipped.len() - 7;
+        flipped[last..last + 4].iter_mut().for_each(|b| *b ^= 0xA5);
+        type Damage<'a> = &'a dyn Fn(&std::path::Path);
+        let damages: [(&str, Damage); 6] = [
+            ("its checksum does not match", &|e| {
+                std::fs::write(e, &flipped).expect("flip")
+            }),
+            ("it is truncated", &|e| {
+                std::fs::write(e, &good[..good.len() - 9]).expect("cut")
+            }),
+            ("it is not a weft cache entry", &|e| {
+                std::fs::write(e, b"").expect("empty")
+            }),
+            ("it is not a weft cache entry", &|e| {
+                std::fs::write(e, b"not spir-v").expect("junk")
+            }),
+            ("it is a device", &|e| {
+                std::fs::remove_file(e).expect("rm");
+                std::os::unix::fs::symlink("/dev/zero", e).expect("link");
+            }),
+            ("it is a directory", &|e| {
+                std::fs::remove_file(e).expect("rm");
+                std::fs::create_dir(e).expect("dir");
+            }),
+        ];
+        for (why, damage) in damages {
+            let entry = entries()[0].clone();
+            damage(&entry);
+            let rebuilt = compiler
+                .compile_file(&shader, ShaderStage::Compute, &[])
+                .expect("compiles");
+            assert_eq!(rebuilt.spirv, cold.spirv, "{why}");
+            let warnings = super::take_warnings();
+            let rebuilt: Vec<_> = warnings
+                .iter()
+                .filter(|w| w.ends_with("; compiled again"))
+                .collect();
+            assert!(
+                rebuilt.len() == 1 && rebuilt[0].contains("a.comp") && rebuilt[0].contains(why),
+                "{why}: {warnings:?}"
+            );
+            if entry.is_dir() {
+                std::fs::remove_dir(&entry).expect("a folder cannot be replaced");
+                compiler
+                    .compile_file(&shader, ShaderStage::Compute, &[])
+                    .expect("compiles");
+                super::take_warnings();
+            }
+            assert_eq!(
+                std::fs::read(&entry).expect("entry"),
+                good,
+                "{why}: rewritten"
+            );
+        }
+
+        // An entry copied onto another key's name is stored for another input.
+        std::fs::write(&include, "const float VALUE = 3.0;\n").expect("write");
+        let other = compiler
             .compile_file(&shader, ShaderStage::Compute, &[])
             .expect("compiles");
-        assert_eq!(rebuilt.spirv, cold.spirv);
+        let other_entry = entries()
+            .into_iter()
+            .find(|e| std::fs::read(e).ok() != Some(good.clone()))
+            .expect("second entry");
+        std::fs::write(&include, "const float VALUE = 1.0;\n").expect("write");
+        std::fs::copy(
+            &other_entry,
+            entries()
+                .into_iter()
+                .find(|e| *e != other_entry)
+                .expect("first"),
+        )
+        .expect("swap");
+        let served = compiler
+            .compile_file(&shader, ShaderStage::Compute, &[])
+            .expect("compiles");
+        assert_eq!(served.spirv, cold.spirv, "never the other shader's SPIR-V");
+        assert_ne!(other.spirv, cold.spirv);
         let warnings = super::take_warnings();
         assert!(
             warnings
                 .iter()
-                .any(|w| w.contains("a.comp") && w.ends_with("is damaged; compiled again")),
+                .any(|w| w.contains("stored for another input")),
             "{warnings:?}"
         );
-        assert_eq!(
-            std::fs::read(&entries()[0]).expect("entry").len(),
-            cold.spirv.len() * 4
-        );
+        std::fs::remove_file(&other_entry).expect("rm");
 
         // Editing an included file, or a define, makes another entry.
         std::fs::write(&include, "const float VALUE = 2.0;\n").expect("write");

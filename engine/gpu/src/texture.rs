@@ -101,6 +101,14 @@ impl<'g> Texture<'g> {
             height: pixels.height.max(1),
             depth: 1,
         };
+        let max = gpu.info().max_image_dimension;
+        if extent.width > max || extent.height > max {
+            // Drivers may crash on such an image rather than refuse it.
+            return Err(GpuError::Plan(format!(
+                "texture {name} is {}x{}; the device allows at most {max} texels per side (maxImageDimension2D)",
+                extent.width, extent.height
+            )));
+        }
         let levels = if single && gpu.linear_filter(format.as_raw()) {
             mip_levels(extent.width, extent.height)
         } else {

@@ -3,7 +3,7 @@
 //! resize or feature toggle costs), validation plus compilation, and for the
 //! deferred graph also loading (RON parsing) plus both.
 
-#[path = "../tests/support/random_graph.rs"]
+#[path = "../tests/graph/support/random_graph.rs"]
 mod random_graph;
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};

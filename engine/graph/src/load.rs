@@ -105,9 +105,15 @@ impl LoadedGraph {
 /// Reads the contents of a file; tests substitute an in-memory file system.
 pub type ReadFile<'a> = &'a dyn Fn(&Path) -> std::io::Result<String>;
 
+/// Reads a graph file from disk through weft's one reader: regular files
+/// only, at most [`weft_io::read::MAX_TEXT_BYTES`].
+pub fn read_from_disk(path: &Path) -> std::io::Result<String> {
+    weft_io::read_text(path, weft_io::read::MAX_TEXT_BYTES).map_err(weft_io::ReadError::into_io)
+}
+
 /// Loads a graph file from disk with its includes.
 pub fn load(path: &Path) -> LoadedGraph {
-    load_with(path, &|p: &Path| std::fs::read_to_string(p))
+    load_with(path, &read_from_disk)
 }
 
 /// Loads a graph with a custom file reader.
@@ -119,7 +125,7 @@ pub fn load_with(path: &Path, read: ReadFile) -> LoadedGraph {
 /// include site would set a fragment's (`weft render --param exposure=2`); a
 /// name the graph does not declare is an error located at its `params`.
 pub fn load_with_params(path: &Path, overrides: BTreeMap<String, ParamValue>) -> LoadedGraph {
-    load_overridden(path, &|p: &Path| std::fs::read_to_string(p), overrides)
+    load_overridden(path, &read_from_disk, overrides)
 }
 
 fn load_overridden(
@@ -194,8 +200,21 @@ fn load_file(
         );
         return;
     }
+    // An include outside the root graph's folder tree, or a system file, may be
+    // anything (`/proc/self/environ`): errors about it name it, never show it.
+    let private = match stack.first().and_then(|root| root.parent()) {
+        Some(root) => !weft_io::read::is_within(path, root) || weft_io::read::is_system(path),
+        None => weft_io::read::is_system(path),
+    };
     let text = match read(path) {
-        Ok(text) => text,
+        Ok(text) => {
+            if private {
+                weft_io::sources::forget(path);
+            } else {
+                weft_io::sources::remember(path, &text);
+            }
+            text
+        }
         Err(err) => {
             let (file, pos) = site_location(graph);
             let message = match &site {
@@ -217,11 +236,14 @@ fn load_file(
                 line: err.span.start.line as u32,
                 col: err.span.start.col as u32,
             };
-            graph.diagnostics.push(Diagnostic::error(
-                path,
-                pos,
-                format!("RON syntax: {}", err.code),
-            ));
+            let message = if private {
+                "RON syntax error (the file is outside the graph's folder, so its content is not shown)".to_string()
+            } else {
+                format!("RON syntax: {}", err.code)
+            };
+            graph
+                .diagnostics
+                .push(Diagnostic::error(path, pos, message));
             return;
         }
     };

@@ -1,65 +1,84 @@
 //! The BVH cached on disk beside the scene cache, so a path-traced scene
-//! whose geometry has not changed skips the build. An entry is named after a
-//! hash of the world-space triangles it was built over (FNV-1a of their
-//! bytes), and holds that hash again, the triangle count, the nodes and the
-//! leaf order. A moved model, a new instance or an edited mesh changes the
-//! triangles, hence the name: the BVH is rebuilt exactly when geometry
-//! changes. A damaged or foreign entry is a miss, never an error.
+//! whose geometry has not changed skips the build. An entry is named after
+//! the hash ([`weft_io::hash`]) of the world-space triangles it was built
+//! over, and is framed by [`weft_io::entry`] with that hash and the triangle
+//! count as its key and a checksum: a moved model, a new instance or an
+//! edited mesh changes the triangles, hence the name, so the BVH is rebuilt
+//! exactly when geometry changes; a damaged or foreign entry is a miss with a
+//! warning, never an error, and is replaced.
 //!
-//! Layout: magic, format version (u32), hash (u64), triangle count (u64),
-//! node count (u64), the nodes as the GPU reads them, the leaf order (u32
-//! each); all little endian.
+//! Payload: node count (u64), the nodes as the GPU reads them, the leaf order
+//! (u32 each); all little endian.
 
 use crate::bvh::{Bvh, GpuBvhNode};
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
-/// The first bytes of every entry.
-const MAGIC: [u8; 8] = *b"WEFTBVH\0";
+/// The entry kind of BVHs; its version is bumped whenever the builder's
+/// output or the layout changes.
+const KIND: weft_io::entry::Kind = weft_io::entry::Kind {
+    name: "bvh",
+    version: 2,
+};
 
-/// Bumped whenever the builder's output or the layout changes.
-pub const BVH_CACHE_VERSION: u32 = 1;
+/// The largest entry read (a BVH of 2^26 triangles is about 1.5 GiB).
+const MAX_ENTRY_BYTES: u64 = 4 << 30;
 
-/// FNV-1a over the triangles' coordinates, the key of their BVH.
-pub fn geometry_hash(triangles: &[[Vec3; 3]]) -> u64 {
-    bytemuck::cast_slice::<[Vec3; 3], u8>(triangles)
-        .iter()
-        .fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-        })
+/// The hash of the triangles' coordinates, the key of their BVH.
+pub fn geometry_hash(triangles: &[[Vec3; 3]]) -> u128 {
+    weft_io::hash::hash(bytemuck::cast_slice::<[Vec3; 3], u8>(triangles))
 }
 
 /// The entry file for geometry of `hash` in cache folder `dir`.
-pub fn entry_for(dir: &Path, hash: u64) -> PathBuf {
-    dir.join(format!("bvh-{hash:016x}.weftbvh"))
+pub fn entry_for(dir: &Path, hash: u128) -> PathBuf {
+    dir.join(format!("bvh-{}.weftbvh", weft_io::hash::hex(hash)))
+}
+
+/// The full key of an entry: the geometry's hash and its triangle count.
+fn key(hash: u128, triangle_count: usize) -> [u8; 24] {
+    let mut key = [0u8; 24];
+    key[..16].copy_from_slice(&hash.to_le_bytes());
+    key[16..].copy_from_slice(&(triangle_count as u64).to_le_bytes());
+    key
 }
 
 /// The BVH over `triangles`: read from `dir` when an entry for exactly these
 /// triangles is there, else built and written there (a failed write only
-/// loses the cache). Without a folder it is built.
-pub fn load_or_build(triangles: &[[Vec3; 3]], dir: Option<&Path>) -> Bvh {
+/// loses the cache). Without a folder it is built. The warning, if any, says
+/// why an entry that was there could not be used or written.
+pub fn load_or_build(triangles: &[[Vec3; 3]], dir: Option<&Path>) -> (Bvh, Option<String>) {
     let Some(dir) = dir else {
-        return Bvh::build(triangles);
+        return (Bvh::build(triangles), None);
     };
     let hash = geometry_hash(triangles);
     let entry = entry_for(dir, hash);
-    if let Some(bvh) = std::fs::read(&entry)
-        .ok()
-        .and_then(|bytes| decode(&bytes, hash, triangles.len()))
-    {
-        return bvh;
-    }
+    let key = key(hash, triangles.len());
+    let damaged = |why: &str| {
+        format!(
+            "the BVH cache entry {} is damaged ({why}); built again",
+            entry.display()
+        )
+    };
+    let mut warning = match weft_io::entry::read(&entry, KIND, &key, MAX_ENTRY_BYTES) {
+        Ok(Some(payload)) => match decode(&payload, triangles.len()) {
+            Some(bvh) => return (bvh, None),
+            None => Some(damaged("its nodes are out of range")),
+        },
+        Ok(None) => None,
+        Err(damage) => Some(damaged(&damage.to_string())),
+    };
     let bvh = Bvh::build(triangles);
-    let _ = write(dir, &entry, &encode(&bvh, hash, triangles.len()));
-    bvh
+    if let Err(e) = weft_io::entry::write(&entry, KIND, &key, &encode(&bvh)) {
+        warning = Some(format!(
+            "cannot write the BVH cache {}: {e}",
+            entry.display()
+        ));
+    }
+    (bvh, warning)
 }
 
-fn encode(bvh: &Bvh, hash: u64, triangle_count: usize) -> Vec<u8> {
-    let mut bytes = MAGIC.to_vec();
-    bytes.extend_from_slice(&BVH_CACHE_VERSION.to_le_bytes());
-    bytes.extend_from_slice(&hash.to_le_bytes());
-    bytes.extend_from_slice(&(triangle_count as u64).to_le_bytes());
-    bytes.extend_from_slice(&(bvh.nodes.len() as u64).to_le_bytes());
+fn encode(bvh: &Bvh) -> Vec<u8> {
+    let mut bytes = (bvh.nodes.len() as u64).to_le_bytes().to_vec();
     for node in &bvh.nodes {
         for v in node.min {
             bytes.extend_from_slice(&v.to_le_bytes());
@@ -97,13 +116,10 @@ impl Reader<'_> {
     }
 }
 
-/// The BVH in `bytes` when it is a current entry for `triangle_count`
-/// triangles hashing to `hash`, and every index in it is in range.
-fn decode(bytes: &[u8], hash: u64, triangle_count: usize) -> Option<Bvh> {
-    let mut r = Reader(bytes.strip_prefix(&MAGIC)?);
-    if r.u32()? != BVH_CACHE_VERSION || r.u64()? != hash || r.u64()? != triangle_count as u64 {
-        return None;
-    }
+/// The BVH in an entry's payload for `triangle_count` triangles, when every
+/// index in it is in range.
+fn decode(bytes: &[u8], triangle_count: usize) -> Option<Bvh> {
+    let mut r = Reader(bytes);
     let node_count = usize::try_from(r.u64()?).ok()?;
     if r.0.len()
         != node_count
@@ -139,14 +155,6 @@ fn decode(bytes: &[u8], hash: u64, triangle_count: usize) -> Option<Bvh> {
     sound.then_some(Bvh { nodes, triangles })
 }
 
-/// Writes an entry atomically (a temporary file renamed into place).
-fn write(dir: &Path, entry: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    std::fs::create_dir_all(dir)?;
-    let temp = entry.with_extension(format!("tmp{}", std::process::id()));
-    std::fs::write(&temp, bytes)?;
-    std::fs::rename(&temp, entry)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -173,57 +181,73 @@ mod tests {
         let dir = temp_dir("roundtrip");
         let _ = std::fs::remove_dir_all(&dir);
         let tris = triangles(0.0);
-        let built = load_or_build(&tris, Some(&dir));
+        let (built, warning) = load_or_build(&tris, Some(&dir));
+        assert_eq!(warning, None);
         let entry = entry_for(&dir, geometry_hash(&tris));
         assert!(entry.exists());
         assert_eq!(built, Bvh::build(&tris));
-        let bytes = std::fs::read(&entry).expect("entry");
-        assert_eq!(
-            decode(&bytes, geometry_hash(&tris), tris.len()),
-            Some(built.clone())
-        );
-        assert_eq!(load_or_build(&tris, Some(&dir)), built);
+        assert_eq!(load_or_build(&tris, Some(&dir)), (built.clone(), None));
         let moved = triangles(0.5);
         assert_ne!(geometry_hash(&moved), geometry_hash(&tris));
-        assert_eq!(decode(&bytes, geometry_hash(&moved), moved.len()), None);
-        assert_eq!(load_or_build(&moved, Some(&dir)), Bvh::build(&moved));
+        assert_eq!(
+            load_or_build(&moved, Some(&dir)),
+            (Bvh::build(&moved), None)
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
-    fn damaged_entries_are_misses() {
+    fn damaged_entries_are_rebuilt_with_a_warning_and_replaced() {
         let tris = triangles(1.0);
         let bvh = Bvh::build(&tris);
-        let hash = geometry_hash(&tris);
-        let bytes = encode(&bvh, hash, tris.len());
+        let payload = encode(&bvh);
+        assert_eq!(decode(&payload, tris.len()), Some(bvh.clone()));
         assert_eq!(
-            decode(&bytes[..bytes.len() - 1], hash, tris.len()),
+            decode(&payload[..payload.len() - 1], tris.len()),
             None,
             "truncated"
         );
-        let mut versioned = bytes.clone();
-        versioned[8..12].copy_from_slice(&(BVH_CACHE_VERSION + 1).to_le_bytes());
-        assert_eq!(
-            decode(&versioned, hash, tris.len()),
-            None,
-            "another version"
-        );
-        let mut wild = bytes.clone();
+        let mut wild = payload.clone();
         // The root's `first` pointing past the nodes.
-        let at = 8 + 4 + 8 + 8 + 8 + 12;
+        let at = 8 + 12;
         wild[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
-        assert_eq!(
-            decode(&wild, hash, tris.len()),
-            None,
-            "an index out of range"
-        );
-        // A damaged entry in the folder is rebuilt and replaced.
+        assert_eq!(decode(&wild, tris.len()), None, "an index out of range");
+
         let dir = temp_dir("damaged");
         let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("dir");
-        std::fs::write(entry_for(&dir, hash), &bytes[..40]).expect("write");
-        assert_eq!(load_or_build(&tris, Some(&dir)), bvh);
-        assert_eq!(std::fs::read(entry_for(&dir, hash)).expect("entry"), bytes);
+        let entry = entry_for(&dir, geometry_hash(&tris));
+        load_or_build(&tris, Some(&dir));
+        let good = std::fs::read(&entry).expect("entry");
+        let other = triangles(2.0);
+        load_or_build(&other, Some(&dir));
+        let foreign = std::fs::read(entry_for(&dir, geometry_hash(&other))).expect("entry");
+        let mut flipped = good.clone();
+        let last = flipped.len() - 1;
+        flipped[last] ^= 1;
+        for (why, bytes) in [
+            ("truncated", good[..good.len() - 9].to_vec()),
+            ("checksum", flipped),
+            ("stored for another input", foreign),
+            ("not a weft cache entry", Vec::new()),
+        ] {
+            std::fs::write(&entry, &bytes).expect("damage");
+            let (read, warning) = load_or_build(&tris, Some(&dir));
+            assert_eq!(read, bvh, "{why}");
+            assert!(
+                warning.as_deref().is_some_and(|w| w.contains(why)),
+                "{why}: {warning:?}"
+            );
+            assert_eq!(
+                std::fs::read(&entry).expect("entry"),
+                good,
+                "{why}: replaced"
+            );
+        }
+        std::fs::remove_file(&entry).expect("rm");
+        std::os::unix::fs::symlink("/dev/zero", &entry).expect("link");
+        let (read, warning) = load_or_build(&tris, Some(&dir));
+        assert_eq!(read, bvh);
+        assert!(warning.is_some_and(|w| w.contains("it is a device")));
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

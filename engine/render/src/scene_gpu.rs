@@ -454,9 +454,10 @@ impl<'g> GpuScene<'g> {
             if let Some(&i) = by_source.get(&key) {
                 return Ok(i);
             }
-            let i = match texture::decode(&t.source) {
-                Ok(pixels) => {
-                    textures.push(Texture::upload(gpu, &key.0, &pixels, srgb)?);
+            let i = match texture::decode(&t.source, gpu.info().max_image_dimension) {
+                Ok(decoded) => {
+                    warnings.extend(decoded.warning);
+                    textures.push(Texture::upload(gpu, &key.0, &decoded.image, srgb)?);
                     textures.len() - 1
                 }
                 Err(e) => {
@@ -639,7 +640,8 @@ impl<'g> GpuScene<'g> {
         let mesh = self.geometry.trace_mesh();
         // Placements a script moves give new geometry each frame: not cached.
         let cache = self.bvh_cache.as_deref().filter(|_| !self.moved);
-        let bvh = crate::bvh_cache::load_or_build(&mesh.corners, cache);
+        let (bvh, cache_warning) = crate::bvh_cache::load_or_build(&mesh.corners, cache);
+        self.warnings.extend(cache_warning);
         let corners: Vec<[f32; 4]> = mesh
             .corners
             .iter()

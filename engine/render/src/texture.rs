@@ -1,25 +1,69 @@
 //! Material textures from files or embedded bytes, decoded to RGBA8 for
-//! upload (`weft_gpu::texture::Texture`).
+//! upload (`weft_gpu::texture::Texture`). Files are read through weft's one
+//! reader; an image with a side over the device's `maxImageDimension2D` is
+//! downscaled here, with a warning, and never reaches the driver.
 
 use crate::error::RenderError;
 use weft_gpu::texture::Rgba8Image;
 use weft_scene::material::TextureSource;
 
-/// Decodes a texture's image file or embedded bytes.
-pub fn decode(source: &TextureSource) -> Result<Rgba8Image, RenderError> {
-    let (path, result) = match source {
-        TextureSource::File(path) => (path.clone(), image::open(path)),
-        TextureSource::Embedded { id, bytes, .. } => (id.into(), image::load_from_memory(bytes)),
+/// The largest texture file read.
+const MAX_TEXTURE_FILE_BYTES: u64 = 1 << 30;
+
+/// A decoded texture and, when it had to be downscaled, why.
+pub struct Decoded {
+    /// The pixels, at most the asked side.
+    pub image: Rgba8Image,
+    /// Why the image was downscaled, when it was.
+    pub warning: Option<String>,
+}
+
+/// Decodes a texture's image file or embedded bytes, downscaled (keeping its
+/// aspect, each side at least 1) so neither side exceeds `max_side`.
+pub fn decode(source: &TextureSource, max_side: u32) -> Result<Decoded, RenderError> {
+    let (name, bytes) = match source {
+        TextureSource::File(path) => (
+            path.clone(),
+            weft_io::read_capped(path, MAX_TEXTURE_FILE_BYTES)
+                .map_err(|e| RenderError::Texture {
+                    path: path.clone(),
+                    message: e.reason(),
+                })?
+                .into(),
+        ),
+        TextureSource::Embedded { id, bytes, .. } => {
+            (id.into(), std::borrow::Cow::from(&bytes[..]))
+        }
     };
-    let img = result
+    let img = image::load_from_memory(&bytes)
         .map_err(|e| RenderError::Texture {
-            path,
+            path: name.clone(),
             message: e.to_string(),
         })?
         .to_rgba8();
-    Ok(Rgba8Image {
-        width: img.width(),
-        height: img.height(),
-        rgba: img.into_raw(),
+    let (width, height) = img.dimensions();
+    let (fit_width, fit_height) = weft_scene::material::fit_within(width, height, max_side);
+    let (img, warning) = if (fit_width, fit_height) == (width, height) {
+        (img, None)
+    } else {
+        let smaller = image::imageops::resize(
+            &img,
+            fit_width,
+            fit_height,
+            image::imageops::FilterType::Triangle,
+        );
+        let warning = format!(
+            "texture {} is {width}x{height}, over the device's maxImageDimension2D of {max_side}: downscaled to {fit_width}x{fit_height}",
+            name.display()
+        );
+        (smaller, Some(warning))
+    };
+    Ok(Decoded {
+        image: Rgba8Image {
+            width: img.width(),
+            height: img.height(),
+            rgba: img.into_raw(),
+        },
+        warning,
     })
 }

@@ -100,8 +100,11 @@ pub fn gather(materials: &[Material]) -> TraceTextures {
         if let Some(&s) = placed.get(&key) {
             return s;
         }
-        let s = match decode(&t.source) {
-            Ok(image) => {
+        // Every texture is resampled to one of the fixed classes below, so any
+        // size decodes; the cap only bounds the memory of the decoded copy.
+        let s = match decode(&t.source, weft_scene::material::MAX_TEXTURE_SIDE) {
+            Ok(decoded) => {
+                let image = decoded.image;
                 let class = class_of(image.width, image.height);
                 let layers = if colour {
                     &mut out.colour[class]

@@ -4,9 +4,11 @@
 //! the same size and modification time as when the entry was written; otherwise the model is
 //! imported again and the entry rewritten. A damaged entry is a miss, never an error.
 //!
-//! An entry is the magic bytes, the format version (u32, little endian), then two
-//! postcard messages: the header (source stamps and the import's warnings), read
-//! first so a stale entry costs no model decoding, and the model.
+//! An entry is framed by [`weft_io::entry`] (format version, the model's absolute
+//! path as its key, a checksum), so a damaged entry, or one copied onto another
+//! model's name, is a miss with a warning. Its payload is two postcard messages:
+//! the header (source stamps and the import's warnings), read first so a stale
+//! entry costs no model decoding, and the model.
 
 use crate::error::{Diagnostics, Location, SceneError, Warning};
 use crate::model::Model;
@@ -15,10 +17,7 @@ use std::path::{Path, PathBuf};
 use std::time::UNIX_EPOCH;
 
 /// Bumped whenever the encoding or the importers' output changes; older entries are ignored.
-pub const CACHE_FORMAT_VERSION: u32 = 9;
-
-/// The first bytes of every entry.
-const MAGIC: [u8; 8] = *b"WEFTMDL\0";
+pub const CACHE_FORMAT_VERSION: u32 = 10;
 
 /// What a source file looked like when the entry was written.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -67,13 +66,6 @@ pub fn user_cache_dir() -> Option<PathBuf> {
         .or_else(|| var("HOME").map(|d| d.join(".cache").join("weft")))
 }
 
-/// The 64-bit FNV-1a hash, to name entries after the model's absolute path.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
-}
-
 /// The entry file for a model in cache folder `dir`.
 pub fn cache_file_for(dir: &Path, model: &Path) -> PathBuf {
     let absolute = std::path::absolute(model).unwrap_or_else(|_| model.to_path_buf());
@@ -82,13 +74,14 @@ pub fn cache_file_for(dir: &Path, model: &Path) -> PathBuf {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     dir.join(format!(
-        "{name}-{:016x}.weftcache",
-        fnv1a(absolute.to_string_lossy().as_bytes())
+        "{name}-{}.weftcache",
+        weft_io::hash::hex(weft_io::hash::hash(absolute.to_string_lossy().as_bytes()))
     ))
 }
 
 /// Returns the cached model for `path` when its entry is current; otherwise runs `import`,
 /// writes a new entry, and returns its result. Warnings of the import are stored and replayed.
+/// A damaged entry, or one stored for another model, is a miss with a warning.
 pub(crate) fn load_cached(
     path: &Path,
     cache_dir: Option<&Path>,
@@ -99,15 +92,24 @@ pub(crate) fn load_cached(
         return import(diag);
     };
     let entry = cache_file_for(dir, path);
-    if let Some((mut model, warnings)) = std::fs::read(&entry).ok().and_then(|b| decode(&b)) {
-        model.path = path.to_path_buf();
-        diag.warnings.extend(warnings);
-        return Ok(model);
+    let key = entry_key(path);
+    match weft_io::entry::read(&entry, KIND, key.as_bytes(), crate::source::MAX_MODEL_BYTES) {
+        Ok(Some(payload)) => match decode(&payload) {
+            Decoded::Current(mut model, warnings) => {
+                model.path = path.to_path_buf();
+                diag.warnings.extend(warnings);
+                return Ok(model);
+            }
+            Decoded::Stale => {}
+            Decoded::Damaged => damaged(diag, &entry, path, "its model does not decode"),
+        },
+        Ok(None) => {}
+        Err(damage) => damaged(diag, &entry, path, &damage.to_string()),
     }
     let first = diag.warnings.len();
     let model = import(diag)?;
     let warnings = diag.warnings[first..].to_vec();
-    if let Err(e) = write_entry(dir, &entry, &model, &warnings) {
+    if let Err(e) = write_entry(&entry, &key, &model, &warnings) {
         diag.warn(
             Location::file(&entry),
             format!("cannot write the model cache: {e}"),
@@ -116,33 +118,67 @@ pub(crate) fn load_cached(
     Ok(model)
 }
 
-/// Decodes an entry, `None` when it is damaged, of another version, or stale.
-fn decode(bytes: &[u8]) -> Option<(Model, Vec<Warning>)> {
-    let rest = bytes.strip_prefix(&MAGIC)?;
-    let (version, rest) = rest.split_first_chunk::<4>()?;
-    if u32::from_le_bytes(*version) != CACHE_FORMAT_VERSION {
-        return None;
-    }
-    let (header, rest) = postcard::take_from_bytes::<Header>(rest).ok()?;
+/// The entry kind of imported models ([`weft_io::entry`]).
+const KIND: weft_io::entry::Kind = weft_io::entry::Kind {
+    name: "model",
+    version: CACHE_FORMAT_VERSION,
+};
+
+/// The full key an entry is stored under: the model's absolute path.
+fn entry_key(model: &Path) -> String {
+    std::path::absolute(model)
+        .unwrap_or_else(|_| model.to_path_buf())
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn damaged(diag: &mut Diagnostics, entry: &Path, model: &Path, why: &str) {
+    diag.warn(
+        Location::file(entry),
+        format!(
+            "the model cache entry for {} is damaged ({why}); imported again",
+            model.display()
+        ),
+    );
+}
+
+/// What an entry's payload holds.
+enum Decoded {
+    Current(Model, Vec<Warning>),
+    /// A source file changed since the entry was written: an ordinary miss.
+    Stale,
+    Damaged,
+}
+
+/// Decodes an entry's payload: the header, then (when every source is unchanged) the model.
+fn decode(bytes: &[u8]) -> Decoded {
+    let Ok((header, rest)) = postcard::take_from_bytes::<Header>(bytes) else {
+        return Decoded::Damaged;
+    };
     if header.stamps.iter().any(|s| Stamp::of(&s.path) != *s) {
-        return None;
+        return Decoded::Stale;
     }
-    let (model, rest) = postcard::take_from_bytes::<Model>(rest).ok()?;
+    let Ok((model, rest)) = postcard::take_from_bytes::<Model>(rest) else {
+        return Decoded::Damaged;
+    };
     let sound = model
         .meshes
         .iter()
         .all(|m| m.is_consistent() && m.material.is_none_or(|i| i < model.materials.len()));
-    (rest.is_empty() && sound).then_some((model, header.warnings))
+    if rest.is_empty() && sound {
+        Decoded::Current(model, header.warnings)
+    } else {
+        Decoded::Damaged
+    }
 }
 
-/// Writes an entry atomically (a temporary file renamed into place).
+/// Writes an entry atomically ([`weft_io::entry::write`]).
 fn write_entry(
-    dir: &Path,
     entry: &Path,
+    key: &str,
     model: &Model,
     warnings: &[Warning],
 ) -> std::io::Result<()> {
-    std::fs::create_dir_all(dir)?;
     let header = Header {
         // Absolute paths, so an entry stays valid when read from another working folder.
         stamps: model
@@ -152,14 +188,10 @@ fn write_entry(
             .collect(),
         warnings: warnings.to_vec(),
     };
-    let mut bytes = MAGIC.to_vec();
-    bytes.extend_from_slice(&CACHE_FORMAT_VERSION.to_le_bytes());
     let encode = |e: postcard::Error| std::io::Error::other(e.to_string());
-    bytes = postcard::to_extend(&header, bytes).map_err(encode)?;
-    bytes = postcard::to_extend(model, bytes).map_err(encode)?;
-    let temp = entry.with_extension(format!("tmp{}", std::process::id()));
-    std::fs::write(&temp, &bytes)?;
-    std::fs::rename(&temp, entry)
+    let mut payload = postcard::to_extend(&header, Vec::new()).map_err(encode)?;
+    payload = postcard::to_extend(model, payload).map_err(encode)?;
+    weft_io::entry::write(entry, KIND, key.as_bytes(), &payload)
 }
 
 #[cfg(test)]
@@ -199,7 +231,11 @@ mod tests {
                 Ok(model(&src, name))
             })
             .expect("loads");
-            assert_eq!(diag.warnings.len(), 1);
+            assert_eq!(
+                diag.warnings.iter().filter(|w| w.message == "w").count(),
+                1,
+                "the import's warning, stored and replayed"
+            );
             m.materials[0].name.clone()
         };
         assert_eq!(load("first", &mut calls), "first");
@@ -215,7 +251,7 @@ mod tests {
         // Another format version is a miss.
         let entry = cache_file_for(&cache, &src);
         let mut bytes = std::fs::read(&entry).expect("entry");
-        bytes[8..12].copy_from_slice(&(CACHE_FORMAT_VERSION + 1).to_le_bytes());
+        bytes[16..20].copy_from_slice(&(CACHE_FORMAT_VERSION + 1).to_le_bytes());
         std::fs::write(&entry, &bytes).expect("write");
         assert_eq!(load("fifth", &mut calls), "fifth");
         // Damage anywhere is a miss, never a panic.
@@ -225,6 +261,57 @@ mod tests {
             assert_eq!(load("again", &mut calls), "again");
         }
         assert_eq!(calls, 9);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn swapped_or_device_entries_are_misses_with_a_warning() {
+        let dir = std::env::temp_dir().join(format!("weft-cache-swap-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("dir");
+        let cache = dir.join("cache");
+        let (bunny, dragon) = (dir.join("bunny.obj"), dir.join("dragon.obj"));
+        std::fs::write(&bunny, "v 0 0 0\n").expect("write");
+        std::fs::write(&dragon, "v 1 1 1\n").expect("write");
+        let load = |src: &Path, name: &str| {
+            let mut diag = Diagnostics::default();
+            let m =
+                load_cached(src, Some(&cache), &mut diag, |_| Ok(model(src, name))).expect("loads");
+            let warnings: Vec<String> = diag.warnings.iter().map(|w| w.message.clone()).collect();
+            (m.materials[0].name.clone(), warnings)
+        };
+        load(&bunny, "bunny");
+        load(&dragon, "dragon");
+        let (b, d) = (
+            cache_file_for(&cache, &bunny),
+            cache_file_for(&cache, &dragon),
+        );
+        let (b_bytes, d_bytes) = (std::fs::read(&b).expect("b"), std::fs::read(&d).expect("d"));
+        std::fs::write(&b, &d_bytes).expect("swap");
+        std::fs::write(&d, &b_bytes).expect("swap");
+        let (name, warnings) = load(&bunny, "bunny again");
+        assert_eq!(name, "bunny again", "never the dragon");
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(
+            warnings[0]
+                .contains("bunny.obj is damaged (it was stored for another input); imported again"),
+            "{warnings:?}"
+        );
+        assert_eq!(
+            load(&bunny, "unused").0,
+            "bunny again",
+            "the entry was rewritten"
+        );
+        std::fs::remove_file(&d).expect("rm");
+        std::os::unix::fs::symlink("/dev/zero", &d).expect("link");
+        let (name, warnings) = load(&dragon, "dragon again");
+        assert_eq!(name, "dragon again");
+        assert!(warnings[0].contains("(it is a device)"), "{warnings:?}");
+        assert_eq!(
+            load(&dragon, "unused").0,
+            "dragon again",
+            "the link was replaced"
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

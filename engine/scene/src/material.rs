@@ -275,3 +275,51 @@ impl Default for Material {
         }
     }
 }
+
+/// The largest side, in texels, of a texture weft uploads when no device says
+/// otherwise: `maxImageDimension2D` of lavapipe and of desktop GPUs. A larger
+/// image is downscaled to fit ([`fit_within`]); `weft scene check` reports it.
+pub const MAX_TEXTURE_SIDE: u32 = 16384;
+
+/// The size of a `width`×`height` image scaled down, keeping its aspect, so
+/// neither side exceeds `max_side` (each side at least 1); the size itself
+/// when it fits.
+pub fn fit_within(width: u32, height: u32, max_side: u32) -> (u32, u32) {
+    let longest = width.max(height);
+    if longest <= max_side || max_side == 0 {
+        return (width, height);
+    }
+    let scale = |side: u32| {
+        ((u64::from(side) * u64::from(max_side) + u64::from(longest) / 2) / u64::from(longest))
+            .clamp(1, u64::from(max_side)) as u32
+    };
+    (scale(width), scale(height))
+}
+
+/// The width and height an image file or embedded image declares, read from
+/// its header alone; `None` when it cannot be read or decoded.
+pub fn declared_size(source: &TextureSource) -> Option<(u32, u32)> {
+    let bytes: std::borrow::Cow<[u8]> = match source {
+        TextureSource::File(path) => weft_io::read_capped(path, 1 << 30).ok()?.into(),
+        TextureSource::Embedded { bytes, .. } => (&bytes[..]).into(),
+    };
+    image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+        .with_guessed_format()
+        .ok()?
+        .into_dimensions()
+        .ok()
+}
+
+#[cfg(test)]
+mod fit_tests {
+    use super::fit_within;
+
+    #[test]
+    fn oversized_images_fit_keeping_their_aspect() {
+        assert_eq!(fit_within(65536, 1, 16384), (16384, 1));
+        assert_eq!(fit_within(1, 32768, 16384), (1, 16384));
+        assert_eq!(fit_within(20000, 10000, 16384), (16384, 8192));
+        assert_eq!(fit_within(4096, 4096, 16384), (4096, 4096));
+        assert_eq!(fit_within(16384, 3, 16384), (16384, 3));
+    }
+}

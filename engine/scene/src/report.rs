@@ -1,10 +1,10 @@
 //! `weft scene check`: a summary of a loaded scene for people (`Display`) and tools (serde).
 
 use crate::bounds::Aabb;
-use crate::error::{SceneError, Warning};
+use crate::error::{Location, SceneError, Warning};
 use crate::light::{energy_cut_share, Light, RadiusSource};
 use crate::load::{load_scene_with, LoadOptions};
-use crate::material::TextureSource;
+use crate::material::{declared_size, fit_within, TextureSource, MAX_TEXTURE_SIDE};
 use crate::scene::Scene;
 use serde::Serialize;
 use std::collections::BTreeSet;
@@ -186,9 +186,48 @@ impl SceneReport {
                 max: (scene.bounds.max.as_dvec3() + scene.origin).as_vec3(),
             }),
             origin: scene.origin.to_array(),
-            warnings: scene.warnings.clone(),
+            warnings: scene
+                .warnings
+                .iter()
+                .cloned()
+                .chain(oversized_textures(scene))
+                .collect(),
         }
     }
+}
+
+/// A warning for each distinct texture with a side over [`MAX_TEXTURE_SIDE`],
+/// which the renderer downscales before upload.
+fn oversized_textures(scene: &Scene) -> Vec<Warning> {
+    let mut seen = BTreeSet::new();
+    let mut warnings = Vec::new();
+    for texture in scene
+        .models
+        .iter()
+        .flat_map(|m| m.materials.iter())
+        .flat_map(|mat| mat.textures.iter())
+    {
+        if !seen.insert(texture_key(&texture.source)) {
+            continue;
+        }
+        let Some((width, height)) = declared_size(&texture.source) else {
+            continue;
+        };
+        let (fit_width, fit_height) = fit_within(width, height, MAX_TEXTURE_SIDE);
+        if (fit_width, fit_height) != (width, height) {
+            let at = match &texture.source {
+                TextureSource::File(path) => Location::file(path),
+                TextureSource::Embedded { id, .. } => Location::file(Path::new(id)),
+            };
+            warnings.push(Warning {
+                at,
+                message: format!(
+                    "texture is {width}x{height}, over {MAX_TEXTURE_SIDE} texels per side (maxImageDimension2D): it is downscaled to {fit_width}x{fit_height} before upload"
+                ),
+            });
+        }
+    }
+    warnings
 }
 
 impl fmt::Display for SceneReport {

@@ -34,7 +34,6 @@ use crate::model::Model;
 use crate::rng::Rng;
 use crate::scene::Scene;
 use glam::{DVec3, Mat4, Vec3};
-use rhai::module_resolvers::FileModuleResolver;
 use rhai::{
     Array, CallFnOptions, Dynamic, Engine, EvalAltResult, Map, Module, ModuleResolver,
     NativeCallContext, Position, Scope, Shared as RhaiShared, AST, FLOAT, INT,
@@ -235,41 +234,124 @@ fn position_at(script: &Path, position: Position) -> Location {
     }
 }
 
-/// `import` for scripts under one folder only; records what it read.
+/// How deeply imports may nest (a script importing one that imports another…).
+pub const MAX_IMPORT_DEPTH: usize = 16;
+
+/// `import` for scripts under one folder only, read through weft's one
+/// reader; records what it read, and refuses an import cycle (which would
+/// otherwise recurse until the stack overflows) naming the chain.
 struct FolderResolver {
     root: PathBuf,
-    files: FileModuleResolver,
     read: Arc<Mutex<Vec<PathBuf>>>,
+    /// The scripts being evaluated, outermost (the scene's script) first.
+    resolving: Mutex<Vec<PathBuf>>,
+    /// Modules already evaluated, by file, so a script imported by several
+    /// (or inside `update`) is read and run once.
+    modules: Mutex<HashMap<PathBuf, RhaiShared<Module>>>,
+}
+
+impl FolderResolver {
+    fn new(root: PathBuf, script: &Path, read: Arc<Mutex<Vec<PathBuf>>>) -> Self {
+        let script = script
+            .canonicalize()
+            .unwrap_or_else(|_| script.to_path_buf());
+        Self {
+            root,
+            read,
+            resolving: Mutex::new(vec![script]),
+            modules: Mutex::new(HashMap::new()),
+        }
+    }
+
+    /// Reads, compiles and runs one imported file.
+    fn evaluate(
+        &self,
+        engine: &Engine,
+        file: &Path,
+        path: &str,
+        position: Position,
+    ) -> Result<RhaiShared<Module>, Box<EvalAltResult>> {
+        let text =
+            crate::source::read_text(file, &Location::file(file), crate::source::MAX_SCENE_BYTES)
+                .map_err(|e| {
+                EvalAltResult::ErrorRuntime(format!("import \"{path}\": {e}").into(), position)
+            })?;
+        let in_module = |e: Box<EvalAltResult>| {
+            Box::new(EvalAltResult::ErrorInModule(path.to_string(), e, position))
+        };
+        let mut ast = engine.compile(&text).map_err(|e| in_module(e.into()))?;
+        ast.set_source(file.to_string_lossy().as_ref());
+        let module = Module::eval_ast_as_new(Scope::new(), &ast, engine).map_err(in_module)?;
+        Ok(module.into())
+    }
 }
 
 impl ModuleResolver for FolderResolver {
     fn resolve(
         &self,
         engine: &Engine,
-        source: Option<&str>,
+        _source: Option<&str>,
         path: &str,
         position: Position,
     ) -> Result<RhaiShared<Module>, Box<EvalAltResult>> {
+        let refuse =
+            |message: String| Err(EvalAltResult::ErrorRuntime(message.into(), position).into());
         let file = self.root.join(format!("{path}.rhai"));
-        let inside = file.canonicalize().is_ok_and(|f| f.starts_with(&self.root));
-        if inside {
+        let Some(canonical) = file
+            .canonicalize()
+            .ok()
+            .filter(|f| f.starts_with(&self.root))
+        else {
+            return refuse(format!(
+                "import \"{path}\": scripts may import only scripts under {}",
+                self.root.display()
+            ));
+        };
+        {
             let mut read = self.read.lock().unwrap_or_else(|p| p.into_inner());
             if !read.contains(&file) {
                 read.push(file.clone());
             }
-        } else {
-            return Err(EvalAltResult::ErrorRuntime(
-                format!(
-                    "import \"{path}\": scripts may import only scripts under {}",
-                    self.root.display()
-                )
-                .into(),
-                position,
-            )
-            .into());
         }
-        self.files.resolve(engine, source, path, position)
+        if let Some(module) = lock_any(&self.modules).get(&canonical) {
+            return Ok(module.clone());
+        }
+        {
+            let mut resolving = lock_any(&self.resolving);
+            if let Some(first) = resolving.iter().position(|f| *f == canonical) {
+                let chain: Vec<String> = resolving[first..]
+                    .iter()
+                    .chain(std::iter::once(&canonical))
+                    .map(|f| {
+                        f.file_name()
+                            .unwrap_or_default()
+                            .to_string_lossy()
+                            .into_owned()
+                    })
+                    .collect();
+                return refuse(format!(
+                    "import \"{path}\" is a cycle: {}",
+                    chain.join(" -> ")
+                ));
+            }
+            if resolving.len() > MAX_IMPORT_DEPTH {
+                return refuse(format!(
+                    "import \"{path}\": imports nest deeper than {MAX_IMPORT_DEPTH} scripts"
+                ));
+            }
+            resolving.push(canonical.clone());
+        }
+        let module = self.evaluate(engine, &file, path, position);
+        lock_any(&self.resolving).pop();
+        let module = module?;
+        lock_any(&self.modules).insert(canonical, module.clone());
+        Ok(module)
     }
+}
+
+/// A mutex's value, also after a panic elsewhere poisoned it.
+fn lock_any<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(|p| p.into_inner())
 }
 
 /// A number from a script value (integers and floats alike).
@@ -778,11 +860,7 @@ fn engine_for(
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     let root = root.canonicalize().unwrap_or_else(|_| root.to_path_buf());
-    engine.set_module_resolver(FolderResolver {
-        files: FileModuleResolver::new_with_path(&root),
-        root,
-        read: imports.clone(),
-    });
+    engine.set_module_resolver(FolderResolver::new(root, script, imports.clone()));
     engine.on_print(|_| {});
     engine.on_debug(|_, _, _| {});
     register(&mut engine, state, origin);
@@ -1415,6 +1493,67 @@ mod tests {
             "{error}"
         );
         std::fs::remove_file(dir.join("../outside.rhai")).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn import_cycles_are_located_errors_naming_the_chain() {
+        let dir = folder(
+            "import-cycle",
+            &[
+                ("scene.rhai", "import \"self\" as s;"),
+                ("self.rhai", "import \"self\" as p;\nfn f() { 1 }"),
+            ],
+        );
+        let error = load(&dir, &Limits::default())
+            .expect_err("a file importing itself")
+            .to_string();
+        assert!(
+            error.contains("import \"self\" is a cycle: self.rhai -> self.rhai"),
+            "{error}"
+        );
+        assert!(
+            error.contains("scene.rhai:1:8: "),
+            "located at the scene script's import: {error}"
+        );
+        std::fs::write(dir.join("scene.rhai"), "import \"a\" as a;").unwrap();
+        std::fs::write(dir.join("a.rhai"), "import \"b\" as b;").unwrap();
+        std::fs::write(dir.join("b.rhai"), "import \"a\" as a;").unwrap();
+        let error = load(&dir, &Limits::default())
+            .expect_err("two files importing each other")
+            .to_string();
+        assert!(
+            error.contains("is a cycle: a.rhai -> b.rhai -> a.rhai"),
+            "{error}"
+        );
+        std::fs::write(dir.join("scene.rhai"), "import \"scene\" as s;").unwrap();
+        let error = load(&dir, &Limits::default())
+            .expect_err("the scene's script importing itself")
+            .to_string();
+        assert!(
+            error.contains("is a cycle: scene.rhai -> scene.rhai"),
+            "{error}"
+        );
+        // The same module imported twice, not in a cycle, is fine.
+        std::fs::write(dir.join("scene.rhai"), "import \"c\" as c1;\nimport \"c\" as c2;\npoint_light(#{ color: [c1::v(), c2::v(), 1.0] });").unwrap();
+        std::fs::write(dir.join("c.rhai"), "fn v() { 0.5 }").unwrap();
+        let desc = load(&dir, &Limits::default()).expect("no cycle");
+        assert_eq!(point(&desc.lights[0]).color, Vec3::new(0.5, 0.5, 1.0));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn an_import_of_a_fifo_is_refused_without_waiting() {
+        let dir = folder("import-fifo", &[("scene.rhai", "import \"pipe\" as p;")]);
+        let made = std::process::Command::new("mkfifo")
+            .arg(dir.join("pipe.rhai"))
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let error = load(&dir, &Limits::default())
+            .expect_err("a FIFO is no script")
+            .to_string();
+        assert!(error.contains("is a FIFO, not a regular file"), "{error}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -1,0 +1,38 @@
+//! The one way these tests run `weft`: the built binary, in a given folder, with
+//! a user cache of this test process's own (`WEFT_CACHE_DIR`), so results never
+//! depend on what the user's `~/.cache/weft` holds.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+/// The repository root.
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// This process's user cache folder, emptied once when first asked for.
+pub fn user_cache() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = std::env::temp_dir().join(format!("weft-cli-cache-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("temp cache dir");
+        dir
+    })
+}
+
+/// `weft ARGS` run in `dir`, not yet started; `.env("WEFT_CACHE_DIR", ..)` may replace the cache.
+pub fn command_in(dir: &Path, args: &[&str]) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_weft"));
+    command
+        .args(args)
+        .current_dir(dir)
+        .env("WEFT_CACHE_DIR", user_cache());
+    command
+}
+
+/// Runs `weft ARGS` in the repository and waits for it.
+pub fn weft(args: &[&str]) -> Output {
+    command_in(&repo(), args).output().expect("weft runs")
+}

@@ -1,0 +1,297 @@
+//! `weft render` as a user runs it: device and output path printed, the image
+//! written at the requested size, validation clean, bad input reported.
+
+use crate::harness::{repo, weft};
+use std::path::{Path, PathBuf};
+
+fn temp_png(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("weft-render-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir.join(name)
+}
+
+#[test]
+fn renders_the_demo_through_deferred_with_validation_and_json() {
+    let out_path = temp_png("demo.png");
+    let out_arg = out_path.to_string_lossy().into_owned();
+    let out = weft(&[
+        "render",
+        "scenes/demo.scene",
+        "--graph",
+        "graphs/deferred.ron",
+        "--size",
+        "64x36",
+        "--frames",
+        "2",
+        "--camera",
+        "closeup",
+        "--validate",
+        "--json",
+        "--out",
+        &out_arg,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(json["camera"], "closeup");
+    assert_eq!(json["size"], serde_json::json!([64, 36]));
+    assert_eq!(json["frames"], 2);
+    assert_eq!(json["validation"]["errors"], 0);
+    assert_eq!(json["validation"]["warnings"], 0);
+    assert_eq!(json["passes"][1], "gbuffer");
+    let image = image_size(&out_path);
+    assert_eq!(image, (64, 36));
+}
+
+#[test]
+fn prints_the_device_and_where_the_image_went() {
+    let out_path = temp_png("text.png");
+    let out_arg = out_path.to_string_lossy().into_owned();
+    let out = weft(&[
+        "render",
+        "scenes/demo.scene",
+        "--size",
+        "32x18",
+        "--features",
+        "!bloom",
+        "--timings",
+        "cpu",
+        "--out",
+        &out_arg,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("device: "), "{text}");
+    assert!(text.contains(&format!("wrote {out_arg}")), "{text}");
+    assert!(text.contains("cpu wall (submit+wait)"), "{text}");
+    assert!(text.contains("shadow_sun -> forward -> tonemap"), "{text}");
+}
+
+#[test]
+fn unknown_camera_and_bad_output_name_fail_with_a_message() {
+    let out = weft(&[
+        "render",
+        "scenes/demo.scene",
+        "--camera",
+        "nope",
+        "--size",
+        "8x8",
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no camera named \"nope\"; the scene has: front, closeup, flythrough"),
+        "{err}"
+    );
+    let out = weft(&["render", "scenes/demo.scene", "--out", "x.jpg"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("use a .png or .exr file name"));
+}
+
+/// Width and height from a PNG's IHDR chunk.
+fn image_size(path: &Path) -> (u32, u32) {
+    let bytes = std::fs::read(path).expect("png written");
+    assert_eq!(&bytes[1..4], b"PNG");
+    let word =
+        |at: usize| u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    (word(16), word(20))
+}
+
+#[test]
+fn bad_times_frame_counts_and_feature_names_are_refused() {
+    let cases: [(&[&str], &str); 5] = [
+        (&["--time", "NaN"], "time must be a finite number of seconds, found \"NaN\""),
+        (&["--time", "inf"], "time must be a finite number of seconds, found \"inf\""),
+        (&["--frames", "0"], "invalid value '0' for '--frames <FRAMES>'"),
+        (
+            &["--features", "blom"],
+            "error: --features: unknown feature \"blom\" (did you mean \"bloom\"?); this graph's features are: ",
+        ),
+        (
+            &["--features", "!shadow_caster"],
+            "unknown feature \"shadow_caster\" (did you mean \"shadow_casters\"?)",
+        ),
+    ];
+    for (extra, expected) in cases {
+        let mut args = vec!["render", "scenes/demo.scene", "--size", "8x8"];
+        args.extend_from_slice(extra);
+        let out = weft(&args);
+        assert_eq!(
+            out.status.code(),
+            Some(if extra[0] == "--features" { 1 } else { 2 }),
+            "{extra:?}"
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(expected), "{extra:?}: {err}");
+    }
+}
+
+#[test]
+fn more_light_volumes_than_the_limit_are_refused_at_the_pass() {
+    let dir = std::env::temp_dir().join(format!("weft-volumes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let scene = dir.join("many.scene");
+    std::fs::write(
+        &scene,
+        "pointlights\n{\n count 65537\n min -1 -1 -1\n max 1 1 1\n radius 0.1 0.2\n}\ncamera\n{\n position 0 0 4\n target 0 0 0\n}\n",
+    )
+    .expect("scene");
+    let out = weft(&[
+        "render",
+        scene.to_str().expect("utf-8"),
+        "--graph",
+        "graphs/deferred.ron",
+        "--size",
+        "16x16",
+        "--out",
+        dir.join("o.png").to_str().expect("utf-8"),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let line = std::fs::read_to_string(repo().join("graphs/deferred.ron"))
+        .expect("graph")
+        .lines()
+        .position(|l| l.contains("name: \"point_lights\""))
+        .expect("the pass")
+        + 1;
+    assert!(
+        err.contains(&format!(
+            "error: graphs/deferred.ron:{line}:19: pass `point_lights`: 65537 light volumes exceed the 65536 a frame draws this way"
+        )),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn readback_images_are_written_beside_the_output_and_the_first_is_the_exr() {
+    let dir = std::env::temp_dir().join(format!("weft-readback-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.join("o.exr");
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "render",
+            "scenes/demo.scene",
+            "--graph",
+            "graphs/deferred.ron",
+            "--size",
+            "16x16",
+            "--out",
+            out.to_str().expect("utf-8"),
+        ];
+        a.extend_from_slice(extra);
+        weft(&a)
+    };
+    let done = args(&["--readback", "hdr,gbuffer_albedo"]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let exr = std::fs::read(&out).expect("exr");
+    assert_eq!(&exr[..4], b"v/1\x01", "OpenEXR magic");
+    assert_eq!(
+        exr,
+        std::fs::read(dir.join("o.hdr.exr")).expect("hdr"),
+        "the first readback is the EXR"
+    );
+    assert!(dir.join("o.gbuffer_albedo.exr").is_file());
+    // Without --readback the graph's own list (`readback: ["hdr"]`) picks the EXR's image.
+    std::fs::remove_file(&out).expect("remove");
+    let done = args(&[]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert_eq!(std::fs::read(&out).expect("exr"), exr);
+    let failed = args(&["--readback", "nope"]);
+    assert_eq!(failed.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&failed.stderr);
+    assert!(
+        err.contains("cannot read back \"nope\": the graph has no image of that name"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Renders the Cornell box through the path tracer to `spp` samples per pixel
+/// with `seed`; returns the JSON summary and the PNG's bytes.
+fn path_traced(name: &str, spp: &str, seed: &str, extra: &[&str]) -> (serde_json::Value, Vec<u8>) {
+    let out_path = temp_png(name);
+    let out_arg = out_path.to_string_lossy().into_owned();
+    let mut args = vec![
+        "render",
+        "scenes/cornell.scene",
+        "--graph",
+        "graphs/pathtrace.ron",
+        "--size",
+        "24x24",
+        "--spp",
+        spp,
+        "--seed",
+        seed,
+        "--validate",
+        "--json",
+        "--out",
+        &out_arg,
+    ];
+    args.extend_from_slice(extra);
+    let out = weft(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(json["validation"]["errors"], 0);
+    assert_eq!(json["validation"]["warnings"], 0);
+    (json, std::fs::read(&out_path).expect("png"))
+}
+
+#[test]
+fn spp_renders_a_progressive_graph_to_a_sample_count_the_same_for_a_seed() {
+    // Two samples per frame: 5 spp takes 3 frames and holds 6 samples.
+    let (json, first) = path_traced("pt-a.png", "5", "7", &["--param", "samples_per_frame=2"]);
+    assert_eq!(json["frames"], 3);
+    assert_eq!(json["samples_per_pixel"], 6);
+    let (_, again) = path_traced("pt-b.png", "5", "7", &["--param", "samples_per_frame=2"]);
+    assert_eq!(first, again, "a seed renders the same image every run");
+    let (_, other) = path_traced("pt-c.png", "5", "8", &["--param", "samples_per_frame=2"]);
+    assert_ne!(first, other, "another seed, other samples");
+}
+
+#[test]
+fn a_time_limit_stops_early_and_reports_the_samples_reached() {
+    let (json, _) = path_traced("pt-limit.png", "100000", "1", &["--time-limit", "0.5"]);
+    let frames = json["frames"].as_u64().expect("frames");
+    assert!((1..100_000).contains(&frames), "{json}");
+    assert_eq!(json["samples_per_pixel"], frames);
+}
+
+#[test]
+fn spp_on_a_graph_that_does_not_accumulate_is_refused() {
+    let out = weft(&[
+        "render",
+        "scenes/cornell.scene",
+        "--graph",
+        "graphs/forward.ron",
+        "--spp",
+        "4",
+        "--size",
+        "16x16",
+    ]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--spp needs a progressive graph") && stderr.contains("graphs/forward.ron"),
+        "{stderr}"
+    );
+}

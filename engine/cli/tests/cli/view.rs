@@ -1,0 +1,525 @@
+//! `weft view` under a private Xvfb: the window opens, renders and presents
+//! with validation (synchronization included) silent, resizes, what it shows
+//! matches the headless render of the same camera, and shader edits are hot
+//! reloaded (a broken one keeps the last good version). Every test starts its
+//! own X server on a display number the server picks (`-displayfd`) and stops
+//! it when the test ends, passed or failed.
+
+use crate::harness::{command_in, repo};
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::mpsc::{channel, Receiver};
+use std::time::{Duration, Instant};
+
+/// An Xvfb server of this test, killed on drop.
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    /// Starts Xvfb, letting it pick a free display and report it on stdout.
+    fn start() -> Self {
+        let mut child = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "1024x768x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("Xvfb runs (tools/setup installs it)");
+        let stdout = child.stdout.take().expect("piped stdout");
+        let mut line = String::new();
+        let read = BufReader::new(stdout).read_line(&mut line);
+        let number = line.trim().to_string();
+        let server = Self {
+            child,
+            display: format!(":{number}"),
+        };
+        assert!(
+            read.is_ok() && !number.is_empty() && number.bytes().all(|b| b.is_ascii_digit()),
+            "Xvfb did not report a display: {line:?}"
+        );
+        server
+    }
+
+    /// `weft` with `args` on this display, run in `dir`.
+    fn command(&self, args: &[&str], dir: &Path) -> Command {
+        let mut command = command_in(dir, args);
+        command
+            .env("DISPLAY", &self.display)
+            .env_remove("WAYLAND_DISPLAY");
+        command
+    }
+
+    /// Runs `weft` with `args` on this display in the repository.
+    fn weft(&self, args: &[&str]) -> Output {
+        self.command(args, &repo()).output().expect("weft runs")
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// A test's own temporary folder, removed when the test ends.
+struct Temp(PathBuf);
+
+impl Temp {
+    fn new(test: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("weft-view-cli-{test}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        Self(dir)
+    }
+
+    fn file(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+}
+
+impl Drop for Temp {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Asserts a clean exit with validation on and nothing reported.
+fn assert_clean(out: &Output) {
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "stdout:\n{stdout}\nstderr:\n{stderr}");
+    assert!(
+        stdout.contains("validation: 0 errors, 0 warnings, 0 performance warnings"),
+        "{stdout}"
+    );
+    assert!(!stderr.contains("validation"), "{stderr}");
+}
+
+fn load(path: &Path) -> image::RgbaImage {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8()
+}
+
+#[test]
+fn opens_renders_presents_and_exits_cleanly() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("open");
+    let shot = tmp.file("open.png");
+    let out = x.weft(&[
+        "view",
+        "scenes/demo.scene",
+        "--size",
+        "160x90",
+        "--frames",
+        "4",
+        "--validate",
+        "--screenshot-on-exit",
+        shot.to_str().expect("utf-8 path"),
+    ]);
+    assert_clean(&out);
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("graph graphs/forward.ron: features 1 "),
+        "{stdout}"
+    );
+    let image = load(&shot);
+    assert_eq!(image.dimensions(), (160, 90));
+    let lit = image
+        .pixels()
+        .filter(|p| p[0] > 8 || p[1] > 8 || p[2] > 8)
+        .count();
+    assert!(lit > 160 * 90 / 4, "only {lit} pixels are not black");
+}
+
+#[test]
+fn resizing_rebuilds_the_swapchain_and_the_plan() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("resize");
+    let shot = tmp.file("resized.png");
+    let out = x.weft(&[
+        "view",
+        "scenes/demo.scene",
+        "--graph",
+        "graphs/deferred.ron",
+        "--size",
+        "160x90",
+        "--frames",
+        "8",
+        "--resize-to",
+        "96x120",
+        "--validate",
+        "--screenshot-on-exit",
+        shot.to_str().expect("utf-8 path"),
+    ]);
+    assert_clean(&out);
+    assert_eq!(load(&shot).dimensions(), (96, 120));
+}
+
+/// The presented image equals the headless render of the same camera: the
+/// blit is same-size and sRGB to sRGB, so the only allowed difference is
+/// rounding, at most 1 of 255 per channel (measured: 0).
+#[test]
+fn screenshot_matches_the_headless_render() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("match");
+    let shown = tmp.file("shown.png");
+    let headless = tmp.file("headless.png");
+    let out = x.weft(&[
+        "view",
+        "scenes/demo.scene",
+        "--size",
+        "128x72",
+        "--camera",
+        "closeup",
+        "--paused",
+        "--frames",
+        "1",
+        "--screenshot-on-exit",
+        shown.to_str().expect("utf-8 path"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = x.weft(&[
+        "render",
+        "scenes/demo.scene",
+        "--size",
+        "128x72",
+        "--camera",
+        "closeup",
+        "--out",
+        headless.to_str().expect("utf-8 path"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (a, b) = (load(&shown), load(&headless));
+    assert_eq!(a.dimensions(), b.dimensions());
+    let mut diffs: Vec<u8> = a
+        .pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c])))
+        .collect();
+    diffs.sort_unstable();
+    let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;
+    let p99 = diffs[diffs.len() * 99 / 100];
+    let max = diffs[diffs.len() - 1];
+    eprintln!("screenshot vs headless: mean {mean:.4}, p99 {p99}, max {max}");
+    assert!(
+        mean <= 0.05 && p99 <= 1 && max <= 1,
+        "mean {mean}, p99 {p99}, max {max}"
+    );
+}
+
+#[test]
+fn a_graph_that_does_not_load_is_reported_at_its_line() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("broken");
+    let graph = tmp.file("broken.ron");
+    std::fs::write(&graph, "(\n  name: \"broken\",\n  passes: [,\n").expect("write graph");
+    let out = x.weft(&[
+        "view",
+        "scenes/demo.scene",
+        "--graph",
+        graph.to_str().expect("utf-8 path"),
+        "--frames",
+        "1",
+    ]);
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains(&format!("{}:3", graph.display())),
+        "{stderr}"
+    );
+}
+
+/// How long a reload may take before the test gives up (lavapipe under load).
+const REPLY: Duration = Duration::from_secs(60);
+
+/// A copy of the graphs and shaders, so edits never touch the repository.
+struct Copy(PathBuf);
+
+impl Copy {
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("weft-view-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        for folder in ["graphs", "shaders"] {
+            copy_dir(&repo().join(folder), &dir.join(folder));
+        }
+        Self(dir)
+    }
+}
+
+impl Drop for Copy {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("create copy folder");
+    for entry in std::fs::read_dir(from).expect("read folder") {
+        let entry = entry.expect("folder entry");
+        let target = to.join(entry.file_name());
+        if entry.path().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).expect("copy file");
+        }
+    }
+}
+
+/// Waits for a line of `lines` that satisfies `wanted`.
+fn wait_for(lines: &Receiver<String>, wanted: impl Fn(&str) -> bool, what: &str) -> String {
+    let deadline = Instant::now() + REPLY;
+    loop {
+        let left = deadline.saturating_duration_since(Instant::now());
+        match lines.recv_timeout(left) {
+            Ok(line) if wanted(&line) => return line,
+            Ok(_) => {}
+            Err(_) => panic!("no {what} within {REPLY:?}"),
+        }
+    }
+}
+
+/// Lines a pipe carries, read on a thread.
+fn lines(pipe: impl Read + Send + 'static) -> Receiver<String> {
+    let (send, receive) = channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(pipe).lines().map_while(Result::ok) {
+            if send.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    receive
+}
+
+#[test]
+fn shader_edits_reload_while_viewing_and_a_broken_one_keeps_the_last_good() {
+    const TONEMAP: &str = "shaders/tonemap.frag";
+    const OUT: &str = "color = vec4(c / (1.0 + c), 1.0);";
+    let x = Xvfb::start();
+    let copy = Copy::new("reload");
+    let shot = copy.0.join("last.png");
+    let scene = repo().join("scenes/demo.scene");
+    let mut child = x
+        .command(
+            &[
+                "view",
+                scene.to_str().expect("utf-8 path"),
+                "--size",
+                "64x36",
+                "--validate",
+                "--screenshot-on-exit",
+                shot.to_str().expect("utf-8 path"),
+            ],
+            &copy.0,
+        )
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("weft starts");
+    let stdout = lines(child.stdout.take().expect("stdout"));
+    let stderr = lines(child.stderr.take().expect("stderr"));
+    wait_for(&stdout, |l| l.starts_with("graph "), "features line");
+    let tonemap = copy.0.join(TONEMAP);
+    let original = std::fs::read_to_string(&tonemap).expect("read shader");
+    assert!(original.contains(OUT));
+
+    let saved = Instant::now();
+    std::fs::write(
+        &tonemap,
+        original.replace(OUT, "color = vec4(1.0, 0.0, 0.0, 1.0);"),
+    )
+    .expect("edit shader");
+    let line = wait_for(&stdout, |l| l.starts_with("reloaded "), "reload line");
+    eprintln!(
+        "edit to shown: {:.1} ms ({line})",
+        saved.elapsed().as_secs_f64() * 1e3
+    );
+    assert!(line.contains("tonemap.frag"), "{line}");
+
+    let broken_line = original.lines().count() + 1;
+    std::fs::write(&tonemap, format!("{original}this is not glsl\n")).expect("break shader");
+    let error = wait_for(&stderr, |l| l.starts_with("error: "), "error line");
+    assert!(
+        error.contains(&format!("tonemap.frag:{broken_line}: "))
+            && error.ends_with("(kept last good)"),
+        "{error}"
+    );
+
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(killed.success());
+    let status = child.wait().expect("weft exits");
+    let rest: Vec<String> = stderr.try_iter().collect();
+    assert!(status.success(), "{status:?}; stderr: {rest:?}");
+    assert!(rest.iter().all(|l| !l.contains("validation")), "{rest:?}");
+    let image = load(&shot);
+    assert_eq!(image.dimensions(), (64, 36));
+    assert!(
+        image.pixels().all(|p| p.0 == [255, 0, 0, 255]),
+        "the red version is still shown after the broken edit"
+    );
+}
+
+/// A reload whose preparation takes 1.5 s (the hidden `--prepare-delay-ms`) is
+/// prepared on the worker: frames keep being presented meanwhile, none of them
+/// as long as the delay, and the edit still goes live.
+#[test]
+fn a_slow_reload_is_prepared_while_frames_keep_being_presented() {
+    const TONEMAP: &str = "shaders/tonemap.frag";
+    const OUT: &str = "color = vec4(c / (1.0 + c), 1.0);";
+    const DELAY_MS: f64 = 1500.0;
+    let x = Xvfb::start();
+    let copy = Copy::new("slow");
+    std::fs::create_dir_all(copy.0.join("scenes")).expect("scenes folder");
+    std::fs::write(
+        copy.0.join("scenes/quad.obj"),
+        "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nvn 0 1 0\nf 1//1 3//1 2//1\nf 1//1 4//1 3//1\n",
+    )
+    .expect("write model");
+    std::fs::write(
+        copy.0.join("scenes/tiny.scene"),
+        "model\n{\n\tfile \"quad.obj\"\n}\ncamera\n{\n\tposition 0 3 5\n\ttarget 0 0 0\n}\n\
+         sunlight\n{\n\tdirection -0.3 -1 -0.4\n\tcolor 0.3 0.3 0.3\n}\n",
+    )
+    .expect("write scene");
+    let shot = copy.0.join("last.png");
+    let mut child = x
+        .command(
+            &[
+                "view",
+                "scenes/tiny.scene",
+                "--size",
+                "64x36",
+                "--validate",
+                "--prepare-delay-ms",
+                "1500",
+                "--screenshot-on-exit",
+                shot.to_str().expect("utf-8 path"),
+            ],
+            &copy.0,
+        )
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("weft starts");
+    let stdout = lines(child.stdout.take().expect("stdout"));
+    let stderr = lines(child.stderr.take().expect("stderr"));
+    wait_for(&stdout, |l| l.starts_with("graph "), "features line");
+    let tonemap = copy.0.join(TONEMAP);
+    let original = std::fs::read_to_string(&tonemap).expect("read shader");
+    std::fs::write(
+        &tonemap,
+        original.replace(OUT, "color = vec4(1.0, 0.0, 0.0, 1.0);"),
+    )
+    .expect("edit shader");
+    let line = wait_for(&stdout, |l| l.starts_with("reloaded "), "reload line");
+    let number_before = |marker: &str| -> f64 {
+        let head = &line[..line
+            .find(marker)
+            .unwrap_or_else(|| panic!("{marker}: {line}"))];
+        let word = head.split_whitespace().last().expect("a number");
+        word.parse().unwrap_or_else(|_| panic!("{word}: {line}"))
+    };
+    let prepare_ms = number_before(" ms; ");
+    let frames = number_before(" frames presented");
+    let longest = line
+        .split("the longest ")
+        .nth(1)
+        .and_then(|rest| rest.split(" ms").next())
+        .and_then(|n| n.parse::<f64>().ok())
+        .unwrap_or_else(|| panic!("longest: {line}"));
+    eprintln!("{line}");
+    assert!(prepare_ms >= DELAY_MS, "{line}");
+    assert!(frames > 0.0, "{line}");
+    assert!(longest < DELAY_MS, "{line}");
+
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(killed.success());
+    let status = child.wait().expect("weft exits");
+    let rest: Vec<String> = stderr.try_iter().collect();
+    assert!(status.success(), "{status:?}; stderr: {rest:?}");
+    assert!(rest.iter().all(|l| !l.contains("validation")), "{rest:?}");
+    assert!(
+        load(&shot).pixels().all(|p| p.0 == [255, 0, 0, 255]),
+        "the edit is live"
+    );
+}
+
+/// Keys pressed by script: G switches to the next graph in `graphs/`, 1 flips the
+/// first feature, F12 saves what the window shows; validation stays silent.
+#[test]
+fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("keys");
+    let dir = tmp.0.clone();
+    let scene = repo().join("scenes/demo.scene");
+    let graph = repo().join("graphs/forward.ron");
+    let out = x
+        .command(
+            &[
+                "view",
+                scene.to_str().expect("utf-8 path"),
+                "--graph",
+                graph.to_str().expect("utf-8 path"),
+                "--size",
+                "96x54",
+                "--frames",
+                "6",
+                "--press",
+                "1:g,2:g,3:1,4:f12",
+                "--validate",
+            ],
+            &dir,
+        )
+        .output()
+        .expect("weft runs");
+    assert_clean(&out);
+    let stdout = text(&out.stdout);
+    let graphs: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
+    assert_eq!(graphs.len(), 4, "{stdout}");
+    assert!(graphs[0].contains("forward.ron: features"), "{stdout}");
+    assert!(
+        graphs[1].contains("pathtrace.ron: features 1 area_lights"),
+        "G moved on to the next graph in graphs/: {stdout}"
+    );
+    assert!(!graphs[2].contains("pathtrace.ron"), "G moved on: {stdout}");
+    let first_feature = |line: &str| {
+        let list = line.split(": features ").nth(1).expect("feature list");
+        list.split(", ").next().expect("first feature").to_string()
+    };
+    let (before, after) = (first_feature(graphs[2]), first_feature(graphs[3]));
+    assert_ne!(before, after, "key 1 flips the first feature");
+    assert_eq!(
+        before.replace("[on]", "[off]").replace("[off]", ""),
+        after.replace("[on]", "[off]").replace("[off]", ""),
+        "the same feature"
+    );
+    let saved = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("wrote weft-"))
+        .unwrap_or_else(|| panic!("no screenshot line: {stdout}"));
+    assert_eq!(
+        load(&dir.join(format!("weft-{saved}"))).dimensions(),
+        (96, 54)
+    );
+}

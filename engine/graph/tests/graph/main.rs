@@ -1,0 +1,9 @@
+//! Every integration test of weft-graph in one binary (one link instead of one per
+//! file), a module per subject. `cargo test -p weft-graph --test graph -- MODULE::` runs one.
+
+mod support;
+
+mod errors;
+mod fuzz;
+mod plans;
+mod random;

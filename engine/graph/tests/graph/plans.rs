@@ -1,0 +1,326 @@
+//! Every graph in `graphs/`: it checks clean, its text plans match the reviewed
+//! snapshots in `tests/snapshots/` (insta: review a change with `cargo insta review`, or
+//! accept it with `INSTA_UPDATE=always`),
+//! and every plan passes the independent synchronization checker.
+
+use crate::support;
+
+use std::path::PathBuf;
+use support::checker::{check_aliasing, check_plan};
+use support::repo_root;
+use weft_graph::{CompileOptions, Extent};
+
+const FEATURE_SETS: &[(&str, &[&str])] = &[
+    ("default", &[]),
+    ("no-bloom", &["!bloom"]),
+    (
+        "all",
+        &[
+            "shadow_casters",
+            "point_lights",
+            "spot_lights",
+            "area_lights",
+            "depth_prepass",
+            "transparent",
+        ],
+    ),
+];
+
+fn graph_files() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(repo_root().join("graphs"))
+        .expect("graphs/ exists")
+        .map(|e| e.expect("readable entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn every_shipped_graph_checks_clean() {
+    let files = graph_files();
+    assert!(
+        files.len() >= 4,
+        "expected the shipped graphs, found {files:?}"
+    );
+    for file in files {
+        let diags = weft_graph::check(&weft_graph::load(&file));
+        assert!(diags.is_empty(), "{}: {diags:#?}", file.display());
+    }
+}
+
+#[test]
+fn plans_match_snapshots_and_pass_the_checker() {
+    let mut compared = 0;
+    for file in graph_files() {
+        let graph = weft_graph::load(&file);
+        if graph.is_fragment {
+            continue;
+        }
+        let stem = file
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .expect("utf-8 name");
+        for (label, requested) in FEATURE_SETS {
+            let options = CompileOptions {
+                extent: Extent {
+                    width: 1920,
+                    height: 1080,
+                },
+                features: graph.features(requested),
+                ..CompileOptions::default()
+            };
+            let plan = weft_graph::compile(&graph, &options)
+                .unwrap_or_else(|e| panic!("{stem} {label}: {e:#?}"));
+            check_plan(&plan, 3).unwrap_or_else(|e| panic!("{stem} {label}: {e}"));
+            check_aliasing(&plan).unwrap_or_else(|e| panic!("{stem} {label}: {e}"));
+            compared += 1;
+            insta::with_settings!({ prepend_module_to_snapshot => false, omit_expression => true }, {
+                insta::assert_snapshot!(format!("{stem}-{label}"), weft_graph::text::render(&plan));
+            });
+        }
+    }
+    assert_eq!(
+        compared, 12,
+        "forward, deferred, tiled and pathtrace, three feature sets each"
+    );
+}
+
+#[test]
+fn removing_any_barrier_makes_the_checker_fail() {
+    let graph = weft_graph::load(&repo_root().join("graphs/deferred.ron"));
+    let options = CompileOptions {
+        features: graph.features(&[
+            "shadow_casters",
+            "point_lights",
+            "spot_lights",
+            "area_lights",
+            "transparent",
+        ]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("deferred compiles");
+    let mut removed = 0;
+    for p in plan.passes.ids() {
+        for b in 0..plan.passes[p].barriers.len() {
+            let mut broken = plan.clone();
+            let barrier = broken.passes[p].barriers.remove(b);
+            let name = &plan.resources[barrier.resource].name;
+            assert!(
+                check_plan(&broken, 2).is_err(),
+                "removing the barrier on \"{name}\" before \"{}\" went unnoticed",
+                plan.passes[p].name
+            );
+            removed += 1;
+        }
+    }
+    for e in 0..plan.epilogue.len() {
+        let mut broken = plan.clone();
+        broken.epilogue.remove(e);
+        assert!(
+            check_plan(&broken, 2).is_err(),
+            "removing epilogue barrier {e} went unnoticed"
+        );
+    }
+    assert!(removed > 15, "only {removed} barriers");
+}
+
+#[test]
+fn scene_features_cull_passes_and_variants() {
+    let graph = weft_graph::load(&repo_root().join("graphs/deferred.ron"));
+    let options = CompileOptions {
+        features: graph.features::<&str>(&[]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let culled: Vec<(&str, &str)> = plan
+        .culled
+        .iter()
+        .map(|c| (c.name.as_str(), c.reason.as_str()))
+        .collect();
+    assert_eq!(
+        culled,
+        [
+            ("shadow_sun", "enabled_if [shadow_casters] is false"),
+            ("bloom_naive_h", "enabled_if [bloom_naive] is false"),
+            ("bloom_naive_v", "enabled_if [bloom_naive] is false"),
+            ("clear_overdraw", "enabled_if [overdraw] is false"),
+            ("overdraw", "enabled_if [overdraw] is false"),
+            ("clear_overshading", "enabled_if [overshading] is false"),
+            ("clear_light_count", "enabled_if [light_count] is false"),
+            ("light_count", "enabled_if [light_count] is false"),
+            ("mesh_density", "enabled_if [mesh_density] is false"),
+            ("normals", "enabled_if [normals] is false"),
+            ("show_overdraw", "enabled_if [overdraw] is false"),
+            ("show_overshading", "enabled_if [overshading] is false"),
+            ("show_mesh_density", "enabled_if [mesh_density] is false"),
+            ("show_normals", "enabled_if [normals] is false"),
+            ("show_light_count", "enabled_if [light_count] is false"),
+            ("floor_meshes", "enabled_if [bench_floors] is false"),
+            ("floor_gbuffer_read", "enabled_if [bench_floors] is false"),
+            ("point_lights", "enabled_if [point_lights] is false"),
+            ("spot_lights", "enabled_if [spot_lights] is false"),
+            ("area_lights", "enabled_if [area_lights] is false"),
+            ("transparent", "enabled_if [transparent] is false"),
+        ]
+    );
+    let sun = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "sun")
+        .expect("sun pass");
+    // No shadow variant without shadow casters, and no light type or shading
+    // model compiled without the scene's features: only the variant marker.
+    assert_eq!(sun.defines, ["SCENE_SPECIALISED"]);
+    assert!(plan.resource("shadow_map").is_none());
+}
+
+#[test]
+fn the_annotated_example_in_graphs_readme_checks_clean() {
+    let readme = std::fs::read_to_string(repo_root().join("graphs/README.md")).expect("README");
+    let start = readme.find("```ron\n").expect("a ron block") + "```ron\n".len();
+    let end = start + readme[start..].find("```").expect("closed block");
+    let example = readme[start..end].to_string();
+    let graphs = repo_root().join("graphs");
+    let root = graphs.join("README-example.ron");
+    let read = |p: &std::path::Path| {
+        if p == root {
+            Ok(example.clone())
+        } else {
+            std::fs::read_to_string(p)
+        }
+    };
+    let graph = weft_graph::load_with(&root, &read);
+    assert_eq!(weft_graph::check(&graph), Vec::new());
+    assert_eq!(graph.sources.len(), 3);
+}
+
+#[test]
+fn images_read_back_after_the_frame_are_kept_and_left_readable() {
+    let graph = weft_graph::load(&repo_root().join("graphs/forward.ron"));
+    let options = CompileOptions {
+        features: graph.features::<&str>(&[]),
+        readback: vec!["hdr".into()],
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let hdr = plan.resource("hdr").expect("hdr");
+    assert_eq!(plan.readback, vec![hdr]);
+    assert_eq!(
+        plan.resources[hdr].residency,
+        weft_graph::plan::Residency::Output
+    );
+    assert_eq!(plan.resources[hdr].placement, None);
+    let last = plan
+        .epilogue
+        .iter()
+        .find(|b| b.resource == hdr)
+        .expect("epilogue barrier");
+    assert_eq!(
+        last.layouts.map(|l| l.1),
+        Some(weft_graph::vk::Layout::TransferSrcOptimal)
+    );
+    check_plan(&plan, 3).expect("synchronized");
+
+    let unknown = CompileOptions {
+        readback: vec!["hdrr".into()],
+        ..CompileOptions::default()
+    };
+    let errors = weft_graph::compile(&graph, &unknown).expect_err("unknown image");
+    assert_eq!(
+        errors[0].message,
+        "cannot read back \"hdrr\": the graph has no image of that name"
+    );
+    assert_eq!(errors[0].hint.as_deref(), Some("did you mean \"hdr\"?"));
+}
+
+#[test]
+fn top_level_parameters_can_be_set_when_loading() {
+    use std::collections::BTreeMap;
+    use weft_graph::schema::ParamValue;
+    let path = repo_root().join("graphs/forward.ron");
+    let set =
+        |name: &str, value: f64| BTreeMap::from([(name.to_string(), ParamValue::Number(value))]);
+    let graph = weft_graph::load_with_params(&path, set("exposure", 2.5));
+    let options = CompileOptions {
+        features: graph.features::<&str>(&[]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let tonemap = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "tonemap")
+        .expect("tonemap pass");
+    assert_eq!(tonemap.params["exposure"], ParamValue::Number(2.5));
+
+    let misspelt = weft_graph::load_with_params(&path, set("exposur", 2.5));
+    let errors: Vec<_> = misspelt
+        .diagnostics
+        .iter()
+        .filter(|d| d.is_error())
+        .collect();
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert_eq!(
+        errors[0].message,
+        "unknown parameter \"exposur\" for \"forward.ron\""
+    );
+    assert_eq!(
+        errors[0].hint.as_deref(),
+        Some("did you mean \"exposure\"?")
+    );
+    assert!(errors[0].file.ends_with("forward.ron"));
+}
+
+/// `fragment.name` reaches a parameter of the include whose file stem is
+/// `fragment` (`--param shadows.pcf_radius=3`); a qualifier naming no
+/// include, or a name the fragment lacks, is an error with the nearest name.
+#[test]
+fn fragment_parameters_are_set_by_qualified_names() {
+    use std::collections::BTreeMap;
+    use weft_graph::schema::ParamValue;
+    let path = repo_root().join("graphs/forward.ron");
+    let set =
+        |name: &str, value: f64| BTreeMap::from([(name.to_string(), ParamValue::Number(value))]);
+    let graph = weft_graph::load_with_params(&path, set("bloom.threshold", 4.0));
+    assert!(
+        graph.diagnostics.iter().all(|d| !d.is_error()),
+        "{:?}",
+        graph.diagnostics
+    );
+    let options = CompileOptions {
+        features: graph.features(&["bloom"]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let bright = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "bloom_bright")
+        .expect("bloom_bright pass");
+    assert_eq!(bright.params["threshold"], ParamValue::Number(4.0));
+
+    let errors = |name: &str| {
+        weft_graph::load_with_params(&path, set(name, 1.0))
+            .diagnostics
+            .into_iter()
+            .filter(|d| d.is_error())
+            .map(|d| (d.message, d.hint))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        errors("blom.threshold"),
+        [(
+            "parameter \"blom.threshold\": \"forward.ron\" includes no fragment \"blom\""
+                .to_string(),
+            Some("did you mean \"bloom\"?".to_string())
+        )]
+    );
+    assert_eq!(
+        errors("shadows.pcf_radus"),
+        [(
+            "unknown parameter \"pcf_radus\" for \"shadows.ron\"".to_string(),
+            Some("did you mean \"pcf_radius\"?".to_string())
+        )]
+    );
+}

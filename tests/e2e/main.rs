@@ -1,0 +1,20 @@
+//! Every end-to-end test of weft in one binary (one link instead of one per file),
+//! a module per subject. `cargo test -p weft-tests --test e2e -- MODULE::` runs one.
+
+mod bloom;
+mod bsdf_sampling;
+mod debug_views;
+mod emissive;
+mod extremes;
+mod lights;
+mod mirrored;
+mod mutants;
+mod normal_maps;
+mod pathtrace;
+mod raycast;
+mod render;
+mod scripting;
+mod shading;
+mod shadows;
+mod shipped;
+mod transparency;
