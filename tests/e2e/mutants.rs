@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use weft_gpu::Gpu;
 use weft_graph::compile::feature_names;
 use weft_graph::plan::Extent;
-use weft_render::{check_graph_and_shaders, render, RenderSettings};
+use weft_render::{check_graph_and_shaders, render, RenderSettings, ShaderTarget};
 
 /// SplitMix64: small, seedable, the same everywhere.
 struct Rng(u64);
@@ -311,7 +311,8 @@ enum Outcome {
 /// features and under all, and returns an error naming anything wrong.
 fn run_mutant(gpu: &Gpu, scene: &weft_scene::Scene, graph: &Path) -> Result<Outcome, String> {
     let loaded = weft_graph::load(graph);
-    let diags = check_graph_and_shaders(&loaded).map_err(|e| format!("check failed: {e}"))?;
+    let diags = check_graph_and_shaders(&loaded, &ShaderTarget::of(gpu))
+        .map_err(|e| format!("check failed: {e}"))?;
     if diags.iter().any(weft_graph::Diagnostic::is_error) {
         return Ok(Outcome::Refused);
     }

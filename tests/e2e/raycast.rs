@@ -160,7 +160,8 @@ fn ray_tracing_data_needs_the_provider_declared() {
             std::fs::read_to_string(p)
         }
     });
-    let diagnostics = weft_render::check_graph_and_shaders(&graph).expect("shaderc");
+    let target = weft_render::ShaderTarget::of(&weft_tests::gpu());
+    let diagnostics = weft_render::check_graph_and_shaders(&graph, &target).expect("shaderc");
     let messages: Vec<&str> = diagnostics.iter().map(|d| d.message.as_str()).collect();
     assert!(
         messages.iter().any(|m| m.contains(
@@ -169,6 +170,6 @@ fn ray_tracing_data_needs_the_provider_declared() {
         "{messages:#?}"
     );
     let declared = weft_graph::load(&path);
-    let clean = weft_render::check_graph_and_shaders(&declared).expect("shaderc");
+    let clean = weft_render::check_graph_and_shaders(&declared, &target).expect("shaderc");
     assert!(clean.iter().all(|d| !d.is_error()), "{clean:#?}");
 }

@@ -23,13 +23,13 @@ use weft_graph::CompileOptions;
 #[derive(Args)]
 pub struct BloomArgs {
     /// Kernel radii (taps either side); the naive shader holds up to 21.
-    #[arg(long, value_delimiter = ',', default_value = "3,7,11,15,21")]
+    #[arg(long, value_delimiter = ',', default_value = "3,7,11,15,21", value_parser = clap::value_parser!(u32).range(0..=64))]
     radii: Vec<u32>,
     /// Output size, WIDTHxHEIGHT (bloom runs at half of it).
     #[arg(long, default_value = "1920x1080", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Frames per measurement; the first (pipeline builds) is left out of the mean.
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     frames: u32,
     /// Where the CSV and the plot go (`bloom_bench.csv`, `bloom_bench.png`).
     #[arg(long, default_value = "docs")]

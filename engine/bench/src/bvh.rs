@@ -18,7 +18,7 @@ pub struct BvhArgs {
     #[arg(required = true)]
     pub scenes: Vec<PathBuf>,
     /// Builds per scene; the median time is reported.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub runs: u32,
 }
 

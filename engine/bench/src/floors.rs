@@ -33,7 +33,7 @@ pub struct FloorsArgs {
     #[arg(long, default_value = "1280x720", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Frames per graph; the first (pipeline builds) is left out of the mean.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(2..))]
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(2..=10_000))]
     frames: u32,
     /// The pass whose time is the floor of mesh passes.
     #[arg(long, default_value = "floor_meshes")]

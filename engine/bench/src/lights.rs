@@ -16,7 +16,7 @@ use weft_render::{light_scene, render, RenderSettings, Rendered};
 #[derive(Args)]
 pub struct LightsArgs {
     /// Point-light counts to measure.
-    #[arg(long, value_delimiter = ',', default_value = "1,16,256,1024,10000")]
+    #[arg(long, value_delimiter = ',', default_value = "1,16,256,1024,10000", value_parser = clap::value_parser!(u32).range(1..=100_000))]
     counts: Vec<u32>,
     /// Graphs to compare; each is named by its file stem.
     #[arg(
@@ -29,7 +29,7 @@ pub struct LightsArgs {
     #[arg(long, default_value = "1280x720", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Frames per measurement; the first (pipeline builds) is left out of the mean.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     frames: u32,
     /// Seed of the generated lights.
     #[arg(long, default_value_t = 1)]

@@ -30,13 +30,13 @@ pub struct PathtraceArgs {
     size: Extent,
     /// Sample counts to render, each a render of its own; the last is the
     /// one whose speed is reported.
-    #[arg(long, value_delimiter = ',', default_value = "4,16,64")]
+    #[arg(long, value_delimiter = ',', default_value = "4,16,64", value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
     spp: Vec<u64>,
     /// Path length limit (`max_depth`, the camera ray counting as 1).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1024))]
     max_depth: u32,
     /// Samples per pixel per frame (`samples_per_frame`).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=1024))]
     samples_per_frame: u32,
     /// A converged image of the same scene, camera and size (linear EXR) to
     /// measure relative MSE against.

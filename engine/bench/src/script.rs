@@ -24,13 +24,13 @@ use weft_scene::script::{Limits, ScriptFrame, ScriptRuntime, STEP};
 #[derive(Args)]
 pub struct ScriptArgs {
     /// Light counts to measure.
-    #[arg(long, value_delimiter = ',', default_value = "100,1000,10000")]
+    #[arg(long, value_delimiter = ',', default_value = "100,1000,10000", value_parser = clap::value_parser!(u32).range(1..=100_000))]
     lights: Vec<u32>,
     /// Placement counts to measure.
-    #[arg(long, value_delimiter = ',', default_value = "100,1000")]
+    #[arg(long, value_delimiter = ',', default_value = "100,1000", value_parser = clap::value_parser!(u32).range(1..=100_000))]
     placements: Vec<u32>,
     /// Frames measured per count (one update step each), after 10 warm-up frames.
-    #[arg(long, default_value_t = 120)]
+    #[arg(long, default_value_t = 120, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     frames: u32,
     /// Vulkan device to use (name substring); the first suitable one by default.
     #[arg(long)]

@@ -32,10 +32,10 @@ pub struct ShadowsArgs {
     #[arg(long, default_value = "graphs/forward.ron")]
     graph: PathBuf,
     /// Shadow-map resolutions.
-    #[arg(long, value_delimiter = ',', default_value = "512,1024,2048,4096")]
+    #[arg(long, value_delimiter = ',', default_value = "512,1024,2048,4096", value_parser = clap::value_parser!(u32).range(16..=16384))]
     resolutions: Vec<u32>,
     /// PCF kernel radii.
-    #[arg(long, value_delimiter = ',', default_value = "0,1,2,3")]
+    #[arg(long, value_delimiter = ',', default_value = "0,1,2,3", value_parser = clap::value_parser!(u32).range(0..=16))]
     radii: Vec<u32>,
     /// Sun cascades.
     #[arg(long, default_value_t = 1)]
@@ -44,11 +44,11 @@ pub struct ShadowsArgs {
     #[arg(long, default_value = "960x540", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Frames per render; times are the last frame's.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     frames: u32,
     /// Renders per configuration; times are the fastest render's (the machine is
     /// shared, and interference only ever adds time).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
     repeats: u32,
     /// Where the CSV and plots go (`shadows_bench.csv`, `shadows_error.png`, `shadows_time.png`).
     #[arg(long, default_value = "docs")]

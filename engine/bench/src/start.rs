@@ -22,7 +22,7 @@ pub struct StartArgs {
     #[arg(long, default_value = "64x64")]
     size: String,
     /// Runs measured per case (the median is reported).
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     repeats: u32,
 }
 

@@ -23,7 +23,7 @@ pub struct TilesArgs {
     /// A scene; by default the generated floor with boxes under `--lights` point lights.
     scene: Option<PathBuf>,
     /// Point lights of the generated scene.
-    #[arg(long, default_value_t = 1024)]
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     lights: u32,
     /// The tiled graph.
     #[arg(long, default_value = "graphs/tiled.ron")]
@@ -32,7 +32,7 @@ pub struct TilesArgs {
     #[arg(long, default_value = "1280x720", value_parser = clap::value_parser!(Extent))]
     size: Extent,
     /// Frames timed per variant; the first (pipeline builds) is left out of the mean.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(2..))]
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(2..=10_000))]
     frames: u32,
     /// The culling pass.
     #[arg(long, default_value = "cull_lights")]

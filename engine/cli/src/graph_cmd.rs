@@ -5,6 +5,7 @@ use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
+use weft_gpu::{Gpu, GpuOptions};
 use weft_graph::{CompileOptions, Diagnostic, Extent, LoadedGraph};
 
 /// Graph subcommands.
@@ -111,6 +112,21 @@ fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Pla
     }
 }
 
+/// The device `check --shaders` checks for: the first Vulkan device, or,
+/// without one, the minimums every Vulkan 1.3 device meets (and it says so).
+fn shader_target() -> weft_render::ShaderTarget {
+    match Gpu::new(&GpuOptions {
+        validation: false,
+        device: None,
+    }) {
+        Ok(gpu) => weft_render::ShaderTarget::of(&gpu),
+        Err(e) => {
+            eprintln!("note: no Vulkan device ({e}): shaders are checked against the minimums every Vulkan 1.3 device meets");
+            weft_render::ShaderTarget::minimum()
+        }
+    }
+}
+
 /// Runs a graph subcommand.
 pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
     match cmd {
@@ -121,10 +137,11 @@ pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
         } => {
             let mut failed = false;
             let mut all = Vec::new();
+            let target = shaders.then(shader_target);
             for file in &files {
                 let graph = weft_graph::load(file);
-                let diags = if shaders {
-                    weft_render::check_graph_and_shaders(&graph)?
+                let diags = if let Some(target) = &target {
+                    weft_render::check_graph_and_shaders(&graph, target)?
                 } else {
                     let mut diags = weft_graph::check(&graph);
                     diags.extend(weft_render::providers::check(&graph));

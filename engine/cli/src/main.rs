@@ -15,6 +15,10 @@ use std::process::ExitCode;
 #[derive(Parser)]
 #[command(name = "weft", version, about)]
 struct Cli {
+    /// Let scenes name scripts, and glTF files name buffers and images,
+    /// outside their own folder tree (refused by default).
+    #[arg(long, global = true)]
+    allow_outside: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -56,6 +60,7 @@ fn die_quietly_on_closed_pipes() {
 fn main() -> ExitCode {
     die_quietly_on_closed_pipes();
     let cli = Cli::parse();
+    weft_scene::outside::allow_outside(cli.allow_outside);
     // Compiled shaders are kept in the user cache; commands with --no-cache
     // turn it off.
     weft_gpu::spirv_cache::set_dir(weft_scene::cache::user_cache_dir().map(|d| d.join("spirv")));

@@ -34,7 +34,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     frames: u32,
     /// Scene time in seconds at the first frame (frames are 1/60 s apart).
-    #[arg(long, default_value_t = 0.0, value_parser = parse_time)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_time, allow_negative_numbers = true)]
     time: f64,
     /// Camera name; the scene's first camera by default.
     #[arg(long)]
@@ -229,6 +229,18 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         Some("exr") => true,
         _ => bail!("--out {}: use a .png or .exr file name", out.display()),
     };
+    if let Some(dir) = args
+        .out
+        .as_deref()
+        .and_then(Path::parent)
+        .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
+    {
+        bail!(
+            "--out {}: the folder {} does not exist (only the default, out/, is created)",
+            out.display(),
+            dir.display()
+        );
+    }
     let extra_readback = readback_names(&args);
     let exr_image = extra_readback.first().filter(|_| exr).cloned();
     crate::graph_cmd::check_feature_names(&args.graph, &args.features)?;
@@ -250,6 +262,9 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     }
     let scene = weft_render::scene_load::load_scene(&args.scene, settings.cache_dir.as_deref())
         .with_context(|| format!("loading {}", args.scene.display()))?;
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {}", w.at, w.message);
+    }
     let gpu = Gpu::new(&GpuOptions {
         validation: args.validate,
         device: args.device.clone(),

@@ -35,10 +35,18 @@ pub struct ShaderSupport {
     pub subgroup_stages: vk::ShaderStageFlags,
     /// The subgroup operation classes offered in those stages.
     pub subgroup_operations: vk::SubgroupFeatureFlags,
+    /// `maxComputeSharedMemorySize`: bytes of `shared` variables.
+    pub compute_shared_bytes: u32,
+    /// `maxComputeWorkGroupInvocations`.
+    pub compute_invocations: u32,
+    /// `maxComputeWorkGroupSize`, per axis.
+    pub compute_size: [u32; 3],
 }
 
 impl ShaderSupport {
-    /// Nothing optional: what every Vulkan 1.3 device accepts.
+    /// Nothing optional, and the limits every Vulkan 1.3 device meets (the
+    /// specification's required minimums): what `weft graph check --shaders`
+    /// assumes without a device.
     pub fn core() -> Self {
         Self {
             geometry: false,
@@ -49,6 +57,9 @@ impl ShaderSupport {
             int8: false,
             subgroup_stages: vk::ShaderStageFlags::empty(),
             subgroup_operations: vk::SubgroupFeatureFlags::empty(),
+            compute_shared_bytes: 16384,
+            compute_invocations: 128,
+            compute_size: [128, 128, 64],
         }
     }
 
@@ -61,6 +72,7 @@ impl ShaderSupport {
         let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
         let mut properties = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
         unsafe { instance.get_physical_device_properties2(physical, &mut properties) };
+        let limits = properties.properties.limits;
         Self {
             geometry: core.geometry_shader == vk::TRUE,
             float64: core.shader_float64 == vk::TRUE,
@@ -70,6 +82,9 @@ impl ShaderSupport {
             int8: f12.shader_int8 == vk::TRUE,
             subgroup_stages: subgroup.supported_stages,
             subgroup_operations: subgroup.supported_operations,
+            compute_shared_bytes: limits.max_compute_shared_memory_size,
+            compute_invocations: limits.max_compute_work_group_invocations,
+            compute_size: limits.max_compute_work_group_size,
         }
     }
 
@@ -77,14 +92,56 @@ impl ShaderSupport {
     /// as "what it is (the Vulkan feature or property)", each once.
     pub fn unmet(&self, shader: &CompiledShader) -> Vec<String> {
         let mut unmet: Vec<String> = Vec::new();
-        for capability in declared(&shader.spirv) {
+        let header = read_header(&shader.spirv);
+        for capability in header.capabilities {
             if let Some(why) = self.lacks(capability, shader.stage) {
                 if !unmet.contains(&why) {
                     unmet.push(why);
                 }
             }
         }
+        for extension in header.extensions {
+            if !ENABLED_EXTENSIONS.contains(&extension.as_str()) {
+                unmet.push(format!(
+                    "the SPIR-V extension {extension} (weft enables no device extension for it)"
+                ));
+            }
+        }
+        if shader.stage == ShaderStage::Compute {
+            unmet.extend(self.exceeded(&crate::workgroup::read(&shader.spirv)));
+        }
         unmet
+    }
+
+    /// The compute limits `workgroup` breaks, each as the limit's name and values.
+    fn exceeded(&self, workgroup: &crate::workgroup::Workgroup) -> Vec<String> {
+        let mut exceeded = Vec::new();
+        if workgroup.shared_bytes > u64::from(self.compute_shared_bytes) {
+            exceeded.push(format!(
+                "{} bytes of shared memory (`maxComputeSharedMemorySize` is {})",
+                workgroup.shared_bytes, self.compute_shared_bytes
+            ));
+        }
+        let [x, y, z] = workgroup.size;
+        for ((axis, size), max) in ["x", "y", "z"]
+            .iter()
+            .zip(workgroup.size)
+            .zip(self.compute_size)
+        {
+            if size > max {
+                exceeded.push(format!(
+                    "a local size {axis} of {size} (`maxComputeWorkGroupSize` {axis} is {max})"
+                ));
+            }
+        }
+        let invocations = u64::from(x) * u64::from(y) * u64::from(z);
+        if invocations > u64::from(self.compute_invocations) {
+            exceeded.push(format!(
+                "{invocations} invocations per workgroup ({x}x{y}x{z}; `maxComputeWorkGroupInvocations` is {})",
+                self.compute_invocations
+            ));
+        }
+        exceeded
     }
 
     /// Why the device (`device`, by name) cannot run `shader`, when it cannot:
@@ -148,8 +205,13 @@ impl ShaderSupport {
                 feature(self.float16, "16-bit float arithmetic", "shaderFloat16")
             }
             Capability::Int8 => feature(self.int8, "8-bit integer arithmetic", "shaderInt8"),
+            other if CORE_CAPABILITIES.contains(&other) => None,
             other => {
-                let (operation, name) = subgroup_operation(other)?;
+                let Some((operation, name)) = subgroup_operation(other) else {
+                    return Some(format!(
+                        "the SPIR-V capability {other:?} (not one weft enables: it needs a device feature or extension)"
+                    ));
+                };
                 let stage_flag = stage_flag(stage);
                 if !self.subgroup_stages.contains(stage_flag) {
                     Some(format!(
@@ -168,22 +230,81 @@ impl ShaderSupport {
     }
 }
 
-/// The capabilities a SPIR-V module declares, in order. They come first in a
-/// module, so reading stops at the first other instruction.
-pub fn declared(spirv: &[u32]) -> Vec<Capability> {
-    let mut found = Vec::new();
+/// The capabilities every Vulkan 1.3 device offers with no feature to enable
+/// (the specification's SPIR-V environment table).
+const CORE_CAPABILITIES: [Capability; 10] = [
+    Capability::Matrix,
+    Capability::Shader,
+    Capability::InputAttachment,
+    Capability::Sampled1D,
+    Capability::Image1D,
+    Capability::SampledBuffer,
+    Capability::ImageBuffer,
+    Capability::ImageQuery,
+    Capability::DerivativeControl,
+    Capability::StorageImageExtendedFormats,
+];
+
+/// SPIR-V extensions that need no device extension on Vulkan 1.3: storage
+/// buffers and non-semantic debug information are core, and the Google ones
+/// only annotate.
+const ENABLED_EXTENSIONS: [&str; 6] = [
+    "SPV_KHR_storage_buffer_storage_class",
+    "SPV_KHR_non_semantic_info",
+    "SPV_KHR_terminate_invocation",
+    "SPV_GOOGLE_decorate_string",
+    "SPV_GOOGLE_hlsl_functionality1",
+    "SPV_GOOGLE_user_type",
+];
+
+/// What a module declares before its code: capabilities and extensions.
+#[derive(Debug, Default, PartialEq)]
+pub struct Header {
+    /// `OpCapability` declarations.
+    pub capabilities: Vec<Capability>,
+    /// `OpExtension` names.
+    pub extensions: Vec<String>,
+}
+
+/// `OpExtension`'s opcode.
+const OP_EXTENSION: u32 = 10;
+
+/// The capabilities and extensions a SPIR-V module declares, in order. They
+/// come first in a module, so reading stops at the first other instruction.
+pub fn read_header(spirv: &[u32]) -> Header {
+    let mut header = Header::default();
     let mut at = HEADER_WORDS;
     while let Some(&word) = spirv.get(at) {
         let (count, opcode) = ((word >> 16) as usize, word & 0xffff);
-        if opcode != OP_CAPABILITY || count < 2 {
+        if count < 2 || at + count > spirv.len() {
             break;
         }
-        if let Some(capability) = spirv.get(at + 1).and_then(|&c| Capability::from_u32(c)) {
-            found.push(capability);
+        match opcode {
+            OP_CAPABILITY => {
+                if let Some(capability) = Capability::from_u32(spirv[at + 1]) {
+                    header.capabilities.push(capability);
+                }
+            }
+            OP_EXTENSION => {
+                let bytes: Vec<u8> = spirv[at + 1..at + count]
+                    .iter()
+                    .flat_map(|w| w.to_le_bytes())
+                    .take_while(|&b| b != 0)
+                    .collect();
+                header
+                    .extensions
+                    .push(String::from_utf8_lossy(&bytes).into_owned());
+            }
+            _ => break,
         }
         at += count;
     }
-    found
+    header
+}
+
+/// The capabilities a SPIR-V module declares, in order.
+pub fn declared(spirv: &[u32]) -> Vec<Capability> {
+    read_header(spirv).capabilities
 }
 
 /// The subgroup operation class a capability needs, and its name.

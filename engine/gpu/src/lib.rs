@@ -33,6 +33,7 @@ pub mod swapchain;
 pub mod texture;
 pub mod timing;
 pub mod validation;
+pub mod workgroup;
 
 pub use capabilities::ShaderSupport;
 pub use check::{check_shaders, ShaderProblem};

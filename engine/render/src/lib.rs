@@ -55,7 +55,7 @@ pub use frame::{
     compile_for_scene, render, render_with_progress, Progress, RenderSettings, Rendered,
 };
 pub use frame_loop::{FrameLoop, FrameRequest};
-pub use graph_check::check_graph_and_shaders;
+pub use graph_check::{check_graph_and_shaders, ShaderTarget};
 pub use prepare::{PreparedReload, ReloadJob};
 pub use recorder::SceneRecorder;
 pub use reload::{startup_files, Committed, LiveRender};

@@ -124,12 +124,17 @@ const KIND: weft_io::entry::Kind = weft_io::entry::Kind {
     version: CACHE_FORMAT_VERSION,
 };
 
-/// The full key an entry is stored under: the model's absolute path.
+/// The full key an entry is stored under: the model's absolute path, and
+/// whether files outside its folder were allowed (such an import is never
+/// served to a process that does not allow them).
 fn entry_key(model: &Path) -> String {
-    std::path::absolute(model)
-        .unwrap_or_else(|_| model.to_path_buf())
-        .to_string_lossy()
-        .into_owned()
+    let path = std::path::absolute(model).unwrap_or_else(|_| model.to_path_buf());
+    let outside = if crate::outside::allowed() {
+        "\n--allow-outside"
+    } else {
+        ""
+    };
+    format!("{}{outside}", path.to_string_lossy())
 }
 
 fn damaged(diag: &mut Diagnostics, entry: &Path, model: &Path, why: &str) {

@@ -113,6 +113,12 @@ fn load_buffers(
                     }
                     None => {
                         let file = dir.join(percent_decode(uri));
+                        if let Some(message) = crate::outside::refusal(&file, dir, "buffer") {
+                            return Err(SceneError::Model {
+                                at: Location::file(path),
+                                message: format!("buffer {}: {message}", buffer.index()),
+                            });
+                        }
                         sources.push(file.clone());
                         read_capped(&file, &Location::file(path), MAX_MODEL_BYTES)?
                     }
@@ -296,6 +302,13 @@ fn image_sources(
                     }
                     None => {
                         let file: PathBuf = dir.join(percent_decode(uri));
+                        if let Some(message) = crate::outside::refusal(&file, dir, "image") {
+                            diag.warn(
+                                Location::file(path),
+                                format!("image {}: {message}; left out", image.index()),
+                            );
+                            return None;
+                        }
                         sources.push(file.clone());
                         if file.is_file() {
                             Some(TextureSource::File(

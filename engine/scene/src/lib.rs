@@ -38,6 +38,7 @@ pub mod mesh;
 pub mod model;
 mod mtl;
 pub mod obj;
+pub mod outside;
 mod props;
 pub mod report;
 pub mod rng;

@@ -66,6 +66,16 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
     if let Some(mut script) = desc.script.take() {
         // The script's objects follow every object of the file.
         script.first_light = desc.lights.len();
+        if let Some(message) = crate::outside::refusal(
+            &script.path,
+            path.parent().unwrap_or(Path::new(".")),
+            "script",
+        ) {
+            return Err(SceneError::Syntax {
+                at: script.at.clone(),
+                message,
+            });
+        }
         if !script.path.is_file() {
             return Err(SceneError::Syntax {
                 at: script.at.clone(),

@@ -66,7 +66,7 @@ pub const STEP: f64 = 1.0 / 60.0;
 pub const MAX_STEPS_AT_ONCE: u64 = 36_000;
 
 /// The sandbox's limits, per call into the script (the load, `init`, each `update`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Limits {
     /// Rhai operations (roughly one per expression node evaluated).
     pub operations: u64,
@@ -80,6 +80,13 @@ pub struct Limits {
     pub array_len: usize,
     /// Entries in one map.
     pub map_len: usize,
+    /// Objects (lights, models, cameras) the load may add: each is read by
+    /// the `.scene` reader, about 0.1 ms apiece.
+    pub objects: usize,
+    /// Wall-clock seconds one call may run: the load, `init` or one `update`
+    /// step. It bounds what the operation count cannot: Rhai re-measures an
+    /// array after every push, so growing one is quadratic in its length.
+    pub call_seconds: f64,
 }
 
 impl Default for Limits {
@@ -91,6 +98,8 @@ impl Default for Limits {
             string_bytes: 1 << 20,
             array_len: 1 << 20,
             map_len: 1 << 16,
+            objects: 100_000,
+            call_seconds: 30.0,
         }
     }
 }
@@ -131,6 +140,11 @@ struct State {
     camera_set: Vec<bool>,
     /// Whether objects may be added (the load) or lights changed (init, update).
     loading: bool,
+    /// Objects the load has added, and how many it may ([`Limits::objects`]).
+    objects_added: usize,
+    object_limit: usize,
+    /// When the call running now must end ([`Limits::call_seconds`]).
+    deadline: Option<std::time::Instant>,
 }
 
 impl State {
@@ -163,6 +177,9 @@ impl State {
             cameras: Vec::new(),
             camera_set: Vec::new(),
             loading: true,
+            objects_added: 0,
+            object_limit: 0,
+            deadline: None,
         }
     }
 
@@ -212,10 +229,25 @@ fn fail(ctx: &NativeCallContext, message: impl Into<String>) -> Box<EvalAltResul
 }
 
 /// The script error as a scene error at the script's file, line and column.
+/// [`located`] for an error raised inside function `name` (`init`,
+/// `update`): one Rhai reports without a position (a time limit, say) is
+/// located at the function's definition.
+fn located_in(script: &Path, error: &EvalAltResult, name: &str) -> SceneError {
+    let mut located = located(script, error);
+    if let SceneError::Syntax { at, .. } = &mut located {
+        if at.line.is_none() {
+            *at = first_mention(script, &format!("fn {name}"));
+        }
+    }
+    located
+}
+
 fn located(script: &Path, error: &EvalAltResult) -> SceneError {
     let at = position_at(script, error.position());
     let message = match error {
-        EvalAltResult::ErrorRuntime(value, _) => value.to_string(),
+        EvalAltResult::ErrorRuntime(value, _) | EvalAltResult::ErrorTerminated(value, _) => {
+            value.to_string()
+        }
         other => other.to_string(),
     };
     let message = message
@@ -423,6 +455,16 @@ fn add_object(
             format!("{kind} objects are added while the scene loads, not in init or update"),
         ));
     }
+    if s.objects_added >= s.object_limit {
+        return Err(fail(
+            ctx,
+            format!(
+                "{kind}: a script may add at most {} objects (lights, models and cameras) while the scene loads",
+                s.object_limit
+            ),
+        ));
+    }
+    s.objects_added += 1;
     let text = block_text(kind, label, props).map_err(|m| fail(ctx, m))?;
     let scene = s.scene.clone();
     let State { desc, diag, .. } = &mut *s;
@@ -863,8 +905,28 @@ fn engine_for(
     engine.set_module_resolver(FolderResolver::new(root, script, imports.clone()));
     engine.on_print(|_| {});
     engine.on_debug(|_, _, _| {});
+    let (watched, seconds) = (state.clone(), limits.call_seconds);
+    engine.on_progress(move |operations| {
+        let deadline = (operations % 1024 == 0).then(|| lock(&watched).deadline)??;
+        (std::time::Instant::now() > deadline).then(|| {
+            Dynamic::from(format!(
+                "the script ran past its limit of {seconds} s for one call (the load, init or one update step)"
+            ))
+        })
+    });
+    {
+        let mut s = lock(state);
+        s.object_limit = limits.objects;
+    }
     register(&mut engine, state, origin);
     engine
+}
+
+/// Starts the clock of one call ([`Limits::call_seconds`]).
+fn start_call(state: &Shared, limits_seconds: f64) {
+    lock(state).deadline = std::time::Instant::now().checked_add(
+        std::time::Duration::from_secs_f64(limits_seconds.clamp(0.0, 1e9)),
+    );
 }
 
 /// Runs the script's top level, then checks the variables it leaves against
@@ -876,7 +938,12 @@ fn run_top_level(engine: &Engine, ast: &AST, script: &Path) -> Result<(), SceneE
         .run_ast_with_scope(&mut scope, ast)
         .map_err(|e| located(script, &e))?;
     for (name, _, value) in scope.iter_raw() {
-        within_limits(engine, script, value, &format!("variable `{name}`"))?;
+        within_limits(
+            engine,
+            script,
+            value,
+            (&format!("variable `{name}`"), &format!("let {name}")),
+        )?;
     }
     Ok(())
 }
@@ -888,14 +955,29 @@ fn within_limits(
     engine: &Engine,
     script: &Path,
     value: &Dynamic,
-    what: &str,
+    (what, declared_by): (&str, &str),
 ) -> Result<(), SceneError> {
     engine
         .ensure_data_size_within_limits(value)
         .map_err(|e| SceneError::Syntax {
-            at: Location::file(script),
+            at: first_mention(script, declared_by),
             message: format!("{what}: {e}"),
         })
+}
+
+/// Where `words` (`fn update`, `let x`) first appear in the script as weft
+/// read it: a value that outgrew a limit is located where it was declared.
+fn first_mention(script: &Path, words: &str) -> Location {
+    let text = weft_io::sources::text_of(script);
+    let found = text.as_deref().and_then(|text| {
+        text.lines().enumerate().find_map(|(i, line)| {
+            let column = line.find(words)?;
+            let end = line[column + words.len()..].chars().next();
+            end.is_none_or(|c| !(c.is_alphanumeric() || c == '_'))
+                .then(|| Location::column(script, i + 1, line[..column].chars().count() + 1))
+        })
+    });
+    found.unwrap_or_else(|| Location::file(script))
 }
 
 fn compile(engine: &Engine, script: &Path) -> Result<AST, SceneError> {
@@ -930,6 +1012,7 @@ pub fn run_load(
     let imports = Arc::new(Mutex::new(Vec::new()));
     let engine = engine_for(script, &state, desc.origin, limits, &imports);
     let ast = compile(&engine, script)?;
+    start_call(&state, limits.call_seconds);
     run_top_level(&engine, &ast, script)?;
     script_ref.imports = std::mem::take(&mut *imports.lock().unwrap_or_else(|p| p.into_inner()));
     let mut s = lock(&state);
@@ -964,6 +1047,9 @@ pub struct ScriptFrame {
 
 /// The per-frame objects as the scene loaded them, to start over from.
 struct Loaded {
+    /// The random sequence where the load left it, so every restart draws
+    /// the same numbers.
+    rng: Rng,
     lights: Vec<Light>,
     transforms: Vec<Mat4>,
     colors: Vec<Option<Vec3>>,
@@ -984,6 +1070,8 @@ pub struct ScriptRuntime {
     this: Dynamic,
     /// Update steps run since time 0.
     steps: u64,
+    /// [`Limits::call_seconds`].
+    call_seconds: f64,
 }
 
 impl ScriptRuntime {
@@ -1007,7 +1095,8 @@ impl ScriptRuntime {
             .map(|m| (canonical(&m.path), m.bounds))
             .collect();
         loading.scene_bounds = scene.bounds;
-        let loaded = Loaded {
+        let mut loaded = Loaded {
+            rng: Rng::new(0),
             lights: scene.lights.clone(),
             transforms: scene.instances.iter().map(|i| i.transform).collect(),
             colors: scene.instances.iter().map(|i| i.material.color).collect(),
@@ -1016,8 +1105,13 @@ impl ScriptRuntime {
         let state: Shared = Arc::new(Mutex::new(loading));
         let engine = engine_for(script, &state, origin, limits, &Arc::default());
         let ast = compile(&engine, script)?;
+        start_call(&state, limits.call_seconds);
         run_top_level(&engine, &ast, script)?;
-        lock(&state).loading = false;
+        {
+            let mut s = lock(&state);
+            s.loading = false;
+            loaded.rng = s.rng.clone();
+        }
         let has = |name: &str, params: usize| {
             ast.iter_functions()
                 .any(|f| f.name == name && f.params.len() == params)
@@ -1032,8 +1126,16 @@ impl ScriptRuntime {
             loaded,
             this: Dynamic::UNIT,
             steps: 0,
+            call_seconds: limits.call_seconds,
         };
         runtime.restart()?;
+        if runtime.has_update {
+            // One step now, so an `update` that fails is refused at load, as
+            // the same located error in `weft render`, `--watch` and `weft
+            // view`, whatever time they start at; then back to time 0.
+            runtime.frame_at(STEP)?;
+            runtime.restart()?;
+        }
         Ok(runtime)
     }
 
@@ -1041,6 +1143,7 @@ impl ScriptRuntime {
     fn restart(&mut self) -> Result<(), SceneError> {
         {
             let mut s = lock(&self.state);
+            s.rng = self.loaded.rng.clone();
             s.lights = self.loaded.lights.clone();
             s.on = vec![true; self.loaded.lights.len()];
             s.touched = vec![false; self.loaded.lights.len()];
@@ -1050,6 +1153,7 @@ impl ScriptRuntime {
             s.camera_set = vec![false; self.loaded.cameras.len()];
         }
         self.steps = 0;
+        start_call(&self.state, self.call_seconds);
         self.this = if self.has_init {
             self.engine
                 .call_fn_with_options::<Dynamic>(
@@ -1059,7 +1163,7 @@ impl ScriptRuntime {
                     "init",
                     (),
                 )
-                .map_err(|e| located(&self.script, &e))?
+                .map_err(|e| located_in(&self.script, &e, "init"))?
         } else {
             Dynamic::UNIT
         };
@@ -1067,7 +1171,7 @@ impl ScriptRuntime {
             &self.engine,
             &self.script,
             &self.this,
-            "the state `init` returned",
+            ("the state `init` returned", "fn init"),
         )
     }
 
@@ -1101,6 +1205,7 @@ impl ScriptRuntime {
         while self.has_update && self.steps < target {
             self.steps += 1;
             let t = self.steps as f64 * STEP;
+            start_call(&self.state, self.call_seconds);
             let result = self.engine.call_fn_with_options::<Dynamic>(
                 CallFnOptions::new()
                     .eval_ast(false)
@@ -1110,14 +1215,19 @@ impl ScriptRuntime {
                 "update",
                 (t, STEP),
             );
-            let checked = result.map_err(|e| located(&self.script, &e)).and_then(|_| {
-                within_limits(
-                    &self.engine,
-                    &self.script,
-                    &self.this,
-                    &format!("the state (`this`) after update at t = {t:.3} s"),
-                )
-            });
+            let checked = result
+                .map_err(|e| located_in(&self.script, &e, "update"))
+                .and_then(|_| {
+                    within_limits(
+                        &self.engine,
+                        &self.script,
+                        &self.this,
+                        (
+                            &format!("the state (`this`) after update at t = {t:.3} s"),
+                            "fn update",
+                        ),
+                    )
+                });
             if let Err(e) = checked {
                 self.steps = u64::MAX;
                 return Err(e);
@@ -1196,8 +1306,14 @@ mod tests {
 
     /// The runtime of the `.rhai` scene at `path`, loaded as a scene.
     fn runtime(path: &Path) -> ScriptRuntime {
+        try_runtime(path).unwrap()
+    }
+
+    /// The runtime of the `.rhai` scene at `path`, or why it is refused (an
+    /// `update` that fails at its first step is refused at load).
+    fn try_runtime(path: &Path) -> Result<ScriptRuntime, SceneError> {
         let scene = crate::load_scene(path).unwrap();
-        ScriptRuntime::new(scene.script.as_ref().unwrap(), &scene, &Limits::default()).unwrap()
+        ScriptRuntime::new(scene.script.as_ref().unwrap(), &scene, &Limits::default())
     }
 
     /// Runs a `.rhai` scene's load with `limits`.
@@ -1334,6 +1450,7 @@ mod tests {
             string_bytes: 64,
             array_len: 16,
             map_len: 4,
+            ..Limits::default()
         };
         let cases = [
             (
@@ -1381,6 +1498,60 @@ mod tests {
     }
 
     #[test]
+    fn the_load_adds_at_most_the_object_limit_and_each_call_has_a_time_limit() {
+        let few = Limits {
+            objects: 3,
+            ..Limits::default()
+        };
+        let error = load_error(
+            "objects",
+            "for i in 0..2000000 {\n    point_light(#{ position: [0, 1, 0], color: [1, 1, 1] });\n}",
+            &few,
+        );
+        assert_eq!(
+            error,
+            "scene.rhai:2:5: pointlight: a script may add at most 3 objects (lights, models and cameras) while the scene loads"
+        );
+        // Growing an array costs Rhai time quadratic in its length; the call's
+        // clock stops it, located where it was.
+        let quick = Limits {
+            call_seconds: 0.2,
+            ..Limits::default()
+        };
+        let started = std::time::Instant::now();
+        let error = load_error("slow", "let a = [];\nloop {\n    a.push(1);\n}", &quick);
+        assert!(
+            started.elapsed() < std::time::Duration::from_secs(5),
+            "{:?}",
+            started.elapsed()
+        );
+        assert!(
+            error.starts_with("scene.rhai:3:")
+                && error.ends_with("the script ran past its limit of 0.2 s for one call (the load, init or one update step)"),
+            "{error}"
+        );
+        let dir = folder(
+            "slow-update",
+            &[(
+                "scene.rhai",
+                "fn update(t, dt) {\n    let a = [];\n    loop { a.push(t); }\n}\n",
+            )],
+        );
+        let path = dir.join("scene.rhai");
+        let scene = crate::load_scene(&path).unwrap();
+        let error = ScriptRuntime::new(scene.script.as_ref().unwrap(), &scene, &quick)
+            .err()
+            .expect("stopped at load, in the first update step")
+            .to_string();
+        assert!(
+            error.starts_with(&format!("{}:1:1: ", path.display()))
+                && error.contains("ran past its limit of 0.2 s"),
+            "{error}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn maps_grown_by_indexing_are_held_to_the_size_limit() {
         let small = Limits {
             map_len: 4,
@@ -1393,7 +1564,7 @@ mod tests {
         );
         assert_eq!(
             error,
-            "scene.rhai: variable `m`: Size of object map too large"
+            "scene.rhai:1:1: variable `m`: Size of object map too large"
         );
         let dir = folder(
             "map-state",
@@ -1417,7 +1588,7 @@ mod tests {
         assert_eq!(
             error,
             format!(
-                "{}: the state (`this`) after update at t = 0.067 s: Size of object map too large",
+                "{}:2:1: the state (`this`) after update at t = 0.067 s: Size of object map too large",
                 path.display()
             )
         );
@@ -1452,8 +1623,10 @@ mod tests {
             )],
         );
         let path = dir.join("scene.rhai");
-        let mut runtime = runtime(&path);
-        let error = runtime.frame_at(1.0).expect_err("refused").to_string();
+        let error = try_runtime(&path)
+            .err()
+            .expect("refused at load, by the first update step")
+            .to_string();
         assert_eq!(
             error,
             format!(
@@ -1676,9 +1849,9 @@ mod tests {
         );
         let error = |body: &str| {
             std::fs::write(&path, format!("camera(\"top\", #{{}});\nmodel(\"tri.obj\", #{{}});\nfn update(t, dt) {{\n    {body}\n}}\n")).unwrap();
-            runtime(&path)
-                .frame_at(1.0)
-                .expect_err("refused")
+            try_runtime(&path)
+                .err()
+                .expect("refused at load, by the first update step")
                 .to_string()
                 .replace(&path.display().to_string(), "scene.rhai")
         };

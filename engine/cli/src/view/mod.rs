@@ -51,7 +51,7 @@ pub struct ViewArgs {
     #[arg(long)]
     camera: Option<String>,
     /// Scene time in seconds at the start.
-    #[arg(long, default_value_t = 0.0, value_parser = crate::render_cmd::parse_time)]
+    #[arg(long, default_value_t = 0.0, value_parser = crate::render_cmd::parse_time, allow_negative_numbers = true)]
     time: f64,
     /// Start with scene time stopped (Space resumes).
     #[arg(long)]

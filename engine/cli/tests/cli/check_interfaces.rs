@@ -23,6 +23,7 @@ impl Copy {
             "shaders",
             "shaders/include",
             "shaders/bench",
+            "shaders/pathtrace",
         ] {
             std::fs::create_dir_all(dir.join(sub)).expect("temp dir");
             for entry in std::fs::read_dir(repo().join(sub)).expect("read dir") {
@@ -186,5 +187,43 @@ fn sampled_image_types_are_compared_with_the_graph_format() {
         &[("shaders/tonemap.frag", "uniform sampler2D hdr;", "uniform sampler2DArray hdr;"),
           ("shaders/tonemap.frag", "texture(hdr, uv).rgb", "texture(hdr, vec3(uv, 0.0)).rgb")],
         "pass \"tonemap\": shader binding 0 `hdr` is an array image, but graph image `hdr` is R16G16B16A16_SFLOAT with 1 layer(s) and 1 sample(s)",
+    );
+}
+
+#[test]
+fn compute_shaders_over_the_devices_limits_or_features_are_refused() {
+    // lavapipe: 32 KiB of shared memory, 1024 invocations per workgroup, no
+    // float atomics enabled; each is named with the limit it breaks.
+    assert_refused(
+        "tiled.ron",
+        &[(
+            "shaders/light_cull.comp",
+            "shared uint count;",
+            "shared uint count;\nshared vec4 hoard[8192];",
+        )],
+        "pass \"cull_lights\": graphs/../shaders/light_cull.comp needs 131",
+    );
+    assert_refused(
+        "tiled.ron",
+        &[("shaders/light_cull.comp", "shared uint count;", "shared uint count;\nshared vec4 hoard[8192];")],
+        "bytes of shared memory (`maxComputeSharedMemorySize` is 32768), which the device `llvmpipe",
+    );
+    assert_refused(
+        "pathtrace.ron",
+        &[(
+            "shaders/pathtrace/trace.comp",
+            "layout(local_size_x = 8, local_size_y = 8) in;",
+            "layout(local_size_x = 64, local_size_y = 64) in;",
+        )],
+        "4096 invocations per workgroup (64x64x1; `maxComputeWorkGroupInvocations` is 1024)",
+    );
+    assert_refused(
+        "tiled.ron",
+        &[
+            ("shaders/light_cull.comp", "#version 450", "#version 450\n#extension GL_EXT_shader_atomic_float : require"),
+            ("shaders/light_cull.comp", "shared uint count;", "shared uint count;\nshared float total;"),
+            ("shaders/light_cull.comp", "void main() {", "void main() {\n    atomicAdd(total, 1.0);"),
+        ],
+        "the SPIR-V capability AtomicFloat32AddEXT (not one weft enables: it needs a device feature or extension)",
     );
 }

@@ -9,6 +9,7 @@ mod check_interfaces;
 mod compare;
 mod graph;
 mod render;
+mod robustness;
 mod scene;
 mod view;
 mod watch;

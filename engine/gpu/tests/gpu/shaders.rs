@@ -267,6 +267,9 @@ void main() { colour = vec4(float(gl_PrimitiveID)); }
             int8: true,
             subgroup_stages: vk::ShaderStageFlags::ALL,
             subgroup_operations: vk::SubgroupFeatureFlags::from_raw(0xff),
+            compute_shared_bytes: 1 << 16,
+            compute_invocations: 1024,
+            compute_size: [1024, 1024, 64],
         }
     }
 
@@ -350,5 +353,63 @@ void main() { colour = vec4(float(gl_PrimitiveID)); }
             error,
             "pass `reduce`: shaders/reduce.comp needs 64-bit integers (the `shaderInt64` feature), which the device `gpu` does not offer"
         );
+    }
+
+    /// 128 KiB of shared memory, a 64x64 workgroup, and float atomics on
+    /// shared memory (an extension weft does not enable).
+    const GREEDY: &str = "#version 450
+#extension GL_EXT_shader_atomic_float : require
+layout(local_size_x = 64, local_size_y = 64) in;
+shared float big[32768];
+shared float sum;
+layout(set = 0, binding = 0) buffer Out { float v[]; };
+void main() {
+    big[gl_LocalInvocationIndex] = v[gl_GlobalInvocationID.x];
+    atomicAdd(sum, 1.0);
+    barrier();
+    v[gl_GlobalInvocationID.x] = big[gl_LocalInvocationIndex ^ 1u] + sum;
+}
+";
+
+    #[test]
+    fn compute_limits_and_unenabled_capabilities_are_refused() {
+        let greedy = compiled(GREEDY, "greedy.comp", ShaderStage::Compute);
+        let workgroup = weft_gpu::workgroup::read(&greedy.spirv);
+        assert_eq!(workgroup.size, [64, 64, 1]);
+        assert_eq!(workgroup.shared_bytes, 32768 * 4 + 4);
+        assert_eq!(
+            ShaderSupport::core().unmet(&greedy),
+            [
+                "the SPIR-V capability AtomicFloat32AddEXT (not one weft enables: it needs a device feature or extension)",
+                "the SPIR-V extension SPV_EXT_shader_atomic_float_add (weft enables no device extension for it)",
+                "131076 bytes of shared memory (`maxComputeSharedMemorySize` is 16384)",
+                "4096 invocations per workgroup (64x64x1; `maxComputeWorkGroupInvocations` is 128)",
+            ]
+        );
+        // One axis over its limit, and shared memory exactly at it.
+        let wide = compiled(
+            "#version 450\nlayout(local_size_x = 512) in;\nshared vec4 s[1024];\nlayout(set = 0, binding = 0) buffer O { vec4 o[]; };\nvoid main() { s[gl_LocalInvocationIndex % 1024] = vec4(1); o[0] = s[0]; }\n",
+            "wide.comp",
+            ShaderStage::Compute,
+        );
+        let workgroup = weft_gpu::workgroup::read(&wide.spirv);
+        assert_eq!(
+            (workgroup.size, workgroup.shared_bytes),
+            ([512, 1, 1], 16384)
+        );
+        assert_eq!(
+            ShaderSupport::core().unmet(&wide),
+            [
+                "a local size x of 512 (`maxComputeWorkGroupSize` x is 128)",
+                "512 invocations per workgroup (512x1x1; `maxComputeWorkGroupInvocations` is 128)",
+            ]
+        );
+        // A shader within every limit needs nothing.
+        let modest = compiled(
+            "#version 450\nlayout(local_size_x = 8, local_size_y = 8) in;\nshared float s[64];\nlayout(set = 0, binding = 0) buffer O { float o[]; };\nvoid main() { s[gl_LocalInvocationIndex] = 1.0; barrier(); o[0] = s[1]; }\n",
+            "modest.comp",
+            ShaderStage::Compute,
+        );
+        assert_eq!(ShaderSupport::core().unmet(&modest), Vec::<String>::new());
     }
 }

@@ -91,7 +91,12 @@ impl<'g> Prepared<'g> {
     pub fn unknown_features<S: AsRef<str>>(&self, requested: &[S]) -> Vec<String> {
         let mut known = feature_names(&self.ir);
         known.extend(self.graph.default_features.iter().cloned());
-        requested
+        let empty = requested
+            .iter()
+            .map(|f| f.as_ref().trim())
+            .any(|f| f.strip_prefix('!').unwrap_or(f).is_empty())
+            .then(|| "an empty feature name (a stray comma, or `!` alone)".to_string());
+        let unknown = requested
             .iter()
             .map(|f| f.as_ref().trim())
             .map(|f| f.strip_prefix('!').unwrap_or(f))
@@ -102,8 +107,8 @@ impl<'g> Prepared<'g> {
                     .unwrap_or_default();
                 let list = known.iter().cloned().collect::<Vec<_>>().join(", ");
                 format!("unknown feature \"{f}\"{hint}; this graph's features are: {list}")
-            })
-            .collect()
+            });
+        empty.into_iter().chain(unknown).collect()
     }
 
     /// Compiles for one size and feature set.
