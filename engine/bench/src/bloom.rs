@@ -23,7 +23,7 @@ use weft_graph::CompileOptions;
 #[derive(Args)]
 pub struct BloomArgs {
     /// Kernel radii (taps either side); the naive shader holds up to 21.
-    #[arg(long, value_delimiter = ',', default_value = "3,7,11,15,21", value_parser = clap::value_parser!(u32).range(0..=64))]
+    #[arg(long, value_delimiter = ',', default_value = "3,7,11,15,21", value_parser = clap::value_parser!(u32).range(1..=128))]
     radii: Vec<u32>,
     /// Output size, WIDTHxHEIGHT (bloom runs at half of it).
     #[arg(long, default_value = "1920x1080", value_parser = clap::value_parser!(Extent))]

@@ -94,9 +94,16 @@ impl LinearImage {
             path: path.to_path_buf(),
             message,
         };
-        let decoded = image::ImageReader::new(std::io::Cursor::new(bytes))
+        let mut decoded = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| read(e.to_string()))?;
+        let named_exr = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        if decoded.format().is_none() && named_exr {
+            // A file named .exr whose bytes are not: say why it does not decode.
+            decoded.set_format(image::ImageFormat::OpenExr);
+        }
         if decoded.format() != Some(image::ImageFormat::OpenExr) {
             return Err(read("not an OpenEXR file".into()));
         }

@@ -2,7 +2,7 @@
 //! the including file, and parameters resolved per file with include-site overrides.
 
 use crate::diagnostic::Diagnostic;
-use crate::schema::{GraphFile, ParamValue, PassDecl, ResourceDecl};
+use crate::schema::{GraphFile, ParamRange, ParamValue, PassDecl, ResourceDecl};
 use crate::spans::{Pos, Seg, SpanTree};
 use ron::extensions::Extensions;
 use std::collections::BTreeMap;
@@ -291,7 +291,13 @@ fn load_file(
     } else {
         (overrides, BTreeMap::new())
     };
-    let params = resolve_params(graph, source, &parsed.params, overrides, site.as_ref());
+    let params = resolve_params(
+        graph,
+        source,
+        (&parsed.params, &parsed.param_ranges),
+        overrides,
+        site.as_ref(),
+    );
     graph.sources[source].params = params;
 
     stack.push(canonical);
@@ -412,13 +418,52 @@ fn split_qualified(
 fn resolve_params(
     graph: &mut LoadedGraph,
     source: usize,
-    declared: &BTreeMap<String, ParamValue>,
+    (declared, ranges): (&BTreeMap<String, ParamValue>, &BTreeMap<String, ParamRange>),
     overrides: BTreeMap<String, ParamValue>,
     site: Option<&IncludeSite>,
 ) -> BTreeMap<String, ParamValue> {
     let mut params: BTreeMap<String, ParamValue> = declared.clone();
+    check_ranges_name_params(graph, source, declared, ranges);
+    for (name, value) in &params {
+        if let Some(why) = refusal(ranges.get(name), declared.get(name), value) {
+            let (file, pos) = graph.locate(source, &[Seg::Field("params"), Seg::Key(name)]);
+            graph.diagnostics.push(Diagnostic::error(
+                file,
+                pos,
+                format!("parameter \"{name}\": its default {why}"),
+            ));
+        }
+    }
     for (name, value) in overrides {
         if let Some(slot) = params.get_mut(&name) {
+            if let Some(why) = refusal(ranges.get(&name), declared.get(&name), &value) {
+                let at = match site {
+                    None => graph.locate(source, &[Seg::Field("params"), Seg::Key(&name)]),
+                    Some(site) => graph.locate(
+                        site.source,
+                        &[
+                            Seg::Field("include"),
+                            Seg::Index(site.index),
+                            Seg::Field("params"),
+                            Seg::Key(&name),
+                        ],
+                    ),
+                };
+                graph.diagnostics.push(
+                    Diagnostic::error(
+                        at.0,
+                        at.1,
+                        format!(
+                            "parameter \"{name}\" set to {}: it {why}",
+                            value_text(&value)
+                        ),
+                    )
+                    .with_hint(format!(
+                        "see \"{name}\" in `params` and `param_ranges` of {}",
+                        file_name(&graph.sources[source].file)
+                    )),
+                );
+            }
             *slot = value;
         } else if site.is_none() {
             let (file, pos) = graph.locate(source, &[Seg::Field("params")]);
@@ -526,4 +571,68 @@ fn normalize(path: &Path) -> PathBuf {
         }
     }
     out
+}
+
+/// Every `param_ranges` entry names a declared parameter, and its bounds agree.
+fn check_ranges_name_params(
+    graph: &mut LoadedGraph,
+    source: usize,
+    declared: &BTreeMap<String, ParamValue>,
+    ranges: &BTreeMap<String, ParamRange>,
+) {
+    for (name, range) in ranges {
+        let (file, pos) = graph.locate(source, &[Seg::Field("param_ranges"), Seg::KeyOf(name)]);
+        if !declared.contains_key(name) {
+            let names: Vec<&str> = declared.keys().map(String::as_str).collect();
+            graph.diagnostics.push(
+                Diagnostic::error(
+                    file,
+                    pos,
+                    format!("`param_ranges` names \"{name}\", which `params` does not declare"),
+                )
+                .suggest(name, names),
+            );
+        } else if range.min.zip(range.max).is_some_and(|(min, max)| min > max) {
+            graph.diagnostics.push(Diagnostic::error(
+                file,
+                pos,
+                format!("the range of \"{name}\" has min above max"),
+            ));
+        }
+    }
+}
+
+/// Why `value` cannot be parameter whose default is `default` and whose
+/// range is `range`: another kind of value than the default, or a number
+/// outside the range. References (`"$x"`) are checked where they resolve.
+fn refusal(
+    range: Option<&ParamRange>,
+    default: Option<&ParamValue>,
+    value: &ParamValue,
+) -> Option<String> {
+    let kind = |v: &ParamValue| match v {
+        ParamValue::Bool(_) => Some("true or false"),
+        ParamValue::Number(_) => Some("a number"),
+        ParamValue::Vector(_) => Some("a vector"),
+        ParamValue::Reference(_) => None,
+    };
+    if let (Some(expected), Some(found)) = (default.and_then(kind), kind(value)) {
+        if expected != found {
+            return Some(format!("must be {expected}, like its default"));
+        }
+    }
+    match (range, value) {
+        (Some(range), ParamValue::Number(n)) => range.refuses(*n),
+        _ => None,
+    }
+}
+
+/// A value as a user would type it.
+fn value_text(value: &ParamValue) -> String {
+    match value {
+        ParamValue::Bool(b) => b.to_string(),
+        ParamValue::Number(n) => format!("{n}"),
+        ParamValue::Vector(v) => format!("{v:?}"),
+        ParamValue::Reference(r) => r.clone(),
+    }
 }

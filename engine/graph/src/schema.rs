@@ -28,6 +28,11 @@ pub struct GraphFile {
     /// Parameters with defaults; passes and sizes refer to them as `"$name"`.
     #[serde(default)]
     pub params: BTreeMap<String, ParamValue>,
+    /// What values parameters accept beyond their default's type
+    /// (`"max_depth": (integer: true, min: 1)`): a `--param` or include-site
+    /// value outside it is an error.
+    #[serde(default)]
+    pub param_ranges: BTreeMap<String, ParamRange>,
     /// Images and buffers.
     #[serde(default)]
     pub resources: Vec<ResourceDecl>,
@@ -88,6 +93,50 @@ pub struct Include {
     /// Overrides for the fragment's declared parameters.
     #[serde(default)]
     pub params: BTreeMap<String, ParamValue>,
+}
+
+/// The values a numeric parameter accepts; every bound is optional.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParamRange {
+    /// The smallest value (inclusive).
+    #[serde(default)]
+    pub min: Option<f64>,
+    /// The largest value (inclusive).
+    #[serde(default)]
+    pub max: Option<f64>,
+    /// Whether the value must be a whole number.
+    #[serde(default)]
+    pub integer: bool,
+    /// The only values accepted (a mode switch), when not empty.
+    #[serde(default)]
+    pub one_of: Vec<f64>,
+}
+
+impl ParamRange {
+    /// Why `value` is outside the range, when it is.
+    pub fn refuses(&self, value: f64) -> Option<String> {
+        let list = |values: &[f64]| {
+            values
+                .iter()
+                .map(|v| format!("{v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        if !self.one_of.is_empty() && !self.one_of.contains(&value) {
+            return Some(format!("must be one of {}", list(&self.one_of)));
+        }
+        if self.integer && value.fract() != 0.0 {
+            return Some("must be a whole number".into());
+        }
+        if let Some(min) = self.min.filter(|&min| value < min) {
+            return Some(format!("must be at least {min}"));
+        }
+        if let Some(max) = self.max.filter(|&max| value > max) {
+            return Some(format!("must be at most {max}"));
+        }
+        None
+    }
 }
 
 /// A parameter value: a number, a vector, a boolean, or a reference `"$name"`.

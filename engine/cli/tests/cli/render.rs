@@ -174,6 +174,7 @@ fn more_light_volumes_than_the_limit_are_refused_at_the_pass() {
 fn readback_images_are_written_beside_the_output_and_the_first_is_the_exr() {
     let dir = std::env::temp_dir().join(format!("weft-readback-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("--out's folder must exist");
     let out = dir.join("o.exr");
     let args = |extra: &[&str]| {
         let mut a = vec![

@@ -462,3 +462,45 @@ fn scenes_and_gltf_files_read_only_inside_their_folder_unless_allowed() {
     );
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+#[test]
+fn params_are_held_to_the_type_and_range_their_graph_declares() {
+    for (param, expected) in [
+        (
+            "max_depth=-1",
+            "pathtrace.ron:12:22: error: parameter \"max_depth\" set to -1: it must be at least 1",
+        ),
+        (
+            "sampling=99",
+            "parameter \"sampling\" set to 99: it must be one of 0, 1, 2",
+        ),
+        (
+            "exposure=true",
+            "parameter \"exposure\" set to true: it must be a number, like its default",
+        ),
+        (
+            "samples_per_frame=0.5",
+            "parameter \"samples_per_frame\" set to 0.5: it must be a whole number",
+        ),
+    ] {
+        let out = weft_within(
+            &repo(),
+            &[
+                "render",
+                "scenes/demo.scene",
+                "--graph",
+                "graphs/pathtrace.ron",
+                "--size",
+                "8x8",
+                "--param",
+                param,
+                "--out",
+                "/tmp/weft-never-written.png",
+            ],
+            60,
+        );
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{param}: {err}");
+        assert!(err.contains(expected), "{param}: {err}");
+    }
+}

@@ -324,3 +324,81 @@ fn fragment_parameters_are_set_by_qualified_names() {
         )]
     );
 }
+
+#[test]
+fn parameter_values_are_held_to_their_declared_type_and_range() {
+    use std::collections::BTreeMap;
+    use weft_graph::schema::ParamValue;
+    let dir = std::env::temp_dir().join(format!("weft-param-ranges-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(
+        dir.join("frag.ron"),
+        "Graph(\n    fragment: true,\n    params: { \"radius\": 2 },\n    param_ranges: { \"radius\": (integer: true, min: 0, max: 7) },\n)\n",
+    )
+    .expect("write");
+    let root = dir.join("g.ron");
+    std::fs::write(
+        &root,
+        "Graph(\n    include: [(file: \"frag.ron\", params: { \"radius\": 9 })],\n    params: {\n        \"depth\": 8,\n        \"mode\": 0,\n        \"gain\": 1.0,\n    },\n    param_ranges: {\n        \"depth\": (integer: true, min: 1),\n        \"mode\": (one_of: [0, 1, 2]),\n        \"missing\": (min: 0),\n    },\n    output: \"x\",\n)\n",
+    )
+    .expect("write");
+    let errors = |overrides: BTreeMap<String, ParamValue>| -> Vec<String> {
+        weft_graph::load_with_params(&root, overrides)
+            .diagnostics
+            .iter()
+            .filter(|d| d.is_error())
+            .map(|d| {
+                format!(
+                    "{}:{}: {}",
+                    d.file.file_name().unwrap().to_string_lossy(),
+                    d.pos.line,
+                    d.message
+                )
+            })
+            .collect()
+    };
+    let base = errors(BTreeMap::new());
+    assert_eq!(
+        base,
+        [
+            "g.ron:11: `param_ranges` names \"missing\", which `params` does not declare",
+            "g.ron:2: parameter \"radius\" set to 9: it must be at most 7",
+        ]
+    );
+    let set = |name: &str, value: ParamValue| BTreeMap::from([(name.to_string(), value)]);
+    for (name, value, expected) in [
+        (
+            "depth",
+            ParamValue::Number(-1.0),
+            "g.ron:4: parameter \"depth\" set to -1: it must be at least 1",
+        ),
+        (
+            "depth",
+            ParamValue::Number(2.5),
+            "g.ron:4: parameter \"depth\" set to 2.5: it must be a whole number",
+        ),
+        (
+            "mode",
+            ParamValue::Number(99.0),
+            "g.ron:5: parameter \"mode\" set to 99: it must be one of 0, 1, 2",
+        ),
+        (
+            "gain",
+            ParamValue::Bool(true),
+            "g.ron:6: parameter \"gain\" set to true: it must be a number, like its default",
+        ),
+    ] {
+        let found = errors(set(name, value));
+        assert!(
+            found.iter().any(|e| e == expected),
+            "{expected}\n{found:#?}"
+        );
+        assert_eq!(found.len(), base.len() + 1, "{found:#?}");
+    }
+    assert_eq!(
+        errors(set("mode", ParamValue::Number(2.0))),
+        base,
+        "in range"
+    );
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
