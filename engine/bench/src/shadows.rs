@@ -186,7 +186,7 @@ pub fn run(args: ShadowsArgs) -> Result<ExitCode> {
     if args.resolutions.is_empty() || args.radii.is_empty() {
         bail!("--resolutions and --radii must name at least one each");
     }
-    let graph_text = std::fs::read_to_string(&args.graph).with_context(|| {
+    let graph_text = weft_graph::load::read_from_disk(&args.graph).with_context(|| {
         format!(
             "reading {} (run from the repository root)",
             args.graph.display()

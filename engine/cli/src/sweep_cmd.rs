@@ -89,7 +89,7 @@ fn settings_text(args: &SweepArgs) -> String {
 fn check_settings(args: &SweepArgs) -> Result<()> {
     let path = args.out.join("sweep.settings");
     let wanted = settings_text(args);
-    match std::fs::read_to_string(&path) {
+    match weft_io::read_text(&path, weft_io::read::MAX_TEXT_BYTES) {
         Ok(found) if found == wanted => Ok(()),
         Ok(found) => bail!(
             "{} holds points measured with other settings:\n{found}this sweep:\n{wanted}use another --out or remove the folder",

@@ -121,17 +121,20 @@ pub fn line(row: &SweepRow, names: &[String]) -> String {
     fields.join(",")
 }
 
+/// The largest sweep CSV read back (a million rows of a few dozen columns).
+const MAX_CSV_BYTES: u64 = 1 << 30;
+
 /// The rows already in `path` (none when it does not exist). A file whose
 /// header is not this sweep's is an error, not silently mixed in.
 pub fn read(path: &Path, names: &[String]) -> Result<Vec<SweepRow>, SweepError> {
     let shown = path.display().to_string();
-    let text = match std::fs::read_to_string(path) {
+    let text = match weft_io::read_text(path, MAX_CSV_BYTES) {
         Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(source) => {
+        Err(weft_io::ReadError::Missing { .. }) => return Ok(Vec::new()),
+        Err(e) => {
             return Err(SweepError::Io {
                 path: shown,
-                source,
+                source: e.into_io(),
             })
         }
     };

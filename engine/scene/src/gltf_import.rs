@@ -30,6 +30,7 @@ pub fn load_gltf(
     };
     let gltf = gltf::Gltf::from_slice(&bytes)
         .map_err(|e| model_error(format!("glTF does not parse: {e}")))?;
+    check_version(&gltf.document.as_json().asset).map_err(model_error)?;
     let dir = path.parent().unwrap_or(Path::new(""));
     let mut sources = vec![path.to_path_buf()];
     let buffers = load_buffers(&gltf, dir, path, &mut sources)?;
@@ -140,6 +141,82 @@ fn load_buffers(
         .collect()
 }
 
+/// glTF 2.0 only: `asset.version` (and `minVersion`, when given) must be
+/// 2.x, as the specification requires of a loader.
+fn check_version(asset: &gltf::json::Asset) -> Result<(), String> {
+    let major = |v: &str| v.split('.').next().and_then(|m| m.parse::<u32>().ok());
+    if major(&asset.version) != Some(2) {
+        return Err(format!(
+            "asset.version is \"{}\"; weft reads glTF 2.x",
+            asset.version
+        ));
+    }
+    match asset.min_version.as_deref() {
+        Some(min) if major(min) != Some(2) => Err(format!(
+            "asset.minVersion is \"{min}\"; weft reads glTF 2.x"
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Each attribute's and the indices' accessor has the type and component
+/// type the glTF 2.0 specification allows it (§3.7.2.1 and §3.7.2.2):
+/// POSITION and NORMAL float VEC3, TANGENT float VEC4, TEXCOORD_n VEC2 of
+/// floats or normalized unsigned bytes or shorts, COLOR_n VEC3 or VEC4,
+/// indices unsigned scalar integers.
+fn check_accessors(primitive: &gltf::Primitive<'_>) -> Result<(), String> {
+    use gltf::accessor::{DataType as D, Dimensions as V};
+    use gltf::Semantic as S;
+    let normalized_unsigned =
+        |a: &gltf::Accessor<'_>| a.normalized() && matches!(a.data_type(), D::U8 | D::U16);
+    let float = |a: &gltf::Accessor<'_>| a.data_type() == D::F32;
+    for (semantic, accessor) in primitive.attributes() {
+        let (allowed, wanted) = match &semantic {
+            S::Positions | S::Normals => (
+                accessor.dimensions() == V::Vec3 && float(&accessor),
+                "float VEC3",
+            ),
+            S::Tangents => (
+                accessor.dimensions() == V::Vec4 && float(&accessor),
+                "float VEC4",
+            ),
+            S::TexCoords(_) => (
+                accessor.dimensions() == V::Vec2
+                    && (float(&accessor) || normalized_unsigned(&accessor)),
+                "VEC2 of floats or normalized unsigned bytes or shorts",
+            ),
+            S::Colors(_) => (
+                matches!(accessor.dimensions(), V::Vec3 | V::Vec4)
+                    && (float(&accessor) || normalized_unsigned(&accessor)),
+                "VEC3 or VEC4 of floats or normalized unsigned bytes or shorts",
+            ),
+            _ => (true, ""),
+        };
+        if !allowed {
+            return Err(format!(
+                "attribute {} is accessor {} of {:?} {:?}; the glTF 2.0 specification allows {wanted}",
+                semantic.to_string(),
+                accessor.index(),
+                accessor.data_type(),
+                accessor.dimensions()
+            ));
+        }
+    }
+    if let Some(indices) = primitive.indices() {
+        if indices.dimensions() != V::Scalar
+            || !matches!(indices.data_type(), D::U8 | D::U16 | D::U32)
+        {
+            return Err(format!(
+                "indices are accessor {} of {:?} {:?}; the glTF 2.0 specification allows unsigned SCALAR integers",
+                indices.index(),
+                indices.data_type(),
+                indices.dimensions()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// One triangle primitive as a mesh in model space; `None` (with a warning) for points,
 /// lines and primitives without positions.
 fn primitive_mesh(
@@ -160,6 +237,10 @@ fn primitive_mesh(
         );
         return Ok(None);
     }
+    check_accessors(primitive).map_err(|m| SceneError::Model {
+        at: Location::file(path),
+        message: format!("primitive '{name}': {m}"),
+    })?;
     let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
     let Some(positions) = reader.read_positions() else {
         diag.warn(

@@ -276,3 +276,85 @@ fn second_uv_set_and_vertex_colours() {
         assert!(mesh.colors.is_empty() || mesh.colors.len() == mesh.positions.len());
     }
 }
+
+/// A one-triangle glTF whose POSITION accessor has `position_type`, indices
+/// of `index_type` (a component type), and `asset` as its asset object.
+fn triangle_gltf(asset: &str, position_type: &str, index_type: u32) -> String {
+    // 3 float VEC3 positions (36 bytes), then 3 u32 indices (12 bytes).
+    let mut bytes: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    bytes.extend([0u32, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
+    let data = base64(&bytes);
+    format!(
+        r#"{{"asset":{asset},"buffers":[{{"uri":"data:application/octet-stream;base64,{data}","byteLength":48}}],
+"bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":12}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"{position_type}","min":[0,0,0],"max":[1,1,0]}},
+{{"bufferView":1,"componentType":{index_type},"count":3,"type":"SCALAR"}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],"nodes":[{{"mesh":0}}],"scenes":[{{"nodes":[0]}}]}}"#
+    )
+}
+
+fn base64(bytes: &[u8]) -> String {
+    const TABLE: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for chunk in bytes.chunks(3) {
+        let n = chunk
+            .iter()
+            .enumerate()
+            .fold(0u32, |n, (i, &b)| n | u32::from(b) << (16 - 8 * i));
+        for i in 0..4 {
+            if i <= chunk.len() {
+                out.push(TABLE[(n >> (18 - 6 * i) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn accessor_types_and_the_asset_version_are_held_to_the_specification() {
+    let dir = common::temp_dir("gltf-spec");
+    let load = |name: &str, text: String| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).expect("write");
+        load_scene(&path)
+            .map(|s| s.triangle_count())
+            .map_err(|e| e.to_string())
+    };
+    let version = r#"{"version":"2.0"}"#;
+    assert_eq!(
+        load("good.gltf", triangle_gltf(version, "VEC3", 5125)),
+        Ok(1)
+    );
+    let error =
+        load("vec2.gltf", triangle_gltf(version, "VEC2", 5125)).expect_err("VEC2 positions");
+    assert!(
+        error.contains("attribute POSITION is accessor 0 of F32 Vec2; the glTF 2.0 specification allows float VEC3"),
+        "{error}"
+    );
+    let error =
+        load("signed.gltf", triangle_gltf(version, "VEC3", 5122)).expect_err("signed indices");
+    assert!(
+        error.contains("indices are accessor 1 of I16 Scalar; the glTF 2.0 specification allows unsigned SCALAR integers"),
+        "{error}"
+    );
+    let error = load(
+        "v3.gltf",
+        triangle_gltf(r#"{"version":"3.0"}"#, "VEC3", 5125),
+    )
+    .expect_err("glTF 3");
+    assert!(
+        error.contains("asset.version is \"3.0\"; weft reads glTF 2.x"),
+        "{error}"
+    );
+    let error = load(
+        "min.gltf",
+        triangle_gltf(r#"{"version":"2.0","minVersion":"3.0"}"#, "VEC3", 5125),
+    )
+    .expect_err("minVersion 3");
+    assert!(error.contains("asset.minVersion is \"3.0\""), "{error}");
+}
