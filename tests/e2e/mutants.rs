@@ -85,7 +85,7 @@ const NUMBERS: &[&str] = &["-1", "0", "1", "2", "9", "1e9", "NaN", "inf", "0.5"]
 /// One edit of one file's text, described for the failure report.
 fn mutate(text: &str, rng: &mut Rng) -> Option<(String, String)> {
     let lines: Vec<&str> = text.lines().collect();
-    match rng.below(8) {
+    match rng.below(10) {
         0 => {
             let i = rng.below(lines.len());
             let mut out = lines.clone();
@@ -153,6 +153,7 @@ fn mutate(text: &str, rng: &mut Rng) -> Option<(String, String)> {
                 ),
             ))
         }
+        8 | 9 => compute_mutation(text, rng),
         _ => {
             let numbers = number_spans(text);
             if numbers.is_empty() {
@@ -168,6 +169,47 @@ fn mutate(text: &str, rng: &mut Rng) -> Option<(String, String)> {
                     &text[start..end]
                 ),
             ))
+        }
+    }
+}
+
+/// An edit that asks more of the device than a compute shader did: a large
+/// `shared` array, a larger workgroup, or float atomics on shared memory
+/// (an extension weft does not enable). `None` for other files.
+fn compute_mutation(text: &str, rng: &mut Rng) -> Option<(String, String)> {
+    let main = text.find("void main()")?;
+    let body = main + text[main..].find('{')? + 1;
+    text.find("local_size_x")?;
+    match rng.below(3) {
+        0 => {
+            let vec4s = *rng.pick(&[512usize, 1024, 2048, 8192]);
+            let declaration = format!("shared vec4 mutant_hoard[{vec4s}];\n");
+            let out = format!(
+                "{}{declaration}{}\n    mutant_hoard[gl_LocalInvocationIndex % {vec4s}u] = vec4(1.0);{}",
+                &text[..main],
+                &text[main..body],
+                &text[body..]
+            );
+            Some((out, format!("added {} bytes of shared memory", vec4s * 16)))
+        }
+        1 => {
+            let at = text.find("local_size_x = ")? + "local_size_x = ".len();
+            let digits = text[at..].bytes().take_while(u8::is_ascii_digit).count();
+            let to = *rng.pick(&["64", "256", "1024"]);
+            let out = format!("{}{to}{}", &text[..at], &text[at + digits..]);
+            Some((out, format!("set local_size_x to {to}")))
+        }
+        _ => {
+            let version = text.find("#version")?;
+            let line_end = version + text[version..].find('\n')? + 1;
+            let out = format!(
+                "{}#extension GL_EXT_shader_atomic_float : require\n{}shared float mutant_total;\n{}\n    atomicAdd(mutant_total, 1.0);{}",
+                &text[..line_end],
+                &text[line_end..main],
+                &text[main..body],
+                &text[body..]
+            );
+            Some((out, "added float atomics on shared memory".to_string()))
         }
     }
 }
@@ -409,4 +451,57 @@ fn every_mutant_check_accepts_renders_clean() {
         refused > 0 && rendered > 0,
         "mutants exercise both sides: {refused} refused, {rendered} rendered"
     );
+}
+
+/// The compute mutations, each applied to the tiled graph's light culling:
+/// what the device cannot run is refused by check (never rendered into a
+/// validation message), and what it can run renders clean.
+#[test]
+fn compute_shaders_asking_more_than_the_device_offers_are_refused() {
+    let gpu = weft_tests::gpu();
+    let scene = weft_scene::load_scene(&demo_scene()).expect("demo scene");
+    let file = Path::new("shaders/light_cull.comp");
+    let text = std::fs::read_to_string(root().join(file)).expect("read");
+    let main = text.find("void main() {").expect("main") + "void main() {".len();
+    let with = |declaration: &str, statement: &str| {
+        format!(
+            "{}{declaration}\n{}\n    {statement}{}",
+            &text[..text.find("void main()").expect("main")],
+            "void main() {",
+            &text[main..]
+        )
+    };
+    let sized = |x: &str| text.replacen("local_size_x = 16", &format!("local_size_x = {x}"), 1);
+    let atomics = with(
+        "shared float mutant_total;",
+        "atomicAdd(mutant_total, 1.0);",
+    )
+    .replacen(
+        "#version 450",
+        "#version 450\n#extension GL_EXT_shader_atomic_float : require",
+        1,
+    );
+    let hoard = |vec4s: usize| {
+        with(
+            &format!("shared vec4 mutant_hoard[{vec4s}];"),
+            &format!("mutant_hoard[gl_LocalInvocationIndex % {vec4s}u] = vec4(1.0);"),
+        )
+    };
+    assert!(
+        text.contains("local_size_x = 16"),
+        "light_cull's workgroup changed"
+    );
+    for (what, mutant, refused) in [
+        ("8 KiB of shared memory more", hoard(512), false),
+        ("128 KiB of shared memory more", hoard(8192), true),
+        ("64x16 invocations", sized("64"), false),
+        ("1024x16 invocations", sized("1024"), true),
+        ("float atomics on shared memory", atomics, true),
+    ] {
+        let tree = Tree::new(1000 + mutant.len());
+        std::fs::write(tree.0.join(file), &mutant).expect("write mutant");
+        let outcome = run_mutant(&gpu, &scene, &tree.0.join("graphs/tiled.ron"))
+            .unwrap_or_else(|problem| panic!("{what}: {problem}"));
+        assert_eq!(matches!(outcome, Outcome::Refused), refused, "{what}");
+    }
 }

@@ -264,4 +264,83 @@ mod tests {
         );
         std::fs::remove_dir_all(&dir).expect("clean up");
     }
+
+    mod damage {
+        use super::super::*;
+        use proptest::prelude::*;
+
+        const KIND: Kind = Kind {
+            name: "prop",
+            version: 1,
+        };
+
+        /// One way an entry is damaged on disk.
+        #[derive(Debug, Clone)]
+        enum Damage {
+            Truncate(usize),
+            Flip(usize, u8),
+            Splice(usize, Vec<u8>),
+            Replace(Vec<u8>),
+        }
+
+        fn damage() -> impl Strategy<Value = Damage> {
+            prop_oneof![
+                any::<usize>().prop_map(Damage::Truncate),
+                (any::<usize>(), 1u8..=255).prop_map(|(at, mask)| Damage::Flip(at, mask)),
+                (
+                    any::<usize>(),
+                    proptest::collection::vec(any::<u8>(), 1..16)
+                )
+                    .prop_map(|(at, bytes)| Damage::Splice(at, bytes)),
+                proptest::collection::vec(any::<u8>(), 0..128).prop_map(Damage::Replace),
+            ]
+        }
+
+        fn apply(entry: &[u8], damage: &Damage) -> Vec<u8> {
+            let mut bytes = entry.to_vec();
+            match damage {
+                Damage::Truncate(at) => bytes.truncate(at % bytes.len()),
+                Damage::Flip(at, mask) => {
+                    let at = at % bytes.len();
+                    bytes[at] ^= mask;
+                }
+                Damage::Splice(at, extra) => {
+                    let at = at % (bytes.len() + 1);
+                    bytes.splice(at..at, extra.iter().copied());
+                }
+                Damage::Replace(other) => bytes = other.clone(),
+            }
+            bytes
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+
+            /// Whatever happens to an entry, reading it gives the payload
+            /// that was stored under this key, or an error: never other bytes.
+            #[test]
+            fn damaged_entries_never_yield_other_bytes(
+                key in proptest::collection::vec(any::<u8>(), 0..40),
+                payload in proptest::collection::vec(any::<u8>(), 0..300),
+                other_key in proptest::collection::vec(any::<u8>(), 0..40),
+                damages in proptest::collection::vec(damage(), 1..4),
+            ) {
+                let entry = encode(KIND, &key, &payload);
+                let mut damaged = entry.clone();
+                for d in &damages {
+                    if damaged.is_empty() {
+                        break;
+                    }
+                    damaged = apply(&damaged, d);
+                }
+                match decode(&damaged, KIND, &key) {
+                    Ok(read) => prop_assert_eq!(read, &payload[..]),
+                    Err(_) => prop_assert_ne!(&damaged, &entry),
+                }
+                if other_key != key {
+                    prop_assert!(decode(&entry, KIND, &other_key).is_err());
+                }
+            }
+        }
+    }
 }
