@@ -329,20 +329,29 @@ impl Gpu {
                 .create_fence(&vk::FenceCreateInfo::default(), None)
         }
         .call("vkCreateFence")?;
-        let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-        let submit = vk::SubmitInfo2::default().command_buffer_infos(&buffers);
-        let result = unsafe {
-            self.device
-                .queue_submit2(self.queue, &[submit], fence)
-                .call("vkQueueSubmit2")
-                .and_then(|()| {
-                    self.device
-                        .wait_for_fences(&[fence], true, u64::MAX)
-                        .call("vkWaitForFences")
-                })
-        };
+        let result = self.submit_and_wait_on(cmd, fence);
         unsafe { self.device.destroy_fence(fence, None) };
         result
+    }
+
+    /// [`Gpu::submit_and_wait`] on a fence the caller keeps (unsignalled on
+    /// entry, and again on return), for work submitted every frame.
+    pub fn submit_and_wait_on(
+        &self,
+        cmd: vk::CommandBuffer,
+        fence: vk::Fence,
+    ) -> Result<(), GpuError> {
+        let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        let submit = vk::SubmitInfo2::default().command_buffer_infos(&buffers);
+        unsafe {
+            self.device
+                .queue_submit2(self.queue, &[submit], fence)
+                .call("vkQueueSubmit2")?;
+            self.device
+                .wait_for_fences(&[fence], true, u64::MAX)
+                .call("vkWaitForFences")?;
+            self.device.reset_fences(&[fence]).call("vkResetFences")
+        }
     }
 
     /// Gives a Vulkan object a name that validation messages will show.

@@ -22,7 +22,8 @@ pub(crate) struct ReadbackBuffer<'g> {
 }
 
 impl<'g> ReadbackBuffer<'g> {
-    pub(crate) fn new(gpu: &'g Gpu, plan: &Plan, resource: ResourceId) -> Result<Self, GpuError> {
+    /// The bytes `resource` of `plan` takes when read back.
+    fn bytes(plan: &Plan, resource: ResourceId) -> Result<u64, GpuError> {
         let ResourceDesc::Image(desc) = &plan
             .resources
             .get(resource)
@@ -37,7 +38,11 @@ impl<'g> ReadbackBuffer<'g> {
                 plan.resources[resource].name, desc.format
             ))
         })?;
-        let size = u64::from(desc.extent.width) * u64::from(desc.extent.height) * u64::from(texel);
+        Ok(u64::from(desc.extent.width) * u64::from(desc.extent.height) * u64::from(texel))
+    }
+
+    pub(crate) fn new(gpu: &'g Gpu, plan: &Plan, resource: ResourceId) -> Result<Self, GpuError> {
+        let size = Self::bytes(plan, resource)?;
         let info = vk::BufferCreateInfo::default()
             .size(size)
             .usage(vk::BufferUsageFlags::TRANSFER_DST)
@@ -75,6 +80,13 @@ impl<'g> ReadbackBuffer<'g> {
 
     /// Copies the image (in TRANSFER_SRC_OPTIMAL after the epilogue) into
     /// the buffer and makes the bytes visible to the host.
+    /// Whether this buffer can take `resource` of `plan`: the same image,
+    /// of the same size in bytes.
+    pub(crate) fn fits(&self, plan: &Plan, resource: ResourceId) -> bool {
+        self.resource == resource
+            && Self::bytes(plan, resource).is_ok_and(|bytes| bytes == self.size)
+    }
+
     pub(crate) fn record(
         &self,
         gpu: &Gpu,

@@ -1,10 +1,15 @@
-//! Objects that live for one frame: debug labels, the descriptor pool and
-//! the command buffers, each released on drop.
+//! What frames record with: debug labels around passes, and the pools every
+//! frame reuses (command buffers, fence, queries, read-back buffers).
 
 use crate::context::Gpu;
+use crate::download::ReadbackBuffer;
 use crate::error::{GpuError, VkCall};
+use crate::statistics::StatisticsPool;
+use crate::timing::QueryPool;
 use ash::vk;
 use std::ffi::CString;
+use weft_graph::id::ResourceId;
+use weft_graph::plan::Plan;
 
 /// A debug-utils label around a pass, so validation messages name it.
 pub(crate) struct Label(bool);
@@ -26,23 +31,108 @@ impl Label {
     }
 }
 
-/// The command buffers of one frame, freed on drop.
-pub(crate) struct CommandBuffers<'g> {
+/// What every frame records into and reads back through, made once and
+/// reused while it fits: command buffers and a fence ([`Commands`]), the
+/// timestamp and statistics query pools, and the read-back buffers. Frames
+/// are recorded, submitted and waited for one at a time, so nothing here is
+/// in use when the next frame starts.
+pub(crate) struct FramePools<'g> {
     gpu: &'g Gpu,
-    buffers: Vec<vk::CommandBuffer>,
+    pub(crate) commands: Commands<'g>,
+    pub(crate) queries: Option<QueryPool<'g>>,
+    pub(crate) statistics: Option<StatisticsPool<'g>>,
+    pub(crate) readbacks: Vec<ReadbackBuffer<'g>>,
 }
 
-impl<'g> CommandBuffers<'g> {
-    pub(crate) fn new(gpu: &'g Gpu) -> Self {
-        Self {
+impl<'g> FramePools<'g> {
+    pub(crate) fn new(gpu: &'g Gpu) -> Result<Self, GpuError> {
+        Ok(Self {
             gpu,
-            buffers: Vec::new(),
-        }
+            commands: Commands::new(gpu)?,
+            queries: None,
+            statistics: None,
+            readbacks: Vec::new(),
+        })
     }
 
+    /// Makes the pools fit a frame of `plan`: `timestamps` and `statistics`
+    /// queries when asked for, and read-back buffers for `readback` (the
+    /// images, in order). Pools that already fit are kept; the command
+    /// buffers start over.
+    pub(crate) fn fit(
+        &mut self,
+        plan: &Plan,
+        (timestamps, statistics): (bool, bool),
+        readback: &[ResourceId],
+    ) -> Result<(), GpuError> {
+        self.commands.used = 0;
+        let passes = plan.passes.len() as u32;
+        if !timestamps {
+            self.queries = None;
+        } else if self
+            .queries
+            .as_ref()
+            .is_none_or(|q| q.count != (2 * passes).max(1))
+        {
+            self.queries = Some(QueryPool::new(self.gpu, 2 * passes)?);
+        }
+        if !statistics {
+            self.statistics = None;
+        } else if self
+            .statistics
+            .as_ref()
+            .is_none_or(|s| s.count() != passes.max(1))
+        {
+            self.statistics = Some(StatisticsPool::new(self.gpu, passes)?);
+        }
+        let fits = self.readbacks.len() == readback.len()
+            && self
+                .readbacks
+                .iter()
+                .zip(readback)
+                .all(|(buffer, &r)| buffer.fits(plan, r));
+        if !fits {
+            self.readbacks = readback
+                .iter()
+                .map(|&r| ReadbackBuffer::new(self.gpu, plan, r))
+                .collect::<Result<_, _>>()?;
+        }
+        Ok(())
+    }
+}
+
+/// Primary command buffers, begun again frame after frame (the pool resets
+/// them), and the fence their submissions are waited on.
+pub(crate) struct Commands<'g> {
+    gpu: &'g Gpu,
+    buffers: Vec<vk::CommandBuffer>,
+    /// Command buffers begun this frame.
+    used: usize,
+    fence: vk::Fence,
+}
+
+impl<'g> Commands<'g> {
+    fn new(gpu: &'g Gpu) -> Result<Self, GpuError> {
+        let fence = unsafe {
+            gpu.device()
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+        }
+        .call("vkCreateFence")?;
+        Ok(Self {
+            gpu,
+            buffers: Vec::new(),
+            used: 0,
+            fence,
+        })
+    }
+
+    /// Begins the frame's next command buffer.
     pub(crate) fn begin(&mut self) -> Result<vk::CommandBuffer, GpuError> {
-        let cmd = self.gpu.allocate_command_buffer()?;
-        self.buffers.push(cmd);
+        if self.used == self.buffers.len() {
+            self.buffers.push(self.gpu.allocate_command_buffer()?);
+        }
+        let cmd = self.buffers[self.used];
+        self.used += 1;
         let info = vk::CommandBufferBeginInfo::default()
             .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         unsafe { self.gpu.device().begin_command_buffer(cmd, &info) }
@@ -50,22 +140,22 @@ impl<'g> CommandBuffers<'g> {
         Ok(cmd)
     }
 
+    /// Ends `cmd`, submits it and waits for it.
     pub(crate) fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<(), GpuError> {
         unsafe { self.gpu.device().end_command_buffer(cmd) }.call("vkEndCommandBuffer")?;
-        self.gpu.submit_and_wait(cmd)
+        self.gpu.submit_and_wait_on(cmd, self.fence)
     }
 }
 
-impl Drop for CommandBuffers<'_> {
+impl Drop for Commands<'_> {
     fn drop(&mut self) {
-        if self.buffers.is_empty() {
-            return;
-        }
+        let device = self.gpu.device();
         unsafe {
-            let _ = self.gpu.device().device_wait_idle();
-            self.gpu
-                .device()
-                .free_command_buffers(self.gpu.command_pool(), &self.buffers);
+            let _ = device.device_wait_idle();
+            if !self.buffers.is_empty() {
+                device.free_command_buffers(self.gpu.command_pool(), &self.buffers);
+            }
+            device.destroy_fence(self.fence, None);
         }
     }
 }

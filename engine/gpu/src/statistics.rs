@@ -43,6 +43,11 @@ pub(crate) struct StatisticsPool<'g> {
 }
 
 impl<'g> StatisticsPool<'g> {
+    /// Queries in the pool.
+    pub(crate) fn count(&self) -> u32 {
+        self.count
+    }
+
     /// A pool with one query per pass.
     pub(crate) fn new(gpu: &'g Gpu, count: u32) -> Result<Self, GpuError> {
         let count = count.max(1);

@@ -176,7 +176,7 @@ impl<'g> FrameLoop<'g> {
     /// both pipeline caches, so the next frame only builds pipelines.
     pub fn adopt_shader(&mut self, key: ShaderKey, module: Arc<ShaderModule>) {
         self.recorder.adopt(key.clone(), Arc::clone(&module));
-        self.renderer.pipelines().adopt(key, module);
+        self.renderer.adopt_shader(key, module);
     }
 
     /// Samples per pixel the plan's history holds after the last frame drawn:

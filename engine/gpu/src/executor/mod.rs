@@ -6,18 +6,17 @@
 use crate::bind::ResolvedBinding;
 use crate::check::{self, PassShaders, ShaderProblem};
 use crate::context::{Gpu, MemoryReport};
-use crate::download::ReadbackBuffer;
 use crate::draw::DrawRecorder;
 use crate::error::GpuError;
-use crate::frame::CommandBuffers;
+use crate::frame::FramePools;
 use crate::pipeline::{Pipeline, PipelineCache, PipelineKey};
 use crate::readback::Readback;
 use crate::record;
 use crate::renderpass::RenderPassCache;
 use crate::resources::FrameResources;
 use crate::samplers::Samplers;
-use crate::statistics::{PassStatistics, StatisticsPool};
-use crate::timing::{PassTiming, QueryPool, TimingMode, TimingSource};
+use crate::statistics::PassStatistics;
+use crate::timing::{PassTiming, TimingMode, TimingSource};
 mod prepare;
 mod record_pass;
 
@@ -69,6 +68,15 @@ pub struct FrameReport {
     pub memory: MemoryReport,
 }
 
+/// What recording and running a frame gave back.
+struct Recorded {
+    timings: Vec<PassTiming>,
+    statistics: Vec<PassStatistics>,
+    /// The output, then the plan's other read-back images.
+    images: Vec<Readback>,
+    record_ms: f64,
+}
+
 /// Everything a pass needs at record time.
 pub(crate) struct Prepared {
     pipeline: Option<Arc<Pipeline>>,
@@ -102,6 +110,10 @@ pub struct Renderer<'g> {
     render_passes: RenderPassCache,
     pipelines: PipelineCache,
     samplers: Samplers,
+    /// Command buffers, fence, queries and read-back buffers, reused by
+    /// every frame (no per-frame Vulkan object creation).
+    /// Taken while a frame records, so the frame can borrow the renderer too.
+    pools: Option<FramePools<'g>>,
 }
 
 impl<'g> Renderer<'g> {
@@ -115,6 +127,7 @@ impl<'g> Renderer<'g> {
             render_passes: RenderPassCache::default(),
             pipelines,
             samplers,
+            pools: None,
         })
     }
 
@@ -123,10 +136,19 @@ impl<'g> Renderer<'g> {
         self.gpu
     }
 
-    /// The shader and pipeline cache (for hot reload and inspection).
-    pub fn pipelines(&mut self) -> &mut PipelineCache {
-        self.generation += 1;
-        &mut self.pipelines
+    /// The shader and pipeline cache, for inspection.
+    pub fn pipelines(&self) -> &PipelineCache {
+        &self.pipelines
+    }
+
+    /// Takes a shader variant a hot reload compiled and checked elsewhere
+    /// ([`PipelineCache::adopt`]); no pipeline changes, so prepared plans stay.
+    pub fn adopt_shader(
+        &mut self,
+        key: crate::pipeline::ShaderKey,
+        module: Arc<crate::pipeline::ShaderModule>,
+    ) {
+        self.pipelines.adopt(key, module);
     }
 
     /// Drops every shader and pipeline built from `changed` so the next frame
@@ -221,30 +243,85 @@ impl<'g> Renderer<'g> {
             prep.push = self.pack_push(pass, prep, options)?;
         }
         let prepared = &ready.passes;
-        let readbacks = if options.readback {
+        let readback: Vec<_> = if options.readback {
             std::iter::once(plan.output)
                 .chain(plan.readback.iter().copied())
-                .map(|r| ReadbackBuffer::new(self.gpu, plan, r))
-                .collect::<Result<Vec<_>, _>>()?
+                .collect()
         } else {
             Vec::new()
         };
-        let queries = if options.timing == TimingMode::GpuTimestamps && self.gpu.info().timestamps {
-            Some(QueryPool::new(self.gpu, 2 * plan.passes.len() as u32)?)
-        } else {
-            None
-        };
-        let stats =
-            if options.timing == TimingMode::GpuTimestamps && self.gpu.info().pipeline_statistics {
-                Some(StatisticsPool::new(self.gpu, plan.passes.len() as u32)?)
-            } else {
-                None
-            };
+        let gpu_timing = options.timing == TimingMode::GpuTimestamps;
+        let info = self.gpu.info();
+        let mut pools = self
+            .pools
+            .take()
+            .map_or_else(|| FramePools::new(self.gpu), Ok)?;
+        pools.fit(
+            plan,
+            (
+                gpu_timing && info.timestamps,
+                gpu_timing && info.pipeline_statistics,
+            ),
+            &readback,
+        )?;
+        let result = self.record_and_submit(
+            plan,
+            (resources, draws),
+            &mut pools,
+            prepared,
+            options,
+            started,
+        );
+        self.pools = Some(pools);
+        let Recorded {
+            timings,
+            statistics,
+            images,
+            record_ms,
+        } = result?;
+        let mut images = images.into_iter();
+        let output = images.next();
+        let readbacks: Vec<(String, Readback)> = plan
+            .readback
+            .iter()
+            .map(|&r| plan.resources[r].name.clone())
+            .zip(images)
+            .collect();
+        resources.prepared = Some(ready);
+        Ok(FrameReport {
+            timings,
+            statistics,
+            output,
+            readbacks,
+            record_ms,
+            transient_bytes: resources.transient_bytes,
+            dedicated_bytes: resources.dedicated_bytes,
+            memory: self.gpu.memory_report(),
+        })
+    }
+
+    /// Records the frame's passes into `pools`' command buffers, submits and
+    /// waits, and reads back the times, statistics and images.
+    fn record_and_submit(
+        &mut self,
+        plan: &Plan,
+        (resources, draws): (&mut FrameResources<'g>, &mut dyn DrawRecorder),
+        pools: &mut FramePools<'g>,
+        prepared: &[Prepared],
+        options: &FrameOptions,
+        started: Instant,
+    ) -> Result<Recorded, GpuError> {
         let mut record_ms = started.elapsed().as_secs_f64() * 1e3;
         let mut timings = Vec::new();
         let per_pass = options.timing == TimingMode::CpuPerPass;
-        let mut buffers = CommandBuffers::new(self.gpu);
-        let mut cmd = buffers.begin()?;
+        let FramePools {
+            commands,
+            queries,
+            statistics: stats,
+            readbacks,
+            ..
+        } = pools;
+        let mut cmd = commands.begin()?;
         if let Some(q) = &queries {
             unsafe {
                 self.gpu
@@ -291,23 +368,23 @@ impl<'g> Renderer<'g> {
             record_ms += t.elapsed().as_secs_f64() * 1e3;
             if per_pass {
                 let wall = Instant::now();
-                buffers.submit_and_wait(cmd)?;
+                commands.submit_and_wait(cmd)?;
                 timings.push(PassTiming {
                     pass: pass.name.clone(),
                     kind: pass.kind,
                     source: TimingSource::CpuWall,
                     ms: wall.elapsed().as_secs_f64() * 1e3,
                 });
-                cmd = buffers.begin()?;
+                cmd = commands.begin()?;
             }
         }
         let t = Instant::now();
         record::barriers(self.gpu.device(), cmd, &plan.epilogue, resources)?;
-        for rb in &readbacks {
+        for rb in readbacks.iter() {
             rb.record(self.gpu, cmd, resources)?;
         }
         record_ms += t.elapsed().as_secs_f64() * 1e3;
-        buffers.submit_and_wait(cmd)?;
+        commands.submit_and_wait(cmd)?;
         if let Some(q) = &queries {
             timings = q.timings(self.gpu, plan)?;
         }
@@ -315,29 +392,15 @@ impl<'g> Renderer<'g> {
             Some(s) => s.read(plan)?,
             None => Vec::new(),
         };
-        let mut images = readbacks
+        let images = readbacks
             .iter()
             .map(|rb| rb.read(plan))
-            .collect::<Result<Vec<_>, _>>()?
-            .into_iter();
-        let output = images.next();
-        let readbacks: Vec<(String, Readback)> = plan
-            .readback
-            .iter()
-            .map(|&r| plan.resources[r].name.clone())
-            .zip(images)
-            .collect();
-        drop(buffers);
-        resources.prepared = Some(ready);
-        Ok(FrameReport {
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Recorded {
             timings,
             statistics,
-            output,
-            readbacks,
+            images,
             record_ms,
-            transient_bytes: resources.transient_bytes,
-            dedicated_bytes: resources.dedicated_bytes,
-            memory: self.gpu.memory_report(),
         })
     }
 }
