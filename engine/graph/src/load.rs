@@ -203,8 +203,8 @@ fn load_file(
     // An include outside the root graph's folder tree, or a system file, may be
     // anything (`/proc/self/environ`): errors about it name it, never show it.
     let private = match stack.first().and_then(|root| root.parent()) {
-        Some(root) => !weft_io::read::is_within(path, root) || weft_io::read::is_system(path),
-        None => weft_io::read::is_system(path),
+        Some(root) => !weft_io::paths::is_within(path, root) || weft_io::paths::is_system(path),
+        None => weft_io::paths::is_system(path),
     };
     let text = match read(path) {
         Ok(text) => {

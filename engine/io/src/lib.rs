@@ -9,7 +9,17 @@
 
 pub mod entry;
 pub mod hash;
+pub mod paths;
 pub mod read;
 pub mod sources;
 
 pub use read::{read_capped, read_text, FileKind, ReadError};
+
+/// A fresh folder for one unit test, under the system's temporary folder.
+#[cfg(test)]
+pub(crate) fn test_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("weft-io-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}

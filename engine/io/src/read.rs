@@ -186,45 +186,13 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String, ReadError> {
 /// The UTF-8 encoding of U+FEFF, the byte-order mark.
 const UTF8_BOM: &[u8] = b"\xEF\xBB\xBF";
 
-/// Whether `path` lies under the folder `root` once both are resolved (links,
-/// `..`); a path that does not exist is judged by its existing parent.
-pub fn is_within(path: &Path, root: &Path) -> bool {
-    let resolve = |p: &Path| {
-        p.canonicalize().ok().or_else(|| {
-            let parent = p.parent()?.canonicalize().ok()?;
-            Some(parent.join(p.file_name()?))
-        })
-    };
-    match (resolve(path), root.canonicalize()) {
-        (Some(path), Ok(root)) => path.starts_with(root),
-        _ => false,
-    }
-}
-
-/// Whether `path` is under a system folder whose files describe the running
-/// machine or process (`/proc`, `/sys`, `/dev`, `/etc`), whose contents must
-/// never be echoed in an error.
-pub fn is_system(path: &Path) -> bool {
-    let resolved = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
-    ["/proc", "/sys", "/dev", "/etc"]
-        .iter()
-        .any(|root| resolved.starts_with(root))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn temp(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("weft-io-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("temp dir");
-        dir
-    }
-
     #[test]
     fn devices_fifos_and_folders_are_refused_without_reading() {
-        let dir = temp("kinds");
+        let dir = crate::test_dir("kinds");
         let fifo = dir.join("fifo");
         let made = std::process::Command::new("mkfifo")
             .arg(&fifo)
@@ -260,7 +228,7 @@ mod tests {
             }) => {}
             other => panic!("{other:?}"),
         }
-        let dir = temp("limit");
+        let dir = crate::test_dir("limit");
         let file = dir.join("big.txt");
         std::fs::write(&file, "0123456789").expect("write");
         let error = read_capped(&file, 9).expect_err("over the limit");
@@ -274,7 +242,7 @@ mod tests {
 
     #[test]
     fn text_reports_the_line_of_bad_utf8_and_drops_a_bom() {
-        let dir = temp("text");
+        let dir = crate::test_dir("text");
         let file = dir.join("t.txt");
         std::fs::write(&file, b"\xEF\xBB\xBFa\nb\n\xFF\n").expect("write");
         match read_text(&file, 100) {
@@ -288,20 +256,6 @@ mod tests {
             Some("a\nb\n"),
             "remembered for printers"
         );
-        std::fs::remove_dir_all(&dir).expect("clean up");
-    }
-
-    #[test]
-    fn within_and_system_paths() {
-        let dir = temp("within");
-        std::fs::create_dir_all(dir.join("a/b")).expect("dirs");
-        assert!(is_within(&dir.join("a/b/x.ron"), &dir));
-        assert!(is_within(&dir.join("a/../a/b"), &dir));
-        assert!(!is_within(&dir.join("../outside.ron"), &dir));
-        assert!(!is_within(Path::new("/etc/passwd"), &dir));
-        assert!(is_system(Path::new("/proc/self/environ")));
-        assert!(is_system(Path::new("/etc/passwd")));
-        assert!(!is_system(&dir));
         std::fs::remove_dir_all(&dir).expect("clean up");
     }
 }

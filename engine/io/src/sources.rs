@@ -14,7 +14,7 @@ fn texts() -> &'static Mutex<HashMap<PathBuf, Arc<str>>> {
 
 /// Keeps `text` as what `path` holds, unless `path` is a system file.
 pub fn remember(path: &Path, text: &str) {
-    if crate::read::is_system(path) {
+    if crate::paths::is_system(path) {
         return;
     }
     let mut texts = texts().lock().unwrap_or_else(|p| p.into_inner());

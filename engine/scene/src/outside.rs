@@ -28,7 +28,7 @@ pub fn refusal(file: &Path, root: &Path, what: &str) -> Option<String> {
     } else {
         root
     };
-    (!allowed() && !weft_io::read::is_within(file, root)).then(|| {
+    (!allowed() && !weft_io::paths::is_within(file, root)).then(|| {
         format!(
             "{what} {} lies outside {} (the folder tree it is named from); weft reads it only with --allow-outside",
             file.display(),

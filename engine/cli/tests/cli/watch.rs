@@ -313,3 +313,36 @@ fn edit_to_image_latency() {
     let status = watch.terminate();
     assert!(status.success(), "{status:?}");
 }
+
+/// A scene script whose `update` fails at its first step is refused at once
+/// with its location, also at the default `--time 0` (where no step would
+/// otherwise run), and the fixed script is picked up.
+#[test]
+fn a_script_whose_update_fails_is_reported_at_time_zero() {
+    let _serial = serial();
+    let fixture = Fixture::new("update-error");
+    fixture.save_in_place(
+        "scenes/tiny.scene",
+        &format!("{SCENE}\nscript \"bad.rhai\"\n"),
+    );
+    fixture.save_in_place(
+        "scenes/bad.rhai",
+        "fn update(t, dt) {\n    set_light_on(99, false);\n}\n",
+    );
+    let mut watch = Watch::spawn(&fixture, &[]);
+    let line = watch.line();
+    assert!(
+        line.starts_with("error: ")
+            && line.contains("bad.rhai:2: no light 99: the scene has 1")
+            && line.ends_with("(no good version yet; waiting for a fix)"),
+        "{line}"
+    );
+    fixture.save_by_rename(
+        "scenes/bad.rhai",
+        "fn update(t, dt) {\n    set_light_on(0, true);\n}\n",
+    );
+    let line = watch.line();
+    assert!(line.starts_with("wrote out/live.png"), "{line}");
+    let status = watch.terminate();
+    assert!(status.success(), "{status:?}");
+}
