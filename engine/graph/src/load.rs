@@ -49,6 +49,9 @@ pub struct LoadedGraph {
     pub name: String,
     /// Toggles declared on by default by the graph and its fragments.
     pub default_features: Vec<String>,
+    /// Features only weft's own tools set, declared by the graph and its
+    /// fragments (`internal_features`).
+    pub internal_features: Vec<String>,
     /// Whether the root file is a fragment (checked alone, never compiled alone).
     pub is_fragment: bool,
     /// Per source: the resources it expects its includer to declare.
@@ -282,6 +285,11 @@ fn load_file(
     for feature in &parsed.features {
         if !graph.default_features.contains(feature) {
             graph.default_features.push(feature.clone());
+        }
+    }
+    for feature in &parsed.internal_features {
+        if !graph.internal_features.contains(feature) {
+            graph.internal_features.push(feature.clone());
         }
     }
     // At the root, `fragment.name` overrides (`--param shadows.resolution=1024`)

@@ -25,6 +25,10 @@ pub struct GraphFile {
     /// User toggles that are on unless turned off (`--features !bloom`).
     #[serde(default)]
     pub features: Vec<String>,
+    /// Features weft's own tools set (`bench_floors` for `weft bench
+    /// floors`): never offered in the viewer, refused from `--features`.
+    #[serde(default)]
+    pub internal_features: Vec<String>,
     /// Parameters with defaults; passes and sizes refer to them as `"$name"`.
     #[serde(default)]
     pub params: BTreeMap<String, ParamValue>,

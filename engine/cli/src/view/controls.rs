@@ -82,9 +82,9 @@ pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
     Ok((frame, action))
 }
 
-/// The features `graph` can switch (names in its conditions and its defaults),
-/// sorted; number keys 1 to 9 toggle them in this order. Empty when the graph
-/// does not load.
+/// The features a user of `graph` can switch (names in its conditions and
+/// its defaults, less its `internal_features`), sorted; number keys 1 to 9
+/// toggle them in this order. Empty when the graph does not load.
 pub fn graph_features(graph: &Path) -> Vec<String> {
     let loaded = weft_graph::load(graph);
     let mut names = match weft_graph::Prepared::new(&loaded) {
@@ -92,6 +92,7 @@ pub fn graph_features(graph: &Path) -> Vec<String> {
         Err(_) => return Vec::new(),
     };
     names.extend(loaded.default_features.iter().cloned());
+    names.retain(|n| !loaded.internal_features.contains(n));
     names.into_iter().collect()
 }
 
@@ -254,6 +255,10 @@ mod tests {
                 "{expected} in {names:?}"
             );
         }
+        assert!(
+            !names.iter().any(|n| n == "bench_floors"),
+            "an internal feature is never offered: {names:?}"
+        );
         let mut sorted = names.clone();
         sorted.sort();
         assert_eq!(names, sorted);

@@ -385,6 +385,26 @@ fn output_folders_negative_times_and_empty_feature_names() {
         "--time -5 is a value: {}",
         stderr(&out)
     );
+    let out = weft_within(
+        &repo(),
+        &[
+            "render",
+            "scenes/demo.scene",
+            "--size",
+            "8x8",
+            "--features",
+            "bench_floors",
+            "--out",
+            &png.to_string_lossy(),
+        ],
+        60,
+    );
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("feature \"bench_floors\" is internal: weft's own tools set it (the graph's `internal_features`), not `--features`"),
+        "{err}"
+    );
     for features in ["!", ",,,", "bloom,,shadow_casters"] {
         let out = weft_within(
             &repo(),

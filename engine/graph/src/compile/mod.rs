@@ -96,11 +96,22 @@ impl<'g> Prepared<'g> {
             .map(|f| f.as_ref().trim())
             .any(|f| f.strip_prefix('!').unwrap_or(f).is_empty())
             .then(|| "an empty feature name (a stray comma, or `!` alone)".to_string());
+        let internal = requested
+            .iter()
+            .map(|f| f.as_ref().trim())
+            .map(|f| f.strip_prefix('!').unwrap_or(f))
+            .filter(|f| self.graph.internal_features.iter().any(|i| i == f))
+            .map(|f| format!("feature \"{f}\" is internal: weft's own tools set it (the graph's `internal_features`), not `--features`"));
+        known.retain(|k| !self.graph.internal_features.contains(k));
         let unknown = requested
             .iter()
             .map(|f| f.as_ref().trim())
             .map(|f| f.strip_prefix('!').unwrap_or(f))
-            .filter(|f| !f.is_empty() && !known.contains(*f))
+            .filter(|f| {
+                !f.is_empty()
+                    && !known.contains(*f)
+                    && !self.graph.internal_features.iter().any(|i| i == f)
+            })
             .map(|f| {
                 let hint = crate::diagnostic::nearest(f, known.iter().map(String::as_str))
                     .map(|n| format!(" (did you mean \"{n}\"?)"))
@@ -108,7 +119,7 @@ impl<'g> Prepared<'g> {
                 let list = known.iter().cloned().collect::<Vec<_>>().join(", ");
                 format!("unknown feature \"{f}\"{hint}; this graph's features are: {list}")
             });
-        empty.into_iter().chain(unknown).collect()
+        empty.into_iter().chain(internal).chain(unknown).collect()
     }
 
     /// Compiles for one size and feature set.
