@@ -13,7 +13,7 @@ pub mod paths;
 pub mod read;
 pub mod sources;
 
-pub use read::{read_capped, read_text, FileKind, ReadError};
+pub use read::{open_regular, read_capped, read_text, FileKind, ReadError};
 
 /// A fresh folder for one unit test, under the system's temporary folder.
 #[cfg(test)]

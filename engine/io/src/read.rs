@@ -107,11 +107,10 @@ impl ReadError {
     }
 }
 
-/// Reads a whole regular file, refusing directories, FIFOs, devices and
-/// sockets (a link is followed to what it names), and files over `limit`
-/// bytes; the limit caps the bytes actually read, since a file can grow (or,
-/// under `/proc`, report no size) after its metadata was read.
-pub fn read_capped(path: &Path, limit: u64) -> Result<Vec<u8>, ReadError> {
+/// Opens a regular file for reading without reading it (for decoders that
+/// read only a header), refusing directories, FIFOs, devices and sockets as
+/// [`read_capped`] does, and checking what was opened.
+pub fn open_regular(path: &Path) -> Result<std::fs::File, ReadError> {
     let io_error = |source: std::io::Error| {
         if source.kind() == std::io::ErrorKind::NotFound {
             ReadError::Missing {
@@ -131,17 +130,7 @@ pub fn read_capped(path: &Path, limit: u64) -> Result<Vec<u8>, ReadError> {
             kind: FileKind::of(&meta),
         });
     }
-    let too_large = |size| ReadError::TooLarge {
-        path: path.to_path_buf(),
-        size,
-        limit,
-    };
-    if meta.len() > limit {
-        return Err(too_large(meta.len()));
-    }
     let file = std::fs::File::open(path).map_err(io_error)?;
-    // The file is opened after the check, so check what was opened too: a
-    // path swapped for a FIFO in between would otherwise block.
     let opened = file.metadata().map_err(io_error)?;
     if !opened.is_file() {
         return Err(ReadError::NotRegular {
@@ -149,10 +138,37 @@ pub fn read_capped(path: &Path, limit: u64) -> Result<Vec<u8>, ReadError> {
             kind: FileKind::of(&opened),
         });
     }
-    let mut bytes = Vec::with_capacity(usize::try_from(meta.len()).unwrap_or(0));
+    Ok(file)
+}
+
+/// Reads a whole regular file, refusing directories, FIFOs, devices and
+/// sockets (a link is followed to what it names), and files over `limit`
+/// bytes; the limit caps the bytes actually read, since a file can grow (or,
+/// under `/proc`, report no size) after its metadata was read.
+pub fn read_capped(path: &Path, limit: u64) -> Result<Vec<u8>, ReadError> {
+    let file = open_regular(path)?;
+    let too_large = |size| ReadError::TooLarge {
+        path: path.to_path_buf(),
+        size,
+        limit,
+    };
+    let len = file
+        .metadata()
+        .map_err(|source| ReadError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?
+        .len();
+    if len > limit {
+        return Err(too_large(len));
+    }
+    let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
     file.take(limit.saturating_add(1))
         .read_to_end(&mut bytes)
-        .map_err(io_error)?;
+        .map_err(|source| ReadError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
     if bytes.len() as u64 > limit {
         return Err(too_large(bytes.len() as u64));
     }

@@ -297,17 +297,26 @@ pub fn fit_within(width: u32, height: u32, max_side: u32) -> (u32, u32) {
 }
 
 /// The width and height an image file or embedded image declares, read from
-/// its header alone; `None` when it cannot be read or decoded.
+/// its header alone (a file is opened through weft's one reader's checks, so
+/// a FIFO is refused); `None` when it cannot be read or decoded.
 pub fn declared_size(source: &TextureSource) -> Option<(u32, u32)> {
-    let bytes: std::borrow::Cow<[u8]> = match source {
-        TextureSource::File(path) => weft_io::read_capped(path, 1 << 30).ok()?.into(),
-        TextureSource::Embedded { bytes, .. } => (&bytes[..]).into(),
-    };
-    image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
-        .with_guessed_format()
-        .ok()?
-        .into_dimensions()
-        .ok()
+    match source {
+        TextureSource::File(path) => {
+            let file = std::io::BufReader::new(weft_io::open_regular(path).ok()?);
+            image::ImageReader::new(file)
+                .with_guessed_format()
+                .ok()?
+                .into_dimensions()
+                .ok()
+        }
+        TextureSource::Embedded { bytes, .. } => {
+            image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+                .with_guessed_format()
+                .ok()?
+                .into_dimensions()
+                .ok()
+        }
+    }
 }
 
 #[cfg(test)]
