@@ -133,6 +133,13 @@ impl<'g> Commands<'g> {
         }
         let cmd = self.buffers[self.used];
         self.used += 1;
+        // Explicitly, so a buffer a failed frame left recording starts clean.
+        unsafe {
+            self.gpu
+                .device()
+                .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
+        }
+        .call("vkResetCommandBuffer")?;
         let info = vk::CommandBufferBeginInfo::default()
             .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         unsafe { self.gpu.device().begin_command_buffer(cmd, &info) }

@@ -1,6 +1,7 @@
 //! The one reader of files: capped, regular files only, errors that say which.
 
 use std::io::Read;
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 
 /// The largest text file read by default (graphs, includes, shaders, scenes,
@@ -130,7 +131,13 @@ pub fn open_regular(path: &Path) -> Result<std::fs::File, ReadError> {
             kind: FileKind::of(&meta),
         });
     }
-    let file = std::fs::File::open(path).map_err(io_error)?;
+    // Non-blocking, so a path swapped for a FIFO after the check above fails
+    // the check below instead of blocking in open (regular files ignore it).
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+        .map_err(io_error)?;
     let opened = file.metadata().map_err(io_error)?;
     if !opened.is_file() {
         return Err(ReadError::NotRegular {

@@ -300,22 +300,18 @@ pub fn fit_within(width: u32, height: u32, max_side: u32) -> (u32, u32) {
 /// its header alone (a file is opened through weft's one reader's checks, so
 /// a FIFO is refused); `None` when it cannot be read or decoded.
 pub fn declared_size(source: &TextureSource) -> Option<(u32, u32)> {
+    fn header<R: std::io::BufRead + std::io::Seek>(reader: R) -> Option<(u32, u32)> {
+        image::ImageReader::new(reader)
+            .with_guessed_format()
+            .ok()?
+            .into_dimensions()
+            .ok()
+    }
     match source {
         TextureSource::File(path) => {
-            let file = std::io::BufReader::new(weft_io::open_regular(path).ok()?);
-            image::ImageReader::new(file)
-                .with_guessed_format()
-                .ok()?
-                .into_dimensions()
-                .ok()
+            header(std::io::BufReader::new(weft_io::open_regular(path).ok()?))
         }
-        TextureSource::Embedded { bytes, .. } => {
-            image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
-                .with_guessed_format()
-                .ok()?
-                .into_dimensions()
-                .ok()
-        }
+        TextureSource::Embedded { bytes, .. } => header(std::io::Cursor::new(&bytes[..])),
     }
 }
 

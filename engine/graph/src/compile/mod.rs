@@ -89,37 +89,33 @@ impl<'g> Prepared<'g> {
     /// of this graph — neither one its passes test nor a default — each as a
     /// message with the nearest known name as a hint.
     pub fn unknown_features<S: AsRef<str>>(&self, requested: &[S]) -> Vec<String> {
+        let internal = |f: &str| self.graph.internal_features.iter().any(|i| i == f);
         let mut known = feature_names(&self.ir);
         known.extend(self.graph.default_features.iter().cloned());
-        let empty = requested
-            .iter()
-            .map(|f| f.as_ref().trim())
-            .any(|f| f.strip_prefix('!').unwrap_or(f).is_empty())
-            .then(|| "an empty feature name (a stray comma, or `!` alone)".to_string());
-        let internal = requested
+        known.retain(|k| !internal(k));
+        let names: Vec<&str> = requested
             .iter()
             .map(|f| f.as_ref().trim())
             .map(|f| f.strip_prefix('!').unwrap_or(f))
-            .filter(|f| self.graph.internal_features.iter().any(|i| i == f))
-            .map(|f| format!("feature \"{f}\" is internal: weft's own tools set it (the graph's `internal_features`), not `--features`"));
-        known.retain(|k| !self.graph.internal_features.contains(k));
-        let unknown = requested
-            .iter()
-            .map(|f| f.as_ref().trim())
-            .map(|f| f.strip_prefix('!').unwrap_or(f))
-            .filter(|f| {
-                !f.is_empty()
-                    && !known.contains(*f)
-                    && !self.graph.internal_features.iter().any(|i| i == f)
-            })
-            .map(|f| {
+            .collect();
+        let mut problems = Vec::new();
+        if names.iter().any(|f| f.is_empty()) {
+            problems.push("an empty feature name (a stray comma, or `!` alone)".to_string());
+        }
+        for f in names.into_iter().filter(|f| !f.is_empty()) {
+            if internal(f) {
+                problems.push(format!("feature \"{f}\" is internal: weft's own tools set it (the graph's `internal_features`), not `--features`"));
+            } else if !known.contains(f) {
                 let hint = crate::diagnostic::nearest(f, known.iter().map(String::as_str))
                     .map(|n| format!(" (did you mean \"{n}\"?)"))
                     .unwrap_or_default();
                 let list = known.iter().cloned().collect::<Vec<_>>().join(", ");
-                format!("unknown feature \"{f}\"{hint}; this graph's features are: {list}")
-            });
-        empty.into_iter().chain(internal).chain(unknown).collect()
+                problems.push(format!(
+                    "unknown feature \"{f}\"{hint}; this graph's features are: {list}"
+                ));
+            }
+        }
+        problems
     }
 
     /// Compiles for one size and feature set.

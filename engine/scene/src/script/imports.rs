@@ -77,16 +77,16 @@ impl ModuleResolver for FolderResolver {
             ));
         };
         {
-            let mut read = self.read.lock().unwrap_or_else(|p| p.into_inner());
+            let mut read = lock(&self.read);
             if !read.contains(&file) {
                 read.push(file.clone());
             }
         }
-        if let Some(module) = lock_any(&self.modules).get(&canonical) {
+        if let Some(module) = lock(&self.modules).get(&canonical) {
             return Ok(module.clone());
         }
         {
-            let mut resolving = lock_any(&self.resolving);
+            let mut resolving = lock(&self.resolving);
             if let Some(first) = resolving.iter().position(|f| *f == canonical) {
                 let chain: Vec<String> = resolving[first..]
                     .iter()
@@ -111,14 +111,9 @@ impl ModuleResolver for FolderResolver {
             resolving.push(canonical.clone());
         }
         let module = self.evaluate(engine, &file, path, position);
-        lock_any(&self.resolving).pop();
+        lock(&self.resolving).pop();
         let module = module?;
-        lock_any(&self.modules).insert(canonical, module.clone());
+        lock(&self.modules).insert(canonical, module.clone());
         Ok(module)
     }
-}
-
-/// A mutex's value, also after a panic elsewhere poisoned it.
-pub(super) fn lock_any<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
-    mutex.lock().unwrap_or_else(|p| p.into_inner())
 }

@@ -175,7 +175,7 @@ pub fn run_load(
     let ast = compile(&engine, script)?;
     start_call(&state, limits.call_seconds);
     run_top_level(&engine, &ast, script)?;
-    script_ref.imports = std::mem::take(&mut *imports.lock().unwrap_or_else(|p| p.into_inner()));
+    script_ref.imports = std::mem::take(&mut *lock(&imports));
     let mut s = lock(&state);
     let added = std::mem::take(&mut s.desc);
     desc.models.extend(added.models);

@@ -116,8 +116,10 @@ impl State {
 
 pub(super) type Shared = Arc<Mutex<State>>;
 
-pub(super) fn lock(state: &Shared) -> MutexGuard<'_, State> {
-    state
+/// A mutex's value (the script's state, or a resolver's records), also
+/// after a panic elsewhere poisoned it.
+pub(super) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
