@@ -10,10 +10,16 @@
 // inf. weft_render::sanitize::HDR_PASS_MAX mirrors it.
 #define HDR_PASS_MAX 8192.0
 
-// `c` with NaN replaced by 0, negatives by 0 and anything above `top`
-// (inf included) by `top`.
+// `c` with NaN and negatives replaced by 0, +inf by `top`, and then scaled
+// down as a whole where its brightest channel exceeds `top`: a clamp keeps
+// the colour's hue rather than clamping channels apart (which turns an
+// overexposed orange white, and a coloured sparkle a different colour in
+// every graph). weft_render::sanitize::radiance follows the same rule.
 vec3 finite_clamped(vec3 c, float top) {
-    return clamp(mix(c, vec3(0.0), isnan(c)), vec3(0.0), vec3(top));
+    c = max(mix(c, vec3(0.0), isnan(c)), vec3(0.0));
+    c = mix(c, vec3(top), isinf(c));
+    float peak = max(c.r, max(c.g, c.b));
+    return peak > top ? c * (top / peak) : c;
 }
 
 // `c` made safe to write to an HDR target by one pass.

@@ -21,6 +21,7 @@
 #define WEFT_LIGHTING_GLSL
 #include "scene.glsl"
 #include "hdr.glsl"
+#include "area_light.glsl"
 
 #ifdef SCENE_SPECIALISED
 #ifdef SCENE_SUNS
@@ -254,8 +255,12 @@ vec3 incoming(uint index, Surface s, out vec3 l) {
     return incoming_spot(index, s, l);
 }
 
-// Light reflected to the camera from `radiance` arriving along `l`, by the
+// Light reflected to the camera from light arriving along `l`, by the
 // material's shading model (only the models this variant compiles).
+// `radiance` is in the unit of a punctual light's colour: C gives a surface
+// facing it irradiance pi C (scenes/FORMAT.md, "Units"), so a Lambert surface
+// of albedo Kd shows Kd C and every model returns pi f cos(theta) C, f its
+// BSDF; the path tracer (pathtrace/lights.glsl) uses the same rule.
 vec3 reflected(Material m, Surface s, vec3 l, vec3 radiance) {
 #ifdef SHADE_METALLIC_ROUGHNESS
 #ifdef SHADE_BLINN_PHONG
@@ -264,51 +269,38 @@ vec3 reflected(Material m, Surface s, vec3 l, vec3 radiance) {
     }
 #endif
     vec3 v = normalize(frame.camera_position.xyz - s.position);
-    return radiance * cook_torrance(m.diffuse.rgb * s.texel, s.metal_rough, s.normal, v, l);
+    return radiance * (PI * cook_torrance(m.diffuse.rgb * s.texel, s.metal_rough, s.normal, v, l));
 #else
     return blinn_phong(m, s, l, radiance);
 #endif
 }
 
-// Shirley-Chiu concentric map of [-1, 1]^2 onto the unit disc; it preserves
-// area, so equal cells of the square stay equal on the disc.
-vec2 concentric(vec2 p) {
-    if (p.x == 0.0 && p.y == 0.0) {
-        return vec2(0.0);
-    }
-    float r = abs(p.x) > abs(p.y) ? p.x : p.y;
-    float phi = abs(p.x) > abs(p.y) ? PI / 4.0 * p.y / p.x : PI / 2.0 - PI / 4.0 * p.x / p.y;
-    return r * vec2(cos(phi), sin(phi));
-}
-
-// Area light `index` by quadrature: the rectangle or disc split into
-// `samples`^2 cells of equal area A, each lighting the surface from its centre
-// with irradiance L cos(theta_light) A / (d^2 + A / pi) (a disc of area A seen
-// head-on gives exactly that, so the sum stays finite next to the light). No
-// shadowing. The graph parameter `area_samples` (0: analytic) chooses it;
-// brdf.rs mirrors it at 8 x 8 for tests.
+// Area light `index` by quadrature: the light split into `samples`^2 cells
+// (outline_point, outline_cell: equal on rectangles and discs), each lighting
+// the surface from its centre with irradiance L cos(theta_light) A / (d^2 +
+// A / pi) for its area A (a disc of area A seen head-on gives exactly that,
+// so the sum stays finite next to the light), which is pi times the punctual
+// colour `reflected` takes. No shadowing. The graph parameter `area_samples`
+// (0: analytic) chooses it; brdf.rs mirrors it at 8 x 8 for tests.
 vec3 shade_area_quadrature(uint index, Surface s, Material m, uint samples) {
-    vec3 centre = lights[index].position_range.xyz;
-    vec3 x = lights[index].direction_type.xyz;
-    vec3 y = lights[index].attenuation_cos.xyz;
-    bool disc = lights[index].direction_type.w == LIGHT_AREA_DISC;
-    bool two_sided = lights[index].color_exponent.w > 0.5;
-    vec3 facing = -normalize(cross(x, y));
-    float cell = (disc ? PI : 4.0) * length(x) * length(y) / float(samples * samples);
+    AreaOutline o = area_outline(index, s.position);
+    if (in_light_plane(o, s.position)) {
+        return vec3(0.0);
+    }
+    vec3 facing = -normalize(o.winding);
+    float step = 2.0 / float(samples);
     vec3 sum = vec3(0.0);
     for (uint j = 0u; j < samples; ++j) {
         for (uint i = 0u; i < samples; ++i) {
-            vec2 uv = (vec2(i, j) + 0.5) * (2.0 / float(samples)) - 1.0;
-            if (disc) {
-                uv = concentric(uv);
-            }
-            vec3 to_light = centre + uv.x * x + uv.y * y - s.position;
+            vec2 uv = (vec2(i, j) + 0.5) * step - 1.0;
+            vec3 to_light = outline_point(o, uv);
+            float cell = outline_cell(o, uv, step);
             float d2 = dot(to_light, to_light);
             vec3 l = to_light * inversesqrt(max(d2, 1e-12));
             float cos_light = -dot(l, facing);
-            cos_light = two_sided ? abs(cos_light) : cos_light;
+            cos_light = o.two_sided ? abs(cos_light) : cos_light;
             if (cos_light > 0.0) {
-                sum += reflected(m, s, l, vec3(cos_light * cell / (d2 + cell / PI)));
+                sum += reflected(m, s, l, vec3(cos_light * cell / (PI * d2 + cell)));
             }
         }
     }
@@ -322,12 +314,12 @@ vec3 shade_area_quadrature(uint index, Surface s, Material m, uint samples) {
 // A glTF material under an area light: diffuse weighted by 1 - F(N.V), the
 // GGX highlight from its table, Fresnel from the table's Fresnel moment.
 // `local` takes world directions to the shading frame; `diffuse` is the
-// cosine's integral over the light.
+// form factor (the cosine's integral over the light, over pi).
 vec3 area_ltc_metallic_roughness(Surface s, Material m, float ndv, mat3 local, float diffuse,
-                                 vec3 centre, vec3 x, vec3 y, bool disc, float side) {
+                                 AreaOutline o, float side) {
     vec2 scale;
     mat3 inverse = ltc_lookup(LTC_GGX, max(s.metal_rough.y, MIN_ROUGHNESS), ndv, scale);
-    float highlight = ltc_integral(inverse * local, centre, x, y, disc, side);
+    float highlight = ltc_integral(inverse * local, o, side);
     vec3 base = m.diffuse.rgb * s.texel;
     vec3 f0 = mix(vec3(DIELECTRIC_F0), base, s.metal_rough.x);
     vec3 f_view = f0 + (1.0 - f0) * pow(1.0 - ndv, 5.0);
@@ -337,18 +329,19 @@ vec3 area_ltc_metallic_roughness(Surface s, Material m, float ndv, mat3 local, f
 #endif
 
 #ifdef SHADE_BLINN_PHONG
-// A Blinn-Phong material under an area light: Kd times the irradiance, and
-// the highlight from its table with the exponent read as roughness
-// (2 / (n + 2))^(1/4).
+// A Blinn-Phong material under an area light: Kd times the form factor (the
+// irradiance over pi, as `blinn_phong` shows Kd C for irradiance pi C), and
+// the highlight from its table, divided by pi likewise, with the exponent read
+// as roughness (2 / (n + 2))^(1/4).
 vec3 area_ltc_blinn_phong(Surface s, Material m, float ndv, mat3 local, float diffuse,
-                          vec3 centre, vec3 x, vec3 y, bool disc, float side) {
-    vec3 result = m.diffuse.rgb * s.texel * PI * diffuse;
+                          AreaOutline o, float side) {
+    vec3 result = m.diffuse.rgb * s.texel * diffuse;
     float shininess = m.specular.w;
     if (shininess > 0.0) {
         vec2 scale;
         mat3 inverse = ltc_lookup(LTC_BLINN_PHONG, pow(2.0 / (shininess + 2.0), 0.25), ndv, scale);
-        float highlight = ltc_integral(inverse * local, centre, x, y, disc, side);
-        result += m.specular.rgb * scale.x * highlight;
+        float highlight = ltc_integral(inverse * local, o, side);
+        result += m.specular.rgb * (scale.x / PI) * highlight;
     }
     return result;
 }
@@ -358,21 +351,20 @@ vec3 area_ltc_blinn_phong(Surface s, Material m, float ndv, mat3 local, float di
 // integral of the cosine over the polygon. Highlights: the fitted LTC of the
 // material's lobe, scaled by the lobe's integral. No shadowing.
 vec3 shade_area_ltc(uint index, Surface s, Material m) {
-    vec3 centre = lights[index].position_range.xyz - s.position;
-    vec3 x = lights[index].direction_type.xyz;
-    vec3 y = lights[index].attenuation_cos.xyz;
+    AreaOutline o = area_outline(index, s.position);
     // Only the shapes the scene has are compiled: lavapipe would run a
-    // 12-gon's corners for every rectangle otherwise.
+    // 12-gon's corners for every rectangle otherwise. Emissive polygons count
+    // as four-cornered lights (scene feature `rect_lights`).
 #if defined(SHADE_RECT_LIGHTS) && defined(SHADE_DISC_LIGHTS)
-    bool disc = lights[index].direction_type.w == LIGHT_AREA_DISC;
 #elif defined(SHADE_DISC_LIGHTS)
-    const bool disc = true;
+    o.disc = true;
 #else
-    const bool disc = false;
+    o.disc = false;
 #endif
-    // The light emits towards -(x cross y); a one-sided light seen from behind gives nothing.
-    float side = dot(centre, cross(x, y)) >= 0.0 ? 1.0 : -1.0;
-    if (side < 0.0 && lights[index].color_exponent.w <= 0.5) {
+    // The light emits towards -winding; a one-sided light seen from behind
+    // gives nothing, nor one whose plane holds the point.
+    float side = dot(o.centre, o.winding) >= 0.0 ? 1.0 : -1.0;
+    if ((side < 0.0 && !o.two_sided) || in_light_plane(o, s.position)) {
         return vec3(0.0);
     }
     vec3 n = s.normal;
@@ -382,15 +374,15 @@ vec3 shade_area_ltc(uint index, Surface s, Material m) {
     vec3 helper = abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
     t1 = dot(t1, t1) > 1e-12 ? normalize(t1) : normalize(cross(n, helper));
     mat3 local = transpose(mat3(t1, cross(n, t1), n));
-    float diffuse = ltc_integral(local, centre, x, y, disc, side);
+    float diffuse = ltc_integral(local, o, side);
 #if defined(SHADE_METALLIC_ROUGHNESS) && defined(SHADE_BLINN_PHONG)
     vec3 result = m.emissive.w == SHADING_METALLIC_ROUGHNESS
-        ? area_ltc_metallic_roughness(s, m, ndv, local, diffuse, centre, x, y, disc, side)
-        : area_ltc_blinn_phong(s, m, ndv, local, diffuse, centre, x, y, disc, side);
+        ? area_ltc_metallic_roughness(s, m, ndv, local, diffuse, o, side)
+        : area_ltc_blinn_phong(s, m, ndv, local, diffuse, o, side);
 #elif defined(SHADE_METALLIC_ROUGHNESS)
-    vec3 result = area_ltc_metallic_roughness(s, m, ndv, local, diffuse, centre, x, y, disc, side);
+    vec3 result = area_ltc_metallic_roughness(s, m, ndv, local, diffuse, o, side);
 #else
-    vec3 result = area_ltc_blinn_phong(s, m, ndv, local, diffuse, centre, x, y, disc, side);
+    vec3 result = area_ltc_blinn_phong(s, m, ndv, local, diffuse, o, side);
 #endif
     return result * lights[index].color_exponent.rgb;
 }
@@ -440,7 +432,9 @@ vec3 shade_suns(Surface s, Material m) {
 vec3 shade_area_lights(Surface s, Material m, uint area_samples) {
     vec3 c = vec3(0.0);
 #ifdef SHADE_AREA_LIGHTS
-    for (uint i = frame.counts.x + frame.counts.y + frame.counts.z; i < frame.counts.w; ++i) {
+    // Area lights, then the emissive polygons after every other record.
+    uint end = frame.counts.w + frame.emitter_lights.x;
+    for (uint i = frame.counts.x + frame.counts.y + frame.counts.z; i < end; ++i) {
         if (area_samples == 0u) {
             c += shade_area_ltc(i, s, m);
         } else {

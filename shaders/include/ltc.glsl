@@ -9,7 +9,7 @@
 // force. Discs are regular 12-gons of the same area.
 #ifndef WEFT_LTC_GLSL
 #define WEFT_LTC_GLSL
-#include "scene.glsl"
+#include "area_light.glsl"
 
 // 32 x 32 entries per table, row j = perceptual roughness j / 31 (at least
 // 0.045), column k = sqrt(1 - N.V) * 31. In vec4s: the GGX inverse matrices
@@ -75,30 +75,30 @@ float ltc_cap_integral(float sin2_radius, float cos_elevation) {
     return max(integral / PI, 0.0);
 }
 
-// Corner k of the light: a rectangle centre +- x +- y (counter-clockwise
-// about x cross y), or a regular LTC_DISC_CORNERS-gon of the disc's area.
-vec3 ltc_corner(int k, vec3 centre, vec3 x, vec3 y, bool disc) {
-    if (disc) {
+// Corner k of the light: its four corners, or a regular LTC_DISC_CORNERS-gon
+// of the disc's area.
+vec3 ltc_corner(int k, AreaOutline o) {
+    if (o.disc) {
         float a = 2.0 * PI * float(k) / float(LTC_DISC_CORNERS);
-        return centre + (cos(a) * x + sin(a) * y) * LTC_DISC_SCALE;
+        return o.centre + (cos(a) * o.x + sin(a) * o.y) * LTC_DISC_SCALE;
     }
-    vec2 signs = vec2(k == 1 || k == 2 ? 1.0 : -1.0, k >= 2 ? 1.0 : -1.0);
-    return centre + signs.x * x + signs.y * y;
+    return o.corners[k];
 }
 
 // The integral of max(z, 0) / pi over the light's polygon after `transform`
-// (the shading point at the origin), seen from the side `side` (+1 the
-// emitting side, -1 behind). The polygon's vector form factor is summed edge
-// by edge without clipping; the horizon is then accounted for by the cap
+// (the outline relative to the shading point), seen from the side `side` (+1
+// the emitting side, -1 behind). The polygon's vector form factor is summed
+// edge by edge without clipping; the horizon is then accounted for by the cap
 // with the same vector form factor (exact while the polygon is wholly above
-// the horizon). engine/ltc/src/polygon.rs is the CPU twin.
-float ltc_integral(mat3 transform, vec3 centre, vec3 x, vec3 y, bool disc, float side) {
-    int count = disc ? LTC_DISC_CORNERS : 4;
-    vec3 first = normalize(transform * ltc_corner(0, centre, x, y, disc));
+// the horizon). A triangle's repeated corner adds an edge of length 0, which
+// contributes nothing. engine/ltc/src/polygon.rs is the CPU twin.
+float ltc_integral(mat3 transform, AreaOutline o, float side) {
+    int count = o.disc ? LTC_DISC_CORNERS : 4;
+    vec3 first = normalize(transform * ltc_corner(0, o));
     vec3 previous = first;
     vec3 f = vec3(0.0);
     for (int k = 1; k < count; ++k) {
-        vec3 next = normalize(transform * ltc_corner(k, centre, x, y, disc));
+        vec3 next = normalize(transform * ltc_corner(k, o));
         f += ltc_edge(previous, next);
         previous = next;
     }

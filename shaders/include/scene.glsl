@@ -11,6 +11,8 @@
 #define LIGHT_SPOT_SPHERE 3.0
 #define LIGHT_AREA_RECT 4.0
 #define LIGHT_AREA_DISC 5.0
+// Emissive geometry as a light for raster shading (include/area_light.glsl).
+#define LIGHT_AREA_POLYGON 6.0
 
 // Shading models (engine/render/src/materials.rs), in Material.emissive.w.
 #define SHADING_BLINN_PHONG 0.0
@@ -26,6 +28,13 @@
 // local X times the half width (or the disc radius), type; color_exponent =
 // emitted radiance, 1 when two-sided; attenuation_cos = local Y times the half
 // height (or the radius), 0. They face -normalize(cross(X, Y)) (local -Z).
+// Emissive polygons (LIGHT_AREA_POLYGON) hold four corners, wound
+// counter-clockwise about the side they do not light: position_range,
+// direction_type and attenuation_cos hold corners 0-2 in xyz, the w's of
+// position_range, attenuation_cos and color_exponent corner 3; color_exponent
+// is the emitted radiance. They follow every other light record
+// (frame.emitter_lights.x of them), so the path tracer, which samples the
+// emissive triangles themselves, never sees them.
 struct Light {
     vec4 position_range;   // xyz world position, w cutoff range
     vec4 direction_type;   // xyz unit direction the light travels, w type
@@ -59,8 +68,9 @@ layout(set = 1, binding = 0) uniform Frame {
     mat4 inv_view_proj;
     vec4 camera_position;
     vec4 ambient;          // sum of the suns' ambient terms
-    uvec4 counts;          // suns, point lights, spots, all lights
+    uvec4 counts;          // suns, point lights, spots, all lights but emissive polygons
     vec4 viewport;         // width, height, 1/width, 1/height
+    uvec4 emitter_lights;  // x: emissive polygon records after the counts.w others
 } frame;
 
 layout(std430, set = 1, binding = 1) readonly buffer Lights { Light lights[]; };

@@ -1,11 +1,12 @@
 // Lights for the path tracer: next-event estimation and the densities that
 // multiple importance sampling needs when a BSDF-sampled ray finds a light.
 //
-// Units follow the raster path (include/lighting.glsl): a sun, point or spot
-// light of colour C gives a surface facing it irradiance pi C times its
-// attenuation and cone (so a white Lambertian surface shows C, as the raster
-// path's Kd N.L shading does); area lights and emissive triangles (MTL Ke,
-// glTF emissive) emit radiance equal to their colour. A light is chosen
+// Units follow the raster path (include/lighting.glsl, scenes/FORMAT.md
+// "Units"): a sun, point or spot light of colour C gives a surface facing it
+// irradiance pi C times its attenuation and cone (so a white Lambertian
+// surface shows C, as the raster path's Kd N.L shading does); area lights and
+// emissive triangles (MTL Ke, glTF emissive) emit radiance equal to their
+// colour. A point in a light's plane gets nothing from it. A light is chosen
 // uniformly among the scene's lights plus, when the scene has any, the set of
 // emissive triangles; within that set a triangle is chosen by power.
 // Area lights are sampled uniformly by area. They are not in the BVH; rays
@@ -54,6 +55,9 @@ float area_cosine(uint index, vec3 facing, vec3 l) {
 }
 
 bool sample_area(uint index, vec3 p, vec2 u, float p_select, out LightSample ls) {
+    if (in_light_plane(area_outline(index, p), p)) {
+        return false;
+    }
     vec3 centre, x, y, facing;
     float area;
     area_shape(index, centre, x, y, area, facing);
@@ -92,6 +96,11 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
     float su = sqrt(u.z);
     vec3 point = (1.0 - su) * a + (u.w * su) * b + (su - u.w * su) * c;
     vec3 ng = normalize(cross(b - a, c - a));
+    // A point in the triangle's plane sees it edge on (area_light.glsl).
+    float scale = max(length(p), length(point)) + length(b - a) + length(c - a);
+    if (abs(dot(a - p, ng)) <= 1e-5 * scale) {
+        return false;
+    }
     vec3 to_light = point - p;
     float d2 = dot(to_light, to_light);
     ls.distance = sqrt(d2);
@@ -154,7 +163,8 @@ int hit_area_light(vec3 origin, vec3 dir, inout float t) {
         float area;
         area_shape(i, centre, x, y, area, facing);
         float along = dot(dir, facing);
-        if (along == 0.0) {
+        // A ray leaving the light's plane never meets the light.
+        if (along == 0.0 || in_light_plane(area_outline(i, origin), origin)) {
             continue;
         }
         float s = dot(centre - origin, facing) / along;

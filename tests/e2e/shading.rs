@@ -10,6 +10,7 @@
 //! within 0.2%, through forward and deferred, with zero validation messages.
 
 use glam::Vec3;
+use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 use weft_graph::plan::Extent;
 use weft_render::brdf::{cook_torrance, AreaGeometry};
@@ -242,7 +243,8 @@ fn gltf_metallic_roughness_matches_the_cpu_brdf_in_both_paths() {
             for x in [4, 16, 28] {
                 let p = on_plane(x);
                 let v = (Vec3::Z * CAMERA_Z - p).normalize();
-                let want = 2.0 * cook_torrance(base, metallic, roughness, normal, v, l);
+                // A sun of colour C gives irradiance pi C (scenes/FORMAT.md, "Units").
+                let want = 2.0 * PI * cook_torrance(base, metallic, roughness, normal, v, l);
                 let got = pixel(&hdr, x, SIZE / 2);
                 assert_relative(got, want, 0.002, &format!("{name} {graph} pixel {x}"));
             }
@@ -287,14 +289,15 @@ fn area_lights_match_a_brute_force_integral_in_both_paths() {
         let quadrature = render_hdr_with(&dir.join("quad.scene"), graph, &[("area_samples", 8.0)]);
         for x in [2, 10, 16, 22, 30] {
             let p = on_plane(x);
+            // A white Lambert surface shows the irradiance over pi.
             let estimate: Vec3 = lights
                 .iter()
-                .map(|(shape, emission)| *emission * shape.irradiance(p, Vec3::Z))
+                .map(|(shape, emission)| *emission * shape.irradiance(p, Vec3::Z) / PI)
                 .sum();
             let reference: Vec3 = lights
                 .iter()
                 .map(|(shape, emission)| {
-                    *emission * shape.irradiance_brute_force(p, Vec3::Z, 1000) as f32
+                    *emission * shape.irradiance_brute_force(p, Vec3::Z, 1000) as f32 / PI
                 })
                 .sum();
             assert_relative(

@@ -11,7 +11,9 @@ use weft_scene::{AreaShape, Light, Scene};
 /// and a light casts shadows (a sun, or a spot narrow enough for a cone),
 /// `suns` / `point_lights` / `spot_lights` when there are such lights, `emissive` when a
 /// placed mesh glows, `transparent` when a placed mesh blends, `area_lights` when
-/// there are area lights (`rect_lights` / `disc_lights` by shape), `punctual_lights` when there is a sun, point or spot
+/// there are area lights or emissive geometry that lights raster passes
+/// (`rect_lights` for four-cornered ones: rectangles and emissive polygons,
+/// `disc_lights` for discs), `punctual_lights` when there is a sun, point or spot
 /// light; and by the shading models placed meshes use (so shaders compile only
 /// the models a scene has): `blinn_phong` for any material raster passes shade
 /// with Blinn-Phong (MTL materials, mirrors and coats included), `glossy` for a
@@ -65,7 +67,10 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     if scene.lights.iter().any(|l| matches!(l, Light::Spot(_))) {
         features.push("spot_lights".to_string());
     }
-    if scene.lights.iter().any(|l| matches!(l, Light::Area(_))) {
+    // Emissive geometry lights raster passes as four-cornered area lights
+    // (crate::emitter_lights).
+    let emitter_lights = placed().any(|m| crate::emitter_lights::lights_raster(&m));
+    if emitter_lights || scene.lights.iter().any(|l| matches!(l, Light::Area(_))) {
         features.push("area_lights".to_string());
     }
     let area_shape = |disc: bool| {
@@ -73,7 +78,7 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
             |l| matches!(l, Light::Area(a) if matches!(a.shape, AreaShape::Disc { .. }) == disc),
         )
     };
-    if area_shape(false) {
+    if emitter_lights || area_shape(false) {
         features.push("rect_lights".to_string());
     }
     if area_shape(true) {

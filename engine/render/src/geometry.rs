@@ -338,6 +338,36 @@ impl SceneGeometry {
         ids.map(|id| self.draws[self.draw_places[id as usize].1].bounds)
     }
 
+    /// The world-space corners of each triangle `draw` draws, as placed now
+    /// and wound as drawn (a mirroring placement's triangles turned back, so
+    /// they stay counter-clockwise about their front).
+    pub fn world_triangles<'a>(
+        &'a self,
+        draw: &'a DrawItem,
+    ) -> impl Iterator<Item = [Vec3; 3]> + 'a {
+        let model = self
+            .draw_records
+            .get(draw.draw_id as usize)
+            .map_or(Mat4::IDENTITY, |r| r.model);
+        let first = (draw.range.first_index as usize).min(self.indices.len());
+        let end = (first + draw.range.index_count as usize).min(self.indices.len());
+        let offset = draw.range.vertex_offset;
+        self.indices[first..end].chunks_exact(3).map(move |t| {
+            let corner = |i: u32| {
+                let v = (offset + i as i32) as usize;
+                self.vertices.get(v).map_or(Vec3::NAN, |v| {
+                    model.transform_point3(Vec3::from(v.position))
+                })
+            };
+            let [a, b, c] = [corner(t[0]), corner(t[1]), corner(t[2])];
+            if draw.mirrored {
+                [a, c, b]
+            } else {
+                [a, b, c]
+            }
+        })
+    }
+
     /// The box around every draw as placed now.
     pub fn placed_bounds(&self) -> Aabb {
         self.draws

@@ -90,10 +90,12 @@ pub struct GpuFrame {
     pub camera_position: Vec4,
     /// Sum of the suns' ambient terms.
     pub ambient: Vec4,
-    /// Suns, point lights, spots, all lights.
+    /// Suns, point lights, spots, all lights but the emissive polygons.
     pub counts: UVec4,
     /// Width, height, 1/width, 1/height.
     pub viewport: Vec4,
+    /// x: emissive polygon records after the others (`crate::emitter_lights`).
+    pub emitter_lights: UVec4,
 }
 
 /// The head of the `Shadows` buffer, before the views.
@@ -128,7 +130,7 @@ const _: () = {
     assert!(size_of::<GpuDraw>() == 160);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMaterial>() == 128);
-    assert!(size_of::<GpuFrame>() == 2 * 64 + 4 * 16);
+    assert!(size_of::<GpuFrame>() == 2 * 64 + 5 * 16);
     assert!(size_of::<GpuShadowsHeader>() == 48);
     assert!(size_of::<GpuShadowView>() == 160);
 };

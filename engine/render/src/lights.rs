@@ -23,6 +23,8 @@ pub const SPOT_SPHERE: f32 = 3.0;
 pub const AREA_RECT: f32 = 4.0;
 /// Type code of a disc area light.
 pub const AREA_DISC: f32 = 5.0;
+/// Type code of an emissive polygon (`crate::emitter_lights`), after every other record.
+pub const AREA_POLYGON: f32 = 6.0;
 /// Widest half-angle (degrees) drawn as a cone; wider cones would be huge or inverted.
 pub const CONE_MAX_ANGLE: f32 = 70.0;
 
@@ -45,8 +47,11 @@ pub struct LightSet {
     pub spot_cones: u32,
     /// Number of spots too wide for a cone, drawn with sphere volumes.
     pub spot_spheres: u32,
-    /// Number of area lights (the last records).
+    /// Number of area lights.
     pub areas: u32,
+    /// Number of emissive polygons, the last records: raster passes shade
+    /// them, the path tracer samples the emissive triangles instead.
+    pub emitter_polygons: u32,
     /// Sum of the suns' ambient terms.
     pub ambient: Vec3,
     /// Direction of the first sun, for its shadow map.
@@ -54,14 +59,20 @@ pub struct LightSet {
 }
 
 impl LightSet {
-    /// Number of records.
+    /// Number of records but the emissive polygons (`frame.counts.w`).
     pub fn len(&self) -> u32 {
         self.suns + self.points + self.spot_cones + self.spot_spheres + self.areas
     }
 
     /// Whether there is no light at all.
     pub fn is_empty(&self) -> bool {
-        self.len() == 0
+        self.records.is_empty()
+    }
+
+    /// Appends the emissive polygons' records after every other light.
+    pub fn add_emitter_polygons(&mut self, emitters: &crate::emitter_lights::EmitterLights) {
+        self.records.extend(emitters.records());
+        self.emitter_polygons += emitters.polygons.len() as u32;
     }
 
     /// Index of the first point light record.

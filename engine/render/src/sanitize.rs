@@ -27,13 +27,22 @@ pub fn bounded(x: f32, max: f32) -> f32 {
     }
 }
 
-/// A colour or radiance, per channel as [`bounded`] to [`RADIANCE_MAX`].
+/// A colour or radiance: NaN and negative channels become 0, +inf becomes
+/// [`RADIANCE_MAX`], and a colour whose brightest channel exceeds it is scaled
+/// down as a whole, so it keeps its hue (`finite_clamped` in `hdr.glsl`).
 pub fn radiance(c: Vec3) -> Vec3 {
-    Vec3::new(
-        bounded(c.x, RADIANCE_MAX),
-        bounded(c.y, RADIANCE_MAX),
-        bounded(c.z, RADIANCE_MAX),
-    )
+    let c = Vec3::new(
+        bounded(c.x, f32::INFINITY),
+        bounded(c.y, f32::INFINITY),
+        bounded(c.z, f32::INFINITY),
+    );
+    let c = Vec3::select(c.cmpeq(Vec3::INFINITY), Vec3::splat(RADIANCE_MAX), c);
+    let peak = c.max_element();
+    if peak > RADIANCE_MAX {
+        c * (RADIANCE_MAX / peak)
+    } else {
+        c
+    }
 }
 
 /// An RGBA reflectance or base colour: RGB as [`radiance`], alpha in [0, 1].
@@ -52,9 +61,17 @@ mod tests {
         assert_eq!(bounded(f32::NEG_INFINITY, 5.0), 0.0);
         assert_eq!(bounded(-1.0, 5.0), 0.0);
         assert_eq!(bounded(1e-30, 5.0), 1e-30);
+        // Too bright: scaled as a whole, so the hue stays (2 : 1e38 keeps its ratio).
+        let scaled = radiance(Vec3::new(f32::NAN, 1e38, 2e30));
+        assert_eq!(scaled.x, 0.0);
+        assert!((scaled.y / RADIANCE_MAX - 1.0).abs() < 1e-6, "{scaled}");
+        assert!(
+            (scaled.z / (2e-8 * RADIANCE_MAX) - 1.0).abs() < 1e-6,
+            "{scaled}"
+        );
         assert_eq!(
-            radiance(Vec3::new(f32::NAN, 1e38, 2.0)),
-            Vec3::new(0.0, RADIANCE_MAX, 2.0)
+            radiance(Vec3::new(-1.0, 3.0, 2.0)),
+            Vec3::new(0.0, 3.0, 2.0)
         );
         assert_eq!(
             colour_alpha(Vec4::new(0.5, f32::INFINITY, -2.0, 7.0)),

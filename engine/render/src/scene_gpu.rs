@@ -379,6 +379,8 @@ pub struct GpuScene<'g> {
     pub view_proj: glam::Mat4,
     /// Light counts by kind (stable over time; animation moves lights only).
     pub light_set: LightSet,
+    /// Emissive geometry as polygon lights for raster passes, as placed now.
+    pub emitter_lights: crate::emitter_lights::EmitterLights,
     /// Textures that could not be loaded (their materials use white), and skipped meshes.
     pub warnings: Vec<String>,
 }
@@ -491,14 +493,19 @@ impl<'g> GpuScene<'g> {
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
         let bounds = scene.effective_bounds();
-        let light_set = pack_lights(
+        let emitter_lights = crate::emitter_lights::emitter_lights(&geometry);
+        if emitter_lights.dropped > 0 || emitter_lights.textured > 0 {
+            warnings.extend(emitter_lights.summary());
+        }
+        let mut light_set = pack_lights(
             &weft_scene::animation::lights_at(&scene.lights, 0.0, 0),
             &bounds,
         );
+        light_set.add_emitter_polygons(&emitter_lights);
         let mut lights = Buffer::host(
             gpu,
             "lights",
-            (light_set.len() as usize * LIGHT_BYTES) as u64,
+            (light_set.records.len() * LIGHT_BYTES) as u64,
             storage,
         )?;
         // `update` writes only the records that change from these.
@@ -564,6 +571,7 @@ impl<'g> GpuScene<'g> {
             camera_position: glam::Vec3::ZERO,
             view_proj: glam::Mat4::IDENTITY,
             light_set,
+            emitter_lights,
             warnings,
         };
         this.create_sets(&material_texture)?;
@@ -801,7 +809,8 @@ impl<'g> GpuScene<'g> {
         self.view_volume =
             ViewVolume::new(eye, rotation, camera.fov_y, w / h, camera.near, camera.far);
         let bounds = self.bounds;
-        let lights = pack_lights(&self.lights_at(time), &bounds);
+        let mut lights = pack_lights(&self.lights_at(time), &bounds);
+        lights.add_emitter_polygons(&self.emitter_lights);
         let frame = GpuFrame {
             view_proj,
             inv_view_proj: view_proj.inverse(),
@@ -814,6 +823,7 @@ impl<'g> GpuScene<'g> {
                 lights.len(),
             ),
             viewport: Vec4::new(w, h, 1.0 / w, 1.0 / h),
+            emitter_lights: UVec4::new(lights.emitter_polygons, 0, 0, 0),
         };
         self.frame.write(bytes_of(&[frame]))?;
         if let Some(changed) = changed_records(&self.light_set.records, &lights.records) {
@@ -879,6 +889,14 @@ impl GpuScene<'_> {
             return Ok(());
         };
         self.moved = true;
+        if !self.emitter_lights.polygons.is_empty() {
+            // The light buffer was sized for the polygons at load: a moved
+            // emitter keeps its count (only non-finite corners could change it).
+            let moved = crate::emitter_lights::emitter_lights(&self.geometry);
+            if moved.polygons.len() == self.emitter_lights.polygons.len() {
+                self.emitter_lights = moved;
+            }
+        }
         let records = &self.geometry.draw_records[ids.start as usize..ids.end as usize];
         self.draws.write_at(
             ids.start as usize * std::mem::size_of::<crate::gpu_types::GpuDraw>(),
