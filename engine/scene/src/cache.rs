@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::time::UNIX_EPOCH;
 
 /// Bumped whenever the encoding or the importers' output changes; older entries are ignored.
-pub const CACHE_FORMAT_VERSION: u32 = 10;
+pub const CACHE_FORMAT_VERSION: u32 = 11;
 
 /// What a source file looked like when the entry was written.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]

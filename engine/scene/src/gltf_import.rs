@@ -487,9 +487,22 @@ fn absorption(color: Vec3, distance: Option<f32>) -> Vec3 {
     Vec3::new(-c.x.ln(), -c.y.ln(), -c.z.ln()) / d
 }
 
+/// Lumens per watt in the conversion of photometric glTF intensities to
+/// radiometric ones, as Blender's glTF importer does by default ("Standard"
+/// lighting mode, `PBR_WATTS_TO_LUMENS`).
+pub const LUMENS_PER_WATT: f32 = 683.0;
+
+/// The `.scene` colour of a KHR_lights_punctual light of `color` and
+/// `intensity` (candela for point and spot lights, lux for directional ones):
+/// irradiance intensity / 683 at 1 unit head-on, which is pi times the colour
+/// (scenes/FORMAT.md, "Units").
+pub fn punctual_color(color: Vec3, intensity: f32) -> Vec3 {
+    color * (intensity / (LUMENS_PER_WATT * std::f32::consts::PI))
+}
+
 /// A KHR_lights_punctual light placed by its node (lights shine down the node's -Z).
 fn punctual(light: &gltf::khr_lights_punctual::Light<'_>, world: &Mat4) -> Light {
-    let color = Vec3::from_array(light.color()) * light.intensity();
+    let color = punctual_color(Vec3::from_array(light.color()), light.intensity());
     let position = world.transform_point3(Vec3::ZERO);
     let direction = world
         .transform_vector3(Vec3::NEG_Z)

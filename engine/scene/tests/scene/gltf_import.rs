@@ -166,6 +166,20 @@ fn punctual_lights_become_scene_lights() {
     );
     assert!((cam.fov_y - 0.399_596_5).abs() < 1e-6);
 
+    // Photometric intensities in Blender's convention: the file's 54351.41 cd spots
+    // (Blender's 1000 W, exported as W x 683 / 4 pi) get colour I / (683 pi), 25.33.
+    let scene = load_scene(&asset("gltf/renderling/shadow_mapping_spots.glb")).expect("loads");
+    let Light::Spot(spot) = &scene.lights[0] else {
+        panic!("spot")
+    };
+    let expected = 54_351.413 / (683.0 * std::f32::consts::PI);
+    assert!(
+        (spot.color - Vec3::splat(expected)).abs().max_element() < 1e-3,
+        "{}",
+        spot.color
+    );
+    assert!((expected - 1000.0 / (4.0 * std::f32::consts::PI * std::f32::consts::PI)).abs() < 1e-3);
+
     let scene = load_scene(&asset("gltf/renderling/four_spotlights.glb")).expect("loads");
     let directions: Vec<Vec3> = scene
         .lights
