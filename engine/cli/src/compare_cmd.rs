@@ -14,7 +14,9 @@ use weft_compare::report::{
     write_contact_sheet, write_flip_map, Configuration, PassTime, ReferenceInfo, Report,
     SheetColumn,
 };
-use weft_compare::{hdr_flip, ldr_flip, psnr, rel_mse, rmse, LinearImage, SrgbImage};
+use weft_compare::{
+    hdr_flip, ldr_flip, luminance_ratio, psnr, rel_mse, rmse, LinearImage, SrgbImage,
+};
 use weft_gpu::{DeviceKind, Gpu, GpuOptions, Readback, TimingMode};
 use weft_graph::plan::Extent;
 use weft_graph::schema::ParamValue;
@@ -523,6 +525,7 @@ impl Session {
             rmse: rmse(&image.pixels, &self.reference.pixels),
             rel_mse: rel_mse(&image.pixels, &self.reference.pixels),
             psnr: psnr(&output, &self.reference_ldr),
+            luminance_ratio: luminance_ratio(&image.pixels, &self.reference.pixels),
             frame_ms: median(&mut frame_ms),
             passes: pass_medians(&rendered),
             transient_bytes: rendered.report.transient_bytes,

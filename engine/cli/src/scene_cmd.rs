@@ -40,17 +40,28 @@ pub fn run(cmd: SceneCommand) -> Result<ExitCode> {
                 Ok(report) => {
                     // The scene loaded once already, so this read is from the cache.
                     let scene = weft_scene::load_scene_with(&file, &options)?;
-                    let vertices = weft_render::geometry::SceneGeometry::new(&scene)
-                        .vertices
-                        .len() as u64;
+                    let geometry = weft_render::geometry::SceneGeometry::new(&scene);
+                    let vertices = geometry.vertices.len() as u64;
+                    let emitters = weft_render::emitter_lights::emitter_lights(&geometry);
                     let vertex_bytes = u64::from(weft_render::geometry::VERTEX_BYTES);
                     if json {
                         let mut value = serde_json::to_value(&report)?;
                         value["vertex_bytes"] = vertex_bytes.into();
                         value["vertex_buffer_bytes"] = (vertices * vertex_bytes).into();
+                        value["emitter_lights"] = serde_json::json!({
+                            "triangles": emitters.triangles,
+                            "polygons": emitters.polygons.len(),
+                            "quads": emitters.quads,
+                            "dropped": emitters.dropped,
+                            "dropped_power": emitters.dropped_power,
+                            "textured": emitters.textured,
+                        });
                         println!("{}", serde_json::to_string_pretty(&value)?);
                     } else {
                         print!("{report}");
+                        if let Some(line) = emitters.summary() {
+                            println!("  {line}");
+                        }
                         println!(
                             "  vertex buffer: {vertices} vertices x {vertex_bytes} bytes = {:.2} MiB (light volumes included)",
                             (vertices * vertex_bytes) as f64 / (1024.0 * 1024.0)

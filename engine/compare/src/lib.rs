@@ -13,4 +13,4 @@ pub mod sweep;
 
 pub use flip::{hdr_flip, ldr_flip, FlipResult};
 pub use image_io::{LinearImage, SrgbImage};
-pub use metrics::{psnr, rel_mse, rmse};
+pub use metrics::{luminance_ratio, psnr, rel_mse, rmse};

@@ -22,6 +22,25 @@ pub fn rel_mse(image: &[[f32; 3]], reference: &[[f32; 3]]) -> f64 {
     sum / channels(reference)
 }
 
+/// Mean Rec. 709 luminance of `image` over that of `reference`: 1 when the
+/// two carry the same light overall, whatever its arrangement (a unit or
+/// energy mismatch shows here first); infinite against a black reference
+/// unless the image is black too (then 1).
+pub fn luminance_ratio(image: &[[f32; 3]], reference: &[[f32; 3]]) -> f64 {
+    let mean = |pixels: &[[f32; 3]]| -> f64 {
+        pixels
+            .iter()
+            .map(|p| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]))
+            .sum::<f64>()
+    };
+    let (a, b) = (mean(image), mean(reference));
+    if a == b {
+        1.0
+    } else {
+        a / b
+    }
+}
+
 /// Peak signal-to-noise ratio of 8-bit images in dB: 10 log10(255² / MSE);
 /// infinite for identical images.
 pub fn psnr(image: &SrgbImage, reference: &SrgbImage) -> f64 {
@@ -80,6 +99,12 @@ mod tests {
         assert!((rmse(&image, &reference) - (0.26f64 / 6.0).sqrt()).abs() < 1e-7);
         let expected = (0.25 / 1.01 + 0.01 / 0.01) / 6.0;
         assert!((rel_mse(&image, &reference) - expected).abs() < 1e-7);
+        // Twice the light, arranged differently: ratio 2; equal and black images: 1.
+        let doubled = [[0.0, 0.0, 0.0], [2.0, 2.0, 2.0]];
+        let flat = [[0.5, 0.5, 0.5], [0.5, 0.5, 0.5]];
+        assert!((luminance_ratio(&doubled, &flat) - 2.0).abs() < 1e-12);
+        assert_eq!(luminance_ratio(&[[0.0; 3]], &[[0.0; 3]]), 1.0);
+        assert!(luminance_ratio(&[[1.0; 3]], &[[0.0; 3]]).is_infinite());
         assert_eq!(rmse(&reference, &reference), 0.0);
         let a = SrgbImage {
             width: 1,

@@ -64,6 +64,8 @@ pub struct Configuration {
     pub rel_mse: f64,
     /// PSNR of the tonemapped output in dB.
     pub psnr: f64,
+    /// Mean luminance over the reference's (1: the same light overall).
+    pub luminance_ratio: f64,
     /// Median wall milliseconds per frame after warm-up.
     pub frame_ms: f64,
     /// Per-pass times.
@@ -101,18 +103,19 @@ impl Report {
     /// The table of results, as markdown (also what stdout shows).
     pub fn table(&self) -> String {
         let mut out = String::from(
-            "| configuration | HDR-FLIP | LDR-FLIP | RMSE | rel. MSE | PSNR (dB) | frame (ms) | transient (MiB) | device (MiB) |\n\
-             |---|---|---|---|---|---|---|---|---|\n",
+            "| configuration | HDR-FLIP | LDR-FLIP | RMSE | rel. MSE | PSNR (dB) | luminance ratio | frame (ms) | transient (MiB) | device (MiB) |\n\
+             |---|---|---|---|---|---|---|---|---|---|\n",
         );
         for c in &self.configurations {
             out += &format!(
-                "| {} | {:.4} | {:.4} | {:.4e} | {:.4e} | {:.2} | {:.2} | {:.1} | {:.1} |\n",
+                "| {} | {:.4} | {:.4} | {:.4e} | {:.4e} | {:.2} | {:.3} | {:.2} | {:.1} | {:.1} |\n",
                 c.name,
                 c.flip,
                 c.flip_ldr,
                 c.rmse,
                 c.rel_mse,
                 c.psnr,
+                c.luminance_ratio,
                 c.frame_ms,
                 mib(c.transient_bytes),
                 mib(c.device_bytes)

@@ -607,6 +607,9 @@ pub enum MaterialFilter {
 pub enum LightKind {
     Point,
     Spot,
+    /// Area lights' own outlines (their panels: a rectangle or a disc), so a
+    /// pass can draw what camera rays see of them.
+    Area,
 }
 
 /// How a compute pass is dispatched.

@@ -163,6 +163,8 @@ pub struct SceneGeometry {
     pub sphere: MeshRange,
     /// The spot-light volume (see [`crate::volumes::cone`]).
     pub cone: MeshRange,
+    /// The area-light panel (see [`crate::volumes::panel`]).
+    pub panel: MeshRange,
     /// Meshes left out because their arrays disagree, as `model file: mesh name`.
     pub skipped: Vec<String>,
     /// Triangles left out because a corner's position is not finite, as
@@ -287,6 +289,7 @@ impl SceneGeometry {
         }
         g.sphere = g.append_volume(&volumes::sphere());
         g.cone = g.append_volume(&volumes::cone());
+        g.panel = g.append_volume(&volumes::panel());
         g
     }
 

@@ -588,6 +588,7 @@ impl DrawRecorder for SceneRecorder<'_> {
                         (g.cone, lights.spot_cones, lights.first_spot_cone()),
                         (g.sphere, lights.spot_spheres, lights.first_spot_sphere()),
                     ],
+                    LightKind::Area => vec![(g.panel, lights.areas, lights.first_area())],
                 };
                 let volumes: u64 = groups.iter().map(|g| u64::from(g.1)).sum();
                 if volumes > u64::from(MAX_LIGHT_VOLUMES) {

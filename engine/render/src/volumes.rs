@@ -110,6 +110,25 @@ pub fn cone() -> VolumeMesh {
     VolumeMesh { positions, indices }
 }
 
+/// Segments around the area-light panel (a multiple of 8, so its outline
+/// passes through the square's corners and edge midpoints).
+const PANEL_SEGMENTS: u32 = 32;
+
+/// An area light's panel: a fan over the unit circle in z = 0, counter-clockwise
+/// about +Z. `shaders/area_panel.vert` keeps it for a disc and pushes each
+/// outline point out to the square |x|, |y| <= 1 for a rectangle: every
+/// corner and edge midpoint of the square is a vertex, so the square is exact.
+pub fn panel() -> VolumeMesh {
+    let n = PANEL_SEGMENTS;
+    let mut positions = vec![Vec3::ZERO];
+    for i in 0..n {
+        let a = std::f32::consts::TAU * i as f32 / n as f32;
+        positions.push(Vec3::new(a.cos(), a.sin(), 0.0));
+    }
+    let indices = (0..n).flat_map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
+    VolumeMesh { positions, indices }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -119,6 +138,29 @@ mod tests {
             let [a, b, c] = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]);
             (b - a).cross(c - a).dot(a - inside) > 0.0
         })
+    }
+
+    #[test]
+    fn the_panel_covers_the_unit_disc_and_has_the_squares_corners() {
+        let p = panel();
+        assert!(p.indices.chunks_exact(3).all(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| p.positions[i as usize]);
+            (b - a).cross(c - a).z > 0.0
+        }));
+        let area: f32 = p
+            .indices
+            .chunks_exact(3)
+            .map(|t| {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| p.positions[i as usize]);
+                0.5 * (b - a).cross(c - a).z
+            })
+            .sum();
+        // The inscribed 32-gon: 16 sin(2 pi / 32), within 0.7% of pi.
+        assert!((area - 16.0 * (std::f32::consts::TAU / 32.0).sin()).abs() < 1e-5);
+        for corner in [(1.0f32, 1.0f32), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)] {
+            let direction = Vec3::new(corner.0, corner.1, 0.0).normalize();
+            assert!(p.positions.iter().any(|q| q.distance(direction) < 1e-6));
+        }
     }
 
     #[test]

@@ -93,6 +93,7 @@ fn a_compare_run_writes_every_file_and_caches_its_reference() {
             "rmse",
             "rel_mse",
             "psnr",
+            "luminance_ratio",
             "frame_ms",
             "passes",
             "transient_bytes",
@@ -102,6 +103,8 @@ fn a_compare_run_writes_every_file_and_caches_its_reference() {
         }
         let flip = c["flip"].as_f64().expect("flip");
         assert!(flip > 0.0 && flip < 1.0, "{flip}");
+        let ratio = c["luminance_ratio"].as_f64().expect("luminance_ratio");
+        assert!(ratio.is_finite() && ratio > 0.0, "{ratio}");
         let passes = c["passes"].as_array().expect("passes");
         assert!(passes.iter().any(|p| p["name"] == "tonemap"), "{passes:?}");
         assert!(passes

@@ -33,13 +33,34 @@ fn check_json_has_counts() {
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     assert_eq!(json["lights"]["sun"], 1);
     assert!(json["triangles"].as_u64().expect("triangles") > 100_000);
-    // 20-byte vertices: every vertex of the demo's models and the two light-volume meshes.
+    // 20-byte vertices: every vertex of the demo's models and the light-volume meshes.
     assert_eq!(json["vertex_bytes"], 20);
     let scene = weft_scene::load_scene(&repo().join("scenes/demo.scene")).expect("demo loads");
     let vertices = weft_render::geometry::SceneGeometry::new(&scene)
         .vertices
         .len() as u64;
     assert_eq!(json["vertex_buffer_bytes"].as_u64(), Some(vertices * 20));
+}
+
+#[test]
+fn check_reports_emissive_geometry_as_raster_lights() {
+    // The Cornell box's ceiling light is one emissive quad (two triangles, Ke 17 12 4).
+    let out = weft(&["scene", "check", "scenes/cornell.scene"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("emissive geometry: 2 triangles -> 1 polygon lights (1 quads merged)"),
+        "{text}"
+    );
+    // The damaged helmet's emission is textured: it glows but lights nothing in raster graphs.
+    let out = weft(&["scene", "check", "scenes/gltf.scene", "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    assert_eq!(json["emitter_lights"]["polygons"], 0);
+    assert_eq!(json["emitter_lights"]["textured"], 1);
 }
 
 #[test]
