@@ -80,6 +80,9 @@ const float MIN_ROUGHNESS = 0.045;
 // Reflectance at normal incidence of every non-metal (brdf.rs DIELECTRIC_F0).
 const float DIELECTRIC_F0 = 0.04;
 
+// Area lights and the environment read the LTC tables' lobe integrals.
+#include "ltc.glsl"
+
 // What shading needs about a surface point.
 struct Surface {
     vec3 position;     // world
@@ -308,7 +311,6 @@ vec3 shade_area_quadrature(uint index, Surface s, Material m, uint samples) {
 }
 
 #ifdef SHADE_AREA_LIGHTS
-#include "ltc.glsl"
 
 #ifdef SHADE_METALLIC_ROUGHNESS
 // A glTF material under an area light: diffuse weighted by 1 - F(N.V), the
@@ -461,23 +463,46 @@ vec3 shade_all_lights(Surface s, Material m, uint area_samples) {
     return c + shade_area_lights(s, m, area_samples);
 }
 
-// What the surface shows without any direct light: the suns' ambient on its
-// ambient reflectance, plus its emission scaled by `emissive_boost` (the graph
+// What the surface shows without any direct light: the environment (the
+// suns' summed ambient A, a constant radiance from every direction; scenes/
+// FORMAT.md, "Units") reflected by the material's directional albedo, times
+// the occlusion texture's sample `occlusion` (glTF occlusionTexture, red; 1
+// without one), plus its emission scaled by `emissive_boost` (the graph
 // parameter of that name, so glowing materials can be pushed over the bloom
-// threshold). Blinn-Phong: Ka (or Kd) times the texture; metallic-roughness:
-// the diffuse colour plus F0, the response to uniform surroundings without the
-// GGX terms' angular detail. `emission_texel` is the emissive texture's sample
-// (MTL map_Ke, glTF emissiveTexture; 1 without one) and `occlusion` the
-// occlusion texture's (glTF occlusionTexture, red; 1 without one), which
-// darkens the ambient term only.
-vec3 shade_ambient_emissive(Surface s, Material m, float emissive_boost, vec3 emission_texel, float occlusion) {
-    vec3 reflectance = m.ambient.rgb * s.texel;
+// threshold) times `emission_texel` (MTL map_Ke, glTF emissiveTexture; 1
+// without one). The albedo is the integral of f cos over the hemisphere, as
+// the path tracer's rays escaping to the environment sum it: Blinn-Phong Kd
+// plus Ks times its highlight lobe's integral over pi; metallic-roughness the
+// GGX lobe's (F0 and Fresnel moment from the LTC table) plus the diffuse
+// weighted by 1 - F(N.V), as its area lights use. Nothing else occludes it.
+vec3 environment_albedo(Surface s, Material m) {
+    vec3 v = normalize(frame.camera_position.xyz - s.position);
+    float ndv = clamp(dot(s.normal, v), 1e-3, 1.0);
+    vec2 scale;
+#ifdef SHADE_METALLIC_ROUGHNESS
     if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
+        ltc_lookup(LTC_GGX, max(s.metal_rough.y, MIN_ROUGHNESS), ndv, scale);
         vec3 base = m.diffuse.rgb * s.texel;
-        float metallic = s.metal_rough.x;
-        reflectance = base * (1.0 - metallic) + mix(vec3(DIELECTRIC_F0), base, metallic);
+        vec3 f0 = mix(vec3(DIELECTRIC_F0), base, s.metal_rough.x);
+        vec3 f_view = f0 + (1.0 - f0) * pow(1.0 - ndv, 5.0);
+        return (1.0 - f_view) * (1.0 - s.metal_rough.x) * base + f0 * scale.x + (1.0 - f0) * scale.y;
     }
-    return frame.ambient.rgb * reflectance * occlusion + m.emissive.rgb * emission_texel * emissive_boost;
+#endif
+    vec3 albedo = m.diffuse.rgb * s.texel;
+    float shininess = m.specular.w;
+    if (shininess > 0.0) {
+        ltc_lookup(LTC_BLINN_PHONG, pow(2.0 / (shininess + 2.0), 0.25), ndv, scale);
+        albedo += m.specular.rgb * (scale.x / PI);
+    }
+    return albedo;
+}
+
+vec3 shade_ambient_emissive(Surface s, Material m, float emissive_boost, vec3 emission_texel, float occlusion) {
+    vec3 environment = vec3(0.0);
+    if (any(greaterThan(frame.ambient.rgb, vec3(0.0)))) {
+        environment = frame.ambient.rgb * environment_albedo(s, m) * occlusion;
+    }
+    return environment + m.emissive.rgb * emission_texel * emissive_boost;
 }
 
 #endif
