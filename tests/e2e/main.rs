@@ -10,6 +10,7 @@ mod lights;
 mod mirrored;
 mod mutants;
 mod normal_maps;
+mod one_physics;
 mod pathtrace;
 mod raycast;
 mod render;

@@ -19,7 +19,8 @@ use image::RgbaImage;
 use std::path::PathBuf;
 
 /// A scene with `model` (a file under ../shared/assets/gltf/rise) facing a
-/// camera, lit by a sun from the upper left.
+/// camera, lit by a sun from the upper left of colour 1/pi: irradiance 1, the
+/// exposure these tolerances were measured at (scenes/FORMAT.md, "Units").
 fn scene(model: &str) -> (tempdir::Dir, PathBuf) {
     let dir = tempdir::Dir::new(model);
     let path = dir.0.join(format!("{model}.scene"));
@@ -28,7 +29,7 @@ fn scene(model: &str) -> (tempdir::Dir, PathBuf) {
         &path,
         format!(
             "model\n{{\n\tfile \"{}\"\n}}\n\
-             sunlight\n{{\n\tdirection 0.4 -0.5 -1\n\tcolor 1 1 1\n}}\n\
+             sunlight\n{{\n\tdirection 0.4 -0.5 -1\n\tcolor 0.31831 0.31831 0.31831\n}}\n\
              camera \"front\"\n{{\n\tposition 0 0 3\n\ttarget 0 0 0\n\tfov_deg 45\n}}\n",
             file.display()
         ),

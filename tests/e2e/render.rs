@@ -37,6 +37,7 @@ fn forward_renders_the_demo_scene_cleanly_and_matches_its_golden() {
         vec![
             "shadow_sun",
             "forward",
+            "area_light_panels",
             "bloom_bright",
             "bloom_blur_h",
             "bloom_blur_v",
@@ -55,7 +56,8 @@ fn forward_renders_the_demo_scene_cleanly_and_matches_its_golden() {
             ("forward".to_string(), 8, 1),
         ]
     );
-    assert_eq!(out.draw_calls, 23);
+    // One more than before issue 32: the demo's area-light panel.
+    assert_eq!(out.draw_calls, 24);
     assert_golden(&out.image, "demo_forward_320x180.png");
 }
 
@@ -72,6 +74,7 @@ fn deferred_renders_the_demo_scene_cleanly_and_matches_its_golden() {
             "point_lights",
             "spot_lights",
             "area_lights",
+            "area_light_panels",
             "bloom_bright",
             "bloom_blur_h",
             "bloom_blur_v",
@@ -99,6 +102,7 @@ fn depth_prepass_and_no_bloom_variants_run_cleanly() {
             "shadow_sun",
             "depth_prepass",
             "forward_after_prepass",
+            "area_light_panels",
             "tonemap"
         ]
     );

@@ -79,9 +79,9 @@ fn plan_json_has_stats() {
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     let stats = &json["stats"];
     assert_eq!(stats["passes"], 8);
-    // bloom_naive_h/v, area_lights, transparent, the two bench floors and
-    // the 12 passes of the debug views (all off).
-    assert_eq!(stats["culled"], 19);
+    // bloom_naive_h/v, area_lights, area_light_panels, transparent, the two
+    // bench floors and the 12 passes of the debug views (all off).
+    assert_eq!(stats["culled"], 20);
     assert!(stats["barriers"].as_u64().expect("barriers") > 10);
     let aliased = stats["transient_bytes"].as_u64().expect("bytes");
     let unaliased = stats["transient_bytes_unaliased"].as_u64().expect("bytes");

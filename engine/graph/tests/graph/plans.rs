@@ -161,6 +161,7 @@ fn scene_features_cull_passes_and_variants() {
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
             ("area_lights", "enabled_if [area_lights] is false"),
+            ("area_light_panels", "enabled_if [area_lights] is false"),
             ("transparent", "enabled_if [transparent] is false"),
         ]
     );

@@ -1,0 +1,171 @@
+//! One physics for raster graphs and the path tracer (scenes/FORMAT.md,
+//! "Units"): an emissive quad lights a floor as a rectangle area light of the
+//! same shape and radiance does, in every raster graph; and a light lying in
+//! the plane of the surface it would light gives that surface exactly nothing,
+//! in every raster graph and in the path tracer, however bright it is.
+
+use glam::Vec3;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use weft_graph::plan::Extent;
+use weft_graph::schema::ParamValue;
+use weft_render::RenderSettings;
+
+const SIZE: u32 = 48;
+
+/// A folder removed when the test ends.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("weft-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("scratch folder");
+        Self(dir)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// The HDR image of `scene` through shipped graph `graph` (validated), RGB per pixel.
+fn render(scene: &Path, graph: &str, samples: Option<u64>, params: &[(&str, f64)]) -> Vec<Vec3> {
+    let settings = RenderSettings {
+        graph: weft_tests::shipped(graph),
+        extent: Extent {
+            width: SIZE,
+            height: SIZE,
+        },
+        features: vec!["!bloom".into()],
+        params: params
+            .iter()
+            .map(|(k, v)| (k.to_string(), ParamValue::Number(*v)))
+            .collect::<BTreeMap<_, _>>(),
+        samples,
+        ..RenderSettings::default()
+    };
+    let (_, values) = weft_tests::render::render_hdr_validated(scene, settings);
+    values
+        .chunks(4)
+        .map(|p| Vec3::new(p[0], p[1], p[2]))
+        .collect()
+}
+
+/// A 6 x 6 white Lambert floor at y = 0 (Kd 0.8), the camera above it looking
+/// down, `extra_obj` appended to the floor's OBJ (with material `glow`,
+/// emitting `Ke 3 2 1`) and `lights` as `.scene` blocks.
+fn floor_scene(dir: &Path, extra_obj: &str, lights: &str) -> PathBuf {
+    std::fs::write(
+        dir.join("floor.obj"),
+        format!(
+            "mtllib floor.mtl\nv -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\nvn 0 1 0\nusemtl white\n\
+             f 1//1 3//1 2//1\nf 1//1 4//1 3//1\n{extra_obj}"
+        ),
+    )
+    .expect("obj");
+    std::fs::write(
+        dir.join("floor.mtl"),
+        "newmtl white\nKd 0.8 0.8 0.8\nKs 0 0 0\nnewmtl glow\nKd 0 0 0\nKs 0 0 0\nKe 3 2 1\n",
+    )
+    .expect("mtl");
+    let scene = dir.join("floor.scene");
+    std::fs::write(
+        &scene,
+        format!(
+            "model\n{{\n\tfile \"floor.obj\"\n}}\n{lights}\
+             camera\n{{\n\tposition 0 4 0.01\n\ttarget 0 0 0\n\tfov_deg 60\n}}\n"
+        ),
+    )
+    .expect("scene");
+    scene
+}
+
+fn mean(image: &[Vec3]) -> Vec3 {
+    image.iter().copied().sum::<Vec3>() / image.len() as f32
+}
+
+#[test]
+fn an_emissive_quad_lights_the_floor_as_the_same_rect_area_light() {
+    // A 1 x 0.6 panel at height 1, emitting (3, 2, 1) downwards: once as two
+    // emissive triangles, once as an `arealight`, seen from above.
+    let quad = TempDir::new("emissive-quad");
+    let quad_scene = floor_scene(
+        &quad.0,
+        "v -0.5 1 -0.3\nv 0.5 1 -0.3\nv 0.5 1 0.3\nv -0.5 1 0.3\nvn 0 -1 0\nusemtl glow\n\
+         f 5//2 6//2 7//2\nf 5//2 7//2 8//2\n",
+        "",
+    );
+    let rect = TempDir::new("rect-light");
+    let rect_scene = floor_scene(
+        &rect.0,
+        "",
+        "arealight\n{\n\tshape rect\n\tsize 1 0.6\n\tposition 0 1 0\n\tdirection 0 -1 0\n\temission 3 2 1\n}\n",
+    );
+    // The panel (about 7 x 4 pixels each way of the centre) shows differently:
+    // an emissive mesh's back is culled, an area light's back is drawn black.
+    // The floor around it is compared.
+    let floor = |image: &[Vec3]| {
+        let around: Vec<Vec3> = (0..SIZE * SIZE)
+            .filter(|i| (i % SIZE).abs_diff(SIZE / 2) > 9 || (i / SIZE).abs_diff(SIZE / 2) > 9)
+            .map(|i| image[i as usize])
+            .collect();
+        mean(&around)
+    };
+    for graph in ["forward.ron", "deferred.ron", "tiled.ron"] {
+        let from_quad = floor(&render(&quad_scene, graph, None, &[]));
+        let from_rect = floor(&render(&rect_scene, graph, None, &[]));
+        assert!(
+            from_rect.min_element() > 0.01,
+            "{graph}: the floor is lit: {from_rect}"
+        );
+        let ratio = from_quad / from_rect;
+        assert!(
+            (ratio - Vec3::ONE).abs().max_element() < 0.01,
+            "{graph}: emissive quad {from_quad} vs rect light {from_rect}"
+        );
+    }
+}
+
+#[test]
+fn a_light_in_the_plane_of_a_surface_gives_it_nothing_in_every_graph() {
+    // A rectangle light of radiance 1e30 lying in the floor's plane, facing up:
+    // every floor point is in its plane, so its cosine is 0 there. The camera
+    // sees the light's panel (clamped) and, around it, a floor that must be
+    // exactly black; rounding once lit it with sparkles of 1e18.
+    let dir = TempDir::new("coplanar-light");
+    let scene = floor_scene(
+        &dir.0,
+        "",
+        "arealight\n{\n\tshape rect\n\tsize 1 1\n\tposition 0 0 0\n\tdirection 0 1 0\n\temission 1e30 1e30 1e30\n}\n",
+    );
+    // The panel covers the middle; pixels 8 or more from the centre column and
+    // row on both axes see only floor (the panel spans about 7 pixels each way).
+    let floor_only = |x: u32, y: u32| x.abs_diff(SIZE / 2) >= 8 || y.abs_diff(SIZE / 2) >= 8;
+    for (graph, samples, params) in [
+        ("forward.ron", None, vec![]),
+        ("deferred.ron", None, vec![]),
+        ("tiled.ron", None, vec![]),
+        ("forward.ron", None, vec![("area_samples", 8.0)]),
+        ("pathtrace.ron", Some(16), vec![("max_depth", 2.0)]),
+    ] {
+        let image = render(&scene, graph, samples, &params);
+        let lit: Vec<(u32, u32, Vec3)> = (0..SIZE * SIZE)
+            .map(|i| (i % SIZE, i / SIZE, image[i as usize]))
+            .filter(|&(x, y, c)| floor_only(x, y) && c != Vec3::ZERO)
+            .collect();
+        assert!(
+            lit.is_empty(),
+            "{graph} {params:?}: {} floor pixels lit, e.g. {:?}",
+            lit.len(),
+            lit.first()
+        );
+        // The panel itself is seen, bright, in every graph.
+        let centre = image[(SIZE / 2 * SIZE + SIZE / 2) as usize];
+        assert!(
+            centre.min_element() > 1000.0,
+            "{graph}: the panel shows {centre}"
+        );
+    }
+}
