@@ -96,6 +96,12 @@ float outline_cell(AreaOutline o, vec2 uv, float step) {
     return length(cross(du, dv)) * step * step;
 }
 
+// Whether a point `distance` from a plane lies in it, to within the rounding
+// of world coordinates of magnitude `scale`.
+bool within_rounding(float distance, float scale) {
+    return abs(distance) <= 1e-5 * scale;
+}
+
 // Whether the shading point (the outline's origin, at world position
 // `origin`) lies in the light's plane, to within the rounding of the world
 // coordinates involved. There the light's cosine is 0 and it gives nothing;
@@ -104,7 +110,7 @@ float outline_cell(AreaOutline o, vec2 uv, float step) {
 bool in_light_plane(AreaOutline o, vec3 origin) {
     float len = length(o.winding);
     float scale = max(length(origin), length(o.centre + origin)) + sqrt(outline_area(o));
-    return len <= 0.0 || abs(dot(o.centre, o.winding)) <= 1e-5 * scale * len;
+    return len <= 0.0 || within_rounding(dot(o.centre, o.winding) / len, scale);
 }
 
 #endif

@@ -36,40 +36,25 @@ struct LightSample {
     float pdf;       // solid-angle density with selection, 0 for a delta light
 };
 
-// Area light `index` as centre, half-extent vectors, area and the unit normal
-// it emits along.
-void area_shape(uint index, out vec3 centre, out vec3 x, out vec3 y, out float area, out vec3 facing) {
-    centre = lights[index].position_range.xyz;
-    x = lights[index].direction_type.xyz;
-    y = lights[index].attenuation_cos.xyz;
-    bool disc = lights[index].direction_type.w == LIGHT_AREA_DISC;
-    area = (disc ? PI : 4.0) * length(x) * length(y);
-    facing = -normalize(cross(x, y));
-}
-
 // The cosine at an area light's surface towards a ray leaving it along -l,
-// zero when it does not emit that way.
-float area_cosine(uint index, vec3 facing, vec3 l) {
-    float c = -dot(l, facing);
-    return lights[index].color_exponent.w > 0.5 ? abs(c) : max(c, 0.0);
+// zero when it does not emit that way (include/area_light.glsl: it emits
+// towards -winding).
+float area_cosine(AreaOutline o, vec3 l) {
+    float c = dot(l, normalize(o.winding));
+    return o.two_sided ? abs(c) : max(c, 0.0);
 }
 
 bool sample_area(uint index, vec3 p, vec2 u, float p_select, out LightSample ls) {
-    if (in_light_plane(area_outline(index, p), p)) {
+    AreaOutline o = area_outline(index, p);
+    if (in_light_plane(o, p)) {
         return false;
     }
-    vec3 centre, x, y, facing;
-    float area;
-    area_shape(index, centre, x, y, area, facing);
-    vec2 q = u * 2.0 - 1.0;
-    if (lights[index].direction_type.w == LIGHT_AREA_DISC) {
-        q = concentric(q);
-    }
-    vec3 to_light = centre + q.x * x + q.y * y - p;
+    vec3 to_light = outline_point(o, u * 2.0 - 1.0);
     float d2 = dot(to_light, to_light);
+    float area = outline_area(o);
     ls.distance = sqrt(d2);
     ls.direction = to_light / max(ls.distance, 1e-20);
-    float cos_light = area_cosine(index, facing, ls.direction);
+    float cos_light = area_cosine(o, ls.direction);
     if (cos_light <= 0.0 || d2 <= 0.0 || area <= 0.0) {
         return false;
     }
@@ -98,7 +83,7 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
     vec3 ng = normalize(cross(b - a, c - a));
     // A point in the triangle's plane sees it edge on (area_light.glsl).
     float scale = max(length(p), length(point)) + length(b - a) + length(c - a);
-    if (abs(dot(a - p, ng)) <= 1e-5 * scale) {
+    if (within_rounding(dot(a - p, ng), scale)) {
         return false;
     }
     vec3 to_light = point - p;
@@ -159,21 +144,20 @@ int hit_area_light(vec3 origin, vec3 dir, inout float t) {
     int found = -1;
 #ifdef SCENE_AREA_LIGHTS
     for (uint i = first_area_light(); i < frame.counts.w; ++i) {
-        vec3 centre, x, y, facing;
-        float area;
-        area_shape(i, centre, x, y, area, facing);
+        AreaOutline o = area_outline(i, origin);
+        vec3 facing = -normalize(o.winding);
         float along = dot(dir, facing);
         // A ray leaving the light's plane never meets the light.
-        if (along == 0.0 || in_light_plane(area_outline(i, origin), origin)) {
+        if (along == 0.0 || in_light_plane(o, origin)) {
             continue;
         }
-        float s = dot(centre - origin, facing) / along;
+        float s = dot(o.centre, facing) / along;
         if (s <= 0.0 || s >= t) {
             continue;
         }
-        vec3 offset = origin + s * dir - centre;
-        vec2 q = vec2(dot(offset, x) / dot(x, x), dot(offset, y) / dot(y, y));
-        bool inside = lights[i].direction_type.w == LIGHT_AREA_DISC ? dot(q, q) <= 1.0 : max(abs(q.x), abs(q.y)) <= 1.0;
+        vec3 offset = s * dir - o.centre;
+        vec2 q = vec2(dot(offset, o.x) / dot(o.x, o.x), dot(offset, o.y) / dot(o.y, o.y));
+        bool inside = o.disc ? dot(q, q) <= 1.0 : max(abs(q.x), abs(q.y)) <= 1.0;
         if (inside) {
             t = s;
             found = int(i);
@@ -186,11 +170,9 @@ int hit_area_light(vec3 origin, vec3 dir, inout float t) {
 // Radiance area light `index` sends back along a ray `dir` that met it at
 // distance t, and in `pdf` the density NEE would have picked that point with.
 vec3 area_emitted(uint index, vec3 dir, float t, out float pdf) {
-    vec3 centre, x, y, facing;
-    float area;
-    area_shape(index, centre, x, y, area, facing);
-    float cos_light = area_cosine(index, facing, dir);
-    pdf = cos_light > 0.0 ? t * t / (light_choices() * cos_light * area) : 0.0;
+    AreaOutline o = area_outline(index, vec3(0.0));
+    float cos_light = area_cosine(o, dir);
+    pdf = cos_light > 0.0 ? t * t / (light_choices() * cos_light * outline_area(o)) : 0.0;
     return cos_light > 0.0 ? lights[index].color_exponent.rgb : vec3(0.0);
 }
 
