@@ -5,11 +5,7 @@
 //! in every raster graph and in the path tracer, however bright it is.
 
 use glam::Vec3;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use weft_graph::plan::Extent;
-use weft_graph::schema::ParamValue;
-use weft_render::RenderSettings;
 
 const SIZE: u32 = 48;
 
@@ -30,22 +26,10 @@ impl Drop for TempDir {
     }
 }
 
-/// The HDR image of `scene` through shipped graph `graph` (validated), RGB per pixel.
+/// The HDR image of `scene` through shipped graph `graph` (validated, bloom
+/// off), RGB per pixel.
 fn render(scene: &Path, graph: &str, samples: Option<u64>, params: &[(&str, f64)]) -> Vec<Vec3> {
-    let settings = RenderSettings {
-        graph: weft_tests::shipped(graph),
-        extent: Extent {
-            width: SIZE,
-            height: SIZE,
-        },
-        features: vec!["!bloom".into()],
-        params: params
-            .iter()
-            .map(|(k, v)| (k.to_string(), ParamValue::Number(*v)))
-            .collect::<BTreeMap<_, _>>(),
-        samples,
-        ..RenderSettings::default()
-    };
+    let settings = weft_tests::render::square_settings(graph, SIZE, samples, params, &["!bloom"]);
     let (_, values) = weft_tests::render::render_hdr_validated(scene, settings);
     values
         .chunks(4)

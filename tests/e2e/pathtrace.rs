@@ -23,11 +23,9 @@
 //!
 //! The figures each test measures are printed (`--nocapture`).
 
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use weft_graph::plan::Extent;
-use weft_graph::schema::ParamValue;
 use weft_render::RenderSettings;
 
 /// Linear RGB per pixel, row by row.
@@ -75,20 +73,7 @@ fn render_hdr(
     params: &[(&str, f64)],
     features: &[&str],
 ) -> Hdr {
-    let settings = RenderSettings {
-        graph: weft_tests::shipped(graph),
-        extent: Extent {
-            width: size,
-            height: size,
-        },
-        features: features.iter().map(|f| f.to_string()).collect(),
-        params: params
-            .iter()
-            .map(|(k, v)| (k.to_string(), ParamValue::Number(*v)))
-            .collect::<BTreeMap<_, _>>(),
-        samples,
-        ..RenderSettings::default()
-    };
+    let settings = weft_tests::render::square_settings(graph, size, samples, params, features);
     let (rendered, values) = weft_tests::render::render_hdr_validated(scene, settings);
     if let Some(spp) = samples {
         assert_eq!(rendered.samples, Some(spp), "the render reached its spp");

@@ -187,6 +187,32 @@ pub fn centre_hdr(
     [values[at], values[at + 1], values[at + 2], values[at + 3]]
 }
 
+/// Settings for a `size` x `size` render of shipped graph `graph` with
+/// feature toggles, graph parameters and, with `samples`, a progressive render
+/// to that many samples per pixel.
+pub fn square_settings(
+    graph: &str,
+    size: u32,
+    samples: Option<u64>,
+    params: &[(&str, f64)],
+    features: &[&str],
+) -> RenderSettings {
+    RenderSettings {
+        graph: crate::shipped(graph),
+        extent: Extent {
+            width: size,
+            height: size,
+        },
+        features: features.iter().map(|f| f.to_string()).collect(),
+        params: params
+            .iter()
+            .map(|(k, v)| (k.to_string(), weft_graph::schema::ParamValue::Number(*v)))
+            .collect(),
+        samples,
+        ..RenderSettings::default()
+    }
+}
+
 /// Renders `scene` with `settings` and `hdr` read back, on a validating
 /// context; asserts no validation message and returns the render and the
 /// `hdr` image as RGBA floats, row by row.
