@@ -1,5 +1,5 @@
 // Shading shared by forward and deferred: material decoding, Blinn-Phong for
-// MTL materials, metallic-roughness GGX for glTF materials, and sun / point /
+// MTL materials, metallic-roughness GGX for glTF materials (brdf.glsl), and sun / point /
 // spot / area light evaluation with the same cutoffs the light volumes use.
 // Both paths call the per-type `shade_*` functions and `shade_ambient_emissive` with the same
 // inputs (the surface and its material, loaded once per pixel), so they cannot
@@ -21,6 +21,7 @@
 #define WEFT_LIGHTING_GLSL
 #include "scene.glsl"
 #include "hdr.glsl"
+#include "brdf.glsl"
 #include "area_light.glsl"
 
 #ifdef SCENE_SPECIALISED
@@ -72,13 +73,6 @@
 #if defined(HAS_SHADOW_MAP) && !defined(SHADE_SUNS) && !defined(SHADE_SPOT_LIGHTS)
 #define SHADE_SUNS
 #endif
-
-const float PI = 3.14159265358979;
-// Roughness is raised to at least this (brdf.rs MIN_ROUGHNESS): a smoother GGX
-// lobe turns point-light highlights into single-pixel sparkles.
-const float MIN_ROUGHNESS = 0.045;
-// Reflectance at normal incidence of every non-metal (brdf.rs DIELECTRIC_F0).
-const float DIELECTRIC_F0 = 0.04;
 
 // Area lights and the environment read the LTC tables' lobe integrals.
 #include "ltc.glsl"
@@ -136,29 +130,6 @@ vec3 mapped_normal(vec3 n, vec4 tangent, vec3 p, vec2 uv, vec3 texel, float scal
     return normalize(mat3(t, cross(n, t) * tangent.w, n) * bent);
 }
 #endif
-
-// Cook-Torrance times N.L: GGX distribution, Smith height-correlated visibility,
-// Schlick Fresnel with F0 = mix(0.04, base, metallic), and Lambert diffuse
-// weighted by (1 - F)(1 - metallic); alpha = roughness^2.
-vec3 cook_torrance(vec3 base, vec2 mr, vec3 n, vec3 v, vec3 l) {
-    float ndl = dot(n, l);
-    if (ndl <= 0.0) {
-        return vec3(0.0);
-    }
-    float ndv = max(dot(n, v), 1e-4);
-    vec3 h = normalize(l + v);
-    float ndh = max(dot(n, h), 0.0);
-    float vdh = max(dot(v, h), 0.0);
-    float r = max(mr.y, MIN_ROUGHNESS);
-    float a2 = r * r * r * r;
-    float q = ndh * ndh * (a2 - 1.0) + 1.0;
-    float distribution = a2 / (PI * q * q);
-    float visibility = 0.5 / (ndl * sqrt(ndv * ndv * (1.0 - a2) + a2) + ndv * sqrt(ndl * ndl * (1.0 - a2) + a2));
-    vec3 f0 = mix(vec3(DIELECTRIC_F0), base, mr.x);
-    vec3 fresnel = f0 + (1.0 - f0) * pow(1.0 - vdh, 5.0);
-    vec3 diffuse = (1.0 - fresnel) * (1.0 - mr.x) * base / PI;
-    return (diffuse + distribution * visibility * fresnel) * ndl;
-}
 
 // Blinn-Phong: Kd * texture * (N.L) + Ks * (N.H)^Ns, times the light's radiance.
 vec3 blinn_phong(Material m, Surface s, vec3 l, vec3 radiance) {
@@ -313,20 +284,23 @@ vec3 shade_area_quadrature(uint index, Surface s, Material m, uint samples) {
 #ifdef SHADE_AREA_LIGHTS
 
 #ifdef SHADE_METALLIC_ROUGHNESS
-// A glTF material under an area light: diffuse weighted by 1 - F(N.V), the
-// GGX highlight from its table, Fresnel from the table's Fresnel moment.
-// `local` takes world directions to the shading frame; `diffuse` is the
-// form factor (the cosine's integral over the light, over pi).
+// A glTF material under an area light: the single-scattering GGX highlight
+// from its table, Fresnel from the table's Fresnel moment; the multiple-
+// scattering and diffuse lobes (brdf.glsl, separable in view and light)
+// times the form factor `diffuse` (the cosine's integral over the light,
+// over pi), their light-side albedo taken towards the light's centre.
+// `local` takes world directions to the shading frame.
 vec3 area_ltc_metallic_roughness(Surface s, Material m, float ndv, mat3 local, float diffuse,
                                  AreaOutline o, float side) {
+    float r = max(s.metal_rough.y, MIN_ROUGHNESS);
     vec2 scale;
-    mat3 inverse = ltc_lookup(LTC_GGX, max(s.metal_rough.y, MIN_ROUGHNESS), ndv, scale);
+    mat3 inverse = ltc_lookup(LTC_GGX, r, ndv, scale);
     float highlight = ltc_integral(inverse * local, o, side);
     vec3 base = m.diffuse.rgb * s.texel;
     vec3 f0 = mix(vec3(DIELECTRIC_F0), base, s.metal_rough.x);
-    vec3 f_view = f0 + (1.0 - f0) * pow(1.0 - ndv, 5.0);
-    return (1.0 - f_view) * (1.0 - s.metal_rough.x) * base * diffuse
-        + (f0 * scale.x + (1.0 - f0) * scale.y) * highlight;
+    float ndl = clamp(dot(s.normal, normalize(o.centre)), 1e-3, 1.0);
+    vec3 separable = ggx_separable(base, s.metal_rough, ggx_albedo(r, ndv), ggx_albedo(r, ndl));
+    return separable * diffuse + (f0 * (scale.x - scale.y) + scale.y) * highlight;
 }
 #endif
 
@@ -472,25 +446,20 @@ vec3 shade_all_lights(Surface s, Material m, uint area_samples) {
 // threshold) times `emission_texel` (MTL map_Ke, glTF emissiveTexture; 1
 // without one). The albedo is the integral of f cos over the hemisphere, as
 // the path tracer's rays escaping to the environment sum it: Blinn-Phong Kd
-// plus Ks times its highlight lobe's integral over pi; metallic-roughness the
-// GGX lobe's (F0 and Fresnel moment from the LTC table) plus the diffuse
-// weighted by 1 - F(N.V), as its area lights use. Nothing else occludes it.
+// plus Ks times its highlight lobe's integral over pi; metallic-roughness
+// exactly its energy-conserving BRDF's (brdf.glsl). Nothing else occludes it.
 vec3 environment_albedo(Surface s, Material m) {
     vec3 v = normalize(frame.camera_position.xyz - s.position);
     float ndv = clamp(dot(s.normal, v), 1e-3, 1.0);
-    vec2 scale;
 #ifdef SHADE_METALLIC_ROUGHNESS
     if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
-        ltc_lookup(LTC_GGX, max(s.metal_rough.y, MIN_ROUGHNESS), ndv, scale);
-        vec3 base = m.diffuse.rgb * s.texel;
-        vec3 f0 = mix(vec3(DIELECTRIC_F0), base, s.metal_rough.x);
-        vec3 f_view = f0 + (1.0 - f0) * pow(1.0 - ndv, 5.0);
-        return (1.0 - f_view) * (1.0 - s.metal_rough.x) * base + f0 * scale.x + (1.0 - f0) * scale.y;
+        return ggx_directional_albedo(m.diffuse.rgb * s.texel, s.metal_rough, ndv);
     }
 #endif
     vec3 albedo = m.diffuse.rgb * s.texel;
     float shininess = m.specular.w;
     if (shininess > 0.0) {
+        vec2 scale;
         ltc_lookup(LTC_BLINN_PHONG, pow(2.0 / (shininess + 2.0), 0.25), ndv, scale);
         albedo += m.specular.rgb * (scale.x / PI);
     }

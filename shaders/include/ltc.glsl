@@ -6,46 +6,17 @@
 // (engine/ltc/tables/ltc_tables.txt, written by `cargo run -p weft-ltc
 // --release --bin ltc-fit`) are uploaded by the engine into set 1; engine/ltc
 // holds the fit, the CPU twin of these functions and the tests against brute
-// force. Discs are regular 12-gons of the same area.
+// force. Discs are regular 12-gons of the same area. The tables themselves
+// are read through ltc_tables.glsl.
 #ifndef WEFT_LTC_GLSL
 #define WEFT_LTC_GLSL
 #include "area_light.glsl"
+#include "ltc_tables.glsl"
 
-// 32 x 32 entries per table, row j = perceptual roughness j / 31 (at least
-// 0.045), column k = sqrt(1 - N.V) * 31. In vec4s: the GGX inverse matrices
-// (a, b, c, d of the rows [[a, 0, b], [0, 1, 0], [c, 0, d]]), the GGX (lobe
-// integral, Fresnel moment, 0, 0), then the same two for Blinn-Phong
-// (weft_render::scene_gpu::ltc_table_words).
-layout(std430, set = 1, binding = 20) readonly buffer LtcTables { vec4 ltc_tables[]; };
-
-const int LTC_SIZE = 32;
-const int LTC_ENTRIES = LTC_SIZE * LTC_SIZE;
-const int LTC_GGX = 0;
-const int LTC_BLINN_PHONG = 2 * LTC_ENTRIES;
 // A disc becomes a regular polygon with this many corners, its corner radius
 // scaled by sqrt(pi / (n/2 sin(2 pi / n))) so its area is the disc's.
 const int LTC_DISC_CORNERS = 12;
 const float LTC_DISC_SCALE = 1.0233267;
-
-// Table entry `k` (vec4 index) interpolated bilinearly with its right, lower
-// and lower-right neighbours.
-vec4 ltc_bilinear(int k, vec2 f) {
-    return mix(mix(ltc_tables[k], ltc_tables[k + 1], f.x),
-               mix(ltc_tables[k + LTC_SIZE], ltc_tables[k + LTC_SIZE + 1], f.x), f.y);
-}
-
-// Bilinear lookup of the table starting at `table` at perceptual roughness r
-// and view cosine ndv: the inverse matrix and the lobe's (integral, Fresnel
-// moment).
-mat3 ltc_lookup(int table, float r, float ndv, out vec2 scale) {
-    vec2 at = clamp(vec2(sqrt(1.0 - ndv), r), 0.0, 1.0) * float(LTC_SIZE - 1);
-    ivec2 i0 = min(ivec2(at), ivec2(LTC_SIZE - 2));
-    vec2 f = at - vec2(i0);
-    int k = table + i0.y * LTC_SIZE + i0.x;
-    vec4 t = ltc_bilinear(k, f);
-    scale = ltc_bilinear(k + LTC_ENTRIES, f).xy;
-    return mat3(vec3(t.x, 0.0, t.z), vec3(0.0, 1.0, 0.0), vec3(t.y, 0.0, t.w));
-}
 
 // One edge's share of the vector form factor: theta / sin(theta) (a x b)
 // / (2 pi) for unit a, b at angle theta. theta / sin(theta) / (2 pi) comes

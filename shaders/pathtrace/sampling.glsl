@@ -1,6 +1,6 @@
-// Direction sampling and MIS weights for the path tracer. Every routine here
-// has a CPU mirror in engine/render/src/pathtrace_sampling.rs, where chi-square
-// tests hold each sampler to its pdf.
+// Direction sampling and MIS weights for the path tracer; the GGX terms
+// they use are the raster passes' own (include/brdf.glsl). Chi-square tests
+// on the GPU (tests/e2e/bsdf_sampling.rs) hold each sampler to its pdf.
 #ifndef WEFT_PT_SAMPLING_GLSL
 #define WEFT_PT_SAMPLING_GLSL
 
@@ -26,19 +26,6 @@ vec3 sample_phong_half(vec2 u, float exponent) {
     float sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
     float phi = 2.0 * PI * u.y;
     return vec3(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
-}
-
-// GGX distribution of normals, alpha = roughness^2.
-float ggx_d(float cos_h, float alpha) {
-    float a2 = alpha * alpha;
-    float q = cos_h * cos_h * (a2 - 1.0) + 1.0;
-    return a2 / (PI * q * q);
-}
-
-// Smith masking for GGX of a direction at cos_v to the normal.
-float ggx_g1(float cos_v, float alpha) {
-    float a2 = alpha * alpha;
-    return 2.0 * cos_v / (cos_v + sqrt(a2 + (1.0 - a2) * cos_v * cos_v));
 }
 
 // A GGX normal visible from v (local, v.z > 0), Heitz's 2018 method; the

@@ -220,13 +220,35 @@ fn every_bsdf_samples_directions_as_its_pdf_says() {
         // Expected counts from the tabulated pdf.
         let cell = (1.0 / GRID_COS as f64) * (std::f64::consts::TAU / GRID_PHI as f64);
         let mut expected = vec![0.0f64; PHI_BINS * COS_BINS + 2];
-        let mut integral = 0.0;
+        let (mut integral, mut albedo) = (0.0, 0.0);
         for j in 0..GRID_COS {
             for i in 0..GRID_PHI {
                 let p = f64::from(density[(j * GRID_PHI + i) * 4]) * cell;
                 let bin = (j * COS_BINS / GRID_COS) * PHI_BINS + i * PHI_BINS / GRID_PHI;
                 expected[bin] += p * n;
                 integral += p;
+                albedo += f64::from(density[(j * GRID_PHI + i) * 4 + 1]) * cell;
+            }
+        }
+        // The tracer's GGX on the GPU reflects what the energy-conserving
+        // model's closed form says (weft_render::brdf, held to the white
+        // furnace there): the grid's integral of f cos, within its
+        // resolution.
+        if case.model == 1.0 {
+            let base = glam::Vec3::splat(case.diffuse as f32);
+            let closed = weft_render::brdf::directional_albedo(
+                base,
+                case.metallic as f32,
+                case.roughness as f32,
+                (case.wo_theta as f32).cos(),
+            );
+            let closed = f64::from(closed.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722)));
+            println!("{}: albedo {albedo:.5}, closed form {closed:.5}", case.name);
+            if (albedo - closed).abs() > 1e-3 * closed {
+                failures.push(format!(
+                    "{}: bsdf_eval reflects {albedo} of a white environment; the model says {closed}",
+                    case.name
+                ));
             }
         }
         let delta = if case.model == 2.0 {

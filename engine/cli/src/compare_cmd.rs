@@ -530,6 +530,7 @@ impl Session {
             passes: pass_medians(&rendered),
             transient_bytes: rendered.report.transient_bytes,
             device_bytes: rendered.report.memory.allocated_bytes,
+            caveats: rendered.plan.caveats.clone(),
             files: Vec::new(),
         };
         Ok(Measured {

@@ -45,6 +45,9 @@ pub struct LoadedGraph {
     pub progressive: Option<crate::schema::Progressive>,
     /// Summarised views from the graph and its fragments, with their source.
     pub views: Vec<(usize, crate::schema::ViewDecl)>,
+    /// Known differences from the reference, from the graph and its
+    /// fragments, with their source.
+    pub caveats: Vec<(usize, crate::schema::CaveatDecl)>,
     /// Human-readable name.
     pub name: String,
     /// Toggles declared on by default by the graph and its fragments.
@@ -282,6 +285,9 @@ fn load_file(
     graph
         .views
         .extend(parsed.views.iter().map(|v| (source, v.clone())));
+    graph
+        .caveats
+        .extend(parsed.caveats.iter().map(|c| (source, c.clone())));
     for feature in &parsed.features {
         if !graph.default_features.contains(feature) {
             graph.default_features.push(feature.clone());

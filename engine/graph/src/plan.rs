@@ -78,6 +78,9 @@ pub struct Plan {
     pub samples_per_frame: Option<u32>,
     /// The views whose features hold: images read back and summarised per pixel.
     pub views: Vec<PlanView>,
+    /// The graph's known differences from the reference whose features hold
+    /// (`caveats` in the file), for `weft compare`.
+    pub caveats: Vec<String>,
     /// Where transient images live.
     pub memory: MemoryPlan,
     /// Barriers after the last pass: the output to `TRANSFER_SRC_OPTIMAL` for presenting or

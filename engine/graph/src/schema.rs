@@ -63,6 +63,25 @@ pub struct GraphFile {
     /// back when its features hold.
     #[serde(default)]
     pub views: Vec<ViewDecl>,
+    /// Where the graph's picture differs from the path-traced reference by
+    /// design, not by error (bloom the reference does not model, filtered
+    /// shadow maps, lights that cast no shadows): `weft compare` lists those
+    /// whose features hold beside each configuration's error, so technique
+    /// error can be told from modelling gaps. Fragments may declare them.
+    #[serde(default)]
+    pub caveats: Vec<CaveatDecl>,
+}
+
+/// One known difference from the reference (see [`GraphFile::caveats`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaveatDecl {
+    /// What differs and why, in a sentence a user reads beside the error.
+    pub note: String,
+    /// Features that must hold for the caveat to apply (`["bloom"]`,
+    /// `["area_lights"]`); empty: always.
+    #[serde(default)]
+    pub enabled_if: Vec<String>,
 }
 
 /// A debug view's summarised image (see [`GraphFile::views`]).

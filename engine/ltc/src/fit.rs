@@ -11,8 +11,12 @@ use crate::nelder_mead::minimise;
 use crate::{column_cos, row_roughness, TABLE_SIZE};
 use glam::{Mat3, Vec3};
 
-/// Samples per axis for moments and fit errors (the reference fit's 32).
+/// Samples per axis for fit errors (the reference fit's 32).
 pub const SAMPLES: usize = 32;
+/// Samples per axis for a lobe's moments: its integral is the directional
+/// albedo energy compensation divides by (`energy`), so it must hold to
+/// 1e-4, which the fit's 32 x 32 samples do not near grazing.
+pub const MOMENT_SAMPLES: usize = 256;
 
 /// One table entry: the inverse matrix normalised to a middle entry of 1,
 /// as `(a, b, c, d)` of `[[a, 0, b], [0, 1, 0], [c, 0, d]]` (rows), the
@@ -39,10 +43,10 @@ impl Entry {
 /// The lobe's integral, Fresnel moment and mean direction seen from `v`.
 pub fn moments<L: Lobe>(lobe: &L, v: Vec3) -> (f32, f32, Vec3) {
     let (mut magnitude, mut fresnel, mut direction) = (0.0f64, 0.0f64, Vec3::ZERO);
-    for j in 0..SAMPLES {
-        for i in 0..SAMPLES {
-            let u1 = (i as f32 + 0.5) / SAMPLES as f32;
-            let u2 = (j as f32 + 0.5) / SAMPLES as f32;
+    for j in 0..MOMENT_SAMPLES {
+        for i in 0..MOMENT_SAMPLES {
+            let u1 = (i as f32 + 0.5) / MOMENT_SAMPLES as f32;
+            let u2 = (j as f32 + 0.5) / MOMENT_SAMPLES as f32;
             let l = lobe.sample(v, u1, u2);
             let (value, pdf) = lobe.eval(v, l);
             if pdf <= 0.0 {
@@ -55,7 +59,7 @@ pub fn moments<L: Lobe>(lobe: &L, v: Vec3) -> (f32, f32, Vec3) {
             direction += l * weight;
         }
     }
-    let count = (SAMPLES * SAMPLES) as f64;
+    let count = (MOMENT_SAMPLES * MOMENT_SAMPLES) as f64;
     let direction = Vec3::new(direction.x, 0.0, direction.z).normalize_or(Vec3::Z);
     (
         (magnitude / count) as f32,

@@ -7,6 +7,7 @@
 //! (`engine/ltc/tables/ltc_tables.txt`, written by `ltc-fit`, uploaded by the
 //! engine for `shaders/include/ltc.glsl`).
 
+pub mod energy;
 pub mod fit;
 pub mod lobe;
 pub mod ltc;

@@ -1,12 +1,15 @@
-//! The metallic-roughness BRDF and the area-light quadrature of
-//! `shaders/include/lighting.glsl` on the CPU, term for term and with the same
-//! constants (a unit test reads them back from the shader source): the GGX math
-//! is tested here without a GPU, and GPU tests compare rendered radiance with it.
+//! The metallic-roughness BRDF of `shaders/include/brdf.glsl` and the
+//! area-light quadrature of `shaders/include/lighting.glsl` on the CPU, term
+//! for term and with the same constants and tables (a unit test reads the
+//! constants back from the shader source): the GGX math and its energy
+//! conservation are tested here without a GPU, and GPU tests compare
+//! rendered radiance with it.
 
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+use weft_ltc::energy::Albedo;
 
-/// Roughness is raised to at least this (`MIN_ROUGHNESS` in `lighting.glsl`).
+/// Roughness is raised to at least this (`MIN_ROUGHNESS` in `brdf.glsl`).
 pub const MIN_ROUGHNESS: f32 = 0.045;
 /// Reflectance at normal incidence of non-metals (`DIELECTRIC_F0`).
 pub const DIELECTRIC_F0: f32 = 0.04;
@@ -30,11 +33,61 @@ pub fn fresnel(f0: Vec3, vdh: f32) -> Vec3 {
     f0 + (Vec3::ONE - f0) * (1.0 - vdh).powi(5)
 }
 
-/// Cook-Torrance (GGX, Smith height-correlated, Schlick with
-/// `F0 = mix(0.04, base, metallic)`) plus Lambert diffuse weighted by
-/// `(1 - F)(1 - metallic)`, times N.L: the radiance reflected towards `v` per
-/// unit irradiance arriving along `l` (`cook_torrance` in `lighting.glsl`).
-pub fn cook_torrance(base: Vec3, metallic: f32, roughness: f32, n: Vec3, v: Vec3, l: Vec3) -> Vec3 {
+/// Single-scattering GGX's albedo entries at perceptual `roughness` seen at
+/// `cos`, from the committed table as the shaders interpolate it
+/// (`ggx_albedo` in `ltc_tables.glsl`).
+pub fn ggx_albedo(roughness: f32, cos: f32) -> Albedo {
+    let (table, averages) =
+        weft_ltc::energy::AlbedoTable::committed().expect("the committed GGX albedo table reads");
+    table.lookup(averages, roughness, cos)
+}
+
+/// Kulla-Conty's share of lost energy that returns through Fresnel
+/// (`ggx_multiple_scattering`).
+fn multiple_scattering(f0: Vec3, e_avg: f32) -> Vec3 {
+    let f_avg = f0 + (Vec3::ONE - f0) / 21.0;
+    f_avg * f_avg * e_avg / (Vec3::ONE - f_avg * (1.0 - e_avg))
+}
+
+/// What the specular layer reflects from a direction with entries `t`
+/// (`ggx_layer_albedo`).
+fn layer_albedo(f0: Vec3, t: &Albedo, multiple: Vec3) -> Vec3 {
+    f0 * (t.integral - t.fresnel) + Vec3::splat(t.fresnel) + multiple * (1.0 - t.integral)
+}
+
+/// The layer's cosine-weighted average (`ggx_layer_average`).
+fn layer_average(f0: Vec3, t: &Albedo, multiple: Vec3) -> Vec3 {
+    f0 * (t.average - t.average_fresnel)
+        + Vec3::splat(t.average_fresnel)
+        + multiple * (1.0 - t.average)
+}
+
+/// The lobes separable in view and light, times pi (`ggx_separable`):
+/// multiple scattering of the dielectric and the metal, and the dielectric's
+/// diffuse base under what its specular layer leaves, blended by `metallic`.
+fn separable(base: Vec3, metallic: f32, tv: &Albedo, tl: &Albedo) -> Vec3 {
+    let lost = (1.0 - tv.integral) * (1.0 - tl.integral) / (1.0 - tv.average).max(1e-6);
+    let f0 = Vec3::splat(DIELECTRIC_F0);
+    let m_dielectric = multiple_scattering(f0, tv.average);
+    let left = (Vec3::ONE - layer_average(f0, tv, m_dielectric)).max(Vec3::splat(1e-6));
+    let dielectric = m_dielectric * lost
+        + base
+            * (Vec3::ONE - layer_albedo(f0, tv, m_dielectric))
+            * (Vec3::ONE - layer_albedo(f0, tl, m_dielectric))
+            / left;
+    dielectric.lerp(multiple_scattering(base, tv.average) * lost, metallic)
+}
+
+/// Single-scattering GGX times N.L: Smith height-correlated visibility,
+/// Schlick's Fresnel with `F0 = mix(0.04, base, metallic)`.
+pub fn single_scattering(
+    base: Vec3,
+    metallic: f32,
+    roughness: f32,
+    n: Vec3,
+    v: Vec3,
+    l: Vec3,
+) -> Vec3 {
     let ndl = n.dot(l);
     if ndl <= 0.0 {
         return Vec3::ZERO;
@@ -46,9 +99,37 @@ pub fn cook_torrance(base: Vec3, metallic: f32, roughness: f32, n: Vec3, v: Vec3
     let r = roughness.max(MIN_ROUGHNESS);
     let a2 = r * r * r * r;
     let f0 = Vec3::splat(DIELECTRIC_F0).lerp(base, metallic);
-    let f = fresnel(f0, vdh);
-    let diffuse = (Vec3::ONE - f) * (1.0 - metallic) * base / PI;
-    (diffuse + distribution(ndh, a2) * visibility(ndl, ndv, a2) * f) * ndl
+    distribution(ndh, a2) * visibility(ndl, ndv, a2) * fresnel(f0, vdh) * ndl
+}
+
+/// Energy-conserving Cook-Torrance times N.L (`cook_torrance` in
+/// `brdf.glsl`): [`single_scattering`], Kulla-Conty multiple scattering, and
+/// the dielectric's diffuse base under what its specular layer leaves, as
+/// glTF's blend of dielectric and metal: the radiance reflected towards `v`
+/// per unit irradiance arriving along `l`.
+pub fn cook_torrance(base: Vec3, metallic: f32, roughness: f32, n: Vec3, v: Vec3, l: Vec3) -> Vec3 {
+    let ndl = n.dot(l);
+    if ndl <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let r = roughness.max(MIN_ROUGHNESS);
+    let lobes = separable(
+        base,
+        metallic,
+        &ggx_albedo(r, n.dot(v).max(1e-4)),
+        &ggx_albedo(r, ndl),
+    );
+    single_scattering(base, metallic, roughness, n, v, l) + lobes / PI * ndl
+}
+
+/// What a metallic-roughness surface reflects of a constant environment of
+/// radiance 1 seen at `ndv` (`ggx_directional_albedo`).
+pub fn directional_albedo(base: Vec3, metallic: f32, roughness: f32, ndv: f32) -> Vec3 {
+    let t = ggx_albedo(roughness.max(MIN_ROUGHNESS), ndv);
+    let f0 = Vec3::splat(DIELECTRIC_F0);
+    let dielectric = layer_albedo(f0, &t, multiple_scattering(f0, t.average));
+    let metal = layer_albedo(base, &t, multiple_scattering(base, t.average));
+    (dielectric + base * (Vec3::ONE - dielectric)).lerp(metal, metallic)
 }
 
 /// Shirley-Chiu concentric map of `[-1, 1]²` onto the unit disc (area-preserving).
@@ -178,16 +259,16 @@ mod tests {
         })
     }
 
-    fn shader_constant(name: &str) -> f32 {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../shaders/include/lighting.glsl"
+    fn shader_constant(file: &str, name: &str) -> f32 {
+        let path = format!(
+            "{}/../../shaders/include/{file}",
+            env!("CARGO_MANIFEST_DIR")
         );
-        let source = std::fs::read_to_string(path).expect("lighting.glsl");
+        let source = std::fs::read_to_string(&path).expect("the shader include");
         let line = source
             .lines()
             .find(|l| l.starts_with("const ") && l.contains(&format!(" {name} = ")))
-            .unwrap_or_else(|| panic!("{name} not in lighting.glsl"));
+            .unwrap_or_else(|| panic!("{name} not in {file}"));
         let value = line.split('=').nth(1).expect("a value");
         value
             .trim()
@@ -198,10 +279,22 @@ mod tests {
 
     #[test]
     fn constants_match_the_shader() {
-        assert_eq!(shader_constant("MIN_ROUGHNESS"), MIN_ROUGHNESS);
-        assert_eq!(shader_constant("DIELECTRIC_F0"), DIELECTRIC_F0);
-        // The LTC tables are fitted down to the same roughness.
+        assert_eq!(shader_constant("brdf.glsl", "MIN_ROUGHNESS"), MIN_ROUGHNESS);
+        assert_eq!(shader_constant("brdf.glsl", "DIELECTRIC_F0"), DIELECTRIC_F0);
+        // The tables are fitted and integrated down to the same roughness.
         assert_eq!(weft_ltc::MIN_ROUGHNESS, MIN_ROUGHNESS);
+        assert_eq!(
+            shader_constant("ltc_tables.glsl", "MIN_ALBEDO_ROUGHNESS"),
+            MIN_ROUGHNESS
+        );
+        assert_eq!(
+            shader_constant("ltc_tables.glsl", "GGX_ALBEDO_ROWS"),
+            weft_ltc::energy::ROWS as f32
+        );
+        assert_eq!(
+            shader_constant("ltc_tables.glsl", "GGX_ALBEDO_COLUMNS"),
+            weft_ltc::energy::COLUMNS as f32
+        );
     }
 
     #[test]
@@ -209,13 +302,13 @@ mod tests {
         // n = v = l: D = 1 / (pi a2), V = 1/4, F = F0, so specular = F0 / (4 pi a2).
         let z = Vec3::Z;
         let base = Vec3::new(0.8, 0.4, 0.2);
-        let dielectric = cook_torrance(base, 0.0, 0.5, z, z, z);
-        let expected = 0.04 / (4.0 * PI * 0.0625) + 0.96 * base / PI;
+        let dielectric = single_scattering(base, 0.0, 0.5, z, z, z);
+        let expected = Vec3::splat(0.04 / (4.0 * PI * 0.0625));
         assert!(
             (dielectric - expected).abs().max_element() < 1e-6,
             "{dielectric}"
         );
-        let metal = cook_torrance(base, 1.0, 0.5, z, z, z);
+        let metal = single_scattering(base, 1.0, 0.5, z, z, z);
         let expected = base / (4.0 * PI * 0.0625);
         assert!((metal - expected).abs().max_element() < 1e-6, "{metal}");
         // Below the horizon nothing is reflected.
@@ -256,38 +349,148 @@ mod tests {
         }
     }
 
-    #[test]
-    fn white_furnace_directional_albedo() {
-        // ∫ f cos dω of a white surface. A white metal (pure GGX) never exceeds 1 and
-        // keeps nearly everything when smooth; single scattering loses energy as
-        // roughness grows (1 - ln 2 = 0.307 at roughness 1 head-on, the closed form).
-        // The (1 - F)-weighted Lambert term of a white dielectric stays within 1 for
-        // views within 45° of the normal but overshoots at grazing views (measured
-        // 1.144 at roughness 0.2, cos 0.3): a limit of the model the brief asks for.
-        let white = Vec3::ONE;
-        let albedo = |metallic: f32, roughness: f32, view_cos: f32| -> f32 {
-            let v = Vec3::new((1.0 - view_cos * view_cos).sqrt(), 0.0, view_cos);
-            hemisphere(300)
-                .map(|(l, dw)| cook_torrance(white, metallic, roughness, Vec3::Z, v, l).x * dw)
-                .sum()
-        };
-        for roughness in [0.2f32, 0.3, 0.6, 1.0] {
-            for view_cos in [1.0f32, 0.7, 0.3] {
-                let metal = albedo(1.0, roughness, view_cos);
-                assert!(
-                    metal <= 1.0 + 2e-3,
-                    "metal r {roughness} v {view_cos}: {metal}"
-                );
-                let dielectric = albedo(0.0, roughness, view_cos);
-                let bound = if view_cos >= 0.7 { 1.0 + 2e-3 } else { 1.15 };
-                assert!(
-                    dielectric <= bound,
-                    "dielectric r {roughness} v {view_cos}: {dielectric}"
-                );
+    /// `∫ f cos dω` of `cook_torrance` seen from `v` (normal +Z), in two
+    /// parts. Single scattering by sampling visible GGX normals (stratified
+    /// 256 x 256, weights at most 1). The rest, `cook_torrance` minus
+    /// [`single_scattering`], by quadrature over (cos θ = t³, φ): at low
+    /// roughness its mass lies at grazing light directions (within
+    /// cos θ < 0.05), which cosine sampling all but misses.
+    fn furnace(base: Vec3, metallic: f32, roughness: f32, v: Vec3) -> Vec3 {
+        use weft_ltc::lobe::{Ggx, Lobe};
+        let r = roughness.max(MIN_ROUGHNESS);
+        let lobe = Ggx { alpha: r * r };
+        let m = 256;
+        let mut single = glam::DVec3::ZERO;
+        for j in 0..m {
+            for i in 0..m {
+                let l = lobe.sample(v, (i as f32 + 0.5) / m as f32, (j as f32 + 0.5) / m as f32);
+                let pdf = lobe.eval(v, l).1;
+                if l.z > 0.0 && pdf > 0.0 {
+                    let f = single_scattering(base, metallic, roughness, Vec3::Z, v, l);
+                    single += f.as_dvec3() / f64::from(pdf);
+                }
             }
         }
-        assert!(albedo(1.0, 0.2, 1.0) >= 0.995);
-        assert!((albedo(1.0, 1.0, 1.0) - (1.0 - 2f32.ln())).abs() < 2e-3);
+        let (steps, azimuths) = (600, 48);
+        let mut rest = glam::DVec3::ZERO;
+        for i in 0..steps {
+            let t = (i as f32 + 0.5) / steps as f32;
+            let cos = t * t * t;
+            let d_cos = 3.0 * t * t / steps as f32;
+            for j in 0..azimuths {
+                let phi = (j as f32 + 0.5) / azimuths as f32 * 2.0 * PI;
+                let sin = (1.0 - cos * cos).sqrt();
+                let l = Vec3::new(sin * phi.cos(), sin * phi.sin(), cos);
+                let f = cook_torrance(base, metallic, roughness, Vec3::Z, v, l)
+                    - single_scattering(base, metallic, roughness, Vec3::Z, v, l);
+                rest += f.as_dvec3() * f64::from(d_cos * 2.0 * PI / azimuths as f32);
+            }
+        }
+        (single / f64::from(m * m) + rest).as_vec3()
+    }
+
+    fn view(cos: f32) -> Vec3 {
+        Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos)
+    }
+
+    #[test]
+    fn white_furnace_reflects_everything_at_every_angle_and_roughness() {
+        // White metals, dielectrics and blends reflect 1 of a uniform white
+        // environment: multiple scattering returns what single scattering
+        // loses (0.69 at roughness 1 head-on), the diffuse base takes what
+        // the specular layer leaves. Never above 1 + 1e-3; below only by the
+        // tables' interpolation between their 32 x 32 entries. Roughness
+        // and cosines off the table's nodes on purpose.
+        let mut worst = (0.0f32, String::new());
+        for metallic in [0.0f32, 0.5, 1.0] {
+            for roughness in [0.0f32, 0.1, 0.23, 0.37, 0.5, 0.77, 1.0] {
+                for cos in [1.0f32, 0.8, 0.5, 0.3, 0.12, 0.05, 0.02] {
+                    let albedo = furnace(Vec3::ONE, metallic, roughness, view(cos)).x;
+                    let what = format!("metallic {metallic}, roughness {roughness}, N.V {cos}");
+                    assert!(albedo <= 1.0 + 1e-3, "{what}: {albedo}");
+                    if (1.0 - albedo).abs() > worst.0 {
+                        worst = ((1.0 - albedo).abs(), format!("{what}: {albedo}"));
+                    }
+                }
+            }
+        }
+        eprintln!(
+            "white furnace: worst |1 - albedo| {:.1e} at {}",
+            worst.0, worst.1
+        );
+        assert!(worst.0 < 2e-3, "worst {}", worst.1);
+    }
+
+    #[test]
+    fn the_directional_albedo_is_the_integral_of_the_brdf() {
+        // What the raster environment term shows equals what rays escaping
+        // to a constant environment sum in the path tracer.
+        for (base, metallic) in [
+            (Vec3::new(0.9, 0.5, 0.1), 0.0),
+            (Vec3::new(0.9, 0.6, 0.3), 1.0),
+            (Vec3::splat(0.5), 0.4),
+        ] {
+            for roughness in [0.1f32, 0.5, 0.9] {
+                for cos in [1.0f32, 0.4, 0.1] {
+                    let integral = furnace(base, metallic, roughness, view(cos));
+                    let closed = directional_albedo(base, metallic, roughness, cos);
+                    assert!(
+                        (integral - closed).abs().max_element() < 4e-3,
+                        "{base} {metallic} {roughness} {cos}: {integral} vs {closed}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn single_scattering_loses_energy_that_compensation_returns() {
+        // The single-scattering lobe alone: 1 - ln 2 = 0.307 at roughness 1
+        // head-on (the closed form), nearly everything when smooth.
+        let single = |roughness: f32, cos: f32| -> f32 {
+            hemisphere(300)
+                .map(|(l, dw)| {
+                    single_scattering(Vec3::ONE, 1.0, roughness, Vec3::Z, view(cos), l).x * dw
+                })
+                .sum()
+        };
+        assert!((single(1.0, 1.0) - (1.0 - 2f32.ln())).abs() < 2e-3);
+        assert!(single(0.2, 1.0) > 0.995);
+        // The table the compensation reads holds the same integrals.
+        for (roughness, cos) in [(1.0f32, 1.0f32), (0.6, 0.5), (0.3, 0.2)] {
+            let table = ggx_albedo(roughness, cos).integral;
+            let integral = single(roughness, cos);
+            assert!(
+                (table - integral).abs() < 2e-3,
+                "{roughness} {cos}: {table} vs {integral}"
+            );
+        }
+        // A white metal at roughness 1 reflects 1 all the same.
+        let metal = furnace(Vec3::ONE, 1.0, 1.0, Vec3::Z).x;
+        assert!((metal - 1.0).abs() < 2e-3, "{metal}");
+    }
+
+    #[test]
+    fn blinn_phong_reflects_at_most_kd_plus_ks() {
+        // The raster Blinn-Phong lobe (N.H)^n N.L / pi never exceeds the
+        // cosine's, so a white split Kd + Ks = 1 reflects at most 1; its
+        // lobe integral is what the environment term reads from the table.
+        use weft_ltc::lobe::{BlinnPhong, Lobe};
+        for exponent in [0.0f32, 1.0, 10.0, 100.0] {
+            for cos in [1.0f32, 0.5, 0.1, 0.02] {
+                let lobe = BlinnPhong { exponent };
+                let integral: f32 = hemisphere(200)
+                    .map(|(l, dw)| lobe.eval(view(cos), l).0 * dw)
+                    .sum::<f32>()
+                    / PI;
+                assert!(
+                    integral <= 1.0 + 1e-3,
+                    "n {exponent}, N.V {cos}: {integral}"
+                );
+                let (kd, ks) = (0.6, 0.4);
+                assert!(kd + ks * integral <= 1.0 + 1e-3);
+            }
+        }
     }
 
     #[test]
@@ -386,51 +589,6 @@ mod tests {
                                 "roughness {roughness}, metallic {metallic}, N.V {cv}, N.L {cl}: {f}"
                             );
                         }
-                    }
-                }
-            }
-        }
-        // A white furnace: the reflected fraction of uniform incident light,
-        // integrated over the hemisphere (stratified, 256 x 256). Metals (GGX
-        // alone, single scattering) never exceed 1 beyond the integration
-        // error. Dielectrics weight Lambert by 1 - F(v.h), not by the
-        // specular lobe's directional albedo, so they gain energy towards
-        // grazing views: measured 1.33 at roughness 0.3 and N.V 0.05
-        // (docs/stability.md). The bound pins that figure so a change to the
-        // model shows here.
-        for roughness in [0.3, 0.6, 1.0] {
-            for metallic in [0.0, 1.0] {
-                for cv in [1.0, 0.5, 0.05] {
-                    let v = dir(cv, 0.0);
-                    let steps = 256;
-                    let mut sum = 0.0f64;
-                    for i in 0..steps {
-                        for j in 0..steps {
-                            // Uniform in solid angle: cos theta uniform in [0, 1].
-                            let cl = (i as f32 + 0.5) / steps as f32;
-                            let azimuth = (j as f32 + 0.5) / steps as f32 * std::f32::consts::TAU;
-                            let f = cook_torrance(
-                                Vec3::ONE,
-                                metallic,
-                                roughness,
-                                n,
-                                v,
-                                dir(cl, azimuth),
-                            );
-                            sum += f64::from(f.x);
-                        }
-                    }
-                    let albedo = sum * std::f64::consts::TAU / f64::from(steps * steps);
-                    let bound = if metallic == 1.0 { 1.005 } else { 1.34 };
-                    assert!(
-                        albedo <= bound,
-                        "roughness {roughness}, metallic {metallic}, N.V {cv}: {albedo}"
-                    );
-                    if metallic == 0.0 && cv == 1.0 {
-                        assert!(
-                            albedo <= 1.005,
-                            "head-on dielectric, roughness {roughness}: {albedo}"
-                        );
                     }
                 }
             }

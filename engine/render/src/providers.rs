@@ -343,6 +343,7 @@ mod tests {
             readback: Vec::new(),
             samples_per_frame: None,
             views: Vec::new(),
+            caveats: Vec::new(),
             memory: Default::default(),
             epilogue: Vec::new(),
             warnings: Vec::new(),

@@ -124,10 +124,16 @@ pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 8] = [
     ),
 ];
 
-/// The LTC tables as `ltc.glsl` reads them, in vec4s: the GGX inverses, the
-/// GGX (integral, Fresnel moment, 0, 0), then the same for Blinn-Phong.
-pub fn ltc_table_words(tables: &weft_ltc::tables::Tables) -> Vec<f32> {
-    let mut words = Vec::with_capacity(4 * 4 * tables.ggx.len());
+/// The LTC tables as `ltc_tables.glsl` reads them, in vec4s: the GGX
+/// inverses, the GGX (integral, Fresnel moment, 0, 0), the same for
+/// Blinn-Phong, then GGX's albedo for energy compensation (integral,
+/// Fresnel moment, and the averages of both over the entry's row,
+/// [`weft_ltc::energy::AlbedoTable::row_averages`]).
+pub fn ltc_table_words(
+    tables: &weft_ltc::tables::Tables,
+    (albedo, averages): &weft_ltc::energy::WithAverages,
+) -> Vec<f32> {
+    let mut words = Vec::with_capacity(4 * (4 * tables.ggx.len() + albedo.entries.len()));
     for table in [&tables.ggx, &tables.blinn_phong] {
         words.extend(table.iter().flat_map(|e| e.inverse));
         words.extend(
@@ -136,6 +142,10 @@ pub fn ltc_table_words(tables: &weft_ltc::tables::Tables) -> Vec<f32> {
                 .flat_map(|e| [e.magnitude, e.fresnel, 0.0, 0.0]),
         );
     }
+    words.extend(albedo.entries.iter().enumerate().flat_map(|(i, e)| {
+        let [average, average_fresnel] = averages[i / weft_ltc::energy::COLUMNS];
+        [e.integral, e.fresnel, average, average_fresnel]
+    }));
     words
 }
 
@@ -516,7 +526,9 @@ impl<'g> GpuScene<'g> {
         shadows.write(&vec![0u8; shadows::SHADOWS_BYTES])?;
         let tables = weft_ltc::tables::committed()
             .map_err(|e| GpuError::Plan(format!("the built-in LTC tables: {e}")))?;
-        let words = ltc_table_words(tables);
+        let albedo = weft_ltc::energy::AlbedoTable::committed()
+            .map_err(|e| GpuError::Plan(format!("the built-in GGX albedo table: {e}")))?;
+        let words = ltc_table_words(tables, albedo);
         let mut ltc_tables = Buffer::host(gpu, "ltc_tables", (words.len() * 4) as u64, storage)?;
         ltc_tables.write(bytes_of(&words))?;
         let sampler = Sampler::linear_repeat(gpu)?;

@@ -98,8 +98,27 @@ fn a_compare_run_writes_every_file_and_caches_its_reference() {
             "passes",
             "transient_bytes",
             "device_bytes",
+            "caveats",
         ] {
             assert!(c.get(key).is_some(), "{key} missing in {c}");
+        }
+        // The graphs' caveats under the demo's features: bloom (on by
+        // default), no bounces, unshadowed area lights (the demo has some).
+        let caveats: Vec<&str> = c["caveats"]
+            .as_array()
+            .expect("caveats")
+            .iter()
+            .filter_map(|n| n.as_str())
+            .collect();
+        for start in [
+            "bloom spreads",
+            "direct light and",
+            "area lights and emissive",
+        ] {
+            assert!(
+                caveats.iter().any(|n| n.starts_with(start)),
+                "{start}: {caveats:?}"
+            );
         }
         let flip = c["flip"].as_f64().expect("flip");
         assert!(flip > 0.0 && flip < 1.0, "{flip}");
@@ -114,6 +133,11 @@ fn a_compare_run_writes_every_file_and_caches_its_reference() {
     assert_eq!(configurations[0]["name"], "forward");
     let markdown = std::fs::read_to_string(out.join("report.md")).expect("report.md");
     assert!(markdown.contains("| forward | "), "{markdown}");
+    assert!(
+        stdout.contains("Caveats: where a configuration differs from the reference by design")
+            && markdown.contains(". bloom spreads bright pixels"),
+        "{stdout}"
+    );
 
     // The same inputs again: the reference comes from the cache, bit for bit.
     let again = compare(&out, &cache);

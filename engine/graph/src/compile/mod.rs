@@ -266,6 +266,12 @@ pub fn compile_ir(
                 threshold: v.threshold,
             })
             .collect(),
+        caveats: graph
+            .caveats
+            .iter()
+            .filter(|(_, c)| conditions_hold(&c.enabled_if, &options.features))
+            .map(|(_, c)| c.note.clone())
+            .collect(),
         resources,
         passes,
         culled,

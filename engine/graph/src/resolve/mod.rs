@@ -169,7 +169,42 @@ impl<'a> Resolver<'a> {
         };
         self.check_usages(&ir);
         self.check_extents(&ir);
+        self.check_caveats(&ir);
         ir
+    }
+
+    /// Every caveat says something, and holds under features the graph has:
+    /// a misspelt feature would silently never show the caveat.
+    fn check_caveats(&mut self, ir: &Ir) {
+        let mut known = crate::compile::feature_names(ir);
+        known.extend(self.graph.default_features.iter().cloned());
+        known.extend(self.graph.internal_features.iter().cloned());
+        for (k, (source, caveat)) in self.graph.caveats.iter().enumerate() {
+            let index = self.graph.caveats[..k]
+                .iter()
+                .filter(|(s, _)| s == source)
+                .count();
+            let path = |field| [Seg::Field("caveats"), Seg::Index(index), Seg::Field(field)];
+            if caveat.note.trim().is_empty() {
+                self.error(*source, &path("note"), "a caveat's note is empty".into())
+                    .hint = Some("say what differs from the reference and why".into());
+            }
+            // A fragment's features may be its includer's: checked there.
+            for condition in caveat.enabled_if.iter().filter(|_| !self.graph.is_fragment) {
+                let feature = condition.trim_start_matches('!');
+                if !known.contains(feature) {
+                    let hint =
+                        crate::diagnostic::nearest(feature, known.iter().map(String::as_str))
+                            .map(|n| format!("did you mean \"{n}\"?"));
+                    self.error(
+                        *source,
+                        &path("enabled_if"),
+                        format!("caveat condition \"{condition}\" names a feature no pass of this graph uses"),
+                    )
+                    .hint = hint;
+                }
+            }
+        }
     }
 
     /// Every image fits [`MAX_IMAGE_DIMENSION`] at each size `check` tries

@@ -526,6 +526,48 @@ fn out_of_range_values_are_located_errors() {
 }
 
 #[test]
+fn caveats_need_a_note_and_features_the_graph_has() {
+    let cases = [
+        (
+            r#"Graph(caveats: [(note: " ")],"#,
+            "a caveat's note is empty",
+            r#"" ")]"#,
+        ),
+        (
+            r#"Graph(caveats: [(note: "glow", enabled_if: ["blom"])],"#,
+            "caveat condition \"blom\" names a feature no pass of this graph uses",
+            r#"["blom"]"#,
+        ),
+    ];
+    for (edit, message, at) in cases {
+        let text = VALID.replacen("Graph(", edit, 1);
+        let found = errors(&text);
+        let d = found
+            .iter()
+            .find(|d| d.message == message)
+            .unwrap_or_else(|| panic!("{edit}: expected \"{message}\", got {found:#?}"));
+        assert!(
+            text_at(&text, d).starts_with(at),
+            "{edit}: located at {:?}",
+            text_at(&text, d)
+        );
+    }
+    // A feature a pass uses is known.
+    let known = VALID
+        .replacen(
+            "Graph(",
+            r#"Graph(caveats: [(note: "glow", enabled_if: ["!glow"])],"#,
+            1,
+        )
+        .replacen(
+            "draw: Meshes(Opaque),",
+            r#"draw: Meshes(Opaque), defines: [(name: "GLOW", enabled_if: ["glow"])],"#,
+            1,
+        );
+    assert_eq!(errors(&known), Vec::<Diagnostic>::new());
+}
+
+#[test]
 fn progressive_samples_per_frame_must_be_a_whole_number_in_range() {
     let graph = |value: &str| {
         VALID.replace(

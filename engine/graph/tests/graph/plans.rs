@@ -87,6 +87,30 @@ fn plans_match_snapshots_and_pass_the_checker() {
 }
 
 #[test]
+fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
+    let graph = weft_graph::load(&repo_root().join("graphs/forward.ron"));
+    let caveats = |requested: &[&str]| -> Vec<String> {
+        let options = CompileOptions {
+            features: graph.features(requested),
+            ..CompileOptions::default()
+        };
+        let plan = weft_graph::compile(&graph, &options).expect("forward compiles");
+        plan.caveats
+            .iter()
+            .map(|c| c.split([' ', ':']).next().unwrap_or_default().to_string())
+            .collect()
+    };
+    // raster_caveats.ron's unconditional note; bloom.ron's while bloom is on
+    // (a default feature).
+    assert_eq!(caveats(&[]), ["bloom", "direct"]);
+    assert_eq!(caveats(&["!bloom"]), ["direct"]);
+    assert_eq!(
+        caveats(&["!bloom", "shadow_casters", "area_lights", "point_lights"]),
+        ["sun", "direct", "area", "point"]
+    );
+}
+
+#[test]
 fn removing_any_barrier_makes_the_checker_fail() {
     let graph = weft_graph::load(&repo_root().join("graphs/deferred.ron"));
     let options = CompileOptions {
