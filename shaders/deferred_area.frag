@@ -6,6 +6,10 @@ layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
 layout(set = 0, binding = 3) uniform sampler2D depth;
+#ifdef HAS_SHADOW_MAP
+// Area lights with a view in the shadow atlas cast soft shadows (shadows.glsl).
+layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
+#endif
 #include "include/deferred.glsl"
 layout(push_constant) uniform Params {
     uint area_samples;  // graph parameter: 0 analytic (LTC), n: n x n quadrature

@@ -67,10 +67,10 @@
 #if !defined(SHADE_METALLIC_ROUGHNESS) && !defined(SHADE_BLINN_PHONG)
 #define SHADE_BLINN_PHONG
 #endif
-// A bound shadow map means a sun or a spot casts shadows: a pass that loops
-// over neither (feature sets `weft graph check --shaders` tries, not scenes)
+// A bound shadow map means a sun, a spot or an area light casts shadows: a
+// pass that loops over none of them (feature sets `weft graph check --shaders` tries, not scenes)
 // keeps the sun loop, so the map it is given is used.
-#if defined(HAS_SHADOW_MAP) && !defined(SHADE_SUNS) && !defined(SHADE_SPOT_LIGHTS)
+#if defined(HAS_SHADOW_MAP) && !defined(SHADE_SUNS) && !defined(SHADE_SPOT_LIGHTS) && !defined(SHADE_AREA_LIGHTS)
 #define SHADE_SUNS
 #endif
 
@@ -411,11 +411,13 @@ vec3 shade_area_lights(Surface s, Material m, uint area_samples) {
     // Area lights, then the emissive polygons after every other record.
     uint end = frame.counts.w + frame.emitter_lights.x;
     for (uint i = frame.counts.x + frame.counts.y + frame.counts.z; i < end; ++i) {
-        if (area_samples == 0u) {
-            c += shade_area_ltc(i, s, m);
-        } else {
-            c += shade_area_quadrature(i, s, m, area_samples);
+        vec3 light = area_samples == 0u ? shade_area_ltc(i, s, m) : shade_area_quadrature(i, s, m, area_samples);
+#ifdef HAS_SHADOW_MAP
+        if (any(greaterThan(light, vec3(0.0)))) {
+            light *= area_visibility(i, s.position, s.normal, area_outline(i, s.position));
         }
+#endif
+        c += light;
     }
 #endif
     return c;

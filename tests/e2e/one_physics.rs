@@ -153,3 +153,90 @@ fn a_light_in_the_plane_of_a_surface_gives_it_nothing_in_every_graph() {
         );
     }
 }
+
+#[test]
+fn area_lights_cast_soft_shadows_as_the_tracer_sees_them() {
+    // The 1 x 0.6 emissive panel at height 1 over the floor, and a 0.4 x 0.4
+    // square blocker at height 0.4 off to the side: its shadow falls further
+    // out, soft (the panel is larger than the blocker's distance to the
+    // floor allows a hard edge). Raster graphs shadow area lights with
+    // PCSS in a view from the light's centre; the path tracer traces the
+    // visibility of every point of the panel. Compared on the band of floor
+    // beside the blocker where the shadow falls, which the camera above sees.
+    let dir = TempDir::new("area-shadow");
+    let scene = floor_scene(
+        &dir.0,
+        "v -0.5 1 -0.3\nv 0.5 1 -0.3\nv 0.5 1 0.3\nv -0.5 1 0.3\nvn 0 -1 0\nusemtl glow\n\
+         f 5//2 6//2 7//2\nf 5//2 7//2 8//2\n\
+         v 0.6 0.4 -0.2\nv 1.0 0.4 -0.2\nv 1.0 0.4 0.2\nv 0.6 0.4 0.2\nusemtl white\n\
+         f 9//1 11//1 10//1\nf 9//1 12//1 11//1\n",
+        "",
+    );
+    // Image x grows with world x (2.31 world units either side at the floor
+    // plane); the shadow spans about x 1.1 to 2.3 and |z| < 0.6.
+    let band = |image: &[Vec3]| -> Vec<f32> {
+        let (mut values, half) = (Vec::new(), SIZE as f32 / 2.0);
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                let world =
+                    (Vec3::new(x as f32 + 0.5 - half, 0.0, y as f32 + 0.5 - half)) / half * 2.31;
+                if (1.15..2.2).contains(&world.x) && world.z.abs() < 0.5 {
+                    values.push(image[(y * SIZE + x) as usize].x);
+                }
+            }
+        }
+        values
+    };
+    let reference = band(&render(
+        &scene,
+        "pathtrace.ron",
+        Some(512),
+        &[("max_depth", 2.0)],
+    ));
+    // Relative L1 error over the band, and the band's mean over the reference's.
+    let error = |image: &[f32]| {
+        image
+            .iter()
+            .zip(&reference)
+            .map(|(a, b)| (a - b).abs())
+            .sum::<f32>()
+            / reference.iter().sum::<f32>()
+    };
+    let ratio = |image: &[f32]| image.iter().sum::<f32>() / reference.iter().sum::<f32>();
+    let settings = weft_tests::render::square_settings(
+        "forward.ron",
+        SIZE,
+        None,
+        &[],
+        &["!bloom", "!shadow_casters"],
+    );
+    let (_, values) = weft_tests::render::render_hdr_validated(&scene, settings);
+    let unshadowed: Vec<Vec3> = values
+        .chunks(4)
+        .map(|p| Vec3::new(p[0], p[1], p[2]))
+        .collect();
+    let unshadowed = band(&unshadowed);
+    println!(
+        "unshadowed: error {:.3}, ratio {:.3}",
+        error(&unshadowed),
+        ratio(&unshadowed)
+    );
+    assert!(
+        error(&unshadowed) > 0.5,
+        "the blocker's shadow is there to find"
+    );
+    for graph in ["forward.ron", "deferred.ron", "tiled.ron"] {
+        let shadowed = band(&render(&scene, graph, None, &[]));
+        println!(
+            "{graph}: error {:.3}, ratio {:.3}",
+            error(&shadowed),
+            ratio(&shadowed)
+        );
+        assert!(
+            error(&shadowed) < 0.16 && (ratio(&shadowed) - 1.0).abs() < 0.08,
+            "{graph}: error {}, ratio {}",
+            error(&shadowed),
+            ratio(&shadowed)
+        );
+    }
+}

@@ -8,7 +8,8 @@ use weft_scene::material::ShadingModel;
 use weft_scene::{AreaShape, Light, Scene};
 
 /// The features `scene` switches on: `shadow_casters` when a placed mesh casts
-/// and a light casts shadows (a sun, or a spot narrow enough for a cone),
+/// and a light casts shadows (a sun, a spot narrow enough for a cone, an area
+/// light or emissive geometry that lights raster passes),
 /// `suns` / `point_lights` / `spot_lights` when there are such lights, `emissive` when a
 /// placed mesh glows, `transparent` when a placed mesh blends, `area_lights` when
 /// there are area lights or emissive geometry that lights raster passes
@@ -44,11 +45,15 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
             })
     };
     let mut features = Vec::new();
-    let shadowing_light = scene.lights.iter().any(|l| match l {
-        Light::Sun(_) => true,
-        Light::Spot(s) => is_cone(s.angle),
-        _ => false,
-    });
+    // Emissive geometry lights raster passes as four-cornered area lights
+    // (crate::emitter_lights), and casts shadows as they do.
+    let emitter_lights = placed().any(|m| crate::emitter_lights::lights_raster(&m));
+    let shadowing_light = emitter_lights
+        || scene.lights.iter().any(|l| match l {
+            Light::Sun(_) | Light::Area(_) => true,
+            Light::Spot(s) => is_cone(s.angle),
+            _ => false,
+        });
     if shadowing_light && placed().any(|m| matches(MaterialFilter::ShadowCasters, &m)) {
         features.push("shadow_casters".to_string());
     }
@@ -67,9 +72,6 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     if scene.lights.iter().any(|l| matches!(l, Light::Spot(_))) {
         features.push("spot_lights".to_string());
     }
-    // Emissive geometry lights raster passes as four-cornered area lights
-    // (crate::emitter_lights).
-    let emitter_lights = placed().any(|m| crate::emitter_lights::lights_raster(&m));
     if emitter_lights || scene.lights.iter().any(|l| matches!(l, Light::Area(_))) {
         features.push("area_lights".to_string());
     }

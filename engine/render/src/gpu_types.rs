@@ -108,6 +108,9 @@ pub struct GpuShadowsHeader {
     pub splits: Vec4,
     /// Camera view direction, w: normal offset in texels.
     pub forward: Vec4,
+    /// First area-light view, light index of the first area light, area
+    /// views, 0.
+    pub areas: UVec4,
 }
 
 /// `struct ShadowView`.
@@ -122,6 +125,9 @@ pub struct GpuShadowView {
     pub rect: Vec4,
     /// x: world size of a texel, y: 1 for perspective views.
     pub texel: Vec4,
+    /// Area-light views: the side of a square of the light's area, the
+    /// view's near and far depth; zero for other views.
+    pub light: Vec4,
 }
 
 const _: () = {
@@ -131,8 +137,8 @@ const _: () = {
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMaterial>() == 128);
     assert!(size_of::<GpuFrame>() == 2 * 64 + 5 * 16);
-    assert!(size_of::<GpuShadowsHeader>() == 48);
-    assert!(size_of::<GpuShadowView>() == 160);
+    assert!(size_of::<GpuShadowsHeader>() == 64);
+    assert!(size_of::<GpuShadowView>() == 176);
 };
 
 /// The bytes of a slice of records, for uploading.

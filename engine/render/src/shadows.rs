@@ -7,15 +7,23 @@
 //! `grid` x `grid` array of square tiles, `grid = ceil(sqrt(views))`; views are
 //! the cascades, then the spots. One cascade and no spot uses the whole map.
 
-use crate::gpu_types::{bytes_of, GpuShadowView, GpuShadowsHeader};
-use crate::lights::LightSet;
+use crate::gpu_types::{bytes_of, GpuLight, GpuShadowView, GpuShadowsHeader};
+use crate::lights::{self, LightSet};
 use glam::{Mat4, Vec3, Vec4};
+use std::f32::consts::PI;
 use weft_scene::Aabb;
 
 /// Most sun cascades (`ShadowAtlas` rejects more).
 pub const MAX_CASCADES: u32 = 4;
 /// Most spot cones given a shadow view; later spots are unshadowed.
 pub const MAX_SPOT_SHADOWS: u32 = 8;
+/// Area lights (rectangles, discs, emissive polygons) given a shadow view:
+/// the first ones in record order.
+pub const MAX_AREA_SHADOWS: u32 = 4;
+/// Half-angle of an area light's view: its hemisphere but the 10° above its
+/// plane, where it sends little light (cos 80° = 0.17 of its head-on
+/// radiance per unit area).
+pub const AREA_HALF_ANGLE_DEGREES: f32 = 80.0;
 /// Largest manual PCF radius (a 15x15 kernel of 2x2 filtered taps; `ShadowAtlas` rejects more).
 pub const MAX_PCF_RADIUS: u32 = 7;
 /// Bytes before the first view record: counts, splits, camera forward + normal bias.
@@ -24,7 +32,7 @@ pub const HEADER_BYTES: usize = std::mem::size_of::<GpuShadowsHeader>();
 pub const VIEW_BYTES: usize = std::mem::size_of::<GpuShadowView>();
 /// Bytes of the whole record with room for every view.
 pub const SHADOWS_BYTES: usize =
-    HEADER_BYTES + VIEW_BYTES * (MAX_CASCADES + MAX_SPOT_SHADOWS) as usize;
+    HEADER_BYTES + VIEW_BYTES * (MAX_CASCADES + MAX_SPOT_SHADOWS + MAX_AREA_SHADOWS) as usize;
 
 /// A shadow pass's settings: the `ShadowAtlas` provider's arguments
 /// (`providers.rs` declares their ranges and defaults).
@@ -231,6 +239,55 @@ pub struct ShadowView {
     pub texel: f32,
     /// Whether `texel` scales with distance from the light (spots).
     pub perspective: bool,
+    /// For an area light's view, the light's size (the side of a square of
+    /// its area) and the view's near and far depth, which soft shadows
+    /// need; `None` for suns and spots.
+    pub area: Option<[f32; 3]>,
+}
+
+/// An area light's record (`lights::AREA_RECT`, `AREA_DISC`,
+/// `AREA_POLYGON`, laid out as `area_outline` in `area_light.glsl` reads it):
+/// its centre, the unit direction it emits towards, and the side of a
+/// square of its area; `None` for other records or a degenerate outline.
+pub fn area_emitter(record: &GpuLight) -> Option<(Vec3, Vec3, f32)> {
+    let kind = record.direction_type.w;
+    let a = record.position_range.truncate();
+    let b = record.direction_type.truncate();
+    let c = record.attenuation_cos.truncate();
+    let (centre, winding, area) = if kind == lights::AREA_POLYGON {
+        let d = Vec3::new(
+            record.position_range.w,
+            record.attenuation_cos.w,
+            record.color_exponent.w,
+        );
+        let winding = (c - a).cross(d - b);
+        (0.25 * (a + b + c + d), winding, 0.5 * winding.length())
+    } else if kind == lights::AREA_RECT {
+        let winding = b.cross(c);
+        (a, winding, 4.0 * winding.length())
+    } else if kind == lights::AREA_DISC {
+        (a, b.cross(c), PI * b.length() * c.length())
+    } else {
+        return None;
+    };
+    let facing = (-winding).try_normalize()?;
+    (area.is_finite() && area > 0.0).then(|| (centre, facing, area.sqrt()))
+}
+
+/// World-to-clip for an area light's view from its `centre` along `facing`
+/// (a perspective of half-angle [`AREA_HALF_ANGLE_DEGREES`] reaching `far`),
+/// the world size of a texel one unit away, and the near depth.
+pub fn area_clip(centre: Vec3, facing: Vec3, far: f32, tile: u32, margin: f32) -> (Mat4, f32, f32) {
+    let far = far.max(1e-3);
+    let (clip, texel) = spot_clip(
+        centre,
+        facing,
+        AREA_HALF_ANGLE_DEGREES.to_radians().cos(),
+        far,
+        tile,
+        margin,
+    );
+    (clip, texel, spot_near(far))
 }
 
 /// An orthographic world-to-clip matrix for the sun travelling along `direction`:
@@ -328,11 +385,16 @@ pub fn spot_clip(
     let tile = tile.max(1) as f32;
     let tan = half.tan() * tile / (tile - 2.0 * margin).max(1.0);
     let far = range.max(1e-3);
-    let near = (far * 1e-3).max(1e-3).min(far * 0.5);
+    let near = spot_near(far);
     let view = Mat4::look_at_rh(position, position + dir, up);
     let mut proj = Mat4::perspective_rh(2.0 * tan.atan(), 1.0, near, far);
     proj.y_axis.y = -proj.y_axis.y;
     (proj * view, 2.0 * tan / tile)
+}
+
+/// The near depth of a perspective view reaching `far`.
+fn spot_near(far: f32) -> f32 {
+    (far * 1e-3).max(1e-3).min(far * 0.5)
 }
 
 /// Everything about this frame's shadows: the views and the record shaders read.
@@ -346,6 +408,11 @@ pub struct ShadowFrame {
     pub spots: u32,
     /// Light index of the first spot cone (spot view k belongs to light `first_spot + k`).
     pub first_spot: u32,
+    /// Area-light views rendered, after the spots'.
+    pub areas: u32,
+    /// Light index of the first area light (area view k belongs to light
+    /// `first_area + k`: rectangles and discs, then emissive polygons).
+    pub first_area: u32,
     /// Far view depth of each cascade.
     pub splits: [f32; 4],
     /// The camera's view direction, for picking a cascade by view depth.
@@ -366,7 +433,16 @@ pub fn shadow_frame(
         0
     };
     let spots = lights.spot_cones.min(MAX_SPOT_SHADOWS);
-    let atlas = Atlas::new(atlas_size, cascades + spots);
+    let first_area = lights.first_area();
+    let emitters: Vec<(Vec3, Vec3, f32)> = lights
+        .records
+        .iter()
+        .skip(first_area as usize)
+        .map_while(area_emitter)
+        .take(MAX_AREA_SHADOWS as usize)
+        .collect();
+    let areas = emitters.len() as u32;
+    let atlas = Atlas::new(atlas_size, cascades + spots + areas);
     let margin = settings.margin();
     let far = volume.shadow_far(bounds);
     let near = volume.near.min(far * 0.5);
@@ -394,11 +470,31 @@ pub fn shadow_frame(
         );
         views.push(view(&atlas, cascades + k, clip, texel, true, margin));
     }
+    let corners = aabb_corners(bounds);
+    for (k, (centre, facing, size)) in emitters.into_iter().enumerate() {
+        let reach = corners
+            .iter()
+            .map(|c| (*c - centre).dot(facing))
+            .fold(0.0f32, f32::max);
+        let (clip, texel, near) = area_clip(centre, facing, reach * 1.01, atlas.tile, margin);
+        let mut v = view(
+            &atlas,
+            cascades + spots + k as u32,
+            clip,
+            texel,
+            true,
+            margin,
+        );
+        v.area = Some([size, near, reach.max(1e-3) * 1.01]);
+        views.push(v);
+    }
     ShadowFrame {
         views,
         cascades,
         spots,
         first_spot,
+        areas,
+        first_area,
         splits,
         forward: volume.forward,
     }
@@ -419,6 +515,7 @@ fn view(
         rect: atlas.inner_rect(i, margin - 1.0),
         texel,
         perspective,
+        area: None,
     }
 }
 
@@ -438,6 +535,7 @@ impl ShadowFrame {
             forward: self
                 .forward
                 .extend(settings.normal_bias * (settings.pcf_radius as f32 + 1.0)),
+            areas: glam::UVec4::new(self.cascades + self.spots, self.first_area, self.areas, 0),
         };
         let views: Vec<GpuShadowView> = self
             .views
@@ -447,6 +545,9 @@ impl ShadowFrame {
                 lookup: v.lookup,
                 rect: v.rect,
                 texel: Vec4::new(v.texel, if v.perspective { 1.0 } else { 0.0 }, 0.0, 0.0),
+                light: v.area.map_or(Vec4::ZERO, |[size, near, far]| {
+                    Vec4::new(size, near, far, 0.0)
+                }),
             })
             .collect();
         let mut bytes = bytes_of(&[header]).to_vec();
