@@ -91,8 +91,10 @@ float area_shadow_depth(vec4 light, float t) {
 const int AREA_SEARCH_TAPS = 3;
 const int AREA_SEARCH_DEPTHS = 8;
 const int AREA_FILTER_TAPS = 6;
-// Widest search and filter radius, in texels.
-const float AREA_MAX_RADIUS = 128.0;
+// Widest search and filter radius, as a share of the view's tile (128
+// texels of a 2048-texel tile), so the kernel's reach in the world does
+// not depend on the atlas' resolution.
+const float AREA_MAX_RADIUS = 1.0 / 16.0;
 // Steepest receiver slope (depth per lateral distance) the bias follows.
 const float AREA_MAX_SLOPE = 20.0;
 
@@ -174,6 +176,7 @@ float area_visibility(uint index, vec3 p, vec3 n, AreaOutline o) {
         return 1.0;
     }
     float texel_uv = 1.0 / float(textureSize(shadow_map, 0).x);
+    float max_radius = AREA_MAX_RADIUS * (rect.z - rect.x) / texel_uv;
     float cos_r = max(cos_signed, 1.0 / AREA_MAX_SLOPE);
     float slope = sqrt(1.0 - cos_r * cos_r) / cos_r;
     vec2 plane = area_receiver_plane(v, q, n, uv, t, 4.0 * texel_world);
@@ -197,7 +200,7 @@ float area_visibility(uint index, vec3 p, vec3 n, AreaOutline o) {
     float texel_depth = shadow_views[v].texel.x * t;
     mat2 search = axes / texel_depth;
     float widest = max(length(search[0]), length(search[1]));
-    search *= min(1.0, AREA_MAX_RADIUS / max(widest, 1e-6));
+    search *= min(1.0, max_radius / max(widest, 1e-6));
     float blocked[AREA_SEARCH_DEPTHS];
     for (int d = 0; d < AREA_SEARCH_DEPTHS; ++d) {
         blocked[d] = 0.0;
@@ -226,7 +229,7 @@ float area_visibility(uint index, vec3 p, vec3 n, AreaOutline o) {
     // The penumbra: the light's outline scaled by (t - d_b) / d_b, in texels.
     mat2 kernel = axes * ((t - blocker) / blocker / texel_world);
     widest = max(length(kernel[0]), length(kernel[1]));
-    kernel *= clamp(widest, 1.0, AREA_MAX_RADIUS) / max(widest, 1e-6);
+    kernel *= clamp(widest, 1.0, max_radius) / max(widest, 1e-6);
     vec2 shift = fract(sin(vec2(dot(p, vec3(12.9898, 78.233, 37.719)), dot(p, vec3(39.3468, 11.135, 83.155))))
                        * 43758.5453) - 0.5;
     float lit = 0.0;

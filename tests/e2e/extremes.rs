@@ -506,9 +506,10 @@ fn one_pixel_one_column_and_one_row_see_what_the_full_image_sees() {
 /// high) and shadow atlases of 16² and the largest (16,384², 1 GiB of D32):
 /// zero validation messages and a finite HDR image in every graph. Against
 /// the default 2,048² atlas at 96x64, the 16,384² atlas changes the image
-/// only where shadow edges sharpen (measured mean 0.048, p99 0, max 62), and
-/// the 16² atlas, a 16-texel sun shadow, blurs them (mean 1.03, p99 63, max
-/// 83), the same in all three graphs. Held to mean <= 0.1 and <= 2.
+/// only where shadow edges sharpen and the area light's penumbra follows
+/// its smaller texels (measured mean 0.161, p99 0, max 79), and the 16²
+/// atlas, a 16-texel sun shadow, blurs them (mean 1.01, p99 57, max 104),
+/// the same in all three graphs. Held to mean <= 0.25 and <= 2.
 #[test]
 fn the_largest_output_and_the_smallest_and_largest_shadow_maps_render() {
     let dir = Scratch::new("largest");
@@ -531,7 +532,7 @@ fn the_largest_output_and_the_smallest_and_largest_shadow_maps_render() {
                 "{graph} shadow atlas {resolution}: against 2048, mean {:.3}, p99 {}, max {}",
                 d.mean, d.p99, d.max
             );
-            let bound = if resolution > 2048.0 { 0.1 } else { 2.0 };
+            let bound = if resolution > 2048.0 { 0.25 } else { 2.0 };
             assert!(d.mean <= bound, "{graph} atlas {resolution}: {d:?}");
         }
     }

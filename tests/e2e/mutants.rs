@@ -331,6 +331,7 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
                 "bloom.ron",
                 "gbuffer.ron",
                 "debug_views.ron",
+                "raster_caveats.ron",
                 "bench/mesh_floor.ron",
                 "bench/gbuffer_floor.ron",
             ] {

@@ -45,19 +45,23 @@ fn forward_renders_the_demo_scene_cleanly_and_matches_its_golden() {
         ]
     );
     // Nine meshes placed (box parts, dragon, bunny, sphere), each drawn by the
-    // shading pass and by the shadow pass once per view (the sun and the spot)
-    // unless it lies outside that view's frustum: the spot's view leaves out
-    // three meshes and the camera one.
+    // shading pass and by the shadow pass once per view (the sun, the spot,
+    // the `arealight` and the box's emissive ceiling quad) unless it lies
+    // outside that view's frustum: the spot's view leaves out three meshes,
+    // each area light's view the two behind its panel, and the camera one.
     assert_eq!(
         out.culling,
         [
             ("shadow_sun[0]".to_string(), 9, 0),
             ("shadow_sun[1]".to_string(), 6, 3),
+            ("shadow_sun[2]".to_string(), 7, 2),
+            ("shadow_sun[3]".to_string(), 7, 2),
             ("forward".to_string(), 8, 1),
         ]
     );
-    // One more than before issue 32: the demo's area-light panel.
-    assert_eq!(out.draw_calls, 24);
+    // The area-light panel (issue 32) and the two area lights' shadow views
+    // (7 meshes each) since the last count of 23.
+    assert_eq!(out.draw_calls, 38);
     assert_golden(&out.image, "demo_forward_320x180.png");
 }
 

@@ -472,11 +472,17 @@ fn an_unchanged_shadow_view_keeps_its_tile_and_the_image_does_not_change() {
             .filter(|c| c.view.starts_with("shadow_sun"))
             .map(|c| (c.view.as_str(), c.kept))
             .collect();
-        // The sun's view is unchanged since the last frame and keeps its
-        // tile; the swivelling spot's view is drawn again.
+        // The sun's view and the two area lights' are unchanged since the
+        // last frame and keep their tiles; the swivelling spot's view is
+        // drawn again.
         assert_eq!(
             shadow_views,
-            [("shadow_sun[0]", true), ("shadow_sun[1]", false)],
+            [
+                ("shadow_sun[0]", true),
+                ("shadow_sun[1]", false),
+                ("shadow_sun[2]", true),
+                ("shadow_sun[3]", true)
+            ],
             "{graph}"
         );
         let (redrawn, culling) = three_frames(&graph_including(&dir, graph, &cleared));

@@ -37,7 +37,13 @@ pub fn graph(name: &str) -> PathBuf {
 pub fn absolute_paths(text: &str) -> String {
     let graphs = root().join("graphs");
     let mut text = text.to_string();
-    for fragment in ["bloom.ron", "debug_views.ron", "gbuffer.ron", "shadows.ron"] {
+    for fragment in [
+        "bloom.ron",
+        "debug_views.ron",
+        "gbuffer.ron",
+        "raster_caveats.ron",
+        "shadows.ron",
+    ] {
         text = text.replace(
             &format!("(file: \"{fragment}\""),
             &format!("(file: \"{}\"", graphs.join(fragment).display()),
