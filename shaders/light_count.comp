@@ -1,7 +1,7 @@
 #version 450
 // Debug view `light_count` (graphs/debug_views.ron): for each pixel with a
 // surface, the point and spot lights that reach it, by the tests the lighting
-// code applies (`point_reaches` and `spot_reaches` in include/lighting.glsl:
+// code applies (`point_reaches` and `spot_reaches` in include/punctual.glsl:
 // within a point light's cutoff range; within a spot's range along its axis
 // and inside its cone). Suns and area
 // lights reach every surface in front of them and are not counted. The

@@ -76,28 +76,14 @@
 
 // Area lights and the environment read the LTC tables' lobe integrals.
 #include "ltc.glsl"
+// The surface point, and the light arriving from punctual lights, as the path
+// tracer reads them too.
+#include "surface.glsl"
+#include "punctual.glsl"
 
-// What shading needs about a surface point.
-struct Surface {
-    vec3 position;     // world
-    vec3 normal;       // unit, facing the viewer
-    vec3 texel;        // base-colour texture sample (white without a texture)
-    uint material;
-    vec2 metal_rough;  // metallic-roughness materials: metallic, roughness
-};
-
-// Metallic and roughness at a pixel: the material's factors times the
-// metallicRoughness texture's B and G, rounded to the 8 bits the G-buffer keeps,
-// so forward and deferred shade identical inputs.
-vec2 metal_rough(Material m, vec4 texel) {
-    return round(clamp(m.specular.xy * texel.bg, 0.0, 1.0) * 255.0) / 255.0;
-}
-
-// The normal `n` bent by a tangent-space normal-map texel (glTF convention:
-// +X along the tangent, +Y along the bitangent, up in the image) with strength
-// `scale`; 0 leaves `n` as it is. `tangent` is the interpolated vertex
-// tangent (w the handedness: bitangent = cross(n, tangent) * w), made
-// orthogonal to `n` here. With SCREEN_SPACE_TANGENTS (graph feature
+// The normal `n` bent by a tangent-space normal-map texel with strength
+// `scale`: in the frame of the interpolated vertex tangent, as the path
+// tracer bends it (bent_normal, surface.glsl). With SCREEN_SPACE_TANGENTS (graph feature
 // `screen_space_tangents`, for comparison) the frame comes instead from
 // screen-space derivatives of the position and UV, as before baked tangents:
 // constant across a triangle, and wrong where UVs are mirrored.
@@ -120,14 +106,7 @@ vec3 mapped_normal(vec3 n, vec4 tangent, vec3 p, vec2 uv, vec3 texel, float scal
 }
 #else
 vec3 mapped_normal(vec3 n, vec4 tangent, vec3 p, vec2 uv, vec3 texel, float scale) {
-    vec3 t = tangent.xyz - n * dot(n, tangent.xyz);
-    if (scale == 0.0 || dot(t, t) <= 1e-20) {
-        return n;
-    }
-    t = normalize(t);
-    vec3 bent = texel * 2.0 - 1.0;
-    bent.xy *= scale;
-    return normalize(mat3(t, cross(n, t) * tangent.w, n) * bent);
+    return bent_normal(n, tangent, texel, scale);
 }
 #endif
 
@@ -143,90 +122,6 @@ vec3 blinn_phong(Material m, Surface s, vec3 l, vec3 radiance) {
     float shininess = m.specular.w;
     vec3 specular = shininess > 0.0 ? m.specular.rgb * pow(ndh, shininess) : vec3(0.0);
     return radiance * (m.diffuse.rgb * s.texel * ndl + specular * ndl);
-}
-
-// Distance falloff 1 / (c + l d + q d^2), never above 1 / 1e-4, faded to zero
-// at the cutoff range by (1 - (d / range)^4)^2 so the cutoff leaves no visible edge.
-float attenuate(uint index, float d) {
-    vec3 k = lights[index].attenuation_cos.xyz;
-    float ratio = d / max(lights[index].position_range.w, 1e-6);
-    float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
-    return window * window / max(k.x + k.y * d + k.z * d * d, 1e-4);
-}
-
-#ifdef HAS_SHADOW_MAP
-#include "shadows.glsl"
-#endif
-
-// Radiance arriving at the surface from light `index` of each punctual type,
-// and the unit direction towards it; zero beyond the light's cutoff range or
-// outside a spot's cone. Fields are read from the buffer where they are needed
-// rather than copied up front: lavapipe then loads only what each light type
-// uses (about 20% faster).
-vec3 incoming_sun(uint index, Surface s, out vec3 l) {
-    l = -lights[index].direction_type.xyz;
-    float visible = 1.0;
-#ifdef HAS_SHADOW_MAP
-    // Surfaces facing away get no light anyway: skip their shadow lookups.
-    if (index == 0u && dot(s.normal, l) > 0.0) {
-        visible = sun_visibility(s.position, s.normal);
-    }
-#endif
-    return lights[index].color_exponent.rgb * visible;
-}
-
-// Whether point light `index` reaches a surface `d` away: within its cutoff
-// range. The light_count view counts lights by this test and the next.
-bool point_reaches(uint index, float d) {
-    return !(d > lights[index].position_range.w);
-}
-
-// Whether spot `index` reaches a surface `to_light` away from it (`l` is the
-// unit direction towards it): within `range` along the axis and inside the cone.
-bool spot_reaches(uint index, vec3 to_light, vec3 l) {
-    vec3 axis = lights[index].direction_type.xyz;
-    return !(dot(-to_light, axis) > lights[index].position_range.w
-        || dot(-l, axis) < lights[index].attenuation_cos.w);
-}
-
-vec3 incoming_point(uint index, Surface s, out vec3 l) {
-    vec3 to_light = lights[index].position_range.xyz - s.position;
-    float d = length(to_light);
-    l = to_light / max(d, 1e-6);
-    if (!point_reaches(index, d)) {
-        return vec3(0.0);
-    }
-    return lights[index].color_exponent.rgb * attenuate(index, d);
-}
-
-// Spot: cut off beyond `range` along the axis and outside the cone.
-vec3 incoming_spot(uint index, Surface s, out vec3 l) {
-    vec3 to_light = lights[index].position_range.xyz - s.position;
-    float d = length(to_light);
-    l = to_light / max(d, 1e-6);
-    if (!spot_reaches(index, to_light, l)) {
-        return vec3(0.0);
-    }
-    float cosine = dot(-l, lights[index].direction_type.xyz);
-    float spot = lights[index].color_exponent.w > 0.0 ? pow(max(cosine, 0.0), lights[index].color_exponent.w) : 1.0;
-#ifdef HAS_SHADOW_MAP
-    if (lights[index].direction_type.w == LIGHT_SPOT_CONE && dot(s.normal, l) > 0.0) {
-        spot *= spot_visibility(index, s.position, s.normal, d);
-    }
-#endif
-    return lights[index].color_exponent.rgb * spot * attenuate(index, d);
-}
-
-// Any punctual light, by its type (the path tracer samples lights this way).
-vec3 incoming(uint index, Surface s, out vec3 l) {
-    float type = lights[index].direction_type.w;
-    if (type == LIGHT_SUN) {
-        return incoming_sun(index, s, l);
-    }
-    if (type == LIGHT_POINT) {
-        return incoming_point(index, s, l);
-    }
-    return incoming_spot(index, s, l);
 }
 
 // Light reflected to the camera from light arriving along `l`, by the

@@ -65,21 +65,6 @@ vec4 trace_texel(uint slot, bool colour, vec2 uv) {
                             : textureLod(trace_data_1024, at, 0.0);
 }
 
-// The shading normal n bent by a tangent-space normal-map texel (glTF
-// convention) with strength `scale`, in the MikkTSpace frame of the
-// interpolated tangent: B = sign * cross(n, T). n itself where the mesh has
-// no tangents.
-vec3 trace_mapped_normal(vec3 n, vec4 tangent, vec3 texel, float scale) {
-    vec3 t = tangent.xyz - n * dot(n, tangent.xyz);
-    if (dot(t, t) <= 1e-20 || tangent.w == 0.0) {
-        return n;
-    }
-    t = normalize(t);
-    vec3 bent = texel * 2.0 - 1.0;
-    bent.xy *= scale;
-    return normalize(mat3(t, cross(n, t) * tangent.w, n) * bent);
-}
-
 // Deepest traversal the stack allows; the builder's trees stay far below it
 // (docs/pathtrace.md: depth 26 on demo.scene).
 #define TRACE_STACK 64

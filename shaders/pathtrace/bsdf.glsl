@@ -1,12 +1,13 @@
 // The path tracer's materials: the raster path's shading models
-// (include/lighting.glsl) as energy-conserving BSDFs with matching sampling
+// (include/brdf.glsl, lighting.glsl) as energy-conserving BSDFs with matching sampling
 // routines and pdfs. Blinn-Phong is the raster lobe divided by pi, so a
 // punctual light of colour C (irradiance pi C, lights.glsl) shades exactly as
 // the raster path does; GGX metallic-roughness is `cook_torrance` itself; a
 // mirror (MTL illum 3) reflects Ks perfectly over a Lambert Kd; a coated
 // diffuse (MTL illum 5) is a Lambert Kd under a smooth dielectric coat. Base
 // colour textures multiply Kd or the base colour, and metallic-roughness
-// textures the factors, as in the raster path; normal maps are not applied.
+// textures the factors, and normal maps bend the shading normal (bent_normal,
+// surface.glsl), as in the raster path.
 //
 // Code for shading models the scene lacks is compiled out: the includer
 // defines SCENE_GLOSSY (Blinn-Phong with a specular lobe), SCENE_MIRRORS,

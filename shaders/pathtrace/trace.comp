@@ -33,7 +33,11 @@
 // light point's value, while BSDF-sampled paths through glass still count:
 // light through glass is counted twice. 0, the default, is unbiased: shadow
 // rays stop at glass and caustics come from BSDF-sampled paths.
-#include "../include/lighting.glsl"
+#include "../include/hdr.glsl"
+#include "../include/brdf.glsl"
+#include "../include/area_light.glsl"
+#include "../include/surface.glsl"
+#include "../include/punctual.glsl"
 #include "../include/trace.glsl"
 #include "random.glsl"
 #include "sampling.glsl"
@@ -167,7 +171,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
 #ifdef SCENE_TEXTURES
         uvec4 slots = material_textures[s.material];
         if (slots.z != NO_TEXTURE && m.ambient.w != 0.0) {
-            s.normal = trace_mapped_normal(s.normal, s.tangent, trace_texel(slots.z, false, s.uv).rgb, m.ambient.w);
+            s.normal = bent_normal(s.normal, s.tangent, trace_texel(slots.z, false, s.uv).rgb, m.ambient.w);
         }
 #endif
         vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;

@@ -5,7 +5,9 @@
 #define SCENE_GLOSSY
 #define SCENE_MIRRORS
 #define SCENE_METALLIC_ROUGHNESS
-#include "../../shaders/include/lighting.glsl"
+#include "../../shaders/include/brdf.glsl"
+#include "../../shaders/include/area_light.glsl"
+#include "../../shaders/include/surface.glsl"
 #include "../../shaders/pathtrace/random.glsl"
 #include "../../shaders/pathtrace/sampling.glsl"
 #include "../../shaders/pathtrace/bsdf.glsl"

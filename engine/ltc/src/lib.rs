@@ -19,7 +19,7 @@ pub mod tables;
 pub const TABLE_SIZE: usize = 32;
 
 /// Smallest GGX roughness the shaders use (`MIN_ROUGHNESS` in
-/// `shaders/include/lighting.glsl`); alpha = roughness².
+/// `shaders/include/brdf.glsl`); alpha = roughness².
 pub const MIN_ROUGHNESS: f32 = 0.045;
 
 /// The view angle's cosine at column `k` of a table: the column coordinate

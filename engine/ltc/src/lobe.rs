@@ -1,6 +1,6 @@
 //! The lobes the raster passes shade area lights with, each as "BRDF times
 //! cosine" with the normal along +Z: GGX as `cook_torrance` in
-//! `shaders/include/lighting.glsl` evaluates it (Fresnel left out: the table
+//! `shaders/include/brdf.glsl` evaluates it (Fresnel left out: the table
 //! carries it separately), and the unnormalised Blinn-Phong highlight
 //! `(N.H)^n (N.L)` of `blinn_phong` there.
 
