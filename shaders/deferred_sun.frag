@@ -27,10 +27,7 @@ void main() {
         return;
     }
     Material m = materials[s.material];
-    vec4 emission_occlusion = vec4(1.0);
-#ifdef HAS_GBUFFER_EMISSION
-    emission_occlusion = texelFetch(gbuffer_emission, ivec2(gl_FragCoord.xy), 0);
-#endif
+    vec4 emission_occlusion = read_emission_occlusion();
     vec3 ambient = shade_ambient_emissive(s, m, params.emissive_boost, emission_occlusion.rgb, emission_occlusion.a);
     color = vec4(hdr_output(ambient + shade_suns(s, m)), 1.0);
 }

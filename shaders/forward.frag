@@ -63,6 +63,8 @@ void main() {
     vec3 emission_texel = vec3(1.0);
     float occlusion = 1.0;
 #endif
+    // Emitters emit from their front only, as the path tracer's do.
+    emission_texel *= gl_FrontFacing ? 1.0 : 0.0;
     vec3 c = shade_ambient_emissive(s, m, params.emissive_boost, emission_texel, occlusion)
         + shade_all_lights(s, m, params.area_samples);
     // Alpha matters only where weft-render blends transparent materials.

@@ -42,7 +42,8 @@ void main() {
     COUNT_INVOCATION(view_overshading, view_overshading_totals.words[0]);
 #endif
     vec3 n = normalize(world_normal);
-    albedo = vec4(texture(base_color, texcoord).rgb, 1.0);
+    // Alpha: whether the camera sees the front, where emitters emit.
+    albedo = vec4(texture(base_color, texcoord).rgb, gl_FrontFacing ? 1.0 : 0.0);
     Material m = materials[material];
     // Seen from behind, the normal turns round and, for the bitangent to
     // stay put, so does the handedness.

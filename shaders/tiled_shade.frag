@@ -39,10 +39,7 @@ void main() {
         return;
     }
     Material m = materials[s.material];
-    vec4 emission_occlusion = vec4(1.0);
-#ifdef HAS_GBUFFER_EMISSION
-    emission_occlusion = texelFetch(gbuffer_emission, ivec2(gl_FragCoord.xy), 0);
-#endif
+    vec4 emission_occlusion = read_emission_occlusion();
     vec3 c = shade_ambient_emissive(s, m, pc.emissive_boost, emission_occlusion.rgb, emission_occlusion.a)
         + shade_suns(s, m);
     uint record = tile_record(tile_of(ivec2(gl_FragCoord.xy)), pc.max_per_tile);

@@ -1,4 +1,5 @@
-// The metallic-roughness BRDF, evaluated the same way by the raster passes
+// The BRDFs both renderers evaluate: the Blinn-Phong highlight, and the
+// metallic-roughness BRDF, evaluated the same way by the raster passes
 // (lighting.glsl) and the path tracer (pathtrace/bsdf.glsl, which adds
 // sampling and pdfs beside it): as glTF defines it, the blend
 // (1 - metallic) dielectric + metallic metal of GGX microfacets with
@@ -28,6 +29,13 @@ const float PI = 3.14159265358979;
 const float MIN_ROUGHNESS = 0.045;
 // Reflectance at normal incidence of every non-metal (brdf.rs DIELECTRIC_F0).
 const float DIELECTRIC_F0 = 0.04;
+
+// The Blinn-Phong highlight (N.H)^Ns, unnormalised as MTL files mean it
+// (raster passes shade Ks times it, the path tracer Ks times it over pi); no
+// highlight for Ns 0.
+float blinn_phong_highlight(float ndh, float exponent) {
+    return exponent > 0.0 ? pow(max(ndh, 0.0), exponent) : 0.0;
+}
 
 // GGX distribution of normals, alpha = roughness^2.
 float ggx_d(float cos_h, float alpha) {

@@ -1,5 +1,5 @@
 // The deferred G-buffer encoding (graphs/deferred.ron): albedo = base-colour
-// texture sample (sRGB 8-bit), normal = octahedral in two 16-bit floats (the
+// texture sample (sRGB 8-bit), alpha 1 where the camera sees the front, normal = octahedral in two 16-bit floats (the
 // closest half-float pair), material = material index in r (low byte) and g
 // (high byte), metallic in b, roughness in a; position comes from reverse-Z
 // depth. Shared by gbuffer.frag and the lighting passes.

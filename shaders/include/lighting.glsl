@@ -119,8 +119,7 @@ vec3 blinn_phong(Material m, Surface s, vec3 l, vec3 radiance) {
     vec3 v = normalize(frame.camera_position.xyz - s.position);
     vec3 h = normalize(l + v);
     float ndh = max(dot(s.normal, h), 0.0);
-    float shininess = m.specular.w;
-    vec3 specular = shininess > 0.0 ? m.specular.rgb * pow(ndh, shininess) : vec3(0.0);
+    vec3 specular = m.specular.rgb * blinn_phong_highlight(ndh, m.specular.w);
     return radiance * (m.diffuse.rgb * s.texel * ndl + specular * ndl);
 }
 

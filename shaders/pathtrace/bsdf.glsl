@@ -141,7 +141,7 @@ vec3 bsdf_eval(Bsdf b, vec3 n, vec3 wo, vec3 wi, out float pdf) {
     }
 #endif
 #ifdef SCENE_GLOSSY
-    float lobe = b.exponent > 0.0 ? pow(cos_h, b.exponent) : 0.0;
+    float lobe = blinn_phong_highlight(cos_h, b.exponent);
     float p_glossy = (b.exponent + 1.0) / (2.0 * PI) * lobe / (4.0 * max(dot(wo, h), 1e-6));
     pdf = p_diffuse + b.p_specular * p_glossy;
     return (b.diffuse + b.specular * lobe) * cos_i / PI;

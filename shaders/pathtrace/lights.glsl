@@ -1,12 +1,12 @@
 // Lights for the path tracer: next-event estimation and the densities that
 // multiple importance sampling needs when a BSDF-sampled ray finds a light.
 //
-// Units follow the raster path (include/lighting.glsl, scenes/FORMAT.md
+// Units follow the raster path (include/punctual.glsl, scenes/FORMAT.md
 // "Units"): a sun, point or spot light of colour C gives a surface facing it
 // irradiance pi C times its attenuation and cone (so a white Lambertian
 // surface shows C, as the raster path's Kd N.L shading does); area lights and
 // emissive triangles (MTL Ke, glTF emissive) emit radiance equal to their
-// colour. A point in a light's plane gets nothing from it. A light is chosen
+// colour (times the emissive texture, emitted_at), from their front. A point in a light's plane gets nothing from it. A light is chosen
 // uniformly among the scene's lights plus, when the scene has any, the set of
 // emissive triangles; within that set a triangle is chosen by power.
 // Area lights are sampled uniformly by area. They are not in the BVH; rays
@@ -63,6 +63,19 @@ bool sample_area(uint index, vec3 p, vec2 u, float p_select, out LightSample ls)
     return true;
 }
 
+// The radiance material `material` emits at texture coordinate uv: its
+// factor (MTL Ke, glTF emissiveFactor) times its emissive texture's sample,
+// as the raster passes show it. Emitters are picked by the factor's power
+// (emitter_area_pdf), so a texture changes what a sample carries, not how
+// often it is drawn.
+vec3 emitted_at(uint material, vec2 uv) {
+    vec3 emitted = materials[material].emissive.rgb;
+#ifdef SCENE_TEXTURES
+    emitted *= trace_texel(material_textures[material].w, true, uv).rgb;
+#endif
+    return emitted;
+}
+
 // The density by area of a point on emissive triangle material `emitted`.
 float emitter_area_pdf(vec3 emitted) {
     return luminance(emitted) / uintBitsToFloat(emitter_info.y);
@@ -91,12 +104,14 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
     ls.distance = sqrt(d2);
     ls.direction = to_light / max(ls.distance, 1e-20);
     float cos_light = -dot(ls.direction, ng);
-    vec3 emitted = materials[triangle_materials[tri]].emissive.rgb;
+    uint material = triangle_materials[tri];
     if (cos_light <= 0.0 || d2 <= 0.0) {
         return false;
     }
-    ls.pdf = p_select * emitter_area_pdf(emitted) * d2 / cos_light;
-    ls.value = emitted / ls.pdf;
+    vec2 uv = (1.0 - su) * corner_uvs[3u * tri] + (u.w * su) * corner_uvs[3u * tri + 1u]
+        + (su - u.w * su) * corner_uvs[3u * tri + 2u];
+    ls.pdf = p_select * emitter_area_pdf(materials[material].emissive.rgb) * d2 / cos_light;
+    ls.value = emitted_at(material, uv) / ls.pdf;
     return true;
 }
 

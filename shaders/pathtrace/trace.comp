@@ -179,7 +179,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
             float cos_light = dot(s.geometric_normal, wo);
             float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t / (light_choices() * cos_light);
-            radiance += throughput * m.emissive.rgb * found_weight(counted_fully, bsdf_pdf, light_pdf);
+            radiance += throughput * emitted_at(s.material, s.uv) * found_weight(counted_fully, bsdf_pdf, light_pdf);
         }
 #endif
         if (depth == params.max_depth) {

@@ -6,6 +6,7 @@ mod bsdf_sampling;
 mod debug_views;
 mod emissive;
 mod extremes;
+mod light_matrix;
 mod lights;
 mod mirrored;
 mod mutants;

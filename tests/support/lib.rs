@@ -2,6 +2,7 @@
 //! paths of the repository's graphs and this package's fixtures, and plans
 //! compiled as the renderer compiles them (provider values included).
 
+pub mod gltf;
 pub mod legend;
 pub mod render;
 

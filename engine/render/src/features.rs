@@ -23,7 +23,7 @@ use weft_scene::{AreaShape, Light, Scene};
 /// `coated` for MTL `illum` 5 (a Fresnel coat over Lambert), `dielectrics`
 /// for glass (MTL `illum` 4, 6 or 7, the dissolve rule, glTF transmission),
 /// `metallic_roughness` for glTF materials; `textures` when a placed mesh has a
-/// base colour, metallic-roughness or normal texture, `normal_maps` when one
+/// base colour, metallic-roughness, normal or emissive texture, `normal_maps` when one
 /// has a normal texture with a non-zero scale, `emission_occlusion_maps` when
 /// one has an emissive or occlusion texture.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
@@ -127,6 +127,7 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
         m.textures.base_color.is_some()
             || m.textures.metallic_roughness.is_some()
             || m.textures.normal.is_some()
+            || m.textures.emissive.is_some()
     }) {
         features.push("textures".to_string());
     }

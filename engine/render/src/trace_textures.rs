@@ -1,10 +1,10 @@
 //! Material textures for the path tracer. Compute shaders on lavapipe can
 //! index neither descriptor arrays at run time (no `runtimeDescriptorArray`)
 //! nor sampled images by a non-uniform value, so every texture (base colour,
-//! metallic-roughness, tangent-space normal map) is resampled
+//! metallic-roughness, tangent-space normal map, emission) is resampled
 //! to a square size class and becomes a layer of that class's `sampler2DArray`:
-//! one array per class and colour space (sRGB base colours, UNORM
-//! metallic-roughness), bound at set 1, bindings 12 to 17
+//! one array per class and colour space (sRGB base colours and emission, UNORM
+//! metallic-roughness and normals), bound at set 1, bindings 12 to 17
 //! (`shaders/include/trace.glsl`). A material's record says which class and
 //! layer each of its textures is in. Sampling a coordinate of an array image
 //! is uniform control flow, so this works on every Vulkan device.
@@ -29,12 +29,12 @@ pub const NO_TEXTURE: u32 = u32::MAX;
 /// The layers of every class, and each material's slots.
 #[derive(Debug, Clone, Default)]
 pub struct TraceTextures {
-    /// Per class: sRGB colour layers (base colour).
+    /// Per class: sRGB colour layers (base colour, emission).
     pub colour: [Vec<Rgba8Image>; 3],
     /// Per class: UNORM data layers (metallic-roughness).
     pub data: [Vec<Rgba8Image>; 3],
     /// Per material: base colour slot, metallic-roughness slot, normal-map
-    /// slot, 0; a slot is `class << 16 | layer`, or [`NO_TEXTURE`].
+    /// slot, emissive slot; a slot is `class << 16 | layer`, or [`NO_TEXTURE`].
     pub slots: Vec<[u32; 4]>,
     /// Textures that could not be decoded (their materials go untextured).
     pub warnings: Vec<String>,
@@ -89,7 +89,7 @@ fn source_key(source: &TextureSource) -> String {
     }
 }
 
-/// Decodes and places the base colour, metallic-roughness and normal textures of
+/// Decodes and places the base colour, metallic-roughness, normal and emissive textures of
 /// `materials`, each distinct source once per colour space.
 pub fn gather(materials: &[Material]) -> TraceTextures {
     let mut out = TraceTextures::default();
@@ -127,7 +127,8 @@ pub fn gather(materials: &[Material]) -> TraceTextures {
         let base = slot(m.textures.base_color.as_ref(), true, &mut out);
         let metal_rough = slot(m.textures.metallic_roughness.as_ref(), false, &mut out);
         let normal = slot(m.textures.normal.as_ref(), false, &mut out);
-        out.slots.push([base, metal_rough, normal, 0]);
+        let emissive = slot(m.textures.emissive.as_ref(), true, &mut out);
+        out.slots.push([base, metal_rough, normal, emissive]);
     }
     out
 }
@@ -166,17 +167,18 @@ mod tests {
         b.textures.metallic_roughness = Some(texture(&small));
         let mut c = Material::default();
         c.textures.base_color = Some(texture(&small));
+        c.textures.emissive = Some(texture(&small));
         let missing = dir.join("missing.png");
         c.textures.metallic_roughness = Some(texture(&missing));
         let t = gather(&[a, b, c, Material::default()]);
-        assert_eq!(t.slots[0], [0, NO_TEXTURE, NO_TEXTURE, 0]);
-        assert_eq!(t.slots[1], [2 << 16, 0, NO_TEXTURE, 0]);
+        assert_eq!(t.slots[0], [0, NO_TEXTURE, NO_TEXTURE, NO_TEXTURE]);
+        assert_eq!(t.slots[1], [2 << 16, 0, NO_TEXTURE, NO_TEXTURE]);
         assert_eq!(
             t.slots[2],
             [0, NO_TEXTURE, NO_TEXTURE, 0],
-            "the small colour texture again"
+            "the small colour texture again, as base colour and as emission"
         );
-        assert_eq!(t.slots[3], [NO_TEXTURE, NO_TEXTURE, NO_TEXTURE, 0]);
+        assert_eq!(t.slots[3], [NO_TEXTURE, NO_TEXTURE, NO_TEXTURE, NO_TEXTURE]);
         assert_eq!(t.colour[0].len(), 1);
         assert_eq!(t.colour[2].len(), 1);
         assert_eq!(t.data[0].len(), 1, "data textures keep their own layers");

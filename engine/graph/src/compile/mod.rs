@@ -170,6 +170,18 @@ pub fn feature_names(ir: &Ir) -> BTreeSet<String> {
     names
 }
 
+/// The notes of the graph's caveats whose features hold, each once (a note
+/// may be declared under several conditions).
+fn active_caveats(graph: &LoadedGraph, features: &BTreeSet<String>) -> Vec<String> {
+    let mut notes: Vec<String> = Vec::new();
+    for (_, caveat) in &graph.caveats {
+        if conditions_hold(&caveat.enabled_if, features) && !notes.contains(&caveat.note) {
+            notes.push(caveat.note.clone());
+        }
+    }
+    notes
+}
+
 /// The file of the graph's root source, for errors about the graph as a whole.
 fn root_file(graph: &LoadedGraph) -> std::path::PathBuf {
     graph
@@ -266,12 +278,7 @@ pub fn compile_ir(
                 threshold: v.threshold,
             })
             .collect(),
-        caveats: graph
-            .caveats
-            .iter()
-            .filter(|(_, c)| conditions_hold(&c.enabled_if, &options.features))
-            .map(|(_, c)| c.note.clone())
-            .collect(),
+        caveats: active_caveats(graph, &options.features),
         resources,
         passes,
         culled,

@@ -104,9 +104,14 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
     // (a default feature).
     assert_eq!(caveats(&[]), ["bloom", "direct"]);
     assert_eq!(caveats(&["!bloom"]), ["direct"]);
+    // Shadow maps under shadow casters with a sun or a spot, once with both.
     assert_eq!(
         caveats(&["!bloom", "shadow_casters", "area_lights", "point_lights"]),
-        ["sun", "direct", "area", "point"]
+        ["direct", "area", "point", "the"]
+    );
+    assert_eq!(
+        caveats(&["!bloom", "shadow_casters", "suns", "spot_lights"]),
+        ["sun", "direct"]
     );
 }
 
