@@ -27,6 +27,11 @@ use weft_scene::{AreaShape, Light, Scene};
 /// has a normal texture with a non-zero scale, `emission_occlusion_maps` when
 /// one has an emissive or occlusion texture.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
+    // Only the names graphs can rely on (weft_graph::SCENE_FEATURES).
+    fn set(features: &mut Vec<String>, name: &'static str) {
+        debug_assert!(weft_graph::SCENE_FEATURES.contains(&name), "{name}");
+        features.push(name.to_string());
+    }
     let placed = || {
         scene
             .instances
@@ -55,25 +60,25 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
             _ => false,
         });
     if shadowing_light && placed().any(|m| matches(MaterialFilter::ShadowCasters, &m)) {
-        features.push("shadow_casters".to_string());
+        set(&mut features, "shadow_casters");
     }
     if placed().any(|m| matches(MaterialFilter::Emissive, &m)) {
-        features.push("emissive".to_string());
+        set(&mut features, "emissive");
     }
     if placed().any(|m| matches(MaterialFilter::Transparent, &m)) {
-        features.push("transparent".to_string());
+        set(&mut features, "transparent");
     }
     if scene.lights.iter().any(|l| matches!(l, Light::Sun(_))) {
-        features.push("suns".to_string());
+        set(&mut features, "suns");
     }
     if scene.lights.iter().any(|l| matches!(l, Light::Point(_))) {
-        features.push("point_lights".to_string());
+        set(&mut features, "point_lights");
     }
     if scene.lights.iter().any(|l| matches!(l, Light::Spot(_))) {
-        features.push("spot_lights".to_string());
+        set(&mut features, "spot_lights");
     }
     if emitter_lights || scene.lights.iter().any(|l| matches!(l, Light::Area(_))) {
-        features.push("area_lights".to_string());
+        set(&mut features, "area_lights");
     }
     let area_shape = |disc: bool| {
         scene.lights.iter().any(
@@ -81,17 +86,17 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
         )
     };
     if emitter_lights || area_shape(false) {
-        features.push("rect_lights".to_string());
+        set(&mut features, "rect_lights");
     }
     if area_shape(true) {
-        features.push("disc_lights".to_string());
+        set(&mut features, "disc_lights");
     }
     if scene
         .lights
         .iter()
         .any(|l| matches!(l, Light::Sun(_) | Light::Point(_) | Light::Spot(_)))
     {
-        features.push("punctual_lights".to_string());
+        set(&mut features, "punctual_lights");
     }
     if placed().any(|m| {
         m.shading == ShadingModel::BlinnPhong
@@ -100,28 +105,28 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
             && m.specular.max_element() > 0.0
             && m.shininess > 0.0
     }) {
-        features.push("glossy".to_string());
+        set(&mut features, "glossy");
     }
     if placed().any(|m| dielectric(&m).is_some()) {
-        features.push("dielectrics".to_string());
+        set(&mut features, "dielectrics");
     }
     if placed().any(|m| is_mirror(&m)) {
-        features.push("mirrors".to_string());
+        set(&mut features, "mirrors");
     }
     if placed().any(|m| coat(&m).is_some()) {
-        features.push("coated".to_string());
+        set(&mut features, "coated");
     }
     if placed().any(|m| m.shading == ShadingModel::MetallicRoughness) {
-        features.push("metallic_roughness".to_string());
+        set(&mut features, "metallic_roughness");
     }
     if placed().any(|m| m.shading != ShadingModel::MetallicRoughness) {
-        features.push("blinn_phong".to_string());
+        set(&mut features, "blinn_phong");
     }
     if placed().any(|m| m.textures.emissive.is_some() || m.textures.occlusion.is_some()) {
-        features.push("emission_occlusion_maps".to_string());
+        set(&mut features, "emission_occlusion_maps");
     }
     if placed().any(|m| m.textures.normal.is_some() && m.normal_scale != 0.0) {
-        features.push("normal_maps".to_string());
+        set(&mut features, "normal_maps");
     }
     if placed().any(|m| {
         m.textures.base_color.is_some()
@@ -129,7 +134,7 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
             || m.textures.normal.is_some()
             || m.textures.emissive.is_some()
     }) {
-        features.push("textures".to_string());
+        set(&mut features, "textures");
     }
     features
 }

@@ -170,6 +170,31 @@ pub fn feature_names(ir: &Ir) -> BTreeSet<String> {
     names
 }
 
+/// The features the engine sets from what a scene holds (weft-render's
+/// `scene_features`, which sets no other): a graph may test them without any
+/// pass of its own doing so (a fragment's caveat, say).
+pub const SCENE_FEATURES: [&str; 19] = [
+    "shadow_casters",
+    "emissive",
+    "transparent",
+    "suns",
+    "point_lights",
+    "spot_lights",
+    "area_lights",
+    "rect_lights",
+    "disc_lights",
+    "punctual_lights",
+    "glossy",
+    "dielectrics",
+    "mirrors",
+    "coated",
+    "metallic_roughness",
+    "blinn_phong",
+    "emission_occlusion_maps",
+    "normal_maps",
+    "textures",
+];
+
 /// The notes of the graph's caveats whose features hold, each once (a note
 /// may be declared under several conditions).
 fn active_caveats(graph: &LoadedGraph, features: &BTreeSet<String>) -> Vec<String> {

@@ -173,12 +173,14 @@ impl<'a> Resolver<'a> {
         ir
     }
 
-    /// Every caveat says something, and holds under features the graph has:
-    /// a misspelt feature would silently never show the caveat.
+    /// Every caveat says something, and holds under features the graph has
+    /// or the engine sets from scenes: a misspelt feature would silently
+    /// never show the caveat.
     fn check_caveats(&mut self, ir: &Ir) {
         let mut known = crate::compile::feature_names(ir);
         known.extend(self.graph.default_features.iter().cloned());
         known.extend(self.graph.internal_features.iter().cloned());
+        known.extend(crate::compile::SCENE_FEATURES.iter().map(|f| f.to_string()));
         for (k, (source, caveat)) in self.graph.caveats.iter().enumerate() {
             let index = self.graph.caveats[..k]
                 .iter()
@@ -199,7 +201,7 @@ impl<'a> Resolver<'a> {
                     self.error(
                         *source,
                         &path("enabled_if"),
-                        format!("caveat condition \"{condition}\" names a feature no pass of this graph uses"),
+                        format!("caveat condition \"{condition}\" names a feature neither this graph nor scenes set"),
                     )
                     .hint = hint;
                 }

@@ -535,7 +535,7 @@ fn caveats_need_a_note_and_features_the_graph_has() {
         ),
         (
             r#"Graph(caveats: [(note: "glow", enabled_if: ["blom"])],"#,
-            "caveat condition \"blom\" names a feature no pass of this graph uses",
+            "caveat condition \"blom\" names a feature neither this graph nor scenes set",
             r#"["blom"]"#,
         ),
     ];
@@ -565,6 +565,13 @@ fn caveats_need_a_note_and_features_the_graph_has() {
             1,
         );
     assert_eq!(errors(&known), Vec::<Diagnostic>::new());
+    // So is a feature the engine sets from scenes, which no pass need use.
+    let scene_feature = VALID.replacen(
+        "Graph(",
+        r#"Graph(caveats: [(note: "no sky", enabled_if: ["suns"])],"#,
+        1,
+    );
+    assert_eq!(errors(&scene_feature), Vec::<Diagnostic>::new());
 }
 
 #[test]
