@@ -3,9 +3,11 @@
 //! area lights analytically, so each emissive triangle of a placed mesh
 //! becomes a polygon light (`LIGHT_AREA_POLYGON`, `shaders/include/area_light.glsl`):
 //! pairs of coplanar triangles sharing an edge that form a convex quad (a
-//! triangulated OBJ quad, a glTF panel) merge into one quad, and when more
-//! than [`MAX_EMITTER_LIGHTS`] polygons remain, the most powerful are kept and
-//! the power left out is reported, which bounds the light lost (docs/lights.md).
+//! triangulated OBJ quad, a glTF panel) merge into one quad; when more than
+//! [`MAX_EMITTER_LIGHTS`] polygons remain, neighbours facing about the same
+//! way are clustered into square lights (`crate::emitter_clusters`, which
+//! reports the power and the angle that costs), and if still too many, the
+//! most powerful are kept and the power left out is reported (docs/lights.md).
 //!
 //! Emission is what the tracer uses: the material's factor (MTL `Ke`, glTF
 //! `emissiveFactor` times `KHR_materials_emissive_strength`, `.scene`
@@ -79,6 +81,14 @@ pub struct EmitterLights {
     pub triangles: usize,
     /// Pairs of triangles merged into quads.
     pub quads: usize,
+    /// Lights that stand for a cluster of polygons.
+    pub clusters: usize,
+    /// Polygons merged into those clusters.
+    pub clustered: usize,
+    /// Largest angle (degrees) between a clustered polygon's normal and its light's.
+    pub cluster_angle: f32,
+    /// Share of the emitted power clustering lost to projection (0 to 1).
+    pub cluster_loss: f64,
     /// Polygons left out past [`MAX_EMITTER_LIGHTS`].
     pub dropped: usize,
     /// The share of the emitted power the dropped polygons had (0 to 1).
@@ -104,6 +114,15 @@ impl EmitterLights {
             self.polygons.len(),
             self.quads
         );
+        if self.clusters > 0 {
+            line += &format!(
+                "; {} polygons clustered into {} lights (normals within {:.0} degrees of their light's, {:.2}% of the emitted power lost)",
+                self.clustered,
+                self.clusters,
+                self.cluster_angle,
+                100.0 * self.cluster_loss
+            );
+        }
         if self.dropped > 0 {
             line += &format!(
                 "; {} more left out past the budget of {MAX_EMITTER_LIGHTS}, {:.2}% of the emitted power",
@@ -159,7 +178,13 @@ pub fn emitter_lights(geometry: &SceneGeometry) -> EmitterLights {
                 .map(|corners| EmitterPolygon { corners, radiance }),
         );
     }
-    (out.polygons, out.dropped, out.dropped_power) = within_budget(polygons, MAX_EMITTER_LIGHTS);
+    let clustered = crate::emitter_clusters::cluster(polygons, MAX_EMITTER_LIGHTS);
+    out.clusters = clustered.clusters;
+    out.clustered = clustered.members;
+    out.cluster_angle = clustered.worst_angle;
+    out.cluster_loss = clustered.lost_power;
+    (out.polygons, out.dropped, out.dropped_power) =
+        within_budget(clustered.polygons, MAX_EMITTER_LIGHTS);
     out
 }
 

@@ -13,6 +13,7 @@ pub mod brdf;
 pub mod bvh;
 pub mod bvh_cache;
 pub mod camera;
+pub mod emitter_clusters;
 pub mod emitter_lights;
 pub mod emitters;
 pub mod error;
