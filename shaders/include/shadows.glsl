@@ -1,4 +1,4 @@
-// Shadow lookups shared by forward and deferred (engine/render/src/shadows.rs
+// Shadow lookups shared by forward and deferred (engine/render/src/shadows/
 // writes the record, laid out by gpu_types.rs). The shadow map is an atlas of square tiles: the sun's
 // cascades, then one perspective view per shadow-casting spot cone. A lookup is
 // one matrix multiply (world to atlas coordinates, precomputed per view) and

@@ -1,6 +1,6 @@
 //! View and projection matrices: reverse-Z perspective for scene cameras (near
 //! maps to depth 1, far to 0, so float depth keeps precision far away) with
-//! Vulkan's downward clip-space Y. Shadow views are in `shadows.rs`.
+//! Vulkan's downward clip-space Y. Shadow views are in `shadows/`.
 
 use glam::{Mat4, Vec3};
 use weft_scene::Camera;

@@ -9,7 +9,7 @@
 //! - `ShadowAtlas(cascades, split_lambda, normal_bias, pcf_radius)`: the shadow
 //!   views of a depth-only scene pass, fitted every frame; the pass is drawn
 //!   once per view with the push-constant member `shadow_view` set to the
-//!   view's index (see `shadows.rs`).
+//!   view's index (see `shadows/`).
 //! - `RayTracing()`: the scene's world-space triangles, their corners'
 //!   normals and UVs, their materials, and a BVH over them (`bvh.rs`), built
 //!   on first use and bound in set 1 of the compute pass.

@@ -1,16 +1,23 @@
 //! Shadow views, pure math: the sun's cascades fitted each frame to slices of
 //! the camera's view volume (orthographic, forward Z), one perspective view per
-//! shadow-casting spot cone, their tiles in the shadow-map atlas, and the record
-//! the shaders read (`Shadows` in `shaders/include/shadows.glsl`).
+//! shadow-casting spot cone and per area light (`perspective`), their tiles in
+//! the shadow-map atlas (`atlas`), and the record the shaders read (`Shadows`
+//! in `shaders/include/shadows.glsl`).
 //!
 //! Atlas: the graph's `shadow_map` (`resolution` squared) is cut into a
 //! `grid` x `grid` array of square tiles, `grid = ceil(sqrt(views))`; views are
-//! the cascades, then the spots. One cascade and no spot uses the whole map.
+//! the cascades, then the spots, then the area lights. One cascade and nothing
+//! else uses the whole map.
 
-use crate::gpu_types::{bytes_of, GpuLight, GpuShadowView, GpuShadowsHeader};
-use crate::lights::{self, LightSet};
+mod atlas;
+mod perspective;
+
+pub use atlas::Atlas;
+pub use perspective::{area_clip, area_emitter, spot_clip};
+
+use crate::gpu_types::{bytes_of, GpuShadowView, GpuShadowsHeader};
+use crate::lights::LightSet;
 use glam::{Mat4, Vec3, Vec4};
-use std::f32::consts::PI;
 use weft_scene::Aabb;
 
 /// Most sun cascades (`ShadowAtlas` rejects more).
@@ -162,68 +169,6 @@ pub fn cascade_splits(near: f32, far: f32, count: u32, lambda: f32) -> Vec<f32> 
         .collect()
 }
 
-/// Square tiles of the shadow-map atlas.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Atlas {
-    /// Texels per side of the whole map.
-    pub size: u32,
-    /// Tiles per side.
-    pub grid: u32,
-    /// Texels per side of one tile.
-    pub tile: u32,
-}
-
-impl Atlas {
-    /// The layout for `views` tiles in a `size` squared map.
-    pub fn new(size: u32, views: u32) -> Self {
-        let mut grid = 1;
-        while grid * grid < views.max(1) {
-            grid += 1;
-        }
-        Self {
-            size,
-            grid,
-            tile: (size / grid).max(1),
-        }
-    }
-
-    /// Texel x, y of tile `i`'s corner and its side, for the viewport.
-    pub fn viewport(&self, i: u32) -> [u32; 3] {
-        [
-            (i % self.grid) * self.tile,
-            (i / self.grid) * self.tile,
-            self.tile,
-        ]
-    }
-
-    /// Clip space of tile `i`'s view to atlas texture coordinates (xy), keeping z and w,
-    /// so `lookup = to_uv * clip` and `textureProj` divides by w.
-    pub fn to_uv(&self, i: u32) -> Mat4 {
-        let [x, y, side] = self.viewport(i);
-        let scale = side as f32 / self.size as f32;
-        let (ox, oy) = (x as f32 / self.size as f32, y as f32 / self.size as f32);
-        Mat4::from_cols(
-            Vec4::new(0.5 * scale, 0.0, 0.0, 0.0),
-            Vec4::new(0.0, 0.5 * scale, 0.0, 0.0),
-            Vec4::new(0.0, 0.0, 1.0, 0.0),
-            Vec4::new(ox + 0.5 * scale, oy + 0.5 * scale, 0.0, 1.0),
-        )
-    }
-
-    /// Tile `i`'s texture-coordinate bounds (min xy, max xy) shrunk by `margin`
-    /// texels: a lookup inside them reads only this tile.
-    pub fn inner_rect(&self, i: u32, margin: f32) -> Vec4 {
-        let [x, y, side] = self.viewport(i);
-        let s = self.size as f32;
-        Vec4::new(
-            (x as f32 + margin) / s,
-            (y as f32 + margin) / s,
-            ((x + side) as f32 - margin) / s,
-            ((y + side) as f32 - margin) / s,
-        )
-    }
-}
-
 /// One rendered shadow view.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadowView {
@@ -243,51 +188,6 @@ pub struct ShadowView {
     /// its area) and the view's near and far depth, which soft shadows
     /// need; `None` for suns and spots.
     pub area: Option<[f32; 3]>,
-}
-
-/// An area light's record (`lights::AREA_RECT`, `AREA_DISC`,
-/// `AREA_POLYGON`, laid out as `area_outline` in `area_light.glsl` reads it):
-/// its centre, the unit direction it emits towards, and the side of a
-/// square of its area; `None` for other records or a degenerate outline.
-pub fn area_emitter(record: &GpuLight) -> Option<(Vec3, Vec3, f32)> {
-    let kind = record.direction_type.w;
-    let a = record.position_range.truncate();
-    let b = record.direction_type.truncate();
-    let c = record.attenuation_cos.truncate();
-    let (centre, winding, area) = if kind == lights::AREA_POLYGON {
-        let d = Vec3::new(
-            record.position_range.w,
-            record.attenuation_cos.w,
-            record.color_exponent.w,
-        );
-        let winding = (c - a).cross(d - b);
-        (0.25 * (a + b + c + d), winding, 0.5 * winding.length())
-    } else if kind == lights::AREA_RECT {
-        let winding = b.cross(c);
-        (a, winding, 4.0 * winding.length())
-    } else if kind == lights::AREA_DISC {
-        (a, b.cross(c), PI * b.length() * c.length())
-    } else {
-        return None;
-    };
-    let facing = (-winding).try_normalize()?;
-    (area.is_finite() && area > 0.0).then(|| (centre, facing, area.sqrt()))
-}
-
-/// World-to-clip for an area light's view from its `centre` along `facing`
-/// (a perspective of half-angle [`AREA_HALF_ANGLE_DEGREES`] reaching `far`),
-/// the world size of a texel one unit away, and the near depth.
-pub fn area_clip(centre: Vec3, facing: Vec3, far: f32, tile: u32, margin: f32) -> (Mat4, f32, f32) {
-    let far = far.max(1e-3);
-    let (clip, texel) = spot_clip(
-        centre,
-        facing,
-        AREA_HALF_ANGLE_DEGREES.to_radians().cos(),
-        far,
-        tile,
-        margin,
-    );
-    (clip, texel, spot_near(far))
 }
 
 /// An orthographic world-to-clip matrix for the sun travelling along `direction`:
@@ -358,43 +258,6 @@ pub fn fit_sun(
     let mut proj = Mat4::orthographic_rh(cx - half, cx + half, cy - half, cy + half, near, far);
     proj.y_axis.y = -proj.y_axis.y;
     (proj * view, texel)
-}
-
-/// Perspective world-to-clip for a spot at `position` shining along `direction`
-/// with half-angle `acos(cos_cutoff)` and reach `range` (forward Z, Y flipped),
-/// widened so the cone fits inside `margin` texels from a `tile`-texel map's edge.
-/// Returns the matrix and the world size of a texel one unit from the light.
-pub fn spot_clip(
-    position: Vec3,
-    direction: Vec3,
-    cos_cutoff: f32,
-    range: f32,
-    tile: u32,
-    margin: f32,
-) -> (Mat4, f32) {
-    let dir = direction.try_normalize().unwrap_or(Vec3::NEG_Y);
-    let up = if dir.cross(Vec3::Y).length_squared() < 1e-6 {
-        Vec3::Z
-    } else {
-        Vec3::Y
-    };
-    let half = cos_cutoff
-        .clamp(-1.0, 1.0)
-        .acos()
-        .clamp(1e-3, 80f32.to_radians());
-    let tile = tile.max(1) as f32;
-    let tan = half.tan() * tile / (tile - 2.0 * margin).max(1.0);
-    let far = range.max(1e-3);
-    let near = spot_near(far);
-    let view = Mat4::look_at_rh(position, position + dir, up);
-    let mut proj = Mat4::perspective_rh(2.0 * tan.atan(), 1.0, near, far);
-    proj.y_axis.y = -proj.y_axis.y;
-    (proj * view, 2.0 * tan / tile)
-}
-
-/// The near depth of a perspective view reaching `far`.
-fn spot_near(far: f32) -> f32 {
-    (far * 1e-3).max(1e-3).min(far * 0.5)
 }
 
 /// Everything about this frame's shadows: the views and the record shaders read.
@@ -559,7 +422,7 @@ impl ShadowFrame {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::{Vec3Swizzles, Vec4Swizzles};
+    use glam::Vec4Swizzles;
 
     fn cube(h: f32) -> Aabb {
         Aabb {
@@ -587,43 +450,6 @@ mod tests {
         );
         let p = cascade_splits(1.0, 100.0, 2, 0.5);
         assert!((p[0] - 0.5 * (10.0 + 50.5)).abs() < 1e-3, "{p:?}");
-    }
-
-    #[test]
-    fn atlas_tiles_cover_the_map_without_overlap() {
-        let a = Atlas::new(2048, 3);
-        assert_eq!((a.grid, a.tile), (2, 1024));
-        assert_eq!(a.viewport(0), [0, 0, 1024]);
-        assert_eq!(a.viewport(1), [1024, 0, 1024]);
-        assert_eq!(a.viewport(2), [0, 1024, 1024]);
-        assert_eq!(
-            Atlas::new(512, 1),
-            Atlas {
-                size: 512,
-                grid: 1,
-                tile: 512
-            }
-        );
-        // Clip corners land on the tile's corners in texture coordinates.
-        let m = a.to_uv(1);
-        assert_eq!(
-            m * Vec4::new(-1.0, -1.0, 0.3, 1.0),
-            Vec4::new(0.5, 0.0, 0.3, 1.0)
-        );
-        assert_eq!(
-            m * Vec4::new(1.0, 1.0, 0.3, 1.0),
-            Vec4::new(1.0, 0.5, 0.3, 1.0)
-        );
-        let r = a.inner_rect(2, 4.0);
-        assert_eq!(
-            r,
-            Vec4::new(
-                4.0 / 2048.0,
-                0.5 + 4.0 / 2048.0,
-                0.5 - 4.0 / 2048.0,
-                1.0 - 4.0 / 2048.0
-            )
-        );
     }
 
     #[test]
@@ -671,23 +497,5 @@ mod tests {
             (shift - shift.round()).abs().max_element() < 1e-2,
             "{shift}"
         );
-    }
-
-    #[test]
-    fn a_spot_view_holds_its_cone_inside_the_margin() {
-        let pos = Vec3::new(0.0, 5.0, 0.0);
-        let dir = Vec3::new(0.2, -1.0, 0.1).normalize();
-        let cos = 30f32.to_radians().cos();
-        let (m, texel) = spot_clip(pos, dir, cos, 10.0, 256, 3.0);
-        // A point on the cone's edge 5 units out lies 3 texels inside the tile.
-        let side = dir.cross(Vec3::X).normalize();
-        let q = glam::Quat::from_axis_angle(side, 30f32.to_radians());
-        let edge = pos + q * dir * 5.0;
-        let c = m * edge.extend(1.0);
-        let ndc = c.xyz() / c.w;
-        let inside = (1.0 - ndc.xy().abs().max_element()) * 128.0;
-        assert!(inside > 2.9, "{inside}");
-        assert!(ndc.z > 0.0 && ndc.z < 1.0);
-        assert!((texel - 2.0 * 30f32.to_radians().tan() * 256.0 / 250.0 / 256.0).abs() < 1e-6);
     }
 }
