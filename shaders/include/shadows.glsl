@@ -1,6 +1,7 @@
 // Shadow lookups shared by forward and deferred (engine/render/src/shadows/
 // writes the record, laid out by gpu_types.rs). The shadow map is an atlas of square tiles: the sun's
-// cascades, then one perspective view per shadow-casting spot cone. A lookup is
+// cascades, then one perspective view per shadow-casting spot cone, then one per
+// area light (soft shadows, `area_visibility` below). A sun or spot lookup is
 // one matrix multiply (world to atlas coordinates, precomputed per view) and
 // textureProj on a compare sampler, whose 2x2 hardware filter is widened by a
 // manual (2r+1)^2 kernel, r = the shadow pass's `pcf_radius`. The lookups are
