@@ -100,18 +100,18 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
             .map(|c| c.split([' ', ':']).next().unwrap_or_default().to_string())
             .collect()
     };
-    // raster_caveats.ron's unconditional note; bloom.ron's while bloom is on
+    // raster_caveats.ron's unconditional notes; bloom.ron's while bloom is on
     // (a default feature).
-    assert_eq!(caveats(&[]), ["bloom", "direct"]);
-    assert_eq!(caveats(&["!bloom"]), ["direct"]);
+    assert_eq!(caveats(&[]), ["bloom", "one", "direct"]);
+    assert_eq!(caveats(&["!bloom"]), ["one", "direct"]);
     // Shadow maps under shadow casters with a sun or a spot, once with both.
     assert_eq!(
         caveats(&["!bloom", "shadow_casters", "area_lights", "point_lights"]),
-        ["direct", "area", "point", "the"]
+        ["one", "direct", "area", "point", "the"]
     );
     assert_eq!(
         caveats(&["!bloom", "shadow_casters", "suns", "spot_lights"]),
-        ["sun", "direct"]
+        ["sun", "one", "direct"]
     );
 }
 
