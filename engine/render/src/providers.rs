@@ -15,7 +15,7 @@
 //!   on first use and bound in set 1 of the compute pass.
 
 use crate::gaussian::{self, GaussianTaps};
-use crate::shadows::{ShadowSettings, MAX_CASCADES, MAX_PCF_RADIUS};
+use crate::shadows::{ShadowSettings, MAX_AREA_SHADOWS, MAX_CASCADES, MAX_PCF_RADIUS};
 use weft_graph::plan::{Plan, PlanPass};
 use weft_graph::provider::{find, ArgDefault, ArgKind, ArgSpec, ProviderSpec};
 use weft_graph::schema::{ParamValue, PassKind, ProviderDecl};
@@ -55,7 +55,8 @@ pub const GAUSSIAN: ProviderSpec = ProviderSpec {
 /// The shadow-atlas provider.
 pub const SHADOW_ATLAS: ProviderSpec = ProviderSpec {
     name: "ShadowAtlas",
-    summary: "sun cascades and spot views in one depth atlas, drawn once per view",
+    summary:
+        "sun cascades, spot views and area-light views in one depth atlas, drawn once per view",
     kinds: &[PassKind::Raster],
     args: &[
         ArgSpec {
@@ -86,6 +87,14 @@ pub const SHADOW_ATLAS: ProviderSpec = ProviderSpec {
                 max: MAX_PCF_RADIUS as i64,
             },
             default: Some(ArgDefault::Number(1.0)),
+        },
+        ArgSpec {
+            name: "area_lights",
+            kind: ArgKind::Integer {
+                min: 0,
+                max: MAX_AREA_SHADOWS as i64,
+            },
+            default: Some(ArgDefault::Number(MAX_AREA_SHADOWS as f64)),
         },
     ],
     supplies: &[SHADOW_VIEW],
@@ -210,6 +219,7 @@ pub fn shadow_atlas(pass: &PlanPass) -> Option<ShadowSettings> {
         pcf_radius: number(&args, "pcf_radius") as u32,
         normal_bias: number(&args, "normal_bias") as f32,
         split_lambda: number(&args, "split_lambda") as f32,
+        area_lights: number(&args, "area_lights") as u32,
     })
 }
 
@@ -324,6 +334,9 @@ mod tests {
             }
         );
         assert_eq!(shadow_atlas(&pass_with(Vec::new())), None);
+        let without_area = decl("ShadowAtlas", &[("area_lights", ParamValue::Number(0.0))]);
+        let settings = shadow_atlas(&pass_with(vec![without_area])).expect("a shadow pass");
+        assert_eq!(settings.area_lights, 0);
     }
 
     fn plan_of(passes: weft_graph::id::IdVec<weft_graph::id::PassId, PlanPass>) -> Plan {

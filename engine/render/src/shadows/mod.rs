@@ -54,6 +54,9 @@ pub struct ShadowSettings {
     pub normal_bias: f32,
     /// Split blend: 0 uniform, 1 logarithmic (practical split scheme).
     pub split_lambda: f32,
+    /// Area lights given soft shadows, 0..=[`MAX_AREA_SHADOWS`]: the first
+    /// ones in record order; 0 turns area shadows off.
+    pub area_lights: u32,
 }
 
 impl Default for ShadowSettings {
@@ -63,6 +66,7 @@ impl Default for ShadowSettings {
             pcf_radius: 1,
             normal_bias: 1.0,
             split_lambda: 0.75,
+            area_lights: MAX_AREA_SHADOWS,
         }
     }
 }
@@ -302,7 +306,7 @@ pub fn shadow_frame(
         .iter()
         .skip(first_area as usize)
         .map_while(area_emitter)
-        .take(MAX_AREA_SHADOWS as usize)
+        .take(settings.area_lights.min(MAX_AREA_SHADOWS) as usize)
         .collect();
     let areas = emitters.len() as u32;
     let atlas = Atlas::new(atlas_size, cascades + spots + areas);
@@ -497,5 +501,41 @@ mod tests {
             (shift - shift.round()).abs().max_element() < 1e-2,
             "{shift}"
         );
+    }
+
+    #[test]
+    fn area_lights_get_views_after_the_spots_up_to_the_setting() {
+        let area = |x: f32| {
+            weft_scene::Light::Area(weft_scene::AreaLight {
+                shape: weft_scene::AreaShape::Rect {
+                    width: 1.0,
+                    height: 0.5,
+                },
+                position: Vec3::new(x, 4.0, 0.0),
+                orientation: glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+                emission: Vec3::ONE,
+                two_sided: false,
+            })
+        };
+        let bounds = cube(5.0);
+        let lights = crate::lights::pack_lights(&[area(-1.0), area(1.0)], &bounds);
+        let frame = |area_lights| {
+            let settings = ShadowSettings {
+                area_lights,
+                ..ShadowSettings::default()
+            };
+            shadow_frame(&settings, 2048, &volume(), &lights, &bounds)
+        };
+        let both = frame(4);
+        assert_eq!((both.cascades, both.spots, both.areas), (0, 0, 2));
+        assert_eq!(both.first_area, lights.first_area());
+        // Each view looks down from its light, the size of a 1 x 0.5 light.
+        for v in &both.views {
+            let [size, near, far] = v.area.expect("an area view");
+            assert!((size - 0.5f32.sqrt()).abs() < 1e-6 && near > 0.0 && far > 4.0);
+        }
+        assert_eq!(frame(1).areas, 1);
+        let none = frame(0);
+        assert_eq!((none.areas, none.views.len()), (0, 0));
     }
 }
