@@ -148,10 +148,10 @@ vec3 reflected(Material m, Surface s, vec3 l, vec3 radiance) {
 // the surface from its centre with irradiance L cos(theta_light) A / (d^2 +
 // A / pi) for its area A (a disc of area A seen head-on gives exactly that,
 // so the sum stays finite next to the light), which is pi times the punctual
-// colour `reflected` takes. No shadowing. The graph parameter `area_samples`
-// (0: analytic) chooses it; brdf.rs mirrors it at 8 x 8 for tests.
-vec3 shade_area_quadrature(uint index, Surface s, Material m, uint samples) {
-    AreaOutline o = area_outline(index, s.position);
+// colour `reflected` takes. No shadowing. `o` is its outline seen from the
+// surface (area_outline). The graph parameter `area_samples` (0: analytic)
+// chooses it; brdf.rs mirrors it at 8 x 8 for tests.
+vec3 shade_area_quadrature(uint index, AreaOutline o, Surface s, Material m, uint samples) {
     if (in_light_plane(o, s.position)) {
         return vec3(0.0);
     }
@@ -219,9 +219,9 @@ vec3 area_ltc_blinn_phong(Surface s, Material m, float ndv, mat3 local, float di
 
 // Area light `index` analytically (include/ltc.glsl). Diffuse: the exact
 // integral of the cosine over the polygon. Highlights: the fitted LTC of the
-// material's lobe, scaled by the lobe's integral. No shadowing.
-vec3 shade_area_ltc(uint index, Surface s, Material m) {
-    AreaOutline o = area_outline(index, s.position);
+// material's lobe, scaled by the lobe's integral. No shadowing. `o` is its
+// outline seen from the surface (area_outline).
+vec3 shade_area_ltc(uint index, AreaOutline o, Surface s, Material m) {
     // Only the shapes the scene has are compiled: lavapipe would run a
     // 12-gon's corners for every rectangle otherwise. Emissive polygons count
     // as four-cornered lights (scene feature `rect_lights`).
@@ -305,10 +305,11 @@ vec3 shade_area_lights(Surface s, Material m, uint area_samples) {
     // Area lights, then the emissive polygons after every other record.
     uint end = frame.counts.w + frame.emitter_lights.x;
     for (uint i = frame.counts.x + frame.counts.y + frame.counts.z; i < end; ++i) {
-        vec3 light = area_samples == 0u ? shade_area_ltc(i, s, m) : shade_area_quadrature(i, s, m, area_samples);
+        AreaOutline o = area_outline(i, s.position);
+        vec3 light = area_samples == 0u ? shade_area_ltc(i, o, s, m) : shade_area_quadrature(i, o, s, m, area_samples);
 #ifdef HAS_SHADOW_MAP
         if (any(greaterThan(light, vec3(0.0)))) {
-            light *= area_visibility(i, s.position, s.normal, area_outline(i, s.position));
+            light *= area_visibility(i, s.position, s.normal, o);
         }
 #endif
         c += light;

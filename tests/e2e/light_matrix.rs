@@ -13,25 +13,9 @@
 use std::path::{Path, PathBuf};
 use weft_compare::{hdr_flip, LinearImage};
 use weft_tests::gltf::write_gltf_quad;
+use weft_tests::TempDir;
 
 const SIZE: u32 = 32;
-
-/// A folder removed when the test ends.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("weft-matrix-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("scratch folder");
-        Self(dir)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// A shading model as the quad's file states it.
 enum Model {
@@ -181,7 +165,7 @@ fn every_light_and_shading_model_matches_the_direct_light_reference_in_every_ras
         };
     for (light_name, light) in LIGHTS {
         for (model_name, model) in &MODELS {
-            let dir = TempDir::new(&format!("{light_name}-{model_name}").replace(' ', "_"));
+            let dir = TempDir::new(&format!("matrix-{light_name}-{model_name}").replace(' ', "_"));
             let scene = scene(&dir.0, model, light);
             let reference = render(&scene, "pathtrace.ron", Some(256), &[("max_depth", 2.0)]);
             // Measured: GGX metal under area lights with LTC, mean within

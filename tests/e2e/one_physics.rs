@@ -6,25 +6,9 @@
 
 use glam::Vec3;
 use std::path::{Path, PathBuf};
+use weft_tests::TempDir;
 
 const SIZE: u32 = 48;
-
-/// A folder removed when the test ends.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("weft-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("scratch folder");
-        Self(dir)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// The HDR image of `scene` through shipped graph `graph` (validated, bloom
 /// off), RGB per pixel.

@@ -76,3 +76,21 @@ pub fn assert_no_validation_messages(gpu: Gpu) {
     drop(gpu);
     assert_eq!(log.messages(), Vec::new());
 }
+
+/// A scratch folder under the system's temporary one, removed when dropped.
+pub struct TempDir(pub PathBuf);
+
+impl TempDir {
+    /// `weft-NAME-PID`, created.
+    pub fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("weft-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("scratch folder");
+        Self(dir)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}

@@ -18,7 +18,7 @@
 
 use crate::fit::moments;
 use crate::lobe::Ggx;
-use crate::tables::ParseError;
+use crate::tables::{parse_numbers, ParseError};
 use crate::MIN_ROUGHNESS;
 use glam::Vec3;
 use std::fmt::Write;
@@ -184,11 +184,7 @@ impl AlbedoTable {
             if line.is_empty() || line.starts_with('#') {
                 continue;
             }
-            let values: Vec<f32> = line
-                .split_whitespace()
-                .map(str::parse)
-                .collect::<Result<_, _>>()
-                .map_err(|e| ParseError(format!("line {}: {e}", number + 1)))?;
+            let values = parse_numbers(line, number)?;
             let [integral, fresnel] = values[..] else {
                 return Err(ParseError(format!(
                     "line {}: expected 2 numbers",

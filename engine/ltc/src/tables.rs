@@ -57,6 +57,14 @@ pub fn write(tables: &Tables) -> String {
     out
 }
 
+/// The numbers of line `number` (counted from 0) of a table's text.
+pub(crate) fn parse_numbers(line: &str, number: usize) -> Result<Vec<f32>, ParseError> {
+    line.split_whitespace()
+        .map(str::parse)
+        .collect::<Result<_, _>>()
+        .map_err(|e| ParseError(format!("line {}: {e}", number + 1)))
+}
+
 /// Reads [`write`]'s format.
 pub fn parse(text: &str) -> Result<Tables, ParseError> {
     let mut tables: Vec<(String, Vec<Entry>)> = Vec::new();
@@ -69,11 +77,7 @@ pub fn parse(text: &str) -> Result<Tables, ParseError> {
             tables.push((name.to_string(), Vec::new()));
             continue;
         }
-        let values: Vec<f32> = line
-            .split_whitespace()
-            .map(str::parse)
-            .collect::<Result<_, _>>()
-            .map_err(|e| ParseError(format!("line {}: {e}", number + 1)))?;
+        let values = parse_numbers(line, number)?;
         let [a, b, c, d, magnitude, fresnel] = values[..] else {
             return Err(ParseError(format!(
                 "line {}: expected 6 numbers",

@@ -207,12 +207,7 @@ pub fn fit_sun(
     tile: u32,
     margin: f32,
 ) -> (Mat4, f32) {
-    let dir = direction.try_normalize().unwrap_or(Vec3::NEG_Y);
-    let up = if dir.cross(Vec3::Y).length_squared() < 1e-6 {
-        Vec3::Z
-    } else {
-        Vec3::Y
-    };
+    let (dir, up) = view_axes(direction);
     let (center, radius) = if bounds.is_empty() {
         (Vec3::ZERO, 1.0)
     } else {
@@ -284,6 +279,18 @@ pub struct ShadowFrame {
     pub splits: [f32; 4],
     /// The camera's view direction, for picking a cascade by view depth.
     pub forward: Vec3,
+}
+
+/// A light view's unit forward axis for `direction` (straight down if it has
+/// no length), and an up vector not parallel to it, for `look_at`.
+fn view_axes(direction: Vec3) -> (Vec3, Vec3) {
+    let dir = direction.try_normalize().unwrap_or(Vec3::NEG_Y);
+    let up = if dir.cross(Vec3::Y).length_squared() < 1e-6 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
+    (dir, up)
 }
 
 /// Lays out and fits this frame's views for a `atlas_size` squared shadow map.

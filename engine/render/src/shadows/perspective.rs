@@ -65,12 +65,7 @@ pub fn spot_clip(
     tile: u32,
     margin: f32,
 ) -> (Mat4, f32) {
-    let dir = direction.try_normalize().unwrap_or(Vec3::NEG_Y);
-    let up = if dir.cross(Vec3::Y).length_squared() < 1e-6 {
-        Vec3::Z
-    } else {
-        Vec3::Y
-    };
+    let (dir, up) = super::view_axes(direction);
     let half = cos_cutoff
         .clamp(-1.0, 1.0)
         .acos()
