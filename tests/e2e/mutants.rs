@@ -311,7 +311,14 @@ impl Drop for Tree {
 /// Root graphs whose files (the graph, its fragments, their shaders) mention
 /// `file`'s name; every root for shared includes.
 fn roots_using(file: &Path) -> Vec<&'static str> {
-    let roots = ["forward.ron", "deferred.ron", "tiled.ron"];
+    let roots = [
+        "forward.ron",
+        "deferred.ron",
+        "tiled.ron",
+        "bench/forward_floors.ron",
+        "bench/deferred_floors.ron",
+        "bench/tiled_floors.ron",
+    ];
     let name = file
         .file_name()
         .expect("name")
@@ -326,16 +333,21 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
         .into_iter()
         .filter(|r| {
             let mut text = text_of(r);
-            for fragment in [
-                "shadows.ron",
-                "bloom.ron",
-                "gbuffer.ron",
-                "debug_views.ron",
-                "raster_caveats.ron",
-                "bench/mesh_floor.ron",
-                "bench/gbuffer_floor.ron",
+            // Included files as the including text names them, and where they
+            // are: the bench graphs include a shipped graph and the floors.
+            for (named, fragment) in [
+                ("../forward.ron", "forward.ron"),
+                ("../deferred.ron", "deferred.ron"),
+                ("../tiled.ron", "tiled.ron"),
+                ("\"mesh_floor.ron", "bench/mesh_floor.ron"),
+                ("\"gbuffer_floor.ron", "bench/gbuffer_floor.ron"),
+                ("shadows.ron", "shadows.ron"),
+                ("bloom.ron", "bloom.ron"),
+                ("gbuffer.ron", "gbuffer.ron"),
+                ("debug_views.ron", "debug_views.ron"),
+                ("raster_caveats.ron", "raster_caveats.ron"),
             ] {
-                if text.contains(fragment) {
+                if text.contains(named) {
                     text.push_str(&text_of(fragment));
                 }
             }

@@ -50,10 +50,6 @@ pub fn absolute_paths(text: &str) -> String {
         );
     }
     text.replace(
-        "(file: \"bench/",
-        &format!("(file: \"{}/", graphs.join("bench").display()),
-    )
-    .replace(
         "\"../shaders/",
         &format!("\"{}/", root().join("shaders").display()),
     )

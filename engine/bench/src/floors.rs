@@ -1,6 +1,6 @@
 //! `weft bench floors`: each pass against its floor in the same frame. The
-//! shipped graphs include the floors of `graphs/bench/` under the feature
-//! `bench_floors`: the scene's meshes with a constant fragment shader, and one
+//! bench graphs of `graphs/bench/` include a shipped graph and the floors
+//! beside it: the scene's meshes with a constant fragment shader, and one
 //! fullscreen read of the G-buffer. A pass that draws meshes at the output's
 //! size is set against the first; a pass that samples every image the second
 //! samples (a deferred lighting pass) against the second. Per-pass CPU wall
@@ -22,11 +22,11 @@ pub struct FloorsArgs {
     /// The scene rendered.
     #[arg(default_value = "scenes/demo.scene")]
     scene: PathBuf,
-    /// Graphs measured, comma-separated.
+    /// Graphs measured, comma-separated: each includes a graph and the floors.
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "graphs/forward.ron,graphs/deferred.ron,graphs/tiled.ron"
+        default_value = "graphs/bench/forward_floors.ron,graphs/bench/deferred_floors.ron,graphs/bench/tiled_floors.ron"
     )]
     graphs: Vec<PathBuf>,
     /// Output size.
@@ -86,7 +86,6 @@ pub fn run(args: FloorsArgs) -> Result<ExitCode> {
             graph: graph.clone(),
             extent: args.size,
             frames: args.frames,
-            features: vec!["bench_floors".into()],
             timing: TimingMode::CpuPerPass,
             extra_readback: weft_graph::load(graph).readback_names(),
             ..RenderSettings::default()

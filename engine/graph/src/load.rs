@@ -52,9 +52,6 @@ pub struct LoadedGraph {
     pub name: String,
     /// Toggles declared on by default by the graph and its fragments.
     pub default_features: Vec<String>,
-    /// Features only weft's own tools set, declared by the graph and its
-    /// fragments (`internal_features`).
-    pub internal_features: Vec<String>,
     /// Whether the root file is a fragment (checked alone, never compiled alone).
     pub is_fragment: bool,
     /// Per source: the resources it expects its includer to declare.
@@ -274,7 +271,9 @@ fn load_file(
         graph.name = parsed.name.clone().unwrap_or_default();
         graph.is_fragment = parsed.fragment;
     }
-    if (site.is_some() || parsed.fragment) && parsed.output.is_some() {
+    if site.is_some() && !parsed.fragment {
+        build_on(graph, source, &parsed);
+    } else if parsed.fragment && parsed.output.is_some() {
         let (file, pos) = graph.locate(source, &[Seg::Field("output")]);
         graph.diagnostics.push(
             Diagnostic::warning(file, pos, "a fragment's output is ignored")
@@ -291,11 +290,6 @@ fn load_file(
     for feature in &parsed.features {
         if !graph.default_features.contains(feature) {
             graph.default_features.push(feature.clone());
-        }
-    }
-    for feature in &parsed.internal_features {
-        if !graph.internal_features.contains(feature) {
-            graph.internal_features.push(feature.clone());
         }
     }
     // At the root, `fragment.name` overrides (`--param shadows.resolution=1024`)
@@ -372,6 +366,39 @@ fn load_file(
             source,
             index,
         });
+    }
+}
+
+/// A whole graph (not a fragment) included by another: the includer builds on
+/// it, as the bench graphs add floor passes to a shipped graph, and takes its
+/// name, output and accumulation where it declares none, and its read-backs
+/// besides its own. An output other than the includer's is ignored, with a warning.
+fn build_on(graph: &mut LoadedGraph, source: usize, parsed: &GraphFile) {
+    if graph.name.is_empty() {
+        graph.name = parsed.name.clone().unwrap_or_default();
+    }
+    match (&graph.output, &parsed.output) {
+        (None, output) => graph.output = output.clone(),
+        (Some(own), Some(other)) if own != other => {
+            let (file, pos) = graph.locate(source, &[Seg::Field("output")]);
+            graph.diagnostics.push(
+                Diagnostic::warning(
+                    file,
+                    pos,
+                    format!("this included graph's output \"{other}\" is ignored"),
+                )
+                .with_hint(format!("the including graph chooses \"{own}\"")),
+            );
+        }
+        _ => {}
+    }
+    if graph.progressive.is_none() {
+        graph.progressive = parsed.progressive.clone();
+    }
+    for read in &parsed.readback {
+        if !graph.readback.iter().any(|r| r.name() == read.name()) {
+            graph.readback.push(read.clone());
+        }
     }
 }
 

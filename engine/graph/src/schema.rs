@@ -25,10 +25,6 @@ pub struct GraphFile {
     /// User toggles that are on unless turned off (`--features !bloom`).
     #[serde(default)]
     pub features: Vec<String>,
-    /// Features weft's own tools set (`bench_floors` for `weft bench
-    /// floors`): never offered in the viewer, refused from `--features`.
-    #[serde(default)]
-    pub internal_features: Vec<String>,
     /// Parameters with defaults; passes and sizes refer to them as `"$name"`.
     #[serde(default)]
     pub params: BTreeMap<String, ParamValue>,
@@ -49,7 +45,8 @@ pub struct GraphFile {
     /// Images besides the output that tools read back, first the linear
     /// image an `.exr` output is written from (`weft render --out F.exr`);
     /// `--readback` replaces the list. An entry may hold only under features:
-    /// `(name: "floor_mesh_color", enabled_if: ["bench_floors"])`.
+    /// `(name: "bloom", enabled_if: ["bloom"])`. A graph that includes a whole
+    /// graph (not a fragment) reads back its images too.
     #[serde(default)]
     pub readback: Vec<ReadDecl>,
     /// Marks a graph whose output converges over frames (a path tracer): each

@@ -89,10 +89,8 @@ impl<'g> Prepared<'g> {
     /// of this graph — neither one its passes test nor a default — each as a
     /// message with the nearest known name as a hint.
     pub fn unknown_features<S: AsRef<str>>(&self, requested: &[S]) -> Vec<String> {
-        let internal = |f: &str| self.graph.internal_features.iter().any(|i| i == f);
         let mut known = feature_names(&self.ir);
         known.extend(self.graph.default_features.iter().cloned());
-        known.retain(|k| !internal(k));
         let names: Vec<&str> = requested
             .iter()
             .map(|f| f.as_ref().trim())
@@ -103,9 +101,7 @@ impl<'g> Prepared<'g> {
             problems.push("an empty feature name (a stray comma, or `!` alone)".to_string());
         }
         for f in names.into_iter().filter(|f| !f.is_empty()) {
-            if internal(f) {
-                problems.push(format!("feature \"{f}\" is internal: weft's own tools set it (the graph's `internal_features`), not `--features`"));
-            } else if !known.contains(f) {
+            if !known.contains(f) {
                 let hint = crate::diagnostic::nearest(f, known.iter().map(String::as_str))
                     .map(|n| format!(" (did you mean \"{n}\"?)"))
                     .unwrap_or_default();

@@ -179,7 +179,6 @@ impl<'a> Resolver<'a> {
     fn check_caveats(&mut self, ir: &Ir) {
         let mut known = crate::compile::feature_names(ir);
         known.extend(self.graph.default_features.iter().cloned());
-        known.extend(self.graph.internal_features.iter().cloned());
         known.extend(crate::compile::SCENE_FEATURES.iter().map(|f| f.to_string()));
         for (k, (source, caveat)) in self.graph.caveats.iter().enumerate() {
             let index = self.graph.caveats[..k]

@@ -5,5 +5,6 @@ mod support;
 
 mod errors;
 mod fuzz;
+mod includes;
 mod plans;
 mod random;

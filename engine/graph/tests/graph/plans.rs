@@ -185,8 +185,6 @@ fn scene_features_cull_passes_and_variants() {
             ("show_mesh_density", "enabled_if [mesh_density] is false"),
             ("show_normals", "enabled_if [normals] is false"),
             ("show_light_count", "enabled_if [light_count] is false"),
-            ("floor_meshes", "enabled_if [bench_floors] is false"),
-            ("floor_gbuffer_read", "enabled_if [bench_floors] is false"),
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
             ("area_lights", "enabled_if [area_lights] is false"),
