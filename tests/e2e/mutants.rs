@@ -14,7 +14,7 @@ use std::collections::BTreeSet;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use weft_gpu::Gpu;
-use weft_graph::compile::feature_names;
+use weft_graph::feature_names;
 use weft_graph::plan::Extent;
 use weft_render::{check_graph_and_shaders, render, RenderSettings, ShaderTarget};
 

@@ -296,7 +296,7 @@ fn draws_are_grouped_by_shading_model_with_one_variant_each_and_the_image_unchan
         .iter()
         .find(|p| p.name == "forward")
         .expect("forward pass");
-    let variants = weft_render::sources::scene_pass_variants(pass);
+    let variants = weft_gpu::check::scene_pass_variants(pass);
     assert_eq!(variants.len(), 2, "one variant per shading model");
     let fragment_defines: Vec<&Vec<String>> = variants.iter().map(|v| &v[1].defines).collect();
     let has = |defines: &Vec<String>, name: &str| defines.iter().any(|d| d == name);
@@ -315,7 +315,7 @@ fn draws_are_grouped_by_shading_model_with_one_variant_each_and_the_image_unchan
         .iter()
         .find(|p| p.name == "forward")
         .expect("forward pass");
-    assert_eq!(weft_render::sources::scene_pass_variants(pass).len(), 1);
+    assert_eq!(weft_gpu::check::scene_pass_variants(pass).len(), 1);
 
     let grouped = render_validated(&scene, &graph("forward.ron"), 160, 90, &["!bloom"]);
     let single = render_validated(&scene, &ungrouped, 160, 90, &["!bloom"]);

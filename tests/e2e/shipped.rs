@@ -12,7 +12,7 @@ use weft_gpu::{DrawRecorder, FrameOptions, GpuError, RasterContext, Renderer};
 struct Paint([f32; 4]);
 
 impl DrawRecorder for Paint {
-    fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError> {
+    fn record(&mut self, ctx: &mut RasterContext<'_>) -> Result<(), GpuError> {
         let colors = ctx
             .pass()
             .render_pass
@@ -52,7 +52,7 @@ impl DrawRecorder for Paint {
 struct BrightSquare;
 
 impl DrawRecorder for BrightSquare {
-    fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError> {
+    fn record(&mut self, ctx: &mut RasterContext<'_>) -> Result<(), GpuError> {
         let colors = ctx
             .pass()
             .render_pass
@@ -144,7 +144,11 @@ fn render_forward(features: &[&str]) -> ([u8; 4], Vec<String>) {
     let passes = plan.passes.iter().map(|p| p.name.clone()).collect();
     let mut renderer = Renderer::new(&gpu).expect("renderer");
     assert_eq!(renderer.check_shaders(&plan), Vec::new());
-    assert_eq!(weft_gpu::check_shaders(&plan).expect("shaderc"), Vec::new());
+    assert_eq!(
+        weft_gpu::check_shaders(&plan, Some(&weft_render::bindings::scene_interface()))
+            .expect("shaderc"),
+        Vec::new()
+    );
     let report = weft_testkit::render_frames(
         &mut renderer,
         &plan,

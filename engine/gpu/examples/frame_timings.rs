@@ -19,7 +19,7 @@ use weft_graph::CompileOptions;
 struct Paint;
 
 impl DrawRecorder for Paint {
-    fn record(&mut self, ctx: &RasterContext<'_>) -> Result<(), GpuError> {
+    fn record(&mut self, ctx: &mut RasterContext<'_>) -> Result<(), GpuError> {
         let colors = ctx
             .pass()
             .render_pass

@@ -40,7 +40,7 @@ pub fn resolve_bindings(
             .unwrap_or("?")
     };
     for (shader, _) in interface.bindings.values() {
-        if shader.set == crate::draw::SCENE_SET {
+        if shader.set == crate::sets::SCENE_SET {
             continue;
         }
         if shader.set != 0 {

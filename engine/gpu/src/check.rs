@@ -1,12 +1,16 @@
-//! Which shaders a pass runs and whether they agree with the graph, without
-//! a device: `weft graph check --shaders` uses this, and the executor runs
-//! the same checks before it builds a pipeline.
+//! Which shaders a pass runs and whether they agree with the graph and the
+//! scene interface, without a device: `weft graph check --shaders` and a hot
+//! reload use this, and the executor runs the same checks before it builds a
+//! pipeline.
 
 use crate::bind::{self, FrameValues, ResolvedBinding};
 use crate::error::GpuError;
 use crate::pipeline::{PipelineCache, ShaderKey};
 use crate::reflect::PipelineInterface;
+use crate::scene::SceneInterface;
+use crate::scene_check::{scene_pass_problems, scene_set_problems};
 use crate::shader::ShaderStage;
+use std::path::Path;
 use weft_graph::plan::{Plan, PlanPass};
 use weft_graph::schema::{Draw, PassKind};
 
@@ -183,10 +187,14 @@ pub struct ShaderProblem {
 }
 
 /// Compiles and reflects every pass's shaders and checks them against the
-/// graph, with no Vulkan device; every problem is returned.
-pub fn check_shaders(plan: &Plan) -> Result<Vec<ShaderProblem>, GpuError> {
+/// graph (and, with `scene`, against the scene data a renderer supplies), with
+/// no Vulkan device; every problem is returned.
+pub fn check_shaders(
+    plan: &Plan,
+    scene: Option<&SceneInterface>,
+) -> Result<Vec<ShaderProblem>, GpuError> {
     let mut cache = PipelineCache::new()?;
-    Ok(check_with(&mut cache, plan))
+    Ok(check_with(&mut cache, plan, scene))
 }
 
 /// One line per problem a pass's check found: the problems themselves, or a
@@ -202,31 +210,135 @@ pub fn problem_messages(found: Result<Vec<String>, GpuError>) -> Vec<String> {
     }
 }
 
-/// `check_shaders` with a given cache (the executor's).
-pub fn check_with(cache: &mut PipelineCache, plan: &Plan) -> Vec<ShaderProblem> {
+/// `check_shaders` with a given cache (the executor's): the one shader check.
+/// Fullscreen and compute passes are checked against the graph and, where
+/// they read scene data, the scene sets; scene-drawing passes (with `scene`)
+/// in every variant they run. Each problem names its pass, once.
+pub fn check_with(
+    cache: &mut PipelineCache,
+    plan: &Plan,
+    scene: Option<&SceneInterface>,
+) -> Vec<ShaderProblem> {
     let mut problems = Vec::new();
     for pass in &plan.passes {
-        let found = pass_shaders(pass).and_then(|shaders| match shaders {
-            None => Ok(Vec::new()),
-            Some(shaders) => {
-                let interface = cache.interface(&shaders.keys())?;
-                let keys: Vec<ShaderKey> = shaders.keys().into_iter().cloned().collect();
-                Ok(pass_problems(plan, pass, &shaders, &interface)
-                    .err()
-                    .unwrap_or_default()
-                    .into_iter()
-                    .map(|m| with_declaration(cache, &keys, m))
-                    .collect())
+        let found = match pass_shaders(pass) {
+            Ok(Some(shaders)) => own_pass_problems(cache, plan, pass, &shaders, scene),
+            Ok(None) => match scene {
+                Some(scene) => scene_pass_shader_problems(cache, scene, plan, pass),
+                None => Ok(Vec::new()),
+            },
+            Err(e) => Err(e),
+        };
+        for message in problem_messages(found) {
+            let problem = ShaderProblem {
+                pass: pass.name.clone(),
+                message,
+            };
+            if !problems.contains(&problem) {
+                problems.push(problem);
             }
-        });
-        problems.extend(
-            problem_messages(found)
-                .into_iter()
-                .map(|message| ShaderProblem {
-                    pass: pass.name.clone(),
-                    message,
-                }),
-        );
+        }
     }
     problems
+}
+
+/// A fullscreen or compute pass's problems, located in its shaders.
+fn own_pass_problems(
+    cache: &mut PipelineCache,
+    plan: &Plan,
+    pass: &PlanPass,
+    shaders: &PassShaders,
+    scene: Option<&SceneInterface>,
+) -> Result<Vec<String>, GpuError> {
+    let interface = cache.interface(&shaders.keys())?;
+    let keys: Vec<ShaderKey> = shaders.keys().into_iter().cloned().collect();
+    let mut found = pass_problems(plan, pass, shaders, &interface)
+        .err()
+        .unwrap_or_default();
+    if let Some(scene) = scene {
+        found.extend(scene_set_problems(
+            scene,
+            &interface,
+            false,
+            (scene.traces)(pass),
+        ));
+    }
+    Ok(found
+        .into_iter()
+        .map(|m| with_declaration(cache, &keys, m))
+        .collect())
+}
+
+/// A scene-drawing pass's shaders, in every variant it runs, compiled through
+/// `cache` and checked against the scene interface.
+fn scene_pass_shader_problems(
+    cache: &mut PipelineCache,
+    scene: &SceneInterface,
+    plan: &Plan,
+    pass: &PlanPass,
+) -> Result<Vec<String>, GpuError> {
+    if pass.draw.is_none() {
+        return Ok(Vec::new());
+    }
+    if pass.shaders.vertex.is_none() {
+        return Ok(vec!["needs a vertex shader".into()]);
+    }
+    let mut found = Vec::new();
+    for keys in scene_pass_variants(pass) {
+        let vs = cache.shader(&keys[0])?;
+        let fs = keys.get(1).map(|k| cache.shader(k)).transpose()?;
+        let problems = scene_pass_problems(
+            scene,
+            plan,
+            pass,
+            &vs.interface,
+            fs.as_ref().map(|f| &f.interface),
+        );
+        for m in problems {
+            let located = with_declaration(cache, &keys, m);
+            if !found.contains(&located) {
+                found.push(located);
+            }
+        }
+    }
+    Ok(found)
+}
+
+/// The shader variant of a scene pass's stage with `defines`.
+fn stage_key(path: &Path, stage: ShaderStage, defines: &[String]) -> ShaderKey {
+    ShaderKey {
+        path: path.to_path_buf(),
+        stage,
+        defines: defines.to_vec(),
+    }
+}
+
+/// A scene pass's vertex shader (and fragment shader, if it has one) with
+/// `defines`; `None` without a vertex shader.
+pub fn scene_pass_keys_with(pass: &PlanPass, defines: &[String]) -> Option<Vec<ShaderKey>> {
+    let vertex = pass.shaders.vertex.as_deref()?;
+    let mut keys = vec![stage_key(vertex, ShaderStage::Vertex, defines)];
+    keys.extend(
+        pass.shaders
+            .fragment
+            .as_deref()
+            .map(|f| stage_key(f, ShaderStage::Fragment, defines)),
+    );
+    Some(keys)
+}
+
+/// The variants a scene-drawing pass runs, each its vertex shader, then its
+/// fragment shader when it has one: one variant, or one per shading model
+/// the pass declares defines for when it groups its draws by model.
+pub fn scene_pass_variants(pass: &PlanPass) -> Vec<Vec<ShaderKey>> {
+    let mut defines = vec![pass.defines.clone()];
+    if pass.groups_by_model() {
+        let mut models: Vec<_> = pass.model_defines.iter().map(|(m, _)| *m).collect();
+        models.dedup();
+        defines = models.into_iter().map(|m| pass.defines_for(m)).collect();
+    }
+    defines
+        .iter()
+        .filter_map(|d| scene_pass_keys_with(pass, d))
+        .collect()
 }

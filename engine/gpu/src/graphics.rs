@@ -4,8 +4,8 @@
 //! with dynamic viewport and scissor.
 
 use crate::error::{GpuError, VkCall};
-use crate::pipeline::{blend_state, BlendCode};
 use crate::shader::CompiledShader;
+use crate::state::{blend_state, BlendCode, DepthState};
 use ash::vk;
 
 /// Vertex buffer 0's layout; pipelines without one draw from no buffers.
@@ -15,26 +15,6 @@ pub struct VertexInput<'a> {
     pub stride: u32,
     /// Location, format and offset of each attribute.
     pub attributes: &'a [vk::VertexInputAttributeDescription],
-}
-
-/// Depth testing and writing.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct DepthState {
-    /// Whether fragments are tested against the depth attachment.
-    pub test: bool,
-    /// Whether passing fragments write their depth.
-    pub write: bool,
-    /// How a fragment's depth is compared with the stored one.
-    pub compare: vk::CompareOp,
-}
-
-impl DepthState {
-    /// No depth test and no writes.
-    pub const OFF: DepthState = DepthState {
-        test: false,
-        write: false,
-        compare: vk::CompareOp::ALWAYS,
-    };
 }
 
 /// Fixed-function state of a graphics pipeline.

@@ -59,9 +59,13 @@ pub struct FrameResources<'g> {
     pub transient_bytes: u64,
     /// Bytes of resources with memory of their own (history, output, buffers).
     pub dedicated_bytes: u64,
-    /// The plan's passes as the executor prepared them on these resources.
-    pub(crate) prepared: Option<crate::executor::PreparedPlan<'g>>,
+    /// Tells these resources apart from any others made in this process,
+    /// so the executor knows what a prepared plan was prepared on.
+    pub(crate) id: u64,
 }
+
+/// The next [`FrameResources::id`].
+static NEXT_RESOURCES_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 /// The memory requirements the device reports for an image, without creating
 /// it (maintenance4); pass this to the graph compiler so placements are exact.
@@ -144,7 +148,7 @@ impl<'g> FrameResources<'g> {
             framebuffers: HashMap::new(),
             transient_bytes: 0,
             dedicated_bytes: 0,
-            prepared: None,
+            id: NEXT_RESOURCES_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         };
         for r in &plan.resources {
             let created = match &r.desc {

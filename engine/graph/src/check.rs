@@ -1,9 +1,10 @@
 //! `weft graph check`: validation across every combination of the features a graph
 //! mentions, so no toggle or scene can produce an invalid configuration.
 
-use crate::compile::{compile_ir, feature_names, CompileOptions};
+use crate::compile::{compile_ir, CompileOptions};
 use crate::diagnostic::Diagnostic;
 use crate::load::LoadedGraph;
+use crate::resolve::feature_names;
 use crate::resolve::resolve;
 use std::collections::BTreeSet;
 

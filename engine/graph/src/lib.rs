@@ -19,9 +19,10 @@ pub mod text;
 pub mod vk;
 
 pub use check::check;
+pub use compile::conditions_hold;
 pub use compile::memory::{estimate_requirements, MemoryRequirements};
 pub use compile::{compile, CompileOptions, Prepared};
-pub use compile::{conditions_hold, feature_names, SCENE_FEATURES};
 pub use diagnostic::{Diagnostic, Severity};
 pub use load::{load, load_with, load_with_params, LoadedGraph};
 pub use plan::{Extent, Plan};
+pub use resolve::{feature_names, SCENE_FEATURES};

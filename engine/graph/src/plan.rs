@@ -17,18 +17,20 @@ pub struct Extent {
     pub height: u32,
 }
 
+/// The largest image side weft creates: `maxImageDimension2D` on the devices
+/// it targets, and the limit of `Absolute` sizes.
+pub const MAX_IMAGE_DIMENSION: u32 = 16_384;
+
 impl std::str::FromStr for Extent {
     type Err = String;
 
     /// Parses `WIDTHxHEIGHT` (`1280x720`), each side 1..=[`MAX_IMAGE_DIMENSION`],
     /// as command lines take sizes.
-    ///
-    /// [`MAX_IMAGE_DIMENSION`]: crate::resolve::MAX_IMAGE_DIMENSION
     fn from_str(text: &str) -> Result<Self, String> {
         let (w, h) = text
             .split_once(['x', 'X'])
             .ok_or_else(|| format!("expected WIDTHxHEIGHT such as 1280x720, found \"{text}\""))?;
-        let max = crate::resolve::MAX_IMAGE_DIMENSION;
+        let max = MAX_IMAGE_DIMENSION;
         let side = |v: &str| match v.trim().parse::<u32>() {
             Ok(n) if (1..=max).contains(&n) => Ok(n),
             _ => Err(format!(

@@ -75,8 +75,9 @@ impl<'g> FrameLoop<'g> {
     /// Creates the plan's resources and the scene's recorder; the first frame
     /// builds the pipelines.
     pub fn new(gpu: &'g Gpu, plan: Arc<Plan>, scene: GpuScene<'g>) -> Result<Self, GpuError> {
-        let renderer = Renderer::new(gpu)?;
-        let recorder = SceneRecorder::new(gpu, scene)?;
+        let mut renderer = Renderer::new(gpu)?;
+        renderer.register_scene(crate::bindings::scene_interface())?;
+        let recorder = SceneRecorder::new(gpu, scene);
         let resources = renderer.create_resources(&plan)?;
         Ok(Self {
             resources,
@@ -96,13 +97,10 @@ impl<'g> FrameLoop<'g> {
             .scene
             .update(request.camera, request.time, extent)?;
         let history_frames = self.accumulation.next(inputs);
-        let shader_time = request.time as f32;
-        self.recorder
-            .set_frame(shader_time, request.frame, history_frames);
         let options = FrameOptions {
             timing: request.timing,
             readback: request.readback,
-            time: shader_time,
+            time: request.time as f32,
             frame: request.frame,
             history_frames,
         };
@@ -162,20 +160,20 @@ impl<'g> FrameLoop<'g> {
         self.recorder = recorder;
     }
 
-    /// Drops every shader and pipeline built from the edited source `changed`,
-    /// in the executor and the scene recorder alike, so the next frame
-    /// rebuilds them; accumulation starts again.
+    /// Drops every shader and pipeline built from the edited source `changed`
+    /// from the one pipeline cache, so the next frame rebuilds them; kept
+    /// shadow tiles and accumulation start again.
     pub fn reload_shader(&mut self, changed: &std::path::Path) -> Result<(), GpuError> {
         self.accumulation.reset();
+        self.recorder.forget_shadow_tiles();
         self.renderer.reload(changed)?;
-        self.recorder.reload(changed)?;
         Ok(())
     }
 
     /// Hands a shader variant a hot reload already compiled and checked to
-    /// both pipeline caches, so the next frame only builds pipelines.
+    /// the pipeline cache, so the next frame only builds pipelines.
     pub fn adopt_shader(&mut self, key: ShaderKey, module: Arc<ShaderModule>) {
-        self.recorder.adopt(key.clone(), Arc::clone(&module));
+        self.recorder.forget_shadow_tiles();
         self.renderer.adopt_shader(key, module);
     }
 

@@ -8,6 +8,7 @@ use crate::materials;
 use crate::volumes::{self, VolumeMesh};
 use glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
 use std::collections::HashMap;
+use weft_gpu::scene::{VertexAttribute, VertexFormat};
 use weft_graph::schema::MaterialFilter;
 use weft_scene::tangent_frame::{self, TangentFrame};
 use weft_scene::{Aabb, Material, Mesh, Scene};
@@ -36,30 +37,6 @@ pub const VERTEX_ATTRIBUTES: [VertexAttribute; 3] = [
 
 /// Bytes per vertex: position (3 floats), tangent frame (32 bits), UV (2 × 16 bits).
 pub const VERTEX_BYTES: u32 = std::mem::size_of::<GpuVertex>() as u32;
-
-/// One attribute of the shared vertex buffer.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct VertexAttribute {
-    /// `layout(location = ...)` in the vertex shader.
-    pub location: u32,
-    /// Bytes from the vertex's start.
-    pub offset: u32,
-    /// How it is stored.
-    pub format: VertexFormat,
-    /// What it holds, for messages.
-    pub what: &'static str,
-}
-
-/// How a vertex attribute is stored.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum VertexFormat {
-    /// Three 32-bit floats (a `vec3` input).
-    Float3,
-    /// One 32-bit unsigned integer (a `uint` input).
-    Uint,
-    /// Two 16-bit unsigned normalized values (a `vec2` input in [0, 1]).
-    Unorm16x2,
-}
 
 /// The box around `uvs` as (smallest, size), the mapping [`quantize_uv`]
 /// stores UVs against; zero for a mesh without UVs. Non-finite UVs are left out.

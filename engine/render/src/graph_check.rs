@@ -3,11 +3,11 @@
 //! and the engine's scene bindings, under every feature set the graph check
 //! enumerates (features change the shader variants through defines).
 
-use crate::scene_interface::check_plan_shaders;
+use weft_gpu::check::check_with;
 use weft_gpu::pipeline::PipelineCache;
 use weft_gpu::{Gpu, GpuError, ShaderProblem, ShaderSupport};
 use weft_graph::check::variant_sets;
-use weft_graph::compile::feature_names;
+use weft_graph::feature_names;
 use weft_graph::{CompileOptions, Diagnostic, LoadedGraph, Prepared};
 
 /// The device shaders are checked for: its name and what it offers.
@@ -60,6 +60,7 @@ pub fn check_graph_and_shaders(
     };
     let names: Vec<String> = feature_names(prepared.ir()).into_iter().collect();
     let mut cache = PipelineCache::new()?;
+    let scene = crate::bindings::scene_interface();
     for features in variant_sets(&names) {
         let options = CompileOptions {
             features,
@@ -77,7 +78,7 @@ pub fn check_graph_and_shaders(
             }
             continue;
         }
-        let mut problems = check_plan_shaders(&mut cache, &plan);
+        let mut problems = check_with(&mut cache, &plan, Some(&scene));
         problems.extend(unoffered(&mut cache, &plan, target));
         for ShaderProblem { pass, message } in problems {
             let at = plan
@@ -107,11 +108,11 @@ fn unoffered(
         let keys = match weft_gpu::check::pass_shaders(pass) {
             Ok(Some(shaders)) => shaders.keys().into_iter().cloned().collect(),
             Ok(None) => crate::sources::scene_pass_keys(pass),
-            Err(_) => continue, // reported by `check_plan_shaders`
+            Err(_) => continue, // reported by `check_with`
         };
         for key in keys {
             let Ok(module) = cache.shader(&key) else {
-                continue; // reported by `check_plan_shaders`
+                continue; // reported by `check_with`
             };
             if let Some(refusal) = target.support.refusal(&target.device, &module.compiled) {
                 let problem = ShaderProblem {

@@ -9,11 +9,11 @@
 
 #![warn(missing_docs)]
 
+pub mod bindings;
 pub mod brdf;
 pub mod bvh;
 pub mod bvh_cache;
 pub mod camera;
-pub mod emitter_clusters;
 pub mod emitter_lights;
 pub mod emitters;
 pub mod error;
@@ -29,7 +29,6 @@ pub mod light_scene;
 pub mod lights;
 pub mod materials;
 pub mod optics;
-pub mod pipelines;
 pub mod prepare;
 pub mod providers;
 pub mod raytrace;
@@ -39,12 +38,10 @@ pub mod reload_error;
 pub mod reload_worker;
 pub mod sanitize;
 pub mod scene_gpu;
-pub mod scene_interface;
 pub mod scene_load;
 pub mod shadow_reference;
 pub mod shadows;
 pub mod sources;
-pub mod state;
 pub mod texture;
 pub mod trace_textures;
 pub mod view_summary;

@@ -69,10 +69,10 @@ impl LightSet {
         self.records.is_empty()
     }
 
-    /// Appends the emissive polygons' records after every other light.
-    pub fn add_emitter_polygons(&mut self, emitters: &crate::emitter_lights::EmitterLights) {
-        self.records.extend(emitters.records());
-        self.emitter_polygons += emitters.polygons.len() as u32;
+    /// Appends the emissive polygons' records (one each) after every other light.
+    pub fn add_emitter_polygons(&mut self, polygons: &[GpuLight]) {
+        self.records.extend_from_slice(polygons);
+        self.emitter_polygons += polygons.len() as u32;
     }
 
     /// Index of the first point light record.

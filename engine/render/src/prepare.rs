@@ -149,7 +149,8 @@ pub(crate) fn check_shaders(
             ));
         }
     }
-    let problems = crate::scene_interface::check_plan_shaders(checker, plan);
+    let scene = crate::bindings::scene_interface();
+    let problems = weft_gpu::check::check_with(checker, plan, Some(&scene));
     match problems.first() {
         None => Ok(()),
         Some(problem) => {

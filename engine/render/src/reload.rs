@@ -210,7 +210,7 @@ impl<'g> LiveRender<'g> {
                 let mut uploaded = GpuScene::new(self.gpu, s)
                     .map_err(|e| ReloadError::render(e, &self.scene_path))?;
                 uploaded.cache_bvh_in(prepared.settings.cache_dir.clone());
-                Some(SceneRecorder::new(self.gpu, uploaded).map_err(fail)?)
+                Some(SceneRecorder::new(self.gpu, uploaded))
             }
             None => None,
         };

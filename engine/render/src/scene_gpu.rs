@@ -2,6 +2,7 @@
 //! textures, and the per-frame camera and light buffers; descriptor set 1 (scene
 //! data) and set 2 (a material's textures) that every scene shader binds.
 
+use crate::bindings::{self, *};
 use crate::camera;
 use crate::error::RenderError;
 use crate::geometry::SceneGeometry;
@@ -15,114 +16,13 @@ use glam::{UVec4, Vec4};
 use std::collections::HashMap;
 use std::path::PathBuf;
 use weft_gpu::buffer::Buffer;
-use weft_gpu::descriptors::{DescriptorPool, DescriptorWriter, SetLayout};
-use weft_gpu::reflect::DescriptorKind;
+use weft_gpu::descriptors::{DescriptorPool, DescriptorWriter};
 use weft_gpu::samplers::Sampler;
+use weft_gpu::scene::{SceneBinding, SceneLayouts, SceneSet};
 use weft_gpu::texture::{Rgba8Image, Texture};
 use weft_gpu::{Gpu, GpuError};
 use weft_scene::material::{TextureRef, TextureSource};
 use weft_scene::{Camera, Scene};
-
-/// Binding of the per-frame uniform block (`Frame` in `scene.glsl`).
-pub const FRAME_BINDING: u32 = 0;
-/// Binding of the light records.
-pub const LIGHTS_BINDING: u32 = 1;
-/// Binding of the draw records.
-pub const DRAWS_BINDING: u32 = 2;
-/// Binding of the material records.
-pub const MATERIALS_BINDING: u32 = 3;
-/// Binding of the shadow views (`Shadows` in `shaders/include/shadows.glsl`).
-pub const SHADOWS_BINDING: u32 = 4;
-/// Binding of the ray tracer's triangles: three world-space corners per
-/// triangle, each a vec4 (`Triangles` in `shaders/include/trace.glsl`).
-pub const TRIANGLES_BINDING: u32 = 5;
-/// Binding of the ray tracer's BVH nodes (`BvhNodes`).
-pub const BVH_NODES_BINDING: u32 = 6;
-/// Binding of the BVH's triangle order (`BvhTriangles`): leaves index it.
-pub const BVH_TRIANGLES_BINDING: u32 = 7;
-/// Binding of the corners' world normals (`TriangleNormals`, a vec4 each).
-pub const TRIANGLE_NORMALS_BINDING: u32 = 8;
-/// Binding of the corners' UVs (`TriangleUvs`, a vec2 each).
-pub const TRIANGLE_UVS_BINDING: u32 = 9;
-/// Binding of each triangle's material index (`TriangleMaterials`).
-pub const TRIANGLE_MATERIALS_BINDING: u32 = 10;
-/// Binding of the emissive triangles' alias table (`Emitters`,
-/// [`crate::emitters::EmitterTable`]).
-pub const EMITTERS_BINDING: u32 = 11;
-/// First of the path tracer's texture arrays (`trace.glsl`): sRGB colour
-/// layers of each size class of [`crate::trace_textures::CLASSES`] at 12, 13,
-/// 14, UNORM data layers at 15, 16, 17.
-pub const TRACE_TEXTURES_BINDING: u32 = 12;
-/// How many texture arrays the path tracer binds from [`TRACE_TEXTURES_BINDING`] on.
-const TRACE_TEXTURE_ARRAYS: u32 = 2 * crate::trace_textures::CLASSES.len() as u32;
-/// Whether set 1 `binding` is one of the path tracer's texture arrays.
-pub fn is_trace_texture(binding: u32) -> bool {
-    (TRACE_TEXTURES_BINDING..TRACE_TEXTURES_BINDING + TRACE_TEXTURE_ARRAYS).contains(&binding)
-}
-
-/// Binding of each material's texture slots (`MaterialTextures`).
-pub const MATERIAL_TEXTURES_BINDING: u32 = 18;
-/// Binding of the corners' world tangents (`TriangleTangents`, a vec4 each,
-/// w the bitangent's sign).
-pub const TRIANGLE_TANGENTS_BINDING: u32 = 19;
-/// Binding of the LTC tables analytic area lights read (`LtcTables` in
-/// `shaders/include/ltc.glsl`, [`ltc_table_words`]).
-pub const LTC_TABLES_BINDING: u32 = 20;
-/// Binding of the vertex buffer as 32-bit words (`Vertices` in
-/// `shaders/include/mesh_data.glsl`), for shaders that fetch whole triangles.
-pub const VERTICES_BINDING: u32 = 21;
-/// Binding of the index buffer (`Indices` in `shaders/include/mesh_data.glsl`).
-pub const INDICES_BINDING: u32 = 22;
-/// Set 2 binding of a material's base-colour texture (sRGB).
-pub const BASE_COLOR_BINDING: u32 = 0;
-/// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
-pub const METALLIC_ROUGHNESS_BINDING: u32 = 1;
-/// Set 2 binding of a material's tangent-space normal map (UNORM).
-pub const NORMAL_BINDING: u32 = 2;
-/// Set 2 binding of the emissive texture (sRGB; white when the material has none).
-pub const EMISSIVE_BINDING: u32 = 3;
-/// Set 2 binding of the occlusion texture (its red channel; white when none).
-pub const OCCLUSION_BINDING: u32 = 4;
-/// Set 1 as the engine creates and writes it: binding, descriptor kind and
-/// what it holds (for the shader check's messages).
-pub const SCENE_SET_BINDINGS: [(u32, DescriptorKind, &str); 8] = [
-    (
-        FRAME_BINDING,
-        DescriptorKind::UniformBuffer,
-        "the Frame block",
-    ),
-    (LIGHTS_BINDING, DescriptorKind::StorageBuffer, "the lights"),
-    (
-        DRAWS_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the draw records",
-    ),
-    (
-        MATERIALS_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the materials",
-    ),
-    (
-        SHADOWS_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the shadow views",
-    ),
-    (
-        LTC_TABLES_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the area-light LTC tables",
-    ),
-    (
-        VERTICES_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the vertices",
-    ),
-    (
-        INDICES_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the indices",
-    ),
-];
 
 /// The LTC tables as `ltc_tables.glsl` reads them, in vec4s: the GGX
 /// inverses, the GGX (integral, Fresnel moment, 0, 0), the same for
@@ -149,147 +49,11 @@ pub fn ltc_table_words(
     words
 }
 
-/// Set 1 bindings for ray tracing: built only when a compute pass that
-/// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
-/// a build (docs/pathtrace.md) that raster graphs should not pay.
-pub const TRACE_SET_BINDINGS: [(u32, DescriptorKind, &str); 15] = [
-    (
-        TRIANGLES_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the ray tracer's triangles",
-    ),
-    (
-        BVH_NODES_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the BVH nodes",
-    ),
-    (
-        BVH_TRIANGLES_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the BVH's triangle order",
-    ),
-    (
-        TRIANGLE_NORMALS_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the corners' normals",
-    ),
-    (
-        TRIANGLE_UVS_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the corners' UVs",
-    ),
-    (
-        TRIANGLE_MATERIALS_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the triangles' materials",
-    ),
-    (
-        EMITTERS_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the emissive triangles",
-    ),
-    (
-        TRACE_TEXTURES_BINDING,
-        DescriptorKind::CombinedImageSampler,
-        "the 256-texel colour texture array",
-    ),
-    (
-        TRACE_TEXTURES_BINDING + 1,
-        DescriptorKind::CombinedImageSampler,
-        "the 512-texel colour texture array",
-    ),
-    (
-        TRACE_TEXTURES_BINDING + 2,
-        DescriptorKind::CombinedImageSampler,
-        "the 1024-texel colour texture array",
-    ),
-    (
-        TRACE_TEXTURES_BINDING + 3,
-        DescriptorKind::CombinedImageSampler,
-        "the 256-texel data texture array",
-    ),
-    (
-        TRACE_TEXTURES_BINDING + 4,
-        DescriptorKind::CombinedImageSampler,
-        "the 512-texel data texture array",
-    ),
-    (
-        TRACE_TEXTURES_BINDING + 5,
-        DescriptorKind::CombinedImageSampler,
-        "the 1024-texel data texture array",
-    ),
-    (
-        MATERIAL_TEXTURES_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the materials' texture slots",
-    ),
-    (
-        TRIANGLE_TANGENTS_BINDING,
-        DescriptorKind::StorageBuffer,
-        "the corners' tangents",
-    ),
-];
-/// Set 2 as the engine creates it: a material's textures, in the order of its
-/// texture slots.
-pub const MATERIAL_SET_BINDINGS: [(u32, DescriptorKind, &str); 5] = [
-    (
-        BASE_COLOR_BINDING,
-        DescriptorKind::CombinedImageSampler,
-        "the base-colour texture",
-    ),
-    (
-        METALLIC_ROUGHNESS_BINDING,
-        DescriptorKind::CombinedImageSampler,
-        "the metallic-roughness texture",
-    ),
-    (
-        NORMAL_BINDING,
-        DescriptorKind::CombinedImageSampler,
-        "the normal map",
-    ),
-    (
-        EMISSIVE_BINDING,
-        DescriptorKind::CombinedImageSampler,
-        "the emissive texture",
-    ),
-    (
-        OCCLUSION_BINDING,
-        DescriptorKind::CombinedImageSampler,
-        "the occlusion texture",
-    ),
-];
 /// Bytes of the `Frame` uniform block.
 pub const FRAME_BYTES: usize = std::mem::size_of::<GpuFrame>();
-/// The layouts of set 1 (scene data, [`SCENE_SET_BINDINGS`]) and set 2 (one
-/// material's textures, [`MATERIAL_SET_BINDINGS`]).
-fn set_layouts(gpu: &Gpu) -> Result<(SetLayout<'_>, SetLayout<'_>), GpuError> {
-    let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-    let scene_bindings: Vec<_> = SCENE_SET_BINDINGS
-        .iter()
-        .map(|&(b, kind, _)| {
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(b)
-                .descriptor_type(kind.vk())
-                .descriptor_count(1)
-                .stage_flags(stages)
-        })
-        .collect();
-    let material_bindings = MATERIAL_SET_BINDINGS.map(|(b, _, _)| {
-        vk::DescriptorSetLayoutBinding::default()
-            .binding(b)
-            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-            .descriptor_count(1)
-            .stage_flags(vk::ShaderStageFlags::FRAGMENT)
-    });
-    Ok((
-        SetLayout::new(gpu, &scene_bindings)?,
-        SetLayout::new(gpu, &material_bindings)?,
-    ))
-}
-
-/// A pool for the scene set, the executor-built scene sets and one set per material.
+/// A pool for the two scene sets (raster, traced) and one set per material.
 fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuError> {
-    let scene_sets = 1 + FOREIGN_SETS;
+    let scene_sets = 2;
     DescriptorPool::new(
         gpu,
         scene_sets + materials,
@@ -301,15 +65,11 @@ fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuE
             ),
             (
                 vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                MATERIAL_SET_BINDINGS.len() as u32 * materials.max(1)
-                    + TRACE_TEXTURE_ARRAYS * FOREIGN_SETS,
+                MATERIAL_SET_BINDINGS.len() as u32 * materials.max(1) + TRACE_TEXTURE_ARRAYS,
             ),
         ],
     )
 }
-
-/// Scene sets that fullscreen pipelines built by the executor may ask for.
-const FOREIGN_SETS: u32 = 32;
 
 /// The ray tracer's scene data on the device.
 struct TraceBuffers<'g> {
@@ -344,16 +104,15 @@ pub struct GpuScene<'g> {
     textures: Vec<Texture<'g>>,
     sampler: Sampler<'g>,
     pool: DescriptorPool<'g>,
-    /// Layout of set 1 (scene data) in pipelines built here.
-    pub scene_layout: SetLayout<'g>,
-    /// Layout of set 2 (one material's textures).
-    pub material_layout: SetLayout<'g>,
-    /// Set 1 for `scene_layout`.
-    pub scene_set: vk::DescriptorSet,
+    /// The layouts of the scene sets, defined as the executor's pipelines
+    /// define them ([`bindings::scene_interface`]).
+    layouts: SceneLayouts<'g>,
+    /// Set 1 with the raster bindings.
+    scene_set: vk::DescriptorSet,
+    /// Set 1 with the ray tracer's bindings too, made when a pass first traces.
+    traced_set: Option<vk::DescriptorSet>,
     /// Set 2 per material.
     pub material_sets: Vec<vk::DescriptorSet>,
-    /// Set 1 for layouts the executor built from reflection, with the bindings written.
-    foreign_sets: HashMap<vk::DescriptorSetLayout, (vk::DescriptorSet, Vec<u32>)>,
     /// Built on first use by a ray-tracing pass.
     trace: Option<TraceBuffers<'g>>,
     /// Where the BVH is cached (`crate::bvh_cache`); `None` builds it every time.
@@ -512,7 +271,7 @@ impl<'g> GpuScene<'g> {
             &weft_scene::animation::lights_at(&scene.lights, 0.0, 0),
             &bounds,
         );
-        light_set.add_emitter_polygons(&emitter_lights);
+        light_set.add_emitter_polygons(&emitter_lights.records());
         let mut lights = Buffer::host(
             gpu,
             "lights",
@@ -533,7 +292,7 @@ impl<'g> GpuScene<'g> {
         let mut ltc_tables = Buffer::host(gpu, "ltc_tables", (words.len() * 4) as u64, storage)?;
         ltc_tables.write(bytes_of(&words))?;
         let sampler = Sampler::linear_repeat(gpu)?;
-        let (scene_layout, material_layout) = set_layouts(gpu)?;
+        let layouts = SceneLayouts::new(gpu, &bindings::scene_interface())?;
         let pool = descriptor_pool(gpu, material_texture.len() as u32)?;
         let mut this = Self {
             gpu,
@@ -549,11 +308,10 @@ impl<'g> GpuScene<'g> {
             textures,
             sampler,
             pool,
-            scene_layout,
-            material_layout,
+            layouts,
             scene_set: vk::DescriptorSet::null(),
+            traced_set: None,
             material_sets: Vec::new(),
-            foreign_sets: HashMap::new(),
             source_lights: scene.lights.clone(),
             script,
             script_error: None,
@@ -592,26 +350,14 @@ impl<'g> GpuScene<'g> {
     }
 
     fn create_sets(&mut self, material_texture: &[[usize; 5]]) -> Result<(), GpuError> {
-        self.scene_set = self.pool.allocate(self.scene_layout.handle())?;
-        self.write_scene_set(
-            self.scene_set,
-            &[
-                FRAME_BINDING,
-                LIGHTS_BINDING,
-                DRAWS_BINDING,
-                MATERIALS_BINDING,
-                SHADOWS_BINDING,
-                LTC_TABLES_BINDING,
-                VERTICES_BINDING,
-                INDICES_BINDING,
-            ],
-        );
+        self.scene_set = self.pool.allocate(self.layouts.scene(SceneSet::Raster))?;
+        self.write_scene_set(self.scene_set, false);
         for slots in material_texture {
-            let set = self.pool.allocate(self.material_layout.handle())?;
+            let set = self.pool.allocate(self.layouts.material.handle())?;
             let mut writer = DescriptorWriter::default();
-            for (&(binding, _, _), slot) in MATERIAL_SET_BINDINGS.iter().zip(slots) {
+            for (binding, slot) in MATERIAL_SET_BINDINGS.iter().zip(slots) {
                 writer.image(
-                    binding,
+                    binding.binding,
                     vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
                     self.sampler.handle(),
                     self.textures[*slot].view,
@@ -624,13 +370,14 @@ impl<'g> GpuScene<'g> {
         Ok(())
     }
 
-    /// Writes the scene buffers into the listed bindings of `set`.
-    fn write_scene_set(&self, set: vk::DescriptorSet, bindings: &[u32]) {
+    /// Writes the scene buffers into set 1 `set`: the raster bindings, and
+    /// the ray tracer's too when `traced`.
+    fn write_scene_set(&self, set: vk::DescriptorSet, traced: bool) {
         let mut writer = DescriptorWriter::default();
-        for &(b, kind, _) in SCENE_SET_BINDINGS
-            .iter()
-            .chain(&TRACE_SET_BINDINGS)
-            .filter(|(b, _, _)| bindings.contains(b))
+        let trace = TRACE_SET_BINDINGS.iter().filter(|_| traced);
+        for &SceneBinding {
+            binding: b, kind, ..
+        } in SCENE_SET_BINDINGS.iter().chain(trace)
         {
             if let Some(buffer) = self.scene_buffer(b) {
                 writer.buffer(b, kind.vk(), buffer.buffer);
@@ -769,28 +516,25 @@ impl<'g> GpuScene<'g> {
         self.bvh_cache = dir;
     }
 
-    /// Set 1 for a pipeline the executor built: allocated from its reflected
-    /// layout once, with the scene bindings its shaders use. `bindings` is
-    /// asked only then, so it may check them; every later frame reuses the set.
-    pub fn foreign_set(
-        &mut self,
-        layout: vk::DescriptorSetLayout,
-        bindings: impl FnOnce() -> Result<Vec<u32>, GpuError>,
-    ) -> Result<vk::DescriptorSet, GpuError> {
-        if let Some((set, _)) = self.foreign_sets.get(&layout) {
-            return Ok(*set);
+    /// Set 1 with the raster bindings, which scene pipelines bind.
+    pub fn raster_set(&self) -> vk::DescriptorSet {
+        self.scene_set
+    }
+
+    /// Set 1 of the layout `kind`: the raster bindings, or with the ray
+    /// tracer's too (its BVH built and its buffers uploaded on first use).
+    pub fn scene_set(&mut self, kind: SceneSet) -> Result<vk::DescriptorSet, GpuError> {
+        match (kind, self.traced_set) {
+            (SceneSet::Raster, _) => Ok(self.scene_set),
+            (SceneSet::Traced, Some(set)) => Ok(set),
+            (SceneSet::Traced, None) => {
+                self.ensure_trace_buffers()?;
+                let set = self.pool.allocate(self.layouts.scene(SceneSet::Traced))?;
+                self.write_scene_set(set, true);
+                self.traced_set = Some(set);
+                Ok(set)
+            }
         }
-        let bindings = bindings()?;
-        if TRACE_SET_BINDINGS
-            .iter()
-            .any(|(b, _, _)| bindings.contains(b))
-        {
-            self.ensure_trace_buffers()?;
-        }
-        let set = self.pool.allocate(layout)?;
-        self.write_scene_set(set, &bindings);
-        self.foreign_sets.insert(layout, (set, bindings));
-        Ok(set)
     }
 
     /// Writes the camera and the lights as they are at `time` for a target of `extent`;
@@ -823,7 +567,7 @@ impl<'g> GpuScene<'g> {
             ViewVolume::new(eye, rotation, camera.fov_y, w / h, camera.near, camera.far);
         let bounds = self.bounds;
         let mut lights = pack_lights(&self.lights_at(time), &bounds);
-        lights.add_emitter_polygons(&self.emitter_lights);
+        lights.add_emitter_polygons(&self.emitter_lights.records());
         let frame = GpuFrame {
             view_proj,
             inv_view_proj: view_proj.inverse(),
@@ -921,15 +665,8 @@ impl GpuScene<'_> {
         if self.trace.is_some() {
             self.trace = None;
             self.ensure_trace_buffers()?;
-            let sets: Vec<(vk::DescriptorSet, Vec<u32>)> =
-                self.foreign_sets.values().cloned().collect();
-            for (set, bindings) in sets {
-                if TRACE_SET_BINDINGS
-                    .iter()
-                    .any(|(b, _, _)| bindings.contains(b))
-                {
-                    self.write_scene_set(set, &bindings);
-                }
+            if let Some(set) = self.traced_set {
+                self.write_scene_set(set, true);
             }
         }
         Ok(())

@@ -5,7 +5,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use weft_gpu::pipeline::{PipelineCache, ShaderKey};
-use weft_gpu::{GpuError, ShaderStage};
+use weft_gpu::GpuError;
 use weft_graph::plan::{Plan, PlanPass};
 use weft_scene::Scene;
 
@@ -60,43 +60,13 @@ pub fn plan_shader_keys(plan: &Plan) -> Result<Vec<ShaderKey>, GpuError> {
     Ok(keys)
 }
 
-/// The variants a scene-drawing pass runs, as the scene recorder builds them,
-/// each its vertex shader, then its fragment shader when it has one: one
-/// variant, or one per shading model the pass declares defines for when it
-/// groups its draws by model.
-pub fn scene_pass_variants(pass: &PlanPass) -> Vec<Vec<ShaderKey>> {
-    let variant = |defines: Vec<String>| {
-        let key = |path: &Path, stage| ShaderKey {
-            path: path.to_path_buf(),
-            stage,
-            defines: defines.clone(),
-        };
-        let vertex = pass
-            .shaders
-            .vertex
-            .as_deref()
-            .map(|p| key(p, ShaderStage::Vertex));
-        let fragment = pass
-            .shaders
-            .fragment
-            .as_deref()
-            .map(|p| key(p, ShaderStage::Fragment));
-        vertex.into_iter().chain(fragment).collect()
-    };
-    if !pass.groups_by_model() {
-        return vec![variant(pass.defines.clone())];
-    }
-    let mut models: Vec<_> = pass.model_defines.iter().map(|(m, _)| *m).collect();
-    models.dedup();
-    models
-        .into_iter()
-        .map(|m| variant(pass.defines_for(m)))
-        .collect()
-}
-
-/// Every shader variant a scene-drawing pass runs (see [`scene_pass_variants`]).
+/// Every shader variant a scene-drawing pass runs
+/// ([`weft_gpu::check::scene_pass_variants`]).
 pub fn scene_pass_keys(pass: &PlanPass) -> Vec<ShaderKey> {
-    scene_pass_variants(pass).into_iter().flatten().collect()
+    weft_gpu::check::scene_pass_variants(pass)
+        .into_iter()
+        .flatten()
+        .collect()
 }
 
 /// Every file the plan's shaders depend on, by normalized path, compiled through

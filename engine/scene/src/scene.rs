@@ -48,7 +48,7 @@ pub struct Scene {
     pub origin: glam::DVec3,
     /// The Rhai script that added to the scene and animates it per frame
     /// ([`crate::script`]), if any.
-    pub script: Option<crate::script::ScriptRef>,
+    pub script: Option<crate::desc::ScriptRef>,
     /// What the loader accepted but reported.
     pub warnings: Vec<Warning>,
 }

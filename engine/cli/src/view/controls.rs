@@ -88,7 +88,7 @@ pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
 pub fn graph_features(graph: &Path) -> Vec<String> {
     let loaded = weft_graph::load(graph);
     let mut names = match weft_graph::Prepared::new(&loaded) {
-        Ok(prepared) => weft_graph::compile::feature_names(prepared.ir()),
+        Ok(prepared) => weft_graph::feature_names(prepared.ir()),
         Err(_) => return Vec::new(),
     };
     names.extend(loaded.default_features.iter().cloned());

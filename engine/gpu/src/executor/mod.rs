@@ -6,7 +6,7 @@
 use crate::bind::ResolvedBinding;
 use crate::check::{self, PassShaders, ShaderProblem};
 use crate::context::{Gpu, MemoryReport};
-use crate::draw::DrawRecorder;
+use crate::draw::{DrawRecorder, Variant};
 use crate::error::GpuError;
 use crate::frame::FramePools;
 use crate::pipeline::{Pipeline, PipelineCache, PipelineKey};
@@ -15,6 +15,9 @@ use crate::record;
 use crate::renderpass::RenderPassCache;
 use crate::resources::FrameResources;
 use crate::samplers::Samplers;
+use crate::scene::{SceneInterface, SceneLayouts, SceneSet};
+use crate::scene_check::scene_set_problems;
+use crate::sets::SCENE_SET;
 use crate::statistics::PassStatistics;
 use crate::timing::{PassTiming, TimingMode, TimingSource};
 mod prepare;
@@ -87,18 +90,24 @@ pub(crate) struct Prepared {
     bindings: Vec<ResolvedBinding>,
     push: Vec<u8>,
     set: vk::DescriptorSet,
+    /// A scene pass's pipeline variants, built as its draws first need them.
+    variants: Vec<Variant>,
 }
 
 /// A plan's passes made ready on its resources, once: pipelines, render
 /// passes, framebuffers, clear values, resolved bindings and written descriptor
-/// sets. Kept with the resources ([`FrameResources`]) until the pipelines it
-/// uses change; a frame then only packs push constants and records.
+/// sets. Kept by the renderer while the same resources run again and the
+/// pipelines it uses stay; a frame then only packs push constants and records.
 pub(crate) struct PreparedPlan<'g> {
     /// The renderer's pipeline generation it was built against.
     generation: u64,
+    /// The [`FrameResources::id`] it was prepared on.
+    resources: u64,
     passes: Vec<Prepared>,
     /// Holds the passes' descriptor sets.
     _pool: DescriptorPool<'g>,
+    /// Holds the scene passes' variants' graph sets.
+    scene_pool: Option<DescriptorPool<'g>>,
 }
 
 /// Executes plans; owns the render-pass and pipeline caches and the samplers.
@@ -110,6 +119,11 @@ pub struct Renderer<'g> {
     render_passes: RenderPassCache,
     pipelines: PipelineCache,
     samplers: Samplers,
+    /// The scene interface a renderer registered, with its set layouts.
+    scene: Option<(SceneInterface, SceneLayouts<'g>)>,
+    /// The plan last run, prepared on the resources it ran on; kept while
+    /// the same resources run again and the pipelines it uses stay.
+    prepared: Option<PreparedPlan<'g>>,
     /// Command buffers, fence, queries and read-back buffers, reused by
     /// every frame (no per-frame Vulkan object creation).
     /// Taken while a frame records, so the frame can borrow the renderer too.
@@ -127,8 +141,30 @@ impl<'g> Renderer<'g> {
             render_passes: RenderPassCache::default(),
             pipelines,
             samplers,
+            scene: None,
+            prepared: None,
             pools: None,
         })
+    }
+
+    /// Registers the scene data a renderer supplies (its sets' bindings and
+    /// its vertex layout): every pipeline that reads scene data is then built
+    /// against it and every shader checked with it. A renderer registers once;
+    /// registering again drops the pipelines built so far.
+    pub fn register_scene(&mut self, interface: SceneInterface) -> Result<(), GpuError> {
+        let layouts = SceneLayouts::new(self.gpu, &interface)?;
+        if self.scene.is_some() {
+            self.gpu.wait_idle()?;
+            self.pipelines.destroy(self.gpu.device());
+            self.generation += 1;
+        }
+        self.scene = Some((interface, layouts));
+        Ok(())
+    }
+
+    /// The registered scene interface, if any.
+    pub fn scene_interface(&self) -> Option<&SceneInterface> {
+        self.scene.as_ref().map(|(i, _)| i)
     }
 
     /// The context this renderer runs on.
@@ -172,7 +208,8 @@ impl<'g> Renderer<'g> {
     /// Compiles and reflects every pass's shaders and cross-checks them with
     /// the graph (see `check::check_shaders`); no pipeline is built.
     pub fn check_shaders(&mut self, plan: &Plan) -> Vec<ShaderProblem> {
-        check::check_with(&mut self.pipelines, plan)
+        let scene = self.scene.as_ref().map(|(i, _)| i);
+        check::check_with(&mut self.pipelines, plan, scene)
     }
 
     /// The pass's pipeline key and resolved bindings, after checking that
@@ -194,15 +231,32 @@ impl<'g> Renderer<'g> {
         let compiled: Vec<_> = modules.iter().map(|m| &m.compiled).collect();
         let info = self.gpu.info();
         info.shaders.check(&info.name, &pass.name, &compiled)?;
-        let bindings =
-            check::pass_problems(plan, pass, &shaders, &interface).map_err(|problems| {
-                GpuError::Mismatch {
-                    pass: pass.name.clone(),
-                    problems,
+        let mismatch = |problems| GpuError::Mismatch {
+            pass: pass.name.clone(),
+            problems,
+        };
+        let bindings = check::pass_problems(plan, pass, &shaders, &interface).map_err(mismatch)?;
+        let reads_scene = interface.bindings.keys().any(|(s, _)| *s == SCENE_SET);
+        let scene = match self.scene.as_ref().filter(|_| reads_scene) {
+            Some((scene, _)) => {
+                let traces = (scene.traces)(pass);
+                let problems = scene_set_problems(scene, &interface, false, traces);
+                if !problems.is_empty() {
+                    return Err(mismatch(problems));
                 }
-            })?;
+                let traced = interface.bindings.values().any(|(b, _)| {
+                    b.set == SCENE_SET && scene.scene_binding(b.binding).is_some_and(|s| s.tracing)
+                });
+                Some(if traced {
+                    SceneSet::Traced
+                } else {
+                    SceneSet::Raster
+                })
+            }
+            None => None,
+        };
         let key = match shaders {
-            PassShaders::Compute(shader) => PipelineKey::Compute { shader },
+            PassShaders::Compute(shader) => PipelineKey::Compute { shader, scene },
             PassShaders::Fullscreen { vertex, fragment } => {
                 let rp = pass.render_pass.as_ref().ok_or_else(|| GpuError::Pass {
                     pass: pass.name.clone(),
@@ -218,6 +272,7 @@ impl<'g> Renderer<'g> {
                         .map(|&i| rp.attachments.get(i).and_then(|a| a.blend).into())
                         .collect(),
                     samples: rp.attachments.first().map(|a| a.samples).unwrap_or(1),
+                    scene,
                 }
             }
         };
@@ -235,14 +290,17 @@ impl<'g> Renderer<'g> {
     ) -> Result<FrameReport, GpuError> {
         let started = Instant::now();
         draws.begin_frame()?;
-        let mut ready = match resources.prepared.take() {
-            Some(ready) if ready.generation == self.generation => ready,
+        let mut ready = match self.prepared.take() {
+            Some(ready)
+                if ready.generation == self.generation && ready.resources == resources.id =>
+            {
+                ready
+            }
             _ => self.prepare_plan(plan, resources)?,
         };
         for (pass, prep) in plan.passes.iter().zip(&mut ready.passes) {
             prep.push = self.pack_push(pass, prep, options)?;
         }
-        let prepared = &ready.passes;
         let readback: Vec<_> = if options.readback {
             std::iter::once(plan.output)
                 .chain(plan.readback.iter().copied())
@@ -268,7 +326,7 @@ impl<'g> Renderer<'g> {
             plan,
             (resources, draws),
             &mut pools,
-            prepared,
+            (&mut ready.passes, ready.scene_pool.as_ref()),
             options,
             started,
         );
@@ -287,7 +345,7 @@ impl<'g> Renderer<'g> {
             .map(|&r| plan.resources[r].name.clone())
             .zip(images)
             .collect();
-        resources.prepared = Some(ready);
+        self.prepared = Some(ready);
         Ok(FrameReport {
             timings,
             statistics,
@@ -307,7 +365,7 @@ impl<'g> Renderer<'g> {
         plan: &Plan,
         (resources, draws): (&mut FrameResources<'g>, &mut dyn DrawRecorder),
         pools: &mut FramePools<'g>,
-        prepared: &[Prepared],
+        (prepared, scene_pool): (&mut [Prepared], Option<&DescriptorPool<'g>>),
         options: &FrameOptions,
         started: Instant,
     ) -> Result<Recorded, GpuError> {
@@ -346,12 +404,10 @@ impl<'g> Renderer<'g> {
                 s.begin(cmd, i as u32);
             }
             self.record_pass(
-                plan,
-                PassId::new(i),
-                pass,
-                &prepared[i],
+                (plan, PassId::new(i), pass),
+                (&mut prepared[i], scene_pool),
                 resources,
-                draws,
+                (draws, options),
                 cmd,
             )?;
             if let Some(s) = &stats {

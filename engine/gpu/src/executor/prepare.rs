@@ -6,12 +6,14 @@ use super::{FrameOptions, Prepared, PreparedPlan, Renderer};
 use crate::bind::{self, FrameValues};
 use crate::context::Gpu;
 use crate::descriptors::DescriptorPool;
+use crate::draw::SCENE_VARIANTS;
 use crate::error::GpuError;
 use crate::layouts;
 use crate::resources::FrameResources;
 use ash::vk;
 use weft_graph::id::PassId;
 use weft_graph::plan::{Plan, PlanPass, PlanResource, ResourceDesc};
+use weft_graph::schema::Draw;
 
 impl<'g> Renderer<'g> {
     /// Prepares every pass of `plan` on `resources` and writes their descriptor sets.
@@ -28,8 +30,10 @@ impl<'g> Renderer<'g> {
         self.write_descriptors(plan, resources, &pool, &mut passes)?;
         Ok(PreparedPlan {
             generation: self.generation,
+            resources: resources.id,
             passes,
             _pool: pool,
+            scene_pool: scene_pool(self.gpu, plan)?,
         })
     }
 
@@ -79,9 +83,11 @@ impl<'g> Renderer<'g> {
             bindings: Vec::new(),
             push: Vec::new(),
             set: vk::DescriptorSet::null(),
+            variants: Vec::new(),
         };
         if let Some((key, bindings)) = checked {
-            prepared.pipeline = Some(self.pipelines.pipeline(self.gpu.device(), &key)?);
+            let scene = self.scene.as_ref().map(|(_, layouts)| layouts);
+            prepared.pipeline = Some(self.pipelines.pipeline(self.gpu.device(), &key, scene)?);
             prepared.bindings = bindings;
         }
         if let Some(rp) = &pass.render_pass {
@@ -153,6 +159,36 @@ fn descriptor_pool<'g>(
         }
     }
     DescriptorPool::new(gpu, sets, &counts)
+}
+
+/// Whether a pass draws scene content through the draw recorder.
+fn draws_scene(pass: &PlanPass) -> bool {
+    matches!(pass.draw, Some(Draw::Meshes(_) | Draw::LightVolumes(_)))
+}
+
+/// A pool with room for the graph sets of [`SCENE_VARIANTS`] pipeline
+/// variants of every scene pass (each binding counted for every descriptor
+/// type, as arrays of up to 8: the variants' layouts are not known before
+/// their shaders are); `None` for a plan without scene passes.
+fn scene_pool<'g>(gpu: &'g Gpu, plan: &Plan) -> Result<Option<DescriptorPool<'g>>, GpuError> {
+    let scene_passes: Vec<&PlanPass> = plan.passes.iter().filter(|p| draws_scene(p)).collect();
+    if scene_passes.is_empty() {
+        return Ok(None);
+    }
+    let sets = SCENE_VARIANTS * scene_passes.len() as u32;
+    let bindings: u32 = scene_passes
+        .iter()
+        .map(|p| p.bindings.len().max(1) as u32)
+        .sum();
+    let per_type = SCENE_VARIANTS * bindings * 8;
+    let counts = [
+        vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        vk::DescriptorType::STORAGE_IMAGE,
+        vk::DescriptorType::STORAGE_BUFFER,
+        vk::DescriptorType::UNIFORM_BUFFER,
+    ]
+    .map(|ty| (ty, per_type));
+    DescriptorPool::new(gpu, sets, &counts).map(Some)
 }
 
 fn clear_value(resource: &PlanResource, clear: &[f64]) -> vk::ClearValue {

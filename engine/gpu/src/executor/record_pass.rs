@@ -1,30 +1,37 @@
 //! Recording one prepared pass: its barriers, then a copy, a dispatch, a
 //! fullscreen triangle or the draw recorder's scene draws inside its render pass.
 
-use super::{Prepared, Renderer};
-use crate::draw::{DrawRecorder, RasterContext, SCENE_SET};
+use super::{FrameOptions, Prepared, Renderer};
+use crate::bind::FrameValues;
+use crate::descriptors::DescriptorPool;
+use crate::draw::{DrawRecorder, RasterContext, ScenePass};
 use crate::error::GpuError;
 use crate::frame::Label;
 use crate::record;
 use crate::resources::FrameResources;
+use crate::sets::SCENE_SET;
 use ash::vk;
 use weft_graph::id::PassId;
 use weft_graph::plan::{Plan, PlanPass};
 use weft_graph::schema::PassKind;
 
 impl<'g> Renderer<'g> {
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn record_pass(
-        &self,
-        plan: &Plan,
-        index: PassId,
-        pass: &PlanPass,
-        prep: &Prepared,
+        &mut self,
+        (plan, index, pass): (&Plan, PassId, &PlanPass),
+        (prep, scene_pool): (&mut Prepared, Option<&DescriptorPool<'g>>),
         resources: &FrameResources<'g>,
-        draws: &mut dyn DrawRecorder,
+        (draws, options): (&mut dyn DrawRecorder, &FrameOptions),
         cmd: vk::CommandBuffer,
     ) -> Result<(), GpuError> {
-        let device = self.gpu.device();
+        let gpu = self.gpu;
+        let device = gpu.device();
+        let frame = FrameValues {
+            time: options.time,
+            frame: options.frame,
+            extent: [prep.extent.width, prep.extent.height],
+            history_frames: options.history_frames,
+        };
         let label = Label::begin(self.gpu, cmd, &pass.name);
         record::barriers(device, cmd, &pass.barriers, resources)?;
         let result = match pass.kind {
@@ -46,16 +53,15 @@ impl<'g> Renderer<'g> {
                 let bound = match scene {
                     Some(p) => draws.bind_scene(
                         &RasterContext {
-                            gpu: self.gpu,
+                            gpu,
                             cmd,
                             plan,
                             pass_index: index,
                             render_pass: vk::RenderPass::null(),
                             extent: prep.extent,
                             resources,
-                            sampler: self.samplers.linear,
-                            nearest_sampler: self.samplers.nearest,
-                            compare_sampler: self.samplers.compare,
+                            frame,
+                            scene: None,
                         },
                         p,
                     ),
@@ -92,21 +98,33 @@ impl<'g> Renderer<'g> {
                     );
                     device.cmd_set_scissor(cmd, 0, &[area]);
                 }
-                let ctx = RasterContext {
-                    gpu: self.gpu,
+                let pipeline = prep.pipeline.clone();
+                if pipeline.is_some() {
+                    self.bind(cmd, prep);
+                }
+                let scene = match (&pipeline, &self.scene) {
+                    (None, Some(scene)) => Some(ScenePass {
+                        pipelines: &mut self.pipelines,
+                        scene,
+                        samplers: &self.samplers,
+                        variants: &mut prep.variants,
+                        pool: scene_pool,
+                    }),
+                    _ => None,
+                };
+                let mut ctx = RasterContext {
+                    gpu,
                     cmd,
                     plan,
                     pass_index: index,
                     render_pass: prep.render_pass,
                     extent: prep.extent,
                     resources,
-                    sampler: self.samplers.linear,
-                    nearest_sampler: self.samplers.nearest,
-                    compare_sampler: self.samplers.compare,
+                    frame,
+                    scene,
                 };
-                let drawn = match &prep.pipeline {
+                let drawn = match &pipeline {
                     Some(p) => {
-                        self.bind(cmd, prep);
                         let scene = p.interface.bindings.keys().any(|(s, _)| *s == SCENE_SET);
                         let bound = if scene {
                             draws.bind_scene(&ctx, p)
@@ -115,7 +133,7 @@ impl<'g> Renderer<'g> {
                         };
                         bound.map(|()| unsafe { device.cmd_draw(cmd, 3, 1, 0, 0) })
                     }
-                    None => draws.record(&ctx),
+                    None => draws.record(&mut ctx),
                 };
                 unsafe { device.cmd_end_render_pass2(cmd, &vk::SubpassEndInfo::default()) };
                 drawn

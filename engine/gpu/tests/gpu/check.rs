@@ -15,7 +15,7 @@ fn reports_every_disagreement_between_shaders_and_graph() {
         .into_iter()
         .map(|p| (p.pass, p.message))
         .collect();
-    let without_device: Vec<(String, String)> = weft_gpu::check_shaders(&plan)
+    let without_device: Vec<(String, String)> = weft_gpu::check_shaders(&plan, None)
         .expect("shaderc")
         .into_iter()
         .map(|p| (p.pass, p.message))

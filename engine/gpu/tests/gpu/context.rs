@@ -83,7 +83,14 @@ fn optional_shader_features_are_enabled_when_the_device_offers_them() {
     }
     if unmet.is_empty() {
         cache
-            .pipeline(gpu.device(), &PipelineKey::Compute { shader: key })
+            .pipeline(
+                gpu.device(),
+                &PipelineKey::Compute {
+                    shader: key,
+                    scene: None,
+                },
+                None,
+            )
             .expect("a pipeline from the offered features");
     }
     cache.destroy(gpu.device());

@@ -17,7 +17,7 @@ use crate::diagnostic::Diagnostic;
 use crate::id::IrPassId;
 use crate::load::LoadedGraph;
 use crate::plan::{Extent, ImageDesc, Plan, PlanView};
-use crate::resolve::{resolve, Ir, IrView};
+use crate::resolve::{feature_names, resolve, Ir, IrView};
 use crate::spans::{Pos, Seg};
 use memory::MemoryRequirements;
 use std::collections::BTreeSet;
@@ -149,47 +149,6 @@ pub fn conditions_hold(conditions: &[String], features: &BTreeSet<String>) -> bo
         None => features.contains(c),
     })
 }
-
-/// Every feature name a graph's conditions mention.
-pub fn feature_names(ir: &Ir) -> BTreeSet<String> {
-    let mut names = BTreeSet::new();
-    for pass in &ir.passes {
-        let conditions = pass
-            .enabled_if
-            .iter()
-            .chain(pass.accesses.iter().flat_map(|a| a.conditions.iter()))
-            .chain(pass.defines.iter().flat_map(|d| d.enabled_if.iter()));
-        for c in conditions {
-            names.insert(c.trim_start_matches('!').to_string());
-        }
-    }
-    names
-}
-
-/// The features the engine sets from what a scene holds (weft-render's
-/// `scene_features`, which sets no other): a graph may test them without any
-/// pass of its own doing so (a fragment's caveat, say).
-pub const SCENE_FEATURES: [&str; 19] = [
-    "shadow_casters",
-    "emissive",
-    "transparent",
-    "suns",
-    "point_lights",
-    "spot_lights",
-    "area_lights",
-    "rect_lights",
-    "disc_lights",
-    "punctual_lights",
-    "glossy",
-    "dielectrics",
-    "mirrors",
-    "coated",
-    "metallic_roughness",
-    "blinn_phong",
-    "emission_occlusion_maps",
-    "normal_maps",
-    "textures",
-];
 
 /// The notes of the graph's caveats whose features hold, each once (a note
 /// may be declared under several conditions).

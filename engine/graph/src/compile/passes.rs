@@ -310,7 +310,7 @@ mod tests {
         assert_eq!(b(&[]), ["ALWAYS", "WITHOUT_EXTRA"]);
         assert_eq!(b(&["extra"]), ["ALWAYS", "WITH_EXTRA"]);
         let (_, ir) = super::super::fixture::resolved(&text);
-        assert!(super::super::feature_names(&ir).contains("extra"));
+        assert!(crate::resolve::feature_names(&ir).contains("extra"));
     }
 
     #[test]

@@ -2,12 +2,14 @@
 //! format, parameter and per-pass rule that does not depend on execution order.
 //! All problems are collected; none stops the others from being found.
 
+mod features;
 mod ir;
 mod passes;
 mod resources;
 mod rules;
 mod values;
 
+pub use features::{feature_names, SCENE_FEATURES};
 pub use ir::*;
 pub use rules::{access_path, usage_name};
 pub(crate) use values::oversized_image;
@@ -177,9 +179,9 @@ impl<'a> Resolver<'a> {
     /// or the engine sets from scenes: a misspelt feature would silently
     /// never show the caveat.
     fn check_caveats(&mut self, ir: &Ir) {
-        let mut known = crate::compile::feature_names(ir);
+        let mut known = feature_names(ir);
         known.extend(self.graph.default_features.iter().cloned());
-        known.extend(crate::compile::SCENE_FEATURES.iter().map(|f| f.to_string()));
+        known.extend(SCENE_FEATURES.iter().map(|f| f.to_string()));
         for (k, (source, caveat)) in self.graph.caveats.iter().enumerate() {
             let index = self.graph.caveats[..k]
                 .iter()

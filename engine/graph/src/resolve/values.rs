@@ -119,9 +119,7 @@ pub const MAX_WORKGROUP_COUNT: u32 = 65_535;
 /// would make a single frame run for seconds even on a fast GPU.
 pub const MAX_SAMPLES_PER_FRAME: u32 = 4096;
 
-/// The largest image side weft creates: `maxImageDimension2D` on the devices
-/// it targets, and the limit of `Absolute` sizes.
-pub const MAX_IMAGE_DIMENSION: u32 = 16_384;
+pub use crate::plan::MAX_IMAGE_DIMENSION;
 
 /// The error for an image side over [`MAX_IMAGE_DIMENSION`].
 pub(crate) fn oversized_image(name: &str, size: Extent, output: Extent) -> String {

@@ -46,6 +46,22 @@ pub struct Placement {
     pub material: MaterialOverride,
 }
 
+/// A scene's script: the file, where the scene named it, and the index of
+/// the first light the script adds (lights before it come from the `.scene`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScriptRef {
+    /// The `.rhai` file.
+    pub path: PathBuf,
+    /// The `script` line, or the script itself for `.rhai` scenes.
+    pub at: Location,
+    /// Lights the scene declared before the script's.
+    pub first_light: usize,
+    /// Model placements the scene declared before the script's.
+    pub first_model: usize,
+    /// The scripts it imported while loading, so they are watched too.
+    pub imports: Vec<PathBuf>,
+}
+
 /// Everything a `.scene` file (with its includes) declares, before models are loaded.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SceneDesc {
@@ -60,7 +76,7 @@ pub struct SceneDesc {
     /// The world point every position above is relative to ([`origin_of`]).
     pub origin: DVec3,
     /// The scene's script (`script "file.rhai"`, or the `.rhai` scene itself).
-    pub script: Option<crate::script::ScriptRef>,
+    pub script: Option<ScriptRef>,
 }
 
 /// Reads a `.scene` file and its includes.
@@ -181,7 +197,7 @@ fn interpret(
                         ),
                     });
                 }
-                desc.script = Some(crate::script::ScriptRef {
+                desc.script = Some(ScriptRef {
                     path: resolve(path, &name),
                     at,
                     first_light: 0,

@@ -26,11 +26,12 @@
 
 use crate::bounds::Aabb;
 use crate::camera::Camera;
+use crate::desc::ScriptRef;
 use crate::desc::{blocks_into, SceneDesc};
 use crate::error::{Diagnostics, Location, SceneError};
 use crate::light::Light;
-use crate::load::{load_model, LoadOptions};
 use crate::model::Model;
+use crate::model_file::{load_model, LoadOptions};
 use crate::rng::Rng;
 use crate::scene::Scene;
 use glam::{DVec3, Mat4, Vec3};
@@ -58,22 +59,6 @@ use state::*;
 pub use imports::MAX_IMPORT_DEPTH;
 pub use limits::Limits;
 pub use runtime::{ScriptFrame, ScriptRuntime};
-
-/// A scene's script: the file, where the scene named it, and the index of
-/// the first light the script adds (lights before it come from the `.scene`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct ScriptRef {
-    /// The `.rhai` file.
-    pub path: PathBuf,
-    /// The `script` line, or the script itself for `.rhai` scenes.
-    pub at: Location,
-    /// Lights the scene declared before the script's.
-    pub first_light: usize,
-    /// Model placements the scene declared before the script's.
-    pub first_model: usize,
-    /// The scripts it imported while loading, so they are watched too.
-    pub imports: Vec<PathBuf>,
-}
 
 /// Seconds per update step.
 pub const STEP: f64 = 1.0 / 60.0;

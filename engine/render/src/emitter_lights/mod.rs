@@ -5,7 +5,7 @@
 //! pairs of coplanar triangles sharing an edge that form a convex quad (a
 //! triangulated OBJ quad, a glTF panel) merge into one quad; when more than
 //! [`MAX_EMITTER_LIGHTS`] polygons remain, neighbours facing about the same
-//! way are clustered into square lights (`crate::emitter_clusters`, which
+//! way are clustered into square lights (`clusters`, which
 //! reports the power and the angle that costs), and if still too many, the
 //! most powerful are kept and the power left out is reported (docs/lights.md).
 //!
@@ -14,6 +14,8 @@
 //! `emission`). Materials whose emission is modulated by an emissive texture
 //! are not turned into lights (their glow is drawn; what they cast is not
 //! modelled) and are counted in [`EmitterLights::textured`].
+
+mod clusters;
 
 use crate::emitters::luminance;
 use crate::geometry::SceneGeometry;
@@ -178,7 +180,7 @@ pub fn emitter_lights(geometry: &SceneGeometry) -> EmitterLights {
                 .map(|corners| EmitterPolygon { corners, radiance }),
         );
     }
-    let clustered = crate::emitter_clusters::cluster(polygons, MAX_EMITTER_LIGHTS);
+    let clustered = clusters::cluster(polygons, MAX_EMITTER_LIGHTS);
     out.clusters = clustered.clusters;
     out.clustered = clustered.members;
     out.cluster_angle = clustered.worst_angle;

@@ -1,6 +1,6 @@
 //! Many-triangle emitters to a light budget: when a scene's emissive
 //! polygons outnumber what raster passes shade
-//! ([`crate::emitter_lights::MAX_EMITTER_LIGHTS`]), polygons that face about
+//! ([`super::MAX_EMITTER_LIGHTS`]), polygons that face about
 //! the same way and lie near each other become one square light each.
 //!
 //! Polygons are grouped by their normal (each component rounded to the
@@ -15,7 +15,7 @@
 //! [`Clustered::worst_angle`] off its light's. A group of one keeps its
 //! polygon as it is.
 
-use crate::emitter_lights::EmitterPolygon;
+use super::EmitterPolygon;
 use crate::emitters::luminance;
 use glam::Vec3;
 use std::collections::BTreeMap;

@@ -1,10 +1,77 @@
 //! Fixed-function state of a scene pass, as its graph declares it: the depth
 //! comparison and bias and the culled faces (`raster`), depth writes (the depth
-//! attachment's `read_only`), blending per colour attachment.
+//! attachment's `read_only`), blending per colour attachment; and the Vulkan
+//! state it becomes.
 
-use weft_gpu::pipeline::BlendCode;
+use ash::vk;
 use weft_graph::plan::PlanPass;
-use weft_graph::schema::{CompareOp, CullMode};
+use weft_graph::schema::{Blend, CompareOp, CullMode};
+
+/// A colour attachment's blend mode as a hashable key part.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum BlendCode {
+    /// No blending: the output replaces the attachment.
+    Off,
+    /// dst + src.
+    Additive,
+    /// Source-over with source alpha.
+    Alpha,
+}
+
+impl From<Option<Blend>> for BlendCode {
+    fn from(b: Option<Blend>) -> Self {
+        match b {
+            None => Self::Off,
+            Some(Blend::Additive) => Self::Additive,
+            Some(Blend::Alpha) => Self::Alpha,
+        }
+    }
+}
+
+/// Depth testing and writing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DepthState {
+    /// Whether fragments are tested against the depth attachment.
+    pub test: bool,
+    /// Whether passing fragments write their depth.
+    pub write: bool,
+    /// How a fragment's depth is compared with the stored one.
+    pub compare: vk::CompareOp,
+}
+
+impl DepthState {
+    /// No depth test and no writes.
+    pub const OFF: DepthState = DepthState {
+        test: false,
+        write: false,
+        compare: vk::CompareOp::ALWAYS,
+    };
+}
+
+/// The colour-blend state of a blend mode.
+pub fn blend_state(blend: BlendCode) -> vk::PipelineColorBlendAttachmentState {
+    let state = vk::PipelineColorBlendAttachmentState::default()
+        .color_write_mask(vk::ColorComponentFlags::RGBA);
+    match blend {
+        BlendCode::Off => state,
+        BlendCode::Additive => state
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+            .alpha_blend_op(vk::BlendOp::ADD),
+        BlendCode::Alpha => state
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
+            .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .alpha_blend_op(vk::BlendOp::ADD),
+    }
+}
 
 /// How the depth attachment is tested.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -70,6 +137,60 @@ pub fn pass_state(pass: &PlanPass) -> PassState {
             .depth_bias
             .map(|(c, s)| ((c as f32).to_bits(), (s as f32).to_bits())),
         samples: rp.attachments.first().map_or(1, |a| a.samples),
+    }
+}
+
+impl DepthTest {
+    /// The Vulkan depth state.
+    pub fn vk(self) -> DepthState {
+        match self {
+            Self::Off => DepthState::OFF,
+            Self::On { compare, write } => DepthState {
+                test: true,
+                write,
+                compare: compare_op(compare),
+            },
+        }
+    }
+}
+
+impl PassState {
+    /// The Vulkan faces culled.
+    pub fn cull_flags(&self) -> vk::CullModeFlags {
+        match self.cull {
+            CullMode::None => vk::CullModeFlags::NONE,
+            CullMode::Front => vk::CullModeFlags::FRONT,
+            CullMode::Back => vk::CullModeFlags::BACK,
+        }
+    }
+
+    /// The constant and slope-scaled depth bias as floats.
+    pub fn depth_bias(&self) -> Option<(f32, f32)> {
+        self.depth_bias
+            .map(|(c, s)| (f32::from_bits(c), f32::from_bits(s)))
+    }
+}
+
+fn compare_op(compare: CompareOp) -> vk::CompareOp {
+    match compare {
+        CompareOp::Never => vk::CompareOp::NEVER,
+        CompareOp::Less => vk::CompareOp::LESS,
+        CompareOp::Equal => vk::CompareOp::EQUAL,
+        CompareOp::LessOrEqual => vk::CompareOp::LESS_OR_EQUAL,
+        CompareOp::Greater => vk::CompareOp::GREATER,
+        CompareOp::NotEqual => vk::CompareOp::NOT_EQUAL,
+        CompareOp::GreaterOrEqual => vk::CompareOp::GREATER_OR_EQUAL,
+        CompareOp::Always => vk::CompareOp::ALWAYS,
+    }
+}
+
+/// The front face of a draw: counter-clockwise model triangles, turned around
+/// by a mirroring (negative-determinant) model matrix.
+pub fn front_face(mirrored: bool) -> vk::FrontFace {
+    if mirrored {
+        vk::FrontFace::CLOCKWISE
+    } else {
+        vk::FrontFace::COUNTER_CLOCKWISE
     }
 }
 

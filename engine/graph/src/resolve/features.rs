@@ -1,0 +1,46 @@
+//! The feature names a graph may test: those its conditions mention, and
+//! those the engine sets from what a scene holds.
+
+use super::Ir;
+use std::collections::BTreeSet;
+
+/// Every feature name a graph's conditions mention.
+pub fn feature_names(ir: &Ir) -> BTreeSet<String> {
+    let mut names = BTreeSet::new();
+    for pass in &ir.passes {
+        let conditions = pass
+            .enabled_if
+            .iter()
+            .chain(pass.accesses.iter().flat_map(|a| a.conditions.iter()))
+            .chain(pass.defines.iter().flat_map(|d| d.enabled_if.iter()));
+        for c in conditions {
+            names.insert(c.trim_start_matches('!').to_string());
+        }
+    }
+    names
+}
+
+/// The features the engine sets from what a scene holds (weft-render's
+/// `scene_features`, which sets no other): a graph may test them without any
+/// pass of its own doing so (a fragment's caveat, say).
+pub const SCENE_FEATURES: [&str; 19] = [
+    "shadow_casters",
+    "emissive",
+    "transparent",
+    "suns",
+    "point_lights",
+    "spot_lights",
+    "area_lights",
+    "rect_lights",
+    "disc_lights",
+    "punctual_lights",
+    "glossy",
+    "dielectrics",
+    "mirrors",
+    "coated",
+    "metallic_roughness",
+    "blinn_phong",
+    "emission_occlusion_maps",
+    "normal_maps",
+    "textures",
+];

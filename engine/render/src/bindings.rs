@@ -1,0 +1,270 @@
+//! The scene data shaders bind, as one table: set 1 (scene buffers, and the
+//! ray tracer's, fed only to passes that trace), set 2 (a material's
+//! textures) and the vertex layout, registered with the executor as a
+//! [`SceneInterface`]. The GLSL side is `shaders/include/scene.glsl`,
+//! `mesh_data.glsl` and `trace.glsl`.
+
+use crate::geometry::VERTEX_ATTRIBUTES;
+use crate::geometry::VERTEX_BYTES;
+use weft_gpu::reflect::DescriptorKind;
+use weft_gpu::scene::{SceneBinding, SceneInterface};
+use weft_graph::plan::PlanPass;
+
+/// A set binding every scene pass may read.
+const fn raster(binding: u32, kind: DescriptorKind, what: &'static str) -> SceneBinding {
+    SceneBinding {
+        binding,
+        kind,
+        what,
+        arrayed: false,
+        tracing: false,
+    }
+}
+
+/// A set-1 binding only passes that trace rays read (a texture array among them).
+const fn tracing(binding: u32, kind: DescriptorKind, what: &'static str) -> SceneBinding {
+    SceneBinding {
+        binding,
+        kind,
+        what,
+        arrayed: is_trace_texture(binding),
+        tracing: true,
+    }
+}
+
+/// Binding of the per-frame uniform block (`Frame` in `scene.glsl`).
+pub const FRAME_BINDING: u32 = 0;
+/// Binding of the light records.
+pub const LIGHTS_BINDING: u32 = 1;
+/// Binding of the draw records.
+pub const DRAWS_BINDING: u32 = 2;
+/// Binding of the material records.
+pub const MATERIALS_BINDING: u32 = 3;
+/// Binding of the shadow views (`Shadows` in `shaders/include/shadows.glsl`).
+pub const SHADOWS_BINDING: u32 = 4;
+/// Binding of the ray tracer's triangles: three world-space corners per
+/// triangle, each a vec4 (`Triangles` in `shaders/include/trace.glsl`).
+pub const TRIANGLES_BINDING: u32 = 5;
+/// Binding of the ray tracer's BVH nodes (`BvhNodes`).
+pub const BVH_NODES_BINDING: u32 = 6;
+/// Binding of the BVH's triangle order (`BvhTriangles`): leaves index it.
+pub const BVH_TRIANGLES_BINDING: u32 = 7;
+/// Binding of the corners' world normals (`TriangleNormals`, a vec4 each).
+pub const TRIANGLE_NORMALS_BINDING: u32 = 8;
+/// Binding of the corners' UVs (`TriangleUvs`, a vec2 each).
+pub const TRIANGLE_UVS_BINDING: u32 = 9;
+/// Binding of each triangle's material index (`TriangleMaterials`).
+pub const TRIANGLE_MATERIALS_BINDING: u32 = 10;
+/// Binding of the emissive triangles' alias table (`Emitters`,
+/// [`crate::emitters::EmitterTable`]).
+pub const EMITTERS_BINDING: u32 = 11;
+/// First of the path tracer's texture arrays (`trace.glsl`): sRGB colour
+/// layers of each size class of [`crate::trace_textures::CLASSES`] at 12, 13,
+/// 14, UNORM data layers at 15, 16, 17.
+pub const TRACE_TEXTURES_BINDING: u32 = 12;
+/// How many texture arrays the path tracer binds from [`TRACE_TEXTURES_BINDING`] on.
+pub const TRACE_TEXTURE_ARRAYS: u32 = 2 * crate::trace_textures::CLASSES.len() as u32;
+/// Whether set 1 `binding` is one of the path tracer's texture arrays.
+pub const fn is_trace_texture(binding: u32) -> bool {
+    binding >= TRACE_TEXTURES_BINDING && binding < TRACE_TEXTURES_BINDING + TRACE_TEXTURE_ARRAYS
+}
+
+/// Binding of each material's texture slots (`MaterialTextures`).
+pub const MATERIAL_TEXTURES_BINDING: u32 = 18;
+/// Binding of the corners' world tangents (`TriangleTangents`, a vec4 each,
+/// w the bitangent's sign).
+pub const TRIANGLE_TANGENTS_BINDING: u32 = 19;
+/// Binding of the LTC tables analytic area lights read (`LtcTables` in
+/// `shaders/include/ltc.glsl`, [`ltc_table_words`]).
+pub const LTC_TABLES_BINDING: u32 = 20;
+/// Binding of the vertex buffer as 32-bit words (`Vertices` in
+/// `shaders/include/mesh_data.glsl`), for shaders that fetch whole triangles.
+pub const VERTICES_BINDING: u32 = 21;
+/// Binding of the index buffer (`Indices` in `shaders/include/mesh_data.glsl`).
+pub const INDICES_BINDING: u32 = 22;
+/// Set 2 binding of a material's base-colour texture (sRGB).
+pub const BASE_COLOR_BINDING: u32 = 0;
+/// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
+pub const METALLIC_ROUGHNESS_BINDING: u32 = 1;
+/// Set 2 binding of a material's tangent-space normal map (UNORM).
+pub const NORMAL_BINDING: u32 = 2;
+/// Set 2 binding of the emissive texture (sRGB; white when the material has none).
+pub const EMISSIVE_BINDING: u32 = 3;
+/// Set 2 binding of the occlusion texture (its red channel; white when none).
+pub const OCCLUSION_BINDING: u32 = 4;
+/// Set 1 as the engine creates and writes it for every scene pass.
+pub const SCENE_SET_BINDINGS: [SceneBinding; 8] = [
+    raster(
+        FRAME_BINDING,
+        DescriptorKind::UniformBuffer,
+        "the Frame block",
+    ),
+    raster(LIGHTS_BINDING, DescriptorKind::StorageBuffer, "the lights"),
+    raster(
+        DRAWS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the draw records",
+    ),
+    raster(
+        MATERIALS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the materials",
+    ),
+    raster(
+        SHADOWS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the shadow views",
+    ),
+    raster(
+        LTC_TABLES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the area-light LTC tables",
+    ),
+    raster(
+        VERTICES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the vertices",
+    ),
+    raster(
+        INDICES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the indices",
+    ),
+];
+
+/// Set 1 bindings for ray tracing: built only when a compute pass that
+/// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
+/// a build (docs/pathtrace.md) that raster graphs should not pay.
+pub const TRACE_SET_BINDINGS: [SceneBinding; 15] = [
+    tracing(
+        TRIANGLES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the ray tracer's triangles",
+    ),
+    tracing(
+        BVH_NODES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the BVH nodes",
+    ),
+    tracing(
+        BVH_TRIANGLES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the BVH's triangle order",
+    ),
+    tracing(
+        TRIANGLE_NORMALS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the corners' normals",
+    ),
+    tracing(
+        TRIANGLE_UVS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the corners' UVs",
+    ),
+    tracing(
+        TRIANGLE_MATERIALS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the triangles' materials",
+    ),
+    tracing(
+        EMITTERS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the emissive triangles",
+    ),
+    tracing(
+        TRACE_TEXTURES_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the 256-texel colour texture array",
+    ),
+    tracing(
+        TRACE_TEXTURES_BINDING + 1,
+        DescriptorKind::CombinedImageSampler,
+        "the 512-texel colour texture array",
+    ),
+    tracing(
+        TRACE_TEXTURES_BINDING + 2,
+        DescriptorKind::CombinedImageSampler,
+        "the 1024-texel colour texture array",
+    ),
+    tracing(
+        TRACE_TEXTURES_BINDING + 3,
+        DescriptorKind::CombinedImageSampler,
+        "the 256-texel data texture array",
+    ),
+    tracing(
+        TRACE_TEXTURES_BINDING + 4,
+        DescriptorKind::CombinedImageSampler,
+        "the 512-texel data texture array",
+    ),
+    tracing(
+        TRACE_TEXTURES_BINDING + 5,
+        DescriptorKind::CombinedImageSampler,
+        "the 1024-texel data texture array",
+    ),
+    tracing(
+        MATERIAL_TEXTURES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the materials' texture slots",
+    ),
+    tracing(
+        TRIANGLE_TANGENTS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the corners' tangents",
+    ),
+];
+/// Set 2 as the engine creates it: a material's textures, in the order of its
+/// texture slots.
+pub const MATERIAL_SET_BINDINGS: [SceneBinding; 5] = [
+    raster(
+        BASE_COLOR_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the base-colour texture",
+    ),
+    raster(
+        METALLIC_ROUGHNESS_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the metallic-roughness texture",
+    ),
+    raster(
+        NORMAL_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the normal map",
+    ),
+    raster(
+        EMISSIVE_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the emissive texture",
+    ),
+    raster(
+        OCCLUSION_BINDING,
+        DescriptorKind::CombinedImageSampler,
+        "the occlusion texture",
+    ),
+];
+
+/// What this renderer hands scene shaders, for the executor to build
+/// pipelines against and check shaders with.
+pub fn scene_interface() -> SceneInterface {
+    SceneInterface {
+        scene_set: SCENE_SET_BINDINGS
+            .iter()
+            .chain(&TRACE_SET_BINDINGS)
+            .copied()
+            .collect(),
+        material_set: MATERIAL_SET_BINDINGS.to_vec(),
+        vertex_stride: VERTEX_BYTES,
+        vertex_attributes: VERTEX_ATTRIBUTES.to_vec(),
+        traces: crate::providers::traces,
+        per_draw_params,
+    }
+}
+
+/// The push-constant parameters the scene recorder sets per draw: a shadow
+/// atlas pass's view index.
+fn per_draw_params(pass: &PlanPass) -> Vec<&'static str> {
+    if crate::providers::supplied(pass, crate::providers::SHADOW_VIEW) {
+        vec![crate::providers::SHADOW_VIEW]
+    } else {
+        Vec::new()
+    }
+}
