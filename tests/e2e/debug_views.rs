@@ -162,9 +162,7 @@ fn stacked_quads_overdraw_every_pixel_exactly_n_times() {
             values.iter().all(|&v| v == QUADS as f64),
             "{graph_name}: every pixel {QUADS}"
         );
-        let summary =
-            weft_render::view_summary::plan_views(&rendered.plan, &rendered.report.readbacks);
-        let (_, s) = &summary[0];
+        let (_, s) = &rendered.views[0];
         assert_eq!((s.mean, s.median, s.p95, s.max), (3.0, 3.0, 3.0, 3.0));
         assert_eq!(s.share_above, 0.0, "threshold 3: none above");
     }

@@ -1,4 +1,4 @@
-//! Many lights: a generated 1,000-light scene (`weft_render::light_scene`,
+//! Many lights: a generated 1,000-light scene (`weft_testkit::light_scene`,
 //! seed 1) rendered at 320x180 through forward, deferred (light volumes) and tiled
 //! shading under validation and synchronization validation (zero messages).
 //! RGB channel differences in 8-bit units: forward vs deferred and tiled vs
@@ -31,7 +31,7 @@ fn golden(name: &str) -> PathBuf {
 #[test]
 fn a_thousand_lights_agree_across_forward_deferred_and_tiled() {
     let dir = scratch("agree");
-    let scene = weft_render::light_scene::write_light_scene(&dir, 1000, 1).unwrap();
+    let scene = weft_testkit::light_scene::write_light_scene(&dir, 1000, 1).unwrap();
     let forward = render_validated(&scene, &graph("forward.ron"), 320, 180, &["!bloom"]);
     let deferred = render_validated(&scene, &graph("deferred.ron"), 320, 180, &["!bloom"]);
     let tiled = render_validated(&scene, &graph("tiled.ron"), 320, 180, &["!bloom"]);

@@ -13,6 +13,7 @@ mod lights;
 mod pathtrace;
 mod plot;
 mod script;
+mod shadow_reference;
 mod shadows;
 mod start;
 mod tangents;

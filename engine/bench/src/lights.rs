@@ -1,5 +1,5 @@
 //! `weft bench lights`: frame time against the number of point lights for
-//! several graphs on one generated scene (`weft_render::light_scene`), written
+//! several graphs on one generated scene (`weft_testkit::light_scene`), written
 //! as a CSV and a log-log plot, with the counts where one graph overtakes another.
 
 use crate::plot::{self, LinePlot, Series};
@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_gpu::{Gpu, GpuOptions};
 use weft_graph::plan::Extent;
-use weft_render::{light_scene, render, RenderSettings, Rendered};
+use weft_render::{render, RenderSettings, Rendered};
+use weft_testkit::light_scene;
 
 /// Arguments of `weft bench lights`.
 #[derive(Args)]

@@ -100,20 +100,23 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// `GpuScene::update` per frame for `scene`, one 1/60 s step each, after 10
-/// warm-up frames.
+/// The scene's update per frame for `scene` (`SceneUpdater::at`, which runs
+/// the script, then `GpuScene::update`, which uploads), one 1/60 s step each,
+/// after 10 warm-up frames.
 fn scene_update_ms(gpu: &Gpu, scene: &weft_scene::Scene, frames: u32) -> Result<Vec<f64>> {
-    let mut gpu_scene = GpuScene::new(gpu, scene)?;
+    let mut updater = weft_scene::SceneUpdater::new(scene)?;
+    let mut gpu_scene = GpuScene::new(gpu, scene, updater.animates())?;
     let camera = scene.cameras[0].clone();
     let mut ms = Vec::new();
     for frame in 0..frames + 10 {
         let t = f64::from(frame + 1) * STEP;
         let started = Instant::now();
-        gpu_scene.update(&camera, t, [1280, 720])?;
+        let at = updater.at(t);
+        gpu_scene.update(&at, &camera, t, [1280, 720])?;
         if frame >= 10 {
             ms.push(started.elapsed().as_secs_f64() * 1e3);
         }
-        if let Some(e) = gpu_scene.take_script_error() {
+        if let Some(e) = updater.take_error() {
             return Err(e.into());
         }
     }

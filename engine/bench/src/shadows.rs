@@ -1,10 +1,11 @@
 //! `weft bench shadows`: shadow-map resolution and PCF radius against error and
 //! time. Error is the share of pixels whose sun visibility differs from a CPU
-//! ray-traced reference of the same view (`weft_render::shadow_reference`);
+//! ray-traced reference of the same view (`crate::shadow_reference`);
 //! time is the shadow pass plus what the lookups add to the shading pass (GPU
 //! timestamps). Writes a CSV and two PNG plots.
 
 use crate::plot::{self, LinePlot, Series};
+use crate::shadow_reference::{compare, scene_sun_visibility};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::fmt::Write as _;
@@ -12,7 +13,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_gpu::{Gpu, GpuOptions, Pixels, TimingMode};
 use weft_graph::plan::Extent;
-use weft_render::shadow_reference::{compare, scene_sun_visibility};
 use weft_render::{render, RenderSettings, Rendered};
 use weft_scene::{Light, Scene};
 

@@ -14,8 +14,9 @@ use std::process::ExitCode;
 use weft_gpu::{Gpu, GpuOptions, TimingMode};
 use weft_graph::plan::Extent;
 use weft_render::lights::{pack_lights, LightSet};
-use weft_render::{camera, light_scene, raytrace, render, RenderSettings};
+use weft_render::{camera, raytrace, render, RenderSettings};
 use weft_scene::Scene;
+use weft_testkit::light_scene;
 
 /// Arguments of `weft bench tiles`.
 #[derive(Args)]

@@ -361,9 +361,9 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             "frame_ms": frame_ms,
             "timings": timings,
             "statistics": rendered.report.statistics,
-            "views": weft_render::view_summary::plan_views(&rendered.plan, &rendered.report.readbacks)
-                .into_iter()
-                .map(|(name, summary)| (name, serde_json::json!(summary)))
+            "views": rendered.views
+                .iter()
+                .map(|(name, summary)| (name.clone(), serde_json::json!(summary)))
                 .collect::<serde_json::Map<String, serde_json::Value>>(),
             "transient_bytes": rendered.report.transient_bytes,
             "device_memory_bytes": rendered.report.memory.allocated_bytes,

@@ -101,6 +101,9 @@ pub struct Rendered {
     /// Per-pass times of every frame (empty lists when timing is off), so
     /// callers can take medians over frames.
     pub timings: Vec<Vec<weft_gpu::PassTiming>>,
+    /// The plan's summarised views of the last frame (mean, median, p95,
+    /// histogram of each per-pixel count or measure), by view name.
+    pub views: Vec<(String, crate::ViewSummary)>,
 }
 
 /// Where a render stands after a frame, for progress displays.
@@ -212,10 +215,11 @@ pub fn render_with_progress(
     } else {
         settings.frame_time
     };
-    let mut uploaded = GpuScene::new(gpu, scene)?;
+    let updater = weft_scene::SceneUpdater::new(scene)?;
+    let mut uploaded = GpuScene::new(gpu, scene, updater.animates())?;
     uploaded.cache_bvh_in(settings.cache_dir.clone());
     let warnings = uploaded.warnings.clone();
-    let mut frames = FrameLoop::new(gpu, Arc::clone(&plan), uploaded)?;
+    let mut frames = FrameLoop::new(gpu, Arc::clone(&plan), (uploaded, updater))?;
     let mut record_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut frame_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut timings = Vec::with_capacity(count.min(4096) as usize);
@@ -260,7 +264,9 @@ pub fn render_with_progress(
     let culling = frames.culling().to_vec();
     drop(frames);
     let plan = Arc::try_unwrap(plan).unwrap_or_else(|shared| (*shared).clone());
+    let views = crate::view_summary::plan_views(&plan, &report.readbacks);
     Ok(Rendered {
+        views,
         plan,
         report,
         camera: camera.name.clone(),

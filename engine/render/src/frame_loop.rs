@@ -13,7 +13,7 @@ use weft_gpu::pipeline::{ShaderKey, ShaderModule};
 use weft_gpu::resources::GpuImage;
 use weft_gpu::{FrameOptions, FrameReport, FrameResources, Gpu, GpuError, Renderer, TimingMode};
 use weft_graph::plan::Plan;
-use weft_scene::Camera;
+use weft_scene::{Camera, SceneUpdater};
 
 /// A plan ready to run on one device, with the scene it draws.
 pub struct FrameLoop<'g> {
@@ -21,6 +21,8 @@ pub struct FrameLoop<'g> {
     // executor whose device objects they were made with.
     resources: FrameResources<'g>,
     recorder: SceneRecorder<'g>,
+    /// Moves the scene to each frame's time (motions, the script).
+    updater: SceneUpdater,
     renderer: Renderer<'g>,
     plan: Arc<Plan>,
     accumulation: Accumulation,
@@ -72,9 +74,13 @@ pub struct FrameRequest<'c> {
 }
 
 impl<'g> FrameLoop<'g> {
-    /// Creates the plan's resources and the scene's recorder; the first frame
-    /// builds the pipelines.
-    pub fn new(gpu: &'g Gpu, plan: Arc<Plan>, scene: GpuScene<'g>) -> Result<Self, GpuError> {
+    /// Creates the plan's resources and the scene's recorder for `scene` as
+    /// uploaded and as `updater` moves it; the first frame builds the pipelines.
+    pub fn new(
+        gpu: &'g Gpu,
+        plan: Arc<Plan>,
+        (scene, updater): (GpuScene<'g>, SceneUpdater),
+    ) -> Result<Self, GpuError> {
         let mut renderer = Renderer::new(gpu)?;
         renderer.register_scene(crate::bindings::scene_interface())?;
         let recorder = SceneRecorder::new(gpu, scene);
@@ -82,6 +88,7 @@ impl<'g> FrameLoop<'g> {
         Ok(Self {
             resources,
             recorder,
+            updater,
             renderer,
             plan,
             accumulation: Accumulation::default(),
@@ -92,10 +99,11 @@ impl<'g> FrameLoop<'g> {
     /// recorded and submitted, waited for, read back when asked.
     pub fn draw(&mut self, request: &FrameRequest<'_>) -> Result<FrameReport, RenderError> {
         let extent = [self.plan.extent.width, self.plan.extent.height];
+        let at = self.updater.at(request.time);
         let inputs = self
             .recorder
             .scene
-            .update(request.camera, request.time, extent)?;
+            .update(&at, request.camera, request.time, extent)?;
         let history_frames = self.accumulation.next(inputs);
         let options = FrameOptions {
             timing: request.timing,
@@ -117,7 +125,7 @@ impl<'g> FrameLoop<'g> {
     /// The scene script's error from `update`, if one failed since the last
     /// call; the frames kept the lights of the last good step.
     pub fn take_script_error(&mut self) -> Option<weft_scene::SceneError> {
-        self.recorder.scene.take_script_error()
+        self.updater.take_error()
     }
 
     /// The plan that runs.
@@ -154,10 +162,11 @@ impl<'g> FrameLoop<'g> {
         self.plan = plan;
     }
 
-    /// Draws another scene from the next frame.
-    pub fn swap_scene(&mut self, recorder: SceneRecorder<'g>) {
+    /// Draws another scene from the next frame, moved by its own updater.
+    pub fn swap_scene(&mut self, recorder: SceneRecorder<'g>, updater: SceneUpdater) {
         self.accumulation.reset();
         self.recorder = recorder;
+        self.updater = updater;
     }
 
     /// Drops every shader and pipeline built from the edited source `changed`

@@ -26,6 +26,7 @@ use weft_gpu::pipeline::PipelineCache;
 use weft_gpu::resources::GpuImage;
 use weft_gpu::{FrameReport, Gpu, GpuError};
 use weft_graph::plan::Plan;
+use weft_scene::SceneUpdater;
 use weft_scene::{Camera, Scene};
 
 /// A render kept alive across edits of its graph, shaders and scene.
@@ -71,15 +72,16 @@ impl<'g> LiveRender<'g> {
         let fail = |e: GpuError| ReloadError::gpu(e, &settings.graph);
         let mut cache = PipelineCache::new().map_err(fail)?;
         check_shaders(gpu, &mut cache, &plan, &settings.graph)?;
-        let mut uploaded =
-            GpuScene::new(gpu, &scene).map_err(|e| ReloadError::render(e, scene_path))?;
+        let updater = SceneUpdater::new(&scene).map_err(|e| ReloadError::scene(&e))?;
+        let mut uploaded = GpuScene::new(gpu, &scene, updater.animates())
+            .map_err(|e| ReloadError::render(e, scene_path))?;
         uploaded.cache_bvh_in(settings.cache_dir.clone());
         let sources = Sources {
             graph: graph_files(&settings.graph),
             shaders: shader_files(&mut cache, &plan).map_err(fail)?,
             scene: scene_files(&scene),
         };
-        let frames = FrameLoop::new(gpu, Arc::new(plan), uploaded).map_err(fail)?;
+        let frames = FrameLoop::new(gpu, Arc::new(plan), (uploaded, updater)).map_err(fail)?;
         Ok(Self {
             frames,
             checker: ShaderChecker::new().map_err(fail)?,
@@ -207,10 +209,11 @@ impl<'g> LiveRender<'g> {
         let fail = |e: GpuError| ReloadError::gpu(e, &graph);
         let new_recorder = match &prepared.scene {
             Some(s) => {
-                let mut uploaded = GpuScene::new(self.gpu, s)
+                let updater = SceneUpdater::new(s).map_err(|e| ReloadError::scene(&e))?;
+                let mut uploaded = GpuScene::new(self.gpu, s, updater.animates())
                     .map_err(|e| ReloadError::render(e, &self.scene_path))?;
                 uploaded.cache_bvh_in(prepared.settings.cache_dir.clone());
-                Some(SceneRecorder::new(self.gpu, uploaded))
+                Some((SceneRecorder::new(self.gpu, uploaded), updater))
             }
             None => None,
         };
@@ -226,8 +229,8 @@ impl<'g> LiveRender<'g> {
             .flat_map(|(_, raw)| raw);
         let rebuild: BTreeSet<PathBuf> =
             prepared.shaders.iter().chain(unwatched).cloned().collect();
-        if let Some(recorder) = new_recorder {
-            self.frames.swap_scene(recorder);
+        if let Some((recorder, updater)) = new_recorder {
+            self.frames.swap_scene(recorder, updater);
         }
         for raw in &rebuild {
             self.frames.reload_shader(raw).map_err(fail)?;

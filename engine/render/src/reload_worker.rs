@@ -43,7 +43,7 @@ impl Generations {
 
 /// A prepared reload (or why it was refused) as the worker hands it back.
 #[derive(Debug)]
-pub struct Prepared {
+pub struct WorkerReply {
     /// The request it answers.
     pub generation: u64,
     /// The thread that prepared it.
@@ -58,7 +58,7 @@ pub struct Prepared {
 /// (after the job in hand), and the scope it was spawned in waits for it.
 pub struct ReloadWorker {
     jobs: Sender<(u64, ReloadJob)>,
-    results: Receiver<Prepared>,
+    results: Receiver<WorkerReply>,
     generations: Generations,
 }
 
@@ -90,7 +90,7 @@ impl ReloadWorker {
                         &err.to_string(),
                     )),
                 };
-                let prepared = Prepared {
+                let prepared = WorkerReply {
                     generation,
                     thread: std::thread::current().id(),
                     elapsed: started.elapsed(),
@@ -120,7 +120,7 @@ impl ReloadWorker {
     }
 
     /// The newest request's result, once it is ready; stale results are dropped.
-    pub fn poll(&mut self) -> Option<Prepared> {
+    pub fn poll(&mut self) -> Option<WorkerReply> {
         let mut newest = None;
         while let Ok(prepared) = self.results.try_recv() {
             if self.generations.accept(prepared.generation) {

@@ -22,7 +22,7 @@ use weft_gpu::scene::{SceneBinding, SceneLayouts, SceneSet};
 use weft_gpu::texture::{Rgba8Image, Texture};
 use weft_gpu::{Gpu, GpuError};
 use weft_scene::material::{TextureRef, TextureSource};
-use weft_scene::{Camera, Scene};
+use weft_scene::{Camera, Scene, SceneAt};
 
 /// The LTC tables as `ltc_tables.glsl` reads them, in vec4s: the GGX
 /// inverses, the GGX (integral, Fresnel moment, 0, 0), the same for
@@ -117,15 +117,6 @@ pub struct GpuScene<'g> {
     trace: Option<TraceBuffers<'g>>,
     /// Where the BVH is cached (`crate::bvh_cache`); `None` builds it every time.
     bvh_cache: Option<PathBuf>,
-    source_lights: Vec<weft_scene::Light>,
-    /// The scene's script, which sets the lights per frame instead of the
-    /// `.scene` motions when it has `fn update`.
-    script: Option<weft_scene::script::ScriptRuntime>,
-    /// The script's last error in `update`; the frame kept the lights of the
-    /// last good step. Taken by [`GpuScene::take_script_error`].
-    script_error: Option<weft_scene::SceneError>,
-    /// What the script left for the last frame it computed.
-    script_frame: weft_scene::script::ScriptFrame,
     /// Each scene instance's transform as the draw records hold it.
     transforms: Vec<glam::Mat4>,
     /// Each scene instance's material overrides as the material records hold them.
@@ -155,20 +146,12 @@ pub struct GpuScene<'g> {
 }
 
 impl<'g> GpuScene<'g> {
-    /// Uploads `scene`.
-    pub fn new(gpu: &'g Gpu, scene: &Scene) -> Result<Self, RenderError> {
-        let script = match &scene.script {
-            Some(script) => Some(weft_scene::script::ScriptRuntime::new(
-                script,
-                scene,
-                &weft_scene::script::Limits::default(),
-            )?),
-            None => None,
-        };
-        // A script that animates may move and recolour placements: each then
-        // draws its own material copies, and the draw records and materials
-        // are rewritten in place each frame.
-        let animates = script.as_ref().is_some_and(|s| s.animates());
+    /// Uploads `scene`; `animates` says whether its placements and colours
+    /// may change per frame ([`weft_scene::SceneUpdater::animates`]).
+    pub fn new(gpu: &'g Gpu, scene: &Scene, animates: bool) -> Result<Self, RenderError> {
+        // A scene whose script animates may move and recolour placements:
+        // each then draws its own material copies, and the draw records and
+        // materials are rewritten in place each frame.
         let geometry = if animates {
             SceneGeometry::with_own_materials(scene)
         } else {
@@ -312,16 +295,6 @@ impl<'g> GpuScene<'g> {
             scene_set: vk::DescriptorSet::null(),
             traced_set: None,
             material_sets: Vec::new(),
-            source_lights: scene.lights.clone(),
-            script,
-            script_error: None,
-            script_frame: weft_scene::script::ScriptFrame {
-                lights: scene.lights.clone(),
-                touched: vec![false; scene.lights.len()],
-                transforms: scene.instances.iter().map(|i| i.transform).collect(),
-                colors: scene.instances.iter().map(|i| i.material.color).collect(),
-                cameras: Vec::new(),
-            },
             transforms: scene.instances.iter().map(|i| i.transform).collect(),
             overrides: scene.instances.iter().map(|i| i.material).collect(),
             normal_mapped,
@@ -537,26 +510,29 @@ impl<'g> GpuScene<'g> {
         }
     }
 
-    /// Writes the camera and the lights as they are at `time` for a target of `extent`;
-    /// call it before each frame (the previous frame must have finished).
-    /// Returns a hash of what it uploaded (camera, lights, placements and their
-    /// colours), so callers can tell whether two frames see the same inputs.
+    /// Uploads the scene as it is at `time` (`at`, from a
+    /// [`weft_scene::SceneUpdater`]): lights, moved and recoloured placements,
+    /// and `camera` (or the script's camera of its name) for a target of
+    /// `extent`; call it before each frame (the previous frame must have
+    /// finished). Returns a hash of what it uploaded (camera, lights,
+    /// placements and their colours), so callers can tell whether two frames
+    /// see the same inputs.
     pub fn update(
         &mut self,
+        at: &SceneAt<'_>,
         camera: &Camera,
         time: f64,
         extent: [u32; 2],
     ) -> Result<u64, GpuError> {
-        self.run_script(time);
-        self.place_instances()?;
-        self.recolour_instances()?;
-        let scripted = self
-            .script_frame
-            .cameras
-            .iter()
-            .find(|c| c.name == camera.name)
-            .cloned();
-        let camera = scripted.as_ref().unwrap_or(camera);
+        if let Some(transforms) = at.transforms {
+            self.place_instances(transforms)?;
+        } else {
+            self.moved_boxes.clear();
+        }
+        if let Some(colors) = at.colors {
+            self.recolour_instances(colors)?;
+        }
+        let camera = at.camera(camera);
         let [w, h] = [extent[0].max(1) as f32, extent[1].max(1) as f32];
         let view_proj = camera::view_projection(camera, time, w / h);
         let eye = camera::camera_position(camera, time);
@@ -566,7 +542,7 @@ impl<'g> GpuScene<'g> {
         self.view_volume =
             ViewVolume::new(eye, rotation, camera.fov_y, w / h, camera.near, camera.far);
         let bounds = self.bounds;
-        let mut lights = pack_lights(&self.lights_at(time), &bounds);
+        let mut lights = pack_lights(at.lights, &bounds);
         lights.add_emitter_polygons(&self.emitter_lights.records());
         let frame = GpuFrame {
             view_proj,
@@ -601,48 +577,15 @@ impl<'g> GpuScene<'g> {
 }
 
 impl GpuScene<'_> {
-    /// Whether the scene's script has `update`, which moves things per frame.
-    fn script_animates(&self) -> bool {
-        self.script.as_ref().is_some_and(|s| s.animates())
-    }
-
-    /// Runs the script, when it animates, up to `time`; on an error keeps
-    /// the last good step's frame, with the error for
-    /// [`GpuScene::take_script_error`].
-    fn run_script(&mut self, time: f64) {
-        if let Some(script) = self.script.as_mut().filter(|s| s.animates()) {
-            match script.frame_at(time) {
-                Ok(frame) => self.script_frame = frame,
-                Err(e) => self.script_error = Some(e),
-            }
-        }
-    }
-
-    /// The lights at `time`: the `.scene` motions', with the lights the
-    /// script has changed as it left them.
-    fn lights_at(&self, time: f64) -> Vec<weft_scene::Light> {
-        let frame = &self.script_frame;
-        let animates = self.script_animates();
-        weft_scene::animation::lights_at_with(&self.source_lights, time, 0, |i| {
-            (animates && frame.touched.get(i) == Some(&true))
-                .then(|| frame.lights.get(i))
-                .flatten()
-        })
-    }
-
     /// Moves the placements the script moved: their draw records rewritten
     /// in place as one range, the scene's box refitted (unless declared),
     /// and the ray tracer's triangles and BVH rebuilt if a pass traces.
-    fn place_instances(&mut self) -> Result<(), GpuError> {
+    fn place_instances(&mut self, transforms: &[glam::Mat4]) -> Result<(), GpuError> {
         self.moved_boxes.clear();
-        if !self.script_animates() {
-            return Ok(());
-        }
-        let Some(ids) = self.geometry.place_instances(
-            &self.script_frame.transforms,
-            &mut self.transforms,
-            &mut self.moved_boxes,
-        ) else {
+        let Some(ids) =
+            self.geometry
+                .place_instances(transforms, &mut self.transforms, &mut self.moved_boxes)
+        else {
             return Ok(());
         };
         self.moved = true;
@@ -674,18 +617,9 @@ impl GpuScene<'_> {
 
     /// Repacks the material copies of the placements the script recoloured
     /// and writes them as one range of the material buffer.
-    fn recolour_instances(&mut self) -> Result<(), GpuError> {
-        if !self.script_animates() {
-            return Ok(());
-        }
+    fn recolour_instances(&mut self, colors: &[Option<glam::Vec3>]) -> Result<(), GpuError> {
         let mut changed: Option<(u32, u32)> = None;
-        for (i, (colour, overrides)) in self
-            .script_frame
-            .colors
-            .iter()
-            .zip(self.overrides.iter_mut())
-            .enumerate()
-        {
+        for (i, (colour, overrides)) in colors.iter().zip(self.overrides.iter_mut()).enumerate() {
             if *colour == overrides.color {
                 continue;
             }
@@ -717,11 +651,6 @@ impl GpuScene<'_> {
     /// (world boxes): a kept shadow tile whose view meets one is stale.
     pub fn moved_boxes(&self) -> &[weft_scene::Aabb] {
         &self.moved_boxes
-    }
-
-    /// The scene script's error from the last frames, if `update` failed.
-    pub fn take_script_error(&mut self) -> Option<weft_scene::SceneError> {
-        self.script_error.take()
     }
 
     /// Fits this frame's shadow views for a `atlas_size` squared shadow map with

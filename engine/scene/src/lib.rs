@@ -49,6 +49,7 @@ pub mod source;
 mod syntax;
 pub mod tangent_frame;
 pub mod tangents;
+pub mod update;
 mod uri;
 
 pub use bounds::Aabb;
@@ -65,3 +66,4 @@ pub use model_file::{load_model, LoadOptions};
 pub use obj::load_obj;
 pub use report::{check_report, check_report_with, SceneReport};
 pub use scene::{Instance, Scene};
+pub use update::{SceneAt, SceneUpdater};

@@ -3,6 +3,7 @@
 //! several frames.
 
 pub mod golden;
+pub mod light_scene;
 pub mod tiles;
 
 pub use golden::{check_golden, Comparison, GoldenError, Tolerance};

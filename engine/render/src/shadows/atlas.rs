@@ -37,8 +37,8 @@ impl Atlas {
     }
 
     /// Clip space of tile `i`'s view to atlas texture coordinates (xy), keeping z and w,
-    /// so `lookup = to_uv * clip` and `textureProj` divides by w.
-    pub fn to_uv(&self, i: u32) -> Mat4 {
+    /// so `lookup = clip_to_uv * clip` and `textureProj` divides by w.
+    pub fn clip_to_uv(&self, i: u32) -> Mat4 {
         let [x, y, side] = self.viewport(i);
         let scale = side as f32 / self.size as f32;
         let (ox, oy) = (x as f32 / self.size as f32, y as f32 / self.size as f32);
@@ -84,7 +84,7 @@ mod tests {
             }
         );
         // Clip corners land on the tile's corners in texture coordinates.
-        let m = a.to_uv(1);
+        let m = a.clip_to_uv(1);
         assert_eq!(
             m * Vec4::new(-1.0, -1.0, 0.3, 1.0),
             Vec4::new(0.5, 0.0, 0.3, 1.0)

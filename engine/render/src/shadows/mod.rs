@@ -384,7 +384,7 @@ fn view(
 ) -> ShadowView {
     ShadowView {
         clip,
-        lookup: atlas.to_uv(i) * clip,
+        lookup: atlas.clip_to_uv(i) * clip,
         viewport: atlas.viewport(i),
         rect: atlas.inner_rect(i, margin - 1.0),
         texel,

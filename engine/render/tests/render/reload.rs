@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use weft_gpu::{Gpu, GpuOptions, ShaderStage};
 use weft_graph::plan::Extent;
-use weft_render::reload_worker::Prepared;
+use weft_render::WorkerReply;
 use weft_render::sources::normalize;
 use weft_render::{Committed, LiveRender, ReloadWorker, RenderSettings};
 
@@ -231,7 +231,7 @@ fn frames_until_prepared(
     worker: &mut ReloadWorker,
     live: &mut LiveRender<'_>,
     shown: &[u8],
-) -> (Prepared, u32) {
+) -> (WorkerReply, u32) {
     let started = Instant::now();
     let mut frames = 0;
     loop {
@@ -343,7 +343,7 @@ fn a_reload_prepared_from_an_older_version_is_not_committed() {
     };
     live.reconfigure(small).expect("reconfigured");
     let plan = live.plan() as *const _;
-    let mut checker = weft_render::prepare::ShaderChecker::new().expect("checker");
+    let mut checker = weft_render::ShaderChecker::new().expect("checker");
     let prepared = job.prepare(&gpu, &mut checker).expect("prepared");
     assert_eq!(live.commit(prepared).expect("commit"), Committed::Stale);
     assert!(std::ptr::eq(live.plan(), plan));

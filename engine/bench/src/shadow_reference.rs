@@ -1,11 +1,11 @@
 //! The ray-traced sun visibility of a view, and how far a shadow-mapped image
 //! is from it: the share of pixels where the two disagree on lit or shadowed.
 
-use crate::camera::{camera_position, view_projection};
-use crate::materials::matches;
-use crate::raytrace::Bvh;
 use glam::{Mat4, Vec2, Vec3};
 use weft_graph::schema::MaterialFilter;
+use weft_render::camera::{camera_position, view_projection};
+use weft_render::materials::matches;
+use weft_render::raytrace::Bvh;
 use weft_scene::{Camera, Light, Scene};
 
 /// The reference for `scene` seen by `camera` at time 0 through a `size` view:
@@ -85,13 +85,6 @@ pub struct Disagreement {
     pub differing: usize,
 }
 
-impl Disagreement {
-    /// `differing` as a percentage of `compared`.
-    pub fn percent(&self) -> f64 {
-        100.0 * self.differing as f64 / self.compared.max(1) as f64
-    }
-}
-
 /// Compares a render with shadows (`shadowed`) and the same render without
 /// (`unshadowed`), one value per pixel of sun light only, with `reference`;
 /// pixels whose unshadowed value is at most `threshold` carry no visibility
@@ -122,7 +115,7 @@ pub fn compare(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::reverse_z_projection;
+    use weft_render::camera::reverse_z_projection;
 
     /// A floor at y = 0 and a square roof at y = 1 over x, z in -1..1.
     fn scene() -> Bvh {
@@ -182,6 +175,5 @@ mod tests {
                 differing: 1
             }
         );
-        assert_eq!(d.percent(), 50.0);
     }
 }
