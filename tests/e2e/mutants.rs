@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use weft_gpu::Gpu;
 use weft_graph::feature_names;
 use weft_graph::plan::Extent;
-use weft_render::{check_graph_and_shaders, render, RenderSettings, ShaderTarget};
+use weft_render::{check_graph_and_shaders, render_with_progress, RenderSettings, ShaderTarget};
 
 /// SplitMix64: small, seedable, the same everywhere.
 struct Rng(u64);
@@ -371,9 +371,9 @@ fn run_mutant(gpu: &Gpu, scene: &weft_scene::Scene, graph: &Path) -> Result<Outc
     if diags.iter().any(weft_graph::Diagnostic::is_error) {
         return Ok(Outcome::Refused);
     }
-    let prepared = weft_graph::Prepared::new(&loaded).map_err(|d| format!("{d:?}"))?;
+    let prepared = weft_graph::Prepared::new(loaded).map_err(|d| format!("{d:?}"))?;
     let mut names: BTreeSet<String> = feature_names(prepared.ir());
-    names.extend(loaded.default_features.iter().cloned());
+    names.extend(prepared.graph().default_features.iter().cloned());
     let none: Vec<String> = names.iter().map(|n| format!("!{n}")).collect();
     let all: Vec<String> = names.iter().cloned().collect();
     for features in [none, all] {
@@ -387,7 +387,7 @@ fn run_mutant(gpu: &Gpu, scene: &weft_scene::Scene, graph: &Path) -> Result<Outc
             features: features.clone(),
             ..RenderSettings::default()
         };
-        let result = render(gpu, scene, &settings);
+        let result = render_with_progress(gpu, scene, &prepared, &settings, &mut |_| {});
         let messages = gpu.validation().messages();
         let new: Vec<String> = messages[before..]
             .iter()

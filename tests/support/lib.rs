@@ -57,15 +57,16 @@ pub fn compile(
     features: &[&str],
     readback: Vec<String>,
 ) -> Plan {
-    let loaded = weft_graph::load(path);
+    let graph = weft_graph::Prepared::new(weft_graph::load(path))
+        .unwrap_or_else(|d| panic!("{} does not load: {d:?}", path.display()));
     let memory = memory_requirements(gpu);
     let options = CompileOptions {
         extent,
-        features: loaded.features(features),
+        features: graph.graph().features(features),
         memory: &memory,
         readback,
     };
-    weft_render::providers::compile(&loaded, &options)
+    weft_render::providers::compile(&graph, &options)
         .unwrap_or_else(|d| panic!("{} does not compile: {d:?}", path.display()))
 }
 

@@ -138,16 +138,19 @@ fn measure(
     naive: bool,
     frames: u32,
 ) -> Result<(f64, Readback)> {
-    let loaded = weft_graph::load(graph);
+    let prepared = match weft_graph::Prepared::new(weft_graph::load(graph)) {
+        Ok(prepared) => prepared,
+        Err(diagnostics) => bail!("the bench graph does not load: {diagnostics:?}"),
+    };
     let memory = memory_requirements(gpu);
     let features: &[&str] = if naive { &["bloom_naive"] } else { &[] };
     let options = CompileOptions {
         extent,
-        features: loaded.features(features),
+        features: prepared.graph().features(features),
         memory: &memory,
         readback: vec!["bloom".into()],
     };
-    let plan = match weft_render::providers::compile(&loaded, &options) {
+    let plan = match weft_render::providers::compile(&prepared, &options) {
         Ok(plan) => plan,
         Err(diagnostics) => bail!("the bench graph does not compile: {diagnostics:?}"),
     };

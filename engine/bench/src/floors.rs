@@ -14,7 +14,7 @@ use std::process::ExitCode;
 use weft_gpu::{Gpu, GpuOptions, TimingMode};
 use weft_graph::plan::{Extent, Plan, PlanPass};
 use weft_graph::schema::Draw;
-use weft_render::{render, RenderSettings};
+use weft_render::{load_graph, render_with_progress, RenderSettings};
 
 /// Arguments of `weft bench floors`.
 #[derive(Args)]
@@ -82,15 +82,16 @@ pub fn run(args: FloorsArgs) -> Result<ExitCode> {
     );
     println!("| graph | pass | ms | floor | floor ms | pass / floor |\n|---|---|---|---|---|---|");
     for graph in &args.graphs {
-        let settings = RenderSettings {
+        let mut settings = RenderSettings {
             graph: graph.clone(),
             extent: args.size,
             frames: args.frames,
             timing: TimingMode::CpuPerPass,
-            extra_readback: weft_graph::load(graph).readback_names(),
             ..RenderSettings::default()
         };
-        let rendered = render(&gpu, &scene, &settings)
+        let prepared = load_graph(&settings)?;
+        settings.extra_readback = prepared.graph().readback_names();
+        let rendered = render_with_progress(&gpu, &scene, &prepared, &settings, &mut |_| {})
             .with_context(|| format!("rendering through {}", graph.display()))?;
         let mut ms: BTreeMap<&str, f64> = BTreeMap::new();
         let measured = &rendered.timings[1..];

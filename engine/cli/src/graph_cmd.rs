@@ -1,12 +1,12 @@
 //! `weft graph check|plan|dot`.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 use weft_gpu::{Gpu, GpuOptions};
-use weft_graph::{CompileOptions, Diagnostic, Extent, LoadedGraph};
+use weft_graph::{CompileOptions, Diagnostic, Extent};
 
 /// Graph subcommands.
 #[derive(Subcommand)]
@@ -56,28 +56,22 @@ pub struct Target {
     scene: Option<PathBuf>,
 }
 
-/// Refuses feature toggles typed on the command line that the graph does not
-/// know (a typo would otherwise be ignored silently). A graph that does not
-/// load is left to the command's own error, which locates the problem.
-pub fn check_feature_names(graph: &Path, features: &[String]) -> Result<()> {
-    let loaded = weft_graph::load(graph);
-    let Ok(prepared) = weft_graph::Prepared::new(&loaded) else {
-        return Ok(());
-    };
-    match prepared.unknown_features(features).as_slice() {
-        [] => Ok(()),
-        unknown => bail!("--features: {}", unknown.join("\n")),
-    }
-}
-
 /// Each diagnostic with its source line and a caret under the position.
 fn print_diagnostics(diags: &[Diagnostic]) {
     eprint!("{}", weft_graph::diagnostic::render(diags));
 }
 
-fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Plan, f64)> {
-    check_feature_names(file, &target.features)?;
-    let graph = weft_graph::load(file);
+fn compile(file: &Path, target: &Target) -> Result<(weft_graph::Prepared, weft_graph::Plan, f64)> {
+    let failed = |diags: Vec<Diagnostic>| {
+        print_diagnostics(&diags);
+        let errors = diags.iter().filter(|d| d.is_error()).count();
+        anyhow::anyhow!(
+            "{} failed to compile with {errors} error(s)",
+            file.display()
+        )
+    };
+    let graph = weft_graph::Prepared::new(weft_graph::load(file)).map_err(failed)?;
+    crate::graphs::check_features(&graph, &target.features)?;
     let mut requested = Vec::new();
     if let Some(path) = &target.scene {
         let scene = weft_scene::load_scene(path)
@@ -93,23 +87,14 @@ fn compile(file: &Path, target: &Target) -> Result<(LoadedGraph, weft_graph::Pla
     requested.extend(target.features.iter().cloned());
     let options = CompileOptions {
         extent: target.size,
-        features: graph.features(&requested),
+        features: graph.graph().features(&requested),
         ..CompileOptions::default()
     };
     let start = Instant::now();
     let result = weft_render::providers::compile(&graph, &options);
     let compile_us = start.elapsed().as_secs_f64() * 1e6;
-    match result {
-        Ok(plan) => Ok((graph, plan, compile_us)),
-        Err(diags) => {
-            print_diagnostics(&diags);
-            let errors = diags.iter().filter(|d| d.is_error()).count();
-            bail!(
-                "{} failed to compile with {errors} error(s)",
-                file.display()
-            )
-        }
-    }
+    let plan = result.map_err(failed)?;
+    Ok((graph, plan, compile_us))
 }
 
 /// The device `check --shaders` checks for: the first Vulkan device, or,
@@ -186,7 +171,7 @@ pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
         }
         GraphCommand::Dot { file, target } => {
             let (graph, plan, _) = compile(&file, &target)?;
-            print!("{}", weft_graph::dot::render(&graph, &plan));
+            print!("{}", weft_graph::dot::render(graph.graph(), &plan));
             Ok(ExitCode::SUCCESS)
         }
     }

@@ -2,6 +2,7 @@
 
 mod compare_cmd;
 mod graph_cmd;
+mod graphs;
 mod render_cmd;
 mod scene_cmd;
 mod sweep_cmd;

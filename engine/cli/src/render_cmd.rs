@@ -139,12 +139,12 @@ pub fn parse_time(text: &str) -> Result<f64, String> {
 }
 
 /// The images to read back besides the output: `--readback`, else the
-/// graph's own `readback` list.
-fn readback_names(args: &RenderArgs) -> Vec<String> {
-    if args.readback.is_empty() {
-        weft_graph::load(&args.graph).readback_names()
-    } else {
-        args.readback.clone()
+/// graph's own `readback` list (none while the graph does not load).
+fn readback_names(args: &RenderArgs, graph: Option<&weft_graph::Prepared>) -> Vec<String> {
+    match graph {
+        _ if !args.readback.is_empty() => args.readback.clone(),
+        Some(graph) => graph.graph().readback_names(),
+        None => Vec::new(),
     }
 }
 
@@ -241,10 +241,15 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             dir.display()
         );
     }
-    let extra_readback = readback_names(&args);
-    let exr_image = extra_readback.first().filter(|_| exr).cloned();
-    crate::graph_cmd::check_feature_names(&args.graph, &args.features)?;
-    let settings = settings(&args, extra_readback);
+    let mut settings = settings(&args, Vec::new());
+    // Loaded once: a render --watch waits for a graph that does not load yet;
+    // a render reports it.
+    let loaded = weft_render::load_graph(&settings);
+    if let Ok(graph) = &loaded {
+        crate::graphs::check_features(graph, &args.features)?;
+    }
+    settings.extra_readback = readback_names(&args, loaded.as_ref().ok());
+    let exr_image = settings.extra_readback.first().filter(|_| exr).cloned();
     if args.watch && (args.spp.is_some() || args.time_limit.is_some()) {
         bail!("--spp and --time-limit render once; use them without --watch (`weft view` shows a progressive graph converging)");
     }
@@ -253,6 +258,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             scene: &args.scene,
             out: &out,
             image: exr_image.as_deref(),
+            graph: loaded.ok(),
             settings,
             gpu: GpuOptions {
                 validation: args.validate,
@@ -260,6 +266,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             },
         });
     }
+    let graph = loaded?;
     let scene = weft_render::scene_load::load_scene(&args.scene, settings.cache_dir.as_deref())
         .with_context(|| format!("loading {}", args.scene.display()))?;
     for w in &scene.warnings {
@@ -275,7 +282,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         println!("device: {device} ({:?})", gpu.info().kind);
     }
     let bar = progress_bar(&args);
-    let rendered = render_with_progress(&gpu, &scene, &settings, &mut |p| {
+    let rendered = render_with_progress(&gpu, &scene, &graph, &settings, &mut |p| {
         bar.set_length(p.planned_frames.into());
         bar.set_position(p.frames.into());
         if let Some(samples) = p.samples {

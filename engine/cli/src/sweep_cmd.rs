@@ -12,6 +12,7 @@ use std::process::ExitCode;
 use weft_compare::pareto::{frontier, write_plot, Point};
 use weft_compare::sweep::{header, line, points, read, SweepPoint, SweepRow};
 use weft_graph::schema::ParamValue;
+use weft_render::RenderSettings;
 
 /// Arguments of `weft sweep`.
 #[derive(Args)]
@@ -128,9 +129,14 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
                 .collect()
         })
         .unwrap_or_default();
+    // The graph loaded (and every feature set checked) before the reference renders.
+    let mut graphs = crate::graphs::Loaded::default();
     for set in &sets {
-        let toggles: Vec<String> = set.split_whitespace().map(String::from).collect();
-        crate::graph_cmd::check_feature_names(&args.graph, &toggles)?;
+        graphs.get(&RenderSettings {
+            graph: args.graph.clone(),
+            features: set.split_whitespace().map(String::from).collect(),
+            ..RenderSettings::default()
+        })?;
     }
     let names: Vec<String> = args.params.iter().map(|(n, _)| n.clone()).collect();
     let csv = args.out.join("sweep.csv");
@@ -149,7 +155,7 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     );
     let mut exit = ExitCode::SUCCESS;
     if !todo.is_empty() {
-        let session = Session::open(common, &args.out)?;
+        let mut session = Session::open(common, &args.out, graphs)?;
         if !csv.exists() {
             std::fs::write(&csv, header(&names) + "\n")
                 .with_context(|| format!("writing {}", csv.display()))?;

@@ -27,13 +27,16 @@ pub struct WatchRequest<'a> {
     pub image: Option<&'a str>,
     /// Graph, size, camera, features and timing.
     pub settings: RenderSettings,
+    /// `settings.graph` as the command loaded it, for the first attempt;
+    /// `None` when it did not load (the watch waits for a fix).
+    pub graph: Option<weft_graph::Prepared>,
     /// Validation and device choice.
     pub gpu: GpuOptions,
 }
 
 /// Runs the watch loop; returns success when interrupted, failure when validation
 /// reported anything. A first version that does not load is waited for, not fatal.
-pub fn run(request: WatchRequest) -> Result<ExitCode> {
+pub fn run(mut request: WatchRequest) -> Result<ExitCode> {
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst))
@@ -42,7 +45,7 @@ pub fn run(request: WatchRequest) -> Result<ExitCode> {
     let log = gpu.validation();
     let graph = request.settings.graph.clone();
     let mut watcher = FileWatcher::new(QUIET)?;
-    let Some(mut live) = first_version(&gpu, &request, &mut watcher, &stop)? else {
+    let Some(mut live) = first_version(&gpu, &mut request, &mut watcher, &stop)? else {
         return Ok(exit_code(report_validation(&log)));
     };
     let started = Instant::now();
@@ -85,13 +88,20 @@ fn exit_code(clean: bool) -> ExitCode {
 /// the files it reads to change. `None` when interrupted first.
 fn first_version<'g>(
     gpu: &'g Gpu,
-    request: &WatchRequest,
+    request: &mut WatchRequest,
     watcher: &mut FileWatcher,
     stop: &AtomicBool,
 ) -> Result<Option<LiveRender<'g>>> {
     let mut watched = BTreeSet::new();
     loop {
-        let err = match LiveRender::new(gpu, request.scene, request.settings.clone()) {
+        // The command's graph on the first attempt; loaded afresh after an edit.
+        let started = match request.graph.take() {
+            Some(graph) => {
+                LiveRender::with_graph(gpu, request.scene, graph, request.settings.clone())
+            }
+            None => LiveRender::new(gpu, request.scene, request.settings.clone()),
+        };
+        let err = match started {
             Ok(live) => return Ok(Some(live)),
             Err(err) => err,
         };

@@ -24,7 +24,7 @@ fn bench(c: &mut Criterion) {
         features: graph.features(&["shadow_casters", "point_lights", "spot_lights"]),
         ..CompileOptions::default()
     };
-    let prepared = weft_graph::Prepared::new(&graph).expect("valid");
+    let prepared = weft_graph::Prepared::new(graph.clone()).expect("valid");
     c.bench_function("compile deferred+shadows+bloom 1920x1080", |b| {
         b.iter(|| black_box(&prepared).compile(&options).expect("compiles"))
     });
@@ -48,7 +48,7 @@ fn bench(c: &mut Criterion) {
             .collect(),
         ..CompileOptions::default()
     };
-    let prepared = weft_graph::Prepared::new(&random).expect("valid");
+    let prepared = weft_graph::Prepared::new(random.clone()).expect("valid");
     c.bench_function("compile random 1000-pass graph", |b| {
         b.iter(|| {
             black_box(&prepared)

@@ -13,6 +13,7 @@ use weft_gpu::{memory_requirements, FrameReport, Gpu, TimingMode};
 use weft_graph::plan::{Extent, Plan};
 use weft_graph::schema::ParamValue;
 use weft_graph::CompileOptions;
+use weft_graph::Prepared;
 use weft_scene::Scene;
 
 /// What to render.
@@ -132,13 +133,22 @@ impl Rendered {
     }
 }
 
-/// Compiles `settings.graph` for `scene` on `gpu`'s memory requirements.
+/// Loads and resolves `settings.graph` with `settings.params`, once: the
+/// graph value a render, a live render or a command keeps and compiles as
+/// often as it needs.
+pub fn load_graph(settings: &RenderSettings) -> Result<Prepared, RenderError> {
+    Prepared::load(&settings.graph, settings.params.clone()).map_err(RenderError::Graph)
+}
+
+/// Compiles `graph` (loaded from `settings.graph`) for `scene` on `gpu`'s
+/// memory requirements, with the scene's features and `settings`' toggles.
 pub fn compile_for_scene(
     gpu: &Gpu,
     scene: &Scene,
+    graph: &Prepared,
     settings: &RenderSettings,
 ) -> Result<Plan, RenderError> {
-    let loaded = weft_graph::load_with_params(&settings.graph, settings.params.clone());
+    let loaded = graph.graph();
     let mut requested = scene_features(scene);
     requested.extend(settings.features.iter().cloned());
     let memory = memory_requirements(gpu);
@@ -148,7 +158,7 @@ pub fn compile_for_scene(
         memory: &memory,
         readback: settings.extra_readback.clone(),
     };
-    let plan = crate::providers::compile(&loaded, &options).map_err(RenderError::Graph)?;
+    let plan = crate::providers::compile(graph, &options).map_err(RenderError::Graph)?;
     if let Some((image, size)) = weft_gpu::oversized_images(gpu, &plan).into_iter().next() {
         return Err(RenderError::ImageTooLarge {
             image,
@@ -160,13 +170,15 @@ pub fn compile_for_scene(
     Ok(plan)
 }
 
-/// Renders `scene` through the graph in `settings`.
+/// Renders `scene` through the graph in `settings` (loaded here; callers
+/// that keep the graph use [`render_with_progress`]).
 pub fn render(
     gpu: &Gpu,
     scene: &Scene,
     settings: &RenderSettings,
 ) -> Result<Rendered, RenderError> {
-    render_with_progress(gpu, scene, settings, &mut |_| {})
+    let graph = load_graph(settings)?;
+    render_with_progress(gpu, scene, &graph, settings, &mut |_| {})
 }
 
 /// Frames to draw: `settings.frames`, or as many as `settings.samples` needs
@@ -185,10 +197,12 @@ fn planned_frames(plan: &Plan, settings: &RenderSettings) -> Result<u32, RenderE
         .clamp(1, u64::from(u32::MAX)) as u32)
 }
 
-/// [`render`], calling `progress` after every frame.
+/// [`render`] of a graph already loaded from `settings.graph` (with
+/// `settings.params`), calling `progress` after every frame.
 pub fn render_with_progress(
     gpu: &Gpu,
     scene: &Scene,
+    graph: &Prepared,
     settings: &RenderSettings,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Rendered, RenderError> {
@@ -207,7 +221,7 @@ pub fn render_with_progress(
             available: "none".into(),
         })?,
     };
-    let plan = Arc::new(compile_for_scene(gpu, scene, settings)?);
+    let plan = Arc::new(compile_for_scene(gpu, scene, graph, settings)?);
     let count = planned_frames(&plan, settings)?;
     // Accumulating to a sample count keeps the scene still.
     let frame_time = if settings.samples.is_some() {

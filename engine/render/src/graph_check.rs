@@ -51,7 +51,7 @@ pub fn check_graph_and_shaders(
     if graph.is_fragment || diags.iter().any(Diagnostic::is_error) {
         return Ok(diags);
     }
-    let prepared = match Prepared::new(graph) {
+    let prepared = match Prepared::new(graph.clone()) {
         Ok(p) => p,
         Err(errors) => {
             diags.extend(errors);

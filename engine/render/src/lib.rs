@@ -49,7 +49,7 @@ pub mod watch;
 pub use error::RenderError;
 pub use features::scene_features;
 pub use frame::{
-    compile_for_scene, render, render_with_progress, Progress, RenderSettings, Rendered,
+    compile_for_scene, load_graph, render, render_with_progress, Progress, RenderSettings, Rendered,
 };
 pub use frame_loop::{FrameLoop, FrameRequest};
 pub use graph_check::{check_graph_and_shaders, ShaderTarget};

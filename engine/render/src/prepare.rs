@@ -4,7 +4,7 @@
 //! reads, so it can run on a worker thread while frames keep coming; the device
 //! work is left to [`crate::LiveRender::commit`].
 
-use crate::frame::{compile_for_scene, RenderSettings};
+use crate::frame::{compile_for_scene, load_graph, RenderSettings};
 use crate::reload_error::ReloadError;
 use crate::sources::{normalize, plan_shader_keys, scene_files, shader_files, Sources};
 use std::collections::{BTreeMap, BTreeSet};
@@ -13,6 +13,7 @@ use std::sync::Arc;
 use weft_gpu::pipeline::{PipelineCache, ShaderKey, ShaderModule};
 use weft_gpu::{Gpu, GpuError};
 use weft_graph::plan::Plan;
+use weft_graph::Prepared;
 use weft_scene::{Camera, Scene};
 
 /// The live version a reload starts from, owned (scene and plan shared) so a
@@ -24,6 +25,8 @@ pub struct ReloadBase {
     pub(crate) version: u64,
     pub(crate) scene_path: PathBuf,
     pub(crate) settings: RenderSettings,
+    /// The live graph, loaded from `settings.graph`.
+    pub(crate) graph: Arc<Prepared>,
     pub(crate) scene: Arc<Scene>,
     pub(crate) plan: Arc<Plan>,
     pub(crate) sources: Sources,
@@ -52,6 +55,8 @@ pub struct ReloadJob {
 pub struct PreparedReload {
     pub(crate) version: u64,
     pub(crate) settings: RenderSettings,
+    /// The graph loaded again, when its files or the settings naming it changed.
+    pub(crate) graph: Option<Arc<Prepared>>,
     /// The reloaded scene, when it changed.
     pub(crate) scene: Option<Arc<Scene>>,
     /// The recompiled plan, when the scene, graph or settings changed.
@@ -187,15 +192,9 @@ fn plan_modules(
         .collect()
 }
 
-/// The graph file and its includes, normalized.
-pub(crate) fn graph_files(graph: &Path) -> BTreeSet<PathBuf> {
-    let mut files: BTreeSet<PathBuf> = weft_graph::load(graph)
-        .files()
-        .iter()
-        .map(|p| normalize(p))
-        .collect();
-    files.insert(normalize(graph));
-    files
+/// A loaded graph's file and its includes, normalized.
+pub(crate) fn graph_files(graph: &weft_graph::LoadedGraph) -> BTreeSet<PathBuf> {
+    graph.files().iter().map(|p| normalize(p)).collect()
 }
 
 impl ReloadJob {
@@ -245,8 +244,15 @@ fn prepare_files(
     };
     let scene = new_scene.as_deref().unwrap_or(&base.scene);
     pick_camera(scene, &base.settings).map_err(|e| ReloadError::render(e, &base.scene_path))?;
+    let new_graph = if graph_changed {
+        let loaded = load_graph(&base.settings).map_err(|e| ReloadError::render(e, graph))?;
+        Some(Arc::new(loaded))
+    } else {
+        None
+    };
     let new_plan = if scene_changed || graph_changed {
-        let plan = compile_for_scene(gpu, scene, &base.settings)
+        let value = new_graph.as_deref().unwrap_or(&base.graph);
+        let plan = compile_for_scene(gpu, scene, value, &base.settings)
             .map_err(|e| ReloadError::render(e, graph))?;
         Some(Arc::new(plan))
     } else {
@@ -256,7 +262,7 @@ fn prepare_files(
     check_shaders(gpu, &mut checker.cache, plan, graph)?;
     let sources = Sources {
         graph: if graph_changed {
-            graph_files(graph)
+            graph_files(new_graph.as_deref().unwrap_or(&base.graph).graph())
         } else {
             base.sources.graph.clone()
         },
@@ -271,6 +277,7 @@ fn prepare_files(
     Ok(PreparedReload {
         version: base.version,
         settings: base.settings.clone(),
+        graph: new_graph,
         scene: new_scene,
         plan: new_plan,
         sources,
@@ -289,13 +296,24 @@ fn prepare_settings(
 ) -> Result<PreparedReload, ReloadError> {
     let graph = &settings.graph;
     pick_camera(&base.scene, settings).map_err(|e| ReloadError::render(e, &base.scene_path))?;
-    let plan =
-        compile_for_scene(gpu, &base.scene, settings).map_err(|e| ReloadError::render(e, graph))?;
+    // The same graph file with the same parameters is the live graph value
+    // (its edits arrive as file changes); another is loaded.
+    let same_graph =
+        settings.graph == base.settings.graph && settings.params == base.settings.params;
+    let new_graph = if same_graph {
+        None
+    } else {
+        let loaded = load_graph(settings).map_err(|e| ReloadError::render(e, graph))?;
+        Some(Arc::new(loaded))
+    };
+    let value = new_graph.as_deref().unwrap_or(&base.graph);
+    let plan = compile_for_scene(gpu, &base.scene, value, settings)
+        .map_err(|e| ReloadError::render(e, graph))?;
     let fail = |e: GpuError| ReloadError::gpu(e, graph);
     let mut cache = PipelineCache::new().map_err(fail)?;
     check_shaders(gpu, &mut cache, &plan, graph)?;
     let sources = Sources {
-        graph: graph_files(graph),
+        graph: graph_files(value.graph()),
         shaders: shader_files(&mut cache, &plan).map_err(fail)?,
         scene: base.sources.scene.clone(),
     };
@@ -303,6 +321,7 @@ fn prepare_settings(
     Ok(PreparedReload {
         version: base.version,
         settings: settings.clone(),
+        graph: new_graph,
         scene: None,
         plan: Some(Arc::new(plan)),
         sources,

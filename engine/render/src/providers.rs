@@ -139,11 +139,10 @@ pub fn check(graph: &weft_graph::LoadedGraph) -> Vec<Diagnostic> {
 /// the graph's own checks, its provider uses against [`PROVIDERS`], the plan,
 /// then the values computed once per plan added to it.
 pub fn compile(
-    graph: &weft_graph::LoadedGraph,
+    prepared: &weft_graph::Prepared,
     options: &weft_graph::CompileOptions,
 ) -> Result<Plan, Vec<Diagnostic>> {
-    let prepared = weft_graph::Prepared::new(graph)?;
-    let errors: Vec<Diagnostic> = check(graph)
+    let errors: Vec<Diagnostic> = check(prepared.graph())
         .into_iter()
         .filter(Diagnostic::is_error)
         .collect();

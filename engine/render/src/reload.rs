@@ -7,7 +7,7 @@
 //! version rendering and is reported at file:line.
 
 use crate::error::RenderError;
-use crate::frame::{compile_for_scene, RenderSettings};
+use crate::frame::{compile_for_scene, load_graph, RenderSettings};
 use crate::frame_loop::{FrameLoop, FrameRequest};
 use crate::prepare::{
     check_shaders, graph_files, pick_camera, PreparedReload, ReloadBase, ReloadChange, ReloadJob,
@@ -26,6 +26,7 @@ use weft_gpu::pipeline::PipelineCache;
 use weft_gpu::resources::GpuImage;
 use weft_gpu::{FrameReport, Gpu, GpuError};
 use weft_graph::plan::Plan;
+use weft_graph::Prepared;
 use weft_scene::SceneUpdater;
 use weft_scene::{Camera, Scene};
 
@@ -36,6 +37,9 @@ pub struct LiveRender<'g> {
     checker: ShaderChecker,
     gpu: &'g Gpu,
     settings: RenderSettings,
+    /// `settings.graph` loaded and resolved: loaded again only when one of
+    /// its files or the settings naming it change.
+    graph: Arc<Prepared>,
     scene_path: PathBuf,
     scene: Arc<Scene>,
     sources: Sources,
@@ -57,17 +61,29 @@ pub enum Committed {
 }
 
 impl<'g> LiveRender<'g> {
-    /// Loads the scene at `scene_path` and compiles `settings.graph` for it; the
-    /// first frame builds the pipelines.
+    /// Loads the scene at `scene_path` and `settings.graph` and compiles the
+    /// graph for the scene; the first frame builds the pipelines.
     pub fn new(
         gpu: &'g Gpu,
         scene_path: &Path,
         settings: RenderSettings,
     ) -> Result<Self, ReloadError> {
+        let graph = load_graph(&settings).map_err(|e| ReloadError::render(e, &settings.graph))?;
+        Self::with_graph(gpu, scene_path, graph, settings)
+    }
+
+    /// [`LiveRender::new`] with `settings.graph` already loaded (with
+    /// `settings.params`) as `graph`.
+    pub fn with_graph(
+        gpu: &'g Gpu,
+        scene_path: &Path,
+        graph: Prepared,
+        settings: RenderSettings,
+    ) -> Result<Self, ReloadError> {
         let scene = crate::scene_load::load_scene(scene_path, settings.cache_dir.as_deref())
             .map_err(|e| ReloadError::scene(&e))?;
         pick_camera(&scene, &settings).map_err(|e| ReloadError::render(e, scene_path))?;
-        let plan = compile_for_scene(gpu, &scene, &settings)
+        let plan = compile_for_scene(gpu, &scene, &graph, &settings)
             .map_err(|e| ReloadError::render(e, &settings.graph))?;
         let fail = |e: GpuError| ReloadError::gpu(e, &settings.graph);
         let mut cache = PipelineCache::new().map_err(fail)?;
@@ -77,7 +93,7 @@ impl<'g> LiveRender<'g> {
             .map_err(|e| ReloadError::render(e, scene_path))?;
         uploaded.cache_bvh_in(settings.cache_dir.clone());
         let sources = Sources {
-            graph: graph_files(&settings.graph),
+            graph: graph_files(graph.graph()),
             shaders: shader_files(&mut cache, &plan).map_err(fail)?,
             scene: scene_files(&scene),
         };
@@ -87,12 +103,18 @@ impl<'g> LiveRender<'g> {
             checker: ShaderChecker::new().map_err(fail)?,
             gpu,
             settings,
+            graph: Arc::new(graph),
             scene_path: scene_path.to_path_buf(),
             scene: Arc::new(scene),
             sources,
             pending: BTreeSet::new(),
             version: 0,
         })
+    }
+
+    /// The graph that renders now, loaded and resolved.
+    pub fn graph(&self) -> &Prepared {
+        &self.graph
     }
 
     /// The files this render depends on, to watch.
@@ -168,6 +190,7 @@ impl<'g> LiveRender<'g> {
             version: self.version,
             scene_path: self.scene_path.clone(),
             settings: self.settings.clone(),
+            graph: Arc::clone(&self.graph),
             scene: Arc::clone(&self.scene),
             plan: Arc::clone(self.frames.plan()),
             sources: self.sources.clone(),
@@ -244,6 +267,9 @@ impl<'g> LiveRender<'g> {
         if let Some(scene) = prepared.scene {
             self.scene = scene;
         }
+        if let Some(graph) = prepared.graph {
+            self.graph = graph;
+        }
         self.sources = prepared.sources;
         self.settings = prepared.settings;
         for file in &prepared.files {
@@ -295,14 +321,16 @@ pub fn startup_files(
     settings: &RenderSettings,
     error: &ReloadError,
 ) -> BTreeSet<PathBuf> {
-    let mut files = graph_files(&settings.graph);
+    let mut files = graph_files(&weft_graph::load(&settings.graph));
+    files.insert(normalize(&settings.graph));
     files.insert(normalize(&error.file));
     files.extend(scene_path_files(scene_path));
     let Ok(scene) = crate::scene_load::load_scene(scene_path, settings.cache_dir.as_deref()) else {
         return files;
     };
     files.extend(scene_files(&scene));
-    if let Ok(keys) = compile_for_scene(gpu, &scene, settings)
+    if let Ok(keys) = load_graph(settings)
+        .and_then(|graph| compile_for_scene(gpu, &scene, &graph, settings))
         .map_err(|e| e.to_string())
         .and_then(|plan| plan_shader_keys(&plan).map_err(|e| e.to_string()))
     {

@@ -88,7 +88,12 @@ pub struct ViewArgs {
 
 /// Runs `weft view`.
 pub fn run(args: ViewArgs) -> Result<ExitCode> {
-    crate::graph_cmd::check_feature_names(&args.graph, &args.features)?;
+    // Loaded once, before the window opens: its errors and unknown toggles stop here.
+    let graph = crate::graphs::load_checked(&RenderSettings {
+        graph: args.graph.clone(),
+        features: args.features.clone(),
+        ..RenderSettings::default()
+    })?;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::SeqCst))
@@ -123,7 +128,7 @@ pub fn run(args: ViewArgs) -> Result<ExitCode> {
         ..RenderSettings::default()
     };
     let outcome = std::thread::scope(|scope| -> Result<Result<()>> {
-        let mut app = app::Viewer::new(&gpu, &args, settings, stop, scope)?;
+        let mut app = app::Viewer::new(&gpu, &args, (graph, settings), stop, scope)?;
         event_loop.run_app(&mut app)?;
         Ok(app.finish())
     })?;

@@ -25,7 +25,16 @@ struct SharedSets<'a, 'g> {
     material: bool,
 }
 
-impl SharedSets<'_, '_> {
+impl<'a, 'g> SharedSets<'a, 'g> {
+    /// Set 1 of kind `scene` shared, for a fullscreen or compute pipeline.
+    fn scene_only((layouts, scene): (&'a SceneLayouts<'g>, SceneSet)) -> Self {
+        Self {
+            layouts,
+            scene,
+            material: false,
+        }
+    }
+
     fn layout(&self, set: u32) -> Option<vk::DescriptorSetLayout> {
         match set {
             SCENE_SET => Some(self.layouts.scene(self.scene)),
@@ -149,11 +158,7 @@ pub(super) fn build_graphics(
     (render_pass, blends, samples): (vk::RenderPass, &[BlendCode], u32),
     scene: Option<(&SceneLayouts<'_>, SceneSet)>,
 ) -> Result<Pipeline, GpuError> {
-    let shared = scene.map(|(layouts, scene)| SharedSets {
-        layouts,
-        scene,
-        material: false,
-    });
+    let shared = scene.map(SharedSets::scene_only);
     let pipeline = with_layout(
         device,
         &[vs, fs],
@@ -251,11 +256,7 @@ pub(super) fn build_compute(
     cs: &ShaderModule,
     scene: Option<(&SceneLayouts<'_>, SceneSet)>,
 ) -> Result<Pipeline, GpuError> {
-    let shared = scene.map(|(layouts, scene)| SharedSets {
-        layouts,
-        scene,
-        material: false,
-    });
+    let shared = scene.map(SharedSets::scene_only);
     let pipeline = with_layout(device, &[cs], vk::PipelineBindPoint::COMPUTE, 0, shared)?;
     let made = crate::graphics::shader_module(device, &cs.compiled).and_then(|m| {
         let stage = vk::PipelineShaderStageCreateInfo::default()

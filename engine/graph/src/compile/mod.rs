@@ -48,36 +48,35 @@ impl Default for CompileOptions<'_> {
     }
 }
 
-/// A loaded graph that passed the checks that do not depend on features or size,
-/// ready to compile many times (on resize, on a feature toggle) without re-validating.
-pub struct Prepared<'g> {
-    graph: &'g LoadedGraph,
+/// A graph loaded and resolved once, owned: it passed the checks that do not
+/// depend on features or size, and compiles many times (on resize, on a
+/// feature toggle, for each scene) without being read or validated again.
+/// Render, view, compare, sweep and hot reload keep one.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    graph: LoadedGraph,
     ir: Ir,
 }
 
-impl<'g> Prepared<'g> {
+impl Prepared {
     /// Validates names, formats, parameters and per-pass rules; returns every error found.
-    pub fn new(graph: &'g LoadedGraph) -> Result<Self, Vec<Diagnostic>> {
-        if graph.has_errors() {
-            return Err(graph.diagnostics.clone());
-        }
-        if graph.is_fragment {
-            let file = root_file(graph);
-            return Err(vec![Diagnostic::error(
-                file,
-                Pos { line: 1, col: 1 },
-                "this file is a fragment (`fragment: true`) and cannot be compiled on its own",
-            )
-            .with_hint(
-                "include it from a graph that declares its inputs and an output",
-            )]);
-        }
-        let (ir, mut diags) = resolve(graph);
-        if diags.iter().any(Diagnostic::is_error) {
-            diags.retain(Diagnostic::is_error);
-            return Err(diags);
-        }
+    pub fn new(graph: LoadedGraph) -> Result<Self, Vec<Diagnostic>> {
+        let ir = resolve_checked(&graph)?;
         Ok(Prepared { graph, ir })
+    }
+
+    /// Loads the graph file at `path` with parameter `overrides` and
+    /// prepares it.
+    pub fn load(
+        path: &std::path::Path,
+        overrides: std::collections::BTreeMap<String, crate::schema::ParamValue>,
+    ) -> Result<Self, Vec<Diagnostic>> {
+        Self::new(crate::load::load_with_params(path, overrides))
+    }
+
+    /// The loaded graph (files, declarations, parameters, features).
+    pub fn graph(&self) -> &LoadedGraph {
+        &self.graph
     }
 
     /// The resolved graph.
@@ -116,13 +115,38 @@ impl<'g> Prepared<'g> {
 
     /// Compiles for one size and feature set.
     pub fn compile(&self, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
-        compile_ir(self.graph, &self.ir, options)
+        compile_ir(&self.graph, &self.ir, options)
     }
+}
+
+/// Resolves a loaded graph after the checks that need no features or size:
+/// load errors, a fragment compiled alone, resolve errors.
+fn resolve_checked(graph: &LoadedGraph) -> Result<Ir, Vec<Diagnostic>> {
+    if graph.has_errors() {
+        return Err(graph.diagnostics.clone());
+    }
+    if graph.is_fragment {
+        let file = root_file(graph);
+        return Err(vec![Diagnostic::error(
+            file,
+            Pos { line: 1, col: 1 },
+            "this file is a fragment (`fragment: true`) and cannot be compiled on its own",
+        )
+        .with_hint(
+            "include it from a graph that declares its inputs and an output",
+        )]);
+    }
+    let (ir, mut diags) = resolve(graph);
+    if diags.iter().any(Diagnostic::is_error) {
+        diags.retain(Diagnostic::is_error);
+        return Err(diags);
+    }
+    Ok(ir)
 }
 
 /// Validates and compiles a loaded graph, or returns every error found.
 pub fn compile(graph: &LoadedGraph, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
-    Prepared::new(graph)?.compile(options)
+    compile_ir(graph, &resolve_checked(graph)?, options)
 }
 
 /// Whether every condition (`"name"` on, `"!name"` off) holds.

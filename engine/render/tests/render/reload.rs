@@ -16,8 +16,8 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use weft_gpu::{Gpu, GpuOptions, ShaderStage};
 use weft_graph::plan::Extent;
-use weft_render::WorkerReply;
 use weft_render::sources::normalize;
+use weft_render::WorkerReply;
 use weft_render::{Committed, LiveRender, ReloadWorker, RenderSettings};
 
 const QUAD_OBJ: &str =

@@ -103,16 +103,17 @@ struct ReloadProgress {
 }
 
 impl<'g> Viewer<'g> {
-    /// Loads the scene and graph and starts watching their files; the window
+    /// Loads the scene, compiles `graph` for it and starts watching their files; the window
     /// comes when the event loop resumes.
     pub fn new(
         gpu: &'g Gpu,
         args: &ViewArgs,
-        settings: RenderSettings,
+        (graph, settings): (weft_graph::Prepared, RenderSettings),
         stop: Arc<AtomicBool>,
         scope: &'g std::thread::Scope<'g, '_>,
     ) -> Result<Self> {
-        let live = LiveRender::new(gpu, &args.scene, settings).map_err(|e| anyhow!("{e}"))?;
+        let live = LiveRender::with_graph(gpu, &args.scene, graph, settings)
+            .map_err(|e| anyhow!("{e}"))?;
         let lens = live.camera()?.clone();
         let (position, orientation) = lens.pose_at(args.time);
         let start = FlyCamera {
@@ -147,7 +148,7 @@ impl<'g> Viewer<'g> {
             screenshot_now: false,
             screenshots: 0,
             graphs: controls::sibling_graphs(&graph),
-            features: controls::graph_features(&graph),
+            features: controls::graph_features(live.graph()),
             error: None,
             stats: Stats::default(),
             timings: Vec::new(),

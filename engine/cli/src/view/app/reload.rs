@@ -16,7 +16,7 @@ impl Viewer<'_> {
         match self.live.reconfigure(settings) {
             Ok(()) => {
                 if graph_changed {
-                    self.features = controls::graph_features(&self.live.settings().graph);
+                    self.features = controls::graph_features(self.live.graph());
                 }
                 if graph_changed || features_changed {
                     self.print_features();

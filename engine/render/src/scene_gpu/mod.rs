@@ -2,6 +2,9 @@
 //! textures, and the per-frame camera and light buffers; descriptor set 1 (scene
 //! data) and set 2 (a material's textures) that every scene shader binds.
 
+mod placement;
+mod trace;
+
 use crate::bindings::{self, *};
 use crate::camera;
 use crate::error::RenderError;
@@ -13,8 +16,10 @@ use crate::shadows::{self, ShadowSettings, ShadowView, ViewVolume};
 use crate::texture;
 use ash::vk;
 use glam::{UVec4, Vec4};
+use placement::changed_records;
 use std::collections::HashMap;
 use std::path::PathBuf;
+use trace::TraceBuffers;
 use weft_gpu::buffer::Buffer;
 use weft_gpu::descriptors::{DescriptorPool, DescriptorWriter};
 use weft_gpu::samplers::Sampler;
@@ -69,21 +74,6 @@ fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuE
             ),
         ],
     )
-}
-
-/// The ray tracer's scene data on the device.
-struct TraceBuffers<'g> {
-    triangles: Buffer<'g>,
-    nodes: Buffer<'g>,
-    order: Buffer<'g>,
-    normals: Buffer<'g>,
-    tangents: Buffer<'g>,
-    uvs: Buffer<'g>,
-    materials: Buffer<'g>,
-    emitters: Buffer<'g>,
-    /// Colour arrays by class, then data arrays by class.
-    textures: Vec<Texture<'g>>,
-    material_textures: Buffer<'g>,
 }
 
 /// Everything the scene shaders read, on the device.
@@ -373,93 +363,7 @@ impl<'g> GpuScene<'g> {
         writer.write(self.gpu, set);
     }
 
-    /// Builds the BVH over the scene's triangles and uploads it with them, once.
-    fn ensure_trace_buffers(&mut self) -> Result<(), GpuError> {
-        if self.trace.is_some() {
-            return Ok(());
-        }
-        let mesh = self.geometry.trace_mesh();
-        // Placements a script moves give new geometry each frame: not cached.
-        let cache = self.bvh_cache.as_deref().filter(|_| !self.moved);
-        let (bvh, cache_warning) = crate::bvh_cache::load_or_build(&mesh.corners, cache);
-        self.warnings.extend(cache_warning);
-        let corners: Vec<[f32; 4]> = mesh
-            .corners
-            .iter()
-            .flat_map(|t| t.map(|p| p.extend(1.0).to_array()))
-            .collect();
-        let normals: Vec<[f32; 4]> = mesh
-            .normals
-            .iter()
-            .flat_map(|t| t.map(|n| n.extend(0.0).to_array()))
-            .collect();
-        let uvs: Vec<[f32; 2]> = mesh
-            .uvs
-            .iter()
-            .flat_map(|t| t.map(|uv| uv.to_array()))
-            .collect();
-        let emitters = crate::emitters::EmitterTable::build(&mesh.corners, |t| {
-            crate::sanitize::radiance(self.geometry.materials[mesh.materials[t] as usize].emissive)
-        });
-        let trace_textures = crate::trace_textures::gather(&self.geometry.materials);
-        self.warnings
-            .extend(trace_textures.warnings.iter().cloned());
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        self.trace = Some(TraceBuffers {
-            triangles: Buffer::device_local(
-                self.gpu,
-                "trace triangles",
-                bytes_of(&corners),
-                storage,
-            )?,
-            nodes: Buffer::device_local(self.gpu, "bvh nodes", bytes_of(&bvh.nodes), storage)?,
-            order: Buffer::device_local(
-                self.gpu,
-                "bvh triangles",
-                bytes_of(&bvh.triangles),
-                storage,
-            )?,
-            normals: Buffer::device_local(self.gpu, "trace normals", bytes_of(&normals), storage)?,
-            tangents: Buffer::device_local(
-                self.gpu,
-                "trace tangents",
-                bytes_of(&mesh.tangents),
-                storage,
-            )?,
-            uvs: Buffer::device_local(self.gpu, "trace uvs", bytes_of(&uvs), storage)?,
-            materials: Buffer::device_local(
-                self.gpu,
-                "trace materials",
-                bytes_of(&mesh.materials),
-                storage,
-            )?,
-            emitters: Buffer::device_local(self.gpu, "emitters", &emitters.bytes(), storage)?,
-            textures: trace_textures
-                .colour
-                .iter()
-                .map(|layers| (layers, true))
-                .chain(trace_textures.data.iter().map(|layers| (layers, false)))
-                .map(|(layers, srgb)| {
-                    let white = [Rgba8Image::white()];
-                    let layers = if layers.is_empty() {
-                        &white[..]
-                    } else {
-                        layers
-                    };
-                    Texture::upload_layers(self.gpu, "trace textures", layers, srgb)
-                })
-                .collect::<Result<_, _>>()?,
-            material_textures: Buffer::device_local(
-                self.gpu,
-                "material texture slots",
-                bytes_of(&trace_textures.slots),
-                storage,
-            )?,
-        });
-        Ok(())
-    }
-
-    /// The buffer behind a set 1 binding of [`SCENE_SET_BINDINGS`].
+    /// The buffer behind a set 1 binding.
     fn scene_buffer(&self, binding: u32) -> Option<&Buffer<'_>> {
         match binding {
             FRAME_BINDING => Some(&self.frame),
@@ -470,17 +374,19 @@ impl<'g> GpuScene<'g> {
             LTC_TABLES_BINDING => Some(&self.ltc_tables),
             VERTICES_BINDING => Some(&self.vertices),
             INDICES_BINDING => Some(&self.indices),
-            TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.triangles),
-            BVH_NODES_BINDING => self.trace.as_ref().map(|t| &t.nodes),
-            BVH_TRIANGLES_BINDING => self.trace.as_ref().map(|t| &t.order),
-            TRIANGLE_NORMALS_BINDING => self.trace.as_ref().map(|t| &t.normals),
-            TRIANGLE_TANGENTS_BINDING => self.trace.as_ref().map(|t| &t.tangents),
-            TRIANGLE_UVS_BINDING => self.trace.as_ref().map(|t| &t.uvs),
-            TRIANGLE_MATERIALS_BINDING => self.trace.as_ref().map(|t| &t.materials),
-            EMITTERS_BINDING => self.trace.as_ref().map(|t| &t.emitters),
-            MATERIAL_TEXTURES_BINDING => self.trace.as_ref().map(|t| &t.material_textures),
-            _ => None,
+            _ => self.trace.as_ref().and_then(|t| t.buffer(binding)),
         }
+    }
+
+    /// Builds the ray tracer's buffers, once; placements a script has moved
+    /// give new geometry each frame, so their BVH is not cached.
+    fn ensure_trace_buffers(&mut self) -> Result<(), GpuError> {
+        if self.trace.is_none() {
+            let cache = self.bvh_cache.as_deref().filter(|_| !self.moved);
+            let built = TraceBuffers::build(self.gpu, &self.geometry, cache, &mut self.warnings)?;
+            self.trace = Some(built);
+        }
+        Ok(())
     }
 
     /// Caches the ray tracer's BVH in `dir` (the user's cache folder), so
@@ -577,76 +483,6 @@ impl<'g> GpuScene<'g> {
 }
 
 impl GpuScene<'_> {
-    /// Moves the placements the script moved: their draw records rewritten
-    /// in place as one range, the scene's box refitted (unless declared),
-    /// and the ray tracer's triangles and BVH rebuilt if a pass traces.
-    fn place_instances(&mut self, transforms: &[glam::Mat4]) -> Result<(), GpuError> {
-        self.moved_boxes.clear();
-        let Some(ids) =
-            self.geometry
-                .place_instances(transforms, &mut self.transforms, &mut self.moved_boxes)
-        else {
-            return Ok(());
-        };
-        self.moved = true;
-        if !self.emitter_lights.polygons.is_empty() {
-            // The light buffer was sized for the polygons at load: a moved
-            // emitter keeps its count (only non-finite corners could change it).
-            let moved = crate::emitter_lights::emitter_lights(&self.geometry);
-            if moved.polygons.len() == self.emitter_lights.polygons.len() {
-                self.emitter_lights = moved;
-            }
-        }
-        let records = &self.geometry.draw_records[ids.start as usize..ids.end as usize];
-        self.draws.write_at(
-            ids.start as usize * std::mem::size_of::<crate::gpu_types::GpuDraw>(),
-            bytes_of(records),
-        )?;
-        if self.declared_bounds.is_none() {
-            self.bounds = self.geometry.placed_bounds();
-        }
-        if self.trace.is_some() {
-            self.trace = None;
-            self.ensure_trace_buffers()?;
-            if let Some(set) = self.traced_set {
-                self.write_scene_set(set, true);
-            }
-        }
-        Ok(())
-    }
-
-    /// Repacks the material copies of the placements the script recoloured
-    /// and writes them as one range of the material buffer.
-    fn recolour_instances(&mut self, colors: &[Option<glam::Vec3>]) -> Result<(), GpuError> {
-        let mut changed: Option<(u32, u32)> = None;
-        for (i, (colour, overrides)) in colors.iter().zip(self.overrides.iter_mut()).enumerate() {
-            if *colour == overrides.color {
-                continue;
-            }
-            overrides.color = *colour;
-            for &(copy, original) in &self.geometry.instance_materials[i] {
-                let material = overrides.apply(&self.geometry.materials[original as usize]);
-                self.geometry.materials[copy as usize] = material;
-                changed = Some(changed.map_or((copy, copy), |(a, b)| (a.min(copy), b.max(copy))));
-            }
-        }
-        let Some((first, last)) = changed else {
-            return Ok(());
-        };
-        let records: Vec<GpuMaterial> = (first..=last)
-            .map(|m| {
-                pack_material(
-                    &self.geometry.materials[m as usize],
-                    self.normal_mapped[m as usize],
-                )
-            })
-            .collect();
-        self.materials.write_at(
-            first as usize * std::mem::size_of::<GpuMaterial>(),
-            bytes_of(&records),
-        )
-    }
-
     /// Where the draws the last [`GpuScene::update`] moved were and are now
     /// (world boxes): a kept shadow tile whose view meets one is stale.
     pub fn moved_boxes(&self) -> &[weft_scene::Aabb] {
@@ -692,20 +528,6 @@ fn rewritable<'g>(
     }
 }
 
-/// The records of `new` that differ from `old` (the light buffer's
-/// contents), as one range to write; all of them when the counts differ,
-/// none when nothing changed: what moved or changed colour is all that is
-/// written each frame.
-fn changed_records(old: &[GpuLight], new: &[GpuLight]) -> Option<std::ops::Range<usize>> {
-    if old.len() != new.len() {
-        return (!new.is_empty()).then_some(0..new.len());
-    }
-    let same = |i: &usize| bytes_of(&old[*i..*i + 1]) == bytes_of(&new[*i..*i + 1]);
-    let first = (0..new.len()).find(|i| !same(i))?;
-    let last = (0..new.len()).rev().find(|i| !same(i))?;
-    Some(first..last + 1)
-}
-
 fn source_key(source: &TextureSource) -> String {
     match source {
         TextureSource::File(p) => PathBuf::from(p).display().to_string(),
@@ -718,43 +540,5 @@ impl Drop for GpuScene<'_> {
     /// the device must have finished with them first.
     fn drop(&mut self) {
         let _ = self.gpu.wait_idle();
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use bytemuck::Zeroable;
-    use glam::Vec4;
-
-    fn at(x: f32) -> GpuLight {
-        GpuLight {
-            position_range: Vec4::new(x, 0.0, 0.0, 1.0),
-            ..GpuLight::zeroed()
-        }
-    }
-
-    #[test]
-    fn only_the_span_of_changed_light_records_is_written() {
-        let old: Vec<GpuLight> = (0..6).map(|i| at(i as f32)).collect();
-        assert_eq!(changed_records(&old, &old), None, "nothing changed");
-        let mut new = old.clone();
-        new[2] = at(20.0);
-        new[4] = at(40.0);
-        assert_eq!(changed_records(&old, &new), Some(2..5));
-        new.truncate(3);
-        assert_eq!(
-            changed_records(&old, &new),
-            Some(0..3),
-            "another count: all"
-        );
-        assert_eq!(
-            changed_records(&old, &[]),
-            None,
-            "no lights: nothing to write"
-        );
-        // NaN records compare by their bits: an unchanged NaN is not rewritten.
-        let nan = vec![at(f32::NAN)];
-        assert_eq!(changed_records(&nan, &nan), None);
     }
 }

@@ -22,6 +22,11 @@ use weft_graph::plan::Extent;
 use weft_graph::schema::ParamValue;
 use weft_render::{render_with_progress, RenderSettings, Rendered};
 
+mod reference;
+mod session;
+
+pub use session::Session;
+
 /// How per-pass times are taken.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Timer {
@@ -165,11 +170,12 @@ fn bar(label: &str) -> indicatif::ProgressBar {
 fn render(
     gpu: &Gpu,
     scene: &weft_scene::Scene,
+    graph: &weft_graph::Prepared,
     settings: &RenderSettings,
     label: &str,
 ) -> Result<Rendered> {
     let bar = bar(label);
-    let rendered = render_with_progress(gpu, scene, settings, &mut |p| {
+    let rendered = render_with_progress(gpu, scene, graph, settings, &mut |p| {
         bar.set_length(p.planned_frames.into());
         bar.set_position(p.frames.into());
         if let Some(samples) = p.samples {
@@ -258,319 +264,20 @@ fn names(graphs: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
-/// The reference: the given EXR, the cached render, or a new render (stored
-/// in the cache, or written to `out` with `--no-cache`).
-fn reference(
-    common: &Common,
-    gpu: &Gpu,
-    scene: &weft_scene::Scene,
-    camera: &str,
-    out: &Path,
-) -> Result<(LinearImage, ReferenceInfo)> {
-    let Extent { width, height } = common.size;
-    if let Some(path) = &common.reference_image {
-        let image = LinearImage::read_exr(path)?;
-        image.check_radiance(path)?;
-        if (image.width, image.height) != (width, height) {
-            bail!(
-                "--reference-image {} is {}x{}, but --size asks for {width}x{height} (images are not resampled)",
-                path.display(),
-                image.width,
-                image.height
-            );
-        }
-        return Ok((
-            image,
-            ReferenceInfo {
-                params: BTreeMap::new(),
-                graph: None,
-                spp: None,
-                seed: None,
-                cached: false,
-                image: path.clone(),
-                seconds: 0.0,
-            },
-        ));
-    }
-    let settings = RenderSettings {
-        graph: common.reference.clone(),
-        extent: common.size,
-        camera: Some(camera.to_string()),
-        features: common.features.clone(),
-        samples: Some(common.spp),
-        params: common
-            .reference_params
-            .iter()
-            .cloned()
-            .chain([(
-                "seed".to_string(),
-                ParamValue::Number(f64::from(common.seed)),
-            )])
-            .collect(),
-        cache_dir: weft_scene::cache::user_cache_dir(),
-        extra_readback: weft_graph::load(&common.reference).readback_names(),
-        ..RenderSettings::default()
-    };
-    let info = |cached, image, seconds| ReferenceInfo {
-        params: common
-            .reference_params
-            .iter()
-            .map(|(k, v)| (k.clone(), param_text(v)))
-            .collect(),
-        graph: Some(common.reference.clone()),
-        spp: Some(common.spp),
-        seed: Some(common.seed),
-        cached,
-        image,
-        seconds,
-    };
-    let cache = weft_scene::cache::user_cache_dir()
-        .filter(|_| !common.no_cache)
-        .map(|root| ReferenceCache::new(&root));
-    let digest = match &cache {
-        Some(_) => Some(reference_key(common, gpu, scene, camera, &settings)?.digest()?),
-        None => None,
-    };
-    // The reference the report links to is always an EXR in the output folder;
-    // the cache keeps its own framed copy.
-    let path = out.join("reference.exr");
-    if let (Some(cache), Some(digest)) = (&cache, &digest) {
-        match cache.load(digest, width, height) {
-            Ok(Some(image)) => {
-                image.write_exr(&path)?;
-                return Ok((image, info(true, path, 0.0)));
-            }
-            Ok(None) => {}
-            Err(damaged) => eprintln!("warning: {damaged}"),
-        }
-    }
-    let started = std::time::Instant::now();
-    let rendered = render(gpu, scene, &settings, "reference")?;
-    let image = linear(first_readback(&rendered, &common.reference)?);
-    let seconds = started.elapsed().as_secs_f64();
-    if let (Some(cache), Some(digest)) = (&cache, &digest) {
-        cache.store(digest, &image)?;
-    }
-    image.write_exr(&path)?;
-    Ok((image, info(false, path, seconds)))
-}
-
-/// Every input of the reference render: the scene's files, the graph's
-/// files and its shaders' sources, and the settings.
-fn reference_key(
-    common: &Common,
-    gpu: &Gpu,
-    scene: &weft_scene::Scene,
-    camera: &str,
-    settings: &RenderSettings,
-) -> Result<ReferenceKey> {
-    let mut files: BTreeSet<PathBuf> = weft_render::sources::scene_files(scene);
-    let loaded = weft_graph::load(&common.reference);
-    files.extend(
-        loaded
-            .sources
-            .iter()
-            .map(|s| weft_render::sources::normalize(&s.file)),
-    );
-    let plan = weft_render::compile_for_scene(gpu, scene, settings)?;
-    let mut shaders = weft_gpu::pipeline::PipelineCache::new()?;
-    files.extend(weft_render::sources::shader_files(&mut shaders, &plan)?.into_keys());
-    Ok(ReferenceKey {
-        files: files.into_iter().filter(|f| f.is_file()).collect(),
-        camera: camera.to_string(),
-        width: common.size.width,
-        height: common.size.height,
-        spp: common.spp,
-        seed: common.seed,
-        settings: common
-            .features
-            .iter()
-            .cloned()
-            .chain(
-                common
-                    .reference_params
-                    .iter()
-                    .map(|(k, v)| format!("{k}={}", param_text(v))),
-            )
-            .collect(),
-    })
-}
-
-/// A loaded scene, a device and the reference, ready to measure
-/// configurations against.
-pub struct Session {
-    gpu: Gpu,
-    log: std::sync::Arc<weft_gpu::validation::ValidationLog>,
-    scene: weft_scene::Scene,
-    /// The camera every configuration renders.
-    pub camera: String,
-    /// The device's name.
-    pub device: String,
-    timer: Timer,
-    /// The reference in linear HDR.
-    pub reference: LinearImage,
-    /// The reference through the engine's tonemap.
-    pub reference_ldr: SrgbImage,
-    /// Where it came from.
-    pub info: ReferenceInfo,
-}
-
-/// One configuration's measurements, and its images for the files.
-pub struct Measured {
-    /// The figures.
-    pub configuration: Configuration,
-    /// Its linear image.
-    pub image: LinearImage,
-    /// Its tonemapped output.
-    pub output: SrgbImage,
-    /// Its HDR-FLIP error map.
-    pub flip: weft_compare::FlipResult,
-}
-
-impl Session {
-    /// Loads the scene, opens the device and gets the reference (`out` is
-    /// where an uncached reference is written).
-    pub fn open(common: &Common, out: &Path) -> Result<Self> {
-        if common.no_cache {
-            weft_gpu::spirv_cache::set_dir(None);
-        }
-        let cache = weft_scene::cache::user_cache_dir().filter(|_| !common.no_cache);
-        let scene = weft_render::scene_load::load_scene(&common.scene, cache.as_deref())
-            .with_context(|| format!("loading {}", common.scene.display()))?;
-        let camera = match &common.camera {
-            Some(name) => name.clone(),
-            None => match scene.cameras.first() {
-                Some(c) => c.name.clone(),
-                None => bail!("{} has no camera", common.scene.display()),
-            },
-        };
-        std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-        let gpu = Gpu::new(&GpuOptions {
-            validation: common.validate,
-            device: common.device.clone(),
-        })?;
-        let log = gpu.validation();
-        let device = gpu.info().name.clone();
-        let timer = common
-            .timer
-            .unwrap_or(if gpu.info().kind == DeviceKind::Cpu {
-                Timer::Cpu
-            } else {
-                Timer::Gpu
-            });
-        let (reference, info) = reference(common, &gpu, &scene, &camera, out)?;
-        let reference_ldr = tonemap(&reference);
-        Ok(Self {
-            gpu,
-            log,
-            scene,
-            camera,
-            device,
-            timer,
-            reference,
-            reference_ldr,
-            info,
-        })
-    }
-
-    /// Renders `graph` (after one warm-up frame, `common.frames` frames) and
-    /// measures it against the reference.
-    pub fn measure(
-        &self,
-        common: &Common,
-        name: &str,
-        graph: &Path,
-        features: &[String],
-        params: &[(String, ParamValue)],
-    ) -> Result<Measured> {
-        let settings = RenderSettings {
-            graph: graph.to_path_buf(),
-            extent: common.size,
-            frames: common.frames + 1,
-            camera: Some(self.camera.clone()),
-            features: features.to_vec(),
-            params: params.iter().cloned().collect(),
-            timing: match self.timer {
-                Timer::Gpu => TimingMode::GpuTimestamps,
-                Timer::Cpu => TimingMode::CpuPerPass,
-            },
-            extra_readback: weft_graph::load(graph).readback_names(),
-            cache_dir: weft_scene::cache::user_cache_dir(),
-            ..RenderSettings::default()
-        };
-        let rendered = render(&self.gpu, &self.scene, &settings, name)?;
-        let image = linear(first_readback(&rendered, graph)?);
-        self.reference
-            .check_size(image.width, image.height, name)
-            .context("configurations must render at the reference's size")?;
-        let output = srgb(
-            rendered
-                .report
-                .output
-                .as_ref()
-                .context("the frame produced no output image")?,
-        );
-        let flip = hdr_flip(&self.reference, &image);
-        let mut frame_ms = rendered.frame_ms[1.min(rendered.frame_ms.len())..].to_vec();
-        let configuration = Configuration {
-            name: name.to_string(),
-            graph: graph.to_path_buf(),
-            features: rendered.plan.features.to_vec(),
-            params: params
-                .iter()
-                .map(|(k, v)| (k.clone(), param_text(v)))
-                .collect(),
-            flip: flip.mean,
-            flip_ldr: ldr_flip(&self.reference_ldr, &output).mean,
-            rmse: rmse(&image.pixels, &self.reference.pixels),
-            rel_mse: rel_mse(&image.pixels, &self.reference.pixels),
-            psnr: psnr(&output, &self.reference_ldr),
-            luminance_ratio: luminance_ratio(&image.pixels, &self.reference.pixels),
-            frame_ms: median(&mut frame_ms),
-            passes: pass_medians(&rendered),
-            transient_bytes: rendered.report.transient_bytes,
-            device_bytes: rendered.report.memory.allocated_bytes,
-            caveats: rendered.plan.caveats.clone(),
-            files: Vec::new(),
-        };
-        Ok(Measured {
-            configuration,
-            image,
-            output,
-            flip,
-        })
-    }
-
-    /// Ends the session: prints the validation messages and says whether
-    /// there were none.
-    pub fn finish(self, validate: bool) -> ExitCode {
-        let log = self.log.clone();
-        drop(self);
-        for w in weft_gpu::spirv_cache::take_warnings() {
-            eprintln!("warning: {w}");
-        }
-        let counts = log.counts();
-        for m in log.messages() {
-            eprintln!("validation {:?}: {}: {}", m.severity, m.id, m.text);
-        }
-        if validate {
-            println!("validation: {counts}");
-        }
-        if counts.is_clean() {
-            ExitCode::SUCCESS
-        } else {
-            ExitCode::FAILURE
-        }
-    }
-}
-
 /// Runs `weft compare`.
 pub fn run(args: CompareArgs) -> Result<ExitCode> {
     let common = &args.common;
+    // Every graph loaded (and its toggles checked) before the reference renders.
+    let mut graphs = crate::graphs::Loaded::default();
     for graph in &args.graphs {
-        crate::graph_cmd::check_feature_names(graph, &common.features)?;
+        graphs.get(&RenderSettings {
+            graph: graph.clone(),
+            features: common.features.clone(),
+            params: args.params.iter().cloned().collect(),
+            ..RenderSettings::default()
+        })?;
     }
-    let session = Session::open(common, &args.out)?;
+    let mut session = Session::open(common, &args.out, graphs)?;
     session
         .reference
         .write_exr(&args.out.join("reference.exr"))?;

@@ -1,0 +1,147 @@
+//! The reference every configuration is measured against: a given EXR, the
+//! cached render, or a new path-traced render stored in the cache.
+
+use super::*;
+
+/// The reference: the given EXR, the cached render, or a new render (stored
+/// in the cache, or written to `out` with `--no-cache`).
+pub(super) fn reference(
+    common: &Common,
+    gpu: &Gpu,
+    scene: &weft_scene::Scene,
+    camera: &str,
+    out: &Path,
+) -> Result<(LinearImage, ReferenceInfo)> {
+    let Extent { width, height } = common.size;
+    if let Some(path) = &common.reference_image {
+        let image = LinearImage::read_exr(path)?;
+        image.check_radiance(path)?;
+        if (image.width, image.height) != (width, height) {
+            bail!(
+                "--reference-image {} is {}x{}, but --size asks for {width}x{height} (images are not resampled)",
+                path.display(),
+                image.width,
+                image.height
+            );
+        }
+        return Ok((
+            image,
+            ReferenceInfo {
+                params: BTreeMap::new(),
+                graph: None,
+                spp: None,
+                seed: None,
+                cached: false,
+                image: path.clone(),
+                seconds: 0.0,
+            },
+        ));
+    }
+    let settings = RenderSettings {
+        graph: common.reference.clone(),
+        extent: common.size,
+        camera: Some(camera.to_string()),
+        features: common.features.clone(),
+        samples: Some(common.spp),
+        params: common
+            .reference_params
+            .iter()
+            .cloned()
+            .chain([(
+                "seed".to_string(),
+                ParamValue::Number(f64::from(common.seed)),
+            )])
+            .collect(),
+        cache_dir: weft_scene::cache::user_cache_dir(),
+        ..RenderSettings::default()
+    };
+    let graph = crate::graphs::load_checked(&settings)?;
+    let settings = RenderSettings {
+        extra_readback: graph.graph().readback_names(),
+        ..settings
+    };
+    let info = |cached, image, seconds| ReferenceInfo {
+        params: common
+            .reference_params
+            .iter()
+            .map(|(k, v)| (k.clone(), param_text(v)))
+            .collect(),
+        graph: Some(common.reference.clone()),
+        spp: Some(common.spp),
+        seed: Some(common.seed),
+        cached,
+        image,
+        seconds,
+    };
+    let cache = weft_scene::cache::user_cache_dir()
+        .filter(|_| !common.no_cache)
+        .map(|root| ReferenceCache::new(&root));
+    let digest = match &cache {
+        Some(_) => {
+            Some(reference_key(common, (gpu, scene), camera, (&graph, &settings))?.digest()?)
+        }
+        None => None,
+    };
+    // The reference the report links to is always an EXR in the output folder;
+    // the cache keeps its own framed copy.
+    let path = out.join("reference.exr");
+    if let (Some(cache), Some(digest)) = (&cache, &digest) {
+        match cache.load(digest, width, height) {
+            Ok(Some(image)) => {
+                image.write_exr(&path)?;
+                return Ok((image, info(true, path, 0.0)));
+            }
+            Ok(None) => {}
+            Err(damaged) => eprintln!("warning: {damaged}"),
+        }
+    }
+    let started = std::time::Instant::now();
+    let rendered = render(gpu, scene, &graph, &settings, "reference")?;
+    let image = linear(first_readback(&rendered, &common.reference)?);
+    let seconds = started.elapsed().as_secs_f64();
+    if let (Some(cache), Some(digest)) = (&cache, &digest) {
+        cache.store(digest, &image)?;
+    }
+    image.write_exr(&path)?;
+    Ok((image, info(false, path, seconds)))
+}
+
+/// Every input of the reference render: the scene's files, the graph's
+/// files and its shaders' sources, and the settings.
+fn reference_key(
+    common: &Common,
+    (gpu, scene): (&Gpu, &weft_scene::Scene),
+    camera: &str,
+    (graph, settings): (&weft_graph::Prepared, &RenderSettings),
+) -> Result<ReferenceKey> {
+    let mut files: BTreeSet<PathBuf> = weft_render::sources::scene_files(scene);
+    files.extend(
+        graph
+            .graph()
+            .sources
+            .iter()
+            .map(|s| weft_render::sources::normalize(&s.file)),
+    );
+    let plan = weft_render::compile_for_scene(gpu, scene, graph, settings)?;
+    let mut shaders = weft_gpu::pipeline::PipelineCache::new()?;
+    files.extend(weft_render::sources::shader_files(&mut shaders, &plan)?.into_keys());
+    Ok(ReferenceKey {
+        files: files.into_iter().filter(|f| f.is_file()).collect(),
+        camera: camera.to_string(),
+        width: common.size.width,
+        height: common.size.height,
+        spp: common.spp,
+        seed: common.seed,
+        settings: common
+            .features
+            .iter()
+            .cloned()
+            .chain(
+                common
+                    .reference_params
+                    .iter()
+                    .map(|(k, v)| format!("{k}={}", param_text(v))),
+            )
+            .collect(),
+    })
+}

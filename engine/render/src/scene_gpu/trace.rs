@@ -1,0 +1,122 @@
+//! The ray tracer's scene data on the device, built when a pass first traces:
+//! world-space triangles, the BVH over them, per-corner normals, tangents and
+//! UVs, per-triangle materials, the emitters' alias table and the texture
+//! arrays (set 1's tracing-only bindings, [`crate::bindings::TRACE_SET_BINDINGS`]).
+
+use crate::bindings::*;
+use crate::geometry::SceneGeometry;
+use crate::gpu_types::bytes_of;
+use ash::vk;
+use std::path::Path;
+use weft_gpu::buffer::Buffer;
+use weft_gpu::texture::{Rgba8Image, Texture};
+use weft_gpu::{Gpu, GpuError};
+
+/// The ray tracer's scene data on the device.
+pub(super) struct TraceBuffers<'g> {
+    pub(super) triangles: Buffer<'g>,
+    pub(super) nodes: Buffer<'g>,
+    pub(super) order: Buffer<'g>,
+    pub(super) normals: Buffer<'g>,
+    pub(super) tangents: Buffer<'g>,
+    pub(super) uvs: Buffer<'g>,
+    pub(super) materials: Buffer<'g>,
+    pub(super) emitters: Buffer<'g>,
+    /// Colour arrays by class, then data arrays by class.
+    pub(super) textures: Vec<Texture<'g>>,
+    pub(super) material_textures: Buffer<'g>,
+}
+
+impl<'g> TraceBuffers<'g> {
+    /// Builds the BVH over `geometry`'s triangles (read from and stored in
+    /// `cache` when given) and uploads it with them; what went wrong on the
+    /// way is added to `warnings`.
+    pub(super) fn build(
+        gpu: &'g Gpu,
+        geometry: &SceneGeometry,
+        cache: Option<&Path>,
+        warnings: &mut Vec<String>,
+    ) -> Result<Self, GpuError> {
+        let mesh = geometry.trace_mesh();
+        let (bvh, cache_warning) = crate::bvh_cache::load_or_build(&mesh.corners, cache);
+        warnings.extend(cache_warning);
+        let corners: Vec<[f32; 4]> = mesh
+            .corners
+            .iter()
+            .flat_map(|t| t.map(|p| p.extend(1.0).to_array()))
+            .collect();
+        let normals: Vec<[f32; 4]> = mesh
+            .normals
+            .iter()
+            .flat_map(|t| t.map(|n| n.extend(0.0).to_array()))
+            .collect();
+        let uvs: Vec<[f32; 2]> = mesh
+            .uvs
+            .iter()
+            .flat_map(|t| t.map(|uv| uv.to_array()))
+            .collect();
+        let emitters = crate::emitters::EmitterTable::build(&mesh.corners, |t| {
+            crate::sanitize::radiance(geometry.materials[mesh.materials[t] as usize].emissive)
+        });
+        let trace_textures = crate::trace_textures::gather(&geometry.materials);
+        warnings.extend(trace_textures.warnings.iter().cloned());
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        Ok(Self {
+            triangles: Buffer::device_local(gpu, "trace triangles", bytes_of(&corners), storage)?,
+            nodes: Buffer::device_local(gpu, "bvh nodes", bytes_of(&bvh.nodes), storage)?,
+            order: Buffer::device_local(gpu, "bvh triangles", bytes_of(&bvh.triangles), storage)?,
+            normals: Buffer::device_local(gpu, "trace normals", bytes_of(&normals), storage)?,
+            tangents: Buffer::device_local(
+                gpu,
+                "trace tangents",
+                bytes_of(&mesh.tangents),
+                storage,
+            )?,
+            uvs: Buffer::device_local(gpu, "trace uvs", bytes_of(&uvs), storage)?,
+            materials: Buffer::device_local(
+                gpu,
+                "trace materials",
+                bytes_of(&mesh.materials),
+                storage,
+            )?,
+            emitters: Buffer::device_local(gpu, "emitters", &emitters.bytes(), storage)?,
+            textures: trace_textures
+                .colour
+                .iter()
+                .map(|layers| (layers, true))
+                .chain(trace_textures.data.iter().map(|layers| (layers, false)))
+                .map(|(layers, srgb)| {
+                    let white = [Rgba8Image::white()];
+                    let layers = if layers.is_empty() {
+                        &white[..]
+                    } else {
+                        layers
+                    };
+                    Texture::upload_layers(gpu, "trace textures", layers, srgb)
+                })
+                .collect::<Result<_, _>>()?,
+            material_textures: Buffer::device_local(
+                gpu,
+                "material texture slots",
+                bytes_of(&trace_textures.slots),
+                storage,
+            )?,
+        })
+    }
+
+    /// The buffer behind a tracing-only set 1 binding.
+    pub(super) fn buffer(&self, binding: u32) -> Option<&Buffer<'g>> {
+        match binding {
+            TRIANGLES_BINDING => Some(&self.triangles),
+            BVH_NODES_BINDING => Some(&self.nodes),
+            BVH_TRIANGLES_BINDING => Some(&self.order),
+            TRIANGLE_NORMALS_BINDING => Some(&self.normals),
+            TRIANGLE_TANGENTS_BINDING => Some(&self.tangents),
+            TRIANGLE_UVS_BINDING => Some(&self.uvs),
+            TRIANGLE_MATERIALS_BINDING => Some(&self.materials),
+            EMITTERS_BINDING => Some(&self.emitters),
+            MATERIAL_TEXTURES_BINDING => Some(&self.material_textures),
+            _ => None,
+        }
+    }
+}
