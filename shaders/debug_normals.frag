@@ -8,13 +8,14 @@
 // +Y green, +Z blue); surfaces seen from behind show the normal turned round,
 // as shading uses it. The colours are written as bytes (UNORM target): the
 // image's values are the mapping's, not tonemapped.
+#include "include/bindings.glsl"
 #include "include/lighting.glsl"
 
 layout(push_constant) uniform Params {
     uint normals_mode;
 } params;
 
-layout(set = 2, binding = 2) uniform sampler2D normal_map;
+layout(set = SET_MATERIAL, binding = MATERIAL_NORMAL) uniform sampler2D normal_map;
 
 layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 world_normal;
@@ -29,7 +30,7 @@ void main() {
     vec4 tangent = gl_FrontFacing ? world_tangent : vec4(world_tangent.xyz, -world_tangent.w);
     n = gl_FrontFacing ? n : -n;
     vec3 mapped = n;
-#ifdef SHADE_NORMAL_MAPS
+#ifdef SCENE_NORMAL_MAPS
     mapped = mapped_normal(n, tangent, world, texcoord, texture(normal_map, texcoord).rgb, materials[material].ambient.w);
 #endif
     if (params.normals_mode == 2u) {

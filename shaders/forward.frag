@@ -7,6 +7,7 @@
 #ifdef HAS_SHADOW_MAP
 layout(set = 0, binding = 0) uniform sampler2DShadow shadow_map;
 #endif
+#include "include/bindings.glsl"
 #include "include/lighting.glsl"
 #ifdef HAS_VIEW_OVERSHADING
 // Debug view `overshading` (graphs/debug_views.ron): every invocation adds one
@@ -24,12 +25,12 @@ layout(push_constant) uniform Params {
     uint area_samples;     // graph parameter: 0 analytic area lights, n: n x n quadrature
 } params;
 
-layout(set = 2, binding = 0) uniform sampler2D base_color;
-layout(set = 2, binding = 1) uniform sampler2D metallic_roughness;
-layout(set = 2, binding = 2) uniform sampler2D normal_map;
+layout(set = SET_MATERIAL, binding = MATERIAL_BASE_COLOR) uniform sampler2D base_color;
+layout(set = SET_MATERIAL, binding = MATERIAL_METALLIC_ROUGHNESS) uniform sampler2D metallic_roughness;
+layout(set = SET_MATERIAL, binding = MATERIAL_NORMAL) uniform sampler2D normal_map;
 #ifdef SCENE_EMISSION_OCCLUSION_MAPS
-layout(set = 2, binding = 3) uniform sampler2D emissive_map;
-layout(set = 2, binding = 4) uniform sampler2D occlusion_map;
+layout(set = SET_MATERIAL, binding = MATERIAL_EMISSIVE) uniform sampler2D emissive_map;
+layout(set = SET_MATERIAL, binding = MATERIAL_OCCLUSION) uniform sampler2D occlusion_map;
 #endif
 
 layout(location = 0) in vec3 world;
@@ -52,7 +53,7 @@ void main() {
     // stay put, so does the handedness.
     vec4 tangent = gl_FrontFacing ? world_tangent : vec4(world_tangent.xyz, -world_tangent.w);
     n = gl_FrontFacing ? n : -n;
-#ifdef SHADE_NORMAL_MAPS
+#ifdef SCENE_NORMAL_MAPS
     n = mapped_normal(n, tangent, world, texcoord, texture(normal_map, texcoord).rgb, m.ambient.w);
 #endif
     Surface s = Surface(world, n, texel.rgb, material, mr);

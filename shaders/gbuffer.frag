@@ -2,6 +2,7 @@
 // Deferred geometry pass: what lighting needs, in the compact encoding of
 // include/gbuffer.glsl (12 bytes per pixel plus depth; 16 when the scene has
 // emissive or occlusion textures, whose samples go to gbuffer_emission).
+#include "include/bindings.glsl"
 #include "include/gbuffer.glsl"
 #ifdef HAS_VIEW_OVERSHADING
 // Debug view `overshading` (graphs/debug_views.ron): every invocation adds one
@@ -14,12 +15,12 @@ layout(std430, set = 0, binding = 7) buffer ViewOvershadingTotals { uint words[4
 #include "include/view_counts.glsl"
 #endif
 
-layout(set = 2, binding = 0) uniform sampler2D base_color;
-layout(set = 2, binding = 1) uniform sampler2D metallic_roughness;
-layout(set = 2, binding = 2) uniform sampler2D normal_map;
+layout(set = SET_MATERIAL, binding = MATERIAL_BASE_COLOR) uniform sampler2D base_color;
+layout(set = SET_MATERIAL, binding = MATERIAL_METALLIC_ROUGHNESS) uniform sampler2D metallic_roughness;
+layout(set = SET_MATERIAL, binding = MATERIAL_NORMAL) uniform sampler2D normal_map;
 #ifdef HAS_GBUFFER_EMISSION
-layout(set = 2, binding = 3) uniform sampler2D emissive_map;
-layout(set = 2, binding = 4) uniform sampler2D occlusion_map;
+layout(set = SET_MATERIAL, binding = MATERIAL_EMISSIVE) uniform sampler2D emissive_map;
+layout(set = SET_MATERIAL, binding = MATERIAL_OCCLUSION) uniform sampler2D occlusion_map;
 #endif
 
 layout(location = 0) in vec3 world;
@@ -49,7 +50,7 @@ void main() {
     // stay put, so does the handedness.
     vec4 tangent = gl_FrontFacing ? world_tangent : vec4(world_tangent.xyz, -world_tangent.w);
     n = gl_FrontFacing ? n : -n;
-#ifdef SHADE_NORMAL_MAPS
+#ifdef SCENE_NORMAL_MAPS
     n = mapped_normal(n, tangent, world, texcoord, texture(normal_map, texcoord).rgb, m.ambient.w);
 #endif
     normal = octahedral_encode_half(n);

@@ -25,8 +25,8 @@ layout(push_constant) uniform Push {
 // The tile lists are this pass's input: a variant for a feature set without
 // point or spot lights (which `weft graph check --shaders` tries) still reads
 // them, looping over the points (none are listed then).
-#if !defined(SHADE_POINT_LIGHTS) && !defined(SHADE_SPOT_LIGHTS)
-#define SHADE_POINT_LIGHTS
+#if !defined(SCENE_POINT_LIGHTS) && !defined(SCENE_SPOT_LIGHTS)
+#define SCENE_POINT_LIGHTS
 #endif
 
 layout(location = 0) in vec2 uv;
@@ -44,13 +44,13 @@ void main() {
         + shade_suns(s, m);
     uint record = tile_record(tile_of(ivec2(gl_FragCoord.xy)), pc.max_per_tile);
     uint slots = record + TILE_HEADER;
-#ifdef SHADE_POINT_LIGHTS
+#ifdef SCENE_POINT_LIGHTS
     uint points = tile_lights.words[record + 1u];
     for (uint k = 0u; k < points; ++k) {
         c += shade_point(tile_lights.words[slots + k], s, m);
     }
 #endif
-#ifdef SHADE_SPOT_LIGHTS
+#ifdef SCENE_SPOT_LIGHTS
     uint spots = tile_lights.words[record + 2u];
     uint last = slots + pc.max_per_tile - 1u;
     for (uint k = 0u; k < spots; ++k) {

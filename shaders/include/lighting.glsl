@@ -15,8 +15,9 @@
 // `SCENE_NORMAL_MAPS`. Code for what the scene lacks is not compiled: GPUs (and
 // lavapipe, which runs both sides of every branch) pay for every light type and
 // model a generic loop contains. A shader compiled without `SCENE_SPECIALISED`
-// shades everything. The `SHADE_*` names below are this file's own, so the
-// includer's `SCENE_*` defines keep their meaning elsewhere (the path tracer).
+// shades everything: this file then defines every `SCENE_*` name above itself.
+// Declared defines are named `SCENE_*` after the scene feature that sets them;
+// `HAS_*` names are the engine's, one per conditional read (`HAS_SHADOW_MAP`).
 #ifndef WEFT_LIGHTING_GLSL
 #define WEFT_LIGHTING_GLSL
 #include "scene.glsl"
@@ -24,54 +25,45 @@
 #include "brdf.glsl"
 #include "area_light.glsl"
 
-#ifdef SCENE_SPECIALISED
-#ifdef SCENE_SUNS
-#define SHADE_SUNS
+// Unspecialised (no `SCENE_SPECIALISED`), every light type and model compiles.
+#ifndef SCENE_SPECIALISED
+#ifndef SCENE_SUNS
+#define SCENE_SUNS
 #endif
-#ifdef SCENE_POINT_LIGHTS
-#define SHADE_POINT_LIGHTS
+#ifndef SCENE_POINT_LIGHTS
+#define SCENE_POINT_LIGHTS
 #endif
-#ifdef SCENE_SPOT_LIGHTS
-#define SHADE_SPOT_LIGHTS
+#ifndef SCENE_SPOT_LIGHTS
+#define SCENE_SPOT_LIGHTS
 #endif
-#ifdef SCENE_AREA_LIGHTS
-#define SHADE_AREA_LIGHTS
+#ifndef SCENE_AREA_LIGHTS
+#define SCENE_AREA_LIGHTS
 #endif
-#ifdef SCENE_RECT_LIGHTS
-#define SHADE_RECT_LIGHTS
+#ifndef SCENE_RECT_LIGHTS
+#define SCENE_RECT_LIGHTS
 #endif
-#ifdef SCENE_DISC_LIGHTS
-#define SHADE_DISC_LIGHTS
+#ifndef SCENE_DISC_LIGHTS
+#define SCENE_DISC_LIGHTS
 #endif
-#ifdef SCENE_BLINN_PHONG
-#define SHADE_BLINN_PHONG
+#ifndef SCENE_BLINN_PHONG
+#define SCENE_BLINN_PHONG
 #endif
-#ifdef SCENE_METALLIC_ROUGHNESS
-#define SHADE_METALLIC_ROUGHNESS
+#ifndef SCENE_METALLIC_ROUGHNESS
+#define SCENE_METALLIC_ROUGHNESS
 #endif
-#ifdef SCENE_NORMAL_MAPS
-#define SHADE_NORMAL_MAPS
+#ifndef SCENE_NORMAL_MAPS
+#define SCENE_NORMAL_MAPS
 #endif
-#else
-#define SHADE_SUNS
-#define SHADE_POINT_LIGHTS
-#define SHADE_SPOT_LIGHTS
-#define SHADE_AREA_LIGHTS
-#define SHADE_RECT_LIGHTS
-#define SHADE_DISC_LIGHTS
-#define SHADE_BLINN_PHONG
-#define SHADE_METALLIC_ROUGHNESS
-#define SHADE_NORMAL_MAPS
 #endif
 // A scene with neither model (no meshes) still compiles one.
-#if !defined(SHADE_METALLIC_ROUGHNESS) && !defined(SHADE_BLINN_PHONG)
-#define SHADE_BLINN_PHONG
+#if !defined(SCENE_METALLIC_ROUGHNESS) && !defined(SCENE_BLINN_PHONG)
+#define SCENE_BLINN_PHONG
 #endif
 // A bound shadow map means a sun, a spot or an area light casts shadows: a
 // pass that loops over none of them (feature sets `weft graph check --shaders` tries, not scenes)
 // keeps the sun loop, so the map it is given is used.
-#if defined(HAS_SHADOW_MAP) && !defined(SHADE_SUNS) && !defined(SHADE_SPOT_LIGHTS) && !defined(SHADE_AREA_LIGHTS)
-#define SHADE_SUNS
+#if defined(HAS_SHADOW_MAP) && !defined(SCENE_SUNS) && !defined(SCENE_SPOT_LIGHTS) && !defined(SCENE_AREA_LIGHTS)
+#define SCENE_SUNS
 #endif
 
 // Area lights and the environment read the LTC tables' lobe integrals.
@@ -130,8 +122,8 @@ vec3 blinn_phong(Material m, Surface s, vec3 l, vec3 radiance) {
 // of albedo Kd shows Kd C and every model returns pi f cos(theta) C, f its
 // BSDF; the path tracer (pathtrace/lights.glsl) uses the same rule.
 vec3 reflected(Material m, Surface s, vec3 l, vec3 radiance) {
-#ifdef SHADE_METALLIC_ROUGHNESS
-#ifdef SHADE_BLINN_PHONG
+#ifdef SCENE_METALLIC_ROUGHNESS
+#ifdef SCENE_BLINN_PHONG
     if (m.emissive.w != SHADING_METALLIC_ROUGHNESS) {
         return blinn_phong(m, s, l, radiance);
     }
@@ -175,9 +167,9 @@ vec3 shade_area_quadrature(uint index, AreaOutline o, Surface s, Material m, uin
     return sum * lights[index].color_exponent.rgb;
 }
 
-#ifdef SHADE_AREA_LIGHTS
+#ifdef SCENE_AREA_LIGHTS
 
-#ifdef SHADE_METALLIC_ROUGHNESS
+#ifdef SCENE_METALLIC_ROUGHNESS
 // A glTF material under an area light: the single-scattering GGX highlight
 // from its table, Fresnel from the table's Fresnel moment; the multiple-
 // scattering and diffuse lobes (brdf.glsl, separable in view and light)
@@ -198,7 +190,7 @@ vec3 area_ltc_metallic_roughness(Surface s, Material m, float ndv, mat3 local, f
 }
 #endif
 
-#ifdef SHADE_BLINN_PHONG
+#ifdef SCENE_BLINN_PHONG
 // A Blinn-Phong material under an area light: Kd times the form factor (the
 // irradiance over pi, as `blinn_phong` shows Kd C for irradiance pi C), and
 // the highlight from its table, divided by pi likewise, with the exponent read
@@ -225,8 +217,8 @@ vec3 shade_area_ltc(uint index, AreaOutline o, Surface s, Material m) {
     // Only the shapes the scene has are compiled: lavapipe would run a
     // 12-gon's corners for every rectangle otherwise. Emissive polygons count
     // as four-cornered lights (scene feature `rect_lights`).
-#if defined(SHADE_RECT_LIGHTS) && defined(SHADE_DISC_LIGHTS)
-#elif defined(SHADE_DISC_LIGHTS)
+#if defined(SCENE_RECT_LIGHTS) && defined(SCENE_DISC_LIGHTS)
+#elif defined(SCENE_DISC_LIGHTS)
     o.disc = true;
 #else
     o.disc = false;
@@ -245,11 +237,11 @@ vec3 shade_area_ltc(uint index, AreaOutline o, Surface s, Material m) {
     t1 = dot(t1, t1) > 1e-12 ? normalize(t1) : normalize(cross(n, helper));
     mat3 local = transpose(mat3(t1, cross(n, t1), n));
     float diffuse = ltc_integral(local, o, side);
-#if defined(SHADE_METALLIC_ROUGHNESS) && defined(SHADE_BLINN_PHONG)
+#if defined(SCENE_METALLIC_ROUGHNESS) && defined(SCENE_BLINN_PHONG)
     vec3 result = m.emissive.w == SHADING_METALLIC_ROUGHNESS
         ? area_ltc_metallic_roughness(s, m, ndv, local, diffuse, o, side)
         : area_ltc_blinn_phong(s, m, ndv, local, diffuse, o, side);
-#elif defined(SHADE_METALLIC_ROUGHNESS)
+#elif defined(SCENE_METALLIC_ROUGHNESS)
     vec3 result = area_ltc_metallic_roughness(s, m, ndv, local, diffuse, o, side);
 #else
     vec3 result = area_ltc_blinn_phong(s, m, ndv, local, diffuse, o, side);
@@ -289,7 +281,7 @@ vec3 shade_spot(uint index, Surface s, Material m) {
 // records' ranges (suns, points, spots, areas: engine/render/src/lights.rs).
 vec3 shade_suns(Surface s, Material m) {
     vec3 c = vec3(0.0);
-#ifdef SHADE_SUNS
+#ifdef SCENE_SUNS
     for (uint i = 0u; i < frame.counts.x; ++i) {
         c += shade_sun(i, s, m);
     }
@@ -301,7 +293,7 @@ vec3 shade_suns(Surface s, Material m) {
 // (LTC), n > 0 by n x n quadrature.
 vec3 shade_area_lights(Surface s, Material m, uint area_samples) {
     vec3 c = vec3(0.0);
-#ifdef SHADE_AREA_LIGHTS
+#ifdef SCENE_AREA_LIGHTS
     // Area lights, then the emissive polygons after every other record.
     uint end = frame.counts.w + frame.emitter_lights.x;
     for (uint i = frame.counts.x + frame.counts.y + frame.counts.z; i < end; ++i) {
@@ -320,12 +312,12 @@ vec3 shade_area_lights(Surface s, Material m, uint area_samples) {
 
 vec3 shade_all_lights(Surface s, Material m, uint area_samples) {
     vec3 c = shade_suns(s, m);
-#ifdef SHADE_POINT_LIGHTS
+#ifdef SCENE_POINT_LIGHTS
     for (uint i = frame.counts.x; i < frame.counts.x + frame.counts.y; ++i) {
         c += shade_point(i, s, m);
     }
 #endif
-#ifdef SHADE_SPOT_LIGHTS
+#ifdef SCENE_SPOT_LIGHTS
     uint first_spot = frame.counts.x + frame.counts.y;
     for (uint i = first_spot; i < first_spot + frame.counts.z; ++i) {
         c += shade_spot(i, s, m);
@@ -348,7 +340,7 @@ vec3 shade_all_lights(Surface s, Material m, uint area_samples) {
 vec3 environment_albedo(Surface s, Material m) {
     vec3 v = normalize(frame.camera_position.xyz - s.position);
     float ndv = clamp(dot(s.normal, v), 1e-3, 1.0);
-#ifdef SHADE_METALLIC_ROUGHNESS
+#ifdef SCENE_METALLIC_ROUGHNESS
     if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
         return ggx_directional_albedo(m.diffuse.rgb * s.texel, s.metal_rough, ndv);
     }

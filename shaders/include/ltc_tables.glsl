@@ -6,13 +6,14 @@
 // (brdf.glsl) reads.
 #ifndef WEFT_LTC_TABLES_GLSL
 #define WEFT_LTC_TABLES_GLSL
+#include "bindings.glsl"
 
 // 32 x 32 entries per table, row j = perceptual roughness j / 31 (at least
 // 0.045), column k = sqrt(1 - N.V) * 31. In vec4s: the GGX inverse matrices
 // (a, b, c, d of the rows [[a, 0, b], [0, 1, 0], [c, 0, d]]), the GGX (lobe
 // integral, Fresnel moment, 0, 0), then the same two for Blinn-Phong
 // (weft_render::scene_gpu::ltc_table_words).
-layout(std430, set = 1, binding = 20) readonly buffer LtcTables { vec4 ltc_tables[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_LTC_TABLES) readonly buffer LtcTables { vec4 ltc_tables[]; };
 
 const int LTC_SIZE = 32;
 const int LTC_ENTRIES = LTC_SIZE * LTC_SIZE;

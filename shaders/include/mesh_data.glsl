@@ -5,10 +5,11 @@
 // three floats.
 #ifndef WEFT_MESH_DATA_GLSL
 #define WEFT_MESH_DATA_GLSL
+#include "bindings.glsl"
 #include "scene.glsl"
 
-layout(std430, set = 1, binding = 21) readonly buffer Vertices { uint vertex_words[]; };
-layout(std430, set = 1, binding = 22) readonly buffer Indices { uint indices[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_VERTICES) readonly buffer Vertices { uint vertex_words[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_INDICES) readonly buffer Indices { uint indices[]; };
 
 // Words per vertex.
 #define VERTEX_WORDS 5u

@@ -3,6 +3,7 @@
 // layouts, with their sizes asserted; keep them in step).
 #ifndef WEFT_SCENE_GLSL
 #define WEFT_SCENE_GLSL
+#include "bindings.glsl"
 
 // Light types (engine/render/src/lights.rs).
 #define LIGHT_SUN 0.0
@@ -63,7 +64,7 @@ struct Draw {
     vec4 uv_box;     // the mesh's UVs: xy smallest, zw size (vertex UVs are fractions of it)
 };
 
-layout(set = 1, binding = 0) uniform Frame {
+layout(set = SET_SCENE, binding = BINDING_FRAME) uniform Frame {
     mat4 view_proj;
     mat4 inv_view_proj;
     vec4 camera_position;
@@ -73,8 +74,8 @@ layout(set = 1, binding = 0) uniform Frame {
     uvec4 emitter_lights;  // x: emissive polygon records after the counts.w others
 } frame;
 
-layout(std430, set = 1, binding = 1) readonly buffer Lights { Light lights[]; };
-layout(std430, set = 1, binding = 2) readonly buffer Draws { Draw draws[]; };
-layout(std430, set = 1, binding = 3) readonly buffer Materials { Material materials[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_LIGHTS) readonly buffer Lights { Light lights[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_DRAWS) readonly buffer Draws { Draw draws[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_MATERIALS) readonly buffer Materials { Material materials[]; };
 
 #endif

@@ -9,6 +9,7 @@
 // `uniform sampler2DShadow shadow_map` first; shadow.vert uses only the record.
 #ifndef WEFT_SHADOWS_GLSL
 #define WEFT_SHADOWS_GLSL
+#include "bindings.glsl"
 #include "scene.glsl"
 #include "area_light.glsl"
 
@@ -20,7 +21,7 @@ struct ShadowView {
     vec4 light;    // area-light views: the light's size, the view's near and far depth
 };
 
-layout(std430, set = 1, binding = 4) readonly buffer Shadows {
+layout(std430, set = SET_SCENE, binding = BINDING_SHADOWS) readonly buffer Shadows {
     uvec4 shadow_counts;    // cascades, spot views, light index of the first spot cone, PCF radius
     vec4 shadow_splits;     // far view depth of each cascade
     vec4 shadow_forward;    // camera view direction, w: normal offset in texels

@@ -3,6 +3,7 @@
 // to brute force). Set 1, beside scene.glsl's bindings 0..4.
 #ifndef WEFT_TRACE_GLSL
 #define WEFT_TRACE_GLSL
+#include "bindings.glsl"
 
 // Inner node: count 0, children at first and first + 1. Leaf: triangles
 // bvh_triangles[first .. first + count].
@@ -13,19 +14,19 @@ struct BvhNode {
     uint count;
 };
 
-layout(std430, set = 1, binding = 5) readonly buffer Triangles { vec4 corners[]; };
-layout(std430, set = 1, binding = 6) readonly buffer BvhNodes { BvhNode nodes[]; };
-layout(std430, set = 1, binding = 7) readonly buffer BvhTriangles { uint bvh_triangles[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLES) readonly buffer Triangles { vec4 corners[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_BVH_NODES) readonly buffer BvhNodes { BvhNode nodes[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_BVH_TRIANGLES) readonly buffer BvhTriangles { uint bvh_triangles[]; };
 // Per corner (3 per triangle, in Triangles' order): unit world normal, UV.
-layout(std430, set = 1, binding = 8) readonly buffer TriangleNormals { vec4 corner_normals[]; };
-layout(std430, set = 1, binding = 9) readonly buffer TriangleUvs { vec2 corner_uvs[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_NORMALS) readonly buffer TriangleNormals { vec4 corner_normals[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_UVS) readonly buffer TriangleUvs { vec2 corner_uvs[]; };
 // Per triangle: index into the Materials buffer (scene.glsl, binding 3).
-layout(std430, set = 1, binding = 10) readonly buffer TriangleMaterials { uint triangle_materials[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_MATERIALS) readonly buffer TriangleMaterials { uint triangle_materials[]; };
 // The emissive triangles as an alias table over emitted power
 // (engine/render/src/emitters.rs): emitter_info = (count, bits of the sum of
 // luminance x area, 0, 0); per emitter (triangle, alias, bits of the keep
 // threshold, 0).
-layout(std430, set = 1, binding = 11) readonly buffer Emitters {
+layout(std430, set = SET_SCENE, binding = BINDING_EMITTERS) readonly buffer Emitters {
     uvec4 emitter_info;
     uvec4 emitters[];
 };
@@ -35,15 +36,15 @@ layout(std430, set = 1, binding = 11) readonly buffer Emitters {
 // colour arrays at 12-14 and UNORM data arrays at 15-17; per material
 // (base colour slot, metallic-roughness slot, 0, 0), a slot being
 // class << 16 | layer, or 0xffffffff for none; the normal map's slot is z.
-layout(set = 1, binding = 12) uniform sampler2DArray trace_colour_256;
-layout(set = 1, binding = 13) uniform sampler2DArray trace_colour_512;
-layout(set = 1, binding = 14) uniform sampler2DArray trace_colour_1024;
-layout(set = 1, binding = 15) uniform sampler2DArray trace_data_256;
-layout(set = 1, binding = 16) uniform sampler2DArray trace_data_512;
-layout(set = 1, binding = 17) uniform sampler2DArray trace_data_1024;
-layout(std430, set = 1, binding = 18) readonly buffer MaterialTextures { uvec4 material_textures[]; };
+layout(set = SET_SCENE, binding = BINDING_TRACE_COLOUR_256) uniform sampler2DArray trace_colour_256;
+layout(set = SET_SCENE, binding = BINDING_TRACE_COLOUR_512) uniform sampler2DArray trace_colour_512;
+layout(set = SET_SCENE, binding = BINDING_TRACE_COLOUR_1024) uniform sampler2DArray trace_colour_1024;
+layout(set = SET_SCENE, binding = BINDING_TRACE_DATA_256) uniform sampler2DArray trace_data_256;
+layout(set = SET_SCENE, binding = BINDING_TRACE_DATA_512) uniform sampler2DArray trace_data_512;
+layout(set = SET_SCENE, binding = BINDING_TRACE_DATA_1024) uniform sampler2DArray trace_data_1024;
+layout(std430, set = SET_SCENE, binding = BINDING_MATERIAL_TEXTURES) readonly buffer MaterialTextures { uvec4 material_textures[]; };
 // Per corner: unit world tangent, w the bitangent's sign (0 without tangents).
-layout(std430, set = 1, binding = 19) readonly buffer TriangleTangents { vec4 corner_tangents[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_TANGENTS) readonly buffer TriangleTangents { vec4 corner_tangents[]; };
 
 #define NO_TEXTURE 0xffffffffu
 

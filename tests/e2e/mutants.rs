@@ -346,6 +346,7 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
                 ("gbuffer.ron", "gbuffer.ron"),
                 ("debug_views.ron", "debug_views.ron"),
                 ("raster_caveats.ron", "raster_caveats.ron"),
+                ("scene_shading.ron", "scene_shading.ron"),
             ] {
                 if text.contains(named) {
                     text.push_str(&text_of(fragment));

@@ -272,12 +272,29 @@ fn mixed_models_scene(dir: &std::path::Path) -> std::path::PathBuf {
 fn draws_are_grouped_by_shading_model_with_one_variant_each_and_the_image_unchanged() {
     let dir = std::env::temp_dir().join(format!("weft-mixed-models-{}", std::process::id()));
     let scene = mixed_models_scene(&dir);
-    // The same graph without `draws:`: one variant with both models, chosen per pixel.
+    // The same graph without `draws:`: one variant with both models, chosen
+    // per pixel. The models' defines come from the define set `scene_models`
+    // (scene_shading.ron), which groups draws; the copy names the models'
+    // defines itself instead, without `draws`.
     let text = std::fs::read_to_string(graph("forward.ron")).expect("forward.ron");
+    let shading = std::fs::read_to_string(graph("scene_shading.ron")).expect("scene_shading.ron");
+    assert!(
+        shading.contains(
+            r#"(name: "SCENE_BLINN_PHONG", enabled_if: ["blinn_phong"], draws: BlinnPhong)"#
+        ),
+        "scene_models groups draws by model"
+    );
     let ungrouped_text = text
-        .replace(", draws: BlinnPhong", "")
-        .replace(", draws: MetallicRoughness", "");
-    assert_ne!(ungrouped_text, text, "forward.ron groups its draws");
+        .replace(r#"define_sets: ["scene_models", "#, "define_sets: [")
+        .replace(
+            "            defines: [\n",
+            "            defines: [\n                (name: \"SCENE_BLINN_PHONG\", enabled_if: [\"blinn_phong\"]),\n                (name: \"SCENE_METALLIC_ROUGHNESS\", enabled_if: [\"metallic_roughness\"]),\n",
+        );
+    assert_eq!(
+        ungrouped_text.matches("SCENE_METALLIC_ROUGHNESS").count(),
+        2,
+        "both forward passes name the models' defines themselves"
+    );
     let ungrouped = dir.join("forward_ungrouped.ron");
     std::fs::write(&ungrouped, absolute_paths(&ungrouped_text)).expect("graph");
 

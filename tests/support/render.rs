@@ -42,6 +42,7 @@ pub fn absolute_paths(text: &str) -> String {
         "debug_views.ron",
         "gbuffer.ron",
         "raster_caveats.ron",
+        "scene_shading.ron",
         "shadows.ron",
     ] {
         text = text.replace(

@@ -101,12 +101,27 @@ pub fn graph_variant(text: &str, dir: &Path, params: &str) -> Result<String> {
     );
     let text = format!("{}{include}{}", &text[..start], &text[end + 1..]);
     let shaders = dir.join("../shaders");
-    Ok(text
-        .replace(
-            "(file: \"bloom.ron\"",
-            &format!("(file: \"{}\"", dir.join("bloom.ron").display()),
-        )
-        .replace("\"../shaders/", &format!("\"{}/", shaders.display())))
+    Ok(
+        absolute_includes(&text, dir)
+            .replace("\"../shaders/", &format!("\"{}/", shaders.display())),
+    )
+}
+
+/// `text` with every include given relative to `dir` made absolute.
+fn absolute_includes(text: &str, dir: &Path) -> String {
+    const INCLUDE: &str = "(file: \"";
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find(INCLUDE) {
+        let (before, after) = rest.split_at(at + INCLUDE.len());
+        out.push_str(before);
+        if !after.starts_with('/') {
+            out.push_str(&format!("{}/", dir.display()));
+        }
+        rest = after;
+    }
+    out.push_str(rest);
+    out
 }
 
 /// The scene reduced to its first sun, without ambient light, and the same

@@ -8,12 +8,16 @@ use crate::context::Gpu;
 use crate::descriptors::SetLayout;
 use crate::error::GpuError;
 use crate::reflect::DescriptorKind;
+use crate::sets::{MATERIAL_SET, SCENE_SET};
 use ash::vk;
 use weft_graph::plan::PlanPass;
 
 /// One binding of a scene set as the renderer creates and writes it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SceneBinding {
+    /// Its name in GLSL: set 1's binding `NAME` is `BINDING_NAME`, set 2's
+    /// is `MATERIAL_NAME` ([`SceneInterface::glsl_header`]).
+    pub glsl: &'static str,
     /// The binding number.
     pub binding: u32,
     /// Its descriptor kind.
@@ -151,6 +155,26 @@ impl<'g> SceneLayouts<'g> {
 }
 
 impl SceneInterface {
+    /// The GLSL header that names every set and binding of this interface,
+    /// so shaders declare `layout(set = SET_SCENE, binding = BINDING_LIGHTS)`
+    /// and the numbers live in one table. `origin` says where the table is.
+    pub fn glsl_header(&self, origin: &str) -> String {
+        let mut text = format!(
+            "// The scene sets' binding numbers, generated from {origin}; do not edit.\n\
+             #ifndef WEFT_BINDINGS_GLSL\n#define WEFT_BINDINGS_GLSL\n\n\
+             #define SET_SCENE {SCENE_SET}\n#define SET_MATERIAL {MATERIAL_SET}\n\n"
+        );
+        let line = |prefix: &str, b: &SceneBinding| {
+            let name = format!("{prefix}_{}", b.glsl);
+            format!("#define {name:<30} {:>2} // {}\n", b.binding, b.what)
+        };
+        text.extend(self.scene_set.iter().map(|b| line("BINDING", b)));
+        text.push('\n');
+        text.extend(self.material_set.iter().map(|b| line("MATERIAL", b)));
+        text.push_str("\n#endif\n");
+        text
+    }
+
     /// The set-1 binding `binding`, if the scene has one there.
     pub fn scene_binding(&self, binding: u32) -> Option<&SceneBinding> {
         self.scene_set.iter().find(|b| b.binding == binding)

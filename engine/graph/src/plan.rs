@@ -203,7 +203,8 @@ pub struct PlanPass {
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub model_defines: Vec<(ShadingModel, String)>,
     /// How many define sets the pass's features can give its shaders (the
-    /// variant this plan compiles is one of them), at most 2^12.
+    /// variant this plan compiles is one of them), at most
+    /// 2^[`crate::resolve::MAX_VARIANT_BITS`].
     pub variants: u64,
     /// Barriers recorded before the pass, batched into one `vkCmdPipelineBarrier2`.
     pub barriers: Vec<Barrier>,

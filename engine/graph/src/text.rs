@@ -104,15 +104,18 @@ pub fn render(plan: &Plan) -> String {
             let _ = writeln!(w, "     dispatch {}x{}x{}", d[0], d[1], d[2]);
         }
         if p.variants > 1 || !p.defines.is_empty() {
+            // Variants are 2^features; the cap is 2^MAX_VARIANT_BITS.
+            let features = p.variants.trailing_zeros();
             let _ = writeln!(
                 w,
-                "     defines {} (variant key; 1 of up to {} variants)",
+                "     defines {} (variant key; 1 of up to {} variants: {features} of the {} features a pass may depend on)",
                 if p.defines.is_empty() {
                     "none".to_string()
                 } else {
                     p.defines.join(" ")
                 },
-                p.variants
+                p.variants,
+                crate::resolve::MAX_VARIANT_BITS
             );
         }
         if p.groups_by_model() {

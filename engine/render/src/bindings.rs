@@ -11,8 +11,14 @@ use weft_gpu::scene::{SceneBinding, SceneInterface};
 use weft_graph::plan::PlanPass;
 
 /// A set binding every scene pass may read.
-const fn raster(binding: u32, kind: DescriptorKind, what: &'static str) -> SceneBinding {
+const fn raster(
+    glsl: &'static str,
+    binding: u32,
+    kind: DescriptorKind,
+    what: &'static str,
+) -> SceneBinding {
     SceneBinding {
+        glsl,
         binding,
         kind,
         what,
@@ -22,8 +28,14 @@ const fn raster(binding: u32, kind: DescriptorKind, what: &'static str) -> Scene
 }
 
 /// A set-1 binding only passes that trace rays read (a texture array among them).
-const fn tracing(binding: u32, kind: DescriptorKind, what: &'static str) -> SceneBinding {
+const fn tracing(
+    glsl: &'static str,
+    binding: u32,
+    kind: DescriptorKind,
+    what: &'static str,
+) -> SceneBinding {
     SceneBinding {
+        glsl,
         binding,
         kind,
         what,
@@ -95,37 +107,49 @@ pub const OCCLUSION_BINDING: u32 = 4;
 /// Set 1 as the engine creates and writes it for every scene pass.
 pub const SCENE_SET_BINDINGS: [SceneBinding; 8] = [
     raster(
+        "FRAME",
         FRAME_BINDING,
         DescriptorKind::UniformBuffer,
         "the Frame block",
     ),
-    raster(LIGHTS_BINDING, DescriptorKind::StorageBuffer, "the lights"),
     raster(
+        "LIGHTS",
+        LIGHTS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the lights",
+    ),
+    raster(
+        "DRAWS",
         DRAWS_BINDING,
         DescriptorKind::StorageBuffer,
         "the draw records",
     ),
     raster(
+        "MATERIALS",
         MATERIALS_BINDING,
         DescriptorKind::StorageBuffer,
         "the materials",
     ),
     raster(
+        "SHADOWS",
         SHADOWS_BINDING,
         DescriptorKind::StorageBuffer,
         "the shadow views",
     ),
     raster(
+        "LTC_TABLES",
         LTC_TABLES_BINDING,
         DescriptorKind::StorageBuffer,
         "the area-light LTC tables",
     ),
     raster(
+        "VERTICES",
         VERTICES_BINDING,
         DescriptorKind::StorageBuffer,
         "the vertices",
     ),
     raster(
+        "INDICES",
         INDICES_BINDING,
         DescriptorKind::StorageBuffer,
         "the indices",
@@ -137,76 +161,91 @@ pub const SCENE_SET_BINDINGS: [SceneBinding; 8] = [
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
 pub const TRACE_SET_BINDINGS: [SceneBinding; 15] = [
     tracing(
+        "TRIANGLES",
         TRIANGLES_BINDING,
         DescriptorKind::StorageBuffer,
         "the ray tracer's triangles",
     ),
     tracing(
+        "BVH_NODES",
         BVH_NODES_BINDING,
         DescriptorKind::StorageBuffer,
         "the BVH nodes",
     ),
     tracing(
+        "BVH_TRIANGLES",
         BVH_TRIANGLES_BINDING,
         DescriptorKind::StorageBuffer,
         "the BVH's triangle order",
     ),
     tracing(
+        "TRIANGLE_NORMALS",
         TRIANGLE_NORMALS_BINDING,
         DescriptorKind::StorageBuffer,
         "the corners' normals",
     ),
     tracing(
+        "TRIANGLE_UVS",
         TRIANGLE_UVS_BINDING,
         DescriptorKind::StorageBuffer,
         "the corners' UVs",
     ),
     tracing(
+        "TRIANGLE_MATERIALS",
         TRIANGLE_MATERIALS_BINDING,
         DescriptorKind::StorageBuffer,
         "the triangles' materials",
     ),
     tracing(
+        "EMITTERS",
         EMITTERS_BINDING,
         DescriptorKind::StorageBuffer,
         "the emissive triangles",
     ),
     tracing(
+        "TRACE_COLOUR_256",
         TRACE_TEXTURES_BINDING,
         DescriptorKind::CombinedImageSampler,
         "the 256-texel colour texture array",
     ),
     tracing(
+        "TRACE_COLOUR_512",
         TRACE_TEXTURES_BINDING + 1,
         DescriptorKind::CombinedImageSampler,
         "the 512-texel colour texture array",
     ),
     tracing(
+        "TRACE_COLOUR_1024",
         TRACE_TEXTURES_BINDING + 2,
         DescriptorKind::CombinedImageSampler,
         "the 1024-texel colour texture array",
     ),
     tracing(
+        "TRACE_DATA_256",
         TRACE_TEXTURES_BINDING + 3,
         DescriptorKind::CombinedImageSampler,
         "the 256-texel data texture array",
     ),
     tracing(
+        "TRACE_DATA_512",
         TRACE_TEXTURES_BINDING + 4,
         DescriptorKind::CombinedImageSampler,
         "the 512-texel data texture array",
     ),
     tracing(
+        "TRACE_DATA_1024",
         TRACE_TEXTURES_BINDING + 5,
         DescriptorKind::CombinedImageSampler,
         "the 1024-texel data texture array",
     ),
     tracing(
+        "MATERIAL_TEXTURES",
         MATERIAL_TEXTURES_BINDING,
         DescriptorKind::StorageBuffer,
         "the materials' texture slots",
     ),
     tracing(
+        "TRIANGLE_TANGENTS",
         TRIANGLE_TANGENTS_BINDING,
         DescriptorKind::StorageBuffer,
         "the corners' tangents",
@@ -216,26 +255,31 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 15] = [
 /// texture slots.
 pub const MATERIAL_SET_BINDINGS: [SceneBinding; 5] = [
     raster(
+        "BASE_COLOR",
         BASE_COLOR_BINDING,
         DescriptorKind::CombinedImageSampler,
         "the base-colour texture",
     ),
     raster(
+        "METALLIC_ROUGHNESS",
         METALLIC_ROUGHNESS_BINDING,
         DescriptorKind::CombinedImageSampler,
         "the metallic-roughness texture",
     ),
     raster(
+        "NORMAL",
         NORMAL_BINDING,
         DescriptorKind::CombinedImageSampler,
         "the normal map",
     ),
     raster(
+        "EMISSIVE",
         EMISSIVE_BINDING,
         DescriptorKind::CombinedImageSampler,
         "the emissive texture",
     ),
     raster(
+        "OCCLUSION",
         OCCLUSION_BINDING,
         DescriptorKind::CombinedImageSampler,
         "the occlusion texture",
@@ -266,5 +310,44 @@ fn per_draw_params(pass: &PlanPass) -> Vec<&'static str> {
         vec![crate::providers::SHADOW_VIEW]
     } else {
         Vec::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// `shaders/include/bindings.glsl` is the header this table generates
+    /// (`WEFT_UPDATE_GOLDEN=1 cargo test -p weft-render --lib bindings` writes
+    /// it), so shaders name bindings instead of repeating their numbers.
+    #[test]
+    fn the_glsl_binding_header_is_generated_from_this_table() {
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shaders/include/bindings.glsl");
+        let generated = scene_interface().glsl_header("engine/render/src/bindings.rs");
+        if std::env::var_os("WEFT_UPDATE_GOLDEN").is_some() {
+            std::fs::write(&path, &generated).expect("write the header");
+        }
+        let committed = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            committed == generated,
+            "{} is out of date; rewrite it with WEFT_UPDATE_GOLDEN=1 cargo test -p weft-render --lib bindings",
+            path.display()
+        );
+    }
+
+    #[test]
+    fn every_binding_has_its_own_number_and_name() {
+        let scene = scene_interface();
+        for set in [&scene.scene_set, &scene.material_set] {
+            let mut numbers: Vec<u32> = set.iter().map(|b| b.binding).collect();
+            let mut names: Vec<&str> = set.iter().map(|b| b.glsl).collect();
+            numbers.sort_unstable();
+            numbers.dedup();
+            names.sort_unstable();
+            names.dedup();
+            assert_eq!((numbers.len(), names.len()), (set.len(), set.len()));
+        }
     }
 }

@@ -1,11 +1,16 @@
 //! Pass kinds and the frame loop: scene meshes, materials, lights and cameras
 //! drawn by compiled weft graphs.
 //!
-//! [`GpuScene`] uploads a `weft_scene::Scene`; [`SceneRecorder`] is the
-//! `weft_gpu::DrawRecorder` that draws it in raster passes (`Meshes(filter)`,
-//! `LightVolumes(kind)`) and binds scene data (set 1) for fullscreen lighting
-//! passes; [`render`] runs a graph over a scene for some frames. The GLSL side
-//! of every layout here is `shaders/include/scene.glsl`.
+//! [`render`] runs a graph over a scene for some frames; [`load_graph`] loads
+//! the graph once for callers that keep it. [`GpuScene`] uploads a
+//! `weft_scene::Scene` (as a `weft_scene::SceneUpdater` moves it through time);
+//! [`SceneRecorder`] is the `weft_gpu::DrawRecorder` that draws it in raster
+//! passes (`Meshes(filter)`, `LightVolumes(kind)`): it picks each run's
+//! pipeline variant, binds the scene (set 1) and materials (set 2) and draws.
+//! The scene interface it registers with the executor is [`bindings`];
+//! [`FrameLoop`] and [`LiveRender`] run frames and hot reloads. The GLSL side
+//! of every layout is `shaders/include/scene.glsl` and the generated
+//! `shaders/include/bindings.glsl`.
 
 #![warn(missing_docs)]
 

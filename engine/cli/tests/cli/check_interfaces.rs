@@ -83,8 +83,8 @@ fn a_scene_binding_the_engine_does_not_write_is_refused_at_check_and_at_render()
     let copy = Copy::new("set1");
     copy.edit(
         "shaders/include/scene.glsl",
-        "set = 1, binding = 3)",
-        "set = 1, binding = 29)",
+        "set = SET_SCENE, binding = BINDING_MATERIALS)",
+        "set = SET_SCENE, binding = 29)",
     );
     let (code, err) = copy.check("forward.ron");
     assert_eq!(code, Some(1), "{err}");
@@ -149,10 +149,14 @@ fn scene_pass_shaders_are_compiled_and_their_interfaces_compared() {
         &[("shaders/mesh.vert", "void main()", "garbage(\nvoid main()")],
         "pass \"gbuffer\": graphs/../shaders/mesh.vert:",
     );
+    let texcoord = line_of(
+        &repo().join("shaders/forward.frag"),
+        "layout(location = 2) in vec2 texcoord;",
+    );
     assert_refused(
         "forward.ron",
         &[("shaders/forward.frag", "layout(location = 2) in vec2 texcoord;", "layout(location = 5) in vec2 texcoord;")],
-        "pass \"forward\": fragment input `texcoord` at location 5 is not written by the vertex shader (declared at graphs/../shaders/forward.frag:37)",
+        &format!("pass \"forward\": fragment input `texcoord` at location 5 is not written by the vertex shader (declared at graphs/../shaders/forward.frag:{texcoord})"),
     );
     assert_refused(
         "forward.ron",

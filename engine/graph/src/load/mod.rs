@@ -54,6 +54,8 @@ pub struct LoadedGraph {
     /// Known differences from the reference, from the graph and its
     /// fragments, with their source.
     pub caveats: Vec<(usize, crate::schema::CaveatDecl)>,
+    /// Define sets from the graph and its fragments: source, name, defines.
+    pub define_sets: Vec<(usize, String, Vec<crate::schema::DefineDecl>)>,
     /// Human-readable name.
     pub name: String,
     /// Toggles declared on by default by the graph and its fragments.
@@ -293,6 +295,12 @@ fn load_file(
     graph
         .caveats
         .extend(parsed.caveats.iter().map(|c| (source, c.clone())));
+    graph.define_sets.extend(
+        parsed
+            .define_sets
+            .iter()
+            .map(|(name, defines)| (source, name.clone(), defines.clone())),
+    );
     for feature in &parsed.features {
         if !graph.default_features.contains(feature) {
             graph.default_features.push(feature.clone());

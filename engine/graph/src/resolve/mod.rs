@@ -172,7 +172,44 @@ impl<'a> Resolver<'a> {
         self.check_usages(&ir);
         self.check_extents(&ir);
         self.check_caveats(&ir);
+        self.check_define_sets();
         ir
+    }
+
+    /// Every define set's names are preprocessor names of the graph's own,
+    /// and no set is declared twice (a fragment included twice declares its
+    /// sets once).
+    fn check_define_sets(&mut self) {
+        let sets = self.graph.define_sets.clone();
+        for (n, (source, name, defines)) in sets.iter().enumerate() {
+            let earlier = sets[..n].iter().find(|(_, other, _)| other == name);
+            if let Some((first, _, _)) = earlier {
+                let same_file = self.graph.sources[*first].file == self.graph.sources[*source].file;
+                if !same_file {
+                    let at = self
+                        .graph
+                        .locate(*first, &[Seg::Field("define_sets"), Seg::Key(name)]);
+                    self.error(
+                        *source,
+                        &[Seg::Field("define_sets"), Seg::Key(name)],
+                        format!("define set \"{name}\" is declared twice"),
+                    )
+                    .hint = Some(format!("first at {}:{}", at.0.display(), at.1.line));
+                }
+                continue;
+            }
+            for (k, define) in defines.iter().enumerate() {
+                if let Some((message, hint)) = passes::define_name_problem(&define.name) {
+                    let path = [
+                        Seg::Field("define_sets"),
+                        Seg::Key(name),
+                        Seg::Index(k),
+                        Seg::Field("name"),
+                    ];
+                    self.error(*source, &path, message).hint = hint;
+                }
+            }
+        }
     }
 
     /// Every caveat says something, and holds under features the graph has

@@ -244,38 +244,80 @@ impl Resolver<'_> {
         pass
     }
 
-    /// The pass's defines, each a preprocessor name the engine does not own.
+    /// The pass's defines: those of the define sets it names, in order, then
+    /// its own, each a preprocessor name the engine does not own. A set's
+    /// `draws` holds only in a pass that draws meshes; a name given twice
+    /// must mean the same define.
     fn check_defines(
         &mut self,
         source: usize,
         index: usize,
         decl: &PassDecl,
     ) -> Vec<crate::schema::DefineDecl> {
+        let meshes = matches!(decl.draw, Some(Draw::Meshes(_)));
+        let mut defines: Vec<crate::schema::DefineDecl> = Vec::new();
+        for (k, set) in decl.define_sets.iter().enumerate() {
+            let found = self
+                .graph
+                .define_sets
+                .iter()
+                .find(|(_, name, _)| name == set);
+            match found {
+                Some((_, _, list)) => {
+                    for d in list {
+                        let define = crate::schema::DefineDecl {
+                            draws: d.draws.filter(|_| meshes),
+                            ..d.clone()
+                        };
+                        match defines.iter().find(|e| e.name == define.name) {
+                            Some(same) if *same == define => {}
+                            Some(_) => {
+                                let path =
+                                    pass_path(index, &[Seg::Field("define_sets"), Seg::Index(k)]);
+                                self.error(
+                                    source,
+                                    &path,
+                                    format!("define set \"{set}\" gives \"{}\" other conditions than an earlier set", define.name),
+                                );
+                            }
+                            None => defines.push(define),
+                        }
+                    }
+                }
+                None => {
+                    let names: Vec<&str> = self
+                        .graph
+                        .define_sets
+                        .iter()
+                        .map(|(_, name, _)| name.as_str())
+                        .collect();
+                    let path = pass_path(index, &[Seg::Field("define_sets"), Seg::Index(k)]);
+                    self.error(source, &path, format!("unknown define set \"{set}\""))
+                        .hint = crate::diagnostic::nearest(set, names.iter().copied())
+                        .map(|n| format!("did you mean \"{n}\"?"))
+                        .or_else(|| {
+                            Some(format!(
+                                "this graph's define sets: {}",
+                                if names.is_empty() {
+                                    "none".into()
+                                } else {
+                                    names.join(", ")
+                                }
+                            ))
+                        });
+                }
+            }
+        }
         for (k, define) in decl.defines.iter().enumerate() {
             let name = &define.name;
-            let valid = name.starts_with(|c: char| c.is_ascii_uppercase() || c == '_')
-                && name
-                    .chars()
-                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_');
             let path = pass_path(
                 index,
                 &[Seg::Field("defines"), Seg::Index(k), Seg::Field("name")],
             );
-            if !valid {
-                self.error(
-                    source,
-                    &path,
-                    format!("define \"{name}\" is not a preprocessor name: use capitals, digits and underscores"),
-                );
-            } else if name.starts_with("HAS_") {
-                self.error(
-                    source,
-                    &path,
-                    format!("define \"{name}\": names starting HAS_ are the engine's, for conditional reads"),
-                )
-                .hint = Some("choose another prefix, e.g. SCENE_".into());
+            if let Some((message, hint)) = define_name_problem(name) {
+                self.error(source, &path, message).hint = hint;
             }
-            if define.draws.is_some() && !matches!(decl.draw, Some(Draw::Meshes(_))) {
+            if define.draws.is_some() && !meshes {
                 let path = pass_path(
                     index,
                     &[Seg::Field("defines"), Seg::Index(k), Seg::Field("draws")],
@@ -290,8 +332,20 @@ impl Resolver<'_> {
                 )
                 .hint = Some("remove `draws`, or give the pass `draw: Meshes(...)`".into());
             }
+            match defines.iter().find(|d| d.name == *name) {
+                Some(same) if same == define => {}
+                Some(_) => {
+                    self.error(
+                        source,
+                        &path,
+                        format!("define \"{name}\" is also in one of the pass's define sets, under other conditions"),
+                    )
+                    .hint = Some("give it once: in the set, or in the pass".into());
+                }
+                None => defines.push(define.clone()),
+            }
         }
-        decl.defines.clone()
+        defines
     }
 
     /// A pass's declared fixed-function state, with bias parameters resolved;
@@ -401,5 +455,29 @@ fn attachment_access(
         conditions: a.enabled_if.clone(),
         field,
         item,
+    }
+}
+
+/// Why `name` cannot be a declared define, with a hint: not a preprocessor
+/// name, or one of the engine's `HAS_` names.
+pub(super) fn define_name_problem(name: &str) -> Option<(String, Option<String>)> {
+    let valid = name.starts_with(|c: char| c.is_ascii_uppercase() || c == '_')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_');
+    if !valid {
+        Some((
+            format!("define \"{name}\" is not a preprocessor name: use capitals, digits and underscores"),
+            None,
+        ))
+    } else if name.starts_with("HAS_") {
+        Some((
+            format!(
+                "define \"{name}\": names starting HAS_ are the engine's, for conditional reads"
+            ),
+            Some("choose another prefix, e.g. SCENE_".into()),
+        ))
+    } else {
+        None
     }
 }

@@ -71,6 +71,11 @@ pub struct GraphFile {
     /// error can be told from modelling gaps. Fragments may declare them.
     #[serde(default)]
     pub caveats: Vec<CaveatDecl>,
+    /// Named lists of shader defines, declared once and used by passes
+    /// (`define_sets: ["scene_models"]`); fragments may declare them. A
+    /// define's `draws` applies where the pass draws meshes.
+    #[serde(default)]
+    pub define_sets: BTreeMap<String, Vec<DefineDecl>>,
 }
 
 /// One known difference from the reference (see [`GraphFile::caveats`]).

@@ -74,6 +74,10 @@ pub struct PassDecl {
     /// compiles mirror code only for scenes with mirrors.
     #[serde(default)]
     pub defines: Vec<DefineDecl>,
+    /// The graph's define sets whose defines the pass's shaders get, in
+    /// order, before its own `defines`.
+    #[serde(default)]
+    pub define_sets: Vec<String>,
 }
 
 /// A shader define a pass sets when its features hold.

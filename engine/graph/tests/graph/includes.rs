@@ -1,22 +1,9 @@
 //! Including a whole graph: the includer builds on it (the bench graphs add
 //! floor passes to a shipped graph), taking its output and read-backs.
 
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use crate::support::load_files;
+use std::path::Path;
 use weft_graph::compile::CompileOptions;
-
-/// A loader over in-memory files under `/g/`.
-fn files(list: &[(&str, &str)]) -> impl Fn(&Path) -> std::io::Result<String> {
-    let map: BTreeMap<PathBuf, String> = list
-        .iter()
-        .map(|(name, text)| (Path::new("/g").join(name), text.to_string()))
-        .collect();
-    move |p: &Path| {
-        map.get(p)
-            .cloned()
-            .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"))
-    }
-}
 
 const BASE: &str = r#"Graph(
     name: "base",
@@ -39,12 +26,14 @@ const FLOOR: &str = r#"Graph(
 #[test]
 fn a_graph_including_a_whole_graph_takes_its_name_output_and_read_backs() {
     let bench = r#"Graph(include: [(file: "base.ron"), (file: "floor.ron")], readback: ["floor"])"#;
-    let read = files(&[
-        ("base.ron", BASE),
-        ("floor.ron", FLOOR),
-        ("bench.ron", bench),
-    ]);
-    let graph = weft_graph::load_with(Path::new("/g/bench.ron"), &read);
+    let graph = load_files(
+        "/g/bench.ron",
+        &[
+            ("/g/base.ron", BASE),
+            ("/g/floor.ron", FLOOR),
+            ("/g/bench.ron", bench),
+        ],
+    );
     assert_eq!(weft_graph::check(&graph), Vec::new());
     assert_eq!(graph.name, "base");
     assert_eq!(graph.output.as_deref(), Some("ldr"));
@@ -65,8 +54,10 @@ fn an_included_graphs_other_output_is_ignored_with_a_warning() {
     include: [(file: "base.ron")],
     output: "hdr",
 )"#;
-    let read = files(&[("base.ron", BASE), ("bench.ron", bench)]);
-    let graph = weft_graph::load_with(Path::new("/g/bench.ron"), &read);
+    let graph = load_files(
+        "/g/bench.ron",
+        &[("/g/base.ron", BASE), ("/g/bench.ron", bench)],
+    );
     assert_eq!(graph.name, "bench");
     assert_eq!(graph.output.as_deref(), Some("hdr"));
     let warnings: Vec<String> = graph.diagnostics.iter().map(|d| d.to_string()).collect();

@@ -3,6 +3,7 @@
 
 mod support;
 
+mod define_sets;
 mod errors;
 mod fuzz;
 mod includes;

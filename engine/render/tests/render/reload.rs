@@ -373,8 +373,8 @@ fn shader_edits_the_gpu_would_reject_are_refused_before_commit() {
     let cases = [
         (
             "shaders/include/scene.glsl",
-            "set = 1, binding = 3)",
-            "set = 1, binding = 29)",
+            "set = SET_SCENE, binding = BINDING_MATERIALS)",
+            "set = SET_SCENE, binding = 29)",
             "pass `forward`: shader binding `Materials` (set 1 binding 29) is not scene data the engine binds",
         ),
         (
