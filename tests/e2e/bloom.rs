@@ -3,7 +3,7 @@
 //! linear-sampled blur matches a brute-force 43x43 Gaussian computed here, and
 //! an image with nothing above the threshold is composited unchanged.
 
-use weft_gpu::{FrameOptions, Gpu, NoDraws, Readback, Renderer};
+use weft_gpu::{Gpu, Readback, Renderer};
 use weft_graph::plan::Extent;
 use weft_graph::schema::ParamValue;
 use weft_render::gaussian::GaussianTaps;
@@ -91,18 +91,7 @@ fn render(
         .params
         .insert("level".into(), ParamValue::Number(level));
     let mut renderer = Renderer::new(gpu).expect("renderer");
-    let mut resources = renderer.create_resources(&plan).expect("resources");
-    let report = renderer
-        .execute(
-            &plan,
-            &mut resources,
-            &mut NoDraws,
-            &FrameOptions {
-                readback: true,
-                ..FrameOptions::default()
-            },
-        )
-        .expect("frame");
+    let report = weft_testkit::one_frame(&mut renderer, &plan).expect("frame");
     (report.output.expect("output"), report.readbacks)
 }
 

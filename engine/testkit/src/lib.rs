@@ -11,6 +11,16 @@ pub use golden::{check_golden, Comparison, GoldenError, Tolerance};
 use weft_gpu::{DrawRecorder, FrameOptions, FrameReport, GpuError, Renderer};
 use weft_graph::Plan;
 
+/// One frame of `plan` with its output and read-back images copied back and
+/// no scene draws (graphs of fullscreen, compute and transfer passes).
+pub fn one_frame(renderer: &mut Renderer<'_>, plan: &Plan) -> Result<FrameReport, GpuError> {
+    let options = FrameOptions {
+        readback: true,
+        ..FrameOptions::default()
+    };
+    render_frames(renderer, plan, &mut weft_gpu::NoDraws, 1, 0.0, &options)
+}
+
 /// Creates the plan's resources, runs `frames` frames (numbered from 0,
 /// `time` advancing by `frame_time` seconds) and returns the last frame's
 /// report, read back when `options.readback` asks for it.

@@ -16,18 +16,7 @@ fn fullscreen_compute_blit_graph_renders_exact_pixels() {
     let gpu = common::gpu();
     let plan = common::compile(&gpu, &common::graph("mixed.ron"), 8, 8);
     let mut renderer = Renderer::new(&gpu).expect("renderer");
-    let mut resources = renderer.create_resources(&plan).expect("resources");
-    let report = renderer
-        .execute(
-            &plan,
-            &mut resources,
-            &mut NoDraws,
-            &FrameOptions {
-                readback: true,
-                ..FrameOptions::default()
-            },
-        )
-        .expect("frame");
+    let report = weft_testkit::one_frame(&mut renderer, &plan).expect("frame");
     let output = report.output.as_ref().expect("readback");
     assert_eq!((output.width, output.height), (8, 8));
     for y in 0..8 {
@@ -55,7 +44,6 @@ fn fullscreen_compute_blit_graph_renders_exact_pixels() {
         ]
     );
     assert_eq!(json["transient_bytes"], plan.memory.transient_bytes);
-    drop(resources);
     drop(renderer);
     common::assert_no_validation_messages(gpu);
 }

@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use weft_gpu::{FrameOptions, NoDraws, Renderer};
+use weft_gpu::Renderer;
 use weft_testkit::{check_golden, Tolerance};
 
 const TOLERANCE: Tolerance = Tolerance {
@@ -16,25 +16,13 @@ fn mixed_graph_matches_its_golden_image() {
     let gpu = common::gpu();
     let plan = common::compile(&gpu, &common::graph("mixed.ron"), 32, 24);
     let mut renderer = Renderer::new(&gpu).expect("renderer");
-    let mut resources = renderer.create_resources(&plan).expect("resources");
-    let report = renderer
-        .execute(
-            &plan,
-            &mut resources,
-            &mut NoDraws,
-            &FrameOptions {
-                readback: true,
-                ..FrameOptions::default()
-            },
-        )
-        .expect("frame");
+    let report = weft_testkit::one_frame(&mut renderer, &plan).expect("frame");
     let image = report.output.expect("readback").to_rgba8();
     let golden =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/mixed_32x24.png");
     if let Err(e) = check_golden(&image, &golden, &TOLERANCE) {
         panic!("{e}");
     }
-    drop(resources);
     drop(renderer);
     common::assert_no_validation_messages(gpu);
 }

@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use weft_gpu::{memory_requirements, FrameOptions, NoDraws, Renderer};
+use weft_gpu::{memory_requirements, Renderer};
 use weft_graph::plan::Extent;
 use weft_graph::CompileOptions;
 
@@ -23,18 +23,7 @@ fn intermediate_images_are_read_back_with_the_output() {
     };
     let plan = weft_graph::compile(&loaded, &options).expect("compiles");
     let mut renderer = Renderer::new(&gpu).expect("renderer");
-    let mut resources = renderer.create_resources(&plan).expect("resources");
-    let report = renderer
-        .execute(
-            &plan,
-            &mut resources,
-            &mut NoDraws,
-            &FrameOptions {
-                readback: true,
-                ..FrameOptions::default()
-            },
-        )
-        .expect("frame");
+    let report = weft_testkit::one_frame(&mut renderer, &plan).expect("frame");
     let names: Vec<&str> = report.readbacks.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(names, ["half", "inverted"]);
     let (half, inverted) = (&report.readbacks[0].1, &report.readbacks[1].1);
@@ -54,7 +43,6 @@ fn intermediate_images_are_read_back_with_the_output() {
     }
     assert!(distinct.len() > 8, "the blitted pattern varies");
     assert!(report.output.is_some());
-    drop(resources);
     drop(renderer);
     let counts = gpu.validation_counts();
     assert_eq!(
