@@ -35,12 +35,9 @@ const fn tracing(
     what: &'static str,
 ) -> SceneBinding {
     SceneBinding {
-        glsl,
-        binding,
-        kind,
-        what,
         arrayed: is_trace_texture(binding),
         tracing: true,
+        ..raster(glsl, binding, kind, what)
     }
 }
 
