@@ -17,7 +17,7 @@
 // that comes back through Fresnel, S what the dielectric's specular layer
 // reflects, so its diffuse base gets exactly what the layer leaves. A white
 // metal, dielectric or blend then reflects 1 at every angle and roughness,
-// and every lobe stays reciprocal. engine/render/src/brdf.rs is the CPU twin,
+// and every lobe stays reciprocal. engine/testkit/src/brdf.rs is the CPU twin,
 // with the white-furnace tests.
 #ifndef WEFT_BRDF_GLSL
 #define WEFT_BRDF_GLSL

@@ -3,7 +3,7 @@
 // spot / area light evaluation with the same cutoffs the light volumes use.
 // Both paths call the per-type `shade_*` functions and `shade_ambient_emissive` with the same
 // inputs (the surface and its material, loaded once per pixel), so they cannot
-// drift apart. engine/render/src/brdf.rs mirrors the BRDFs on the CPU for
+// drift apart. engine/testkit/src/brdf.rs mirrors the BRDFs on the CPU for
 // tests. An includer that defines HAS_SHADOW_MAP must declare
 // `uniform sampler2DShadow shadow_map` before including this file
 // (include/shadows.glsl holds the lookups).

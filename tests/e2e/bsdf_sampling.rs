@@ -231,12 +231,12 @@ fn every_bsdf_samples_directions_as_its_pdf_says() {
             }
         }
         // The tracer's GGX on the GPU reflects what the energy-conserving
-        // model's closed form says (weft_render::brdf, held to the white
+        // model's closed form says (weft_testkit::brdf, held to the white
         // furnace there): the grid's integral of f cos, within its
         // resolution.
         if case.model == 1.0 {
             let base = glam::Vec3::splat(case.diffuse as f32);
-            let closed = weft_render::brdf::directional_albedo(
+            let closed = weft_testkit::brdf::directional_albedo(
                 base,
                 case.metallic as f32,
                 case.roughness as f32,

@@ -1,7 +1,7 @@
 //! Shading measured in linear HDR against the CPU reference: a glTF
 //! metallic-roughness quad under a sun (factors, a metallicRoughness texture read
 //! as B = metallic, G = roughness, a normal map with a scale) equals
-//! `weft_render::brdf::cook_torrance`
+//! `weft_testkit::brdf::cook_torrance`
 //! within 0.2% (measured at most 0.086%: half-float storage), and a diffuse quad
 //! under a rectangle and a two-sided disc area light equals a brute-force
 //! integral: analytically (the default, `area_samples` 0: exact for the
@@ -13,10 +13,10 @@ use glam::Vec3;
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 use weft_graph::plan::Extent;
-use weft_render::brdf::{cook_torrance, AreaGeometry};
 use weft_render::lights::area_shape;
 use weft_render::RenderSettings;
 use weft_scene::Light;
+use weft_testkit::brdf::{cook_torrance, AreaGeometry, AreaIrradiance};
 use weft_tests::gltf::{write_gltf_quad, Texel};
 
 /// Image size: odd, so the centre pixel looks straight down the camera axis.

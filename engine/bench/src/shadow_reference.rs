@@ -5,8 +5,8 @@ use glam::{Mat4, Vec2, Vec3};
 use weft_graph::schema::MaterialFilter;
 use weft_render::camera::{camera_position, view_projection};
 use weft_render::materials::matches;
-use weft_render::raytrace::Bvh;
 use weft_scene::{Camera, Light, Scene};
+use weft_testkit::raytrace::Bvh;
 
 /// The reference for `scene` seen by `camera` at time 0 through a `size` view:
 /// [`sun_visibility`] of the first sun against every shadow-casting triangle,

@@ -14,9 +14,10 @@ use std::process::ExitCode;
 use weft_gpu::{Gpu, GpuOptions, TimingMode};
 use weft_graph::plan::Extent;
 use weft_render::lights::{pack_lights, LightSet};
-use weft_render::{camera, raytrace, render, RenderSettings};
+use weft_render::{camera, render, RenderSettings};
 use weft_scene::Scene;
 use weft_testkit::light_scene;
+use weft_testkit::raytrace;
 
 /// Arguments of `weft bench tiles`.
 #[derive(Args)]

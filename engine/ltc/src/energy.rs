@@ -14,7 +14,7 @@
 //! underestimate `E` by up to 0.02, and every underestimate is energy the
 //! diffuse base gains. `E_avg = 2 ∫ E(μ) μ dμ` is integrated from the
 //! interpolant the shaders read, so a white surface reflects 1 to the
-//! interpolation's accuracy (engine/render/src/brdf.rs tests it).
+//! interpolation's accuracy (engine/testkit/src/brdf.rs tests it).
 
 use crate::fit::moments;
 use crate::lobe::Ggx;

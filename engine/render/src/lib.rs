@@ -15,7 +15,6 @@
 #![warn(missing_docs)]
 
 pub mod bindings;
-pub mod brdf;
 pub mod bvh;
 pub mod bvh_cache;
 pub mod camera;
@@ -35,7 +34,6 @@ pub mod materials;
 mod optics;
 mod prepare;
 pub mod providers;
-pub mod raytrace;
 pub mod recorder;
 mod reload;
 mod reload_error;

@@ -2,10 +2,10 @@
 //! cutoff range both forward and deferred shading apply, so the light volumes
 //! and the per-pixel loop cut light off at the same distance; area lights last.
 
-use crate::brdf::AreaGeometry;
 use crate::gpu_types::GpuLight;
 use crate::sanitize;
 use glam::{Vec3, Vec4};
+use std::f32::consts::PI;
 use weft_scene::light::{derive_radius, DEFAULT_LUMINANCE_THRESHOLD};
 use weft_scene::{Aabb, AreaLight, AreaShape, Attenuation, Light};
 
@@ -237,6 +237,34 @@ pub fn pack_lights(lights: &[Light], bounds: &Aabb) -> LightSet {
         }
     }
     set
+}
+
+/// An area light as the shaders see it: centre, half-extent axes (local X and
+/// Y scaled by the half size, or by the radius for a disc), facing `-(x × y)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AreaGeometry {
+    /// World centre.
+    pub centre: Vec3,
+    /// Local X times the half width (or the radius).
+    pub x: Vec3,
+    /// Local Y times the half height (or the radius).
+    pub y: Vec3,
+    /// A disc inscribed in the rectangle rather than the rectangle.
+    pub disc: bool,
+    /// Whether both faces emit.
+    pub two_sided: bool,
+}
+
+impl AreaGeometry {
+    /// The unit direction the light faces.
+    pub fn facing(&self) -> Vec3 {
+        -self.x.cross(self.y).normalize()
+    }
+
+    /// The emitting area.
+    pub fn area(&self) -> f32 {
+        (if self.disc { PI } else { 4.0 }) * self.x.length() * self.y.length()
+    }
 }
 
 /// An area light as the shaders see it (centre, half-extent axes: local X and Y

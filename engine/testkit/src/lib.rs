@@ -2,8 +2,10 @@
 //! comparison, the CPU mirror of tiled light culling, and running a plan for
 //! several frames.
 
+pub mod brdf;
 pub mod golden;
 pub mod light_scene;
+pub mod raytrace;
 pub mod tiles;
 
 pub use golden::{check_golden, Comparison, GoldenError, Tolerance};

@@ -8,6 +8,7 @@
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 use weft_ltc::energy::Albedo;
+pub use weft_render::lights::AreaGeometry;
 
 /// Roughness is raised to at least this (`MIN_ROUGHNESS` in `brdf.glsl`).
 pub const MIN_ROUGHNESS: f32 = 0.045;
@@ -145,49 +146,35 @@ pub fn concentric(p: Vec2) -> Vec2 {
     r * Vec2::new(phi.cos(), phi.sin())
 }
 
-/// An area light as the shaders see it: centre, half-extent axes (local X and
-/// Y scaled by the half size, or by the radius for a disc), facing `-(x × y)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AreaGeometry {
-    /// World centre.
-    pub centre: Vec3,
-    /// Local X times the half width (or the radius).
-    pub x: Vec3,
-    /// Local Y times the half height (or the radius).
-    pub y: Vec3,
-    /// A disc inscribed in the rectangle rather than the rectangle.
-    pub disc: bool,
-    /// Whether both faces emit.
-    pub two_sided: bool,
-}
-
-impl AreaGeometry {
-    /// The unit direction the light faces.
-    pub fn facing(&self) -> Vec3 {
-        -self.x.cross(self.y).normalize()
-    }
-
-    /// The emitting area.
-    pub fn area(&self) -> f32 {
-        (if self.disc { PI } else { 4.0 }) * self.x.length() * self.y.length()
-    }
-
-    /// `L cos(theta_light) / d²`-style weight of the light seen from `p` in
-    /// direction `l` at squared distance `d2` with cell area `cell`, or 0 from behind.
-    fn cell_weight(&self, l: Vec3, d2: f32, cell: f32) -> f32 {
-        let c = -l.dot(self.facing());
-        let c = if self.two_sided { c.abs() } else { c };
-        if c > 0.0 {
-            c * cell / (d2 + cell / PI)
-        } else {
-            0.0
-        }
-    }
-
+/// The area-light quadratures of `shaders/include/lighting.glsl` on the CPU,
+/// for an area light as the renderer packs it
+/// ([`weft_render::lights::AreaGeometry`]).
+pub trait AreaIrradiance {
     /// Irradiance at `p` on a surface with normal `n` per unit emitted radiance,
     /// as the shaders estimate it: `AREA_SAMPLES²` equal-area cells, each seen
     /// from its centre with weight `cos(theta_light) A / (d² + A / pi)`.
-    pub fn irradiance(&self, p: Vec3, n: Vec3) -> f32 {
+    fn irradiance(&self, p: Vec3, n: Vec3) -> f32;
+
+    /// The same irradiance integrated by brute force: the point-source formula
+    /// `cos(theta_light) cos(theta) dA / d²` at the centres of `n × n` cells
+    /// (points outside a disc dropped), for references.
+    fn irradiance_brute_force(&self, p: Vec3, normal: Vec3, n: u32) -> f64;
+}
+
+/// `L cos(theta_light) / d²`-style weight of `light` seen from a point in
+/// direction `l` at squared distance `d2` with cell area `cell`, or 0 from behind.
+fn cell_weight(light: &AreaGeometry, l: Vec3, d2: f32, cell: f32) -> f32 {
+    let c = -l.dot(light.facing());
+    let c = if light.two_sided { c.abs() } else { c };
+    if c > 0.0 {
+        c * cell / (d2 + cell / PI)
+    } else {
+        0.0
+    }
+}
+
+impl AreaIrradiance for AreaGeometry {
+    fn irradiance(&self, p: Vec3, n: Vec3) -> f32 {
         let cells = AREA_SAMPLES * AREA_SAMPLES;
         let cell = self.area() / cells as f32;
         (0..cells)
@@ -200,15 +187,12 @@ impl AreaGeometry {
                 let to_light = self.centre + uv.x * self.x + uv.y * self.y - p;
                 let d2 = to_light.length_squared();
                 let l = to_light / d2.max(1e-12).sqrt();
-                self.cell_weight(l, d2, cell) * n.dot(l).max(0.0)
+                cell_weight(self, l, d2, cell) * n.dot(l).max(0.0)
             })
             .sum()
     }
 
-    /// The same irradiance integrated by brute force: the point-source formula
-    /// `cos(theta_light) cos(theta) dA / d²` at the centres of `n × n` cells
-    /// (points outside a disc dropped), for references.
-    pub fn irradiance_brute_force(&self, p: Vec3, normal: Vec3, n: u32) -> f64 {
+    fn irradiance_brute_force(&self, p: Vec3, normal: Vec3, n: u32) -> f64 {
         let step = 2.0 / f64::from(n);
         let cell = f64::from(self.x.length() * self.y.length()) * step * step;
         let mut sum = 0.0;
