@@ -13,7 +13,7 @@ use crate::error::GpuError;
 use crate::pipeline::{Pipeline, PipelineCache, PipelineKey, ShaderKey};
 use crate::resources::FrameResources;
 use crate::samplers::Samplers;
-use crate::scene::{SceneInterface, SceneLayouts};
+use crate::scene::RegisteredScene;
 use crate::scene_check::{scene_pass_problems, with_per_draw};
 use crate::sets::SCENE_SET;
 use crate::state::{pass_state, PassState};
@@ -38,7 +38,7 @@ pub(crate) struct Variant {
 /// What the executor lends a scene pass for building and binding its variants.
 pub(crate) struct ScenePass<'a> {
     pub(crate) pipelines: &'a mut PipelineCache,
-    pub(crate) scene: &'a (SceneInterface, SceneLayouts<'a>),
+    pub(crate) scene: &'a RegisteredScene<'a>,
     pub(crate) samplers: &'a Samplers,
     pub(crate) variants: &'a mut Vec<Variant>,
     pub(crate) pool: Option<&'a DescriptorPool<'a>>,
@@ -118,28 +118,28 @@ impl RasterContext<'_> {
             render_pass: self.render_pass,
             state: state.clone(),
         };
-        let found = self
-            .scene
-            .as_ref()
-            .ok_or_else(|| self.fail("draws scene content but no scene interface is registered"))?
-            .variants
-            .iter()
-            .position(|v| v.key == key);
-        let index = match found {
-            Some(index) => index,
-            None => self.prepare_variant(key, &keys, state)?,
+        let (gpu, plan, pass, resources) = (self.gpu, self.plan, self.pass_index, self.resources);
+        let Some(scene) = self.scene.as_mut() else {
+            return Err(self.fail("draws scene content but no scene interface is registered"));
         };
-        let scene = self.scene.as_ref().expect("checked above");
+        let index = match scene.variants.iter().position(|v| v.key == key) {
+            Some(index) => index,
+            None => {
+                let variant = scene.prepare_variant((gpu, plan, pass, resources), key, &keys)?;
+                scene.variants.push(variant);
+                scene.variants.len() - 1
+            }
+        };
         let variant = &scene.variants[index];
-        let pipeline = Arc::clone(&variant.pipeline);
+        let (pipeline, graph_set) = (Arc::clone(&variant.pipeline), variant.graph_set);
         let commands = self.commands();
         commands.bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
-        if variant.graph_set != vk::DescriptorSet::null() {
+        if graph_set != vk::DescriptorSet::null() {
             commands.bind_sets(
                 vk::PipelineBindPoint::GRAPHICS,
                 pipeline.layout,
                 0,
-                &[variant.graph_set],
+                &[graph_set],
             );
         }
         self.push_constants(&pipeline, &[])?;
@@ -161,7 +161,7 @@ impl RasterContext<'_> {
             .scene
             .as_ref()
             .ok_or_else(|| self.fail("no scene interface is registered"))?;
-        let mut params = with_per_draw(&scene.scene.0, self.pass());
+        let mut params = with_per_draw(&scene.scene.interface, self.pass());
         for (name, value) in overrides {
             params.insert(name.to_string(), ParamValue::Number(*value));
         }
@@ -171,38 +171,38 @@ impl RasterContext<'_> {
             .push_constants(pipeline.layout, *stages, &bytes);
         Ok(())
     }
+}
 
+impl ScenePass<'_> {
     /// Checks the variant's shaders against the graph and the scene
-    /// interface, builds its pipeline and writes its set 0; returns its index.
+    /// interface, builds its pipeline and writes its set 0.
     fn prepare_variant(
         &mut self,
+        (gpu, plan, pass_index, resources): (&Gpu, &Plan, PassId, &FrameResources<'_>),
         key: PipelineKey,
         keys: &[ShaderKey],
-        state: &PassState,
-    ) -> Result<usize, GpuError> {
-        let (gpu, plan, pass_index) = (self.gpu, self.plan, self.pass_index);
+    ) -> Result<Variant, GpuError> {
         let pass = &plan.passes[pass_index];
-        let resources = self.resources;
         let fail = |message: String| GpuError::Pass {
             pass: pass.name.clone(),
             message,
         };
-        if state.depth_clamp && !gpu.info().depth_clamp {
+        let depth_clamp = matches!(&key, PipelineKey::Scene { state, .. } if state.depth_clamp);
+        if depth_clamp && !gpu.info().depth_clamp {
             return Err(fail(
                 "`raster.depth_clamp` needs the device feature depthClamp, which this device lacks"
                     .into(),
             ));
         }
-        let scene = self.scene.as_mut().expect("checked by the caller");
         let modules = keys
             .iter()
-            .map(|k| scene.pipelines.shader(k))
+            .map(|k| self.pipelines.shader(k))
             .collect::<Result<Vec<_>, _>>()?;
         let compiled: Vec<_> = modules.iter().map(|m| &m.compiled).collect();
         let info = gpu.info();
         info.shaders.check(&info.name, &pass.name, &compiled)?;
         let problems = scene_pass_problems(
-            &scene.scene.0,
+            &self.scene.interface,
             plan,
             pass,
             &modules[0].interface,
@@ -211,9 +211,9 @@ impl RasterContext<'_> {
         if !problems.is_empty() {
             return Err(fail(problems.join("; ")));
         }
-        let pipeline = scene
+        let pipeline = self
             .pipelines
-            .pipeline(gpu.device(), &key, Some(&scene.scene.1))?;
+            .pipeline(gpu.device(), &key, Some(self.scene))?;
         let mut graph_only = pipeline.interface.clone();
         graph_only.bindings.retain(|(set, _), _| *set == 0);
         let mut graph_set = vk::DescriptorSet::null();
@@ -224,7 +224,7 @@ impl RasterContext<'_> {
                     problems,
                 }
             })?;
-            let pool = scene
+            let pool = self
                 .pool
                 .ok_or_else(|| fail("no descriptor pool for scene passes".into()))?;
             graph_set = pool.allocate(pipeline.set_layouts[0]).map_err(|e| {
@@ -233,7 +233,7 @@ impl RasterContext<'_> {
                     SCENE_VARIANTS
                 ))
             })?;
-            let samplers = scene.samplers;
+            let samplers = self.samplers;
             write_graph_set(
                 gpu,
                 graph_set,
@@ -243,12 +243,11 @@ impl RasterContext<'_> {
                 |r| crate::convert::layout(crate::layouts::layout_at(plan, pass_index, r)),
             )?;
         }
-        scene.variants.push(Variant {
+        Ok(Variant {
             key,
             pipeline,
             graph_set,
-        });
-        Ok(scene.variants.len() - 1)
+        })
     }
 }
 

@@ -105,10 +105,23 @@ pub struct SceneLayouts<'g> {
     pub traced: SetLayout<'g>,
     /// Set 2.
     pub material: SetLayout<'g>,
-    /// Bytes per vertex.
-    pub vertex_stride: u32,
-    /// The vertex attributes, as [`SceneInterface::vertex_attributes`].
-    pub vertex_attributes: Vec<VertexAttribute>,
+}
+
+/// A scene interface registered with the executor, with the set layouts its
+/// pipelines are built against.
+pub struct RegisteredScene<'g> {
+    /// What the renderer supplies.
+    pub interface: SceneInterface,
+    /// Its sets' layouts.
+    pub layouts: SceneLayouts<'g>,
+}
+
+impl<'g> RegisteredScene<'g> {
+    /// Creates `interface`'s set layouts.
+    pub fn new(gpu: &'g Gpu, interface: SceneInterface) -> Result<Self, GpuError> {
+        let layouts = SceneLayouts::new(gpu, &interface)?;
+        Ok(Self { interface, layouts })
+    }
 }
 
 /// Every stage a scene set is visible to.
@@ -140,8 +153,6 @@ impl<'g> SceneLayouts<'g> {
             raster: SetLayout::new(gpu, &layout_bindings(raster))?,
             traced: SetLayout::new(gpu, &layout_bindings(interface.scene_set.iter()))?,
             material: SetLayout::new(gpu, &layout_bindings(interface.material_set.iter()))?,
-            vertex_stride: interface.vertex_stride,
-            vertex_attributes: interface.vertex_attributes.clone(),
         })
     }
 

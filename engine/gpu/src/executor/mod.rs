@@ -15,7 +15,7 @@ use crate::record;
 use crate::renderpass::RenderPassCache;
 use crate::resources::FrameResources;
 use crate::samplers::Samplers;
-use crate::scene::{SceneInterface, SceneLayouts, SceneSet};
+use crate::scene::{RegisteredScene, SceneInterface, SceneSet};
 use crate::scene_check::scene_set_problems;
 use crate::sets::SCENE_SET;
 use crate::statistics::PassStatistics;
@@ -120,7 +120,7 @@ pub struct Renderer<'g> {
     pipelines: PipelineCache,
     samplers: Samplers,
     /// The scene interface a renderer registered, with its set layouts.
-    scene: Option<(SceneInterface, SceneLayouts<'g>)>,
+    scene: Option<RegisteredScene<'g>>,
     /// The plan last run, prepared on the resources it ran on; kept while
     /// the same resources run again and the pipelines it uses stay.
     prepared: Option<PreparedPlan<'g>>,
@@ -152,19 +152,19 @@ impl<'g> Renderer<'g> {
     /// against it and every shader checked with it. A renderer registers once;
     /// registering again drops the pipelines built so far.
     pub fn register_scene(&mut self, interface: SceneInterface) -> Result<(), GpuError> {
-        let layouts = SceneLayouts::new(self.gpu, &interface)?;
+        let registered = RegisteredScene::new(self.gpu, interface)?;
         if self.scene.is_some() {
             self.gpu.wait_idle()?;
             self.pipelines.destroy(self.gpu.device());
             self.generation += 1;
         }
-        self.scene = Some((interface, layouts));
+        self.scene = Some(registered);
         Ok(())
     }
 
     /// The registered scene interface, if any.
     pub fn scene_interface(&self) -> Option<&SceneInterface> {
-        self.scene.as_ref().map(|(i, _)| i)
+        self.scene.as_ref().map(|r| &r.interface)
     }
 
     /// The context this renderer runs on.
@@ -208,7 +208,7 @@ impl<'g> Renderer<'g> {
     /// Compiles and reflects every pass's shaders and cross-checks them with
     /// the graph (see `check::check_shaders`); no pipeline is built.
     pub fn check_shaders(&mut self, plan: &Plan) -> Vec<ShaderProblem> {
-        let scene = self.scene.as_ref().map(|(i, _)| i);
+        let scene = self.scene.as_ref().map(|r| &r.interface);
         check::check_with(&mut self.pipelines, plan, scene)
     }
 
@@ -238,7 +238,9 @@ impl<'g> Renderer<'g> {
         let bindings = check::pass_problems(plan, pass, &shaders, &interface).map_err(mismatch)?;
         let reads_scene = interface.bindings.keys().any(|(s, _)| *s == SCENE_SET);
         let scene = match self.scene.as_ref().filter(|_| reads_scene) {
-            Some((scene, _)) => {
+            Some(RegisteredScene {
+                interface: scene, ..
+            }) => {
                 let traces = (scene.traces)(pass);
                 let problems = scene_set_problems(scene, &interface, false, traces);
                 if !problems.is_empty() {

@@ -86,7 +86,7 @@ impl<'g> Renderer<'g> {
             variants: Vec::new(),
         };
         if let Some((key, bindings)) = checked {
-            let scene = self.scene.as_ref().map(|(_, layouts)| layouts);
+            let scene = self.scene.as_ref();
             prepared.pipeline = Some(self.pipelines.pipeline(self.gpu.device(), &key, scene)?);
             prepared.bindings = bindings;
         }

@@ -5,7 +5,7 @@ use super::{Pipeline, ShaderModule};
 use crate::error::{GpuError, VkCall};
 use crate::graphics::{GraphicsState, VertexInput};
 use crate::reflect::{PipelineInterface, ShaderInterface};
-use crate::scene::{SceneLayouts, SceneSet};
+use crate::scene::{RegisteredScene, SceneLayouts, SceneSet};
 
 use crate::sets::{MATERIAL_SET, SCENE_SET};
 use crate::state::{BlendCode, PassState};
@@ -193,8 +193,9 @@ pub(super) fn build_scene(
     device: &ash::Device,
     (vs, fs): (&ShaderModule, Option<&ShaderModule>),
     (render_pass, state): (vk::RenderPass, &PassState),
-    layouts: &SceneLayouts<'_>,
+    scene: &RegisteredScene<'_>,
 ) -> Result<Pipeline, GpuError> {
+    let layouts = &scene.layouts;
     let mut modules = vec![vs];
     modules.extend(fs);
     let shared = SharedSets {
@@ -211,7 +212,8 @@ pub(super) fn build_scene(
     )?;
     // The attributes the vertex shader reads (a subset of the vertex, which
     // the shader check guarantees): unread ones would only draw warnings.
-    let attributes: Vec<vk::VertexInputAttributeDescription> = layouts
+    let attributes: Vec<vk::VertexInputAttributeDescription> = scene
+        .interface
         .vertex_attributes
         .iter()
         .filter(|a| vs.interface.inputs.iter().any(|i| i.location == a.location))
@@ -228,7 +230,7 @@ pub(super) fn build_scene(
     // determinant) turns its triangles' winding around (`state::front_face`).
     let graphics = GraphicsState {
         vertex_input: Some(VertexInput {
-            stride: layouts.vertex_stride,
+            stride: scene.interface.vertex_stride,
             attributes: &attributes,
         }),
         cull: state.cull_flags(),

@@ -9,7 +9,7 @@ use build::{build_compute, build_graphics, build_scene, destroy_pipeline, merged
 
 use crate::error::GpuError;
 use crate::reflect::{PipelineInterface, ShaderInterface};
-use crate::scene::{SceneLayouts, SceneSet};
+use crate::scene::{RegisteredScene, SceneSet};
 use crate::shader::{CompiledShader, ShaderCompiler, ShaderStage};
 use crate::state::{BlendCode, PassState};
 use ash::vk;
@@ -190,17 +190,21 @@ impl PipelineCache {
         &mut self,
         device: &ash::Device,
         key: &PipelineKey,
-        scene: Option<&SceneLayouts<'_>>,
+        scene: Option<&RegisteredScene<'_>>,
     ) -> Result<Arc<Pipeline>, GpuError> {
         if let Some(p) = self.pipelines.get(key) {
             return Ok(Arc::clone(p));
         }
-        let scene_layouts = |set: Option<SceneSet>| match (set, scene) {
-            (None, _) => Ok(None),
-            (Some(set), Some(layouts)) => Ok(Some((layouts, set))),
-            (Some(_), None) => Err(GpuError::Plan(
-                "a pipeline reads scene data, but no scene interface is registered".into(),
-            )),
+        let registered = || {
+            scene.ok_or_else(|| {
+                GpuError::Plan(
+                    "a pipeline reads scene data, but no scene interface is registered".into(),
+                )
+            })
+        };
+        let scene_layouts = |set: Option<SceneSet>| {
+            set.map(|set| registered().map(|r| (&r.layouts, set)))
+                .transpose()
         };
         let pipeline = match key {
             PipelineKey::Fullscreen {
@@ -226,12 +230,15 @@ impl PipelineCache {
                 render_pass,
                 state,
             } => {
-                let layouts = scene_layouts(Some(SceneSet::Raster))?
-                    .map(|(l, _)| l)
-                    .ok_or_else(|| GpuError::Plan("no scene layouts".into()))?;
+                let registered = registered()?;
                 let vs = self.shader(vertex)?;
                 let fs = fragment.as_ref().map(|f| self.shader(f)).transpose()?;
-                build_scene(device, (&vs, fs.as_deref()), (*render_pass, state), layouts)?
+                build_scene(
+                    device,
+                    (&vs, fs.as_deref()),
+                    (*render_pass, state),
+                    registered,
+                )?
             }
         };
         let pipeline = Arc::new(pipeline);

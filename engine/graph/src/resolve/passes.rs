@@ -269,18 +269,15 @@ impl Resolver<'_> {
                             draws: d.draws.filter(|_| meshes),
                             ..d.clone()
                         };
-                        match defines.iter().find(|e| e.name == define.name) {
-                            Some(same) if *same == define => {}
-                            Some(_) => {
-                                let path =
-                                    pass_path(index, &[Seg::Field("define_sets"), Seg::Index(k)]);
-                                self.error(
-                                    source,
-                                    &path,
-                                    format!("define set \"{set}\" gives \"{}\" other conditions than an earlier set", define.name),
-                                );
-                            }
-                            None => defines.push(define),
+                        let name = define.name.clone();
+                        if !add_define(&mut defines, define) {
+                            let path =
+                                pass_path(index, &[Seg::Field("define_sets"), Seg::Index(k)]);
+                            self.error(
+                                source,
+                                &path,
+                                format!("define set \"{set}\" gives \"{name}\" other conditions than an earlier set"),
+                            );
                         }
                     }
                 }
@@ -332,17 +329,13 @@ impl Resolver<'_> {
                 )
                 .hint = Some("remove `draws`, or give the pass `draw: Meshes(...)`".into());
             }
-            match defines.iter().find(|d| d.name == *name) {
-                Some(same) if same == define => {}
-                Some(_) => {
-                    self.error(
-                        source,
-                        &path,
-                        format!("define \"{name}\" is also in one of the pass's define sets, under other conditions"),
-                    )
-                    .hint = Some("give it once: in the set, or in the pass".into());
-                }
-                None => defines.push(define.clone()),
+            if !add_define(&mut defines, define.clone()) {
+                self.error(
+                    source,
+                    &path,
+                    format!("define \"{name}\" is also in one of the pass's define sets, under other conditions"),
+                )
+                .hint = Some("give it once: in the set, or in the pass".into());
             }
         }
         defines
@@ -455,6 +448,21 @@ fn attachment_access(
         conditions: a.enabled_if.clone(),
         field,
         item,
+    }
+}
+
+/// Adds `define` to `defines` unless the same define is there; false when a
+/// define of its name is there under other conditions.
+fn add_define(
+    defines: &mut Vec<crate::schema::DefineDecl>,
+    define: crate::schema::DefineDecl,
+) -> bool {
+    match defines.iter().find(|d| d.name == define.name) {
+        Some(same) => *same == define,
+        None => {
+            defines.push(define);
+            true
+        }
     }
 }
 
