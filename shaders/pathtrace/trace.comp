@@ -1,9 +1,13 @@
 #version 450
-// Progressive unidirectional path tracer (docs/pathtrace.md). Each frame adds
-// `samples_per_frame` samples per pixel to the running mean in `accumulation`
-// (a history image: rgb the mean, a the sample count), and writes the mean to
-// `hdr`. `history_frames` (0 after any change of camera, scene, graph or
-// parameter) says whether the history holds earlier samples of this image.
+// Progressive unidirectional path tracer (docs/pathtrace.md). Each dispatch
+// adds one sample per pixel to the running mean in `accumulation` (a history
+// image: rgb the mean, a the sample count) and writes the mean to `hdr`; the
+// pass repeats `samples_per_frame` times a frame (`repeat_index` says which),
+// so one invocation traces one path: lavapipe silently ends every loop of an
+// invocation after 65,535 iterations in all, which a loop over samples
+// reached (docs/pathtrace.md). `history_frames` (0 after any change of
+// camera, scene, graph or parameter) says whether the history holds earlier
+// samples of this image.
 //
 // Only the code for what the scene has is compiled: the graph defines
 // SCENE_AREA_LIGHTS, SCENE_EMISSIVE, SCENE_PUNCTUAL_LIGHTS, SCENE_GLOSSY,
@@ -58,6 +62,7 @@ layout(push_constant) uniform Params {
     uint fresnel;
     uint nee_through_glass;
     uint history_frames;
+    uint repeat_index;
 } params;
 
 const uint SAMPLING_MIS = 0u;
@@ -277,25 +282,21 @@ void main() {
     }
     vec3 eye = frame.camera_position.xyz;
     uint spf = max(params.samples_per_frame, 1u);
-    vec3 sum = vec3(0.0);
-    for (uint i = 0u; i < spf; ++i) {
-        Rng rng = rng_start(uvec2(pixel), params.history_frames * spf + i, params.seed);
-        vec2 jitter = rng_next(rng).xy;
-        vec2 ndc = (vec2(pixel) + jitter) / vec2(size) * 2.0 - 1.0;
-        vec4 on_near = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
-        vec3 dir = normalize(on_near.xyz / on_near.w - eye);
-        vec3 sample_radiance = path(eye, dir, rng);
-        // A sample that overflowed or met a degenerate case counts as black
-        // rather than poisoning the pixel's mean for good.
-        bool finite = !any(isnan(sample_radiance)) && !any(isinf(sample_radiance));
-        sum += finite ? sample_radiance : vec3(0.0);
-    }
-    vec3 mean = sum / float(spf);
-    float count = float(spf);
-    if (params.history_frames > 0u) {
+    Rng rng = rng_start(uvec2(pixel), params.history_frames * spf + params.repeat_index, params.seed);
+    vec2 jitter = rng_next(rng).xy;
+    vec2 ndc = (vec2(pixel) + jitter) / vec2(size) * 2.0 - 1.0;
+    vec4 on_near = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+    vec3 dir = normalize(on_near.xyz / on_near.w - eye);
+    vec3 mean = path(eye, dir, rng);
+    // A sample that overflowed or met a degenerate case counts as black
+    // rather than poisoning the pixel's mean for good.
+    bool finite = !any(isnan(mean)) && !any(isinf(mean));
+    mean = finite ? mean : vec3(0.0);
+    float count = 1.0;
+    if (params.history_frames > 0u || params.repeat_index > 0u) {
         vec4 previous = imageLoad(accumulation, pixel);
         count += previous.a;
-        mean = previous.rgb + (mean - previous.rgb) * (float(spf) / count);
+        mean = previous.rgb + (mean - previous.rgb) * (1.0 / count);
     }
     imageStore(accumulation, pixel, vec4(mean, count));
     imageStore(hdr, pixel, vec4(mean, 1.0));

@@ -265,11 +265,15 @@ pub struct FrameValues {
     /// plan (`history_frames`): how many frames' results history images hold,
     /// 0 when they hold nothing usable. Progressive graphs accumulate with it.
     pub history_frames: u32,
+    /// Which of a repeating compute pass's dispatches this is, from 0
+    /// (`repeat_index`; always 0 for a pass that does not repeat).
+    pub repeat_index: u32,
 }
 
 /// Packs parameters into the push-constant block; every member must be a
 /// parameter of the pass (declared in the graph, or derived by a provider and
-/// added to the plan's parameters) or one of `time`, `frame`, `extent`, `history_frames`. An
+/// added to the plan's parameters) or one of `time`, `frame`, `extent`,
+/// `history_frames`, `repeat_index`. An
 /// array member may be given fewer elements than it holds; the rest are zero.
 pub fn pack_push(
     block: &PushBlock,
@@ -301,6 +305,7 @@ pub fn pack_push(
                 "time" => vec![f64::from(frame.time)],
                 "frame" => vec![f64::from(frame.frame)],
                 "history_frames" => vec![f64::from(frame.history_frames)],
+                "repeat_index" => vec![f64::from(frame.repeat_index)],
                 "extent" => frame.extent.iter().map(|&v| f64::from(v)).collect(),
                 name => {
                     problems.push(format!(
@@ -366,13 +371,14 @@ mod tests {
     #[test]
     fn packs_params_and_frame_values_by_name() {
         let block = PushBlock {
-            size: 32,
+            size: 36,
             members: vec![
                 member("tint", 0, ScalarKind::Float, 4),
                 member("radius", 16, ScalarKind::Int, 1),
                 member("frame", 20, ScalarKind::Uint, 1),
                 member("enabled", 24, ScalarKind::Uint, 1),
                 member("history_frames", 28, ScalarKind::Uint, 1),
+                member("repeat_index", 32, ScalarKind::Uint, 1),
             ],
         };
         let params = BTreeMap::from([
@@ -388,11 +394,13 @@ mod tests {
             frame: 7,
             extent: [4, 4],
             history_frames: 3,
+            repeat_index: 5,
         };
         let bytes = pack_push(&block, &params, &frame).expect("packs");
         let word = |i: usize| [bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]];
         assert_eq!(f32::from_ne_bytes(word(8)), 2.0);
         assert_eq!(u32::from_ne_bytes(word(28)), 3);
+        assert_eq!(u32::from_ne_bytes(word(32)), 5);
         assert_eq!(i32::from_ne_bytes(word(16)), 21);
         assert_eq!(u32::from_ne_bytes(word(20)), 7);
         assert_eq!(u32::from_ne_bytes(word(24)), 1);

@@ -193,6 +193,12 @@ pub struct PlanPass {
     pub draw: Option<Draw>,
     /// Work groups for compute passes.
     pub dispatch: Option<[u32; 3]>,
+    /// Dispatches in a row each frame (1 unless the pass declares `repeat`).
+    #[serde(skip_serializing_if = "once")]
+    pub repeat: u32,
+    /// Barriers recorded between a repeating pass's dispatches.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub repeat_barriers: Vec<Barrier>,
     /// Parameter values for the shaders, with `$references` resolved.
     pub params: BTreeMap<String, ParamValue>,
     /// Preprocessor defines selecting the shader variant (`HAS_SHADOW_MAP`, ...).
@@ -220,6 +226,11 @@ pub struct PlanPass {
     /// resolved (checked against the registry by `check_providers`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub derive: Vec<ProviderDecl>,
+}
+
+/// Whether a pass runs once per frame (serialized plans leave `repeat: 1` out).
+fn once(repeat: &u32) -> bool {
+    *repeat == 1
 }
 
 impl PlanPass {

@@ -103,6 +103,12 @@ pub fn render(plan: &Plan) -> String {
         if let Some(d) = p.dispatch {
             let _ = writeln!(w, "     dispatch {}x{}x{}", d[0], d[1], d[2]);
         }
+        if p.repeat > 1 {
+            let _ = writeln!(w, "     repeat {} times, between them:", p.repeat);
+            for b in &p.repeat_barriers {
+                let _ = writeln!(w, "       barrier {}", barrier_line(plan, b));
+            }
+        }
         if p.variants > 1 || !p.defines.is_empty() {
             // Variants are 2^features; the cap is 2^MAX_VARIANT_BITS.
             let features = p.variants.trailing_zeros();

@@ -301,7 +301,7 @@ impl<'g> Renderer<'g> {
             _ => self.prepare_plan(plan, resources)?,
         };
         for (pass, prep) in plan.passes.iter().zip(&mut ready.passes) {
-            prep.push = self.pack_push(pass, prep, options)?;
+            prep.push = self.pack_push(pass, prep, options, 0)?;
         }
         let readback: Vec<_> = if options.readback {
             std::iter::once(plan.output)

@@ -37,13 +37,15 @@ impl<'g> Renderer<'g> {
         })
     }
 
-    /// This frame's push-constant bytes of a prepared pass: its parameters and
-    /// the frame's time, number and extent.
+    /// This frame's push-constant bytes of a prepared pass for its
+    /// `repeat_index`-th dispatch: its parameters and the frame's time,
+    /// number and extent.
     pub(super) fn pack_push(
         &self,
         pass: &PlanPass,
         prep: &Prepared,
         options: &FrameOptions,
+        repeat_index: u32,
     ) -> Result<Vec<u8>, GpuError> {
         let Some((block, _)) = prep
             .pipeline
@@ -57,6 +59,7 @@ impl<'g> Renderer<'g> {
             frame: options.frame,
             extent: [prep.extent.width, prep.extent.height],
             history_frames: options.history_frames,
+            repeat_index,
         };
         bind::pack_push(block, &pass.params, &frame).map_err(|problems| GpuError::Pass {
             pass: pass.name.clone(),

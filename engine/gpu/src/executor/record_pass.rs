@@ -31,6 +31,7 @@ impl<'g> Renderer<'g> {
             frame: options.frame,
             extent: [prep.extent.width, prep.extent.height],
             history_frames: options.history_frames,
+            repeat_index: 0,
         };
         let label = Label::begin(self.gpu, cmd, &pass.name);
         record::barriers(device, cmd, &pass.barriers, resources)?;
@@ -67,9 +68,7 @@ impl<'g> Renderer<'g> {
                     ),
                     None => Ok(()),
                 };
-                bound.map(|()| unsafe {
-                    device.cmd_dispatch(cmd, dispatch[0], dispatch[1], dispatch[2])
-                })
+                bound.and_then(|()| self.dispatch(cmd, pass, prep, (resources, options), dispatch))
             }
             PassKind::Fullscreen | PassKind::Raster => {
                 let area = vk::Rect2D {
@@ -141,6 +140,34 @@ impl<'g> Renderer<'g> {
         };
         label.end(self.gpu, cmd);
         result
+    }
+
+    /// A compute pass's dispatches: one, or `repeat` in a row with the pass's
+    /// repeat barriers between them and each one's `repeat_index` pushed.
+    fn dispatch(
+        &self,
+        cmd: vk::CommandBuffer,
+        pass: &PlanPass,
+        prep: &Prepared,
+        (resources, options): (&FrameResources<'g>, &FrameOptions),
+        groups: [u32; 3],
+    ) -> Result<(), GpuError> {
+        let device = self.gpu.device();
+        for repeat_index in 0..pass.repeat.max(1) {
+            if repeat_index > 0 {
+                record::barriers(device, cmd, &pass.repeat_barriers, resources)?;
+                if let Some((p, (_, stages))) = prep
+                    .pipeline
+                    .as_ref()
+                    .and_then(|p| p.interface.push.as_ref().map(|push| (p, push)))
+                {
+                    let push = self.pack_push(pass, prep, options, repeat_index)?;
+                    unsafe { device.cmd_push_constants(cmd, p.layout, *stages, 0, &push) };
+                }
+            }
+            unsafe { device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+        }
+        Ok(())
     }
 
     pub(super) fn bind(&self, cmd: vk::CommandBuffer, prep: &Prepared) {

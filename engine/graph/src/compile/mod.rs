@@ -261,6 +261,7 @@ pub fn compile_ir(
         },
         &sequence,
         sync.pass_barriers,
+        sync.repeat_barriers,
     );
     Ok(Plan {
         name: graph.name.clone(),

@@ -30,22 +30,29 @@ pub(crate) struct PassContext<'a> {
     pub options: &'a CompileOptions<'a>,
 }
 
-/// Describes the passes of `sequence`, each with the barriers recorded before it.
+/// Describes the passes of `sequence`, each with the barriers recorded before
+/// it and between its dispatches.
 pub(crate) fn describe(
     cx: &PassContext,
     sequence: &[IrPassId],
     barriers: IdVec<PassId, Vec<Barrier>>,
+    repeat_barriers: IdVec<PassId, Vec<Barrier>>,
 ) -> IdVec<PassId, PlanPass> {
     sequence
         .iter()
-        .zip(barriers)
+        .zip(barriers.into_iter().zip(repeat_barriers))
         .enumerate()
         .map(|(i, (&p, barriers))| plan_pass(cx, p, PassId::new(i), barriers))
         .collect()
 }
 
 /// One pass: bindings, defines, render pass, dispatch size and copy endpoints.
-fn plan_pass(cx: &PassContext, p: IrPassId, i: PassId, barriers: Vec<Barrier>) -> PlanPass {
+fn plan_pass(
+    cx: &PassContext,
+    p: IrPassId,
+    i: PassId,
+    (barriers, repeat_barriers): (Vec<Barrier>, Vec<Barrier>),
+) -> PlanPass {
     let PassContext {
         graph,
         ir,
@@ -226,6 +233,8 @@ fn plan_pass(cx: &PassContext, p: IrPassId, i: PassId, barriers: Vec<Barrier>) -
         shaders: pass.shaders.clone(),
         draw: pass.draw.clone(),
         dispatch,
+        repeat: pass.repeat,
+        repeat_barriers,
         params: pass.params.clone(),
         defines: defines.into_iter().collect(),
         model_defines,

@@ -20,6 +20,9 @@ use crate::vk::{Access, Layout, Stage};
 pub(crate) struct Synchronization {
     /// Per plan pass, the barriers recorded before it.
     pub pass_barriers: IdVec<PassId, Vec<Barrier>>,
+    /// Per plan pass, the barriers between its dispatches when it repeats:
+    /// each dispatch sees what the one before it wrote.
+    pub repeat_barriers: IdVec<PassId, Vec<Barrier>>,
     /// Barriers after the last pass.
     pub epilogue: Vec<Barrier>,
 }
@@ -53,8 +56,42 @@ pub(crate) fn synchronize(
     let epilogue = epilogue(resources, &gpu_uses, &scopes, &end_of_frame);
     Synchronization {
         pass_barriers,
+        repeat_barriers: repeat_barriers(ir, sequence, &gpu_uses, resources),
         epilogue,
     }
+}
+
+/// For each pass that repeats, a barrier per resource it writes, from its
+/// own writes to its own accesses, so the next dispatch sees them; the layout
+/// stays.
+fn repeat_barriers(
+    ir: &Ir,
+    sequence: &[IrPassId],
+    gpu_uses: &GpuUses,
+    resources: &Resources,
+) -> IdVec<PassId, Vec<Barrier>> {
+    sequence
+        .iter()
+        .zip(gpu_uses.iter())
+        .map(|(&p, accesses)| {
+            if ir.passes[p].repeat < 2 {
+                return Vec::new();
+            }
+            accesses
+                .iter()
+                .filter(|(_, a)| a.access.is_write())
+                .map(|&(resource, a)| Barrier {
+                    resource,
+                    src_stage: a.stage,
+                    src_access: a.access & Access::WRITES,
+                    dst_stage: a.stage,
+                    dst_access: a.access,
+                    layouts: matches!(resources[resource].desc, ResourceDesc::Image(_))
+                        .then_some((a.layout, a.layout)),
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// Per plan pass, each resource it uses (plan index) and how the GPU accesses it.
@@ -386,5 +423,59 @@ mod tests {
             plan.resources[out].frame_start_layout,
             Layout::TransferSrcOptimal
         );
+    }
+
+    /// `accumulate` reads and writes a history image and writes the output;
+    /// `params.reps` sets how often it repeats.
+    fn repeating(reps: &str) -> String {
+        format!(
+            r#"Graph(
+            output: "out",
+            params: {{ "reps": {reps} }},
+            resources: [
+                Image(name: "acc", format: R32G32B32A32_SFLOAT, history: true),
+                Image(name: "out", format: R32G32B32A32_SFLOAT),
+            ],
+            passes: [
+                Pass(name: "accumulate", kind: Compute, shaders: (compute: "a.comp"),
+                     storage_read: ["acc"], storage_write: ["acc", "out"],
+                     dispatch: Output(8, 8), repeat: "$reps"),
+            ],
+        )"#
+        )
+    }
+
+    #[test]
+    fn a_repeating_pass_waits_for_its_own_writes_between_dispatches() {
+        let plan = plan_of(&repeating("3"), &[]);
+        let pass = &plan.passes[PassId::new(0)];
+        assert_eq!(pass.repeat, 3);
+        let acc = plan.resource("acc").expect("acc");
+        let out = plan.resource("out").expect("out");
+        let storage = Access::SHADER_STORAGE_READ | Access::SHADER_STORAGE_WRITE;
+        assert_eq!(
+            pass.repeat_barriers,
+            [
+                Barrier {
+                    resource: acc,
+                    src_stage: Stage::COMPUTE_SHADER,
+                    src_access: Access::SHADER_STORAGE_WRITE,
+                    dst_stage: Stage::COMPUTE_SHADER,
+                    dst_access: storage,
+                    layouts: Some((Layout::General, Layout::General)),
+                },
+                Barrier {
+                    resource: out,
+                    src_stage: Stage::COMPUTE_SHADER,
+                    src_access: Access::SHADER_STORAGE_WRITE,
+                    dst_stage: Stage::COMPUTE_SHADER,
+                    dst_access: Access::SHADER_STORAGE_WRITE,
+                    layouts: Some((Layout::General, Layout::General)),
+                },
+            ]
+        );
+        let once = plan_of(&repeating("1"), &[]);
+        assert_eq!(once.passes[PassId::new(0)].repeat, 1);
+        assert!(once.passes[PassId::new(0)].repeat_barriers.is_empty());
     }
 }

@@ -92,6 +92,8 @@ pub struct IrPass {
     pub shaders: ShaderFiles,
     pub draw: Option<Draw>,
     pub dispatch: Option<IrDispatch>,
+    /// Dispatches per frame of a compute pass (1 unless it declares `repeat`).
+    pub repeat: u32,
     pub params: BTreeMap<String, ParamValue>,
     pub accesses: Vec<IrAccess>,
     pub after: Vec<IrPassId>,

@@ -1,7 +1,8 @@
 //! Resolving pass declarations: accesses, shaders, dispatch and fixed-function state.
 
 use super::{
-    pass_path, IrAccess, IrDispatch, IrPass, IrResource, Resolver, Usage, MAX_WORKGROUP_COUNT,
+    pass_path, IrAccess, IrDispatch, IrPass, IrResource, Resolver, Usage, MAX_REPEAT,
+    MAX_WORKGROUP_COUNT,
 };
 use crate::id::{IdVec, IrResourceId};
 use crate::load::Located;
@@ -200,6 +201,16 @@ impl Resolver<'_> {
                 .lookup(source, &pass_path(index, &[Seg::Field("dispatch")]), name)
                 .map(|r| IrDispatch::Image(r, *x, *y)),
         };
+        let repeat = match &decl.repeat {
+            None => 1,
+            Some(dim) => self.count(
+                source,
+                &pass_path(index, &[Seg::Field("repeat")]),
+                dim,
+                "repeat",
+                MAX_REPEAT,
+            ),
+        };
         let dir = self.graph.sources[source]
             .file
             .parent()
@@ -218,6 +229,7 @@ impl Resolver<'_> {
             shaders,
             draw: decl.draw.clone(),
             dispatch,
+            repeat,
             params,
             derive,
             accesses,

@@ -76,6 +76,16 @@ impl Resolver<'_> {
                 }
             }
         }
+        if decl.repeat.is_some() && pass.kind != PassKind::Compute {
+            self.error(
+                source,
+                &pass_path(index, &[Seg::Field("repeat")]),
+                format!(
+                    "only compute passes repeat; pass \"{name}\" is {:?}",
+                    pass.kind
+                ),
+            );
+        }
         let shader_fields: [(&str, bool); 3] = [
             ("vertex", decl.shaders.vertex.is_some()),
             ("fragment", decl.shaders.fragment.is_some()),

@@ -119,6 +119,10 @@ pub const MAX_WORKGROUP_COUNT: u32 = 65_535;
 /// would make a single frame run for seconds even on a fast GPU.
 pub const MAX_SAMPLES_PER_FRAME: u32 = 4096;
 
+/// The most dispatches per frame a compute pass may `repeat` (as many as a
+/// progressive graph may add samples per frame).
+pub const MAX_REPEAT: u32 = MAX_SAMPLES_PER_FRAME;
+
 pub use crate::plan::MAX_IMAGE_DIMENSION;
 
 /// The error for an image side over [`MAX_IMAGE_DIMENSION`].

@@ -53,6 +53,14 @@ pub struct PassDecl {
     /// How a compute pass is dispatched.
     #[serde(default)]
     pub dispatch: Option<Dispatch>,
+    /// How many times in a row a compute pass is dispatched each frame (a
+    /// number or `"$param"`), each dispatch seeing the previous one's storage
+    /// writes and its index in the `repeat_index` push constant. Splitting
+    /// long work (a progressive pass's samples) into dispatches bounds what
+    /// one shader invocation runs: lavapipe silently ends every loop of an
+    /// invocation after 65,535 iterations in all.
+    #[serde(default)]
+    pub repeat: Option<Dim>,
     /// Values handed to the shaders.
     #[serde(default)]
     pub params: BTreeMap<String, ParamValue>,

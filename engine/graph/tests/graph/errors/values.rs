@@ -240,3 +240,33 @@ fn conditional_colour_attachments_come_last_and_depth_is_never_conditional() {
     );
     assert!(text_at(&text, &d).starts_with("[\"x\"]"), "{d:?}");
 }
+
+#[test]
+fn repeat_is_a_whole_number_in_range_on_compute_passes_only() {
+    let graph = |value: &str| {
+        COMPUTE
+            .replace("Output(8, 8),", &format!("Output(8, 8), repeat: {value},"))
+            .replace(
+                "    output: \"img\",",
+                "    output: \"img\",\n    params: { \"n\": 2.5 },",
+            )
+    };
+    for (value, found) in [("0", "0"), ("4097", "4097"), ("\"$n\"", "2.5")] {
+        let text = graph(value);
+        let d = only_error(&text);
+        assert_eq!(
+            d.message,
+            format!("repeat must be a whole number from 1 to 4096, found {found}")
+        );
+        assert!(text_at(&text, &d).starts_with(value), "{d:?}");
+    }
+    assert!(check_text(&graph("64")).is_empty());
+    let fullscreen = VALID.replacen("kind: Fullscreen,", "kind: Fullscreen, repeat: 2,", 1);
+    let d = only_error(&fullscreen);
+    assert!(
+        d.message.starts_with("only compute passes repeat; pass \"")
+            && d.message.ends_with("\" is Fullscreen"),
+        "{d:?}"
+    );
+    assert!(text_at(&fullscreen, &d).starts_with("2,"), "{d:?}");
+}
