@@ -6,7 +6,7 @@
 use weft_gpu::{Gpu, Readback, Renderer};
 use weft_graph::plan::Extent;
 use weft_graph::schema::ParamValue;
-use weft_render::gaussian::GaussianTaps;
+use weft_render::GaussianTaps;
 use weft_tests as common;
 
 const WIDTH: u32 = 128;

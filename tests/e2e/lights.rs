@@ -14,7 +14,7 @@ use common::{agreement, graph, render_validated};
 use glam::{Mat4, Vec2, Vec3};
 use std::path::{Path, PathBuf};
 use weft_graph::plan::Extent;
-use weft_render::{camera, render, RenderSettings};
+use weft_render::{render, RenderSettings};
 use weft_testkit::tiles;
 
 /// A fresh folder under the system temp folder for this test's scene files.
@@ -190,9 +190,9 @@ fn check_tile_counts(culling: Culling) -> (weft_render::Rendered, u32, u32) {
     // corner pixel centres bounds the slab (depth on a plane is affine on
     // screen); the floor under each pixel centre gives the surface points.
     let camera = &scene.cameras[0];
-    let view_proj = camera::view_projection(camera, 0.0, w as f32 / h as f32);
+    let view_proj = camera.view_projection(0.0, w as f32 / h as f32);
     let inv = view_proj.inverse();
-    let eye = camera::camera_position(camera, 0.0);
+    let eye = camera.pose_at(0.0).0;
     let viewport = Vec2::new(w as f32, h as f32);
     let (tiles_x, tiles_y) = tiles::tile_grid(w, h);
     let (mut ambiguous, mut most, mut zero, mut tighter, mut total) = (0, 0, 0, 0, 0);

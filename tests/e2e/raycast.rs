@@ -2,7 +2,7 @@
 //! `derive: [RayTracing()]` casts one camera ray per pixel through the BVH
 //! (`shaders/include/trace.glsl`), and every pixel's hit distance, triangle,
 //! interpolated normal and UV, and material match the CPU traversal
-//! (`weft_render::bvh`) of the same ray over the same triangles
+//! (`weft_render::Bvh`) of the same ray over the same triangles
 //! (`SceneGeometry::trace_mesh`, the order the GPU buffers use). The CPU
 //! traces the very ray the GPU traced (read back), so only traversal and
 //! surface interpolation are compared.
@@ -13,9 +13,8 @@
 use glam::Vec3;
 use weft_gpu::Pixels;
 use weft_graph::plan::Extent;
-use weft_render::bvh::Bvh;
-use weft_render::camera::camera_position;
-use weft_render::geometry::SceneGeometry;
+use weft_render::Bvh;
+use weft_render::SceneGeometry;
 use weft_render::{render, RenderSettings};
 use weft_tests::render as common;
 
@@ -72,7 +71,7 @@ fn traced_pixels_match_the_cpu(scene: &std::path::Path, textured: bool) {
     let mesh = SceneGeometry::new(&scene).trace_mesh();
     let triangles = &mesh.corners;
     let bvh = Bvh::build(triangles);
-    let eye = camera_position(&scene.cameras[0], 0.0);
+    let eye = scene.cameras[0].pose_at(0.0).0;
     let (mut hits, mut disagree) = (0, 0);
     let (mut worst, mut worst_normal, mut worst_uv) = (0.0f32, 0.0f32, 0.0f32);
     for y in 0..HEIGHT {
@@ -126,11 +125,7 @@ fn traced_pixels_match_the_cpu(scene: &std::path::Path, textured: bool) {
 
 /// The normal and UV at `p` on triangle `tri`, interpolated from its corners
 /// by barycentric weights (the CPU side of `trace_surface`).
-fn interpolated(
-    mesh: &weft_render::geometry::TraceMesh,
-    tri: usize,
-    p: Vec3,
-) -> (Vec3, glam::Vec2) {
+fn interpolated(mesh: &weft_render::TraceMesh, tri: usize, p: Vec3) -> (Vec3, glam::Vec2) {
     let [a, b, c] = mesh.corners[tri];
     let (e1, e2, d) = (b - a, c - a, p - a);
     let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));

@@ -13,7 +13,7 @@ use glam::Vec3;
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 use weft_graph::plan::Extent;
-use weft_render::lights::area_shape;
+use weft_render::area_shape;
 use weft_render::RenderSettings;
 use weft_scene::Light;
 use weft_testkit::brdf::{cook_torrance, AreaGeometry, AreaIrradiance};

@@ -124,7 +124,7 @@ fn render_hdr(scene: &Path, graph: &Path) -> Vec<f32> {
 /// Pixel coordinates (x right, y down, pixel centres at +0.5) of a world point.
 fn project(scene: &Path, p: Vec3) -> glam::Vec2 {
     let scene = weft_scene::load_scene(scene).expect("scene loads");
-    let m = weft_render::camera::view_projection(&scene.cameras[0], 0.0, 1.0);
+    let m = scene.cameras[0].view_projection(0.0, 1.0);
     let c = m * p.extend(1.0);
     (c.xy() / c.w * 0.5 + 0.5) * SIZE as f32
 }
@@ -238,7 +238,7 @@ fn shadows_in_a_scene_1e4_units_across_keep_their_place_with_cascades() {
     for (half, cascades) in [(8.0, 4), (5000.0, 4), (5000.0, 1)] {
         let scene = write_scene_sized(&dir, &sun_block(SUN), TOP, true, half, "\tfar 20000\n");
         let loaded = weft_scene::load_scene(&scene).expect("scene loads");
-        let inv = weft_render::camera::view_projection(&loaded.cameras[0], 0.0, 1.0).inverse();
+        let inv = loaded.cameras[0].view_projection(0.0, 1.0).inverse();
         let lit = 1.0 / 5f32.sqrt();
         let g = graph_with(&dir, "forward.ron", &format!("\"cascades\": {cascades}"));
         let image = render_hdr(&scene, &g);
@@ -314,7 +314,7 @@ fn a_lit_plane_shows_no_acne_at_the_default_bias() {
         let scene = write_scene(&d, &sun_block(sun), camera, false);
         // Pixels whose centre sees the plane at least 0.25 from its edges.
         let loaded = weft_scene::load_scene(&scene).expect("scene loads");
-        let inv = weft_render::camera::view_projection(&loaded.cameras[0], 0.0, 1.0).inverse();
+        let inv = loaded.cameras[0].view_projection(0.0, 1.0).inverse();
         let inside: Vec<usize> = (0..SIZE * SIZE)
             .filter(|i| {
                 plane_hit(&inv, i % SIZE, i / SIZE)
@@ -427,7 +427,7 @@ fn graph_including(dir: &Path, graph: &str, shadows: &Path) -> PathBuf {
 
 /// The last of three frames of the demo scene (its spot swivels, the sun and
 /// camera stand still) through `graph`: the image and each view's culling.
-fn three_frames(graph: &Path) -> (image::RgbaImage, Vec<weft_render::recorder::ViewCulling>) {
+fn three_frames(graph: &Path) -> (image::RgbaImage, Vec<weft_render::ViewCulling>) {
     let scene = weft_scene::load_scene(&common::demo_scene()).expect("scene loads");
     let gpu = weft_tests::gpu();
     let log = gpu.validation();

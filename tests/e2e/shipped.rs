@@ -145,8 +145,7 @@ fn render_forward(features: &[&str]) -> ([u8; 4], Vec<String>) {
     let mut renderer = Renderer::new(&gpu).expect("renderer");
     assert_eq!(renderer.check_shaders(&plan), Vec::new());
     assert_eq!(
-        weft_gpu::check_shaders(&plan, Some(&weft_render::bindings::scene_interface()))
-            .expect("shaderc"),
+        weft_gpu::check_shaders(&plan, Some(&weft_render::scene_interface())).expect("shaderc"),
         Vec::new()
     );
     let report = weft_testkit::render_frames(

@@ -66,7 +66,7 @@ pub fn compile(
         memory: &memory,
         readback,
     };
-    weft_render::providers::compile(&graph, &options)
+    weft_render::compile_plan(&graph, &options)
         .unwrap_or_else(|d| panic!("{} does not compile: {d:?}", path.display()))
 }
 

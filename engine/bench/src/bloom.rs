@@ -150,7 +150,7 @@ fn measure(
         memory: &memory,
         readback: vec!["bloom".into()],
     };
-    let plan = match weft_render::providers::compile(&prepared, &options) {
+    let plan = match weft_render::compile_plan(&prepared, &options) {
         Ok(plan) => plan,
         Err(diagnostics) => bail!("the bench graph does not compile: {diagnostics:?}"),
     };

@@ -8,8 +8,8 @@ use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use weft_render::bvh::Bvh;
-use weft_render::geometry::SceneGeometry;
+use weft_render::Bvh;
+use weft_render::SceneGeometry;
 
 /// Options of `weft bench bvh`.
 #[derive(Args)]
@@ -30,7 +30,7 @@ struct Row {
     nodes: usize,
     leaves: usize,
     depth: usize,
-    /// Reading the BVH back from the cache (`weft_render::bvh_cache`), median.
+    /// Reading the BVH back from the cache (`weft_render::load_or_build_bvh`), median.
     cached_ms: f64,
     texture_bytes: u64,
 }
@@ -43,7 +43,7 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
             .with_context(|| format!("loading scene {}", path.display()))?;
         let geometry = SceneGeometry::new(&scene);
         let triangles = geometry.trace_mesh().corners;
-        let textures = weft_render::trace_textures::gather(&geometry.materials);
+        let textures = weft_render::gather_trace_textures(&geometry.materials);
         for w in &textures.warnings {
             eprintln!("warning: {}: {w}", path.display());
         }
@@ -64,11 +64,11 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
         times.sort_by(f64::total_cmp);
         let bvh = bvh.context("at least one build")?;
         let cache = std::env::temp_dir().join(format!("weft-bench-bvh-{}", std::process::id()));
-        weft_render::bvh_cache::load_or_build(&triangles, Some(&cache));
+        weft_render::load_or_build_bvh(&triangles, Some(&cache));
         let mut cached = Vec::new();
         for _ in 0..args.runs {
             let started = Instant::now();
-            let (read, _) = weft_render::bvh_cache::load_or_build(&triangles, Some(&cache));
+            let (read, _) = weft_render::load_or_build_bvh(&triangles, Some(&cache));
             cached.push(started.elapsed().as_secs_f64() * 1e3);
             anyhow::ensure!(read == bvh, "the cached BVH differs from the built one");
         }

@@ -17,7 +17,7 @@ use clap::Args;
 use std::process::ExitCode;
 use std::time::Instant;
 use weft_gpu::{Gpu, GpuOptions};
-use weft_render::scene_gpu::GpuScene;
+use weft_render::GpuScene;
 use weft_scene::script::{Limits, ScriptFrame, ScriptRuntime, STEP};
 
 /// Arguments of `weft bench script`.
@@ -131,7 +131,7 @@ fn rewrite_ms(
     scene: &weft_scene::Scene,
     frames: &[Vec<glam::Mat4>],
 ) -> Result<Vec<f64>> {
-    let mut geometry = weft_render::geometry::SceneGeometry::new(scene);
+    let mut geometry = weft_render::SceneGeometry::new(scene);
     let bytes = bytemuck::cast_slice::<_, u8>(&geometry.draw_records).to_vec();
     let mut buffer = weft_gpu::buffer::Buffer::host(
         gpu,
@@ -149,7 +149,7 @@ fn rewrite_ms(
         if let Some(ids) = geometry.place_instances(transforms, &mut placed, &mut moved) {
             let records = &geometry.draw_records[ids.start as usize..ids.end as usize];
             buffer.write_at(
-                ids.start as usize * std::mem::size_of::<weft_render::gpu_types::GpuDraw>(),
+                ids.start as usize * std::mem::size_of::<weft_render::GpuDraw>(),
                 bytemuck::cast_slice(records),
             )?;
         }

@@ -3,8 +3,7 @@
 
 use glam::{Mat4, Vec2, Vec3};
 use weft_graph::schema::MaterialFilter;
-use weft_render::camera::{camera_position, view_projection};
-use weft_render::materials::matches;
+use weft_render::material_matches as matches;
 use weft_scene::{Camera, Light, Scene};
 use weft_testkit::raytrace::Bvh;
 
@@ -32,8 +31,8 @@ pub fn scene_sun_visibility(
         matches(MaterialFilter::ShadowCasters, &material)
     });
     let aspect = size[0].max(1) as f32 / size[1].max(1) as f32;
-    let view_proj = view_projection(camera, 0.0, aspect);
-    let eye = camera_position(camera, 0.0);
+    let view_proj = camera.view_projection(0.0, aspect);
+    let eye = camera.pose_at(0.0).0;
     let offset = scene.effective_bounds().diagonal().max(1e-3) * 1e-4;
     Some(sun_visibility(&bvh, &view_proj, eye, size, sun, offset))
 }
@@ -115,7 +114,7 @@ pub fn compare(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use weft_render::camera::reverse_z_projection;
+    use weft_scene::reverse_z_projection;
 
     /// A floor at y = 0 and a square roof at y = 1 over x, z in -1..1.
     fn scene() -> Bvh {

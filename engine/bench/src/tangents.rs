@@ -8,7 +8,7 @@ use clap::Args;
 use glam::Vec2;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use weft_render::geometry::{quantize_uv, uv_box, SceneGeometry, VERTEX_BYTES};
+use weft_render::{quantize_uv, uv_box, SceneGeometry, VERTEX_BYTES};
 use weft_scene::tangent_frame::{self, ErrorSummary, TangentFrame};
 
 /// Arguments of `weft bench tangents`.

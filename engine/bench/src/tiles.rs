@@ -13,8 +13,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use weft_gpu::{Gpu, GpuOptions, TimingMode};
 use weft_graph::plan::Extent;
-use weft_render::lights::{pack_lights, LightSet};
-use weft_render::{camera, render, RenderSettings};
+use weft_render::{pack_lights, LightSet};
+use weft_render::{render, RenderSettings};
 use weft_scene::Scene;
 use weft_testkit::light_scene;
 use weft_testkit::raytrace;
@@ -77,9 +77,9 @@ fn reaches(set: &LightSet, light: usize, point: Vec3) -> bool {
 fn reaching_per_pixel(scene: &Scene, size: Extent) -> Result<Vec<Option<u32>>> {
     let camera = scene.cameras.first().context("the scene has no camera")?;
     let (w, h) = (size.width, size.height);
-    let view_proj = camera::view_projection(camera, 0.0, w as f32 / h as f32);
+    let view_proj = camera.view_projection(0.0, w as f32 / h as f32);
     let inv = view_proj.inverse();
-    let eye = camera::camera_position(camera, 0.0);
+    let eye = camera.pose_at(0.0).0;
     let set = pack_lights(
         &weft_scene::animation::lights_at(&scene.lights, 0.0, 0),
         &scene.effective_bounds(),

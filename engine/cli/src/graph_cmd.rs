@@ -91,7 +91,7 @@ fn compile(file: &Path, target: &Target) -> Result<(weft_graph::Prepared, weft_g
         ..CompileOptions::default()
     };
     let start = Instant::now();
-    let result = weft_render::providers::compile(&graph, &options);
+    let result = weft_render::compile_plan(&graph, &options);
     let compile_us = start.elapsed().as_secs_f64() * 1e6;
     let plan = result.map_err(failed)?;
     Ok((graph, plan, compile_us))
@@ -129,7 +129,7 @@ pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
                     weft_render::check_graph_and_shaders(&graph, target)?
                 } else {
                     let mut diags = weft_graph::check(&graph);
-                    diags.extend(weft_render::providers::check(&graph));
+                    diags.extend(weft_render::check_providers(&graph));
                     diags
                 };
                 if !json {

@@ -267,7 +267,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         });
     }
     let graph = loaded?;
-    let scene = weft_render::scene_load::load_scene(&args.scene, settings.cache_dir.as_deref())
+    let scene = weft_render::load_scene(&args.scene, settings.cache_dir.as_deref())
         .with_context(|| format!("loading {}", args.scene.display()))?;
     for w in &scene.warnings {
         eprintln!("warning: {}: {}", w.at, w.message);

@@ -40,10 +40,10 @@ pub fn run(cmd: SceneCommand) -> Result<ExitCode> {
                 Ok(report) => {
                     // The scene loaded once already, so this read is from the cache.
                     let scene = weft_scene::load_scene_with(&file, &options)?;
-                    let geometry = weft_render::geometry::SceneGeometry::new(&scene);
+                    let geometry = weft_render::SceneGeometry::new(&scene);
                     let vertices = geometry.vertices.len() as u64;
-                    let emitters = weft_render::emitter_lights::emitter_lights(&geometry);
-                    let vertex_bytes = u64::from(weft_render::geometry::VERTEX_BYTES);
+                    let emitters = weft_render::emitter_lights(&geometry);
+                    let vertex_bytes = u64::from(weft_render::VERTEX_BYTES);
                     if json {
                         let mut value = serde_json::to_value(&report)?;
                         value["vertex_bytes"] = vertex_bytes.into();

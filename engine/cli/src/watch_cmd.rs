@@ -11,8 +11,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use weft_gpu::{Gpu, GpuOptions, ValidationLog};
-use weft_render::watch::{FileWatcher, QUIET};
 use weft_render::{startup_files, LiveRender, RenderSettings};
+use weft_render::{FileWatcher, QUIET};
 
 /// How often the loop looks for an interrupt while no file changes.
 const POLL: Duration = Duration::from_millis(100);

@@ -42,7 +42,7 @@ impl Frustum {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::reverse_z_projection;
+    use weft_scene::reverse_z_projection;
 
     fn unit_box_at(centre: Vec3) -> Aabb {
         Aabb {

@@ -1,53 +1,62 @@
 //! Pass kinds and the frame loop: scene meshes, materials, lights and cameras
 //! drawn by compiled weft graphs.
 //!
-//! [`render`] runs a graph over a scene for some frames; [`load_graph`] loads
-//! the graph once for callers that keep it. [`GpuScene`] uploads a
-//! `weft_scene::Scene` (as a `weft_scene::SceneUpdater` moves it through time);
-//! [`SceneRecorder`] is the `weft_gpu::DrawRecorder` that draws it in raster
-//! passes (`Meshes(filter)`, `LightVolumes(kind)`): it picks each run's
-//! pipeline variant, binds the scene (set 1) and materials (set 2) and draws.
-//! The scene interface it registers with the executor is [`bindings`];
-//! [`FrameLoop`] and [`LiveRender`] run frames and hot reloads. The GLSL side
-//! of every layout is `shaders/include/scene.glsl` and the generated
-//! `shaders/include/bindings.glsl`.
+//! What a caller needs:
+//! - **Render**: [`render`] runs a graph over a scene for some frames;
+//!   [`load_graph`] loads a graph once for callers that keep it, and
+//!   [`compile_for_scene`] / [`render_with_progress`] use it.
+//! - **Frame loop**: [`FrameLoop`] draws frame after frame into a window or
+//!   an image; [`LiveRender`] adds hot reload ([`ReloadWorker`] prepares
+//!   reloads off the frame thread; [`FileWatcher`] reports edited files).
+//! - **Scene upload**: [`GpuScene`] uploads a `weft_scene::Scene` as a
+//!   `weft_scene::SceneUpdater` moves it through time; [`SceneRecorder`] is
+//!   the `weft_gpu::DrawRecorder` that draws it in raster passes
+//!   (`Meshes(filter)`, `LightVolumes(kind)`); [`scene_interface`] is the
+//!   scene's bindings as the executor sees them. The GLSL side of every
+//!   layout is `shaders/include/scene.glsl` and the generated
+//!   `shaders/include/bindings.glsl`.
+//!
+//! The other items are the building blocks those use, public for the
+//! benchmarks, CPU references and tests that check them piece by piece: the
+//! BVH ([`Bvh`]), scene geometry as uploaded ([`SceneGeometry`]), light and
+//! draw records ([`pack_lights`], [`GpuDraw`]), the renderer's value
+//! providers ([`compile_plan`]) and the files a render depends on.
 
 #![warn(missing_docs)]
 
-pub mod bindings;
-pub mod bvh;
-pub mod bvh_cache;
-pub mod camera;
-pub mod emitter_lights;
+mod bindings;
+mod bvh;
+mod bvh_cache;
+mod emitter_lights;
 mod emitters;
 mod error;
 mod features;
 mod frame;
 mod frame_loop;
 mod frustum;
-pub mod gaussian;
-pub mod geometry;
-pub mod gpu_types;
+mod gaussian;
+mod geometry;
+mod gpu_types;
 mod graph_check;
-pub mod lights;
-pub mod materials;
+mod lights;
+mod materials;
 mod optics;
 mod prepare;
-pub mod providers;
-pub mod recorder;
+mod providers;
+mod recorder;
 mod reload;
 mod reload_error;
 mod reload_worker;
-pub mod sanitize;
-pub mod scene_gpu;
-pub mod scene_load;
+mod sanitize;
+mod scene_gpu;
+mod scene_load;
 mod shadows;
-pub mod sources;
+mod sources;
 mod texture;
-pub mod trace_textures;
+mod trace_textures;
 mod view_summary;
 mod volumes;
-pub mod watch;
+mod watch;
 
 pub use error::RenderError;
 pub use features::scene_features;
@@ -57,9 +66,25 @@ pub use frame::{
 pub use frame_loop::{FrameLoop, FrameRequest};
 pub use graph_check::{check_graph_and_shaders, ShaderTarget};
 pub use prepare::{PreparedReload, ReloadJob, ShaderChecker};
-pub use recorder::SceneRecorder;
+pub use recorder::{SceneRecorder, ViewCulling};
 pub use reload::{startup_files, Committed, LiveRender};
 pub use reload_error::ReloadError;
 pub use reload_worker::{ReloadWorker, WorkerReply};
 pub use scene_gpu::GpuScene;
+pub use scene_load::load_scene;
 pub use view_summary::{Bin, ViewSummary};
+pub use watch::{FileWatcher, QUIET};
+
+pub use bindings::scene_interface;
+pub use bvh::{intersect, scene_triangles_where, Bvh};
+pub use bvh_cache::load_or_build as load_or_build_bvh;
+pub use emitter_lights::emitter_lights;
+pub use gaussian::GaussianTaps;
+pub use geometry::{quantize_uv, uv_box, SceneGeometry, TraceMesh, VERTEX_BYTES};
+pub use gpu_types::GpuDraw;
+pub use lights::{area_shape, pack_lights, AreaGeometry, LightSet};
+pub use materials::matches as material_matches;
+pub use providers::{check as check_providers, compile as compile_plan};
+pub use sanitize::RADIANCE_MAX;
+pub use sources::{normalize as normalize_path, scene_files, shader_files};
+pub use trace_textures::gather as gather_trace_textures;

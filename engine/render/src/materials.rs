@@ -10,8 +10,6 @@ use weft_graph::schema::MaterialFilter;
 use weft_scene::material::{AlphaMode, Optics, ShadingModel};
 use weft_scene::Material;
 
-/// Bytes of one material record (`struct Material` in `shaders/include/scene.glsl`).
-pub const MATERIAL_BYTES: usize = std::mem::size_of::<GpuMaterial>();
 /// Shading-model code of MTL materials (`SHADING_BLINN_PHONG`).
 pub const BLINN_PHONG: f32 = 0.0;
 /// Shading-model code of glTF materials (`SHADING_METALLIC_ROUGHNESS`).

@@ -244,6 +244,8 @@ mod tests {
             shaders: Default::default(),
             draw: None,
             dispatch: None,
+            repeat: 1,
+            repeat_barriers: Vec::new(),
             params: BTreeMap::new(),
             defines: Vec::new(),
             model_defines: Vec::new(),

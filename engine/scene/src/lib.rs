@@ -53,7 +53,7 @@ pub mod update;
 mod uri;
 
 pub use bounds::Aabb;
-pub use camera::Camera;
+pub use camera::{reverse_z_projection, Camera};
 pub use desc::{read_scene_desc, scene_desc_from_str, Placement, SceneDesc};
 pub use error::{Diagnostics, Location, SceneError, Warning};
 pub use gltf_import::load_gltf;

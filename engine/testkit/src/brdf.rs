@@ -8,7 +8,7 @@
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 use weft_ltc::energy::Albedo;
-pub use weft_render::lights::AreaGeometry;
+pub use weft_render::AreaGeometry;
 
 /// Roughness is raised to at least this (`MIN_ROUGHNESS` in `brdf.glsl`).
 pub const MIN_ROUGHNESS: f32 = 0.045;
@@ -148,7 +148,7 @@ pub fn concentric(p: Vec2) -> Vec2 {
 
 /// The area-light quadratures of `shaders/include/lighting.glsl` on the CPU,
 /// for an area light as the renderer packs it
-/// ([`weft_render::lights::AreaGeometry`]).
+/// ([`weft_render::AreaGeometry`]).
 pub trait AreaIrradiance {
     /// Irradiance at `p` on a surface with normal `n` per unit emitted radiance,
     /// as the shaders estimate it: `AREA_SAMPLES²` equal-area cells, each seen

@@ -17,7 +17,7 @@ pub struct Hit {
 /// World-space triangles in a hierarchy of boxes.
 #[derive(Debug, Clone)]
 pub struct Bvh {
-    tree: weft_render::bvh::Bvh,
+    tree: weft_render::Bvh,
     triangles: Vec<[Vec3; 3]>,
 }
 
@@ -25,7 +25,7 @@ impl Bvh {
     /// Builds the hierarchy over `triangles`.
     pub fn new(triangles: Vec<[Vec3; 3]>) -> Self {
         Self {
-            tree: weft_render::bvh::Bvh::build(&triangles),
+            tree: weft_render::Bvh::build(&triangles),
             triangles,
         }
     }
@@ -33,7 +33,7 @@ impl Bvh {
     /// The world-space triangles of every placed mesh in `scene` for which
     /// `include(model, mesh)` holds.
     pub fn from_scene(scene: &Scene, include: impl Fn(usize, usize) -> bool) -> Self {
-        Self::new(weft_render::bvh::scene_triangles_where(scene, include))
+        Self::new(weft_render::scene_triangles_where(scene, include))
     }
 
     /// Number of triangles.
@@ -68,7 +68,7 @@ impl Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use weft_render::bvh::intersect;
+    use weft_render::intersect;
 
     fn quad(y: f32, half: f32) -> Vec<[Vec3; 3]> {
         let c = |x, z| Vec3::new(x, y, z);

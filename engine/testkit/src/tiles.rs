@@ -217,7 +217,7 @@ pub fn spot_bounds(apex: Vec3, axis: Vec3, cos_half: f32, range: f32) -> (Vec3, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use weft_render::camera::reverse_z_projection;
+    use weft_scene::reverse_z_projection;
 
     /// A camera at the origin looking down -Z, 90 degrees vertical field of view,
     /// square 64x64 image (4x4 tiles), and its reverse-Z depth of view distance `z`.

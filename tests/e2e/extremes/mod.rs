@@ -25,7 +25,7 @@ use image::RgbaImage;
 use std::path::{Path, PathBuf};
 use weft_gpu::Pixels;
 use weft_graph::plan::Extent;
-use weft_render::sanitize::RADIANCE_MAX;
+use weft_render::RADIANCE_MAX;
 use weft_render::{render, RenderSettings};
 use weft_scene::{Light, Scene};
 

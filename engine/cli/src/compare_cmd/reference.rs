@@ -114,17 +114,17 @@ fn reference_key(
     camera: &str,
     (graph, settings): (&weft_graph::Prepared, &RenderSettings),
 ) -> Result<ReferenceKey> {
-    let mut files: BTreeSet<PathBuf> = weft_render::sources::scene_files(scene);
+    let mut files: BTreeSet<PathBuf> = weft_render::scene_files(scene);
     files.extend(
         graph
             .graph()
             .sources
             .iter()
-            .map(|s| weft_render::sources::normalize(&s.file)),
+            .map(|s| weft_render::normalize_path(&s.file)),
     );
     let plan = weft_render::compile_for_scene(gpu, scene, graph, settings)?;
     let mut shaders = weft_gpu::pipeline::PipelineCache::new()?;
-    files.extend(weft_render::sources::shader_files(&mut shaders, &plan)?.into_keys());
+    files.extend(weft_render::shader_files(&mut shaders, &plan)?.into_keys());
     Ok(ReferenceKey {
         files: files.into_iter().filter(|f| f.is_file()).collect(),
         camera: camera.to_string(),

@@ -36,9 +36,7 @@ fn check_json_has_counts() {
     // 20-byte vertices: every vertex of the demo's models and the light-volume meshes.
     assert_eq!(json["vertex_bytes"], 20);
     let scene = weft_scene::load_scene(&repo().join("scenes/demo.scene")).expect("demo loads");
-    let vertices = weft_render::geometry::SceneGeometry::new(&scene)
-        .vertices
-        .len() as u64;
+    let vertices = weft_render::SceneGeometry::new(&scene).vertices.len() as u64;
     assert_eq!(json["vertex_buffer_bytes"].as_u64(), Some(vertices * 20));
 }
 

@@ -6,7 +6,6 @@ mod placement;
 mod trace;
 
 use crate::bindings::{self, *};
-use crate::camera;
 use crate::error::RenderError;
 use crate::geometry::SceneGeometry;
 use crate::gpu_types::{bytes_of, GpuFrame, GpuLight, GpuMaterial};
@@ -440,8 +439,8 @@ impl<'g> GpuScene<'g> {
         }
         let camera = at.camera(camera);
         let [w, h] = [extent[0].max(1) as f32, extent[1].max(1) as f32];
-        let view_proj = camera::view_projection(camera, time, w / h);
-        let eye = camera::camera_position(camera, time);
+        let view_proj = camera.view_projection(time, w / h);
+        let eye = camera.pose_at(time).0;
         self.camera_position = eye;
         self.view_proj = view_proj;
         let (_, rotation) = camera.pose_at(time);

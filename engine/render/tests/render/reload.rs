@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use weft_gpu::{Gpu, GpuOptions, ShaderStage};
 use weft_graph::plan::Extent;
-use weft_render::sources::normalize;
+use weft_render::normalize_path as normalize;
 use weft_render::WorkerReply;
 use weft_render::{Committed, LiveRender, ReloadWorker, RenderSettings};
 

@@ -5,8 +5,8 @@
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
-use weft_render::sources::normalize;
-use weft_render::watch::{FileWatcher, QUIET};
+use weft_render::normalize_path as normalize;
+use weft_render::{FileWatcher, QUIET};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("weft-watch-{name}-{}", std::process::id()));

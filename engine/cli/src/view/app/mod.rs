@@ -19,7 +19,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 use weft_gpu::{Gpu, PresentSource, Presented, Presenter, Readback, Swapchain};
 use weft_graph::plan::Extent;
-use weft_render::watch::{FileWatcher, QUIET};
+use weft_render::{FileWatcher, QUIET};
 use weft_render::{LiveRender, ReloadWorker, RenderSettings};
 use weft_scene::Camera;
 use winit::application::ApplicationHandler;
