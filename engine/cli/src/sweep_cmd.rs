@@ -108,6 +108,23 @@ fn check_settings(args: &SweepArgs) -> Result<()> {
     }
 }
 
+/// The graph, features (the command's, then the point's) and parameters one
+/// sweep point renders with.
+fn point_settings(args: &SweepArgs, point: &SweepPoint) -> RenderSettings {
+    let mut features = args.common.features.clone();
+    features.extend(point.features.split_whitespace().map(String::from));
+    RenderSettings {
+        graph: args.graph.clone(),
+        features,
+        params: point
+            .params
+            .iter()
+            .map(|(k, v)| (k.clone(), value(v)))
+            .collect(),
+        ..RenderSettings::default()
+    }
+}
+
 /// Runs `weft sweep`.
 pub fn run(args: SweepArgs) -> Result<ExitCode> {
     let common = &args.common;
@@ -129,20 +146,17 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
                 .collect()
         })
         .unwrap_or_default();
-    // The graph loaded (and every feature set checked) before the reference renders.
+    let all = points(&args.params, &sets);
+    // The graph loaded with every point's parameters and features before the
+    // reference renders: a misspelt parameter or value fails at once.
     let mut graphs = crate::graphs::Loaded::default();
-    for set in &sets {
-        graphs.get(&RenderSettings {
-            graph: args.graph.clone(),
-            features: set.split_whitespace().map(String::from).collect(),
-            ..RenderSettings::default()
-        })?;
+    for point in &all {
+        graphs.get(&point_settings(&args, point))?;
     }
     let names: Vec<String> = args.params.iter().map(|(n, _)| n.clone()).collect();
     let csv = args.out.join("sweep.csv");
     check_settings(&args)?;
     let mut rows = read(&csv, &names)?;
-    let all = points(&args.params, &sets);
     let todo: Vec<&SweepPoint> = all
         .iter()
         .filter(|p| !rows.iter().any(|r| &r.point == *p))
@@ -170,15 +184,15 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
         );
         for point in todo {
             overall.set_message(point.label());
-            let mut features = common.features.clone();
-            features.extend(point.features.split_whitespace().map(String::from));
-            let params: Vec<(String, ParamValue)> = point
-                .params
-                .iter()
-                .map(|(k, v)| (k.clone(), value(v)))
-                .collect();
-            let measured =
-                session.measure(common, &point.label(), &args.graph, &features, &params)?;
+            let settings = point_settings(&args, point);
+            let params: Vec<(String, ParamValue)> = settings.params.into_iter().collect();
+            let measured = session.measure(
+                common,
+                &point.label(),
+                &args.graph,
+                &settings.features,
+                &params,
+            )?;
             let row = SweepRow {
                 point: point.clone(),
                 flip: measured.configuration.flip,

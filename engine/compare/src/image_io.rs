@@ -118,20 +118,15 @@ impl LinearImage {
         })
     }
 
-    /// The image as the bytes of an RGB OpenEXR file; `path` names it in errors.
+    /// The image as the bytes of an RGB OpenEXR file (`weft_io::exr`:
+    /// scanlines, float channels); `path` names it in errors.
     pub fn encode_exr(&self, path: &Path) -> Result<Vec<u8>, ImageError> {
-        let write = |message: String| ImageError::Write {
-            path: path.to_path_buf(),
-            message,
-        };
-        let flat: Vec<f32> = self.pixels.iter().flatten().copied().collect();
-        let image = image::Rgb32FImage::from_raw(self.width, self.height, flat)
-            .ok_or_else(|| write("pixel count does not match the size".into()))?;
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        image
-            .write_to(&mut bytes, image::ImageFormat::OpenExr)
-            .map_err(|e| write(e.to_string()))?;
-        Ok(bytes.into_inner())
+        weft_io::exr::encode_rgb(self.width, self.height, &self.pixels).map_err(|e| {
+            ImageError::Write {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            }
+        })
     }
 
     /// An error unless every channel of every pixel is finite and not

@@ -97,6 +97,10 @@ pub struct Report {
     pub device: String,
     /// Frames measured per configuration (after one warm-up frame).
     pub frames: u32,
+    /// Whether LDR-FLIP and PSNR measure each graph's own output, post
+    /// effects such as bloom included (`--post`), rather than its HDR image
+    /// through the reference's tonemap.
+    pub post_effects: bool,
     /// The reference.
     pub reference: ReferenceInfo,
     /// The configurations in command-line order.
@@ -188,6 +192,11 @@ impl Report {
             self.device,
             self.frames
         );
+        out += if self.post_effects {
+            "LDR-FLIP and PSNR measure each configuration's own output, post effects such as bloom included (`--post`); the reference has none.\n\n"
+        } else {
+            "LDR-FLIP and PSNR measure each configuration's HDR image through the reference's tonemap, so post effects the reference does not model (bloom) are not counted as error (`--post` counts them).\n\n"
+        };
         out += &self.table();
         out += "\n## Passes\n\n| configuration | pass | ms | timer |\n|---|---|---|---|\n";
         for c in &self.configurations {

@@ -200,14 +200,17 @@ impl Readback {
         }
     }
 
-    /// Saves linear floats as OpenEXR.
+    /// Saves linear floats as an RGBA OpenEXR file (`weft_io::exr`:
+    /// scanlines, float channels).
     pub fn save_exr(&self, path: &Path) -> Result<(), ReadbackError> {
-        self.to_rgba_f32()
-            .save_with_format(path, image::ImageFormat::OpenExr)
-            .map_err(|e| ReadbackError::Write {
-                path: path.display().to_string(),
-                message: e.to_string(),
-            })
+        let write = |message: String| ReadbackError::Write {
+            path: path.display().to_string(),
+            message,
+        };
+        let rgba: Vec<[f32; 4]> = self.to_rgba_f32().pixels().map(|p| p.0).collect();
+        let bytes = weft_io::exr::encode_rgba(self.width, self.height, &rgba)
+            .map_err(|e| write(e.to_string()))?;
+        std::fs::write(path, bytes).map_err(|e| write(e.to_string()))
     }
 
     /// Saves the 8-bit image as PNG.

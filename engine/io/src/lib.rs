@@ -6,8 +6,10 @@
 //! printers show the offending line without reading the file again.
 //! [`hash`] is the one stable hasher; [`entry`] frames cache entries so a
 //! damaged, swapped or foreign entry is a miss, never a wrong answer.
+//! [`exr`] is the one OpenEXR writer (scanline float files every reader reads).
 
 pub mod entry;
+pub mod exr;
 pub mod hash;
 pub mod paths;
 pub mod read;

@@ -72,6 +72,11 @@ pub struct Common {
     /// have the size asked for.
     #[arg(long)]
     pub reference_image: Option<PathBuf>,
+    /// Measure LDR-FLIP and PSNR on each graph's own output, post effects
+    /// (bloom) included; by default they measure its HDR image through the
+    /// reference's tonemap, as the reference models no post effects.
+    #[arg(long)]
+    pub post: bool,
     /// Frames measured per configuration, after one warm-up frame.
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
@@ -112,7 +117,7 @@ pub struct CompareArgs {
 /// The reference graph's exposure and the tonemap every raster graph ends
 /// with (`shaders/tonemap.frag`: Reinhard per channel, then sRGB), for the
 /// LDR measures of a reference that exists only as linear floats.
-fn tonemap(image: &LinearImage) -> SrgbImage {
+pub(crate) fn tonemap(image: &LinearImage) -> SrgbImage {
     SrgbImage {
         width: image.width,
         height: image.height,
@@ -305,6 +310,7 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         height: common.size.height,
         device: session.device.clone(),
         frames: common.frames,
+        post_effects: common.post,
         reference: session.info.clone(),
         configurations: measured.iter().map(|m| m.configuration.clone()).collect(),
     };

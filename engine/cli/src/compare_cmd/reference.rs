@@ -41,7 +41,6 @@ pub(super) fn reference(
         graph: common.reference.clone(),
         extent: common.size,
         camera: Some(camera.to_string()),
-        features: common.features.clone(),
         samples: Some(common.spp),
         params: common
             .reference_params
@@ -55,8 +54,17 @@ pub(super) fn reference(
         cache_dir: weft_scene::cache::user_cache_dir(),
         ..RenderSettings::default()
     };
-    let graph = crate::graphs::load_checked(&settings)?;
+    let graph = weft_render::load_graph(&settings)?;
+    // `--features` are for the configurations; the reference takes the
+    // toggles it knows (`!textures`), not raster ones (`!bloom`).
+    let features = common
+        .features
+        .iter()
+        .filter(|t| graph.unknown_features(&[t.as_str()]).is_empty())
+        .cloned()
+        .collect();
     let settings = RenderSettings {
+        features,
         extra_readback: graph.graph().readback_names(),
         ..settings
     };

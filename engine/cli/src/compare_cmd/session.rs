@@ -86,7 +86,9 @@ impl Session {
     }
 
     /// Renders `graph` (after one warm-up frame, `common.frames` frames) and
-    /// measures it against the reference.
+    /// measures it against the reference. Every frame shows the scene at the
+    /// reference's time (0): frames repeat one scene state, so the image
+    /// measured is the state the reference shows, however many frames are timed.
     pub fn measure(
         &mut self,
         common: &Common,
@@ -99,6 +101,7 @@ impl Session {
             graph: graph.to_path_buf(),
             extent: common.size,
             frames: common.frames + 1,
+            frame_time: 0.0,
             camera: Some(self.camera.clone()),
             features: features.to_vec(),
             params: params.iter().cloned().collect(),
@@ -127,6 +130,12 @@ impl Session {
                 .context("the frame produced no output image")?,
         );
         let flip = hdr_flip(&self.reference, &image);
+        // Like with like: the LDR measures see what the reference models.
+        let measured_ldr = if common.post {
+            output.clone()
+        } else {
+            super::tonemap(&image)
+        };
         let mut frame_ms = rendered.frame_ms[1.min(rendered.frame_ms.len())..].to_vec();
         let configuration = Configuration {
             name: name.to_string(),
@@ -137,10 +146,10 @@ impl Session {
                 .map(|(k, v)| (k.clone(), param_text(v)))
                 .collect(),
             flip: flip.mean,
-            flip_ldr: ldr_flip(&self.reference_ldr, &output).mean,
+            flip_ldr: ldr_flip(&self.reference_ldr, &measured_ldr).mean,
             rmse: rmse(&image.pixels, &self.reference.pixels),
             rel_mse: rel_mse(&image.pixels, &self.reference.pixels),
-            psnr: psnr(&output, &self.reference_ldr),
+            psnr: psnr(&measured_ldr, &self.reference_ldr),
             luminance_ratio: luminance_ratio(&image.pixels, &self.reference.pixels),
             frame_ms: median(&mut frame_ms),
             passes: pass_medians(&rendered),

@@ -273,6 +273,66 @@ fn a_reference_image_with_non_finite_or_negative_pixels_is_refused() {
     }
 }
 
+/// Every configuration frame shows the scene at the reference's time: on a
+/// scene whose lights move, forward's own render at time 0 as the reference
+/// scores exactly 0 however many frames are timed (the frames used to move
+/// on by 1/60 s each, and scored 0.0014 to 0.0035 against themselves).
+#[test]
+fn a_graph_against_its_own_render_of_the_same_scene_state_scores_zero() {
+    let cache = temp("self-cache");
+    let out = temp("self");
+    let reference = out.join("forward.exr");
+    let render = weft(
+        &[
+            "render",
+            "scenes/animation.scene",
+            "--size",
+            "48x32",
+            "--out",
+            &reference.to_string_lossy(),
+        ],
+        &cache,
+    );
+    assert!(
+        render.status.success(),
+        "{}",
+        String::from_utf8_lossy(&render.stderr)
+    );
+    for frames in ["1", "6"] {
+        let run = weft(
+            &[
+                "compare",
+                "scenes/animation.scene",
+                "--graphs",
+                "graphs/forward.ron",
+                "--size",
+                "48x32",
+                "--frames",
+                frames,
+                "--reference-image",
+                &reference.to_string_lossy(),
+                "--out",
+                &out.to_string_lossy(),
+            ],
+            &cache,
+        );
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let configuration = &report(&out)["configurations"][0];
+        assert_eq!(
+            configuration["flip"], 0.0,
+            "{frames} frames: {configuration}"
+        );
+        assert_eq!(
+            configuration["rmse"], 0.0,
+            "{frames} frames: {configuration}"
+        );
+    }
+}
+
 /// Writes a black RGBA EXR of `width` x `height` with weft itself (a render
 /// of the demo scene at that size).
 fn image_of_size(path: &Path, width: u32, height: u32) {
@@ -292,6 +352,109 @@ fn image_of_size(path: &Path, width: u32, height: u32) {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+/// Bloom, which the reference does not model, is not error by default: the
+/// LDR measures of forward with bloom equal those of forward without it (its
+/// HDR image, before bloom, goes through the reference's tonemap), and with
+/// `--post` they measure the bloomed output and differ. report.md says which.
+#[test]
+fn post_effects_count_as_error_only_when_asked() {
+    let cache = temp("post-cache");
+    let measure = |features: &str, post: bool| {
+        let out = temp(&format!("post-{}-{post}", features.replace('!', "no-")));
+        let mut args = vec![
+            "compare",
+            "scenes/demo.scene",
+            "--graphs",
+            "graphs/forward.ron",
+            "--features",
+            features,
+            "--size",
+            "48x32",
+            "--spp",
+            "4",
+            "--frames",
+            "1",
+        ];
+        if post {
+            args.push("--post");
+        }
+        let out_arg = out.to_string_lossy().into_owned();
+        args.extend(["--out", &out_arg]);
+        let run = weft(&args, &cache);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let markdown = std::fs::read_to_string(out.join("report.md")).expect("report.md");
+        let said = if post {
+            "post effects such as bloom included (`--post`)"
+        } else {
+            "post effects the reference does not model (bloom) are not counted as error"
+        };
+        assert!(markdown.contains(said), "{markdown}");
+        let c = report(&out)["configurations"][0].clone();
+        (
+            c["flip_ldr"].as_f64().expect("flip_ldr"),
+            c["psnr"].as_f64().expect("psnr"),
+        )
+    };
+    let bloom = measure("bloom", false);
+    let no_bloom = measure("!bloom", false);
+    assert_eq!(bloom, no_bloom);
+    let bloom_post = measure("bloom", true);
+    assert_ne!(bloom_post, bloom);
+    // Without bloom the graph's output is its HDR image through the same
+    // tonemap (on the GPU, to 8 bits), so the two ways agree closely.
+    let (flip, psnr) = measure("!bloom", true);
+    assert!(
+        (flip - no_bloom.0).abs() < 2e-3 && (psnr - no_bloom.1).abs() < 0.5,
+        "{flip} {psnr} against {no_bloom:?}"
+    );
+}
+
+/// Every point's parameters and features are checked before the reference
+/// renders: a value out of its declared range in the last point, or a
+/// misspelt parameter, fails at once with the file and line, and nothing is
+/// rendered (no reference in the output folder, nothing cached).
+#[test]
+fn a_sweep_checks_every_point_before_it_renders_the_reference() {
+    let cache = temp("sweep-check-cache");
+    let out = temp("sweep-check");
+    for (param, expected) in [
+        (
+            "area_samples=4,65",
+            "parameter \"area_samples\" set to 65: it must be at most 64",
+        ),
+        ("area_sample=4,8", "unknown parameter \"area_sample\""),
+    ] {
+        let run = weft(
+            &[
+                "sweep",
+                "scenes/demo.scene",
+                "--graph",
+                "graphs/forward.ron",
+                "--param",
+                param,
+                "--size",
+                "48x32",
+                "--spp",
+                "4",
+                "--out",
+                &out.to_string_lossy(),
+            ],
+            &cache,
+        );
+        assert!(!run.status.success(), "{param}");
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            stderr.contains(expected) && stderr.contains("forward.ron:"),
+            "{param}: {stderr}"
+        );
+        assert!(!out.join("reference.exr").exists(), "{param}: rendered");
+    }
 }
 
 #[test]
