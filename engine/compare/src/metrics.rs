@@ -69,6 +69,53 @@ pub fn median(values: &mut [f64]) -> f64 {
     }
 }
 
+/// How a set of timings spreads: the least, the quartiles and the count.
+/// Two configurations whose interquartile ranges overlap are not told apart
+/// by these timings.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct Spread {
+    /// How many samples.
+    pub samples: usize,
+    /// The least sample.
+    pub min: f64,
+    /// The first quartile.
+    pub p25: f64,
+    /// The median.
+    pub median: f64,
+    /// The third quartile.
+    pub p75: f64,
+}
+
+impl Spread {
+    /// The spread of `values` (quartiles interpolated between the sorted
+    /// samples, as numpy's default does); all zero for none.
+    pub fn of(values: &[f64]) -> Spread {
+        let mut sorted = values.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let at = |q: f64| {
+            if sorted.is_empty() {
+                return 0.0;
+            }
+            let position = q * (sorted.len() - 1) as f64;
+            let (low, high) = (position.floor() as usize, position.ceil() as usize);
+            sorted[low] + (sorted[high] - sorted[low]) * (position - low as f64)
+        };
+        Spread {
+            samples: sorted.len(),
+            min: sorted.first().copied().unwrap_or(0.0),
+            p25: at(0.25),
+            median: at(0.5),
+            p75: at(0.75),
+        }
+    }
+
+    /// Whether the two interquartile ranges overlap: the timings do not say
+    /// which is faster.
+    pub fn overlaps(&self, other: &Spread) -> bool {
+        self.p25 <= other.p75 && other.p25 <= self.p75
+    }
+}
+
 fn pairs<'a>(
     image: &'a [[f32; 3]],
     reference: &'a [[f32; 3]],
@@ -86,6 +133,27 @@ fn channels(image: &[[f32; 3]]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spread_interpolates_quartiles_and_tells_overlap() {
+        let s = Spread::of(&[5.0, 1.0, 4.0, 2.0, 3.0]);
+        assert_eq!(
+            s,
+            Spread {
+                samples: 5,
+                min: 1.0,
+                p25: 2.0,
+                median: 3.0,
+                p75: 4.0
+            }
+        );
+        // Four samples: positions 0.75, 1.5 and 2.25 between 10, 20, 30, 40.
+        let four = Spread::of(&[40.0, 10.0, 30.0, 20.0]);
+        assert_eq!((four.p25, four.median, four.p75), (17.5, 25.0, 32.5));
+        assert!(s.overlaps(&Spread::of(&[3.5, 4.5])));
+        assert!(!s.overlaps(&Spread::of(&[4.5, 5.5])));
+        assert_eq!(Spread::of(&[]), Spread::default());
+    }
 
     fn linear(values: &[[f32; 3]]) -> Vec<[f32; 3]> {
         values.to_vec()

@@ -4,6 +4,7 @@
 
 use crate::flip::FlipResult;
 use crate::image_io::{ImageError, SrgbImage};
+use crate::metrics::Spread;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
 use serde::Serialize;
@@ -37,6 +38,8 @@ pub struct PassTime {
     pub name: String,
     /// Median milliseconds over the measured frames.
     pub ms: f64,
+    /// How those milliseconds spread.
+    pub spread: Spread,
     /// How it was measured: `gpu` timestamps, or `cpu` wall time of the pass
     /// submitted alone (where timestamps are meaningless, e.g. compute on
     /// lavapipe).
@@ -68,6 +71,8 @@ pub struct Configuration {
     pub luminance_ratio: f64,
     /// Median wall milliseconds per frame after warm-up.
     pub frame_ms: f64,
+    /// How the measured frames' wall times spread (every round's frames).
+    pub frame_spread: Spread,
     /// Per-pass times.
     pub passes: Vec<PassTime>,
     /// Bytes of transient (graph) images and buffers.
@@ -95,8 +100,13 @@ pub struct Report {
     pub height: u32,
     /// The Vulkan device.
     pub device: String,
-    /// Frames measured per configuration (after one warm-up frame).
+    /// Frames measured per configuration (after one warm-up frame) in each
+    /// round.
     pub frames: u32,
+    /// Rounds of measurement: the configurations take turns, A B C A B C.
+    pub rounds: u32,
+    /// The frame-time budget asked for (`--budget-ms`).
+    pub budget_ms: Option<f64>,
     /// Whether LDR-FLIP and PSNR measure each graph's own output, post
     /// effects such as bloom included (`--post`), rather than its HDR image
     /// through the reference's tonemap.
@@ -114,7 +124,7 @@ impl Report {
     pub fn table(&self) -> String {
         let notes = self.caveat_notes();
         let mut out = String::from(
-            "| configuration | HDR-FLIP | LDR-FLIP | RMSE | rel. MSE | PSNR (dB) | luminance ratio | frame (ms) | transient (MiB) | device (MiB) | caveats |\n\
+            "| configuration | HDR-FLIP | LDR-FLIP | RMSE | rel. MSE | PSNR (dB) | luminance ratio | frame ms: median (IQR) | transient (MiB) | device (MiB) | caveats |\n\
              |---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         for c in &self.configurations {
@@ -125,7 +135,7 @@ impl Report {
                 .map(|i| (i + 1).to_string())
                 .collect();
             out += &format!(
-                "| {} | {:.4} | {:.4} | {:.4e} | {:.4e} | {:.2} | {:.3} | {:.2} | {:.1} | {:.1} | {} |\n",
+                "| {} | {:.4} | {:.4} | {:.4e} | {:.4e} | {:.2} | {:.3} | {:.2} ({:.2}–{:.2}) | {:.1} | {:.1} | {} |\n",
                 c.name,
                 c.flip,
                 c.flip_ldr,
@@ -133,7 +143,9 @@ impl Report {
                 c.rel_mse,
                 c.psnr,
                 c.luminance_ratio,
-                c.frame_ms,
+                c.frame_spread.median,
+                c.frame_spread.p25,
+                c.frame_spread.p75,
                 mib(c.transient_bytes),
                 mib(c.device_bytes),
                 if numbers.is_empty() {
@@ -143,6 +155,7 @@ impl Report {
                 }
             );
         }
+        out += &self.timing_note();
         if !notes.is_empty() {
             out += "\nCaveats: where a configuration differs from the reference by design, so part of its error is a modelling gap, not the technique's:\n\n";
             for (i, note) in notes.iter().enumerate() {
@@ -150,6 +163,56 @@ impl Report {
             }
         }
         out
+    }
+
+    /// Which configurations the frame times cannot tell from the fastest
+    /// (their interquartile ranges overlap its).
+    fn timing_note(&self) -> String {
+        let Some(fastest) = self
+            .configurations
+            .iter()
+            .min_by(|a, b| a.frame_spread.median.total_cmp(&b.frame_spread.median))
+        else {
+            return String::new();
+        };
+        let tied: Vec<&str> = self
+            .configurations
+            .iter()
+            .filter(|c| c.name != fastest.name && c.frame_spread.overlaps(&fastest.frame_spread))
+            .map(|c| c.name.as_str())
+            .collect();
+        if tied.is_empty() {
+            return format!(
+                "\nFrame times: {} is the fastest, outside every other configuration's interquartile range.\n",
+                fastest.name
+            );
+        }
+        format!(
+            "\nFrame times: {} has the lowest median, but the interquartile range of {} overlaps its: the timings do not order them.\n",
+            fastest.name,
+            tied.join(" and ")
+        )
+    }
+
+    /// The budget verdict: the configuration with the least HDR-FLIP whose
+    /// median frame time is within `budget_ms`, with its margin.
+    pub fn budget_verdict(&self) -> Option<String> {
+        let budget = self.budget_ms?;
+        let best = self
+            .configurations
+            .iter()
+            .filter(|c| c.frame_spread.median <= budget)
+            .min_by(|a, b| a.flip.total_cmp(&b.flip));
+        Some(match best {
+            Some(c) => format!(
+                "Within {budget} ms a frame: **{}**, the most accurate (HDR-FLIP {:.4}) at a median {:.2} ms, {:.2} ms to spare.",
+                c.name,
+                c.flip,
+                c.frame_spread.median,
+                budget - c.frame_spread.median
+            ),
+            None => format!("No configuration's median frame time is within {budget} ms."),
+        })
     }
 
     /// Every configuration's caveats, each once, in the order first met.
@@ -184,24 +247,32 @@ impl Report {
             _ => format!("the image {}", self.reference.image.display()),
         };
         let mut out = format!(
-            "# weft compare: {}\n\nCamera \"{}\", {}x{}, on {}; reference: {reference}. Frame times are medians of {} frames after one warm-up frame.\n\n",
+            "# weft compare: {}\n\nCamera \"{}\", {}x{}, on {}; reference: {reference}. Frame times: {} round(s), the configurations taking turns, each round one warm-up frame and {} measured; medians and interquartile ranges over all measured frames.\n\n",
             self.scene.display(),
             self.camera,
             self.width,
             self.height,
             self.device,
+            self.rounds,
             self.frames
         );
+        if let Some(verdict) = self.budget_verdict() {
+            out += &verdict;
+            out += "\n\n";
+        }
         out += if self.post_effects {
             "LDR-FLIP and PSNR measure each configuration's own output, post effects such as bloom included (`--post`); the reference has none.\n\n"
         } else {
             "LDR-FLIP and PSNR measure each configuration's HDR image through the reference's tonemap, so post effects the reference does not model (bloom) are not counted as error (`--post` counts them).\n\n"
         };
         out += &self.table();
-        out += "\n## Passes\n\n| configuration | pass | ms | timer |\n|---|---|---|---|\n";
+        out += "\n## Passes\n\n| configuration | pass | ms: median (IQR) | timer |\n|---|---|---|---|\n";
         for c in &self.configurations {
             for p in &c.passes {
-                out += &format!("| {} | {} | {:.3} | {} |\n", c.name, p.name, p.ms, p.timer);
+                out += &format!(
+                    "| {} | {} | {:.3} ({:.3}–{:.3}) | {} |\n",
+                    c.name, p.name, p.ms, p.spread.p25, p.spread.p75, p.timer
+                );
             }
         }
         out += "\n## Images\n\nEach configuration's output and its HDR-FLIP error map (magma: black 0, yellow 1).\n\n![contact sheet](contact_sheet.png)\n";

@@ -9,7 +9,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_compare::cache::{ReferenceCache, ReferenceKey};
-use weft_compare::metrics::median;
+use weft_compare::metrics::Spread;
 use weft_compare::report::{
     write_contact_sheet, write_flip_map, Configuration, PassTime, ReferenceInfo, Report,
     SheetColumn,
@@ -112,6 +112,23 @@ pub struct CompareArgs {
     /// Where the images and reports go.
     #[arg(long, default_value = "out/compare")]
     out: PathBuf,
+    /// Rounds of measurement: the configurations take turns (A B C A B C),
+    /// each round one warm-up frame and --frames measured, so a drift in the
+    /// machine's speed falls on every configuration alike.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
+    rounds: u32,
+    /// A frame-time budget in milliseconds: the report names the most
+    /// accurate configuration whose median frame time is within it.
+    #[arg(long, value_parser = parse_budget)]
+    budget_ms: Option<f64>,
+}
+
+/// A budget: a positive, finite number of milliseconds.
+fn parse_budget(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(ms) if ms.is_finite() && ms > 0.0 => Ok(ms),
+        _ => Err(format!("{text:?} is not a positive number of milliseconds")),
+    }
 }
 
 /// The reference graph's exposure and the tonemap every raster graph ends
@@ -216,31 +233,45 @@ fn param_text(value: &ParamValue) -> String {
     }
 }
 
-/// Per-pass medians over the frames after the first.
-fn pass_medians(rendered: &Rendered) -> Vec<PassTime> {
+/// One pass's measured times: its name, its timer's label and the
+/// milliseconds of every measured frame.
+pub struct PassSamples {
+    name: String,
+    timer: String,
+    ms: Vec<f64>,
+}
+
+/// Per-pass times of the frames after the first, passes in frame order.
+fn pass_samples(rendered: &Rendered) -> Vec<PassSamples> {
     let measured = &rendered.timings[1.min(rendered.timings.len())..];
-    let mut order: Vec<String> = Vec::new();
-    let mut by_pass: BTreeMap<String, (Vec<f64>, String)> = BTreeMap::new();
+    let mut passes: Vec<PassSamples> = Vec::new();
     for frame in measured {
         for t in frame {
-            if !by_pass.contains_key(&t.pass) {
-                order.push(t.pass.clone());
+            match passes.iter_mut().find(|p| p.name == t.pass) {
+                Some(p) => p.ms.push(t.ms),
+                None => passes.push(PassSamples {
+                    name: t.pass.clone(),
+                    timer: t.source.label().to_string(),
+                    ms: vec![t.ms],
+                }),
             }
-            let entry = by_pass
-                .entry(t.pass.clone())
-                .or_insert_with(|| (Vec::new(), t.source.label().to_string()));
-            entry.0.push(t.ms);
         }
     }
-    order
-        .into_iter()
-        .filter_map(|name| {
-            let (mut ms, timer) = by_pass.remove(&name)?;
-            Some(PassTime {
-                name,
-                ms: median(&mut ms),
-                timer,
-            })
+    passes
+}
+
+/// Each pass's median and spread.
+fn pass_times(samples: &[PassSamples]) -> Vec<PassTime> {
+    samples
+        .iter()
+        .map(|p| {
+            let spread = Spread::of(&p.ms);
+            PassTime {
+                name: p.name.clone(),
+                ms: spread.median,
+                spread,
+                timer: p.timer.clone(),
+            }
         })
         .collect()
 }
@@ -289,9 +320,16 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
     session
         .reference_ldr
         .write_png(&args.out.join("reference.png"))?;
+    let names = names(&args.graphs);
+    let mut rounds: Vec<Vec<session::Measured>> = args.graphs.iter().map(|_| Vec::new()).collect();
+    for _ in 0..args.rounds {
+        for ((graph, name), taken) in args.graphs.iter().zip(&names).zip(&mut rounds) {
+            taken.push(session.measure(common, name, graph, &common.features, &args.params)?);
+        }
+    }
     let mut measured = Vec::new();
-    for (graph, name) in args.graphs.iter().zip(names(&args.graphs)) {
-        let mut m = session.measure(common, &name, graph, &common.features, &args.params)?;
+    for (taken, name) in rounds.into_iter().zip(names) {
+        let mut m = session::Measured::merge(taken).context("no round measured")?;
         let files = [
             args.out.join(format!("{name}.png")),
             args.out.join(format!("{name}.exr")),
@@ -310,6 +348,8 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         height: common.size.height,
         device: session.device.clone(),
         frames: common.frames,
+        rounds: args.rounds,
+        budget_ms: args.budget_ms,
         post_effects: common.post,
         reference: session.info.clone(),
         configurations: measured.iter().map(|m| m.configuration.clone()).collect(),
@@ -340,9 +380,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn medians_and_names() {
-        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), 2.5);
+    fn names_are_stems_numbered_when_shared() {
         assert_eq!(
             names(&[
                 PathBuf::from("graphs/forward.ron"),

@@ -29,12 +29,58 @@ pub struct Session {
 pub struct Measured {
     /// The figures.
     pub configuration: Configuration,
+    /// Every measured frame's wall milliseconds.
+    frame_samples: Vec<f64>,
+    /// Every measured frame's per-pass milliseconds.
+    pass_samples: Vec<super::PassSamples>,
     /// Its linear image.
     pub image: LinearImage,
     /// Its tonemapped output.
     pub output: SrgbImage,
     /// Its HDR-FLIP error map.
     pub flip: weft_compare::FlipResult,
+}
+
+impl Measured {
+    /// The figures with the timings summarised from the samples.
+    fn timed(mut self) -> Self {
+        let spread = Spread::of(&self.frame_samples);
+        self.configuration.frame_ms = spread.median;
+        self.configuration.frame_spread = spread;
+        self.configuration.passes = super::pass_times(&self.pass_samples);
+        self
+    }
+
+    /// One configuration measured in several rounds: the last round's images
+    /// and figures (they are the same every round), every round's timings.
+    pub fn merge(rounds: Vec<Measured>) -> Option<Measured> {
+        let mut frame_samples = Vec::new();
+        let mut pass_samples: Vec<super::PassSamples> = Vec::new();
+        let mut last = None;
+        for round in rounds {
+            frame_samples.extend(&round.frame_samples);
+            for p in &round.pass_samples {
+                match pass_samples.iter_mut().find(|q| q.name == p.name) {
+                    Some(q) => q.ms.extend(&p.ms),
+                    None => pass_samples.push(super::PassSamples {
+                        name: p.name.clone(),
+                        timer: p.timer.clone(),
+                        ms: p.ms.clone(),
+                    }),
+                }
+            }
+            last = Some(round);
+        }
+        let last = last?;
+        Some(
+            Measured {
+                frame_samples,
+                pass_samples,
+                ..last
+            }
+            .timed(),
+        )
+    }
 }
 
 impl Session {
@@ -146,7 +192,8 @@ impl Session {
         } else {
             super::tonemap(&image)
         };
-        let mut frame_ms = rendered.frame_ms[1.min(rendered.frame_ms.len())..].to_vec();
+        let frame_samples = rendered.frame_ms[1.min(rendered.frame_ms.len())..].to_vec();
+        let pass_samples = super::pass_samples(&rendered);
         let configuration = Configuration {
             name: name.to_string(),
             graph: graph.to_path_buf(),
@@ -161,8 +208,9 @@ impl Session {
             rel_mse: rel_mse(&image.pixels, &self.reference.pixels),
             psnr: psnr(&measured_ldr, &self.reference_ldr),
             luminance_ratio: luminance_ratio(&image.pixels, &self.reference.pixels),
-            frame_ms: median(&mut frame_ms),
-            passes: pass_medians(&rendered),
+            frame_ms: 0.0,
+            frame_spread: Spread::default(),
+            passes: Vec::new(),
             transient_bytes,
             device_bytes: rendered.report.memory.allocated_bytes,
             caveats: rendered.plan.caveats.clone(),
@@ -170,10 +218,13 @@ impl Session {
         };
         Ok(Measured {
             configuration,
+            frame_samples,
+            pass_samples,
             image,
             output,
             flip,
-        })
+        }
+        .timed())
     }
 
     /// Ends the session: prints the validation messages and says whether

@@ -273,6 +273,98 @@ fn a_reference_image_with_non_finite_or_negative_pixels_is_refused() {
     }
 }
 
+/// Timings come with their spread: configurations take turns over
+/// `--rounds`, every measured frame of every round counts (2 rounds × 2
+/// frames = 4 samples a configuration and a pass), the report gives medians
+/// and interquartile ranges, and `--budget-ms` names the most accurate
+/// configuration within the budget, or says none is.
+#[test]
+fn timings_carry_their_spread_and_a_budget_picks_a_configuration() {
+    let cache = temp("rounds-cache");
+    let out = temp("rounds");
+    let reference = out.join("reference-given.exr");
+    let render = weft(
+        &[
+            "render",
+            "scenes/demo.scene",
+            "--size",
+            "48x32",
+            "--out",
+            &reference.to_string_lossy(),
+        ],
+        &cache,
+    );
+    assert!(
+        render.status.success(),
+        "{}",
+        String::from_utf8_lossy(&render.stderr)
+    );
+    let run = |budget: &str| {
+        let result = weft(
+            &[
+                "compare",
+                "scenes/demo.scene",
+                "--graphs",
+                "graphs/forward.ron,graphs/deferred.ron",
+                "--size",
+                "48x32",
+                "--frames",
+                "2",
+                "--rounds",
+                "2",
+                "--budget-ms",
+                budget,
+                "--reference-image",
+                &reference.to_string_lossy(),
+                "--out",
+                &out.to_string_lossy(),
+            ],
+            &cache,
+        );
+        assert!(
+            result.status.success(),
+            "{}",
+            String::from_utf8_lossy(&result.stderr)
+        );
+        std::fs::read_to_string(out.join("report.md")).expect("report.md")
+    };
+    let markdown = run("1e9");
+    let json = report(&out);
+    assert_eq!(json["rounds"], 2);
+    let configurations = json["configurations"].as_array().expect("configurations");
+    for c in configurations {
+        let spread = &c["frame_spread"];
+        assert_eq!(spread["samples"], 4, "{c}");
+        let q = |k: &str| spread[k].as_f64().expect("number");
+        assert!(
+            q("min") <= q("p25") && q("p25") <= q("median") && q("median") <= q("p75"),
+            "{spread}"
+        );
+        assert_eq!(c["frame_ms"], spread["median"]);
+        for pass in c["passes"].as_array().expect("passes") {
+            assert_eq!(pass["spread"]["samples"], 4, "{pass}");
+        }
+    }
+    // Forward against its own render is exact, so it is the most accurate.
+    assert_eq!(configurations[0]["flip"], 0.0);
+    assert!(
+        markdown.contains(
+            "Within 1000000000 ms a frame: **forward**, the most accurate (HDR-FLIP 0.0000)"
+        ),
+        "{markdown}"
+    );
+    assert!(
+        markdown.contains("2 round(s), the configurations taking turns"),
+        "{markdown}"
+    );
+    assert!(markdown.contains("Frame times: "), "{markdown}");
+    let markdown = run("0.000001");
+    assert!(
+        markdown.contains("No configuration's median frame time is within 0.000001 ms."),
+        "{markdown}"
+    );
+}
+
 /// Every configuration frame shows the scene at the reference's time: on a
 /// scene whose lights move, forward's own render at time 0 as the reference
 /// scores exactly 0 however many frames are timed (the frames used to move
