@@ -29,6 +29,20 @@ pub struct ReferenceInfo {
     pub image: PathBuf,
     /// Seconds it took to render (0 when cached or given).
     pub seconds: f64,
+    /// Its own noise, when asked for (`--noise-floor`).
+    pub noise_floor: Option<NoiseFloor>,
+}
+
+/// The reference's noise: HDR-FLIP between it and the same render with
+/// another seed. Differences between configurations below it are noise.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NoiseFloor {
+    /// The other render's seed.
+    pub seed: u32,
+    /// HDR-FLIP between the two renders.
+    pub flip: f64,
+    /// The other render (linear EXR).
+    pub image: PathBuf,
 }
 
 /// One pass's time.
@@ -256,6 +270,12 @@ impl Report {
             self.rounds,
             self.frames
         );
+        if let Some(floor) = &self.reference.noise_floor {
+            out += &format!(
+                "Reference noise floor: HDR-FLIP {:.4} between this reference and the same render with seed {}; differences in HDR-FLIP smaller than that are the reference's noise.\n\n",
+                floor.flip, floor.seed
+            );
+        }
         if let Some(verdict) = self.budget_verdict() {
             out += &verdict;
             out += "\n\n";

@@ -68,6 +68,11 @@ pub struct Common {
     /// direct light only); repeatable.
     #[arg(long = "reference-param", value_parser = crate::render_cmd::parse_param)]
     pub reference_params: Vec<(String, ParamValue)>,
+    /// Also render the reference with the next seed and report the HDR-FLIP
+    /// between the two: the reference's own noise, below which differences
+    /// between configurations mean nothing (cached like the reference).
+    #[arg(long, conflicts_with = "reference_image")]
+    pub noise_floor: bool,
     /// A linear EXR to use as the reference instead of rendering one; it must
     /// have the size asked for.
     #[arg(long)]

@@ -3,14 +3,14 @@
 
 use super::*;
 
-/// The reference: the given EXR, the cached render, or a new render (stored
-/// in the cache, or written to `out` with `--no-cache`).
+/// The reference: the given EXR, the cached render, or a new render with
+/// `seed` (stored in the cache); written to `path` either way.
 pub(super) fn reference(
     common: &Common,
-    gpu: &Gpu,
-    scene: &weft_scene::Scene,
+    seed: u32,
+    (gpu, scene): (&Gpu, &weft_scene::Scene),
     camera: &str,
-    out: &Path,
+    path: &Path,
 ) -> Result<(LinearImage, ReferenceInfo)> {
     let Extent { width, height } = common.size;
     if let Some(path) = &common.reference_image {
@@ -34,6 +34,7 @@ pub(super) fn reference(
                 cached: false,
                 image: path.clone(),
                 seconds: 0.0,
+                noise_floor: None,
             },
         ));
     }
@@ -46,10 +47,7 @@ pub(super) fn reference(
             .reference_params
             .iter()
             .cloned()
-            .chain([(
-                "seed".to_string(),
-                ParamValue::Number(f64::from(common.seed)),
-            )])
+            .chain([("seed".to_string(), ParamValue::Number(f64::from(seed)))])
             .collect(),
         cache_dir: weft_scene::cache::user_cache_dir(),
         ..RenderSettings::default()
@@ -76,28 +74,28 @@ pub(super) fn reference(
             .collect(),
         graph: Some(common.reference.clone()),
         spp: Some(common.spp),
-        seed: Some(common.seed),
+        seed: Some(seed),
         cached,
         image,
         seconds,
+        noise_floor: None,
     };
     let cache = weft_scene::cache::user_cache_dir()
         .filter(|_| !common.no_cache)
         .map(|root| ReferenceCache::new(&root));
     let digest = match &cache {
-        Some(_) => {
-            Some(reference_key(common, (gpu, scene), camera, (&graph, &settings))?.digest()?)
-        }
+        Some(_) => Some(
+            reference_key((common, seed), (gpu, scene), camera, (&graph, &settings))?.digest()?,
+        ),
         None => None,
     };
     // The reference the report links to is always an EXR in the output folder;
     // the cache keeps its own framed copy.
-    let path = out.join("reference.exr");
     if let (Some(cache), Some(digest)) = (&cache, &digest) {
         match cache.load(digest, width, height) {
             Ok(Some(image)) => {
-                image.write_exr(&path)?;
-                return Ok((image, info(true, path, 0.0)));
+                image.write_exr(path)?;
+                return Ok((image, info(true, path.to_path_buf(), 0.0)));
             }
             Ok(None) => {}
             Err(damaged) => eprintln!("warning: {damaged}"),
@@ -110,14 +108,14 @@ pub(super) fn reference(
     if let (Some(cache), Some(digest)) = (&cache, &digest) {
         cache.store(digest, &image)?;
     }
-    image.write_exr(&path)?;
-    Ok((image, info(false, path, seconds)))
+    image.write_exr(path)?;
+    Ok((image, info(false, path.to_path_buf(), seconds)))
 }
 
 /// Every input of the reference render: the scene's files, the graph's
 /// files and its shaders' sources, and the settings.
 fn reference_key(
-    common: &Common,
+    (common, seed): (&Common, u32),
     (gpu, scene): (&Gpu, &weft_scene::Scene),
     camera: &str,
     (graph, settings): (&weft_graph::Prepared, &RenderSettings),
@@ -139,7 +137,7 @@ fn reference_key(
         width: common.size.width,
         height: common.size.height,
         spp: common.spp,
-        seed: common.seed,
+        seed,
         settings: common
             .features
             .iter()

@@ -1,7 +1,7 @@
 //! A measuring session: the scene, the device and the reference, then each
 //! configuration rendered and measured against it (compare and sweep).
 
-use super::reference::reference;
+use super::reference::reference as render_reference;
 use super::*;
 
 /// A loaded scene, a device and the reference, ready to measure
@@ -115,7 +115,23 @@ impl Session {
             } else {
                 Timer::Gpu
             });
-        let (reference, info) = reference(common, &gpu, &scene, &camera, out)?;
+        let (reference, mut info) = render_reference(
+            common,
+            common.seed,
+            (&gpu, &scene),
+            &camera,
+            &out.join("reference.exr"),
+        )?;
+        if common.noise_floor {
+            let seed = common.seed.wrapping_add(1);
+            let path = out.join(format!("reference-seed{seed}.exr"));
+            let (other, _) = render_reference(common, seed, (&gpu, &scene), &camera, &path)?;
+            info.noise_floor = Some(weft_compare::report::NoiseFloor {
+                seed,
+                flip: hdr_flip(&reference, &other).mean,
+                image: path,
+            });
+        }
         let reference_ldr = tonemap(&reference);
         Ok(Self {
             gpu,

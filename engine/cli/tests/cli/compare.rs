@@ -365,6 +365,54 @@ fn timings_carry_their_spread_and_a_budget_picks_a_configuration() {
     );
 }
 
+/// `--noise-floor` renders the reference again with the next seed and
+/// reports the HDR-FLIP between the two renders, which the test recomputes
+/// from the two EXRs written.
+#[test]
+fn the_noise_floor_is_the_flip_between_two_seeds_of_the_reference() {
+    let cache = temp("floor-cache");
+    let out = temp("floor");
+    let run = weft(
+        &[
+            "compare",
+            "scenes/demo.scene",
+            "--graphs",
+            "graphs/forward.ron",
+            "--size",
+            "48x32",
+            "--spp",
+            "4",
+            "--seed",
+            "5",
+            "--frames",
+            "1",
+            "--rounds",
+            "1",
+            "--noise-floor",
+            "--out",
+            &out.to_string_lossy(),
+        ],
+        &cache,
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let floor = report(&out)["reference"]["noise_floor"].clone();
+    assert_eq!(floor["seed"], 6, "{floor}");
+    let read = |name: &str| weft_compare::LinearImage::read_exr(&out.join(name)).expect(name);
+    let expected =
+        weft_compare::hdr_flip(&read("reference.exr"), &read("reference-seed6.exr")).mean;
+    assert!(expected > 0.0);
+    assert_eq!(floor["flip"].as_f64(), Some(expected));
+    let markdown = std::fs::read_to_string(out.join("report.md")).expect("report.md");
+    assert!(
+        markdown.contains(&format!("Reference noise floor: HDR-FLIP {expected:.4} between this reference and the same render with seed 6")),
+        "{markdown}"
+    );
+}
+
 /// Every configuration frame shows the scene at the reference's time: on a
 /// scene whose lights move, forward's own render at time 0 as the reference
 /// scores exactly 0 however many frames are timed (the frames used to move
