@@ -7,16 +7,46 @@ use crate::compare_cmd::{Common, Session};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::io::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_compare::pareto::{frontier, write_plot, Point};
 use weft_compare::sweep::{header, line, points, read, SweepPoint, SweepRow};
 use weft_graph::schema::ParamValue;
 use weft_render::RenderSettings;
 
-/// Arguments of `weft sweep`.
+/// Arguments of `weft sweep`: a sweep (or one shard of it), or `weft sweep
+/// merge` joining shards.
 #[derive(Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct SweepArgs {
+    #[command(subcommand)]
+    command: Option<SweepCommand>,
+    #[command(flatten)]
+    sweep: SweepRun,
+}
+
+/// What `weft sweep` can do besides sweeping.
+#[derive(clap::Subcommand)]
+enum SweepCommand {
+    /// Joins the folders of a sharded sweep (`--shard K/N`) into one:
+    /// sweep.csv, pareto.png and sweep.md over every shard's points.
+    Merge(MergeArgs),
+}
+
+/// Arguments of `weft sweep merge`.
+#[derive(Args)]
+struct MergeArgs {
+    /// The shards' output folders.
+    #[arg(required = true)]
+    shards: Vec<PathBuf>,
+    /// Where the joined sweep goes.
+    #[arg(long, default_value = "out/sweep")]
+    out: PathBuf,
+}
+
+/// Arguments of one sweep.
+#[derive(Args)]
+struct SweepRun {
     #[command(flatten)]
     common: Common,
     /// The graph swept.
@@ -33,6 +63,37 @@ pub struct SweepArgs {
     /// Where `sweep.csv`, `pareto.png` and `sweep.md` go.
     #[arg(long, default_value = "out/sweep")]
     out: PathBuf,
+    /// Measure only shard K of N (`K/N`, K from 1): every N-th point of the
+    /// sweep's order from the K-th, so N machines share a sweep; join their
+    /// folders with `weft sweep merge`.
+    #[arg(long, value_parser = parse_shard)]
+    shard: Option<Shard>,
+}
+
+/// Shard K of N (K from 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Shard {
+    k: usize,
+    n: usize,
+}
+
+impl Shard {
+    /// Whether the sweep's `index`-th point (from 0) is this shard's.
+    fn takes(&self, index: usize) -> bool {
+        index % self.n == self.k - 1
+    }
+}
+
+fn parse_shard(text: &str) -> Result<Shard, String> {
+    let parsed = text
+        .split_once('/')
+        .and_then(|(k, n)| Some((k.trim().parse().ok()?, n.trim().parse().ok()?)));
+    match parsed {
+        Some((k, n)) if (1..=n).contains(&k) => Ok(Shard { k, n }),
+        _ => Err(format!(
+            "\"{text}\" is not a shard K/N with 1 <= K <= N (e.g. 2/4)"
+        )),
+    }
 }
 
 /// Parses `NAME=v1,v2,...`: each value a number or true/false.
@@ -61,7 +122,7 @@ fn value(text: &str) -> ParamValue {
 }
 
 /// What every point of a sweep shares; a resumed sweep must share it too.
-fn settings_text(args: &SweepArgs) -> String {
+fn settings_text(args: &SweepRun) -> String {
     let c = &args.common;
     let reference = match &c.reference_image {
         Some(image) => format!("image {}", image.display()),
@@ -75,19 +136,26 @@ fn settings_text(args: &SweepArgs) -> String {
     };
     format!(
         "scene {}\ngraph {}\nsize {}x{}\ncamera {}\nreference {reference}\nfeatures {}\nframes {}\n",
-        c.scene.display(),
+        c.scene().display(),
         args.graph.display(),
         c.size.width,
         c.size.height,
         c.camera.as_deref().unwrap_or("(first)"),
         c.features.join(","),
         c.frames
-    )
+    ) + args
+        .shard
+        .map(|s| format!("{SHARD_LINE}{}/{}\n", s.k, s.n))
+        .unwrap_or_default()
+        .as_str()
 }
+
+/// How `sweep.settings` names a shard.
+const SHARD_LINE: &str = "shard ";
 
 /// Records the sweep's settings beside its CSV (`sweep.settings`), or, when
 /// resuming, refuses to mix points measured with other settings.
-fn check_settings(args: &SweepArgs) -> Result<()> {
+fn check_settings(args: &SweepRun) -> Result<()> {
     let path = args.out.join("sweep.settings");
     let wanted = settings_text(args);
     match weft_io::read_text(&path, weft_io::read::MAX_TEXT_BYTES) {
@@ -110,7 +178,7 @@ fn check_settings(args: &SweepArgs) -> Result<()> {
 
 /// The graph, features (the command's, then the point's) and parameters one
 /// sweep point renders with.
-fn point_settings(args: &SweepArgs, point: &SweepPoint) -> RenderSettings {
+fn point_settings(args: &SweepRun, point: &SweepPoint) -> RenderSettings {
     let mut features = args.common.features.clone();
     features.extend(point.features.split_whitespace().map(String::from));
     RenderSettings {
@@ -125,8 +193,58 @@ fn point_settings(args: &SweepArgs, point: &SweepPoint) -> RenderSettings {
     }
 }
 
-/// Runs `weft sweep`.
+/// Runs `weft sweep` or `weft sweep merge`.
 pub fn run(args: SweepArgs) -> Result<ExitCode> {
+    match args.command {
+        Some(SweepCommand::Merge(merge)) => merge_shards(&merge),
+        None => run_sweep(args.sweep),
+    }
+}
+
+/// `pareto.png` and `sweep.md` for the measured points `rows` of a sweep of
+/// `scene` through `graph`: the frontier plotted and tabled.
+fn write_report(out: &Path, (scene, graph): (&str, &str), rows: &[&SweepRow]) -> Result<()> {
+    let plotted: Vec<Point> = rows
+        .iter()
+        .map(|r| Point {
+            label: r.point.label(),
+            time: r.frame_ms,
+            error: r.flip,
+        })
+        .collect();
+    let on = frontier(&plotted);
+    write_plot(
+        &plotted,
+        &format!("{graph}: HDR-FLIP against frame time"),
+        "HDR-FLIP",
+        &out.join("pareto.png"),
+    )?;
+    let mut table = format!(
+        "# weft sweep: {scene} through {graph}\n\nPareto frontier of HDR-FLIP against frame time ({} of {} points; the rest are dominated):\n\n| # | setting | HDR-FLIP | RMSE | frame (ms) | device (MiB) |\n|---|---|---|---|---|---|\n",
+        on.len(),
+        rows.len()
+    );
+    for (rank, &i) in on.iter().enumerate() {
+        let r = rows[i];
+        table += &format!(
+            "| {} | {} | {:.4} | {:.4e} | {:.2} | {:.1} |\n",
+            rank + 1,
+            r.point.label(),
+            r.flip,
+            r.rmse,
+            r.frame_ms,
+            r.device_bytes as f64 / (1024.0 * 1024.0)
+        );
+    }
+    table += "\nThe numbers label the frontier's points in `pareto.png`.\n\n![error against time](pareto.png)\n";
+    std::fs::write(out.join("sweep.md"), &table)?;
+    print!("{table}");
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
+/// Runs one sweep (or one shard of it).
+fn run_sweep(args: SweepRun) -> Result<ExitCode> {
     let common = &args.common;
     if args.params.is_empty() && args.features_set.is_none() {
         bail!("nothing to sweep: give --param NAME=v1,v2,... or --features-set a,b;c");
@@ -146,13 +264,19 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
                 .collect()
         })
         .unwrap_or_default();
-    let all = points(&args.params, &sets);
+    let every = points(&args.params, &sets);
     // The graph loaded with every point's parameters and features before the
     // reference renders: a misspelt parameter or value fails at once.
     let mut graphs = crate::graphs::Loaded::default();
-    for point in &all {
+    for point in &every {
         graphs.get(&point_settings(&args, point))?;
     }
+    let all: Vec<SweepPoint> = every
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| args.shard.is_none_or(|s| s.takes(*i)))
+        .map(|(_, p)| p)
+        .collect();
     let names: Vec<String> = args.params.iter().map(|(n, _)| n.clone()).collect();
     let csv = args.out.join("sweep.csv");
     check_settings(&args)?;
@@ -213,43 +337,122 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
         exit = session.finish(common.validate);
     }
     let wanted: Vec<&SweepRow> = rows.iter().filter(|r| all.contains(&r.point)).collect();
-    let plotted: Vec<Point> = wanted
-        .iter()
-        .map(|r| Point {
-            label: r.point.label(),
-            time: r.frame_ms,
-            error: r.flip,
-        })
-        .collect();
-    let on = frontier(&plotted);
-    write_plot(
-        &plotted,
-        &format!("{}: HDR-FLIP against frame time", args.graph.display()),
-        "HDR-FLIP",
-        &args.out.join("pareto.png"),
+    write_report(
+        &args.out,
+        (
+            &common.scene().display().to_string(),
+            &args.graph.display().to_string(),
+        ),
+        &wanted,
     )?;
-    let mut table = format!(
-        "# weft sweep: {} through {}\n\nPareto frontier of HDR-FLIP against frame time ({} of {} points; the rest are dominated):\n\n| # | setting | HDR-FLIP | RMSE | frame (ms) | device (MiB) |\n|---|---|---|---|---|---|\n",
-        common.scene.display(),
-        args.graph.display(),
-        on.len(),
-        wanted.len()
-    );
-    for (rank, &i) in on.iter().enumerate() {
-        let r = wanted[i];
-        table += &format!(
-            "| {} | {} | {:.4} | {:.4e} | {:.2} | {:.1} |\n",
-            rank + 1,
-            r.point.label(),
-            r.flip,
-            r.rmse,
-            r.frame_ms,
-            r.device_bytes as f64 / (1024.0 * 1024.0)
+    Ok(exit)
+}
+
+/// One shard folder of a sharded sweep: its settings (less the shard line),
+/// which shard it is, and its rows.
+struct ShardFolder {
+    settings: String,
+    shard: Shard,
+    names: Vec<String>,
+    rows: Vec<SweepRow>,
+}
+
+/// Reads a shard's `sweep.settings` and `sweep.csv`.
+fn read_shard(dir: &Path) -> Result<ShardFolder> {
+    let path = dir.join("sweep.settings");
+    let text = weft_io::read_text(&path, weft_io::read::MAX_TEXT_BYTES)
+        .with_context(|| format!("reading {}", path.display()))?;
+    let mut settings = String::new();
+    let mut shard = None;
+    for line in text.lines() {
+        match line.strip_prefix(SHARD_LINE) {
+            Some(k_of_n) => shard = Some(parse_shard(k_of_n).map_err(anyhow::Error::msg)?),
+            None => settings += &format!("{line}\n"),
+        }
+    }
+    let shard = shard.with_context(|| {
+        format!(
+            "{} is not a shard's: it names no `shard K/N`",
+            path.display()
+        )
+    })?;
+    let csv = dir.join("sweep.csv");
+    let first = weft_io::read_text(&csv, weft_io::read::MAX_TEXT_BYTES)
+        .with_context(|| format!("reading {}", csv.display()))?;
+    let header = first.lines().next().unwrap_or_default();
+    let names: Vec<String> = header
+        .split(',')
+        .take_while(|c| *c != "features")
+        .map(String::from)
+        .collect();
+    let rows = read(&csv, &names)?;
+    Ok(ShardFolder {
+        settings,
+        shard,
+        names,
+        rows,
+    })
+}
+
+/// Runs `weft sweep merge`: every shard of one sweep, with the same
+/// settings, joined in the order the unsharded sweep measures its points.
+fn merge_shards(args: &MergeArgs) -> Result<ExitCode> {
+    let mut shards = args
+        .shards
+        .iter()
+        .map(|dir| read_shard(dir))
+        .collect::<Result<Vec<_>>>()?;
+    shards.sort_by_key(|s| s.shard.k);
+    let first = &shards[0];
+    let n = first.shard.n;
+    for (dir, s) in args.shards.iter().zip(&shards) {
+        if s.settings != first.settings || s.names != first.names || s.shard.n != n {
+            bail!(
+                "{} was measured with other settings than shard {}/{n}; only shards of one sweep merge",
+                dir.display(),
+                first.shard.k
+            );
+        }
+    }
+    let found: Vec<usize> = shards.iter().map(|s| s.shard.k).collect();
+    let missing: Vec<String> = (1..=n)
+        .filter(|k| !found.contains(k))
+        .map(|k| format!("{k}/{n}"))
+        .collect();
+    if !missing.is_empty() || found.len() != n {
+        bail!(
+            "the shards given are {:?} of {n}; missing: {}",
+            found,
+            if missing.is_empty() {
+                "none, but one is given twice".to_string()
+            } else {
+                missing.join(", ")
+            }
         );
     }
-    table += "\nThe numbers label the frontier's points in `pareto.png`.\n\n![error against time](pareto.png)\n";
-    std::fs::write(args.out.join("sweep.md"), &table)?;
-    print!("{table}");
-    println!("wrote {}", args.out.display());
-    Ok(exit)
+    // Point i of the whole sweep is point i / n of shard i % n + 1.
+    let longest = shards.iter().map(|s| s.rows.len()).max().unwrap_or(0);
+    let mut rows: Vec<&SweepRow> = Vec::new();
+    for position in 0..longest {
+        rows.extend(shards.iter().filter_map(|s| s.rows.get(position)));
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let mut csv = header(&first.names) + "\n";
+    for r in &rows {
+        csv += &(line(r, &first.names) + "\n");
+    }
+    std::fs::write(args.out.join("sweep.csv"), csv)?;
+    std::fs::write(args.out.join("sweep.settings"), &first.settings)?;
+    let field = |name: &str| {
+        first
+            .settings
+            .lines()
+            .find_map(|l| l.strip_prefix(name))
+            .unwrap_or_default()
+            .to_string()
+    };
+    println!("{} points from {n} shards", rows.len());
+    write_report(&args.out, (&field("scene "), &field("graph ")), &rows)?;
+    Ok(ExitCode::SUCCESS)
 }

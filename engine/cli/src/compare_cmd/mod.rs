@@ -41,7 +41,8 @@ pub enum Timer {
 #[derive(Args)]
 pub struct Common {
     /// The scene file.
-    pub scene: PathBuf,
+    #[arg(required = true)]
+    scene: Option<PathBuf>,
     /// Feature toggles for every configuration (`name` on, `!name` off).
     #[arg(long, value_delimiter = ',')]
     pub features: Vec<String>,
@@ -101,6 +102,14 @@ pub struct Common {
     /// warning makes the command fail.
     #[arg(long)]
     pub validate: bool,
+}
+
+impl Common {
+    /// The scene file. Required on the command line; absent only where a
+    /// subcommand that takes none (`weft sweep merge`) stands in for it.
+    pub fn scene(&self) -> &Path {
+        self.scene.as_deref().unwrap_or(Path::new(""))
+    }
 }
 
 /// Arguments of `weft compare`.
@@ -347,7 +356,7 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         measured.push(m);
     }
     let report = Report {
-        scene: common.scene.clone(),
+        scene: common.scene().to_path_buf(),
         camera: session.camera.clone(),
         width: common.size.width,
         height: common.size.height,

@@ -92,13 +92,13 @@ impl Session {
             weft_gpu::spirv_cache::set_dir(None);
         }
         let cache = weft_scene::cache::user_cache_dir().filter(|_| !common.no_cache);
-        let scene = weft_render::load_scene(&common.scene, cache.as_deref())
-            .with_context(|| format!("loading {}", common.scene.display()))?;
+        let scene = weft_render::load_scene(common.scene(), cache.as_deref())
+            .with_context(|| format!("loading {}", common.scene().display()))?;
         let camera = match &common.camera {
             Some(name) => name.clone(),
             None => match scene.cameras.first() {
                 Some(c) => c.name.clone(),
-                None => bail!("{} has no camera", common.scene.display()),
+                None => bail!("{} has no camera", common.scene().display()),
             },
         };
         std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;

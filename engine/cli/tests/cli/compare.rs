@@ -597,6 +597,125 @@ fn a_sweep_checks_every_point_before_it_renders_the_reference() {
     }
 }
 
+/// A sweep split into 3 shards run as 3 processes at once, sharing one
+/// cache folder (the reference rendered by whichever gets there, written
+/// atomically), then merged, has the unsharded sweep's rows in its order,
+/// with the same figures but frame time (which is measured again).
+#[test]
+fn three_shards_run_at_once_and_merged_equal_the_whole_sweep() {
+    let cache = temp("shard-cache");
+    let root = temp("shards");
+    let sweep_args = |out: &Path, shard: Option<&str>| {
+        let mut args: Vec<String> = [
+            "sweep",
+            "scenes/demo.scene",
+            "--graph",
+            "graphs/forward.ron",
+            "--param",
+            "shadows.pcf_radius=0,2",
+            "--features-set",
+            "bloom;!bloom",
+            "--size",
+            "48x32",
+            "--spp",
+            "4",
+            "--frames",
+            "1",
+            "--out",
+        ]
+        .map(String::from)
+        .to_vec();
+        args.push(out.to_string_lossy().into_owned());
+        if let Some(shard) = shard {
+            args.extend(["--shard".to_string(), shard.to_string()]);
+        }
+        args
+    };
+    let shards: Vec<PathBuf> = (1..=3).map(|k| root.join(format!("shard{k}"))).collect();
+    let running: Vec<_> = shards
+        .iter()
+        .enumerate()
+        .map(|(i, dir)| {
+            let args = sweep_args(dir, Some(&format!("{}/3", i + 1)));
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            command_in(&repo(), &args)
+                .env("WEFT_CACHE_DIR", &cache)
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .expect("weft starts")
+        })
+        .collect();
+    for child in running {
+        let done = child.wait_with_output().expect("weft runs");
+        assert!(
+            done.status.success(),
+            "{}",
+            String::from_utf8_lossy(&done.stderr)
+        );
+    }
+    let whole = root.join("whole");
+    let args = sweep_args(&whole, None);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let run = weft(&args, &cache);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let merged = root.join("merged");
+    let mut merge: Vec<String> = vec!["sweep".into(), "merge".into()];
+    merge.extend(
+        shards
+            .iter()
+            .rev()
+            .map(|d| d.to_string_lossy().into_owned()),
+    );
+    merge.extend(["--out".to_string(), merged.to_string_lossy().into_owned()]);
+    let merge: Vec<&str> = merge.iter().map(String::as_str).collect();
+    let run = weft(&merge, &cache);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(stdout.starts_with("4 points from 3 shards"), "{stdout}");
+    assert!(merged.join("pareto.png").is_file() && merged.join("sweep.md").is_file());
+    // Every column but frame_ms (the fifth from the end).
+    let rows = |dir: &Path| -> Vec<Vec<String>> {
+        let csv = std::fs::read_to_string(dir.join("sweep.csv")).expect("sweep.csv");
+        csv.lines()
+            .map(|l| {
+                let mut fields: Vec<String> = l.split(',').map(String::from).collect();
+                let at = fields.len() - 2;
+                fields.remove(at);
+                fields
+            })
+            .collect()
+    };
+    assert_eq!(rows(&merged), rows(&whole));
+    assert_eq!(
+        std::fs::read_to_string(merged.join("sweep.settings")).expect("settings"),
+        std::fs::read_to_string(whole.join("sweep.settings")).expect("settings")
+    );
+    // Two shards of three are not a whole sweep.
+    let partial = weft(
+        &[
+            "sweep",
+            "merge",
+            &shards[0].to_string_lossy(),
+            &shards[2].to_string_lossy(),
+            "--out",
+            &root.join("partial").to_string_lossy(),
+        ],
+        &cache,
+    );
+    assert!(!partial.status.success());
+    let stderr = String::from_utf8_lossy(&partial.stderr);
+    assert!(stderr.contains("missing: 2/3"), "{stderr}");
+}
+
 #[test]
 fn a_sweep_writes_its_csv_plot_and_frontier_and_resumes() {
     let cache = temp("sweep-cache");
