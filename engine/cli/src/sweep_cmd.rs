@@ -9,7 +9,7 @@ use clap::Args;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use weft_compare::pareto::{frontier, write_plot, Point};
+use weft_compare::pareto::{dominated_marks, frontier, write_plot, Point};
 use weft_compare::sweep::{header, line, points, read, SweepPoint, SweepRow};
 use weft_graph::schema::ParamValue;
 use weft_render::RenderSettings;
@@ -236,7 +236,22 @@ fn write_report(out: &Path, (scene, graph): (&str, &str), rows: &[&SweepRow]) ->
             r.device_bytes as f64 / (1024.0 * 1024.0)
         );
     }
-    table += "\nThe numbers label the frontier's points in `pareto.png`.\n\n![error against time](pareto.png)\n";
+    let dominated = dominated_marks(&plotted);
+    if !dominated.is_empty() {
+        table += "\nDominated points (another point is both faster and more accurate):\n\n| mark | setting | HDR-FLIP | RMSE | frame (ms) | device (MiB) |\n|---|---|---|---|---|---|\n";
+        for (i, mark) in &dominated {
+            let r = rows[*i];
+            table += &format!(
+                "| {mark} | {} | {:.4} | {:.4e} | {:.2} | {:.1} |\n",
+                r.point.label(),
+                r.flip,
+                r.rmse,
+                r.frame_ms,
+                r.device_bytes as f64 / (1024.0 * 1024.0)
+            );
+        }
+    }
+    table += "\nThe numbers and letters label the points in `pareto.png`.\n\n![error against time](pareto.png)\n";
     std::fs::write(out.join("sweep.md"), &table)?;
     print!("{table}");
     println!("wrote {}", out.display());

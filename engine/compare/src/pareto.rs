@@ -45,6 +45,32 @@ pub fn frontier(points: &[Point]) -> Vec<usize> {
 /// Writes error against time, every point in grey, the frontier in red with
 /// each of its points numbered 1, 2, ... by increasing time, as the frontier
 /// table lists them (axes padded by 10% of their span).
+/// Marks for the points off the frontier, in point order: `a`, `b`, …, `z`,
+/// `aa`, `ab`, … (the frontier's points are numbered by rank), so every
+/// point of a plot can be found in its table.
+pub fn dominated_marks(points: &[Point]) -> Vec<(usize, String)> {
+    let on = frontier(points);
+    (0..points.len())
+        .filter(|i| !on.contains(i))
+        .enumerate()
+        .map(|(n, i)| (i, letters(n)))
+        .collect()
+}
+
+/// `a` … `z`, then `aa`, `ab`, …: the n-th mark from 0.
+fn letters(mut n: usize) -> String {
+    let mut out = Vec::new();
+    loop {
+        out.push(b'a' + (n % 26) as u8);
+        if n < 26 {
+            break;
+        }
+        n = n / 26 - 1;
+    }
+    out.reverse();
+    String::from_utf8(out).unwrap_or_default()
+}
+
 pub fn write_plot(
     points: &[Point],
     title: &str,
@@ -133,6 +159,23 @@ pub fn write_plot(
         )
         .map_err(|e| fail(&e))?;
     chart
+        .draw_series(
+            dominated_marks(points)
+                .into_iter()
+                .filter(|(i, _)| points[*i].time > 0.0 && points[*i].error > 0.0)
+                .map(|(i, mark)| {
+                    EmptyElement::at((points[i].time, points[i].error))
+                        + Text::new(
+                            mark,
+                            (6, 4),
+                            (crate::report::FAMILY, 12)
+                                .into_font()
+                                .color(&RGBColor(110, 110, 110)),
+                        )
+                }),
+        )
+        .map_err(|e| fail(&e))?;
+    chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperRight)
         .border_style(BLACK)
@@ -153,6 +196,25 @@ mod tests {
             time,
             error,
         }
+    }
+
+    #[test]
+    fn every_point_off_the_frontier_gets_a_mark() {
+        let points = [
+            p("a", 1.0, 0.5),
+            p("b", 2.0, 0.6),
+            p("c", 3.0, 0.1),
+            p("d", 4.0, 0.2),
+        ];
+        assert_eq!(frontier(&points), [0, 2]);
+        assert_eq!(
+            dominated_marks(&points),
+            [(1, "a".to_string()), (3, "b".to_string())]
+        );
+        assert_eq!(letters(25), "z");
+        assert_eq!(letters(26), "aa");
+        assert_eq!(letters(27), "ab");
+        assert_eq!(letters(26 + 26 * 26), "aaa");
     }
 
     #[test]

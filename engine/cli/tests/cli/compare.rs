@@ -772,6 +772,12 @@ fn a_sweep_writes_its_csv_plot_and_frontier_and_resumes() {
         table.contains("Pareto frontier of HDR-FLIP against frame time"),
         "{table}"
     );
+    // Every point is in a table, on the frontier (numbered) or off it (lettered).
+    let listed = table
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| #") && !l.starts_with("| mark"))
+        .count();
+    assert_eq!(listed, 4, "{table}");
 
     // Run again: nothing left to measure, the CSV unchanged.
     let again = sweep("4");
