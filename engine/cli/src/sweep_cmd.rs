@@ -10,7 +10,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_compare::pareto::{dominated_marks, frontier, write_plot, Point};
-use weft_compare::sweep::{header, line, points, read, SweepPoint, SweepRow};
+use weft_compare::sweep::{header, line, points, read, read_with_form, SweepPoint, SweepRow};
 use weft_graph::schema::ParamValue;
 use weft_render::RenderSettings;
 
@@ -209,6 +209,7 @@ fn write_report(out: &Path, (scene, graph): (&str, &str), rows: &[&SweepRow]) ->
         .map(|r| Point {
             label: r.point.label(),
             time: r.frame_ms,
+            time_iqr: r.frame_iqr,
             error: r.flip,
         })
         .collect();
@@ -220,33 +221,37 @@ fn write_report(out: &Path, (scene, graph): (&str, &str), rows: &[&SweepRow]) ->
         &out.join("pareto.png"),
     )?;
     let mut table = format!(
-        "# weft sweep: {scene} through {graph}\n\nPareto frontier of HDR-FLIP against frame time ({} of {} points; the rest are dominated):\n\n| # | setting | HDR-FLIP | RMSE | frame (ms) | device (MiB) |\n|---|---|---|---|---|---|\n",
+        "# weft sweep: {scene} through {graph}\n\nPareto frontier of HDR-FLIP against frame time ({} of {} points; the rest are dominated):\n\n| # | setting | HDR-FLIP | RMSE | frame ms: median (IQR) | device (MiB) |\n|---|---|---|---|---|---|\n",
         on.len(),
         rows.len()
     );
     for (rank, &i) in on.iter().enumerate() {
         let r = rows[i];
         table += &format!(
-            "| {} | {} | {:.4} | {:.4e} | {:.2} | {:.1} |\n",
+            "| {} | {} | {:.4} | {:.4e} | {:.2} ({:.2}–{:.2}) | {:.1} |\n",
             rank + 1,
             r.point.label(),
             r.flip,
             r.rmse,
             r.frame_ms,
+            r.frame_iqr.0,
+            r.frame_iqr.1,
             r.device_bytes as f64 / (1024.0 * 1024.0)
         );
     }
     let dominated = dominated_marks(&plotted);
     if !dominated.is_empty() {
-        table += "\nDominated points (another point is both faster and more accurate):\n\n| mark | setting | HDR-FLIP | RMSE | frame (ms) | device (MiB) |\n|---|---|---|---|---|---|\n";
+        table += "\nDominated points (another point is both faster and more accurate):\n\n| mark | setting | HDR-FLIP | RMSE | frame ms: median (IQR) | device (MiB) |\n|---|---|---|---|---|---|\n";
         for (i, mark) in &dominated {
             let r = rows[*i];
             table += &format!(
-                "| {mark} | {} | {:.4} | {:.4e} | {:.2} | {:.1} |\n",
+                "| {mark} | {} | {:.4} | {:.4e} | {:.2} ({:.2}–{:.2}) | {:.1} |\n",
                 r.point.label(),
                 r.flip,
                 r.rmse,
                 r.frame_ms,
+                r.frame_iqr.0,
+                r.frame_iqr.1,
                 r.device_bytes as f64 / (1024.0 * 1024.0)
             );
         }
@@ -295,7 +300,16 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
     let names: Vec<String> = args.params.iter().map(|(n, _)| n.clone()).collect();
     let csv = args.out.join("sweep.csv");
     check_settings(&args)?;
-    let mut rows = read(&csv, &names)?;
+    let (mut rows, old_form) = read_with_form(&csv, &names)?;
+    if old_form {
+        // Rewritten in the current form (each old row's range its median),
+        // atomically, before new rows are appended to it.
+        let text = rows.iter().fold(header(&names) + "\n", |text, r| {
+            text + line(r, &names).as_str() + "\n"
+        });
+        weft_io::entry::write_atomic(&csv, text.as_bytes())
+            .with_context(|| format!("rewriting {}", csv.display()))?;
+    }
     let todo: Vec<&SweepPoint> = all
         .iter()
         .filter(|p| !rows.iter().any(|r| &r.point == *p))
@@ -338,6 +352,10 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
                 rmse: measured.configuration.rmse,
                 frame_ms: measured.configuration.frame_ms,
                 device_bytes: measured.configuration.device_bytes,
+                frame_iqr: (
+                    measured.configuration.frame_spread.p25,
+                    measured.configuration.frame_spread.p75,
+                ),
             };
             // Appended at once, so an interrupted sweep keeps what it measured.
             let mut file = std::fs::OpenOptions::new()

@@ -11,8 +11,10 @@ use std::path::Path;
 pub struct Point {
     /// What the setting was (`resolution=1024 radius=2`).
     pub label: String,
-    /// Cost: milliseconds per frame.
+    /// Cost: milliseconds per frame (the median).
     pub time: f64,
+    /// The frame times' interquartile range, drawn as a bar through the point.
+    pub time_iqr: (f64, f64),
     /// Error against the reference.
     pub error: f64,
 }
@@ -95,7 +97,8 @@ pub fn write_plot(
         let pad = if hi > lo { 0.1 * (hi - lo) } else { 0.1 * hi };
         ((lo - pad).max(0.0), hi + pad)
     };
-    let (t0, t1) = range(&|p| p.time);
+    let (t0, _) = range(&|p| p.time_iqr.0.min(p.time));
+    let (_, t1) = range(&|p| p.time_iqr.1.max(p.time));
     let (e0, e1) = range(&|p| p.error);
     let on = frontier(points);
     let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
@@ -114,6 +117,16 @@ pub fn write_plot(
         .label_style((crate::report::FAMILY, 14))
         .draw()
         .map_err(|e| fail(&e))?;
+    chart
+        .draw_series(usable.iter().map(|p| {
+            PathElement::new(
+                vec![(p.time_iqr.0, p.error), (p.time_iqr.1, p.error)],
+                RGBColor(90, 90, 90).stroke_width(1),
+            )
+        }))
+        .map_err(|e| fail(&e))?
+        .label("frame time IQR")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(90, 90, 90)));
     chart
         .draw_series(
             usable
@@ -194,6 +207,7 @@ mod tests {
         Point {
             label: label.into(),
             time,
+            time_iqr: (time, time),
             error,
         }
     }

@@ -43,7 +43,23 @@ pub struct SweepRow {
     pub frame_ms: f64,
     /// Device memory allocated, bytes.
     pub device_bytes: u64,
+    /// The frame times' interquartile range (first and third quartile);
+    /// both the median for rows written before sweeps recorded it.
+    pub frame_iqr: (f64, f64),
 }
+
+/// The columns after the parameters, as written now; [`OLD_COLUMNS`] is the
+/// form before the interquartile range was recorded, still read.
+const COLUMNS: [&str; 7] = [
+    "features",
+    "flip",
+    "rmse",
+    "frame_ms",
+    "device_bytes",
+    "frame_p25",
+    "frame_p75",
+];
+const OLD_COLUMNS: usize = 5;
 
 /// Why `sweep.csv` could not be used.
 #[derive(Debug, thiserror::Error)]
@@ -102,9 +118,13 @@ pub fn points(params: &[(String, Vec<String>)], feature_sets: &[String]) -> Vec<
 
 /// The CSV header for a sweep over `names`.
 pub fn header(names: &[String]) -> String {
-    let mut columns: Vec<String> = names.to_vec();
-    columns.extend(["features", "flip", "rmse", "frame_ms", "device_bytes"].map(String::from));
-    columns.join(",")
+    header_with(names, COLUMNS.len())
+}
+
+fn header_with(names: &[String], columns: usize) -> String {
+    let mut all: Vec<String> = names.to_vec();
+    all.extend(COLUMNS[..columns].iter().map(|c| c.to_string()));
+    all.join(",")
 }
 
 /// One CSV line.
@@ -118,19 +138,29 @@ pub fn line(row: &SweepRow, names: &[String]) -> String {
     fields.push(format!("{:.6e}", row.rmse));
     fields.push(format!("{:.3}", row.frame_ms));
     fields.push(row.device_bytes.to_string());
+    fields.push(format!("{:.3}", row.frame_iqr.0));
+    fields.push(format!("{:.3}", row.frame_iqr.1));
     fields.join(",")
 }
 
 /// The largest sweep CSV read back (a million rows of a few dozen columns).
 const MAX_CSV_BYTES: u64 = 1 << 30;
 
-/// The rows already in `path` (none when it does not exist). A file whose
-/// header is not this sweep's is an error, not silently mixed in.
+/// The rows already in `path` (none when it does not exist), from a file in
+/// the current form or in the form before the interquartile range was
+/// recorded. A file whose header is not this sweep's is an error, not
+/// silently mixed in.
 pub fn read(path: &Path, names: &[String]) -> Result<Vec<SweepRow>, SweepError> {
+    Ok(read_with_form(path, names)?.0)
+}
+
+/// [`read`], and whether the file is in the form before the interquartile
+/// range was recorded (so appending to it needs it rewritten first).
+pub fn read_with_form(path: &Path, names: &[String]) -> Result<(Vec<SweepRow>, bool), SweepError> {
     let shown = path.display().to_string();
     let text = match weft_io::read_text(path, MAX_CSV_BYTES) {
         Ok(text) => text,
-        Err(weft_io::ReadError::Missing { .. }) => return Ok(Vec::new()),
+        Err(weft_io::ReadError::Missing { .. }) => return Ok((Vec::new(), false)),
         Err(e) => {
             return Err(SweepError::Io {
                 path: shown,
@@ -140,8 +170,9 @@ pub fn read(path: &Path, names: &[String]) -> Result<Vec<SweepRow>, SweepError> 
     };
     let mut lines = text.lines().enumerate();
     let expected = header(names);
-    match lines.next() {
-        Some((_, found)) if found == expected => {}
+    let columns = match lines.next() {
+        Some((_, found)) if found == expected => COLUMNS.len(),
+        Some((_, found)) if found == header_with(names, OLD_COLUMNS) => OLD_COLUMNS,
         Some((_, found)) => {
             return Err(SweepError::Format {
                 path: shown,
@@ -151,8 +182,8 @@ pub fn read(path: &Path, names: &[String]) -> Result<Vec<SweepRow>, SweepError> 
                 ),
             })
         }
-        None => return Ok(Vec::new()),
-    }
+        None => return Ok((Vec::new(), false)),
+    };
     let mut rows = Vec::new();
     for (i, text) in lines {
         let fields: Vec<&str> = text.split(',').collect();
@@ -161,11 +192,11 @@ pub fn read(path: &Path, names: &[String]) -> Result<Vec<SweepRow>, SweepError> 
             line: i + 1,
             message,
         };
-        if fields.len() != names.len() + 5 {
+        if fields.len() != names.len() + columns {
             return Err(bad(format!(
                 "{} fields, expected {}",
                 fields.len(),
-                names.len() + 5
+                names.len() + columns
             )));
         }
         let number = |s: &str| {
@@ -188,9 +219,15 @@ pub fn read(path: &Path, names: &[String]) -> Result<Vec<SweepRow>, SweepError> 
             device_bytes: fields[n + 4]
                 .parse()
                 .map_err(|_| bad(format!("\"{}\" is not a byte count", fields[n + 4])))?,
+            frame_iqr: if columns == OLD_COLUMNS {
+                let median = number(fields[n + 3])?;
+                (median, median)
+            } else {
+                (number(fields[n + 5])?, number(fields[n + 6])?)
+            },
         });
     }
-    Ok(rows)
+    Ok((rows, columns == OLD_COLUMNS))
 }
 
 #[cfg(test)]
@@ -230,6 +267,7 @@ mod tests {
             rmse: 0.0625,
             frame_ms: 12.5,
             device_bytes: 1024,
+            frame_iqr: (12.25, 13.0),
         };
         std::fs::write(
             &path,
@@ -245,7 +283,22 @@ mod tests {
                 .contains("sweep.csv:1: the header is \"radius,features"),
             "{error}"
         );
-        std::fs::write(&path, format!("{}\n3,bloom,abc,1,2,3\n", header(&names))).expect("write");
+        // A file from before the interquartile range was recorded reads, each
+        // row's range its median, and says it is in the old form.
+        std::fs::write(
+            &path,
+            "radius,features,flip,rmse,frame_ms,device_bytes\n3,bloom,0.125,6.25e-2,12.5,1024\n",
+        )
+        .expect("write");
+        let (old, is_old) = read_with_form(&path, &names).expect("old form");
+        assert!(is_old);
+        assert_eq!(old[0].frame_iqr, (12.5, 12.5));
+        assert_eq!(old[0].frame_ms, 12.5);
+        std::fs::write(
+            &path,
+            format!("{}\n3,bloom,abc,1,2,3,4,5\n", header(&names)),
+        )
+        .expect("write");
         let error = read(&path, &names).expect_err("damaged");
         assert!(
             error

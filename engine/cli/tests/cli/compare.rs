@@ -516,6 +516,8 @@ fn post_effects_count_as_error_only_when_asked() {
             "4",
             "--frames",
             "1",
+            "--rounds",
+            "1",
         ];
         if post {
             args.push("--post");
@@ -682,15 +684,19 @@ fn three_shards_run_at_once_and_merged_equal_the_whole_sweep() {
     );
     assert!(stdout.starts_with("4 points from 3 shards"), "{stdout}");
     assert!(merged.join("pareto.png").is_file() && merged.join("sweep.md").is_file());
-    // Every column but frame_ms (the fifth from the end).
+    // Every column but the frame times (frame_ms, frame_p25, frame_p75).
     let rows = |dir: &Path| -> Vec<Vec<String>> {
         let csv = std::fs::read_to_string(dir.join("sweep.csv")).expect("sweep.csv");
         csv.lines()
             .map(|l| {
-                let mut fields: Vec<String> = l.split(',').map(String::from).collect();
-                let at = fields.len() - 2;
-                fields.remove(at);
+                let fields: Vec<&str> = l.split(',').collect();
+                let n = fields.len();
                 fields
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| ![n - 4, n - 2, n - 1].contains(i))
+                    .map(|(_, f)| f.to_string())
+                    .collect()
             })
             .collect()
     };
@@ -761,7 +767,7 @@ fn a_sweep_writes_its_csv_plot_and_frontier_and_resumes() {
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(
         lines[0],
-        "shadows.pcf_radius,features,flip,rmse,frame_ms,device_bytes"
+        "shadows.pcf_radius,features,flip,rmse,frame_ms,device_bytes,frame_p25,frame_p75"
     );
     assert_eq!(lines.len(), 5, "{csv}");
     assert!(lines[1].starts_with("0,bloom,"), "{csv}");
@@ -788,6 +794,26 @@ fn a_sweep_writes_its_csv_plot_and_frontier_and_resumes() {
         std::fs::read_to_string(out.join("sweep.csv")).expect("csv"),
         csv
     );
+
+    // A sweep.csv from before the frame-time range was recorded resumes: it
+    // is rewritten in the current form, each row's range its median.
+    let old_form: String = csv
+        .lines()
+        .map(|l| l.rsplitn(3, ',').nth(2).unwrap_or_default().to_string() + "\n")
+        .collect();
+    assert!(old_form.starts_with("shadows.pcf_radius,features,flip,rmse,frame_ms,device_bytes\n"));
+    std::fs::write(out.join("sweep.csv"), &old_form).expect("old form");
+    let resumed = sweep("4");
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let rewritten = std::fs::read_to_string(out.join("sweep.csv")).expect("csv");
+    for (new, old) in rewritten.lines().zip(old_form.lines()).skip(1) {
+        let median = old.split(',').nth(4).expect("frame_ms");
+        assert_eq!(new, format!("{old},{median},{median}"));
+    }
 
     // Other settings in the same folder are refused, not mixed in.
     let other = sweep("8");
