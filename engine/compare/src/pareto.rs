@@ -76,7 +76,7 @@ fn letters(mut n: usize) -> String {
 pub fn write_plot(
     points: &[Point],
     title: &str,
-    error_name: &str,
+    (error_name, budget_ms): (&str, Option<f64>),
     path: &Path,
 ) -> Result<(), ImageError> {
     crate::report::ensure_font()?;
@@ -99,6 +99,8 @@ pub fn write_plot(
     };
     let (t0, _) = range(&|p| p.time_iqr.0.min(p.time));
     let (_, t1) = range(&|p| p.time_iqr.1.max(p.time));
+    // A budget inside the drawn range is drawn; one beyond it is said in the table.
+    let budget = budget_ms.filter(|b| (t0..=t1).contains(b));
     let (e0, e1) = range(&|p| p.error);
     let on = frontier(points);
     let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
@@ -188,6 +190,21 @@ pub fn write_plot(
                 }),
         )
         .map_err(|e| fail(&e))?;
+    if let Some(b) = budget {
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(b, e0), (b, e1)],
+                RGBColor(30, 90, 200).stroke_width(2),
+            )))
+            .map_err(|e| fail(&e))?
+            .label(format!("budget {b} ms"))
+            .legend(|(x, y)| {
+                PathElement::new(
+                    vec![(x, y), (x + 20, y)],
+                    RGBColor(30, 90, 200).stroke_width(2),
+                )
+            });
+    }
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperRight)

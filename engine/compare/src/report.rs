@@ -208,15 +208,20 @@ impl Report {
         )
     }
 
-    /// The budget verdict: the configuration with the least HDR-FLIP whose
-    /// median frame time is within `budget_ms`, with its margin.
+    /// The budget verdict: the configuration with the least HDR-FLIP (the
+    /// faster of equals) whose median frame time is within `budget_ms`, with
+    /// its margin.
     pub fn budget_verdict(&self) -> Option<String> {
         let budget = self.budget_ms?;
         let best = self
             .configurations
             .iter()
             .filter(|c| c.frame_spread.median <= budget)
-            .min_by(|a, b| a.flip.total_cmp(&b.flip));
+            .min_by(|a, b| {
+                a.flip
+                    .total_cmp(&b.flip)
+                    .then(a.frame_spread.median.total_cmp(&b.frame_spread.median))
+            });
         Some(match best {
             Some(c) => format!(
                 "Within {budget} ms a frame: **{}**, the most accurate (HDR-FLIP {:.4}) at a median {:.2} ms, {:.2} ms to spare.",

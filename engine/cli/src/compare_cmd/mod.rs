@@ -78,6 +78,11 @@ pub struct Common {
     /// have the size asked for.
     #[arg(long)]
     pub reference_image: Option<PathBuf>,
+    /// A frame-time budget in milliseconds: the report (compare) or the
+    /// frontier table and plot (sweep) name the most accurate configuration
+    /// whose median frame time is within it.
+    #[arg(long, value_parser = parse_budget)]
+    pub budget_ms: Option<f64>,
     /// Measure LDR-FLIP and PSNR on each graph's own output, post effects
     /// (bloom) included; by default they measure its HDR image through the
     /// reference's tonemap, as the reference models no post effects.
@@ -131,14 +136,10 @@ pub struct CompareArgs {
     /// machine's speed falls on every configuration alike.
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
     rounds: u32,
-    /// A frame-time budget in milliseconds: the report names the most
-    /// accurate configuration whose median frame time is within it.
-    #[arg(long, value_parser = parse_budget)]
-    budget_ms: Option<f64>,
 }
 
 /// A budget: a positive, finite number of milliseconds.
-fn parse_budget(text: &str) -> Result<f64, String> {
+pub(crate) fn parse_budget(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(ms) if ms.is_finite() && ms > 0.0 => Ok(ms),
         _ => Err(format!("{text:?} is not a positive number of milliseconds")),
@@ -363,7 +364,7 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         device: session.device.clone(),
         frames: common.frames,
         rounds: args.rounds,
-        budget_ms: args.budget_ms,
+        budget_ms: common.budget_ms,
         post_effects: common.post,
         reference: session.info.clone(),
         configurations: measured.iter().map(|m| m.configuration.clone()).collect(),

@@ -744,6 +744,8 @@ fn a_sweep_writes_its_csv_plot_and_frontier_and_resumes() {
                 spp,
                 "--frames",
                 "1",
+                "--budget-ms",
+                "1000000",
                 "--validate",
                 "--out",
                 &out_arg,
@@ -777,6 +779,25 @@ fn a_sweep_writes_its_csv_plot_and_frontier_and_resumes() {
     assert!(
         table.contains("Pareto frontier of HDR-FLIP against frame time"),
         "{table}"
+    );
+    // The budget names the most accurate point within it: the frontier's last.
+    let within = table
+        .lines()
+        .find(|l| l.starts_with("Within 1000000 ms a frame: **"))
+        .expect("a budget verdict");
+    let frontier_settings: Vec<&str> = table
+        .lines()
+        .filter(|l| {
+            l.split('|')
+                .nth(1)
+                .is_some_and(|n| n.trim().parse::<u32>().is_ok())
+        })
+        .filter_map(|l| l.split('|').nth(2).map(str::trim))
+        .collect();
+    let most_accurate = frontier_settings.last().expect("a frontier");
+    assert!(
+        within.contains(&format!("**{most_accurate}**")),
+        "{within}\n{table}"
     );
     // Every point is in a table, on the frontier (numbered) or off it (lettered).
     let listed = table
