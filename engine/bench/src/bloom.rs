@@ -271,6 +271,7 @@ pub fn run(args: BloomArgs) -> Result<ExitCode> {
         y_label: "GPU time (ms)".into(),
         log_x: false,
         log_y: false,
+        x_ticks: Vec::new(),
         series: vec![
             Series {
                 name: "one fetch per texel".into(),

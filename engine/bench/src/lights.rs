@@ -263,6 +263,7 @@ pub fn run(args: LightsArgs) -> Result<ExitCode> {
         y_label: "frame time (ms)".into(),
         log_x: true,
         log_y: true,
+        x_ticks: Vec::new(),
         series: names
             .iter()
             .map(|g| Series {

@@ -179,6 +179,7 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
             y_label: "relative MSE against the reference".into(),
             log_x: true,
             log_y: true,
+            x_ticks: Vec::new(),
             series: vec![Series {
                 name: "weft (lavapipe)".into(),
                 points: samples

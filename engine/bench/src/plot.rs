@@ -37,6 +37,10 @@ pub struct LinePlot {
     pub log_x: bool,
     /// Logarithmic vertical axis.
     pub log_y: bool,
+    /// Where a logarithmic horizontal axis is labelled: the values swept
+    /// (shadow-map resolutions), rather than round numbers between them;
+    /// empty for those. A linear axis keeps its evenly spaced labels.
+    pub x_ticks: Vec<f64>,
     /// The lines, one colour each, in legend order.
     pub series: Vec<Series>,
 }
@@ -105,27 +109,23 @@ pub fn write_png(plot: &LinePlot, path: &Path, width: u32, height: u32) -> Resul
         .margin(16)
         .x_label_area_size(48)
         .y_label_area_size(72);
-    match (plot.log_x, plot.log_y) {
-        (true, true) => draw(
-            plot,
-            builder.build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())?,
-            &usable,
-        )?,
-        (true, false) => draw(
-            plot,
-            builder.build_cartesian_2d((x.0..x.1).log_scale(), y.0..y.1)?,
-            &usable,
-        )?,
-        (false, true) => draw(
-            plot,
-            builder.build_cartesian_2d(x.0..x.1, (y.0..y.1).log_scale())?,
-            &usable,
-        )?,
-        (false, false) => draw(
-            plot,
-            builder.build_cartesian_2d(x.0..x.1, y.0..y.1)?,
-            &usable,
-        )?,
+    // One arm per axis kind: with or without the swept values as ticks.
+    macro_rules! chart {
+        ($xs:expr, $ys:expr) => {
+            draw(plot, builder.build_cartesian_2d($xs, $ys)?, &usable)?
+        };
+    }
+    let ticks = plot.x_ticks.clone();
+    match (plot.log_x, !ticks.is_empty(), plot.log_y) {
+        (true, true, true) => chart!(
+            (x.0..x.1).log_scale().with_key_points(ticks),
+            (y.0..y.1).log_scale()
+        ),
+        (true, true, false) => chart!((x.0..x.1).log_scale().with_key_points(ticks), y.0..y.1),
+        (true, false, true) => chart!((x.0..x.1).log_scale(), (y.0..y.1).log_scale()),
+        (true, false, false) => chart!((x.0..x.1).log_scale(), y.0..y.1),
+        (false, _, true) => chart!(x.0..x.1, (y.0..y.1).log_scale()),
+        (false, _, false) => chart!(x.0..x.1, y.0..y.1),
     }
     root.present()
         .with_context(|| format!("writing {}", path.display()))?;
@@ -194,6 +194,40 @@ mod tests {
         assert_eq!(axis_range([f64::NAN], false), None);
     }
 
+    /// Swept values as ticks move the axis labels (drawn at 512, 1024, 2048
+    /// and 4096 rather than at 1000, 2000, …), and nothing else: the plot
+    /// area and the lines are the same.
+    #[test]
+    fn swept_values_label_a_log_axis() {
+        let dir = std::env::temp_dir().join(format!("weft-plot-ticks-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let draw = |ticks: Vec<f64>, name: &str| {
+            let path = dir.join(name);
+            let plot = LinePlot {
+                title: "ticks".into(),
+                x_label: "resolution".into(),
+                y_label: "error".into(),
+                log_x: true,
+                log_y: false,
+                x_ticks: ticks,
+                series: vec![Series {
+                    name: "a".into(),
+                    points: vec![(512.0, 3.0), (1024.0, 2.0), (2048.0, 1.5), (4096.0, 1.4)],
+                }],
+            };
+            write_png(&plot, &path, 640, 400).unwrap();
+            image::open(&path).unwrap().to_rgb8()
+        };
+        let round = draw(Vec::new(), "round.png");
+        let swept = draw(vec![512.0, 1024.0, 2048.0, 4096.0], "swept.png");
+        let differing = round
+            .pixels()
+            .zip(swept.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(differing > 100, "{differing}");
+    }
+
     #[test]
     fn a_log_log_plot_is_written_as_a_png_of_the_requested_size() {
         let dir = std::env::temp_dir().join(format!("weft-plot-{}", std::process::id()));
@@ -205,6 +239,7 @@ mod tests {
             y_label: "ms".into(),
             log_x: true,
             log_y: true,
+            x_ticks: Vec::new(),
             series: vec![
                 Series {
                     name: "a".into(),
@@ -240,6 +275,7 @@ mod tests {
             y_label: "y".into(),
             log_x: true,
             log_y: true,
+            x_ticks: Vec::new(),
             series: vec![Series {
                 name: "zero".into(),
                 points: vec![(0.0, 1.0)],
