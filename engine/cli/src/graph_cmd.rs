@@ -54,6 +54,11 @@ pub struct Target {
     /// so the plan shows what this scene culls and why.
     #[arg(long)]
     scene: Option<PathBuf>,
+    /// Size memory with the first Vulkan device's requirements, as renders,
+    /// `weft compare` and the viewer do, instead of the device-free estimate
+    /// (64 KiB pages).
+    #[arg(long)]
+    on_device: bool,
 }
 
 /// Each diagnostic with its source line and a caret under the position.
@@ -85,9 +90,30 @@ fn compile(file: &Path, target: &Target) -> Result<(weft_graph::Prepared, weft_g
         requested.extend(from_scene);
     }
     requested.extend(target.features.iter().cloned());
+    let gpu = if target.on_device {
+        Some(Gpu::new(&GpuOptions {
+            validation: false,
+            device: None,
+        })?)
+    } else {
+        None
+    };
+    let device_memory = gpu.as_ref().map(weft_gpu::memory_requirements);
+    let memory: &dyn Fn(&weft_graph::plan::ImageDesc) -> weft_graph::MemoryRequirements =
+        match &device_memory {
+            Some(m) => m,
+            None => &weft_graph::estimate_requirements,
+        };
+    match &gpu {
+        Some(gpu) => eprintln!("memory: sized for {}", gpu.info().name),
+        None => eprintln!(
+            "memory: estimated without a device (64 KiB pages); --on-device sizes it for the first Vulkan device"
+        ),
+    }
     let options = CompileOptions {
         extent: target.size,
         features: graph.graph().features(&requested),
+        memory,
         ..CompileOptions::default()
     };
     let start = Instant::now();

@@ -365,6 +365,87 @@ fn timings_carry_their_spread_and_a_budget_picks_a_configuration() {
     );
 }
 
+/// One definition of transient memory: what compare reports for a graph is
+/// what `weft graph plan --on-device` prints for the same graph, scene and
+/// size (the plan as the graph runs, sized by the device), not the plan
+/// compare measures with, which keeps the image it reads back whole.
+#[test]
+fn compare_reports_the_transient_memory_graph_plan_prints_on_the_device() {
+    let cache = temp("memory-cache");
+    let out = temp("memory");
+    let reference = out.join("given.exr");
+    let render = weft(
+        &[
+            "render",
+            "scenes/demo.scene",
+            "--size",
+            "96x54",
+            "--out",
+            &reference.to_string_lossy(),
+        ],
+        &cache,
+    );
+    assert!(
+        render.status.success(),
+        "{}",
+        String::from_utf8_lossy(&render.stderr)
+    );
+    for graph in ["forward", "deferred"] {
+        let file = format!("graphs/{graph}.ron");
+        let run = weft(
+            &[
+                "compare",
+                "scenes/demo.scene",
+                "--graphs",
+                &file,
+                "--size",
+                "96x54",
+                "--frames",
+                "1",
+                "--rounds",
+                "1",
+                "--reference-image",
+                &reference.to_string_lossy(),
+                "--out",
+                &out.to_string_lossy(),
+            ],
+            &cache,
+        );
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let reported = report(&out)["configurations"][0]["transient_bytes"].clone();
+        let plan = weft(
+            &[
+                "graph",
+                "plan",
+                &file,
+                "--scene",
+                "scenes/demo.scene",
+                "--size",
+                "96x54",
+                "--on-device",
+                "--json",
+            ],
+            &cache,
+        );
+        assert!(
+            plan.status.success(),
+            "{}",
+            String::from_utf8_lossy(&plan.stderr)
+        );
+        assert!(String::from_utf8_lossy(&plan.stderr).contains("memory: sized for "));
+        let plan: serde_json::Value = serde_json::from_slice(&plan.stdout).expect("JSON");
+        assert_eq!(reported, plan["stats"]["transient_bytes"], "{graph}");
+        assert!(
+            reported.as_u64().is_some_and(|b| b > 0),
+            "{graph}: {reported}"
+        );
+    }
+}
+
 /// `--noise-floor` renders the reference again with the next seed and
 /// reports the HDR-FLIP between the two renders, which the test recomputes
 /// from the two EXRs written.
