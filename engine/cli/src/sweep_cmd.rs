@@ -254,34 +254,13 @@ fn write_report(
         );
     }
     for (rank, &i) in on.iter().enumerate() {
-        let r = rows[i];
-        table += &format!(
-            "| {} | {} | {:.4} | {:.4e} | {:.2} ({:.2}–{:.2}) | {:.1} |\n",
-            rank + 1,
-            r.point.label(),
-            r.flip,
-            r.rmse,
-            r.frame_ms,
-            r.frame_iqr.0,
-            r.frame_iqr.1,
-            r.device_bytes as f64 / (1024.0 * 1024.0)
-        );
+        table += &table_row(&(rank + 1).to_string(), rows[i]);
     }
     let dominated = dominated_marks(&plotted);
     if !dominated.is_empty() {
         table += "\nDominated points (another point is both faster and more accurate):\n\n| mark | setting | HDR-FLIP | RMSE | frame ms: median (IQR) | device (MiB) |\n|---|---|---|---|---|---|\n";
         for (i, mark) in &dominated {
-            let r = rows[*i];
-            table += &format!(
-                "| {mark} | {} | {:.4} | {:.4e} | {:.2} ({:.2}–{:.2}) | {:.1} |\n",
-                r.point.label(),
-                r.flip,
-                r.rmse,
-                r.frame_ms,
-                r.frame_iqr.0,
-                r.frame_iqr.1,
-                r.device_bytes as f64 / (1024.0 * 1024.0)
-            );
+            table += &table_row(mark, rows[*i]);
         }
     }
     table += "\nThe numbers and letters label the points in `pareto.png`.\n\n![error against time](pareto.png)\n";
@@ -289,6 +268,20 @@ fn write_report(
     print!("{table}");
     println!("wrote {}", out.display());
     Ok(())
+}
+
+/// One point's line in sweep.md's tables, under its number or letter.
+fn table_row(label: &str, r: &SweepRow) -> String {
+    format!(
+        "| {label} | {} | {:.4} | {:.4e} | {:.2} ({:.2}–{:.2}) | {:.1} |\n",
+        r.point.label(),
+        r.flip,
+        r.rmse,
+        r.frame_ms,
+        r.frame_iqr.0,
+        r.frame_iqr.1,
+        r.device_bytes as f64 / (1024.0 * 1024.0)
+    )
 }
 
 /// Runs one sweep (or one shard of it).

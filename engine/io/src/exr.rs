@@ -35,44 +35,45 @@ const ENCODING: Encoding = Encoding {
     line_order: LineOrder::Increasing,
 };
 
+/// Writes one layer of `channels` over `size` with weft's [`ENCODING`].
+macro_rules! encode_layer {
+    ($size:expr, $channels:expr) => {{
+        let mut bytes = Cursor::new(Vec::new());
+        Image::from_layer(Layer::new(
+            $size,
+            LayerAttributes::default(),
+            ENCODING,
+            $channels,
+        ))
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(encode_error)?;
+        Ok(bytes.into_inner())
+    }};
+}
+
 /// An RGB float image, rows from the top, as the bytes of an EXR file.
 pub fn encode_rgb(width: u32, height: u32, pixels: &[[f32; 3]]) -> Result<Vec<u8>, ExrError> {
     let size = checked_size(width, height, pixels.len())?;
-    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
-        let [r, g, b] = pixels[y * size.0 + x];
-        (r, g, b)
-    });
-    let mut bytes = Cursor::new(Vec::new());
-    Image::from_layer(Layer::new(
+    encode_layer!(
         size,
-        LayerAttributes::default(),
-        ENCODING,
-        channels,
-    ))
-    .write()
-    .to_buffered(&mut bytes)
-    .map_err(encode_error)?;
-    Ok(bytes.into_inner())
+        SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+            let [r, g, b] = pixels[y * size.0 + x];
+            (r, g, b)
+        })
+    )
 }
 
 /// An RGBA float image, rows from the top, as the bytes of an EXR file.
 pub fn encode_rgba(width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<Vec<u8>, ExrError> {
     let size = checked_size(width, height, pixels.len())?;
-    let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
-        let [r, g, b, a] = pixels[y * size.0 + x];
-        (r, g, b, a)
-    });
-    let mut bytes = Cursor::new(Vec::new());
-    Image::from_layer(Layer::new(
+    encode_layer!(
         size,
-        LayerAttributes::default(),
-        ENCODING,
-        channels,
-    ))
-    .write()
-    .to_buffered(&mut bytes)
-    .map_err(encode_error)?;
-    Ok(bytes.into_inner())
+        SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
+            let [r, g, b, a] = pixels[y * size.0 + x];
+            (r, g, b, a)
+        })
+    )
 }
 
 /// The image size as the encoder takes it, when `count` pixels fill it.

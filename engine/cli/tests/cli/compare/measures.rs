@@ -2,7 +2,7 @@
 //! and a budget, one definition of memory, the reference's noise floor and
 //! post effects only when asked.
 
-use super::{report, temp, weft};
+use super::{render_exr, report, temp, weft};
 
 /// Timings come with their spread: configurations take turns over
 /// `--rounds`, every measured frame of every round counts (2 rounds × 2
@@ -14,22 +14,7 @@ fn timings_carry_their_spread_and_a_budget_picks_a_configuration() {
     let cache = temp("rounds-cache");
     let out = temp("rounds");
     let reference = out.join("reference-given.exr");
-    let render = weft(
-        &[
-            "render",
-            "scenes/demo.scene",
-            "--size",
-            "48x32",
-            "--out",
-            &reference.to_string_lossy(),
-        ],
-        &cache,
-    );
-    assert!(
-        render.status.success(),
-        "{}",
-        String::from_utf8_lossy(&render.stderr)
-    );
+    render_exr("scenes/demo.scene", "48x32", &reference, &cache);
     let run = |budget: &str| {
         let result = weft(
             &[
@@ -105,22 +90,7 @@ fn compare_reports_the_transient_memory_graph_plan_prints_on_the_device() {
     let cache = temp("memory-cache");
     let out = temp("memory");
     let reference = out.join("given.exr");
-    let render = weft(
-        &[
-            "render",
-            "scenes/demo.scene",
-            "--size",
-            "96x54",
-            "--out",
-            &reference.to_string_lossy(),
-        ],
-        &cache,
-    );
-    assert!(
-        render.status.success(),
-        "{}",
-        String::from_utf8_lossy(&render.stderr)
-    );
+    render_exr("scenes/demo.scene", "96x54", &reference, &cache);
     for graph in ["forward", "deferred"] {
         let file = format!("graphs/{graph}.ron");
         let run = weft(
@@ -234,22 +204,7 @@ fn a_graph_against_its_own_render_of_the_same_scene_state_scores_zero() {
     let cache = temp("self-cache");
     let out = temp("self");
     let reference = out.join("forward.exr");
-    let render = weft(
-        &[
-            "render",
-            "scenes/animation.scene",
-            "--size",
-            "48x32",
-            "--out",
-            &reference.to_string_lossy(),
-        ],
-        &cache,
-    );
-    assert!(
-        render.status.success(),
-        "{}",
-        String::from_utf8_lossy(&render.stderr)
-    );
+    render_exr("scenes/animation.scene", "48x32", &reference, &cache);
     for frames in ["1", "6"] {
         let run = weft(
             &[

@@ -183,7 +183,7 @@ fn a_reference_image_of_the_wrong_size_or_kind_is_an_error() {
     let cache = temp("bad-cache");
     let out = temp("bad");
     let wrong = out.join("small.exr");
-    image_of_size(&wrong, 8, 8);
+    render_exr("scenes/demo.scene", "8x8", &wrong, &cache);
     let run = |reference: &Path| {
         weft(
             &[
@@ -277,19 +277,19 @@ fn a_reference_image_with_non_finite_or_negative_pixels_is_refused() {
     }
 }
 
-/// Writes a black RGBA EXR of `width` x `height` with weft itself (a render
-/// of the demo scene at that size).
-fn image_of_size(path: &Path, width: u32, height: u32) {
+/// Renders `scene` through forward at `size` (`WxH`) into the EXR `path`
+/// with weft itself: a linear image to compare against, or a reference.
+fn render_exr(scene: &str, size: &str, path: &Path, cache: &Path) {
     let out = weft(
         &[
             "render",
-            "scenes/demo.scene",
+            scene,
             "--size",
-            &format!("{width}x{height}"),
+            size,
             "--out",
             &path.to_string_lossy(),
         ],
-        &temp("render-cache"),
+        cache,
     );
     assert!(
         out.status.success(),
