@@ -17,27 +17,7 @@ use weft_gpu::Gpu;
 use weft_graph::feature_names;
 use weft_graph::plan::Extent;
 use weft_render::{check_graph_and_shaders, render_with_progress, RenderSettings, ShaderTarget};
-
-/// SplitMix64: small, seedable, the same everywhere.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-
-    fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
-        &items[self.below(items.len())]
-    }
-}
+use weft_scene::rng::Rng;
 
 /// Words of one kind that may replace each other.
 const SWAPS: &[&[&str]] = &[
@@ -423,7 +403,7 @@ fn every_mutant_check_accepts_renders_clean() {
     let gpu = weft_tests::gpu();
     let scene = weft_scene::load_scene(&demo_scene()).expect("demo scene");
     let files = mutable_files();
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let (mut refused, mut rendered, mut failures) = (0, 0, Vec::new());
     let mut made = 0;
     while made < count {

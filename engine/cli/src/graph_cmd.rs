@@ -90,14 +90,15 @@ fn compile(file: &Path, target: &Target) -> Result<(weft_graph::Prepared, weft_g
         requested.extend(from_scene);
     }
     requested.extend(target.features.iter().cloned());
-    let gpu = if target.on_device {
-        Some(Gpu::new(&GpuOptions {
-            validation: false,
-            device: None,
-        })?)
-    } else {
-        None
-    };
+    let gpu = target
+        .on_device
+        .then(|| {
+            Gpu::new(&GpuOptions {
+                validation: false,
+                device: None,
+            })
+        })
+        .transpose()?;
     let device_memory = gpu.as_ref().map(weft_gpu::memory_requirements);
     let memory: &dyn Fn(&weft_graph::plan::ImageDesc) -> weft_graph::MemoryRequirements =
         match &device_memory {

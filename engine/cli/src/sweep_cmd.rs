@@ -3,14 +3,17 @@
 //! Pareto frontier of error against time plotted and tabled
 //! (docs/compare.md). Resumable: points already in `sweep.csv` are skipped.
 
-use crate::compare_cmd::{Common, Session};
+use crate::compare_cmd::{Common, Session, Timings};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_compare::pareto::{dominated_marks, frontier, write_plot, Point};
-use weft_compare::sweep::{header, line, points, read, read_with_form, SweepPoint, SweepRow};
+use weft_compare::report::within_budget;
+use weft_compare::sweep::{
+    document, header, line, points, read_named, read_with_form, SweepPoint, SweepRow,
+};
 use weft_graph::schema::ParamValue;
 use weft_render::RenderSettings;
 
@@ -228,31 +231,21 @@ fn write_report(
         ("HDR-FLIP", budget_ms),
         &out.join("pareto.png"),
     )?;
-    let mut table = format!(
-        "# weft sweep: {scene} through {graph}\n\nPareto frontier of HDR-FLIP against frame time ({} of {} points; the rest are dominated):\n\n| # | setting | HDR-FLIP | RMSE | frame ms: median (IQR) | device (MiB) |\n|---|---|---|---|---|---|\n",
+    let mut table = format!("# weft sweep: {scene} through {graph}\n\n");
+    if let Some(budget) = budget_ms {
+        let labels: Vec<String> = rows.iter().map(|r| r.point.label()).collect();
+        let candidates = rows
+            .iter()
+            .zip(&labels)
+            .map(|(r, label)| (label.as_str(), r.flip, r.frame_ms));
+        table += &within_budget(budget, candidates, "point");
+        table += "\n\n";
+    }
+    table += &format!(
+        "Pareto frontier of HDR-FLIP against frame time ({} of {} points; the rest are dominated):\n\n| # | setting | HDR-FLIP | RMSE | frame ms: median (IQR) | device (MiB) |\n|---|---|---|---|---|---|\n",
         on.len(),
         rows.len()
     );
-    if let Some(budget) = budget_ms {
-        let best = rows.iter().filter(|r| r.frame_ms <= budget).min_by(|a, b| {
-            a.flip
-                .total_cmp(&b.flip)
-                .then(a.frame_ms.total_cmp(&b.frame_ms))
-        });
-        table.insert_str(
-            table.find("Pareto frontier").unwrap_or(0),
-            &match best {
-                Some(r) => format!(
-                    "Within {budget} ms a frame: **{}**, the most accurate (HDR-FLIP {:.4}) at a median {:.2} ms, {:.2} ms to spare.\n\n",
-                    r.point.label(),
-                    r.flip,
-                    r.frame_ms,
-                    budget - r.frame_ms
-                ),
-                None => format!("No point's median frame time is within {budget} ms.\n\n"),
-            },
-        );
-    }
     for (rank, &i) in on.iter().enumerate() {
         table += &table_row(&(rank + 1).to_string(), rows[i]);
     }
@@ -325,10 +318,7 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
     if old_form {
         // Rewritten in the current form (each old row's range its median),
         // atomically, before new rows are appended to it.
-        let text = rows.iter().fold(header(&names) + "\n", |text, r| {
-            text + line(r, &names).as_str() + "\n"
-        });
-        weft_io::entry::write_atomic(&csv, text.as_bytes())
+        weft_io::entry::write_atomic(&csv, document(&names, &rows).as_bytes())
             .with_context(|| format!("rewriting {}", csv.display()))?;
     }
     let todo: Vec<&SweepPoint> = all
@@ -364,8 +354,8 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
                 common,
                 &point.label(),
                 &args.graph,
-                &settings.features,
-                &params,
+                (&settings.features, &params),
+                Timings::default(),
             )?;
             let row = SweepRow {
                 point: point.clone(),
@@ -406,6 +396,7 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
 /// One shard folder of a sharded sweep: its settings (less the shard line),
 /// which shard it is, and its rows.
 struct ShardFolder {
+    dir: PathBuf,
     settings: String,
     shard: Shard,
     names: Vec<String>,
@@ -431,17 +422,9 @@ fn read_shard(dir: &Path) -> Result<ShardFolder> {
             path.display()
         )
     })?;
-    let csv = dir.join("sweep.csv");
-    let first = weft_io::read_text(&csv, weft_io::read::MAX_TEXT_BYTES)
-        .with_context(|| format!("reading {}", csv.display()))?;
-    let header = first.lines().next().unwrap_or_default();
-    let names: Vec<String> = header
-        .split(',')
-        .take_while(|c| *c != "features")
-        .map(String::from)
-        .collect();
-    let rows = read(&csv, &names)?;
+    let (names, rows) = read_named(&dir.join("sweep.csv"))?;
     Ok(ShardFolder {
+        dir: dir.to_path_buf(),
         settings,
         shard,
         names,
@@ -460,11 +443,11 @@ fn merge_shards(args: &MergeArgs) -> Result<ExitCode> {
     shards.sort_by_key(|s| s.shard.k);
     let first = &shards[0];
     let n = first.shard.n;
-    for (dir, s) in args.shards.iter().zip(&shards) {
+    for s in &shards {
         if s.settings != first.settings || s.names != first.names || s.shard.n != n {
             bail!(
                 "{} was measured with other settings than shard {}/{n}; only shards of one sweep merge",
-                dir.display(),
+                s.dir.display(),
                 first.shard.k
             );
         }
@@ -493,11 +476,10 @@ fn merge_shards(args: &MergeArgs) -> Result<ExitCode> {
     }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    let mut csv = header(&first.names) + "\n";
-    for r in &rows {
-        csv += &(line(r, &first.names) + "\n");
-    }
-    std::fs::write(args.out.join("sweep.csv"), csv)?;
+    std::fs::write(
+        args.out.join("sweep.csv"),
+        document(&first.names, rows.iter().copied()),
+    )?;
     std::fs::write(args.out.join("sweep.settings"), &first.settings)?;
     let field = |name: &str| {
         first

@@ -131,6 +131,27 @@ pub struct Report {
     pub configurations: Vec<Configuration>,
 }
 
+/// Of `candidates` (name, HDR-FLIP, median frame milliseconds), the most
+/// accurate whose median is within `budget` ms (the faster of equals), as a
+/// sentence with its margin; or that no `what` is within it.
+pub fn within_budget<'a>(
+    budget: f64,
+    candidates: impl IntoIterator<Item = (&'a str, f64, f64)>,
+    what: &str,
+) -> String {
+    let best = candidates
+        .into_iter()
+        .filter(|&(_, _, ms)| ms <= budget)
+        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.2.total_cmp(&b.2)));
+    match best {
+        Some((name, flip, ms)) => format!(
+            "Within {budget} ms a frame: **{name}**, the most accurate (HDR-FLIP {flip:.4}) at a median {ms:.2} ms, {:.2} ms to spare.",
+            budget - ms
+        ),
+        None => format!("No {what}'s median frame time is within {budget} ms."),
+    }
+}
+
 impl Report {
     /// The table of results, as markdown (also what stdout shows), then the
     /// caveats the configurations' graphs declare, numbered in the table's
@@ -208,30 +229,13 @@ impl Report {
         )
     }
 
-    /// The budget verdict: the configuration with the least HDR-FLIP (the
-    /// faster of equals) whose median frame time is within `budget_ms`, with
-    /// its margin.
+    /// The budget verdict ([`within_budget`]) over the configurations.
     pub fn budget_verdict(&self) -> Option<String> {
-        let budget = self.budget_ms?;
-        let best = self
+        let candidates = self
             .configurations
             .iter()
-            .filter(|c| c.frame_spread.median <= budget)
-            .min_by(|a, b| {
-                a.flip
-                    .total_cmp(&b.flip)
-                    .then(a.frame_spread.median.total_cmp(&b.frame_spread.median))
-            });
-        Some(match best {
-            Some(c) => format!(
-                "Within {budget} ms a frame: **{}**, the most accurate (HDR-FLIP {:.4}) at a median {:.2} ms, {:.2} ms to spare.",
-                c.name,
-                c.flip,
-                c.frame_spread.median,
-                budget - c.frame_spread.median
-            ),
-            None => format!("No configuration's median frame time is within {budget} ms."),
-        })
+            .map(|c| (c.name.as_str(), c.flip, c.frame_spread.median));
+        Some(within_budget(self.budget_ms?, candidates, "configuration"))
     }
 
     /// Every configuration's caveats, each once, in the order first met.

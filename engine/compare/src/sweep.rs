@@ -143,31 +143,54 @@ pub fn line(row: &SweepRow, names: &[String]) -> String {
     fields.join(",")
 }
 
+/// A whole `sweep.csv`: the header for `names`, then a line per row.
+pub fn document<'a>(names: &[String], rows: impl IntoIterator<Item = &'a SweepRow>) -> String {
+    rows.into_iter().fold(header(names) + "\n", |text, r| {
+        text + line(r, names).as_str() + "\n"
+    })
+}
+
 /// The largest sweep CSV read back (a million rows of a few dozen columns).
 const MAX_CSV_BYTES: u64 = 1 << 30;
 
 /// The rows already in `path` (none when it does not exist), from a file in
 /// the current form or in the form before the interquartile range was
-/// recorded. A file whose header is not this sweep's is an error, not
-/// silently mixed in.
-pub fn read(path: &Path, names: &[String]) -> Result<Vec<SweepRow>, SweepError> {
-    Ok(read_with_form(path, names)?.0)
+/// recorded, and whether it is in that old form (so appending to it needs it
+/// rewritten first). A file whose header is not this sweep's is an error,
+/// not silently mixed in.
+pub fn read_with_form(path: &Path, names: &[String]) -> Result<(Vec<SweepRow>, bool), SweepError> {
+    match weft_io::read_text(path, MAX_CSV_BYTES) {
+        Err(weft_io::ReadError::Missing { .. }) => Ok((Vec::new(), false)),
+        text => parse(path, &text.map_err(|e| io_error(path, e))?, names),
+    }
 }
 
-/// [`read`], and whether the file is in the form before the interquartile
-/// range was recorded (so appending to it needs it rewritten first).
-pub fn read_with_form(path: &Path, names: &[String]) -> Result<(Vec<SweepRow>, bool), SweepError> {
+/// A sweep.csv that must exist, with the parameter names its header gives
+/// (the columns before `features`), and its rows.
+pub fn read_named(path: &Path) -> Result<(Vec<String>, Vec<SweepRow>), SweepError> {
+    let text = weft_io::read_text(path, MAX_CSV_BYTES).map_err(|e| io_error(path, e))?;
+    let names: Vec<String> = text
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .split(',')
+        .take_while(|c| *c != "features")
+        .map(String::from)
+        .collect();
+    let (rows, _) = parse(path, &text, &names)?;
+    Ok((names, rows))
+}
+
+fn io_error(path: &Path, e: weft_io::ReadError) -> SweepError {
+    SweepError::Io {
+        path: path.display().to_string(),
+        source: e.into_io(),
+    }
+}
+
+/// The rows of sweep.csv text for `names`, and whether it is in the old form.
+fn parse(path: &Path, text: &str, names: &[String]) -> Result<(Vec<SweepRow>, bool), SweepError> {
     let shown = path.display().to_string();
-    let text = match weft_io::read_text(path, MAX_CSV_BYTES) {
-        Ok(text) => text,
-        Err(weft_io::ReadError::Missing { .. }) => return Ok((Vec::new(), false)),
-        Err(e) => {
-            return Err(SweepError::Io {
-                path: shown,
-                source: e.into_io(),
-            })
-        }
-    };
     let mut lines = text.lines().enumerate();
     let expected = header(names);
     let columns = match lines.next() {
@@ -233,6 +256,11 @@ pub fn read_with_form(path: &Path, names: &[String]) -> Result<(Vec<SweepRow>, b
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The rows alone.
+    fn read(path: &Path, names: &[String]) -> Result<Vec<SweepRow>, SweepError> {
+        Ok(read_with_form(path, names)?.0)
+    }
 
     #[test]
     fn points_are_the_cartesian_product() {

@@ -252,6 +252,9 @@ fn attachment_scalar(format: &str) -> ScalarKind {
 /// minimum of `maxPushConstantsSize`).
 pub const MAX_PUSH_CONSTANT_BYTES: u32 = 128;
 
+/// The push-constant member a repeating compute pass's dispatch number goes to.
+pub const REPEAT_INDEX: &str = "repeat_index";
+
 /// Values the executor supplies to push-constant members no parameter names.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct FrameValues {
@@ -305,7 +308,7 @@ pub fn pack_push(
                 "time" => vec![f64::from(frame.time)],
                 "frame" => vec![f64::from(frame.frame)],
                 "history_frames" => vec![f64::from(frame.history_frames)],
-                "repeat_index" => vec![f64::from(frame.repeat_index)],
+                REPEAT_INDEX => vec![f64::from(frame.repeat_index)],
                 "extent" => frame.extent.iter().map(|&v| f64::from(v)).collect(),
                 name => {
                     problems.push(format!(

@@ -29,6 +29,16 @@ impl Rng {
     pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
         lo + (hi - lo) * self.next_f32()
     }
+
+    /// A whole number below `n` (0 when `n` is 0).
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n.max(1) as u64) as usize
+    }
+
+    /// One of `items`, which must not be empty.
+    pub fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
+        &items[self.below(items.len())]
+    }
 }
 
 #[cfg(test)]
@@ -44,6 +54,9 @@ mod tests {
         for _ in 0..1000 {
             let x = a.range(-2.0, 3.0);
             assert!((-2.0..3.0).contains(&x));
+            assert!(a.below(7) < 7);
         }
+        assert_eq!(a.below(0), 0);
+        assert_eq!(*Rng::new(3).pick(&["only"]), "only");
     }
 }

@@ -250,45 +250,73 @@ fn param_text(value: &ParamValue) -> String {
 
 /// One pass's measured times: its name, its timer's label and the
 /// milliseconds of every measured frame.
-pub struct PassSamples {
+struct PassSamples {
     name: String,
     timer: String,
     ms: Vec<f64>,
 }
 
-/// Per-pass times of the frames after the first, passes in frame order.
-fn pass_samples(rendered: &Rendered) -> Vec<PassSamples> {
-    let measured = &rendered.timings[1.min(rendered.timings.len())..];
-    let mut passes: Vec<PassSamples> = Vec::new();
-    for frame in measured {
-        for t in frame {
-            match passes.iter_mut().find(|p| p.name == t.pass) {
-                Some(p) => p.ms.push(t.ms),
-                None => passes.push(PassSamples {
-                    name: t.pass.clone(),
-                    timer: t.source.label().to_string(),
-                    ms: vec![t.ms],
-                }),
-            }
-        }
-    }
-    passes
+/// A configuration's measured frames, from one round or several: every
+/// frame's wall milliseconds and every pass's.
+#[derive(Default)]
+pub struct Timings {
+    frames: Vec<f64>,
+    passes: Vec<PassSamples>,
 }
 
-/// Each pass's median and spread.
-fn pass_times(samples: &[PassSamples]) -> Vec<PassTime> {
-    samples
-        .iter()
-        .map(|p| {
-            let spread = Spread::of(&p.ms);
-            PassTime {
-                name: p.name.clone(),
-                ms: spread.median,
-                spread,
-                timer: p.timer.clone(),
+impl Timings {
+    /// The frames of a render after the first (the warm-up), passes in frame
+    /// order.
+    fn of(rendered: &Rendered) -> Self {
+        let mut timings = Timings {
+            frames: rendered.frame_ms[1.min(rendered.frame_ms.len())..].to_vec(),
+            passes: Vec::new(),
+        };
+        for frame in &rendered.timings[1.min(rendered.timings.len())..] {
+            for t in frame {
+                timings.add_pass(&t.pass, t.source.label(), &[t.ms]);
             }
-        })
-        .collect()
+        }
+        timings
+    }
+
+    /// `ms` more of pass `name`, measured by `timer`.
+    fn add_pass(&mut self, name: &str, timer: &str, ms: &[f64]) {
+        match self.passes.iter_mut().find(|p| p.name == name) {
+            Some(p) => p.ms.extend(ms),
+            None => self.passes.push(PassSamples {
+                name: name.to_string(),
+                timer: timer.to_string(),
+                ms: ms.to_vec(),
+            }),
+        }
+    }
+
+    /// These timings and `other`'s together.
+    fn extend(&mut self, other: &Timings) {
+        self.frames.extend(&other.frames);
+        for p in &other.passes {
+            self.add_pass(&p.name, &p.timer, &p.ms);
+        }
+    }
+
+    /// The frames' spread, and each pass's median and spread.
+    fn summary(&self) -> (Spread, Vec<PassTime>) {
+        let passes = self
+            .passes
+            .iter()
+            .map(|p| {
+                let spread = Spread::of(&p.ms);
+                PassTime {
+                    name: p.name.clone(),
+                    ms: spread.median,
+                    spread,
+                    timer: p.timer.clone(),
+                }
+            })
+            .collect();
+        (Spread::of(&self.frames), passes)
+    }
 }
 
 /// Distinct short names for the configurations: each graph's file stem,
@@ -328,23 +356,29 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
             ..RenderSettings::default()
         })?;
     }
+    // Session::open writes reference.exr.
     let mut session = Session::open(common, &args.out, graphs)?;
-    session
-        .reference
-        .write_exr(&args.out.join("reference.exr"))?;
     session
         .reference_ldr
         .write_png(&args.out.join("reference.png"))?;
     let names = names(&args.graphs);
-    let mut rounds: Vec<Vec<session::Measured>> = args.graphs.iter().map(|_| Vec::new()).collect();
-    for _ in 0..args.rounds {
-        for ((graph, name), taken) in args.graphs.iter().zip(&names).zip(&mut rounds) {
-            taken.push(session.measure(common, name, graph, &common.features, &args.params)?);
+    // The configurations take turns: every round but the last is timed only;
+    // the last is timed and measured (its images are every round's).
+    let mut earlier: Vec<Timings> = args.graphs.iter().map(|_| Timings::default()).collect();
+    for _ in 1..args.rounds {
+        for ((graph, name), timings) in args.graphs.iter().zip(&names).zip(&mut earlier) {
+            timings.extend(&session.time(common, name, graph, &common.features, &args.params)?);
         }
     }
     let mut measured = Vec::new();
-    for (taken, name) in rounds.into_iter().zip(names) {
-        let mut m = session::Measured::merge(taken).context("no round measured")?;
+    for ((graph, name), earlier) in args.graphs.iter().zip(names).zip(earlier) {
+        let mut m = session.measure(
+            common,
+            &name,
+            graph,
+            (&common.features, &args.params),
+            earlier,
+        )?;
         let files = [
             args.out.join(format!("{name}.png")),
             args.out.join(format!("{name}.exr")),

@@ -29,58 +29,12 @@ pub struct Session {
 pub struct Measured {
     /// The figures.
     pub configuration: Configuration,
-    /// Every measured frame's wall milliseconds.
-    frame_samples: Vec<f64>,
-    /// Every measured frame's per-pass milliseconds.
-    pass_samples: Vec<super::PassSamples>,
     /// Its linear image.
     pub image: LinearImage,
     /// Its tonemapped output.
     pub output: SrgbImage,
     /// Its HDR-FLIP error map.
     pub flip: weft_compare::FlipResult,
-}
-
-impl Measured {
-    /// The figures with the timings summarised from the samples.
-    fn timed(mut self) -> Self {
-        let spread = Spread::of(&self.frame_samples);
-        self.configuration.frame_ms = spread.median;
-        self.configuration.frame_spread = spread;
-        self.configuration.passes = super::pass_times(&self.pass_samples);
-        self
-    }
-
-    /// One configuration measured in several rounds: the last round's images
-    /// and figures (they are the same every round), every round's timings.
-    pub fn merge(rounds: Vec<Measured>) -> Option<Measured> {
-        let mut frame_samples = Vec::new();
-        let mut pass_samples: Vec<super::PassSamples> = Vec::new();
-        let mut last = None;
-        for round in rounds {
-            frame_samples.extend(&round.frame_samples);
-            for p in &round.pass_samples {
-                match pass_samples.iter_mut().find(|q| q.name == p.name) {
-                    Some(q) => q.ms.extend(&p.ms),
-                    None => pass_samples.push(super::PassSamples {
-                        name: p.name.clone(),
-                        timer: p.timer.clone(),
-                        ms: p.ms.clone(),
-                    }),
-                }
-            }
-            last = Some(round);
-        }
-        let last = last?;
-        Some(
-            Measured {
-                frame_samples,
-                pass_samples,
-                ..last
-            }
-            .timed(),
-        )
-    }
 }
 
 impl Session {
@@ -147,18 +101,21 @@ impl Session {
         })
     }
 
-    /// Renders `graph` (after one warm-up frame, `common.frames` frames) and
-    /// measures it against the reference. Every frame shows the scene at the
-    /// reference's time (0): frames repeat one scene state, so the image
-    /// measured is the state the reference shows, however many frames are timed.
-    pub fn measure(
+    /// Renders `graph` with `features` and `params`: one warm-up frame, then
+    /// `common.frames` frames. Every frame shows the scene at the reference's
+    /// time (0): frames repeat one scene state, so the image measured is the
+    /// state the reference shows, however many frames are timed.
+    fn render_configuration(
         &mut self,
         common: &Common,
         name: &str,
         graph: &Path,
-        features: &[String],
-        params: &[(String, ParamValue)],
-    ) -> Result<Measured> {
+        (features, params): (&[String], &[(String, ParamValue)]),
+    ) -> Result<(
+        Rendered,
+        RenderSettings,
+        std::sync::Arc<weft_graph::Prepared>,
+    )> {
         let settings = RenderSettings {
             graph: graph.to_path_buf(),
             extent: common.size,
@@ -180,11 +137,40 @@ impl Session {
             ..settings
         };
         let rendered = render(&self.gpu, &self.scene, &loaded, &settings, name)?;
+        Ok((rendered, settings, loaded))
+    }
+
+    /// Renders `graph` and keeps only its timings (a round before the
+    /// measured one).
+    pub fn time(
+        &mut self,
+        common: &Common,
+        name: &str,
+        graph: &Path,
+        features: &[String],
+        params: &[(String, ParamValue)],
+    ) -> Result<Timings> {
+        let (rendered, ..) = self.render_configuration(common, name, graph, (features, params))?;
+        Ok(Timings::of(&rendered))
+    }
+
+    /// Renders `graph` and measures it against the reference; its frame
+    /// times are this render's with `earlier` rounds' added.
+    pub fn measure(
+        &mut self,
+        common: &Common,
+        name: &str,
+        graph: &Path,
+        (features, params): (&[String], &[(String, ParamValue)]),
+        mut earlier: Timings,
+    ) -> Result<Measured> {
+        let (rendered, settings, loaded) =
+            self.render_configuration(common, name, graph, (features, params))?;
         // The graph's own memory, as `weft graph plan` reports it: the images
         // read back here for measuring are kept whole only for measuring.
         let as_shipped = RenderSettings {
             extra_readback: Vec::new(),
-            ..settings.clone()
+            ..settings
         };
         let transient_bytes =
             weft_render::compile_for_scene(&self.gpu, &self.scene, &loaded, &as_shipped)?
@@ -208,8 +194,8 @@ impl Session {
         } else {
             super::tonemap(&image)
         };
-        let frame_samples = rendered.frame_ms[1.min(rendered.frame_ms.len())..].to_vec();
-        let pass_samples = super::pass_samples(&rendered);
+        earlier.extend(&Timings::of(&rendered));
+        let (frame_spread, passes) = earlier.summary();
         let configuration = Configuration {
             name: name.to_string(),
             graph: graph.to_path_buf(),
@@ -224,9 +210,9 @@ impl Session {
             rel_mse: rel_mse(&image.pixels, &self.reference.pixels),
             psnr: psnr(&measured_ldr, &self.reference_ldr),
             luminance_ratio: luminance_ratio(&image.pixels, &self.reference.pixels),
-            frame_ms: 0.0,
-            frame_spread: Spread::default(),
-            passes: Vec::new(),
+            frame_ms: frame_spread.median,
+            frame_spread,
+            passes,
             transient_bytes,
             device_bytes: rendered.report.memory.allocated_bytes,
             caveats: rendered.plan.caveats.clone(),
@@ -234,13 +220,10 @@ impl Session {
         };
         Ok(Measured {
             configuration,
-            frame_samples,
-            pass_samples,
             image,
             output,
             flip,
-        }
-        .timed())
+        })
     }
 
     /// Ends the session: prints the validation messages and says whether

@@ -2,7 +2,7 @@
 //! fullscreen triangle or the draw recorder's scene draws inside its render pass.
 
 use super::{FrameOptions, Prepared, Renderer};
-use crate::bind::FrameValues;
+use crate::bind::{FrameValues, REPEAT_INDEX};
 use crate::descriptors::DescriptorPool;
 use crate::draw::{DrawRecorder, RasterContext, ScenePass};
 use crate::error::GpuError;
@@ -143,7 +143,8 @@ impl<'g> Renderer<'g> {
     }
 
     /// A compute pass's dispatches: one, or `repeat` in a row with the pass's
-    /// repeat barriers between them and each one's `repeat_index` pushed.
+    /// repeat barriers between them and, where the shader reads it, each
+    /// one's `repeat_index` pushed (the other push constants stay bound).
     fn dispatch(
         &self,
         cmd: vk::CommandBuffer,
@@ -160,6 +161,7 @@ impl<'g> Renderer<'g> {
                     .pipeline
                     .as_ref()
                     .and_then(|p| p.interface.push.as_ref().map(|push| (p, push)))
+                    .filter(|(_, (block, _))| block.members.iter().any(|m| m.name == REPEAT_INDEX))
                 {
                     let push = self.pack_push(pass, prep, options, repeat_index)?;
                     unsafe { device.cmd_push_constants(cmd, p.layout, *stages, 0, &push) };

@@ -1,23 +1,7 @@
 //! Random damage to random cache entries never changes the image.
 
 use super::*;
-
-/// SplitMix64, so the random damage below repeats from its seed.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
+use weft_scene::rng::Rng;
 
 /// The cache as a property: random damage to random entries (SPIR-V, models,
 /// the path tracer's BVH) in rounds; every render exits 0 and writes the
@@ -68,7 +52,7 @@ fn random_damage_to_random_cache_entries_never_changes_the_image() {
         found.sort();
         found
     };
-    let mut rng = Rng(0x000C_AC4E);
+    let mut rng = Rng::new(0x000C_AC4E);
     for round in 0..6 {
         let all = entries();
         assert!(all.len() > 3, "{all:?}");
@@ -92,7 +76,8 @@ fn random_damage_to_random_cache_entries_never_changes_the_image() {
                     std::fs::write(entry, flipped).expect("flip");
                 }
                 2 => {
-                    let noise: Vec<u8> = (0..rng.below(256)).map(|_| rng.next() as u8).collect();
+                    let noise: Vec<u8> =
+                        (0..rng.below(256)).map(|_| rng.next_u64() as u8).collect();
                     std::fs::write(entry, noise).expect("replace");
                 }
                 3 => {
