@@ -13,17 +13,18 @@ pub(super) fn reference(
     path: &Path,
 ) -> Result<(LinearImage, ReferenceInfo)> {
     let Extent { width, height } = common.size;
-    if let Some(path) = &common.reference_image {
-        let image = LinearImage::read_exr(path)?;
-        image.check_radiance(path)?;
+    if let Some(given) = &common.reference_image {
+        let image = LinearImage::read_exr(given)?;
+        image.check_radiance(given)?;
         if (image.width, image.height) != (width, height) {
             bail!(
                 "--reference-image {} is {}x{}, but --size asks for {width}x{height} (images are not resampled)",
-                path.display(),
+                given.display(),
                 image.width,
                 image.height
             );
         }
+        image.write_exr(path)?;
         return Ok((
             image,
             ReferenceInfo {
@@ -32,7 +33,7 @@ pub(super) fn reference(
                 spp: None,
                 seed: None,
                 cached: false,
-                image: path.clone(),
+                image: given.clone(),
                 seconds: 0.0,
                 noise_floor: None,
             },
