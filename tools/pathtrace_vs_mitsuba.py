@@ -98,7 +98,13 @@ def split_by_material(path, out_dir):
     return files
 
 
+# --max-depth, when given, replaces the scene's own path length limit.
+MAX_DEPTH = None
+
+
 def max_depth(ball):
+    if MAX_DEPTH is not None:
+        return MAX_DEPTH
     return 16 if ball else 8
 
 
@@ -200,9 +206,16 @@ def main():
     parser.add_argument("--size", type=int, default=256)
     parser.add_argument("--out", default=os.path.join(ROOT, "target", "pathtrace-vs-mitsuba"))
     parser.add_argument("--ball", choices=["glass", "absorbing", "coated"])
+    parser.add_argument("--max-depth", type=int, help="path length limit (default 8, 16 with a ball)")
+    parser.add_argument("--weft", default=WEFT, help="the weft binary (a debug build times the same "
+                        "shaders: the path tracer runs on the Vulkan device)")
     args = parser.parse_args()
+    global MAX_DEPTH
+    MAX_DEPTH = args.max_depth
     if args.ball:
         args.out = os.path.join(args.out, args.ball)
+    if args.max_depth is not None:
+        args.out = os.path.join(args.out, f"depth{args.max_depth}")
     os.makedirs(args.out, exist_ok=True)
     mi.set_variant("scalar_rgb")
     with tempfile.TemporaryDirectory() as work:
@@ -220,7 +233,7 @@ def main():
         mi.util.write_bitmap(mitsuba_path, image, write_async=False)
         samples = args.size * args.size * args.spp
         result = subprocess.run(
-            [WEFT, "bench", "pathtrace", "--scene", weft_scene(args.ball, work), "--size", f"{args.size}x{args.size}",
+            [args.weft, "bench", "pathtrace", "--scene", weft_scene(args.ball, work), "--size", f"{args.size}x{args.size}",
              "--spp", str(args.spp), "--max-depth", str(max_depth(args.ball)), "--reference", reference_path,
              "--out-dir", args.out, "--image", os.path.join(args.out, f"weft_{args.spp}spp.exr"), "--json"],
             cwd=ROOT, check=True, capture_output=True, text=True)

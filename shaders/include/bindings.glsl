@@ -15,7 +15,7 @@
 #define BINDING_INDICES                22 // the indices
 #define BINDING_TRIANGLES               5 // the ray tracer's triangles
 #define BINDING_BVH_NODES               6 // the BVH nodes
-#define BINDING_BVH_TRIANGLES           7 // the BVH's triangle order
+#define BINDING_BVH_LEAF_TRIANGLES      7 // the BVH's leaf triangles
 #define BINDING_TRIANGLE_NORMALS        8 // the corners' normals
 #define BINDING_TRIANGLE_UVS            9 // the corners' UVs
 #define BINDING_TRIANGLE_MATERIALS     10 // the triangles' materials

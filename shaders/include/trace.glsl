@@ -1,23 +1,39 @@
 // Ray tracing against the scene (the `RayTracing` provider; engine/render/src/bvh.rs
-// builds the BVH and mirrors this traversal on the CPU, where its tests hold it
-// to brute force). Set 1, beside scene.glsl's bindings 0..4.
+// builds the BVH, bvh_wide.rs collapses it into the 4-wide form walked here
+// and mirrors this walk on the CPU, where its tests hold it to brute force).
+// Set 1, beside scene.glsl's bindings 0..4.
 #ifndef WEFT_TRACE_GLSL
 #define WEFT_TRACE_GLSL
 #include "bindings.glsl"
 
-// Inner node: count 0, children at first and first + 1. Leaf: triangles
-// bvh_triangles[first .. first + count].
-struct BvhNode {
-    vec3 bmin;
-    uint first;
-    vec3 bmax;
-    uint count;
+// A node of the 4-wide BVH (engine/render/src/bvh_wide.rs): its children's
+// boxes per axis, one child per component; per child, an inner node's index
+// (count 0), or a leaf's first slot in leaf_triangles and its triangle count,
+// or no child (count NO_CHILD).
+struct WideNode {
+    vec4 lo_x;
+    vec4 lo_y;
+    vec4 lo_z;
+    vec4 hi_x;
+    vec4 hi_y;
+    vec4 hi_z;
+    uvec4 child;
+    uvec4 count;
 };
 
+// A leaf triangle: corner a with the triangle's index (bits) in a.w, and its
+// two edges from a.
+struct LeafTriangle {
+    vec4 a;
+    vec4 e1;
+    vec4 e2;
+};
+
+#define NO_CHILD 0xffffffffu
+
 layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLES) readonly buffer Triangles { vec4 corners[]; };
-layout(std430, set = SET_SCENE, binding = BINDING_BVH_NODES) readonly buffer BvhNodes { BvhNode nodes[]; };
-layout(std430, set = SET_SCENE, binding = BINDING_BVH_TRIANGLES) readonly buffer BvhTriangles { uint bvh_triangles[]; };
-// Per corner (3 per triangle, in Triangles' order): unit world normal, UV.
+layout(std430, set = SET_SCENE, binding = BINDING_BVH_NODES) readonly buffer BvhNodes { WideNode nodes[]; };
+layout(std430, set = SET_SCENE, binding = BINDING_BVH_LEAF_TRIANGLES) readonly buffer BvhLeafTriangles { LeafTriangle leaf_triangles[]; };
 layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_NORMALS) readonly buffer TriangleNormals { vec4 corner_normals[]; };
 layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_UVS) readonly buffer TriangleUvs { vec2 corner_uvs[]; };
 // Per triangle: index into the Materials buffer (scene.glsl, binding 3).
@@ -66,31 +82,19 @@ vec4 trace_texel(uint slot, bool colour, vec2 uv) {
                             : textureLod(trace_data_1024, at, 0.0);
 }
 
-// Deepest traversal the stack allows; the builder's trees stay far below it
-// (docs/pathtrace.md: depth 26 on demo.scene).
+// Most pending nodes the walk's stack holds: up to three per level of the
+// wide tree, whose depth is about half the binary tree's (docs/pathtrace.md:
+// 26 binary levels on demo.scene).
 #define TRACE_STACK 64
-
-// Entry distance into a node's box, or a negative value when the ray misses it.
-float trace_slab(BvhNode node, vec3 origin, vec3 inv_dir) {
-    vec3 t0 = (node.bmin - origin) * inv_dir;
-    vec3 t1 = (node.bmax - origin) * inv_dir;
-    vec3 lo = min(t0, t1);
-    vec3 hi = max(t0, t1);
-    float near = max(max(max(lo.x, lo.y), lo.z), 0.0);
-    float far = min(min(hi.x, hi.y), hi.z);
-    return near <= far ? near : -1.0;
-}
 
 // How far outside a triangle, in barycentric units, a hit still counts, so a
 // ray through an edge two triangles share cannot slip between them
 // (bvh.rs EDGE_TOLERANCE).
 #define EDGE_TOLERANCE 1e-5
 
-// Moller-Trumbore: the ray parameter of a hit in front of the origin, or -1.
-float trace_triangle(uint tri, vec3 origin, vec3 dir) {
-    vec3 a = corners[3u * tri].xyz;
-    vec3 e1 = corners[3u * tri + 1u].xyz - a;
-    vec3 e2 = corners[3u * tri + 2u].xyz - a;
+// Moller-Trumbore: the ray parameter of a hit on the triangle with corner a
+// and edges e1, e2 in front of the origin, or -1.
+float trace_triangle(vec3 a, vec3 e1, vec3 e2, vec3 origin, vec3 dir) {
     vec3 p = cross(dir, e2);
     float det = dot(e1, p);
     if (abs(det) < 1e-12) {
@@ -107,10 +111,31 @@ float trace_triangle(uint tri, vec3 origin, vec3 dir) {
     return (outside || t <= 0.0) ? -1.0 : t;
 }
 
-// Walks the BVH nearest child first: a hit with t in (0, t_max), its
-// distance in .x and triangle in .y (as uint bits), or x = -1 when nothing is
-// hit. With `first_hit` it stops at the first hit found (shadow rays);
-// otherwise it returns the nearest.
+// Puts the pair (da, sa), (db, sb) in order of distance.
+void trace_order(inout float da, inout uint sa, inout float db, inout uint sb) {
+    bool swap = db < da;
+    float d = swap ? db : da;
+    uint s = swap ? sb : sa;
+    db = swap ? da : db;
+    sb = swap ? sa : sb;
+    da = d;
+    sa = s;
+}
+
+// How many triangles to test in the child in `slot`: a leaf's count when the
+// ray enters it at distance d before the nearest hit so far, else 0.
+uint trace_tests(WideNode node, uint slot, float d, float best_t) {
+    uint count = node.count[slot];
+    return (d < best_t && count != NO_CHILD) ? count : 0u;
+}
+
+// Walks the wide BVH: each step pops a node, measures where the ray enters
+// its four child boxes, orders them nearest first, tests the triangles of
+// the leaves among them and pushes the inner ones, the nearest last. A hit
+// with t in (0, t_max): its distance in .x and triangle in .y (as uint bits),
+// or x = -1 when nothing is hit. With `first_hit` it stops at the first hit
+// found (shadow rays); otherwise it returns the nearest. WideBvh::walk in
+// bvh_wide.rs is its CPU mirror, step for step.
 vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
     float best_t = t_max;
     uint best_tri = 0u;
@@ -122,54 +147,76 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
     vec3 inv_dir = 1.0 / dir;
     uint stack[TRACE_STACK];
     float entry[TRACE_STACK];
-    int top = 0;
-    float root = trace_slab(nodes[0], origin, inv_dir);
-    if (root >= 0.0) {
-        stack[0] = 0u;
-        entry[0] = root;
-        top = 1;
-    }
+    stack[0] = 0u;
+    entry[0] = 0.0;
+    int top = 1;
     while (top > 0) {
         --top;
         if (entry[top] >= best_t) {
             continue;
         }
-        BvhNode node = nodes[stack[top]];
-        if (node.count == 0u) {
-            uint near = node.first;
-            uint far = node.first + 1u;
-            float t_near = trace_slab(nodes[near], origin, inv_dir);
-            float t_far = trace_slab(nodes[far], origin, inv_dir);
-            if (t_near > t_far) {
-                uint n = near;
-                near = far;
-                far = n;
-                float t = t_near;
-                t_near = t_far;
-                t_far = t;
-            }
-            // Push the farther child first, so the nearer one is walked first.
-            if (t_far >= 0.0 && t_far < best_t && top < TRACE_STACK) {
-                stack[top] = far;
-                entry[top++] = t_far;
-            }
-            if (t_near >= 0.0 && t_near < best_t && top < TRACE_STACK) {
-                stack[top] = near;
-                entry[top++] = t_near;
-            }
-            continue;
-        }
-        for (uint i = 0u; i < node.count; ++i) {
-            uint tri = bvh_triangles[node.first + i];
-            float t = trace_triangle(tri, origin, dir);
+        WideNode node = nodes[stack[top]];
+        vec4 x0 = (node.lo_x - origin.x) * inv_dir.x;
+        vec4 x1 = (node.hi_x - origin.x) * inv_dir.x;
+        vec4 y0 = (node.lo_y - origin.y) * inv_dir.y;
+        vec4 y1 = (node.hi_y - origin.y) * inv_dir.y;
+        vec4 z0 = (node.lo_z - origin.z) * inv_dir.z;
+        vec4 z1 = (node.hi_z - origin.z) * inv_dir.z;
+        vec4 near = max(max(max(min(x0, x1), min(y0, y1)), min(z0, z1)), vec4(0.0));
+        vec4 far = min(min(max(x0, x1), max(y0, y1)), max(z0, z1));
+        bvec4 meets = bvec4(uvec4(lessThanEqual(near, far)) & uvec4(lessThan(near, vec4(best_t)))
+            & uvec4(notEqual(node.count, uvec4(NO_CHILD))));
+        near = mix(vec4(uintBitsToFloat(0x7f800000u)), near, meets);
+        float d0 = near.x, d1 = near.y, d2 = near.z, d3 = near.w;
+        uint s0 = 0u, s1 = 1u, s2 = 2u, s3 = 3u;
+        trace_order(d0, s0, d1, s1);
+        trace_order(d2, s2, d3, s3);
+        trace_order(d0, s0, d2, s2);
+        trace_order(d1, s1, d3, s3);
+        trace_order(d1, s1, d2, s2);
+        // The leaves' triangles in one loop, nearest leaf first: one loop
+        // costs a SIMD group the most tests any lane makes, where a loop per
+        // leaf cost the sum of each leaf's most.
+        uint n0 = trace_tests(node, s0, d0, best_t);
+        uint n1 = trace_tests(node, s1, d1, best_t);
+        uint n2 = trace_tests(node, s2, d2, best_t);
+        uint n3 = trace_tests(node, s3, d3, best_t);
+        uint to1 = n0;
+        uint to2 = to1 + n1;
+        uint to3 = to2 + n2;
+        uint tests = to3 + n3;
+        for (uint j = 0u; j < tests; ++j) {
+            uint at = j < to1 ? node.child[s0] + j
+                : j < to2 ? node.child[s1] + (j - to1)
+                : j < to3 ? node.child[s2] + (j - to2)
+                          : node.child[s3] + (j - to3);
+            LeafTriangle tri = leaf_triangles[at];
+            float t = trace_triangle(tri.a.xyz, tri.e1.xyz, tri.e2.xyz, origin, dir);
             if (t > 0.0 && t < best_t) {
                 best_t = t;
-                best_tri = tri;
+                best_tri = floatBitsToUint(tri.a.w);
                 hit = true;
             }
         }
         if (hit && first_hit) {
             break;
+        }
+        // Inner children, the farthest pushed first.
+        if (d3 < best_t && node.count[s3] == 0u && top < TRACE_STACK) {
+            stack[top] = node.child[s3];
+            entry[top++] = d3;
+        }
+        if (d2 < best_t && node.count[s2] == 0u && top < TRACE_STACK) {
+            stack[top] = node.child[s2];
+            entry[top++] = d2;
+        }
+        if (d1 < best_t && node.count[s1] == 0u && top < TRACE_STACK) {
+            stack[top] = node.child[s1];
+            entry[top++] = d1;
+        }
+        if (d0 < best_t && node.count[s0] == 0u && top < TRACE_STACK) {
+            stack[top] = node.child[s0];
+            entry[top++] = d0;
         }
     }
     return hit ? vec2(best_t, uintBitsToFloat(best_tri)) : vec2(-1.0, 0.0);

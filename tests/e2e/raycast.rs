@@ -2,7 +2,7 @@
 //! `derive: [RayTracing()]` casts one camera ray per pixel through the BVH
 //! (`shaders/include/trace.glsl`), and every pixel's hit distance, triangle,
 //! interpolated normal and UV, and material match the CPU traversal
-//! (`weft_render::Bvh`) of the same ray over the same triangles
+//! (`weft_render::WideBvh`, the walk the shader takes) of the same ray over the same triangles
 //! (`SceneGeometry::trace_mesh`, the order the GPU buffers use). The CPU
 //! traces the very ray the GPU traced (read back), so only traversal and
 //! surface interpolation are compared.
@@ -13,9 +13,9 @@
 use glam::Vec3;
 use weft_gpu::Pixels;
 use weft_graph::plan::Extent;
-use weft_render::Bvh;
 use weft_render::SceneGeometry;
 use weft_render::{render, RenderSettings};
+use weft_render::{Bvh, WideBvh};
 use weft_tests::render as common;
 
 const WIDTH: u32 = 64;
@@ -70,7 +70,8 @@ fn traced_pixels_match_the_cpu(scene: &std::path::Path, textured: bool) {
 
     let mesh = SceneGeometry::new(&scene).trace_mesh();
     let triangles = &mesh.corners;
-    let bvh = Bvh::build(triangles);
+    // The shader walks the wide form; its CPU mirror finds the same hits.
+    let bvh = WideBvh::collapse(&Bvh::build(triangles), triangles);
     let eye = scene.cameras[0].pose_at(0.0).0;
     let (mut hits, mut disagree) = (0, 0);
     let (mut worst, mut worst_normal, mut worst_uv) = (0.0f32, 0.0f32, 0.0f32);
@@ -79,7 +80,7 @@ fn traced_pixels_match_the_cpu(scene: &std::path::Path, textured: bool) {
             let at = ((y * WIDTH + x) * 4) as usize;
             let dir = Vec3::new(rays[at], rays[at + 1], rays[at + 2]);
             assert!(dir.is_normalized(), "pixel ({x}, {y}) traced {dir}");
-            let cpu = bvh.closest_hit(triangles, eye, dir, 1e30);
+            let cpu = bvh.closest_hit(eye, dir, 1e30);
             let gpu_t = texels[at];
             match (cpu, gpu_t >= 0.0) {
                 (Some((t, tri)), true) => {

@@ -1,15 +1,16 @@
 //! `weft bench bvh`: how long the ray tracer's BVH takes to build over a
 //! scene's world-space triangles (the ones the `RayTracing` provider uploads),
-//! its shape (nodes, leaves, depth), and the memory of the path tracer's
-//! texture arrays for the scene's materials.
+//! its shape (nodes, leaves, depth) and quality (surface area heuristic cost)
+//! as built and in the 4-wide form shaders walk, and the memory of the path
+//! tracer's texture arrays for the scene's materials.
 
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use weft_render::Bvh;
 use weft_render::SceneGeometry;
+use weft_render::{Bvh, WideBvh};
 
 /// Options of `weft bench bvh`.
 #[derive(Args)]
@@ -30,6 +31,12 @@ struct Row {
     nodes: usize,
     leaves: usize,
     depth: usize,
+    sah: f32,
+    /// The 4-wide form: collapse time (median), nodes, depth, SAH cost.
+    wide_ms: f64,
+    wide_nodes: usize,
+    wide_depth: usize,
+    wide_sah: f32,
     /// Reading the BVH back from the cache (`weft_render::load_or_build_bvh`), median.
     cached_ms: f64,
     texture_bytes: u64,
@@ -73,6 +80,15 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
             anyhow::ensure!(read == bvh, "the cached BVH differs from the built one");
         }
         let _ = std::fs::remove_dir_all(&cache);
+        let mut collapses = Vec::new();
+        let mut wide = None;
+        for _ in 0..args.runs {
+            let started = Instant::now();
+            wide = Some(WideBvh::collapse(&bvh, &triangles));
+            collapses.push(started.elapsed().as_secs_f64() * 1e3);
+        }
+        collapses.sort_by(f64::total_cmp);
+        let wide = wide.context("at least one collapse")?;
         cached.sort_by(f64::total_cmp);
         rows.push(Row {
             scene: path.display().to_string(),
@@ -81,6 +97,11 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
             nodes: bvh.nodes.len(),
             leaves: bvh.leaf_count(),
             depth: bvh.depth(),
+            sah: bvh.sah_cost(),
+            wide_ms: collapses[collapses.len() / 2],
+            wide_nodes: wide.nodes.len(),
+            wide_depth: wide.depth(),
+            wide_sah: wide.sah_cost(),
             cached_ms: cached[cached.len() / 2],
             texture_bytes,
         });
@@ -90,10 +111,10 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
 }
 
 fn table(rows: &[Row]) -> String {
-    let mut out = String::from("| scene | triangles | build (ms, median) | from the cache (ms, median) | nodes | leaves | depth | texture arrays (MiB) |\n|---|---|---|---|---|---|---|---|\n");
+    let mut out = String::from("| scene | triangles | build (ms, median) | from the cache (ms, median) | nodes | leaves | depth | SAH cost | 4-wide: collapse (ms, median) | nodes | depth | SAH cost | texture arrays (MiB) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for r in rows {
         out.push_str(&format!(
-            "| {} | {} | {:.1} | {:.1} | {} | {} | {} | {:.1} |\n",
+            "| {} | {} | {:.1} | {:.1} | {} | {} | {} | {:.1} | {:.1} | {} | {} | {:.1} | {:.1} |\n",
             r.scene,
             r.triangles,
             r.build_ms,
@@ -101,6 +122,11 @@ fn table(rows: &[Row]) -> String {
             r.nodes,
             r.leaves,
             r.depth,
+            r.sah,
+            r.wide_ms,
+            r.wide_nodes,
+            r.wide_depth,
+            r.wide_sah,
             r.texture_bytes as f64 / (1024.0 * 1024.0)
         ));
     }
@@ -120,12 +146,17 @@ mod tests {
             nodes: 7,
             leaves: 4,
             depth: 3,
+            sah: 9.5,
+            wide_ms: 0.05,
+            wide_nodes: 2,
+            wide_depth: 2,
+            wide_sah: 7.25,
             cached_ms: 0.125,
             texture_bytes: 3 * 1024 * 1024,
         }];
         assert_eq!(
             table(&rows),
-            "| scene | triangles | build (ms, median) | from the cache (ms, median) | nodes | leaves | depth | texture arrays (MiB) |\n|---|---|---|---|---|---|---|---|\n| a.scene | 12 | 0.2 | 0.1 | 7 | 4 | 3 | 3.0 |\n"
+            "| scene | triangles | build (ms, median) | from the cache (ms, median) | nodes | leaves | depth | SAH cost | 4-wide: collapse (ms, median) | nodes | depth | SAH cost | texture arrays (MiB) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n| a.scene | 12 | 0.2 | 0.1 | 7 | 4 | 3 | 9.5 | 0.1 | 2 | 2 | 7.2 | 3.0 |\n"
         );
     }
 }

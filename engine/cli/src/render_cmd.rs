@@ -286,9 +286,11 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         bar.set_length(p.planned_frames.into());
         bar.set_position(p.frames.into());
         if let Some(samples) = p.samples {
+            let per_second = samples as f64 / p.elapsed.max(1e-9);
+            let pixels = f64::from(args.size.width) * f64::from(args.size.height);
             bar.set_message(format!(
-                "{samples} spp, {:.1} spp/s",
-                samples as f64 / p.elapsed.max(1e-9)
+                "{samples} spp, {per_second:.1} spp/s, {:.2} M samples/s",
+                per_second * pixels / 1e6
             ));
         }
     })?;

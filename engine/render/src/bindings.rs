@@ -54,10 +54,11 @@ pub const SHADOWS_BINDING: u32 = 4;
 /// Binding of the ray tracer's triangles: three world-space corners per
 /// triangle, each a vec4 (`Triangles` in `shaders/include/trace.glsl`).
 pub const TRIANGLES_BINDING: u32 = 5;
-/// Binding of the ray tracer's BVH nodes (`BvhNodes`).
+/// Binding of the ray tracer's 4-wide BVH nodes (`BvhNodes`).
 pub const BVH_NODES_BINDING: u32 = 6;
-/// Binding of the BVH's triangle order (`BvhTriangles`): leaves index it.
-pub const BVH_TRIANGLES_BINDING: u32 = 7;
+/// Binding of the BVH's leaf triangles, in leaf order with their edges
+/// (`BvhLeafTriangles`): leaves point into it.
+pub const BVH_LEAF_TRIANGLES_BINDING: u32 = 7;
 /// Binding of the corners' world normals (`TriangleNormals`, a vec4 each).
 pub const TRIANGLE_NORMALS_BINDING: u32 = 8;
 /// Binding of the corners' UVs (`TriangleUvs`, a vec2 each).
@@ -170,10 +171,10 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 15] = [
         "the BVH nodes",
     ),
     tracing(
-        "BVH_TRIANGLES",
-        BVH_TRIANGLES_BINDING,
+        "BVH_LEAF_TRIANGLES",
+        BVH_LEAF_TRIANGLES_BINDING,
         DescriptorKind::StorageBuffer,
-        "the BVH's triangle order",
+        "the BVH's leaf triangles",
     ),
     tracing(
         "TRIANGLE_NORMALS",

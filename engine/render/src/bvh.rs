@@ -1,11 +1,12 @@
 //! A bounding volume hierarchy over world-space triangles, for tracing rays on
 //! the GPU: a binary tree built top-down with the surface area heuristic over
 //! binned centroids (16 bins per axis, as in Wald 2007), flattened into 32-byte
-//! nodes a compute shader walks with a small stack. Inner nodes keep their two
-//! children next to each other, so a node stores one index.
+//! nodes (the form the BVH cache stores). Inner nodes keep their two children
+//! next to each other, so a node stores one index.
 //!
-//! `Bvh::closest_hit` is the CPU mirror of the GPU traversal; the tests hold it
-//! to brute force on random rays.
+//! Shaders walk its 4-wide form (`bvh_wide.rs`); `Bvh::closest_hit` walks
+//! the binary tree for CPU references, and the tests hold both to brute force
+//! on random rays.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -16,12 +17,12 @@ const BINS: usize = 16;
 /// Most triangles in a leaf.
 pub const MAX_LEAF: usize = 4;
 /// Cost of visiting a node relative to intersecting one triangle.
-const TRAVERSAL_COST: f32 = 1.0;
+pub(crate) const TRAVERSAL_COST: f32 = 1.0;
 
-/// One node as the GPU reads it (`struct BvhNode`, std430).
+/// One node of the binary tree.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuBvhNode {
+pub struct BvhNode {
     /// Lower corner of the node's box.
     pub min: [f32; 3],
     /// Inner node: index of the first child (the second follows it). Leaf:
@@ -33,14 +34,14 @@ pub struct GpuBvhNode {
     pub count: u32,
 }
 
-const _: () = assert!(std::mem::size_of::<GpuBvhNode>() == 32);
+const _: () = assert!(std::mem::size_of::<BvhNode>() == 32);
 
 /// A built hierarchy.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bvh {
     /// Nodes, the root first. Without triangles the root is an empty leaf
     /// and traversal must not start (check the triangle count first).
-    pub nodes: Vec<GpuBvhNode>,
+    pub nodes: Vec<BvhNode>,
     /// Triangle indices in leaf order; leaves point into this list.
     pub triangles: Vec<u32>,
 }
@@ -83,6 +84,14 @@ fn half_area(b: &Aabb) -> f32 {
     d.x * d.y + d.y * d.z + d.z * d.x
 }
 
+/// Half the surface area of a node's box.
+pub(crate) fn node_area(node: &BvhNode) -> f32 {
+    half_area(&Aabb {
+        min: Vec3::from(node.min),
+        max: Vec3::from(node.max),
+    })
+}
+
 /// A triangle's box and centroid.
 struct Primitive {
     bounds: Aabb,
@@ -111,6 +120,25 @@ impl Bvh {
         self.nodes.iter().filter(|n| n.count > 0).count()
     }
 
+    /// The tree's cost by the surface area heuristic the builder minimises:
+    /// for a ray that meets the root's box, the expected inner-node visits
+    /// (each weighted `TRAVERSAL_COST`) plus triangle tests, a node being met
+    /// with the ratio of its box's area to the root's.
+    pub fn sah_cost(&self) -> f32 {
+        let root = node_area(&self.nodes[0]).max(f32::MIN_POSITIVE);
+        self.nodes
+            .iter()
+            .map(|n| {
+                let weight = if n.count == 0 {
+                    TRAVERSAL_COST
+                } else {
+                    n.count as f32
+                };
+                weight * node_area(n) / root
+            })
+            .sum()
+    }
+
     /// Builds the hierarchy over `triangles` (three corners each). Degenerate
     /// triangles are kept (a ray never hits them).
     pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
@@ -122,7 +150,7 @@ impl Bvh {
             })
             .collect();
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-        let mut nodes = vec![GpuBvhNode::zeroed()];
+        let mut nodes = vec![BvhNode::zeroed()];
         // (node index, first, count) still to split.
         let mut pending = vec![(0usize, 0usize, order.len())];
         while let Some((node, first, count)) = pending.pop() {
@@ -131,7 +159,7 @@ impl Bvh {
                 .iter()
                 .fold(Aabb::EMPTY, |b, &i| b.union(&prims[i as usize].bounds));
             let centroids = Aabb::from_points(slice.iter().map(|&i| &prims[i as usize].centroid));
-            nodes[node] = GpuBvhNode {
+            nodes[node] = BvhNode {
                 min: bounds.min.to_array(),
                 first: first as u32,
                 max: bounds.max.to_array(),
@@ -141,8 +169,8 @@ impl Bvh {
                 continue;
             };
             let children = nodes.len();
-            nodes.push(GpuBvhNode::zeroed());
-            nodes.push(GpuBvhNode::zeroed());
+            nodes.push(BvhNode::zeroed());
+            nodes.push(BvhNode::zeroed());
             nodes[node].first = children as u32;
             nodes[node].count = 0;
             pending.push((children, first, left));
@@ -312,7 +340,7 @@ fn partition(slice: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
 }
 
 /// Entry distance of a ray into a node's box, if it meets it in front of the origin.
-fn slab(node: &GpuBvhNode, origin: Vec3, inv: Vec3) -> Option<f32> {
+fn slab(node: &BvhNode, origin: Vec3, inv: Vec3) -> Option<f32> {
     let t0 = (Vec3::from(node.min) - origin) * inv;
     let t1 = (Vec3::from(node.max) - origin) * inv;
     let near = t0.min(t1).max_element().max(0.0);
@@ -328,15 +356,19 @@ pub const EDGE_TOLERANCE: f32 = 1e-5;
 
 /// Möller–Trumbore: the ray parameter of the hit, if in front of the origin.
 pub fn intersect(tri: &[Vec3; 3], origin: Vec3, dir: Vec3) -> Option<f32> {
-    let e1 = tri[1] - tri[0];
-    let e2 = tri[2] - tri[0];
+    intersect_edges(tri[0], tri[1] - tri[0], tri[2] - tri[0], origin, dir)
+}
+
+/// [`intersect`] for the triangle with corner `a` and edges `e1`, `e2` from
+/// it (the wide BVH stores leaf triangles so).
+pub fn intersect_edges(a: Vec3, e1: Vec3, e2: Vec3, origin: Vec3, dir: Vec3) -> Option<f32> {
     let p = dir.cross(e2);
     let det = e1.dot(p);
     if det.abs() < 1e-12 {
         return None;
     }
     let inv_det = 1.0 / det;
-    let s = origin - tri[0];
+    let s = origin - a;
     let u = s.dot(p) * inv_det;
     if !(-EDGE_TOLERANCE..=1.0 + EDGE_TOLERANCE).contains(&u) {
         return None;

@@ -10,7 +10,7 @@
 //! Payload: node count (u64), the nodes as the GPU reads them, the leaf order
 //! (u32 each); all little endian.
 
-use crate::bvh::{Bvh, GpuBvhNode};
+use crate::bvh::{Bvh, BvhNode};
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
@@ -134,7 +134,7 @@ fn decode(bytes: &[u8], triangle_count: usize) -> Option<Bvh> {
         let first = r.u32()?;
         let max = [r.f32()?, r.f32()?, r.f32()?];
         let count = r.u32()?;
-        nodes.push(GpuBvhNode {
+        nodes.push(BvhNode {
             min,
             first,
             max,

@@ -46,7 +46,8 @@ pub struct RenderSettings {
     /// at a fixed time, instead of `frames` frames.
     pub samples: Option<u64>,
     /// Stop before a frame that would end past this many seconds of
-    /// rendering (at least one frame is drawn).
+    /// rendering, judged by the latest frame after the first (at least one
+    /// frame is drawn; the first, which builds pipelines, is no measure).
     pub time_limit: Option<f64>,
     /// Where derived scene data is cached between runs (the ray tracer's
     /// BVH); `None` caches nothing.
@@ -118,6 +119,19 @@ pub struct Progress {
     pub samples: Option<u64>,
     /// Seconds since the first frame started.
     pub elapsed: f64,
+}
+
+/// How long the next frame is expected to take, from the frames drawn so far
+/// (`frame_ms`): the latest one after the first, which also compiles shaders,
+/// builds pipelines and the BVH and so says nothing about the frames after it;
+/// 0 when only the first has been drawn.
+fn typical_frame_seconds(frame_ms: &[f64]) -> f64 {
+    frame_ms
+        .get(1..)
+        .and_then(<[f64]>::last)
+        .copied()
+        .unwrap_or(0.0)
+        / 1e3
 }
 
 impl Rendered {
@@ -240,11 +254,9 @@ pub fn render_with_progress(
     let mut last = None;
     let start = std::time::Instant::now();
     for frame in 0..count {
-        let elapsed = start.elapsed().as_secs_f64();
-        let typical = frame_ms.last().copied().unwrap_or(0.0) / 1e3;
-        let out_of_time = settings
-            .time_limit
-            .is_some_and(|limit| frame > 0 && elapsed + 2.0 * typical > limit);
+        let out_of_time = settings.time_limit.is_some_and(|limit| {
+            frame > 0 && start.elapsed().as_secs_f64() + typical_frame_seconds(&frame_ms) > limit
+        });
         let final_frame = frame + 1 == count || out_of_time;
         let started = std::time::Instant::now();
         let report = frames.draw(&FrameRequest {
@@ -292,4 +304,17 @@ pub fn render_with_progress(
         samples,
         timings,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::typical_frame_seconds;
+
+    #[test]
+    fn the_first_frame_is_no_measure_of_the_next() {
+        assert_eq!(typical_frame_seconds(&[]), 0.0);
+        assert_eq!(typical_frame_seconds(&[600.0]), 0.0);
+        assert_eq!(typical_frame_seconds(&[600.0, 20.0]), 0.02);
+        assert_eq!(typical_frame_seconds(&[600.0, 20.0, 30.0]), 0.03);
+    }
 }

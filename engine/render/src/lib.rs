@@ -27,6 +27,7 @@
 mod bindings;
 mod bvh;
 mod bvh_cache;
+mod bvh_wide;
 mod emitter_lights;
 mod emitters;
 mod error;
@@ -78,6 +79,7 @@ pub use watch::{FileWatcher, QUIET};
 pub use bindings::scene_interface;
 pub use bvh::{intersect, scene_triangles_where, Bvh};
 pub use bvh_cache::load_or_build as load_or_build_bvh;
+pub use bvh_wide::WideBvh;
 pub use emitter_lights::emitter_lights;
 pub use gaussian::GaussianTaps;
 pub use geometry::{quantize_uv, uv_box, SceneGeometry, TraceMesh, VERTEX_BYTES};

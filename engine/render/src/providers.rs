@@ -114,7 +114,7 @@ pub const RAY_TRACING: ProviderSpec = ProviderSpec {
     supplies: &[
         "Triangles",
         "BvhNodes",
-        "BvhTriangles",
+        "BvhLeafTriangles",
         "TriangleNormals",
         "TriangleUvs",
         "TriangleMaterials",

@@ -1,5 +1,5 @@
 //! The ray tracer's scene data on the device, built when a pass first traces:
-//! world-space triangles, the BVH over them, per-corner normals, tangents and
+//! world-space triangles, the BVH over them (in its 4-wide form), per-corner normals, tangents and
 //! UVs, per-triangle materials, the emitters' alias table and the texture
 //! arrays (set 1's tracing-only bindings, [`crate::bindings::TRACE_SET_BINDINGS`]).
 
@@ -16,7 +16,7 @@ use weft_gpu::{Gpu, GpuError};
 pub(super) struct TraceBuffers<'g> {
     pub(super) triangles: Buffer<'g>,
     pub(super) nodes: Buffer<'g>,
-    pub(super) order: Buffer<'g>,
+    pub(super) leaf_triangles: Buffer<'g>,
     pub(super) normals: Buffer<'g>,
     pub(super) tangents: Buffer<'g>,
     pub(super) uvs: Buffer<'g>,
@@ -40,6 +40,7 @@ impl<'g> TraceBuffers<'g> {
         let mesh = geometry.trace_mesh();
         let (bvh, cache_warning) = crate::bvh_cache::load_or_build(&mesh.corners, cache);
         warnings.extend(cache_warning);
+        let wide = crate::bvh_wide::WideBvh::collapse(&bvh, &mesh.corners);
         let corners: Vec<[f32; 4]> = mesh
             .corners
             .iter()
@@ -63,8 +64,13 @@ impl<'g> TraceBuffers<'g> {
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         Ok(Self {
             triangles: Buffer::device_local(gpu, "trace triangles", bytes_of(&corners), storage)?,
-            nodes: Buffer::device_local(gpu, "bvh nodes", bytes_of(&bvh.nodes), storage)?,
-            order: Buffer::device_local(gpu, "bvh triangles", bytes_of(&bvh.triangles), storage)?,
+            nodes: Buffer::device_local(gpu, "bvh nodes", bytes_of(&wide.nodes), storage)?,
+            leaf_triangles: Buffer::device_local(
+                gpu,
+                "bvh leaf triangles",
+                bytes_of(&wide.triangles),
+                storage,
+            )?,
             normals: Buffer::device_local(gpu, "trace normals", bytes_of(&normals), storage)?,
             tangents: Buffer::device_local(
                 gpu,
@@ -109,7 +115,7 @@ impl<'g> TraceBuffers<'g> {
         match binding {
             TRIANGLES_BINDING => Some(&self.triangles),
             BVH_NODES_BINDING => Some(&self.nodes),
-            BVH_TRIANGLES_BINDING => Some(&self.order),
+            BVH_LEAF_TRIANGLES_BINDING => Some(&self.leaf_triangles),
             TRIANGLE_NORMALS_BINDING => Some(&self.normals),
             TRIANGLE_TANGENTS_BINDING => Some(&self.tangents),
             TRIANGLE_UVS_BINDING => Some(&self.uvs),

@@ -1,0 +1,477 @@
+//! The 4-wide form of a [`Bvh`] that shaders walk (`trace_walk` in
+//! `trace.glsl`): each node holds its up to four children's boxes, so one
+//! step of the walk tests four boxes at once and reads one node, and leaves
+//! are children that point straight at their triangles, stored in leaf order
+//! with their edges precomputed. The binary tree is collapsed into it by
+//! pulling up, while a node has fewer than four children, the grandchildren
+//! of its largest inner child (the collapse of Wald et al. 2008 and Ylitie et
+//! al. 2017's compressed wide BVH, without the compression).
+//!
+//! On lavapipe a step of a divergent walk costs the same for every lane of a
+//! SIMD group, whatever node each lane is at; fewer, wider steps are what
+//! makes the wide tree faster (docs/pathtrace.md measures it).
+//!
+//! [`WideBvh::closest_hit`] is the CPU mirror of the shader's walk, step for
+//! step, so a test can hold the GPU to it exactly.
+
+use crate::bvh::{intersect_edges, node_area, Bvh, TRAVERSAL_COST};
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+/// Children per node.
+pub const WIDTH: usize = 4;
+
+/// `count` of a child slot that holds no child.
+pub const NO_CHILD: u32 = u32::MAX;
+
+/// One node as the shader reads it (`struct WideNode`, std430).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuWideNode {
+    /// Lower corners of the children's boxes, per axis then per child.
+    pub lo: [[f32; WIDTH]; 3],
+    /// Upper corners of the children's boxes, per axis then per child.
+    pub hi: [[f32; WIDTH]; 3],
+    /// An inner child's node index, or a leaf's first slot in
+    /// [`WideBvh::triangles`].
+    pub child: [u32; WIDTH],
+    /// 0 for an inner child, the triangle count of a leaf, or [`NO_CHILD`].
+    pub count: [u32; WIDTH],
+}
+
+const _: () = assert!(std::mem::size_of::<GpuWideNode>() == 128);
+
+impl GpuWideNode {
+    /// A node whose slots are all empty.
+    const EMPTY: GpuWideNode = GpuWideNode {
+        lo: [[0.0; WIDTH]; 3],
+        hi: [[0.0; WIDTH]; 3],
+        child: [0; WIDTH],
+        count: [NO_CHILD; WIDTH],
+    };
+}
+
+/// A leaf triangle as the shader reads it (`struct LeafTriangle`): its first
+/// corner with the triangle's index in the scene's triangle list (as bits),
+/// and its two edges from that corner.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuLeafTriangle {
+    pub a: [f32; 3],
+    pub triangle: u32,
+    pub e1: [f32; 4],
+    pub e2: [f32; 4],
+}
+
+/// A hierarchy in the form the shaders walk.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WideBvh {
+    /// Nodes, the root first; without triangles, one node with no children.
+    pub nodes: Vec<GpuWideNode>,
+    /// The triangles in leaf order.
+    pub triangles: Vec<GpuLeafTriangle>,
+}
+
+impl WideBvh {
+    /// The wide form of `bvh`, built over `triangles`.
+    pub fn collapse(bvh: &Bvh, triangles: &[[Vec3; 3]]) -> WideBvh {
+        let leaf_triangles = bvh
+            .triangles
+            .iter()
+            .map(|&t| {
+                let [a, b, c] = triangles[t as usize];
+                GpuLeafTriangle {
+                    a: a.to_array(),
+                    triangle: t,
+                    e1: (b - a).extend(0.0).to_array(),
+                    e2: (c - a).extend(0.0).to_array(),
+                }
+            })
+            .collect();
+        let mut nodes = vec![GpuWideNode::EMPTY];
+        if bvh.triangles.is_empty() {
+            return WideBvh {
+                nodes,
+                triangles: leaf_triangles,
+            };
+        }
+        // (wide node, binary node whose children it takes).
+        let mut pending = vec![(0usize, 0u32)];
+        while let Some((wide, binary)) = pending.pop() {
+            for (slot, c) in wide_children(bvh, binary).into_iter().enumerate() {
+                let child = &bvh.nodes[c as usize];
+                for axis in 0..3 {
+                    nodes[wide].lo[axis][slot] = child.min[axis];
+                    nodes[wide].hi[axis][slot] = child.max[axis];
+                }
+                if child.count > 0 {
+                    nodes[wide].child[slot] = child.first;
+                    nodes[wide].count[slot] = child.count;
+                } else {
+                    let index = nodes.len();
+                    nodes.push(GpuWideNode::EMPTY);
+                    nodes[wide].child[slot] = index as u32;
+                    nodes[wide].count[slot] = 0;
+                    pending.push((index, c));
+                }
+            }
+        }
+        WideBvh {
+            nodes,
+            triangles: leaf_triangles,
+        }
+    }
+
+    /// Depth of the deepest leaf (the root's children are depth 1).
+    pub fn depth(&self) -> usize {
+        if self.triangles.is_empty() {
+            return 0;
+        }
+        let mut deepest = 0;
+        let mut stack = vec![(0usize, 1usize)];
+        while let Some((n, d)) = stack.pop() {
+            let node = &self.nodes[n];
+            for slot in 0..WIDTH {
+                match node.count[slot] {
+                    0 => stack.push((node.child[slot] as usize, d + 1)),
+                    NO_CHILD => {}
+                    _ => deepest = deepest.max(d),
+                }
+            }
+        }
+        deepest
+    }
+
+    /// [`Bvh::sah_cost`] for the wide tree: a visit, which tests four boxes,
+    /// costs `TRAVERSAL_COST`, the root's box being the union of its
+    /// children's.
+    pub fn sah_cost(&self) -> f32 {
+        if self.triangles.is_empty() {
+            return 0.0;
+        }
+        let root = &self.nodes[0];
+        let slots = || (0..WIDTH).filter(|&s| root.count[s] != NO_CHILD);
+        let lo = slots().fold(Vec3::INFINITY, |m, s| {
+            m.min(Vec3::new(root.lo[0][s], root.lo[1][s], root.lo[2][s]))
+        });
+        let hi = slots().fold(Vec3::NEG_INFINITY, |m, s| {
+            m.max(Vec3::new(root.hi[0][s], root.hi[1][s], root.hi[2][s]))
+        });
+        let d = (hi - lo).max(Vec3::ZERO);
+        let area = (d.x * d.y + d.y * d.z + d.z * d.x).max(f32::MIN_POSITIVE);
+        let children: f32 = self
+            .nodes
+            .iter()
+            .flat_map(|n| (0..WIDTH).map(move |s| (n, s)))
+            .map(|(n, s)| match n.count[s] {
+                NO_CHILD => 0.0,
+                0 => TRAVERSAL_COST * slot_area(n, s) / area,
+                count => count as f32 * slot_area(n, s) / area,
+            })
+            .sum();
+        TRAVERSAL_COST + children
+    }
+
+    /// The nearest hit of the ray `origin + t * dir` with `t` in `(0, t_max)`:
+    /// `(t, triangle index)`, found as the shader finds it.
+    pub fn closest_hit(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<(f32, u32)> {
+        self.walk(origin, dir, t_max, false)
+    }
+
+    /// Whether anything lies on the ray with `t` in `(0, t_max)`; stops at the
+    /// first hit found, as the shader's shadow rays do.
+    pub fn any_hit(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        self.walk(origin, dir, t_max, true).is_some()
+    }
+
+    /// `trace_walk`: pops a node, measures the ray's entry into its four
+    /// boxes, orders them nearest first, tests the triangles of the leaves
+    /// the ray enters before the nearest hit so far, in that order, and
+    /// pushes the inner children, the nearest last.
+    fn walk(&self, origin: Vec3, dir: Vec3, t_max: f32, first_hit: bool) -> Option<(f32, u32)> {
+        if self.triangles.is_empty() {
+            return None;
+        }
+        let inv = dir.recip();
+        let mut best: Option<(f32, u32)> = None;
+        let mut limit = t_max;
+        let mut stack = vec![(0u32, 0.0f32)];
+        while let Some((n, entry)) = stack.pop() {
+            if entry >= limit {
+                continue;
+            }
+            let node = &self.nodes[n as usize];
+            let mut near = entries(node, origin, inv, limit);
+            let mut slot = [0, 1, 2, 3];
+            for (i, j) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+                if near[j] < near[i] {
+                    near.swap(i, j);
+                    slot.swap(i, j);
+                }
+            }
+            // Which leaves to test is settled before any of them is: the
+            // shader tests them in one loop.
+            let tests = std::array::from_fn::<_, WIDTH, _>(|k| {
+                let count = node.count[slot[k]];
+                if near[k] < limit && count != NO_CHILD {
+                    count as usize
+                } else {
+                    0
+                }
+            });
+            for k in 0..WIDTH {
+                let first = node.child[slot[k]] as usize;
+                for tri in &self.triangles[first..first + tests[k]] {
+                    let hit = intersect_edges(
+                        Vec3::from(tri.a),
+                        Vec3::from_slice(&tri.e1[..3]),
+                        Vec3::from_slice(&tri.e2[..3]),
+                        origin,
+                        dir,
+                    );
+                    if let Some(t) = hit.filter(|&t| t < limit) {
+                        limit = t;
+                        best = Some((t, tri.triangle));
+                    }
+                }
+            }
+            if first_hit && best.is_some() {
+                return best;
+            }
+            for k in (0..WIDTH).rev() {
+                if near[k] < limit && node.count[slot[k]] == 0 {
+                    stack.push((node.child[slot[k]], near[k]));
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Where the ray enters each child's box, or infinity for a child it misses,
+/// meets only at or beyond `limit`, or an empty slot.
+fn entries(node: &GpuWideNode, origin: Vec3, inv: Vec3, limit: f32) -> [f32; WIDTH] {
+    std::array::from_fn(|slot| {
+        let lo = Vec3::new(node.lo[0][slot], node.lo[1][slot], node.lo[2][slot]);
+        let hi = Vec3::new(node.hi[0][slot], node.hi[1][slot], node.hi[2][slot]);
+        let t0 = (lo - origin) * inv;
+        let t1 = (hi - origin) * inv;
+        let near = t0.min(t1).max_element().max(0.0);
+        let far = t0.max(t1).min_element();
+        let meets = near <= far && near < limit && node.count[slot] != NO_CHILD;
+        if meets {
+            near
+        } else {
+            f32::INFINITY
+        }
+    })
+}
+
+/// The binary nodes that become the wide children of binary inner node
+/// `node` (or the root itself when it is a leaf): its two children, then,
+/// while fewer than four, the largest inner one among them replaced by its
+/// own two.
+fn wide_children(bvh: &Bvh, node: u32) -> Vec<u32> {
+    let root = &bvh.nodes[node as usize];
+    if root.count > 0 {
+        return vec![node];
+    }
+    let mut children = vec![root.first, root.first + 1];
+    while children.len() < WIDTH {
+        let largest = children
+            .iter()
+            .enumerate()
+            .filter(|(_, &c)| bvh.nodes[c as usize].count == 0)
+            .max_by(|a, b| half_area(bvh, *a.1).total_cmp(&half_area(bvh, *b.1)))
+            .map(|(i, _)| i);
+        let Some(i) = largest else {
+            break;
+        };
+        let first = bvh.nodes[children[i] as usize].first;
+        children[i] = first;
+        children.insert(i + 1, first + 1);
+    }
+    children
+}
+
+/// Half the surface area of a binary node's box.
+fn half_area(bvh: &Bvh, node: u32) -> f32 {
+    node_area(&bvh.nodes[node as usize])
+}
+
+/// Half the surface area of the box a node holds for its child in `slot`.
+fn slot_area(node: &GpuWideNode, slot: usize) -> f32 {
+    let d = Vec3::new(
+        node.hi[0][slot] - node.lo[0][slot],
+        node.hi[1][slot] - node.lo[1][slot],
+        node.hi[2][slot] - node.lo[2][slot],
+    )
+    .max(Vec3::ZERO);
+    d.x * d.y + d.y * d.z + d.z * d.x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::intersect;
+    use weft_scene::rng::Rng;
+
+    fn point(rng: &mut Rng, scale: f32) -> Vec3 {
+        Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * scale
+    }
+
+    fn soup(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
+        let mut rng = Rng::new(seed);
+        (0..n)
+            .map(|_| {
+                let c = point(&mut rng, 10.0);
+                [c, c + point(&mut rng, 0.8), c + point(&mut rng, 0.8)]
+            })
+            .collect()
+    }
+
+    fn brute_force(tris: &[[Vec3; 3]], origin: Vec3, dir: Vec3) -> Option<(f32, u32)> {
+        tris.iter()
+            .enumerate()
+            .filter_map(|(i, t)| intersect(t, origin, dir).map(|d| (d, i as u32)))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    }
+
+    fn slot_box(node: &GpuWideNode, slot: usize) -> (Vec3, Vec3) {
+        (
+            Vec3::new(node.lo[0][slot], node.lo[1][slot], node.lo[2][slot]),
+            Vec3::new(node.hi[0][slot], node.hi[1][slot], node.hi[2][slot]),
+        )
+    }
+
+    #[test]
+    fn every_triangle_is_in_one_leaf_inside_its_box_and_boxes_nest() {
+        let tris = soup(3000, 1);
+        let bvh = Bvh::build(&tris);
+        let wide = WideBvh::collapse(&bvh, &tris);
+        let mut seen = vec![0u32; tris.len()];
+        // (node, the box its parent holds for it)
+        let mut stack = vec![(0usize, None::<(Vec3, Vec3)>)];
+        let mut visited = 0;
+        while let Some((n, outer)) = stack.pop() {
+            visited += 1;
+            let node = &wide.nodes[n];
+            let children = node.count.iter().filter(|&&c| c != NO_CHILD).count();
+            assert!(children >= 2, "node {n} has {children} children");
+            for slot in 0..WIDTH {
+                if node.count[slot] == NO_CHILD {
+                    continue;
+                }
+                let (lo, hi) = slot_box(node, slot);
+                if let Some((olo, ohi)) = outer {
+                    assert!(lo.cmpge(olo).all() && hi.cmple(ohi).all());
+                }
+                if node.count[slot] == 0 {
+                    stack.push((node.child[slot] as usize, Some((lo, hi))));
+                    continue;
+                }
+                assert!(node.count[slot] as usize <= crate::bvh::MAX_LEAF);
+                let first = node.child[slot] as usize;
+                for leaf in &wide.triangles[first..first + node.count[slot] as usize] {
+                    seen[leaf.triangle as usize] += 1;
+                    for p in tris[leaf.triangle as usize] {
+                        assert!(p.cmpge(lo).all() && p.cmple(hi).all());
+                    }
+                    let [a, b, c] = tris[leaf.triangle as usize];
+                    assert_eq!(leaf.a, a.to_array());
+                    assert_eq!(leaf.e1, (b - a).extend(0.0).to_array());
+                    assert_eq!(leaf.e2, (c - a).extend(0.0).to_array());
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n == 1));
+        assert_eq!(visited, wide.nodes.len(), "every node is reachable once");
+        // Same leaves, a third of the visits: the wide tree costs less.
+        assert!(
+            wide.sah_cost() < bvh.sah_cost(),
+            "{} vs {}",
+            wide.sah_cost(),
+            bvh.sah_cost()
+        );
+        // Four children per node but where the binary tree ran out: about a
+        // third of the binary tree's inner nodes, and half its depth.
+        let binary_inner = bvh.nodes.len() - bvh.leaf_count();
+        assert!(
+            wide.nodes.len() * 2 < binary_inner,
+            "{} vs {binary_inner}",
+            wide.nodes.len()
+        );
+        assert!(
+            wide.depth() * 3 <= bvh.depth() * 2,
+            "{} vs {}",
+            wide.depth(),
+            bvh.depth()
+        );
+    }
+
+    #[test]
+    fn closest_and_any_hits_equal_brute_force_on_random_rays() {
+        let tris = soup(2000, 2);
+        let wide = WideBvh::collapse(&Bvh::build(&tris), &tris);
+        let mut rng = Rng::new(3);
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let origin = point(&mut rng, 14.0) - Vec3::splat(2.0);
+            let dir = (point(&mut rng, 2.0) - Vec3::ONE).normalize_or(Vec3::X);
+            let expected = brute_force(&tris, origin, dir);
+            let got = wide.closest_hit(origin, dir, f32::INFINITY);
+            assert_eq!(got.is_some(), wide.any_hit(origin, dir, f32::INFINITY));
+            match (expected, got) {
+                (None, None) => {}
+                (Some(e), Some(g)) => {
+                    hits += 1;
+                    assert_eq!(e.0, g.0, "{e:?} vs {g:?}");
+                    let shorter = wide.closest_hit(origin, dir, e.0);
+                    assert_eq!(shorter, None, "t_max is exclusive");
+                }
+                other => panic!("brute force and the wide BVH disagree: {other:?}"),
+            }
+        }
+        assert!(
+            hits > 500,
+            "the test rays must hit often enough to mean something: {hits}"
+        );
+    }
+
+    #[test]
+    fn empty_single_and_four_triangle_scenes() {
+        let empty = WideBvh::collapse(&Bvh::build(&[]), &[]);
+        assert_eq!(empty.nodes, vec![GpuWideNode::EMPTY]);
+        assert_eq!(empty.closest_hit(Vec3::ZERO, Vec3::X, f32::INFINITY), None);
+        assert_eq!(empty.depth(), 0);
+        // A root that is one leaf becomes the root's only child.
+        let wall = |x: f32| {
+            [
+                Vec3::new(x, -1.0, -1.0),
+                Vec3::new(x, 1.0, -1.0),
+                Vec3::new(x, 0.0, 1.0),
+            ]
+        };
+        let one = [wall(1.0)];
+        let wide = WideBvh::collapse(&Bvh::build(&one), &one);
+        // A leaf root: one test; wide, a visit to the root and the test.
+        assert_eq!(Bvh::build(&one).sah_cost(), 1.0);
+        assert_eq!(wide.sah_cost(), 2.0);
+        assert_eq!(wide.nodes.len(), 1);
+        assert_eq!(wide.nodes[0].count, [1, NO_CHILD, NO_CHILD, NO_CHILD]);
+        assert_eq!(
+            wide.closest_hit(Vec3::ZERO, Vec3::X, f32::INFINITY),
+            Some((1.0, 0))
+        );
+        assert_eq!(wide.closest_hit(Vec3::ZERO, Vec3::X, 0.5), None);
+        assert_eq!(wide.closest_hit(Vec3::ZERO, -Vec3::X, f32::INFINITY), None);
+        let four = [wall(3.0), wall(1.0), wall(4.0), wall(2.0)];
+        let wide = WideBvh::collapse(&Bvh::build(&four), &four);
+        assert_eq!(
+            wide.closest_hit(Vec3::ZERO, Vec3::X, f32::INFINITY),
+            Some((1.0, 1))
+        );
+        assert!(wide.any_hit(Vec3::ZERO, Vec3::X, 1.5));
+        assert!(!wide.any_hit(Vec3::ZERO, Vec3::X, 1.0));
+    }
+}
