@@ -35,7 +35,9 @@ pub struct PathtraceArgs {
     /// Path length limit (`max_depth`, the camera ray counting as 1).
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1024))]
     max_depth: u32,
-    /// Samples per pixel per frame (`samples_per_frame`).
+    /// Samples per pixel per frame (`samples_per_frame`), at most half of
+    /// each count so that a frame after the first (which builds pipelines)
+    /// is timed.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=1024))]
     samples_per_frame: u32,
     /// A converged image of the same scene, camera and size (linear EXR) to
@@ -111,6 +113,12 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
     let mut samples = Vec::new();
     let mut last_image = None;
     for &spp in &args.spp {
+        // At least two frames where spp allows: the first builds pipelines
+        // and the BVH and is not timed, so a one-frame render would time
+        // the builds.
+        let per_frame = args
+            .samples_per_frame
+            .min(u32::try_from(spp / 2).unwrap_or(u32::MAX).max(1));
         let settings = RenderSettings {
             graph: args.graph.clone(),
             extent: args.size,
@@ -123,7 +131,7 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
                 ),
                 (
                     "samples_per_frame".into(),
-                    ParamValue::Number(args.samples_per_frame.into()),
+                    ParamValue::Number(per_frame.into()),
                 ),
             ]),
             ..RenderSettings::default()
@@ -132,7 +140,7 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
         let reached = rendered.samples.context("the graph is progressive")?;
         // The first frame builds pipelines and the BVH: time the rest and
         // scale to the whole count.
-        let per_frame = u64::from(args.samples_per_frame);
+        let per_frame = u64::from(per_frame);
         let (steady_ms, steady_samples) = if rendered.frame_ms.len() > 1 {
             (
                 rendered.frame_ms[1..].iter().sum::<f64>(),

@@ -101,35 +101,41 @@ pub fn write_png(plot: &LinePlot, path: &Path, width: u32, height: u32) -> Resul
     ) else {
         bail!("nothing to plot in \"{}\"", plot.title);
     };
-    let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let mut builder = ChartBuilder::on(&root);
-    builder
-        .caption(&plot.title, (FAMILY, 24))
-        .margin(16)
-        .x_label_area_size(48)
-        .y_label_area_size(72);
-    // One arm per axis kind: with or without the swept values as ticks.
-    macro_rules! chart {
-        ($xs:expr, $ys:expr) => {
-            draw(plot, builder.build_cartesian_2d($xs, $ys)?, &usable)?
-        };
+    let mut buffer = vec![0u8; width as usize * height as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut builder = ChartBuilder::on(&root);
+        builder
+            .caption(&plot.title, (FAMILY, 24))
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(72);
+        // One arm per axis kind: with or without the swept values as ticks.
+        macro_rules! chart {
+            ($xs:expr, $ys:expr) => {
+                draw(plot, builder.build_cartesian_2d($xs, $ys)?, &usable)?
+            };
+        }
+        let ticks = plot.x_ticks.clone();
+        match (plot.log_x, !ticks.is_empty(), plot.log_y) {
+            (true, true, true) => chart!(
+                (x.0..x.1).log_scale().with_key_points(ticks),
+                (y.0..y.1).log_scale()
+            ),
+            (true, true, false) => chart!((x.0..x.1).log_scale().with_key_points(ticks), y.0..y.1),
+            (true, false, true) => chart!((x.0..x.1).log_scale(), (y.0..y.1).log_scale()),
+            (true, false, false) => chart!((x.0..x.1).log_scale(), y.0..y.1),
+            (false, _, true) => chart!(x.0..x.1, (y.0..y.1).log_scale()),
+            (false, _, false) => chart!(x.0..x.1, y.0..y.1),
+        }
+        root.present()?;
     }
-    let ticks = plot.x_ticks.clone();
-    match (plot.log_x, !ticks.is_empty(), plot.log_y) {
-        (true, true, true) => chart!(
-            (x.0..x.1).log_scale().with_key_points(ticks),
-            (y.0..y.1).log_scale()
-        ),
-        (true, true, false) => chart!((x.0..x.1).log_scale().with_key_points(ticks), y.0..y.1),
-        (true, false, true) => chart!((x.0..x.1).log_scale(), (y.0..y.1).log_scale()),
-        (true, false, false) => chart!((x.0..x.1).log_scale(), y.0..y.1),
-        (false, _, true) => chart!(x.0..x.1, (y.0..y.1).log_scale()),
-        (false, _, false) => chart!(x.0..x.1, y.0..y.1),
-    }
-    root.present()
-        .with_context(|| format!("writing {}", path.display()))?;
-    Ok(())
+    // Encoded with the image crate the rest of weft uses, not plotters' own.
+    image::RgbImage::from_raw(width, height, buffer)
+        .context("the plot's buffer has the plot's size")?
+        .save(path)
+        .with_context(|| format!("writing {}", path.display()))
 }
 
 /// Draws the mesh, axis labels, every series with markers, and the legend.

@@ -79,7 +79,6 @@ pub fn write_plot(
     (error_name, budget_ms): (&str, Option<f64>),
     path: &Path,
 ) -> Result<(), ImageError> {
-    crate::report::ensure_font()?;
     let fail = |e: &dyn std::fmt::Display| ImageError::Write {
         path: path.to_path_buf(),
         message: e.to_string(),
@@ -103,117 +102,116 @@ pub fn write_plot(
     let budget = budget_ms.filter(|b| (t0..=t1).contains(b));
     let (e0, e1) = range(&|p| p.error);
     let on = frontier(points);
-    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| fail(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, (crate::report::FAMILY, 22))
-        .margin(16)
-        .x_label_area_size(48)
-        .y_label_area_size(72)
-        .build_cartesian_2d(t0..t1, e0..e1)
-        .map_err(|e| fail(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("frame time (ms)")
-        .y_desc(error_name)
-        .label_style((crate::report::FAMILY, 14))
-        .draw()
-        .map_err(|e| fail(&e))?;
-    chart
-        .draw_series(usable.iter().map(|p| {
-            PathElement::new(
-                vec![(p.time_iqr.0, p.error), (p.time_iqr.1, p.error)],
-                RGBColor(90, 90, 90).stroke_width(1),
-            )
-        }))
-        .map_err(|e| fail(&e))?
-        .label("frame time IQR")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(90, 90, 90)));
-    chart
-        .draw_series(
-            usable
-                .iter()
-                .map(|p| Circle::new((p.time, p.error), 4, RGBColor(150, 150, 150).filled())),
-        )
-        .map_err(|e| fail(&e))?
-        .label("dominated")
-        .legend(|(x, y)| Circle::new((x, y), 4, RGBColor(150, 150, 150).filled()));
-    let frontier_points: Vec<(f64, f64)> = on
-        .iter()
-        .map(|&i| (points[i].time, points[i].error))
-        .filter(|(t, e)| *t > 0.0 && *e > 0.0)
-        .collect();
-    chart
-        .draw_series(LineSeries::new(
-            frontier_points.clone(),
-            RED.stroke_width(2),
-        ))
-        .map_err(|e| fail(&e))?
-        .label("Pareto frontier")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
-    chart
-        .draw_series(
-            frontier_points
-                .iter()
-                .map(|&(t, e)| Circle::new((t, e), 5, RED.filled())),
-        )
-        .map_err(|e| fail(&e))?;
-    chart
-        .draw_series(
-            on.iter()
-                .enumerate()
-                .filter(|(_, &i)| points[i].time > 0.0 && points[i].error > 0.0)
-                .map(|(rank, &i)| {
-                    EmptyElement::at((points[i].time, points[i].error))
-                        + Text::new(
-                            (rank + 1).to_string(),
-                            (6, -18),
-                            (crate::report::FAMILY, 13).into_font().color(&BLACK),
-                        )
-                }),
-        )
-        .map_err(|e| fail(&e))?;
-    chart
-        .draw_series(
-            dominated_marks(points)
-                .into_iter()
-                .filter(|(i, _)| points[*i].time > 0.0 && points[*i].error > 0.0)
-                .map(|(i, mark)| {
-                    EmptyElement::at((points[i].time, points[i].error))
-                        + Text::new(
-                            mark,
-                            (6, 4),
-                            (crate::report::FAMILY, 12)
-                                .into_font()
-                                .color(&RGBColor(110, 110, 110)),
-                        )
-                }),
-        )
-        .map_err(|e| fail(&e))?;
-    if let Some(b) = budget {
+    crate::report::draw_png(900, 600, path, |root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (crate::report::FAMILY, 22))
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(72)
+            .build_cartesian_2d(t0..t1, e0..e1)
+            .map_err(|e| fail(&e))?;
         chart
-            .draw_series(std::iter::once(PathElement::new(
-                vec![(b, e0), (b, e1)],
-                RGBColor(30, 90, 200).stroke_width(2),
-            )))
-            .map_err(|e| fail(&e))?
-            .label(format!("budget {b} ms"))
-            .legend(|(x, y)| {
+            .configure_mesh()
+            .x_desc("frame time (ms)")
+            .y_desc(error_name)
+            .label_style((crate::report::FAMILY, 14))
+            .draw()
+            .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(usable.iter().map(|p| {
                 PathElement::new(
-                    vec![(x, y), (x + 20, y)],
-                    RGBColor(30, 90, 200).stroke_width(2),
+                    vec![(p.time_iqr.0, p.error), (p.time_iqr.1, p.error)],
+                    RGBColor(90, 90, 90).stroke_width(1),
                 )
-            });
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.8))
-        .label_font((crate::report::FAMILY, 14))
-        .draw()
-        .map_err(|e| fail(&e))?;
-    root.present().map_err(|e| fail(&e))
+            }))
+            .map_err(|e| fail(&e))?
+            .label("frame time IQR")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(90, 90, 90)));
+        chart
+            .draw_series(
+                usable
+                    .iter()
+                    .map(|p| Circle::new((p.time, p.error), 4, RGBColor(150, 150, 150).filled())),
+            )
+            .map_err(|e| fail(&e))?
+            .label("dominated")
+            .legend(|(x, y)| Circle::new((x, y), 4, RGBColor(150, 150, 150).filled()));
+        let frontier_points: Vec<(f64, f64)> = on
+            .iter()
+            .map(|&i| (points[i].time, points[i].error))
+            .filter(|(t, e)| *t > 0.0 && *e > 0.0)
+            .collect();
+        chart
+            .draw_series(LineSeries::new(
+                frontier_points.clone(),
+                RED.stroke_width(2),
+            ))
+            .map_err(|e| fail(&e))?
+            .label("Pareto frontier")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+        chart
+            .draw_series(
+                frontier_points
+                    .iter()
+                    .map(|&(t, e)| Circle::new((t, e), 5, RED.filled())),
+            )
+            .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(
+                on.iter()
+                    .enumerate()
+                    .filter(|(_, &i)| points[i].time > 0.0 && points[i].error > 0.0)
+                    .map(|(rank, &i)| {
+                        EmptyElement::at((points[i].time, points[i].error))
+                            + Text::new(
+                                (rank + 1).to_string(),
+                                (6, -18),
+                                (crate::report::FAMILY, 13).into_font().color(&BLACK),
+                            )
+                    }),
+            )
+            .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(
+                dominated_marks(points)
+                    .into_iter()
+                    .filter(|(i, _)| points[*i].time > 0.0 && points[*i].error > 0.0)
+                    .map(|(i, mark)| {
+                        EmptyElement::at((points[i].time, points[i].error))
+                            + Text::new(
+                                mark,
+                                (6, 4),
+                                (crate::report::FAMILY, 12)
+                                    .into_font()
+                                    .color(&RGBColor(110, 110, 110)),
+                            )
+                    }),
+            )
+            .map_err(|e| fail(&e))?;
+        if let Some(b) = budget {
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(b, e0), (b, e1)],
+                    RGBColor(30, 90, 200).stroke_width(2),
+                )))
+                .map_err(|e| fail(&e))?
+                .label(format!("budget {b} ms"))
+                .legend(|(x, y)| {
+                    PathElement::new(
+                        vec![(x, y), (x + 20, y)],
+                        RGBColor(30, 90, 200).stroke_width(2),
+                    )
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.8))
+            .label_font((crate::report::FAMILY, 14))
+            .draw()
+            .map_err(|e| fail(&e))
+    })
 }
 
 #[cfg(test)]

@@ -338,8 +338,9 @@ fn drawing_error(path: &Path, e: impl std::fmt::Display) -> ImageError {
     }
 }
 
-/// Draws on a white `w` x `h` canvas with `draw` and writes it to `path` as PNG.
-fn draw_png(
+/// Draws on a white `w` x `h` canvas with `draw` and writes it to `path` as PNG
+/// (with the image crate the rest of weft uses, not plotters' own encoder).
+pub(crate) fn draw_png(
     w: u32,
     h: u32,
     path: &Path,
