@@ -152,6 +152,12 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
     // dielectric's `absorption` after refracting into it, 0 in air.
     vec3 medium = vec3(0.0);
     for (uint depth = 1u; depth <= params.max_depth; ++depth) {
+        // A path whose throughput is zero (a black surface, or absorption
+        // that underflowed) can add nothing more: without Russian roulette
+        // it would walk on to max_depth and hold its SIMD group there.
+        if (all(equal(throughput, vec3(0.0)))) {
+            break;
+        }
         vec2 found = trace_closest(origin, dir, 1e30);
         float t = found.x < 0.0 ? 1e30 : found.x;
         int area = hit_area_light(origin, dir, t);
