@@ -194,9 +194,12 @@ def write_png(exr):
     return png
 
 
-def rel_mse(a, b):
-    """Mean of (a - b)^2 / (b^2 + 0.01) over pixels and channels."""
-    return dr.mean(dr.square(a - b) / (dr.square(b) + 0.01), axis=None).array[0]
+def rel_mse(a, b, scale=None):
+    """Mean of (a - b)^2 / (s^2 + 0.01) over pixels and channels, s being b
+    or, between two noisy images, the converged `scale` (a noisy denominator
+    near 0 inflates the figure)."""
+    s = b if scale is None else scale
+    return dr.mean(dr.square(a - b) / (dr.square(s) + 0.01), axis=None).array[0]
 
 
 def main():
@@ -241,7 +244,12 @@ def main():
     run = weft["renders"][-1]
     weft_path = weft["image"]
     mitsuba_error = rel_mse(rgb(mitsuba_path), rgb(reference_path))
-    between = rel_mse(rgb(weft_path), rgb(mitsuba_path))
+    between = rel_mse(rgb(weft_path), rgb(mitsuba_path), rgb(reference_path))
+    # Each image's error against the reference holds the reference's own noise,
+    # (reference_spp / spp) times less than Mitsuba's: what is left of each is
+    # its own noise, and two unbiased renderers differ by the sum of theirs.
+    mitsuba_noise = mitsuba_error / (1 + args.spp / args.reference_spp)
+    weft_noise = run["rel_mse"] - mitsuba_noise * args.spp / args.reference_spp
     mean = lambda path: list(dr.mean(rgb(path), axis=(0, 1)).array)
     print(f"\n{args.ball or 'Cornell box'}: {args.size}x{args.size}, {args.spp} spp, "
           f"max_depth {max_depth(args.ball)}, on {os.cpu_count()} cores\n")
@@ -252,7 +260,9 @@ def main():
           f"{mitsuba_error:.4e} | {', '.join(f'{v:.4f}' for v in mean(mitsuba_path))} |")
     print(f"| weft pathtrace.ron | {weft['device']} | {run['samples_per_second']:,.0f} | "
           f"{run['rel_mse']:.4e} | {', '.join(f'{v:.4f}' for v in mean(weft_path))} |")
-    print(f"\nrelative MSE between the two {args.spp}-spp images: {between:.4e}")
+    print(f"\nrelative MSE between the two {args.spp}-spp images (over the reference): {between:.4e}, "
+          f"{between / (mitsuba_noise + weft_noise):.2f}x the sum of their noise levels "
+          f"({mitsuba_noise:.4e} + {weft_noise:.4e})")
     print("images:", ", ".join(write_png(p) for p in (mitsuba_path, weft_path, reference_path)))
     print(f"reference image mean: {', '.join(f'{v:.4f}' for v in mean(reference_path))}")
 

@@ -1,0 +1,153 @@
+#!/usr/bin/env python3
+"""Equal-time error: weft's path tracer and Mitsuba 3 given the same seconds (issue 34).
+
+Renders the Cornell box of tools/pathtrace_vs_mitsuba.py (same geometry,
+camera, max_depth 8, Russian roulette from depth 5) for each time budget in
+both renderers and measures each image's HDR-FLIP (NVIDIA's flip-evaluator)
+and relative MSE against a converged Mitsuba reference. Budgets run
+interleaved, round by round. The time to HDR-FLIP 0.06 is interpolated
+between budgets on log-log axes.
+
+- Mitsuba (`scalar_rgb`, all cores) renders chunks of `--chunk` spp with
+  successive seeds, averaged, until another chunk would end past the budget
+  (the scene is loaded and the thread pool warm before the clock starts).
+- weft runs `weft render --time-limit S` on the progressive graph: its clock
+  includes the first frame's pipeline builds, not the process start or the
+  scene load.
+
+    pip install mitsuba flip-evaluator
+    cargo build --release -p weft-cli
+    python3 tools/pathtrace_equal_time.py --budgets 5,20,60 --rounds 2
+"""
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pathtrace_vs_mitsuba as side_by_side  # noqa: E402
+
+try:
+    import flip_evaluator as flip
+    import numpy as np
+except ImportError:
+    sys.exit("flip-evaluator is not installed: pip install flip-evaluator")
+
+mi = side_by_side.mi
+
+
+def linear(path):
+    """An EXR's linear RGB as a float32 HxWx3 array."""
+    bitmap = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
+    return np.array(bitmap)
+
+
+def errors(image, reference):
+    """HDR-FLIP and relative MSE of `image` against `reference`."""
+    _, mean_flip, _ = flip.evaluate(reference, image, "HDR", applyMagma=False)
+    rel_mse = float(np.mean((image - reference) ** 2 / (reference ** 2 + 0.01)))
+    return float(mean_flip), rel_mse
+
+
+def mitsuba_for(seconds, scene, chunk, size):
+    """Mitsuba's mean image over as many `chunk`-spp renders as fit in `seconds`."""
+    total, spp, seed = None, 0, 1
+    started = time.perf_counter()
+    last = 0.0
+    while True:
+        elapsed = time.perf_counter() - started
+        if spp > 0 and elapsed + last > seconds:
+            break
+        chunk_start = time.perf_counter()
+        image = np.array(mi.render(scene, spp=chunk, seed=seed))[:, :, :3]
+        last = time.perf_counter() - chunk_start
+        total = image if total is None else total + image
+        spp += chunk
+        seed += 1
+    return total / (spp // chunk), spp, time.perf_counter() - started
+
+
+def weft_for(seconds, weft, graph, size, out):
+    """weft's image after `weft render --time-limit seconds` through `graph`."""
+    run = subprocess.run(
+        [weft, "render", "scenes/cornell.scene", "--graph", graph, "--size", f"{size}x{size}",
+         "--time-limit", str(seconds), "--param", f"max_depth={side_by_side.max_depth(None)}",
+         "--out", out, "--json"],
+        cwd=side_by_side.ROOT, check=True, capture_output=True, text=True)
+    report = json.loads(run.stdout)
+    return linear(out), report["samples_per_pixel"]
+
+
+def crossing(points, target):
+    """Seconds where error falls to `target`, interpolated on log-log axes
+    between the two budgets around it; None outside the measured range."""
+    points = sorted(points)
+    for (t0, e0), (t1, e1) in zip(points, points[1:]):
+        if e0 >= target >= e1 and e0 > e1:
+            k = (math.log(target) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(t0) + k * (math.log(t1) - math.log(t0)))
+    return None
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--budgets", default="5,20,60", help="seconds, comma-separated")
+    parser.add_argument("--rounds", type=int, default=2)
+    parser.add_argument("--size", type=int, default=128)
+    parser.add_argument("--reference-spp", type=int, default=16384)
+    parser.add_argument("--chunk", type=int, default=16, help="Mitsuba spp per render call")
+    parser.add_argument("--target", type=float, default=0.06, help="HDR-FLIP to report the time to")
+    parser.add_argument("--weft", default=side_by_side.WEFT)
+    parser.add_argument("--graph", default="graphs/pathtrace.ron",
+                        help="weft's progressive graph (a changed copy, to weigh a change of the tracer)")
+    parser.add_argument("--out", default=os.path.join(side_by_side.ROOT, "target", "pathtrace-equal-time"))
+    args = parser.parse_args()
+    budgets = [float(b) for b in args.budgets.split(",")]
+    os.makedirs(args.out, exist_ok=True)
+    mi.set_variant("scalar_rgb")
+    with tempfile.TemporaryDirectory() as work:
+        reference_path = os.path.join(args.out, f"mitsuba_{args.size}_{args.reference_spp}spp.exr")
+        if not os.path.exists(reference_path):
+            print(f"Mitsuba reference at {args.reference_spp} spp ...", file=sys.stderr, flush=True)
+            scene = side_by_side.mitsuba_scene(args.reference_spp, args.size, work)
+            mi.util.write_bitmap(reference_path, mi.render(scene, spp=args.reference_spp), write_async=False)
+        reference = linear(reference_path)
+        scene = side_by_side.mitsuba_scene(args.chunk, args.size, work)
+        mi.render(scene, spp=1)  # warm up the thread pool
+        results = {(who, b): [] for who in ("mitsuba", "weft") for b in budgets}
+        for round_index in range(args.rounds):
+            for budget in budgets:
+                image, spp, took = mitsuba_for(budget, scene, args.chunk, args.size)
+                results[("mitsuba", budget)].append((spp, took) + errors(image, reference))
+                out = os.path.join(args.out, f"weft_{budget:g}s.exr")
+                image, spp = weft_for(budget, args.weft, args.graph, args.size, out)
+                results[("weft", budget)].append((spp, budget) + errors(image, reference))
+                print(f"round {round_index + 1}/{args.rounds}, {budget:g} s: "
+                      f"Mitsuba {results[('mitsuba', budget)][-1]}, weft {results[('weft', budget)][-1]}",
+                      file=sys.stderr, flush=True)
+    span = lambda xs, f: f"{f(min(xs))}–{f(max(xs))}" if min(xs) != max(xs) else f(xs[0])  # noqa: E731
+    print(f"Cornell box, {args.size}x{args.size}, max_depth {side_by_side.max_depth(None)}, weft's {args.graph} "
+          f"against Mitsuba "
+          f"at {args.reference_spp} spp; ranges over {args.rounds} interleaved rounds\n")
+    print("| budget | Mitsuba scalar_rgb spp | weft spp | Mitsuba HDR-FLIP | weft HDR-FLIP | "
+          "Mitsuba rel. MSE | weft rel. MSE |")
+    print("|---|---|---|---|---|---|---|")
+    for budget in budgets:
+        m, w = results[("mitsuba", budget)], results[("weft", budget)]
+        print(f"| {budget:g} s | {span([r[0] for r in m], str)} | {span([r[0] for r in w], str)} | "
+              f"{span([r[2] for r in m], '{:.4f}'.format)} | {span([r[2] for r in w], '{:.4f}'.format)} | "
+              f"{span([r[3] for r in m], '{:.2e}'.format)} | {span([r[3] for r in w], '{:.2e}'.format)} |")
+    for who in ("mitsuba", "weft"):
+        medians = [(b, sorted(r[2] for r in results[(who, b)])[len(results[(who, b)]) // 2]) for b in budgets]
+        t = crossing(medians, args.target)
+        said = f"{t:.1f} s" if t is not None else "outside the budgets measured"
+        print(f"\n{who}: time to HDR-FLIP {args.target}: {said}")
+
+
+if __name__ == "__main__":
+    main()
