@@ -11,7 +11,8 @@ between budgets on log-log axes.
 - Mitsuba (`scalar_rgb`, all cores) renders chunks of `--chunk` spp with
   successive seeds, averaged, until another chunk would end past the budget
   (the scene is loaded and the thread pool warm before the clock starts).
-- weft runs `weft render --time-limit S` on the progressive graph: its clock
+- weft runs `weft render --spp 1000000 --time-limit S` on the progressive
+  graph (the time limit ends it long before that count): its clock
   includes the first frame's pipeline builds, not the process start or the
   scene load.
 
@@ -76,7 +77,7 @@ def weft_for(seconds, weft, graph, size, out):
     """weft's image after `weft render --time-limit seconds` through `graph`."""
     run = subprocess.run(
         [weft, "render", "scenes/cornell.scene", "--graph", graph, "--size", f"{size}x{size}",
-         "--time-limit", str(seconds), "--param", f"max_depth={side_by_side.max_depth(None)}",
+         "--spp", "1000000", "--time-limit", str(seconds), "--param", f"max_depth={side_by_side.max_depth(None)}",
          "--out", out, "--json"],
         cwd=side_by_side.ROOT, check=True, capture_output=True, text=True)
     report = json.loads(run.stdout)
