@@ -32,8 +32,10 @@ pub struct BloomArgs {
     #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     frames: u32,
     /// Where the CSV and the plot go (`bloom_bench.csv`, `bloom_bench.png`).
-    #[arg(long, default_value = "docs")]
-    out_dir: PathBuf,
+    /// Default: the user's cache (`~/.cache/weft/bench/bloom`); `docs`
+    /// refreshes the committed figures.
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
     /// Use the first device whose name contains this.
     #[arg(long)]
     device: Option<String>,
@@ -254,9 +256,8 @@ pub fn run(args: BloomArgs) -> Result<ExitCode> {
         samples.push(sample);
     }
     let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&args.out_dir)
-        .with_context(|| format!("creating {}", args.out_dir.display()))?;
-    let csv_path = args.out_dir.join("bloom_bench.csv");
+    let out_dir = crate::output::out_dir(args.out_dir.as_deref(), "bloom")?;
+    let csv_path = out_dir.join("bloom_bench.csv");
     std::fs::write(&csv_path, csv(&samples))
         .with_context(|| format!("writing {}", csv_path.display()))?;
     let footprint = |s: &Sample| f64::from(2 * s.radius + 1);
@@ -286,7 +287,7 @@ pub fn run(args: BloomArgs) -> Result<ExitCode> {
             },
         ],
     };
-    let png_path = args.out_dir.join("bloom_bench.png");
+    let png_path = out_dir.join("bloom_bench.png");
     plot::write_png(&chart, &png_path, 960, 600)?;
     println!("wrote {} and {}", csv_path.display(), png_path.display());
     Ok(ExitCode::SUCCESS)

@@ -10,6 +10,7 @@ mod bloom;
 mod bvh;
 mod floors;
 mod lights;
+mod output;
 mod pathtrace;
 mod plot;
 mod script;

@@ -39,8 +39,10 @@ pub struct LightsArgs {
     #[arg(long, value_delimiter = ',', default_value = "!bloom")]
     features: Vec<String>,
     /// Where the CSV and the plot go (`lights_bench.csv`, `lights_bench.png`).
-    #[arg(long, default_value = "docs")]
-    out_dir: PathBuf,
+    /// Default: the user's cache (`~/.cache/weft/bench/lights`); `docs`
+    /// refreshes the committed figures.
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
     /// Keep the generated scenes (`floor.obj`, `lights_<N>.scene`) in this folder
     /// instead of a temporary one that is removed afterwards.
     #[arg(long)]
@@ -246,12 +248,11 @@ pub fn run(args: LightsArgs) -> Result<ExitCode> {
     if args.scenes.is_none() {
         let _ = std::fs::remove_dir_all(&scenes);
     }
-    std::fs::create_dir_all(&args.out_dir)
-        .with_context(|| format!("creating {}", args.out_dir.display()))?;
-    let csv_path = args.out_dir.join("lights_bench.csv");
+    let out_dir = crate::output::out_dir(args.out_dir.as_deref(), "lights")?;
+    let csv_path = out_dir.join("lights_bench.csv");
     std::fs::write(&csv_path, csv(&samples))
         .with_context(|| format!("writing {}", csv_path.display()))?;
-    let png_path = args.out_dir.join("lights_bench.png");
+    let png_path = out_dir.join("lights_bench.png");
     let chart = LinePlot {
         title: format!(
             "Frame time vs point lights, {}x{} ({})",

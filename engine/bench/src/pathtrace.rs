@@ -46,8 +46,10 @@ pub struct PathtraceArgs {
     reference: Option<PathBuf>,
     /// Where the CSV and the plot go (`pathtrace_bench.csv`,
     /// `pathtrace_convergence.png`, the plot only with --reference).
-    #[arg(long, default_value = "docs")]
-    out_dir: PathBuf,
+    /// Default: the user's cache (`~/.cache/weft/bench/pathtrace`); `docs`
+    /// refreshes the committed figures.
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
     /// Also write the last render here (linear EXR).
     #[arg(long)]
     image: Option<PathBuf>,
@@ -167,9 +169,8 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
         });
         last_image = Some(hdr.clone());
     }
-    std::fs::create_dir_all(&args.out_dir)
-        .with_context(|| format!("creating {}", args.out_dir.display()))?;
-    let csv_path = args.out_dir.join("pathtrace_bench.csv");
+    let out_dir = crate::output::out_dir(args.out_dir.as_deref(), "pathtrace")?;
+    let csv_path = out_dir.join("pathtrace_bench.csv");
     std::fs::write(&csv_path, csv(&samples))
         .with_context(|| format!("writing {}", csv_path.display()))?;
     if let Some(path) = &args.image {
@@ -196,12 +197,7 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
                     .collect(),
             }],
         };
-        write_png(
-            &plot,
-            &args.out_dir.join("pathtrace_convergence.png"),
-            900,
-            600,
-        )?;
+        write_png(&plot, &out_dir.join("pathtrace_convergence.png"), 900, 600)?;
     }
     if args.json {
         let rows: Vec<_> = samples

@@ -51,8 +51,10 @@ pub struct ShadowsArgs {
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
     repeats: u32,
     /// Where the CSV and plots go (`shadows_bench.csv`, `shadows_error.png`, `shadows_time.png`).
-    #[arg(long, default_value = "docs")]
-    out_dir: PathBuf,
+    /// Default: the user's cache (`~/.cache/weft/bench/shadows`); `docs`
+    /// refreshes the committed figures.
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
     /// Use the first device whose name contains this.
     #[arg(long)]
     device: Option<String>,
@@ -322,8 +324,8 @@ pub fn run(args: ShadowsArgs) -> Result<ExitCode> {
         }
     }
     let _ = std::fs::remove_dir_all(&work);
-    std::fs::create_dir_all(&args.out_dir)?;
-    let csv_path = args.out_dir.join("shadows_bench.csv");
+    let out_dir = crate::output::out_dir(args.out_dir.as_deref(), "shadows")?;
+    let csv_path = out_dir.join("shadows_bench.csv");
     std::fs::write(&csv_path, csv(&samples))?;
     let series = |y: &dyn Fn(&Sample) -> f64| -> Vec<Series> {
         args.radii
@@ -346,7 +348,7 @@ pub fn run(args: ShadowsArgs) -> Result<ExitCode> {
             gpu.info().name
         )
     };
-    let error_png = args.out_dir.join("shadows_error.png");
+    let error_png = out_dir.join("shadows_error.png");
     plot::write_png(
         &LinePlot {
             title: title("Visibility error"),
@@ -361,7 +363,7 @@ pub fn run(args: ShadowsArgs) -> Result<ExitCode> {
         960,
         600,
     )?;
-    let time_png = args.out_dir.join("shadows_time.png");
+    let time_png = out_dir.join("shadows_time.png");
     plot::write_png(
         &LinePlot {
             title: title("Shadow cost"),

@@ -27,7 +27,7 @@ Controls:
   G / Shift+G    next / previous graph in the graph's folder
   1-9            toggle the graph's features (listed on stdout when a graph loads)
   Space          pause / resume scene time            R       back to the scene camera
-  F12            save a screenshot (weft-<time>-<n>.png, name printed)
+  F12            save a screenshot (weft-<time>-<n>.png in --screenshot-dir, path printed)
   Esc            quit
 The title shows the graph, its features, frame time, samples per pixel for a
 progressive graph such as graphs/pathtrace.ron (it converges while nothing moves;
@@ -80,6 +80,11 @@ pub struct ViewArgs {
     /// (after --frames, Esc, closing the window, SIGINT or SIGTERM).
     #[arg(long)]
     screenshot_on_exit: Option<PathBuf>,
+    /// Where F12 saves screenshots. Default: `weft` in the user's pictures
+    /// folder (XDG `PICTURES`, e.g. ~/Pictures/weft) where one is set up, else
+    /// the user cache (~/.cache/weft/screenshots); never the current directory.
+    #[arg(long)]
+    screenshot_dir: Option<PathBuf>,
     /// Make every reload's preparation (on the worker thread) sleep this long
     /// first, to see the frame loop keep going during a slow one (tests).
     #[arg(long, hide = true, default_value_t = 0)]

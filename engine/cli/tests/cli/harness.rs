@@ -1,6 +1,7 @@
 //! The one way these tests run `weft`: the built binary, in a given folder, with
-//! a user cache of this test process's own (`WEFT_CACHE_DIR`), so results never
-//! depend on what the user's `~/.cache/weft` holds.
+//! a user cache of this test process's own (`WEFT_CACHE_DIR`) and an empty XDG
+//! config (no pictures folder for screenshots), so results never depend on what
+//! the user's `~/.cache/weft` or `~/.config/user-dirs.dirs` hold.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -28,7 +29,8 @@ pub fn command_in(dir: &Path, args: &[&str]) -> Command {
     command
         .args(args)
         .current_dir(dir)
-        .env("WEFT_CACHE_DIR", user_cache());
+        .env("WEFT_CACHE_DIR", user_cache())
+        .env("XDG_CONFIG_HOME", user_cache().join("xdg-config"));
     command
 }
 

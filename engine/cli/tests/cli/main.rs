@@ -5,6 +5,7 @@
 mod harness;
 mod watch_support;
 
+mod bench;
 mod check_interfaces;
 mod compare;
 mod graph;

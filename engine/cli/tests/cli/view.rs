@@ -466,12 +466,22 @@ fn a_slow_reload_is_prepared_while_frames_keep_being_presented() {
 }
 
 /// Keys pressed by script: G switches to the next graph in `graphs/`, 1 flips the
-/// first feature, F12 saves what the window shows; validation stays silent.
+/// first feature, F12 saves what the window shows into the user's pictures
+/// folder (here one set up in a temporary XDG config), not the current
+/// directory; validation stays silent.
 #[test]
 fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
     let x = Xvfb::start();
     let tmp = Temp::new("keys");
     let dir = tmp.0.clone();
+    let config = dir.join("config");
+    let pictures = dir.join("pictures");
+    std::fs::create_dir_all(&config).expect("config dir");
+    std::fs::write(
+        config.join("user-dirs.dirs"),
+        format!("XDG_PICTURES_DIR=\"{}\"\n", pictures.display()),
+    )
+    .expect("user-dirs.dirs");
     let scene = repo().join("scenes/demo.scene");
     let graph = repo().join("graphs/forward.ron");
     let out = x
@@ -491,6 +501,7 @@ fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
             ],
             &dir,
         )
+        .env("XDG_CONFIG_HOME", &config)
         .output()
         .expect("weft runs");
     assert_clean(&out);
@@ -516,10 +527,25 @@ fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
     );
     let saved = stdout
         .lines()
-        .find_map(|l| l.strip_prefix("wrote weft-"))
+        .find_map(|l| l.strip_prefix("wrote "))
         .unwrap_or_else(|| panic!("no screenshot line: {stdout}"));
+    let saved = Path::new(saved);
     assert_eq!(
-        load(&dir.join(format!("weft-{saved}"))).dimensions(),
-        (96, 54)
+        saved.parent(),
+        Some(pictures.join("weft").as_path()),
+        "{stdout}"
+    );
+    assert!(saved
+        .file_name()
+        .is_some_and(|n| n.to_string_lossy().starts_with("weft-")));
+    assert_eq!(load(saved).dimensions(), (96, 54));
+    let in_cwd: Vec<_> = std::fs::read_dir(&dir)
+        .expect("test dir")
+        .filter_map(|e| e.ok())
+        .filter(|e| e.path().extension().is_some_and(|x| x == "png"))
+        .collect();
+    assert!(
+        in_cwd.is_empty(),
+        "a PNG in the current directory: {in_cwd:?}"
     );
 }

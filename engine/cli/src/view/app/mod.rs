@@ -69,6 +69,7 @@ pub struct Viewer<'g> {
     resize_to: Option<Extent>,
     pending_size: Option<[u32; 2]>,
     screenshot_on_exit: Option<PathBuf>,
+    screenshot_dir: Option<PathBuf>,
     screenshot_now: bool,
     screenshots: u32,
     graphs: Vec<PathBuf>,
@@ -145,6 +146,9 @@ impl<'g> Viewer<'g> {
             resize_to: args.resize_to,
             pending_size: None,
             screenshot_on_exit: args.screenshot_on_exit.clone(),
+            screenshot_dir: args.screenshot_dir.clone().or_else(|| {
+                screenshot_folder(dirs::picture_dir(), weft_scene::cache::user_cache_dir())
+            }),
             screenshot_now: false,
             screenshots: 0,
             graphs: controls::sibling_graphs(&graph),
@@ -451,7 +455,10 @@ impl<'g> Viewer<'g> {
             let stamp = std::time::SystemTime::now()
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0, |d| d.as_secs());
-            let path = PathBuf::from(format!("weft-{stamp}-{}.png", self.screenshots));
+            let dir = self.screenshot_dir.as_ref().context(
+                "no folder for screenshots: give --screenshot-dir (there is no pictures folder, WEFT_CACHE_DIR or HOME)",
+            )?;
+            let path = dir.join(format!("weft-{stamp}-{}.png", self.screenshots));
             save(pixels, &path)?;
         }
         if on_exit {
@@ -488,6 +495,14 @@ impl<'g> Viewer<'g> {
 }
 
 /// Writes a screenshot and says where.
+/// The default screenshot folder: `weft` in the user's pictures folder when
+/// there is one, else `screenshots` in the user cache.
+fn screenshot_folder(pictures: Option<PathBuf>, cache: Option<PathBuf>) -> Option<PathBuf> {
+    pictures
+        .map(|p| p.join("weft"))
+        .or_else(|| cache.map(|c| c.join("screenshots")))
+}
+
 fn save(pixels: &Readback, path: &Path) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -551,5 +566,25 @@ impl ApplicationHandler for Viewer<'_> {
             _ if self.stop.load(Ordering::SeqCst) => event_loop.exit(),
             _ => {}
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn screenshots_go_to_the_pictures_folder_else_the_user_cache() {
+        let pictures = Some(PathBuf::from("/home/u/Pictures"));
+        let cache = Some(PathBuf::from("/home/u/.cache/weft"));
+        assert_eq!(
+            screenshot_folder(pictures, cache.clone()),
+            Some(PathBuf::from("/home/u/Pictures/weft"))
+        );
+        assert_eq!(
+            screenshot_folder(None, cache),
+            Some(PathBuf::from("/home/u/.cache/weft/screenshots"))
+        );
+        assert_eq!(screenshot_folder(None, None), None);
     }
 }

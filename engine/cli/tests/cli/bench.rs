@@ -1,0 +1,46 @@
+//! Where `weft bench` writes its figures.
+
+use crate::harness::{command_in, repo};
+
+/// Without `--out-dir` a benchmark writes into the user cache and says so;
+/// run inside the repository, it leaves the committed figures in `docs/` as
+/// they are.
+#[test]
+fn bench_figures_go_to_the_user_cache_unless_an_out_dir_is_given() {
+    let cache = std::env::temp_dir().join(format!("weft-cli-bench-cache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&cache);
+    let committed = repo().join("docs/pathtrace_bench.csv");
+    let before = std::fs::read(&committed).expect("docs/pathtrace_bench.csv");
+    let output = command_in(
+        &repo(),
+        &[
+            "bench",
+            "pathtrace",
+            "--size",
+            "8x8",
+            "--spp",
+            "2",
+            "--max-depth",
+            "2",
+        ],
+    )
+    .env("WEFT_CACHE_DIR", &cache)
+    .output()
+    .expect("weft runs");
+    let said = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(output.status.success(), "{said}");
+    let csv = cache.join("bench/pathtrace/pathtrace_bench.csv");
+    let text =
+        std::fs::read_to_string(&csv).unwrap_or_else(|e| panic!("{}: {e}\n{said}", csv.display()));
+    assert!(
+        text.starts_with("spp,seconds,samples_per_second,rel_mse\n2,"),
+        "{text}"
+    );
+    assert!(said.contains(&csv.display().to_string()), "{said}");
+    assert_eq!(std::fs::read(&committed).expect("docs csv"), before);
+    std::fs::remove_dir_all(&cache).expect("remove the test's cache");
+}
