@@ -162,6 +162,46 @@ pub struct Status<'a> {
     pub error: Option<&'a str>,
     /// Samples per pixel accumulated, for a progressive graph.
     pub samples: Option<u64>,
+    /// Whether the progressive image has started over frame after frame
+    /// with the camera still: the scene animates ([`RestartWatch`]).
+    pub animating: bool,
+}
+
+/// What the title says while [`RestartWatch::animating`].
+pub const ANIMATING: &str = "restarts every frame: the scene animates; Space pauses time";
+
+/// Frames in a row a progressive image must start over, the camera still and
+/// scene time running, before the viewer says the scene's animation is why.
+const RESTARTS_TO_SAY: u32 = 3;
+
+/// Watches a progressive graph's image start over: when it does frame after
+/// frame although the camera stands still and scene time runs, the scene
+/// animates and the image cannot converge until time is paused (Space).
+#[derive(Debug, Default)]
+pub struct RestartWatch {
+    in_a_row: u32,
+}
+
+impl RestartWatch {
+    /// Notes one frame: whether its image started over, whether the camera
+    /// moved for it, whether scene time ran.
+    pub fn observe(&mut self, restarted: bool, camera_moved: bool, time_runs: bool) {
+        self.in_a_row = if restarted && !camera_moved && time_runs {
+            self.in_a_row.saturating_add(1)
+        } else {
+            0
+        };
+    }
+
+    /// Whether the frames seen say the scene's animation restarts the image.
+    pub fn animating(&self) -> bool {
+        self.in_a_row >= RESTARTS_TO_SAY
+    }
+
+    /// Whether the last frame is the one that made it so (say it once).
+    pub fn just_began(&self) -> bool {
+        self.in_a_row == RESTARTS_TO_SAY
+    }
 }
 
 /// The window title: graph, features, frame time and per-pass times, or the
@@ -184,6 +224,9 @@ pub fn title(status: &Status) -> String {
     );
     if let Some(samples) = status.samples {
         line.push_str(&format!(" {samples} spp"));
+        if status.animating {
+            line.push_str(&format!(" ({ANIMATING})"));
+        }
     }
     if !status.timings.is_empty() {
         let passes: Vec<String> = status
@@ -300,6 +343,7 @@ mod tests {
             timings: &timings,
             error: None,
             samples: None,
+            animating: false,
         };
         assert_eq!(
             title(&status),
@@ -310,9 +354,44 @@ mod tests {
             title(&status),
             "weft view: forward.ron [bloom shadow_casters] 20.0 ms (50 fps) 48 spp | forward 1.23"
         );
+        status.animating = true;
+        assert_eq!(
+            title(&status),
+            "weft view: forward.ron [bloom shadow_casters] 20.0 ms (50 fps) 48 spp \
+             (restarts every frame: the scene animates; Space pauses time) | forward 1.23"
+        );
         status.samples = None;
         status.error = Some("graphs/forward.ron:3: unknown pass kind");
         assert!(title(&status)
             .starts_with("ERROR graphs/forward.ron:3: unknown pass kind (kept last good) | weft view: forward.ron"));
+    }
+
+    #[test]
+    fn restarts_with_the_camera_still_and_time_running_mean_the_scene_animates() {
+        let mut watch = RestartWatch::default();
+        for _ in 0..2 {
+            watch.observe(true, false, true);
+        }
+        assert!(
+            !watch.animating(),
+            "two restarts could be an edit or a reload"
+        );
+        watch.observe(true, false, true);
+        assert!(watch.animating() && watch.just_began());
+        watch.observe(true, false, true);
+        assert!(watch.animating() && !watch.just_began());
+        // Flying restarts the image for a reason the user knows.
+        watch.observe(true, true, true);
+        assert!(!watch.animating());
+        // Paused, a restart has another cause (an edit); converging ends it.
+        for _ in 0..5 {
+            watch.observe(true, false, false);
+        }
+        assert!(!watch.animating());
+        for _ in 0..3 {
+            watch.observe(true, false, true);
+        }
+        watch.observe(false, false, true);
+        assert!(!watch.animating());
     }
 }

@@ -549,3 +549,35 @@ fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
         "a PNG in the current directory: {in_cwd:?}"
     );
 }
+
+/// The path tracer on an animated scene starts over every frame: the viewer
+/// says why and that Space pauses time, once, and says nothing when time is
+/// paused from the start (then the image converges).
+#[test]
+fn a_progressive_graph_on_an_animated_scene_says_the_animation_restarts_it() {
+    let x = Xvfb::start();
+    let scene = repo().join("scenes/animation.scene");
+    let graph = repo().join("graphs/pathtrace.ron");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "view",
+            scene.to_str().expect("utf-8 path"),
+            "--graph",
+            graph.to_str().expect("utf-8 path"),
+            "--size",
+            "32x18",
+            "--frames",
+            "8",
+            "--validate",
+        ];
+        args.extend_from_slice(extra);
+        let out = x.weft(&args);
+        assert_clean(&out);
+        text(&out.stdout)
+    };
+    let hint = "progressive image restarts every frame: the scene animates; Space pauses time";
+    let running = run(&[]);
+    assert_eq!(running.matches(hint).count(), 1, "{running}");
+    let paused = run(&["--paused"]);
+    assert!(!paused.contains(hint), "{paused}");
+}

@@ -72,6 +72,7 @@ pub struct Viewer<'g> {
     screenshot_dir: Option<PathBuf>,
     screenshot_now: bool,
     screenshots: u32,
+    restarts: controls::RestartWatch,
     graphs: Vec<PathBuf>,
     features: Vec<String>,
     error: Option<String>,
@@ -151,6 +152,7 @@ impl<'g> Viewer<'g> {
             }),
             screenshot_now: false,
             screenshots: 0,
+            restarts: controls::RestartWatch::default(),
             graphs: controls::sibling_graphs(&graph),
             features: controls::graph_features(live.graph()),
             error: None,
@@ -352,7 +354,10 @@ impl<'g> Viewer<'g> {
             .map_or(0.0, |t| now.duration_since(t).as_secs_f32());
         self.last_frame = Some(now);
         let input = self.input(dt);
+        let (position, orientation) = (self.camera.position, self.camera.orientation);
         self.camera.update(&input, dt);
+        let camera_moved =
+            self.camera.position != position || self.camera.orientation != orientation;
         if !self.paused {
             self.time += f64::from(dt);
         }
@@ -364,6 +369,13 @@ impl<'g> Viewer<'g> {
             ..self.lens.clone()
         };
         let report = self.live.draw(&camera, self.time, self.frames, false)?;
+        let restarted = self.live.samples().is_some()
+            && self.live.samples() == self.live.plan().samples_per_frame.map(u64::from);
+        self.restarts
+            .observe(restarted, camera_moved, !self.paused && dt > 0.0);
+        if self.restarts.just_began() {
+            println!("progressive image {}", controls::ANIMATING);
+        }
         if let Some(error) = self.live.take_script_error() {
             eprintln!("error: {error} (the lights of the last good step kept)");
         }
@@ -487,6 +499,7 @@ impl<'g> Viewer<'g> {
             timings: &self.timings,
             error: self.error.as_deref(),
             samples: self.live.samples(),
+            animating: self.restarts.animating(),
         });
         if let Some(window) = &self.window {
             window.set_title(&title);
@@ -494,7 +507,6 @@ impl<'g> Viewer<'g> {
     }
 }
 
-/// Writes a screenshot and says where.
 /// The default screenshot folder: `weft` in the user's pictures folder when
 /// there is one, else `screenshots` in the user cache.
 fn screenshot_folder(pictures: Option<PathBuf>, cache: Option<PathBuf>) -> Option<PathBuf> {
@@ -503,6 +515,7 @@ fn screenshot_folder(pictures: Option<PathBuf>, cache: Option<PathBuf>) -> Optio
         .or_else(|| cache.map(|c| c.join("screenshots")))
 }
 
+/// Writes a screenshot and says where.
 fn save(pixels: &Readback, path: &Path) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
