@@ -83,11 +83,17 @@ pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
 }
 
 /// The features a user of `graph` can switch (names in its conditions and
-/// its defaults), sorted; number keys 1 to 9 toggle them in this order.
+/// its defaults): the graph's own first (bloom, debug views, a depth
+/// prepass), then those a scene switches on by what it has (`shadow_casters`,
+/// `textures`, ...), each group sorted; number keys 1 to 9 toggle them in this
+/// order, so they reach the graph's own choices before the scene's.
 pub fn graph_features(graph: &weft_graph::Prepared) -> Vec<String> {
     let mut names = weft_graph::feature_names(graph.ir());
     names.extend(graph.graph().default_features.iter().cloned());
-    names.into_iter().collect()
+    let (scene, own): (Vec<String>, Vec<String>) = names
+        .into_iter()
+        .partition(|n| weft_graph::SCENE_FEATURES.contains(&n.as_str()));
+    own.into_iter().chain(scene).collect()
 }
 
 /// The requested toggles with `name` flipped: any earlier toggle of it is
@@ -297,9 +303,18 @@ mod tests {
             !names.iter().any(|n| n.starts_with("bench")),
             "no bench feature is offered: {names:?}"
         );
-        let mut sorted = names.clone();
-        sorted.sort();
-        assert_eq!(names, sorted);
+        // The graph's own features first, then the scene's, each sorted.
+        let own = names
+            .iter()
+            .take_while(|n| !weft_graph::SCENE_FEATURES.contains(&n.as_str()))
+            .count();
+        assert!(own >= 2, "bloom and depth_prepass come first: {names:?}");
+        assert!(names[own..]
+            .iter()
+            .all(|n| weft_graph::SCENE_FEATURES.contains(&n.as_str())));
+        assert!(names[..own].is_sorted() && names[own..].is_sorted(), "{names:?}");
+        assert!(names[..own].iter().any(|n| n == "bloom"), "{names:?}");
+        assert!(names[own..].iter().any(|n| n == "shadow_casters"), "{names:?}");
     }
 
     #[test]
