@@ -34,6 +34,8 @@ pub enum Action {
     Graph(isize),
     /// 1-9: toggle the graph's feature with this index.
     Feature(usize),
+    /// C: print the flown camera as a `.scene` `camera` block.
+    PrintCamera,
 }
 
 /// The action of a key pressed with or without Shift.
@@ -43,6 +45,7 @@ pub fn action(code: KeyCode, shift: bool) -> Option<Action> {
         KeyCode::F12 => Some(Action::Screenshot),
         KeyCode::Space => Some(Action::Pause),
         KeyCode::KeyR => Some(Action::ResetCamera),
+        KeyCode::KeyC => Some(Action::PrintCamera),
         KeyCode::KeyG => Some(Action::Graph(if shift { -1 } else { 1 })),
         _ => FEATURE_KEYS
             .iter()
@@ -53,7 +56,7 @@ pub fn action(code: KeyCode, shift: bool) -> Option<Action> {
 
 /// Parses one `--press` entry, `FRAME:KEY`: the key is pressed before frame
 /// FRAME (counted from 0) renders. KEY is `g`, `G` (Shift+G), `1`-`9`, `f12`,
-/// `space`, `r` or `esc`.
+/// `space`, `r`, `c` or `esc`.
 pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
     let (frame, key) = text
         .split_once(':')
@@ -68,12 +71,13 @@ pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
         "f12" | "F12" => (KeyCode::F12, false),
         "space" => (KeyCode::Space, false),
         "r" => (KeyCode::KeyR, false),
+        "c" => (KeyCode::KeyC, false),
         "esc" => (KeyCode::Escape, false),
         digit => match digit.parse::<usize>() {
             Ok(n @ 1..=9) => (FEATURE_KEYS[n - 1], false),
             _ => {
                 return Err(format!(
-                    "unknown key \"{digit}\" (use g, G, 1-9, f12, space, r or esc)"
+                    "unknown key \"{digit}\" (use g, G, 1-9, f12, space, r, c or esc)"
                 ))
             }
         },
@@ -312,9 +316,15 @@ mod tests {
         assert!(names[own..]
             .iter()
             .all(|n| weft_graph::SCENE_FEATURES.contains(&n.as_str())));
-        assert!(names[..own].is_sorted() && names[own..].is_sorted(), "{names:?}");
+        assert!(
+            names[..own].is_sorted() && names[own..].is_sorted(),
+            "{names:?}"
+        );
         assert!(names[..own].iter().any(|n| n == "bloom"), "{names:?}");
-        assert!(names[own..].iter().any(|n| n == "shadow_casters"), "{names:?}");
+        assert!(
+            names[own..].iter().any(|n| n == "shadow_casters"),
+            "{names:?}"
+        );
     }
 
     #[test]

@@ -3,6 +3,7 @@
 //! screenshots, and hot reload of the graph, its shaders and the scene.
 
 mod app;
+mod camera_block;
 mod controls;
 mod fly;
 
@@ -27,6 +28,7 @@ Controls:
   G / Shift+G    next / previous graph in the graph's folder
   1-9            toggle the graph's features (listed on stdout when a graph loads)
   Space          pause / resume scene time            R       back to the scene camera
+  C              print the camera as a .scene `camera` block (world coordinates)
   F12            save a screenshot (weft-<time>-<n>.png in --screenshot-dir, path printed)
   Esc            quit
 The title shows the graph, its features, frame time, samples per pixel for a
@@ -73,7 +75,7 @@ pub struct ViewArgs {
     #[arg(long, value_parser = clap::value_parser!(Extent), requires = "frames")]
     resize_to: Option<Extent>,
     /// Press keys without a keyboard (for scripts and tests): FRAME:KEY,... where KEY
-    /// is g, G (Shift+G), 1-9, f12, space, r or esc, pressed before frame FRAME.
+    /// is g, G (Shift+G), 1-9, f12, space, r, c or esc, pressed before frame FRAME.
     #[arg(long, value_delimiter = ',', value_parser = controls::parse_press)]
     press: Vec<(u32, controls::Action)>,
     /// Save the last presented frame, as shown in the window, to this PNG on exit

@@ -581,3 +581,34 @@ fn a_progressive_graph_on_an_animated_scene_says_the_animation_restarts_it() {
     let paused = run(&["--paused"]);
     assert!(!paused.contains(hint), "{paused}");
 }
+
+/// C prints the camera as a `.scene` block; before any flying it is the
+/// scene's own camera (scenes/cornell.scene's "front": position 0 1 3.9,
+/// target 0 1 0, 40 degrees, near 0.1, far 20), with the target one unit ahead.
+#[test]
+fn c_prints_the_camera_as_a_scene_block() {
+    let x = Xvfb::start();
+    let scene = repo().join("scenes/cornell.scene");
+    let graph = repo().join("graphs/forward.ron");
+    let out = x.weft(&[
+        "view",
+        scene.to_str().expect("utf-8 path"),
+        "--graph",
+        graph.to_str().expect("utf-8 path"),
+        "--size",
+        "32x18",
+        "--frames",
+        "3",
+        "--press",
+        "1:c",
+        "--validate",
+    ]);
+    assert_clean(&out);
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains(
+            "camera \"flown\"\n{\n\tposition 0 1 3.9\n\ttarget 0 1 2.9\n\tfov_deg 40\n\tnear 0.1\n\tfar 20\n}\n"
+        ),
+        "{stdout}"
+    );
+}

@@ -287,6 +287,16 @@ impl<'g> Viewer<'g> {
                 }
             }
             Action::Feature(index) => self.toggle_feature(index),
+            Action::PrintCamera => print!(
+                "{}",
+                super::camera_block::camera_block(
+                    "flown",
+                    &self.lens,
+                    self.live.scene().origin,
+                    self.camera.position,
+                    self.camera.orientation,
+                )
+            ),
         }
     }
 
