@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use weft_gpu::PassTiming;
 use winit::keyboard::KeyCode;
 
-/// The number keys that toggle features, in order.
+/// The number keys that toggle features, in order: alone for the first nine,
+/// with Shift for the next nine.
 pub const FEATURE_KEYS: [KeyCode; 9] = [
     KeyCode::Digit1,
     KeyCode::Digit2,
@@ -32,7 +33,7 @@ pub enum Action {
     ResetCamera,
     /// G (+1) or Shift+G (-1): another graph from the graph's folder.
     Graph(isize),
-    /// 1-9: toggle the graph's feature with this index.
+    /// 1-9, then Shift+1-9: toggle the graph's feature with this index.
     Feature(usize),
     /// C: print the flown camera as a `.scene` `camera` block.
     PrintCamera,
@@ -50,13 +51,24 @@ pub fn action(code: KeyCode, shift: bool) -> Option<Action> {
         _ => FEATURE_KEYS
             .iter()
             .position(|&k| k == code)
-            .map(Action::Feature),
+            .map(|i| Action::Feature(if shift { FEATURE_KEYS.len() + i } else { i })),
+    }
+}
+
+/// The key that toggles the feature at `index`: `1`-`9`, then `Shift+1`-`Shift+9`;
+/// `None` past those.
+pub fn feature_key(index: usize) -> Option<String> {
+    let keys = FEATURE_KEYS.len();
+    match index {
+        i if i < keys => Some(format!("{}", i + 1)),
+        i if i < 2 * keys => Some(format!("Shift+{}", i - keys + 1)),
+        _ => None,
     }
 }
 
 /// Parses one `--press` entry, `FRAME:KEY`: the key is pressed before frame
-/// FRAME (counted from 0) renders. KEY is `g`, `G` (Shift+G), `1`-`9`, `f12`,
-/// `space`, `r`, `c` or `esc`.
+/// FRAME (counted from 0) renders. KEY is `g`, `G` (Shift+G), `1`-`9`,
+/// `shift+1`-`shift+9`, `f12`, `space`, `r`, `c` or `esc`.
 pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
     let (frame, key) = text
         .split_once(':')
@@ -73,14 +85,20 @@ pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
         "r" => (KeyCode::KeyR, false),
         "c" => (KeyCode::KeyC, false),
         "esc" => (KeyCode::Escape, false),
-        digit => match digit.parse::<usize>() {
-            Ok(n @ 1..=9) => (FEATURE_KEYS[n - 1], false),
-            _ => {
-                return Err(format!(
-                    "unknown key \"{digit}\" (use g, G, 1-9, f12, space, r, c or esc)"
+        other => {
+            let (digit, shift) = match other.strip_prefix("shift+") {
+                Some(digit) => (digit, true),
+                None => (other, false),
+            };
+            match digit.parse::<usize>() {
+                Ok(n @ 1..=9) => (FEATURE_KEYS[n - 1], shift),
+                _ => {
+                    return Err(format!(
+                    "unknown key \"{other}\" (use g, G, 1-9, shift+1-9, f12, space, r, c or esc)"
                 ))
+                }
             }
-        },
+        }
     };
     let action = action(code, shift).ok_or_else(|| format!("no action for \"{key}\""))?;
     Ok((frame, action))
@@ -267,11 +285,21 @@ mod tests {
         assert_eq!(action(KeyCode::KeyG, false), Some(Action::Graph(1)));
         assert_eq!(action(KeyCode::KeyG, true), Some(Action::Graph(-1)));
         assert_eq!(action(KeyCode::Digit1, false), Some(Action::Feature(0)));
-        assert_eq!(action(KeyCode::Digit9, true), Some(Action::Feature(8)));
+        assert_eq!(action(KeyCode::Digit9, true), Some(Action::Feature(17)));
         assert_eq!(action(KeyCode::F12, false), Some(Action::Screenshot));
         assert_eq!(action(KeyCode::KeyW, false), None);
         assert_eq!(parse_press("3:G"), Ok((3, Action::Graph(-1))));
         assert_eq!(parse_press("0:2"), Ok((0, Action::Feature(1))));
+        assert_eq!(parse_press("4:shift+1"), Ok((4, Action::Feature(9))));
+        assert_eq!(parse_press("4:shift+9"), Ok((4, Action::Feature(17))));
+        assert_eq!(parse_press("5:c"), Ok((5, Action::PrintCamera)));
+        assert!(parse_press("1:shift+0").is_err());
+        assert_eq!(action(KeyCode::Digit3, true), Some(Action::Feature(11)));
+        assert_eq!(feature_key(0).as_deref(), Some("1"));
+        assert_eq!(feature_key(8).as_deref(), Some("9"));
+        assert_eq!(feature_key(9).as_deref(), Some("Shift+1"));
+        assert_eq!(feature_key(17).as_deref(), Some("Shift+9"));
+        assert_eq!(feature_key(18), None);
         assert_eq!(parse_press(" 7 : f12 "), Ok((7, Action::Screenshot)));
         assert_eq!(parse_press("1:esc"), Ok((1, Action::Quit)));
         assert!(parse_press("1:0").is_err());

@@ -26,7 +26,7 @@ Controls:
   mouse drag     look (left button)                   arrows  look
   Shift          move 4x faster                       wheel   change speed (x1.25 a notch)
   G / Shift+G    next / previous graph in the graph's folder
-  1-9            toggle the graph's features (listed on stdout when a graph loads)
+  1-9, Shift+1-9 toggle the graph's features (listed with their keys when a graph loads)
   Space          pause / resume scene time            R       back to the scene camera
   C              print the camera as a .scene `camera` block (world coordinates)
   F12            save a screenshot (weft-<time>-<n>.png in --screenshot-dir, path printed)
@@ -75,7 +75,7 @@ pub struct ViewArgs {
     #[arg(long, value_parser = clap::value_parser!(Extent), requires = "frames")]
     resize_to: Option<Extent>,
     /// Press keys without a keyboard (for scripts and tests): FRAME:KEY,... where KEY
-    /// is g, G (Shift+G), 1-9, f12, space, r, c or esc, pressed before frame FRAME.
+    /// is g, G (Shift+G), 1-9, shift+1-9, f12, space, r, c or esc, pressed before frame FRAME.
     #[arg(long, value_delimiter = ',', value_parser = controls::parse_press)]
     press: Vec<(u32, controls::Action)>,
     /// Save the last presented frame, as shown in the window, to this PNG on exit

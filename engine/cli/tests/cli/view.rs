@@ -612,3 +612,42 @@ fn c_prints_the_camera_as_a_scene_block() {
         "{stdout}"
     );
 }
+
+/// Features past the ninth are reached with Shift: on the forward graph over
+/// the Cornell box, the graph's own nine take 1-9 and the scene's follow,
+/// `shadow_casters` at Shift+9, which turns it off.
+#[test]
+fn shift_and_a_digit_toggle_the_features_past_the_ninth() {
+    let x = Xvfb::start();
+    let scene = repo().join("scenes/cornell.scene");
+    let graph = repo().join("graphs/forward.ron");
+    let out = x.weft(&[
+        "view",
+        scene.to_str().expect("utf-8 path"),
+        "--graph",
+        graph.to_str().expect("utf-8 path"),
+        "--size",
+        "32x18",
+        "--frames",
+        "3",
+        "--press",
+        "1:shift+9",
+        "--validate",
+    ]);
+    assert_clean(&out);
+    let stdout = text(&out.stdout);
+    let lists: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
+    assert_eq!(lists.len(), 2, "{stdout}");
+    assert!(
+        lists[0].contains(", Shift+9 shadow_casters [on]"),
+        "{stdout}"
+    );
+    assert!(
+        lists[1].contains(", Shift+9 shadow_casters [off]"),
+        "{stdout}"
+    );
+    assert!(
+        lists[0].contains("9 screen_space_tangents [off]"),
+        "{stdout}"
+    );
+}

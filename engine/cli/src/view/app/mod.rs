@@ -204,11 +204,10 @@ impl<'g> Viewer<'g> {
         let list: Vec<String> = self
             .features
             .iter()
-            .take(controls::FEATURE_KEYS.len())
             .enumerate()
-            .map(|(i, f)| {
+            .filter_map(|(i, f)| {
                 let state = if on.contains(f) { "on" } else { "off" };
-                format!("{} {f} [{state}]", i + 1)
+                controls::feature_key(i).map(|key| format!("{key} {f} [{state}]"))
             })
             .collect();
         println!(
