@@ -582,11 +582,9 @@ fn a_progressive_graph_on_an_animated_scene_says_the_animation_restarts_it() {
     assert!(!paused.contains(hint), "{paused}");
 }
 
-/// C prints the camera as a `.scene` block; before any flying it is the
-/// scene's own camera (scenes/cornell.scene's "front": position 0 1 3.9,
-/// target 0 1 0, 40 degrees, near 0.1, far 20), with the target one unit ahead.
-#[test]
-fn c_prints_the_camera_as_a_scene_block() {
+/// Three frames of the Cornell box through the forward graph with `press`
+/// (a `--press` script), validation on and silent; what it printed.
+fn cornell_pressing(press: &str) -> String {
     let x = Xvfb::start();
     let scene = repo().join("scenes/cornell.scene");
     let graph = repo().join("graphs/forward.ron");
@@ -600,11 +598,19 @@ fn c_prints_the_camera_as_a_scene_block() {
         "--frames",
         "3",
         "--press",
-        "1:c",
+        press,
         "--validate",
     ]);
     assert_clean(&out);
-    let stdout = text(&out.stdout);
+    text(&out.stdout)
+}
+
+/// C prints the camera as a `.scene` block; before any flying it is the
+/// scene's own camera (scenes/cornell.scene's "front": position 0 1 3.9,
+/// target 0 1 0, 40 degrees, near 0.1, far 20), with the target one unit ahead.
+#[test]
+fn c_prints_the_camera_as_a_scene_block() {
+    let stdout = cornell_pressing("1:c");
     assert!(
         stdout.contains(
             "camera \"flown\"\n{\n\tposition 0 1 3.9\n\ttarget 0 1 2.9\n\tfov_deg 40\n\tnear 0.1\n\tfar 20\n}\n"
@@ -618,24 +624,7 @@ fn c_prints_the_camera_as_a_scene_block() {
 /// `shadow_casters` at Shift+9, which turns it off.
 #[test]
 fn shift_and_a_digit_toggle_the_features_past_the_ninth() {
-    let x = Xvfb::start();
-    let scene = repo().join("scenes/cornell.scene");
-    let graph = repo().join("graphs/forward.ron");
-    let out = x.weft(&[
-        "view",
-        scene.to_str().expect("utf-8 path"),
-        "--graph",
-        graph.to_str().expect("utf-8 path"),
-        "--size",
-        "32x18",
-        "--frames",
-        "3",
-        "--press",
-        "1:shift+9",
-        "--validate",
-    ]);
-    assert_clean(&out);
-    let stdout = text(&out.stdout);
+    let stdout = cornell_pressing("1:shift+9");
     let lists: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
     assert_eq!(lists.len(), 2, "{stdout}");
     assert!(
