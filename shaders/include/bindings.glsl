@@ -28,6 +28,7 @@
 #define BINDING_TRACE_DATA_1024        17 // the 1024-texel data texture array
 #define BINDING_MATERIAL_TEXTURES      18 // the materials' texture slots
 #define BINDING_TRIANGLE_TANGENTS      19 // the corners' tangents
+#define BINDING_LIGHT_CHOICES          23 // the light choice table
 
 #define MATERIAL_BASE_COLOR             0 // the base-colour texture
 #define MATERIAL_METALLIC_ROUGHNESS     1 // the metallic-roughness texture

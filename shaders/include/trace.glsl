@@ -46,6 +46,14 @@ layout(std430, set = SET_SCENE, binding = BINDING_EMITTERS) readonly buffer Emit
     uvec4 emitter_info;
     uvec4 emitters[];
 };
+// Which light next-event estimation picks (engine/render/src/light_choice.rs):
+// light_choice_info = (choices, 0, 0, 0), the analytic lights in record order
+// then, when there are emissive triangles, one choice for them; per choice
+// (alias, bits of the keep threshold, bits of its probability, 0).
+layout(std430, set = SET_SCENE, binding = BINDING_LIGHT_CHOICES) readonly buffer LightChoices {
+    uvec4 light_choice_info;
+    uvec4 light_choice_records[];
+};
 
 // Material textures (engine/render/src/trace_textures.rs): every texture is a
 // layer of one array per size class (256, 512, 1024 texels square), sRGB

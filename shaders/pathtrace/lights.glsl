@@ -25,8 +25,21 @@ uint first_area_light() {
     return frame.counts.x + frame.counts.y + frame.counts.z;
 }
 
-float light_choices() {
-    return float(frame.counts.w + (emitter_info.x > 0u ? 1u : 0u));
+// One over the probability next-event estimation picks choice `index`
+// (analytic light `index`, or the emissive triangles at index
+// frame.counts.w): the number of choices when picking uniformly, else from
+// the table (half uniform, half by power).
+float light_choice_odds(uint index, bool by_power) {
+    return by_power ? 1.0 / uintBitsToFloat(light_choice_records[index].z) : float(light_choice_info.x);
+}
+
+// A choice: the slot u.x falls in; `by_power`, kept while u.y is below its
+// threshold, else its alias.
+uint pick_light(vec2 u, bool by_power) {
+    uint count = light_choice_info.x;
+    uint slot = min(uint(u.x * float(count)), count - 1u);
+    uvec4 choice = light_choice_records[slot];
+    return (!by_power || u.y < uintBitsToFloat(choice.y)) ? slot : choice.x;
 }
 
 struct LightSample {
@@ -117,13 +130,12 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
 
 // Picks a light and a point on it for a surface at p with normal n. False
 // when there is no light or it sends nothing towards p.
-bool sample_light(vec3 p, vec3 n, vec4 u_pick, vec4 u_point, out LightSample ls) {
-    float choices = light_choices();
-    if (choices == 0.0) {
+bool sample_light(vec3 p, vec3 n, vec4 u_pick, vec4 u_point, bool by_power, out LightSample ls) {
+    if (light_choice_info.x == 0u) {
         return false;
     }
-    uint pick = min(uint(u_pick.x * choices), uint(choices) - 1u);
-    float p_select = 1.0 / choices;
+    uint pick = pick_light(u_pick.xy, by_power);
+    float p_select = 1.0 / light_choice_odds(pick, by_power);
 #ifdef SCENE_EMISSIVE
     if (pick >= frame.counts.w) {
         return sample_emitter(p, u_point, p_select, ls);
@@ -184,10 +196,10 @@ int hit_area_light(vec3 origin, vec3 dir, inout float t) {
 
 // Radiance area light `index` sends back along a ray `dir` that met it at
 // distance t, and in `pdf` the density NEE would have picked that point with.
-vec3 area_emitted(uint index, vec3 dir, float t, out float pdf) {
+vec3 area_emitted(uint index, vec3 dir, float t, bool by_power, out float pdf) {
     AreaOutline o = area_outline(index, vec3(0.0));
     float cos_light = area_cosine(o, dir);
-    pdf = cos_light > 0.0 ? t * t / (light_choices() * cos_light * outline_area(o)) : 0.0;
+    pdf = cos_light > 0.0 ? t * t / (light_choice_odds(index, by_power) * cos_light * outline_area(o)) : 0.0;
     return cos_light > 0.0 ? lights[index].color_exponent.rgb : vec3(0.0);
 }
 

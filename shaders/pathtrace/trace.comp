@@ -24,6 +24,9 @@
 // camera does not see that sky (as with Mitsuba's hide_emitters), so the
 // background stays black as in the raster graphs.
 //
+// `light_choice` 0 picks the light NEE samples uniformly; 1 half uniformly,
+// half by its power (engine/render/src/light_choice.rs).
+//
 // `sampling` chooses how lights with area are found: 0 combines NEE and BSDF
 // sampling by MIS; 1 is NEE only (a BSDF-sampled ray that finds such a light
 // adds nothing); 2 is BSDF sampling only (no NEE towards them). All three
@@ -61,6 +64,7 @@ layout(push_constant) uniform Params {
     uint sampling;
     uint fresnel;
     uint nee_through_glass;
+    uint light_choice;
     uint history_frames;
     uint repeat_index;
 } params;
@@ -163,7 +167,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         int area = hit_area_light(origin, dir, t);
         if (area >= 0) {
             float light_pdf;
-            vec3 emitted = area_emitted(uint(area), dir, t, light_pdf);
+            vec3 emitted = area_emitted(uint(area), dir, t, params.light_choice != 0u, light_pdf);
             radiance += throughput * emitted * found_weight(counted_fully, bsdf_pdf, light_pdf);
             break;
         }
@@ -189,7 +193,8 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
 #ifdef SCENE_EMISSIVE
         if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
             float cos_light = dot(s.geometric_normal, wo);
-            float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t / (light_choices() * cos_light);
+            float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t
+                / (light_choice_odds(frame.counts.w, params.light_choice != 0u) * cos_light);
             radiance += throughput * emitted_at(s.material, s.uv) * found_weight(counted_fully, bsdf_pdf, light_pdf);
         }
 #endif
@@ -241,7 +246,8 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         vec4 u_point = rng_next(rng);
         LightSample ls;
         if (b.p_specular < 1.0 || b.model != SHADING_MIRROR) {
-            bool found = sample_light(s.position, n, u_pick, u_point, ls) && dot(ls.direction, ng) > 0.0;
+            bool found = sample_light(s.position, n, u_pick, u_point, params.light_choice != 0u, ls)
+                && dot(ls.direction, ng) > 0.0;
             if (found && (ls.pdf == 0.0 || params.sampling != SAMPLING_BSDF)) {
                 float pdf;
                 vec3 f = bsdf_eval(b, n, wo, ls.direction, pdf);

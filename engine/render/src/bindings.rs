@@ -92,6 +92,9 @@ pub const LTC_TABLES_BINDING: u32 = 20;
 pub const VERTICES_BINDING: u32 = 21;
 /// Binding of the index buffer (`Indices` in `shaders/include/mesh_data.glsl`).
 pub const INDICES_BINDING: u32 = 22;
+/// Binding of the table next-event estimation picks a light from
+/// (`LightChoices`, [`crate::light_choice::LightChoices`]).
+pub const LIGHT_CHOICES_BINDING: u32 = 23;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -157,7 +160,7 @@ pub const SCENE_SET_BINDINGS: [SceneBinding; 8] = [
 /// Set 1 bindings for ray tracing: built only when a compute pass that
 /// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
-pub const TRACE_SET_BINDINGS: [SceneBinding; 15] = [
+pub const TRACE_SET_BINDINGS: [SceneBinding; 16] = [
     tracing(
         "TRIANGLES",
         TRIANGLES_BINDING,
@@ -247,6 +250,12 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 15] = [
         TRIANGLE_TANGENTS_BINDING,
         DescriptorKind::StorageBuffer,
         "the corners' tangents",
+    ),
+    tracing(
+        "LIGHT_CHOICES",
+        LIGHT_CHOICES_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the light choice table",
     ),
 ];
 /// Set 2 as the engine creates it: a material's textures, in the order of its

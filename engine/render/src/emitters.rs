@@ -62,7 +62,7 @@ impl EmitterTable {
 /// an alias, so that picking a slot uniformly and keeping it when a uniform
 /// number is below its threshold (else taking its alias) picks slot `i` with
 /// probability `weights[i] / sum`.
-fn alias_table(weights: &[f64]) -> (Vec<f32>, Vec<u32>) {
+pub(crate) fn alias_table(weights: &[f64]) -> (Vec<f32>, Vec<u32>) {
     let n = weights.len();
     let total: f64 = weights.iter().sum();
     let mut scaled: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();

@@ -39,6 +39,7 @@ mod gaussian;
 mod geometry;
 mod gpu_types;
 mod graph_check;
+mod light_choice;
 mod lights;
 mod materials;
 mod optics;

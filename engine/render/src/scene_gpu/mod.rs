@@ -382,7 +382,13 @@ impl<'g> GpuScene<'g> {
     fn ensure_trace_buffers(&mut self) -> Result<(), GpuError> {
         if self.trace.is_none() {
             let cache = self.bvh_cache.as_deref().filter(|_| !self.moved);
-            let built = TraceBuffers::build(self.gpu, &self.geometry, cache, &mut self.warnings)?;
+            let built = TraceBuffers::build(
+                self.gpu,
+                &self.geometry,
+                cache,
+                (&self.light_set, scene_radius(&self.bounds)),
+                &mut self.warnings,
+            )?;
             self.trace = Some(built);
         }
         Ok(())
@@ -468,6 +474,9 @@ impl<'g> GpuScene<'g> {
             let offset = changed.start * std::mem::size_of::<GpuLight>();
             self.lights
                 .write_at(offset, bytes_of(&lights.records[changed]))?;
+            if let Some(trace) = self.trace.as_mut() {
+                trace.update_light_choices(&lights, scene_radius(&bounds))?;
+            }
         }
         let mut inputs = std::collections::hash_map::DefaultHasher::new();
         std::hash::Hash::hash(bytes_of(&[frame]), &mut inputs);
@@ -539,5 +548,15 @@ impl Drop for GpuScene<'_> {
     /// the device must have finished with them first.
     fn drop(&mut self) {
         let _ = self.gpu.wait_idle();
+    }
+}
+
+/// The radius a sun's light choice is sized by: half the scene's diagonal,
+/// 1 for an empty scene.
+fn scene_radius(bounds: &weft_scene::Aabb) -> f32 {
+    if bounds.is_empty() {
+        1.0
+    } else {
+        (0.5 * bounds.diagonal()).max(f32::MIN_POSITIVE)
     }
 }

@@ -1,11 +1,14 @@
 //! The ray tracer's scene data on the device, built when a pass first traces:
 //! world-space triangles, the BVH over them (in its 4-wide form), per-corner normals, tangents and
-//! UVs, per-triangle materials, the emitters' alias table and the texture
-//! arrays (set 1's tracing-only bindings, [`crate::bindings::TRACE_SET_BINDINGS`]).
+//! UVs, per-triangle materials, the emitters' alias table, the lights' choice
+//! table and the texture arrays (set 1's tracing-only bindings,
+//! [`crate::bindings::TRACE_SET_BINDINGS`]).
 
 use crate::bindings::*;
 use crate::geometry::SceneGeometry;
 use crate::gpu_types::bytes_of;
+use crate::light_choice::LightChoices;
+use crate::lights::LightSet;
 use ash::vk;
 use std::path::Path;
 use weft_gpu::buffer::Buffer;
@@ -22,6 +25,10 @@ pub(super) struct TraceBuffers<'g> {
     pub(super) uvs: Buffer<'g>,
     pub(super) materials: Buffer<'g>,
     pub(super) emitters: Buffer<'g>,
+    /// Which light NEE samples ([`LightChoices`]), rewritten when lights change.
+    pub(super) light_choices: Buffer<'g>,
+    /// The emissive triangles' power as one light choice, `None` without any.
+    emitter_power: Option<f32>,
     /// Colour arrays by class, then data arrays by class.
     pub(super) textures: Vec<Texture<'g>>,
     pub(super) material_textures: Buffer<'g>,
@@ -29,12 +36,14 @@ pub(super) struct TraceBuffers<'g> {
 
 impl<'g> TraceBuffers<'g> {
     /// Builds the BVH over `geometry`'s triangles (read from and stored in
-    /// `cache` when given) and uploads it with them; what went wrong on the
-    /// way is added to `warnings`.
+    /// `cache` when given) and uploads it with them and the choice table over
+    /// `lights` (a scene of radius `scene_radius`); what went wrong on the way
+    /// is added to `warnings`.
     pub(super) fn build(
         gpu: &'g Gpu,
         geometry: &SceneGeometry,
         cache: Option<&Path>,
+        (lights, scene_radius): (&LightSet, f32),
         warnings: &mut Vec<String>,
     ) -> Result<Self, GpuError> {
         let mesh = geometry.trace_mesh();
@@ -59,6 +68,10 @@ impl<'g> TraceBuffers<'g> {
         let emitters = crate::emitters::EmitterTable::build(&mesh.corners, |t| {
             crate::sanitize::radiance(geometry.materials[mesh.materials[t] as usize].emissive)
         });
+        // Luminance times area, summed; π times that is their power.
+        let emitter_power =
+            (!emitters.records.is_empty()).then_some(std::f32::consts::PI * emitters.total);
+        let choices = light_choices(lights, emitter_power, scene_radius);
         let trace_textures = crate::trace_textures::gather(&geometry.materials);
         warnings.extend(trace_textures.warnings.iter().cloned());
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
@@ -86,6 +99,13 @@ impl<'g> TraceBuffers<'g> {
                 storage,
             )?,
             emitters: Buffer::device_local(gpu, "emitters", &emitters.bytes(), storage)?,
+            light_choices: {
+                let bytes = choices.bytes();
+                let mut buffer = Buffer::host(gpu, "light choices", bytes.len() as u64, storage)?;
+                buffer.write(&bytes)?;
+                buffer
+            },
+            emitter_power,
             textures: trace_textures
                 .colour
                 .iter()
@@ -110,6 +130,17 @@ impl<'g> TraceBuffers<'g> {
         })
     }
 
+    /// Rewrites the light choice table for `lights` as they are now (the
+    /// count of lights never changes: animation moves and recolours them).
+    pub(super) fn update_light_choices(
+        &mut self,
+        lights: &LightSet,
+        scene_radius: f32,
+    ) -> Result<(), GpuError> {
+        let choices = light_choices(lights, self.emitter_power, scene_radius);
+        self.light_choices.write(&choices.bytes())
+    }
+
     /// The buffer behind a tracing-only set 1 binding.
     pub(super) fn buffer(&self, binding: u32) -> Option<&Buffer<'g>> {
         match binding {
@@ -121,8 +152,19 @@ impl<'g> TraceBuffers<'g> {
             TRIANGLE_UVS_BINDING => Some(&self.uvs),
             TRIANGLE_MATERIALS_BINDING => Some(&self.materials),
             EMITTERS_BINDING => Some(&self.emitters),
+            LIGHT_CHOICES_BINDING => Some(&self.light_choices),
             MATERIAL_TEXTURES_BINDING => Some(&self.material_textures),
             _ => None,
         }
     }
+}
+
+/// The choice table over `lights`' analytic records (the emissive polygons
+/// after them are the raster path's; the tracer samples the triangles).
+fn light_choices(lights: &LightSet, emitter_power: Option<f32>, scene_radius: f32) -> LightChoices {
+    LightChoices::build(
+        &lights.records[..lights.len() as usize],
+        emitter_power,
+        scene_radius,
+    )
 }

@@ -1,0 +1,198 @@
+//! Which light next-event estimation samples (`LightChoices` in
+//! `shaders/include/trace.glsl`): one choice per analytic light in record
+//! order, then one for "an emissive triangle" when the scene has any. A
+//! choice is picked with probability half uniform, half in proportion to an
+//! estimate of the power it emits, through an alias table (Vose).
+//!
+//! The estimate only has to be positive for the estimator to stay unbiased;
+//! the better it follows what reaches the camera, the less noise. Uniform
+//! choice wastes samples on dim lights where one light dominates; pure power
+//! choice starves a dim light that is the only one near what the camera sees.
+//! The even mixture keeps every light at least half its uniform share, so no
+//! light's noise grows more than twofold, while bright lights get most of the
+//! samples.
+
+use crate::emitters::{alias_table, luminance};
+use crate::gpu_types::GpuLight;
+use crate::lights::{AREA_DISC, AREA_RECT, POINT, SPOT_CONE, SPOT_SPHERE, SUN};
+use std::f32::consts::PI;
+
+/// Share of the probability spread evenly over the choices.
+const UNIFORM_SHARE: f64 = 0.5;
+
+/// The alias table the shaders read.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LightChoices {
+    /// Per choice: alias, threshold below which the choice itself is kept
+    /// (f32 bits), the probability of the choice (f32 bits), 0.
+    pub records: Vec<[u32; 4]>,
+}
+
+impl LightChoices {
+    /// The table over `lights` (the analytic light records, suns to area
+    /// lights) and, when `emitter_power` is given, the emissive triangles as
+    /// one more choice; `scene_radius` sizes a sun's power.
+    pub fn build(lights: &[GpuLight], emitter_power: Option<f32>, scene_radius: f32) -> Self {
+        let powers: Vec<f64> = lights
+            .iter()
+            .map(|l| f64::from(power(l, scene_radius)))
+            .chain(emitter_power.map(|p| f64::from(p.max(0.0))))
+            .map(|p| if p.is_finite() { p } else { 0.0 })
+            .collect();
+        let probabilities = mixture(&powers);
+        let (threshold, alias) = alias_table(&probabilities);
+        let records = probabilities
+            .iter()
+            .zip(threshold.iter().zip(&alias))
+            .map(|(&p, (&t, &a))| [a, t.to_bits(), (p as f32).to_bits(), 0])
+            .collect();
+        Self { records }
+    }
+
+    /// The GPU buffer: a header (choice count, 0, 0, 0), then the records.
+    pub fn bytes(&self) -> Vec<u8> {
+        let header = [self.records.len() as u32, 0, 0, 0];
+        std::iter::once(header)
+            .chain(self.records.iter().copied())
+            .flat_map(|r| r.into_iter().flat_map(u32::to_ne_bytes))
+            .collect()
+    }
+}
+
+/// Each choice's probability: [`UNIFORM_SHARE`] spread evenly, the rest in
+/// proportion to `powers` (all even when they sum to nothing).
+fn mixture(powers: &[f64]) -> Vec<f64> {
+    let n = powers.len() as f64;
+    let total: f64 = powers.iter().sum();
+    powers
+        .iter()
+        .map(|&p| {
+            if total > 0.0 && total.is_finite() {
+                UNIFORM_SHARE / n + (1.0 - UNIFORM_SHARE) * p / total
+            } else {
+                1.0 / n
+            }
+        })
+        .collect()
+}
+
+/// An estimate of the luminous power a light record emits, in the path
+/// tracer's units (docs/pathtrace.md, "Lights and units"): a point light of
+/// colour C gives irradiance π C at unit attenuation, so intensity π C and
+/// power 4π² C; a spot, its cone's share of that; a sun, irradiance π C over
+/// the scene's cross-section π r²; an area light, π L A per emitting face.
+/// Attenuation and cutoff ranges are left out.
+pub fn power(light: &GpuLight, scene_radius: f32) -> f32 {
+    let colour = luminance(light.color_exponent.truncate()).max(0.0);
+    let kind = light.direction_type.w;
+    if kind == SUN {
+        PI * colour * PI * scene_radius * scene_radius
+    } else if kind == POINT {
+        4.0 * PI * PI * colour
+    } else if kind == SPOT_CONE || kind == SPOT_SPHERE {
+        let cos_cutoff = light.attenuation_cos.w.clamp(-1.0, 1.0);
+        2.0 * PI * (1.0 - cos_cutoff) * PI * colour
+    } else if kind == AREA_RECT || kind == AREA_DISC {
+        let (x, y) = (
+            light.direction_type.truncate().length(),
+            light.attenuation_cos.truncate().length(),
+        );
+        let area = if kind == AREA_DISC { PI } else { 4.0 } * x * y;
+        let faces = if light.color_exponent.w != 0.0 {
+            2.0
+        } else {
+            1.0
+        };
+        PI * colour * area * faces
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Vec3, Vec4};
+
+    fn light(kind: f32, colour: f32) -> GpuLight {
+        GpuLight {
+            position_range: Vec4::ZERO,
+            direction_type: Vec3::Y.extend(kind),
+            color_exponent: Vec4::new(colour, colour, colour, 0.0),
+            attenuation_cos: Vec4::new(0.0, 0.0, 1.0, 0.5),
+        }
+    }
+
+    /// The probability the table gives each choice: its own threshold share
+    /// plus the shares of every choice that aliases to it.
+    fn picked(table: &LightChoices) -> Vec<f64> {
+        let n = table.records.len() as f64;
+        let mut p = vec![0.0; table.records.len()];
+        for (i, r) in table.records.iter().enumerate() {
+            let keep = f64::from(f32::from_bits(r[1]));
+            p[i] += keep / n;
+            p[r[0] as usize] += (1.0 - keep) / n;
+        }
+        p
+    }
+
+    #[test]
+    fn the_table_picks_each_choice_with_its_stored_probability() {
+        let lights = [
+            light(POINT, 1.0),
+            light(POINT, 100.0),
+            light(SPOT_CONE, 3.0),
+            light(SUN, 0.1),
+        ];
+        let table = LightChoices::build(&lights, Some(50.0), 10.0);
+        assert_eq!(table.records.len(), 5);
+        let stored: Vec<f64> = table
+            .records
+            .iter()
+            .map(|r| f64::from(f32::from_bits(r[2])))
+            .collect();
+        for (p, s) in picked(&table).iter().zip(&stored) {
+            assert!((p - s).abs() < 1e-6, "{p} vs {s}");
+        }
+        assert!((stored.iter().sum::<f64>() - 1.0).abs() < 1e-6);
+        // Half spread evenly: no choice below half its uniform share.
+        assert!(stored.iter().all(|&p| p >= 0.5 / 5.0 - 1e-7), "{stored:?}");
+        // The bright point light gets most of the rest.
+        assert!(stored[1] > 0.4 && stored[1] > stored[0] * 3.0, "{stored:?}");
+    }
+
+    #[test]
+    fn equal_or_powerless_lights_are_chosen_evenly() {
+        let same = LightChoices::build(&[light(POINT, 2.0), light(POINT, 2.0)], None, 1.0);
+        let dark = LightChoices::build(&[light(POINT, 0.0), light(POINT, f32::NAN)], None, 1.0);
+        for table in [same, dark] {
+            for r in &table.records {
+                assert_eq!(f32::from_bits(r[2]), 0.5);
+            }
+        }
+        assert!(LightChoices::build(&[], None, 1.0).records.is_empty());
+    }
+
+    #[test]
+    fn powers_follow_the_path_tracers_units() {
+        // A point light of colour 1: intensity π, power 4π².
+        assert!((power(&light(POINT, 1.0), 1.0) - 4.0 * PI * PI).abs() < 1e-4);
+        // A spot of half-angle 60° (cos 0.5) emits a quarter of that.
+        assert!((power(&light(SPOT_CONE, 1.0), 1.0) - PI * PI).abs() < 1e-4);
+        // A one-sided 2 x 1 rectangle of radiance 1 (half axes 1 and 0.5): π A.
+        let rect = GpuLight {
+            position_range: Vec4::ZERO,
+            direction_type: Vec3::X.extend(AREA_RECT),
+            color_exponent: Vec4::new(1.0, 1.0, 1.0, 0.0),
+            attenuation_cos: (Vec3::Y * 0.5).extend(0.0),
+        };
+        assert!((power(&rect, 1.0) - 2.0 * PI).abs() < 1e-5);
+        let two_sided = GpuLight {
+            color_exponent: Vec4::new(1.0, 1.0, 1.0, 1.0),
+            ..rect
+        };
+        assert!((power(&two_sided, 1.0) - 4.0 * PI).abs() < 1e-5);
+        // A sun of colour 1 over a scene of radius 2: π · π 2².
+        assert!((power(&light(SUN, 1.0), 2.0) - 4.0 * PI * PI).abs() < 1e-4);
+    }
+}
