@@ -555,40 +555,21 @@ fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
 /// paused from the start (then the image converges).
 #[test]
 fn a_progressive_graph_on_an_animated_scene_says_the_animation_restarts_it() {
-    let x = Xvfb::start();
-    let scene = repo().join("scenes/animation.scene");
-    let graph = repo().join("graphs/pathtrace.ron");
-    let run = |extra: &[&str]| {
-        let mut args = vec![
-            "view",
-            scene.to_str().expect("utf-8 path"),
-            "--graph",
-            graph.to_str().expect("utf-8 path"),
-            "--size",
-            "32x18",
-            "--frames",
-            "8",
-            "--validate",
-        ];
-        args.extend_from_slice(extra);
-        let out = x.weft(&args);
-        assert_clean(&out);
-        text(&out.stdout)
-    };
     let hint = "progressive image restarts every frame: the scene animates; Space pauses time";
-    let running = run(&[]);
+    let running = view_32x18("animation.scene", "pathtrace.ron", 8, &[]);
     assert_eq!(running.matches(hint).count(), 1, "{running}");
-    let paused = run(&["--paused"]);
+    let paused = view_32x18("animation.scene", "pathtrace.ron", 8, &["--paused"]);
     assert!(!paused.contains(hint), "{paused}");
 }
 
-/// Three frames of the Cornell box through the forward graph with `press`
-/// (a `--press` script), validation on and silent; what it printed.
-fn cornell_pressing(press: &str) -> String {
+/// `frames` frames at 32x18 of `scenes/SCENE` through `graphs/GRAPH` with
+/// `extra` arguments, validation on and silent; what it printed.
+fn view_32x18(scene: &str, graph: &str, frames: u32, extra: &[&str]) -> String {
     let x = Xvfb::start();
-    let scene = repo().join("scenes/cornell.scene");
-    let graph = repo().join("graphs/forward.ron");
-    let out = x.weft(&[
+    let scene = repo().join("scenes").join(scene);
+    let graph = repo().join("graphs").join(graph);
+    let frames = frames.to_string();
+    let mut args = vec![
         "view",
         scene.to_str().expect("utf-8 path"),
         "--graph",
@@ -596,13 +577,19 @@ fn cornell_pressing(press: &str) -> String {
         "--size",
         "32x18",
         "--frames",
-        "3",
-        "--press",
-        press,
+        &frames,
         "--validate",
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let out = x.weft(&args);
     assert_clean(&out);
     text(&out.stdout)
+}
+
+/// Three frames of the Cornell box through the forward graph with `press`
+/// (a `--press` script).
+fn cornell_pressing(press: &str) -> String {
+    view_32x18("cornell.scene", "forward.ron", 3, &["--press", press])
 }
 
 /// C prints the camera as a `.scene` block; before any flying it is the
