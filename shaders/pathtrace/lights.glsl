@@ -7,8 +7,10 @@
 // surface shows C, as the raster path's Kd N.L shading does); area lights and
 // emissive triangles (MTL Ke, glTF emissive) emit radiance equal to their
 // colour (times the emissive texture, emitted_at), from their front. A point in a light's plane gets nothing from it. A light is chosen
-// uniformly among the scene's lights plus, when the scene has any, the set of
-// emissive triangles; within that set a triangle is chosen by power.
+// among the scene's lights plus, when the scene has any, the set of emissive
+// triangles: uniformly, or half uniformly and half by power with the graph's
+// `light_choice` 1 (the LightChoices table); within that set a triangle is
+// chosen by power.
 // Area lights are sampled uniformly by area. They are not in the BVH; rays
 // (BSDF-sampled and shadow rays alike) test them one by one, and they are
 // opaque: a light's back and a light between a point and another light
