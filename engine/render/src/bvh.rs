@@ -383,44 +383,43 @@ pub fn intersect_edges(a: Vec3, e1: Vec3, e2: Vec3, origin: Vec3, dir: Vec3) -> 
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
+/// Random triangle soups and brute-force hits, for the tests of both BVH forms.
+#[cfg(test)]
+pub(crate) mod test_scenes {
+    use super::intersect;
+    use glam::Vec3;
+    use weft_scene::rng::Rng;
 
-    /// A small deterministic generator (PCG32), so the tests need no crate.
-    struct Pcg(u64);
-
-    impl Pcg {
-        fn next(&mut self) -> f32 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let x = (((self.0 >> 18) ^ self.0) >> 27) as u32;
-            let r = (self.0 >> 59) as u32;
-            x.rotate_right(r) as f32 / u32::MAX as f32
-        }
-
-        fn point(&mut self, scale: f32) -> Vec3 {
-            Vec3::new(self.next(), self.next(), self.next()) * scale
-        }
+    /// A point in the cube [0, scale)³.
+    pub(crate) fn point(rng: &mut Rng, scale: f32) -> Vec3 {
+        Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * scale
     }
 
-    fn soup(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
-        let mut rng = Pcg(seed);
+    /// `n` small random triangles in a 10-unit cube.
+    pub(crate) fn soup(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
+        let mut rng = Rng::new(seed);
         (0..n)
             .map(|_| {
-                let c = rng.point(10.0);
-                [c, c + rng.point(0.8), c + rng.point(0.8)]
+                let c = point(&mut rng, 10.0);
+                [c, c + point(&mut rng, 0.8), c + point(&mut rng, 0.8)]
             })
             .collect()
     }
 
-    fn brute_force(tris: &[[Vec3; 3]], origin: Vec3, dir: Vec3) -> Option<(f32, u32)> {
+    /// The nearest hit over every triangle: (t, triangle index).
+    pub(crate) fn brute_force(tris: &[[Vec3; 3]], origin: Vec3, dir: Vec3) -> Option<(f32, u32)> {
         tris.iter()
             .enumerate()
             .filter_map(|(i, t)| intersect(t, origin, dir).map(|d| (d, i as u32)))
             .min_by(|a, b| a.0.total_cmp(&b.0))
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_scenes::{brute_force, point, soup};
+    use super::*;
+    use weft_scene::rng::Rng;
 
     #[test]
     fn every_triangle_is_in_exactly_one_leaf_and_boxes_nest() {
@@ -455,11 +454,11 @@ mod tests {
     fn closest_hits_equal_brute_force_on_random_rays() {
         let tris = soup(2000, 2);
         let bvh = Bvh::build(&tris);
-        let mut rng = Pcg(3);
+        let mut rng = Rng::new(3);
         let mut hits = 0;
         for _ in 0..2000 {
-            let origin = rng.point(14.0) - Vec3::splat(2.0);
-            let dir = (rng.point(2.0) - Vec3::ONE).normalize_or(Vec3::X);
+            let origin = point(&mut rng, 14.0) - Vec3::splat(2.0);
+            let dir = (point(&mut rng, 2.0) - Vec3::ONE).normalize_or(Vec3::X);
             let expected = brute_force(&tris, origin, dir);
             let got = bvh.closest_hit(&tris, origin, dir, f32::INFINITY);
             match (expected, got) {

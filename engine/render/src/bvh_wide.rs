@@ -313,29 +313,8 @@ fn slot_area(node: &GpuWideNode, slot: usize) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::intersect;
+    use crate::bvh::test_scenes::{brute_force, point, soup};
     use weft_scene::rng::Rng;
-
-    fn point(rng: &mut Rng, scale: f32) -> Vec3 {
-        Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * scale
-    }
-
-    fn soup(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
-        let mut rng = Rng::new(seed);
-        (0..n)
-            .map(|_| {
-                let c = point(&mut rng, 10.0);
-                [c, c + point(&mut rng, 0.8), c + point(&mut rng, 0.8)]
-            })
-            .collect()
-    }
-
-    fn brute_force(tris: &[[Vec3; 3]], origin: Vec3, dir: Vec3) -> Option<(f32, u32)> {
-        tris.iter()
-            .enumerate()
-            .filter_map(|(i, t)| intersect(t, origin, dir).map(|d| (d, i as u32)))
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-    }
 
     fn slot_box(node: &GpuWideNode, slot: usize) -> (Vec3, Vec3) {
         (
