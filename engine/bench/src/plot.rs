@@ -5,7 +5,7 @@
 //! crate) rather than found through system font discovery, so the output
 //! depends on neither fontconfig nor a distribution's font path.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
@@ -131,11 +131,14 @@ pub fn write_png(plot: &LinePlot, path: &Path, width: u32, height: u32) -> Resul
         }
         root.present()?;
     }
-    // Encoded with the image crate the rest of weft uses, not plotters' own.
-    image::RgbImage::from_raw(width, height, buffer)
-        .context("the plot's buffer has the plot's size")?
-        .save(path)
-        .with_context(|| format!("writing {}", path.display()))
+    // Encoded as every weft PNG is, not with plotters' own encoder.
+    weft_compare::SrgbImage {
+        width,
+        height,
+        bytes: buffer,
+    }
+    .write_png(path)?;
+    Ok(())
 }
 
 /// Draws the mesh, axis labels, every series with markers, and the legend.
