@@ -40,8 +40,11 @@ float light_choice_odds(uint index, bool by_power) {
 uint pick_light(vec2 u, bool by_power) {
     uint count = light_choice_info.x;
     uint slot = min(uint(u.x * float(count)), count - 1u);
+    if (!by_power) {
+        return slot;
+    }
     uvec4 choice = light_choice_records[slot];
-    return (!by_power || u.y < uintBitsToFloat(choice.y)) ? slot : choice.x;
+    return u.y < uintBitsToFloat(choice.y) ? slot : choice.x;
 }
 
 struct LightSample {

@@ -155,6 +155,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
     // Beer-Lambert coefficient of the medium the ray travels in: a
     // dielectric's `absorption` after refracting into it, 0 in air.
     vec3 medium = vec3(0.0);
+    bool by_power = params.light_choice != 0u;
     for (uint depth = 1u; depth <= params.max_depth; ++depth) {
         // A path whose throughput is zero (a black surface, or absorption
         // that underflowed) can add nothing more: without Russian roulette
@@ -167,7 +168,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         int area = hit_area_light(origin, dir, t);
         if (area >= 0) {
             float light_pdf;
-            vec3 emitted = area_emitted(uint(area), dir, t, params.light_choice != 0u, light_pdf);
+            vec3 emitted = area_emitted(uint(area), dir, t, by_power, light_pdf);
             radiance += throughput * emitted * found_weight(counted_fully, bsdf_pdf, light_pdf);
             break;
         }
@@ -194,7 +195,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
             float cos_light = dot(s.geometric_normal, wo);
             float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t
-                / (light_choice_odds(frame.counts.w, params.light_choice != 0u) * cos_light);
+                / (light_choice_odds(frame.counts.w, by_power) * cos_light);
             radiance += throughput * emitted_at(s.material, s.uv) * found_weight(counted_fully, bsdf_pdf, light_pdf);
         }
 #endif
@@ -246,7 +247,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         vec4 u_point = rng_next(rng);
         LightSample ls;
         if (b.p_specular < 1.0 || b.model != SHADING_MIRROR) {
-            bool found = sample_light(s.position, n, u_pick, u_point, params.light_choice != 0u, ls)
+            bool found = sample_light(s.position, n, u_pick, u_point, by_power, ls)
                 && dot(ls.direction, ng) > 0.0;
             if (found && (ls.pdf == 0.0 || params.sampling != SAMPLING_BSDF)) {
                 float pdf;
