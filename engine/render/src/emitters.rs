@@ -50,12 +50,19 @@ impl EmitterTable {
 
     /// The GPU buffer: a header (count, total as f32 bits, 0, 0), then the records.
     pub fn bytes(&self) -> Vec<u8> {
-        let header = [self.records.len() as u32, self.total.to_bits(), 0, 0];
-        std::iter::once(header)
-            .chain(self.records.iter().copied())
-            .flat_map(|r| r.into_iter().flat_map(u32::to_ne_bytes))
-            .collect()
+        table_bytes(
+            [self.records.len() as u32, self.total.to_bits(), 0, 0],
+            &self.records,
+        )
     }
+}
+
+/// An alias table's GPU buffer: a `uvec4` header, then a `uvec4` per record.
+pub(crate) fn table_bytes(header: [u32; 4], records: &[[u32; 4]]) -> Vec<u8> {
+    std::iter::once(header)
+        .chain(records.iter().copied())
+        .flat_map(|r| r.into_iter().flat_map(u32::to_ne_bytes))
+        .collect()
 }
 
 /// Vose's alias method: for `n` weights, per slot a threshold in [0, 1] and

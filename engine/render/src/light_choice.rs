@@ -12,7 +12,7 @@
 //! light's noise grows more than twofold, while bright lights get most of the
 //! samples.
 
-use crate::emitters::{alias_table, luminance};
+use crate::emitters::{alias_table, luminance, table_bytes};
 use crate::gpu_types::GpuLight;
 use crate::lights::{AREA_DISC, AREA_RECT, POINT, SPOT_CONE, SPOT_SPHERE, SUN};
 use std::f32::consts::PI;
@@ -51,11 +51,7 @@ impl LightChoices {
 
     /// The GPU buffer: a header (choice count, 0, 0, 0), then the records.
     pub fn bytes(&self) -> Vec<u8> {
-        let header = [self.records.len() as u32, 0, 0, 0];
-        std::iter::once(header)
-            .chain(self.records.iter().copied())
-            .flat_map(|r| r.into_iter().flat_map(u32::to_ne_bytes))
-            .collect()
+        table_bytes([self.records.len() as u32, 0, 0, 0], &self.records)
     }
 }
 
