@@ -55,7 +55,7 @@ def errors(image, reference):
     return float(mean_flip), rel_mse
 
 
-def mitsuba_for(seconds, scene, chunk, size):
+def mitsuba_for(seconds, scene, chunk):
     """Mitsuba's mean image over as many `chunk`-spp renders as fit in `seconds`."""
     total, spp, seed = None, 0, 1
     started = time.perf_counter()
@@ -123,7 +123,7 @@ def main():
         results = {(who, b): [] for who in ("mitsuba", "weft") for b in budgets}
         for round_index in range(args.rounds):
             for budget in budgets:
-                image, spp, took = mitsuba_for(budget, scene, args.chunk, args.size)
+                image, spp, took = mitsuba_for(budget, scene, args.chunk)
                 results[("mitsuba", budget)].append((spp, took) + errors(image, reference))
                 out = os.path.join(args.out, f"weft_{budget:g}s.exr")
                 image, spp = weft_for(budget, args.weft, args.graph, args.size, out)
