@@ -1,17 +1,20 @@
-//! FLIP (Andersson et al. 2020, 2021): LDR-FLIP through NVIDIA's own C++
-//! (the `nv-flip` crate) and HDR-FLIP built on it the way the reference
-//! implementation builds it: the reference's exposure range from its
-//! luminance, then at each exposure both images exposed, tonemapped with
-//! FLIP's ACES fit, clamped, and compared by LDR-FLIP, keeping each pixel's
-//! largest error. `nv-flip` takes 8-bit sRGB, so each exposure is quantised
-//! to bytes before it is compared; tests hold the result to the reference
-//! implementation's (`flip-evaluator` 1.7) values.
+//! FLIP (Andersson et al. 2020, 2021): LDR-FLIP on float images
+//! ([`ldr`], in [`colour`]'s spaces) and HDR-FLIP built on it the way the
+//! reference implementation builds it: the reference's exposure range from
+//! its luminance, then at each exposure both images exposed, tonemapped with
+//! FLIP's ACES fit, clamped, and compared by LDR-FLIP in float, keeping each
+//! pixel's largest error. Tests hold the results to the reference
+//! implementation's (`flip-evaluator` 1.7) values on hand-made pairs and on
+//! real renders.
 
-use crate::image_io::{linear_to_srgb, to_byte, LinearImage, SrgbImage};
+mod colour;
+mod ldr;
+
+use crate::image_io::{LinearImage, SrgbImage};
 
 /// Pixels per degree of visual angle FLIP assumes: a 0.7 m wide, 3840-pixel
-/// monitor seen from 0.7 m (FLIP's default, 67.02).
-pub const PIXELS_PER_DEGREE: f32 = nv_flip::DEFAULT_PIXELS_PER_DEGREE;
+/// monitor seen from 0.7 m (FLIP's default, 0.7 × 3840 / 0.7 × π / 180).
+pub const PIXELS_PER_DEGREE: f32 = 67.020_64;
 
 /// FLIP's ACES filmic fit, as its HDR mode tonemaps: (x (a x + b) + c) /
 /// (x (d x + e) + f), the 0.6 pre-exposure folded into the constants.
@@ -58,26 +61,48 @@ impl FlipResult {
 
     /// The error map coloured with FLIP's magma map (black 0 to yellow-white 1).
     pub fn magma(&self) -> SrgbImage {
-        let map = nv_flip::FlipImageFloat::with_data(self.width, self.height, &self.map);
-        let coloured = map.apply_color_lut(&nv_flip::magma_lut());
         SrgbImage {
             width: self.width,
             height: self.height,
-            bytes: coloured.to_vec(),
+            bytes: self
+                .map
+                .iter()
+                .flat_map(|&e| {
+                    let step = (e.clamp(0.0, 1.0) * 255.0).round() as usize;
+                    let c = colorous::MAGMA.eval_rational(step, 256);
+                    [c.r, c.g, c.b]
+                })
+                .collect(),
         }
     }
 }
 
 /// LDR-FLIP between two 8-bit sRGB images of the same size.
 pub fn ldr_flip(reference: &SrgbImage, test: &SrgbImage) -> FlipResult {
-    let map = ldr_map(reference, test);
+    let linear = |image: &SrgbImage| -> Vec<[f32; 3]> {
+        image
+            .bytes
+            .chunks_exact(3)
+            .map(|p| [p[0], p[1], p[2]].map(|b| colour::srgb_to_linear(f32::from(b) / 255.0)))
+            .collect()
+    };
+    let map = ldr_map(
+        reference.width,
+        reference.height,
+        &linear(reference),
+        &linear(test),
+    );
     FlipResult::from_map(reference.width, reference.height, map, None)
 }
 
-fn ldr_map(reference: &SrgbImage, test: &SrgbImage) -> Vec<f32> {
-    let r = nv_flip::FlipImageRgb8::with_data(reference.width, reference.height, &reference.bytes);
-    let t = nv_flip::FlipImageRgb8::with_data(test.width, test.height, &test.bytes);
-    nv_flip::flip(r, t, PIXELS_PER_DEGREE).to_vec()
+fn ldr_map(width: u32, height: u32, reference: &[[f32; 3]], test: &[[f32; 3]]) -> Vec<f32> {
+    ldr::error_map(
+        reference,
+        test,
+        width as usize,
+        height as usize,
+        PIXELS_PER_DEGREE,
+    )
 }
 
 /// FLIP's ACES fit of one linear value.
@@ -89,10 +114,10 @@ pub fn aces(x: f32) -> f32 {
 /// The exposure range HDR-FLIP compares over, from the reference: from the
 /// exposure that maps its brightest pixel to where the tonemapper reaches
 /// 0.85, to the one that maps its median luminance there; and how many
-/// exposures (one per stop, at least 2). Where the reference implementation
-/// would divide by zero — a median luminance of 0, as in a render with a black
-/// background over half the frame, or an all-black image — the median of the
-/// lit pixels is used, or exposure 0; and the range is held to 32 stops.
+/// exposures (one per stop, at least 2). As in the reference implementation,
+/// a median below `f32::EPSILON` (a black background over half the frame)
+/// counts as `f32::EPSILON`, so the range ends 23 stops below 0.85. Non-finite
+/// pixels are left out; an image with no light gives exposure 0.
 pub fn exposure_range(reference: &LinearImage) -> (f32, f32, u32) {
     // The input x at which the tonemapper gives t: a x^2 + b x + c = 0.
     let t = 0.85f32;
@@ -115,14 +140,9 @@ pub fn exposure_range(reference: &LinearImage) -> (f32, f32, u32) {
         return (0.0, 0.0, 2);
     }
     let middle = luminance.len() / 2;
-    let mut median = *luminance.select_nth_unstable_by(middle, f32::total_cmp).1;
-    if median <= 0.0 {
-        luminance.retain(|&y| y > 0.0);
-        let middle = luminance.len() / 2;
-        median = *luminance.select_nth_unstable_by(middle, f32::total_cmp).1;
-    }
+    let median = *luminance.select_nth_unstable_by(middle, f32::total_cmp).1;
     let start = (x_max / y_max).log2();
-    let stop = (x_max / median).log2().min(start + 32.0);
+    let stop = (x_max / median.max(f32::EPSILON)).log2();
     let count = (stop - start).ceil().max(2.0) as u32;
     (start, stop, count)
 }
@@ -134,19 +154,20 @@ pub fn hdr_flip(reference: &LinearImage, test: &LinearImage) -> FlipResult {
     let mut map = vec![0.0f32; reference.pixels.len()];
     for i in 0..count {
         let scale = (start + i as f32 * step).exp2();
-        let exposed = |image: &LinearImage| SrgbImage {
-            width: image.width,
-            height: image.height,
-            bytes: image
+        let exposed = |image: &LinearImage| -> Vec<[f32; 3]> {
+            image
                 .pixels
                 .iter()
-                .flat_map(|p| p.map(|c| to_byte(linear_to_srgb(aces(c * scale)))))
-                .collect(),
+                .map(|p| p.map(|c| aces(c * scale).clamp(0.0, 1.0)))
+                .collect()
         };
-        for (m, e) in map
-            .iter_mut()
-            .zip(ldr_map(&exposed(reference), &exposed(test)))
-        {
+        let exposure = ldr_map(
+            reference.width,
+            reference.height,
+            &exposed(reference),
+            &exposed(test),
+        );
+        for (m, e) in map.iter_mut().zip(exposure) {
             *m = m.max(e);
         }
     }
@@ -217,7 +238,8 @@ mod tests {
     }
 
     /// A black background over most of the frame, a black image, and a
-    /// NaN pixel give finite exposure ranges.
+    /// NaN pixel give finite exposure ranges: a median of 0 counts as
+    /// `f32::EPSILON`, as in the reference implementation.
     #[test]
     fn dark_references_give_finite_exposures() {
         let mut pixels = vec![[0.0f32; 3]; 100];
@@ -230,12 +252,12 @@ mod tests {
             pixels,
         };
         let (start, stop, count) = exposure_range(&image);
-        // the lit median is 1 (of 1 and 0.25, the upper middle); x_max / 1
+        // start maps luminance 1 to 0.85, stop maps 2^-23: 23 stops on
         assert!(
-            start.is_finite() && (stop - start).abs() < 1e-6,
+            start.is_finite() && (stop - start - 23.0).abs() < 1e-5,
             "{start} {stop}"
         );
-        assert_eq!(count, 2);
+        assert_eq!(count, 23);
         let black = LinearImage {
             width: 2,
             height: 1,
@@ -257,15 +279,13 @@ mod tests {
     /// (`pip install flip-evaluator`, version 1.7:
     /// `flip_evaluator.evaluate(ref, test, "LDR")` on the bytes / 255, and
     /// `"HDR"` on the linear floats): LDR 0.36355054, HDR 0.03144910 with
-    /// exposures -0.18402869 to 0.76261032 in 2 steps. `nv-flip` carries an
-    /// earlier version of the same C++, and HDR-FLIP here compares 8-bit sRGB
-    /// exposures where the reference keeps floats; both agree within 1e-4
-    /// (measured: LDR 0.36352351, 2.7e-5 off; HDR 0.03138648, 6.3e-5 off).
+    /// exposures -0.18402869 to 0.76261032 in 2 steps. Measured: LDR
+    /// 0.36355050, HDR 0.03144903 (both under 1e-7 off); held to 1e-6.
     #[test]
     fn matches_the_reference_implementation() {
         let (r, t) = ldr_pair();
         let ldr = ldr_flip(&r, &t).mean;
-        assert!((ldr - 0.363_550_54).abs() < 1e-4, "{ldr}");
+        assert!((ldr - 0.363_550_54).abs() < 1e-6, "{ldr}");
         let (r, t) = hdr_pair();
         let (start, stop, count) = exposure_range(&r);
         assert!((start - -0.184_028_69).abs() < 1e-5, "{start}");
@@ -273,9 +293,58 @@ mod tests {
         assert_eq!(count, 2);
         let hdr = hdr_flip(&r, &t).mean;
         assert!(
-            (hdr - 0.031_449_10).abs() < 1e-4,
+            (hdr - 0.031_449_10).abs() < 1e-6,
             "{hdr}: {:.2e} from the reference implementation",
             (hdr - 0.031_449_10).abs()
         );
+    }
+
+    fn testdata(name: &str) -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("testdata/flip")
+            .join(name)
+    }
+
+    fn exr(name: &str) -> LinearImage {
+        LinearImage::read_exr(&testdata(&format!("{name}.exr"))).expect(name)
+    }
+
+    fn png(name: &str) -> SrgbImage {
+        let rgb = image::open(testdata(&format!("{name}.png")))
+            .expect(name)
+            .into_rgb8();
+        SrgbImage {
+            width: rgb.width(),
+            height: rgb.height(),
+            bytes: rgb.into_raw(),
+        }
+    }
+
+    /// Real renders (weft's, 320×180, stored as half floats in
+    /// `testdata/flip`): the demo's 64-spp path-traced reference, the same
+    /// with the next seed, its forward and deferred renders, the flight
+    /// helmet's reference and deferred render. Expected values are the
+    /// reference implementation's (`pip install flip-evaluator`, version
+    /// 1.7: `flip_evaluator.evaluate(reference, test, "HDR")` on the EXRs
+    /// read as float32, and `"LDR"` on the PNGs' bytes / 255), from FLIP 0.003
+    /// to 0.19, where differences of 0.001 decide sweeps. Measured: within
+    /// 6.3e-7 of every value; held to 1e-5.
+    #[test]
+    fn matches_the_reference_implementation_on_renders() {
+        let hdr_pairs = [
+            ("demo_reference", "demo_forward", 0.189_693_93),
+            ("demo_reference", "demo_reference_seed1", 0.075_850_77),
+            ("demo_forward", "demo_deferred", 0.002_734_77),
+            ("helmet_reference", "helmet_deferred", 0.059_050_78),
+        ];
+        for (reference, test, expected) in hdr_pairs {
+            let flip = hdr_flip(&exr(reference), &exr(test)).mean;
+            assert!(
+                (flip - expected).abs() < 1e-5,
+                "{reference} against {test}: {flip:.8}, the reference implementation {expected:.8}"
+            );
+        }
+        let ldr = ldr_flip(&png("demo_reference"), &png("demo_forward")).mean;
+        assert!((ldr - 0.122_833_86).abs() < 1e-5, "{ldr:.8}");
     }
 }
