@@ -1,5 +1,5 @@
-//! `weft sweep`: one graph over the cartesian product of parameter values and
-//! feature sets, every point measured against one cached reference, the
+//! `weft sweep`: a graph (or several) over the cartesian product of parameter
+//! values and feature sets, every point measured against one cached reference, the
 //! Pareto frontier of error against time plotted and tabled
 //! (docs/compare.md). Resumable: points already in `sweep.csv` are skipped.
 
@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use weft_compare::pareto::{dominated_marks, frontier, write_plot, Point};
 use weft_compare::report::within_budget;
 use weft_compare::sweep::{
-    document, header, line, points, read_named, read_with_form, SweepPoint, SweepRow,
+    document, header, line, points, read_named, read_with_form, SweepPoint, SweepRow, GRAPH_COLUMN,
 };
 use weft_graph::schema::ParamValue;
 use weft_render::RenderSettings;
@@ -56,8 +56,13 @@ struct SweepRun {
     #[command(flatten)]
     common: Common,
     /// The graph swept.
-    #[arg(long, default_value = "graphs/forward.ron")]
+    #[arg(long, default_value = "graphs/forward.ron", conflicts_with = "graphs")]
     graph: PathBuf,
+    /// Several graphs swept as one more dimension (comma-separated), every
+    /// point of each against the same reference, on one frontier; sweep.csv
+    /// names each point's graph in its first column.
+    #[arg(long, value_delimiter = ',')]
+    graphs: Vec<PathBuf>,
     /// A parameter and its values, NAME=v1,v2,...; repeatable (the points are
     /// every combination).
     #[arg(long = "param", value_parser = parse_values)]
@@ -127,6 +132,26 @@ fn value(text: &str) -> ParamValue {
     }
 }
 
+impl SweepRun {
+    /// The graphs swept, as the CSV and settings name them.
+    fn graph_names(&self) -> Vec<String> {
+        match self.graphs.as_slice() {
+            [] => vec![self.graph.display().to_string()],
+            many => many.iter().map(|g| g.display().to_string()).collect(),
+        }
+    }
+
+    /// The columns before `features` in sweep.csv: the graph's in a sweep
+    /// over graphs, then the parameters'.
+    fn columns(&self) -> Vec<String> {
+        let graph = (!self.graphs.is_empty()).then(|| GRAPH_COLUMN.to_string());
+        graph
+            .into_iter()
+            .chain(self.params.iter().map(|(n, _)| n.clone()))
+            .collect()
+    }
+}
+
 /// What every point of a sweep shares; a resumed sweep must share it too.
 fn settings_text(args: &SweepRun) -> String {
     let c = &args.common;
@@ -143,7 +168,7 @@ fn settings_text(args: &SweepRun) -> String {
     format!(
         "scene {}\ngraph {}\nsize {}x{}\ncamera {}\nreference {reference}\nfeatures {}\nframes {}\n",
         c.scene().display(),
-        args.graph.display(),
+        args.graph_names().join(","),
         c.size.width,
         c.size.height,
         c.camera.as_deref().unwrap_or("(first)"),
@@ -188,7 +213,10 @@ fn point_settings(args: &SweepRun, point: &SweepPoint) -> RenderSettings {
     let mut features = args.common.features.clone();
     features.extend(point.features.split_whitespace().map(String::from));
     RenderSettings {
-        graph: args.graph.clone(),
+        graph: point
+            .graph
+            .as_ref()
+            .map_or_else(|| args.graph.clone(), PathBuf::from),
         features,
         params: point
             .params
@@ -280,8 +308,8 @@ fn table_row(label: &str, r: &SweepRow) -> String {
 /// Runs one sweep (or one shard of it).
 fn run_sweep(args: SweepRun) -> Result<ExitCode> {
     let common = &args.common;
-    if args.params.is_empty() && args.features_set.is_none() {
-        bail!("nothing to sweep: give --param NAME=v1,v2,... or --features-set a,b;c");
+    if args.params.is_empty() && args.features_set.is_none() && args.graphs.len() < 2 {
+        bail!("nothing to sweep: give --param NAME=v1,v2,..., --features-set a,b;c or --graphs a.ron,b.ron");
     }
     let sets: Vec<String> = args
         .features_set
@@ -298,7 +326,15 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
                 .collect()
         })
         .unwrap_or_default();
-    let every = points(&args.params, &sets);
+    if !args.graphs.is_empty() && args.params.iter().any(|(n, _)| n == GRAPH_COLUMN) {
+        bail!("--param {GRAPH_COLUMN}=... cannot be swept with --graphs: sweep.csv's `{GRAPH_COLUMN}` column names each point's graph");
+    }
+    let graph_names: Vec<String> = if args.graphs.is_empty() {
+        Vec::new()
+    } else {
+        args.graph_names()
+    };
+    let every = points(&graph_names, &args.params, &sets);
     // The graph loaded with every point's parameters and features before the
     // reference renders: a misspelt parameter or value fails at once.
     let mut graphs = crate::graphs::Loaded::default();
@@ -311,7 +347,7 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
         .filter(|(i, _)| args.shard.is_none_or(|s| s.takes(*i)))
         .map(|(_, p)| p)
         .collect();
-    let names: Vec<String> = args.params.iter().map(|(n, _)| n.clone()).collect();
+    let names = args.columns();
     let csv = args.out.join("sweep.csv");
     check_settings(&args)?;
     let (mut rows, old_form) = read_with_form(&csv, &names)?;
@@ -353,7 +389,7 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
             let measured = session.measure(
                 common,
                 &point.label(),
-                &args.graph,
+                &settings.graph,
                 (&settings.features, &params),
                 Timings::default(),
             )?;
@@ -385,7 +421,7 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
         &args.out,
         (
             &common.scene().display().to_string(),
-            &args.graph.display().to_string(),
+            &args.graph_names().join(", "),
         ),
         &wanted,
         common.budget_ms,

@@ -1,14 +1,20 @@
-//! The points of a sweep (the cartesian product of parameter values and
-//! feature sets) and `sweep.csv`, one row per measured point, which makes a
-//! sweep resumable: points already in the file are skipped when it runs
+//! The points of a sweep (the cartesian product of graphs, parameter values
+//! and feature sets) and `sweep.csv`, one row per measured point, which makes
+//! a sweep resumable: points already in the file are skipped when it runs
 //! again.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
+/// The CSV column naming each point's graph, in a sweep over several graphs
+/// (first, before the parameters); a single-graph sweep has none.
+pub const GRAPH_COLUMN: &str = "graph";
+
 /// One setting of a sweep.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 pub struct SweepPoint {
+    /// The graph's path as given, in a sweep over several graphs.
+    pub graph: Option<String>,
     /// Parameter values by name, as given.
     pub params: BTreeMap<String, String>,
     /// Feature toggles, space-separated (`bloom !shadows`), empty for none.
@@ -16,12 +22,17 @@ pub struct SweepPoint {
 }
 
 impl SweepPoint {
-    /// A short label: `name=value` pairs, then the features.
+    /// A short label: the graph's file stem (in a sweep over graphs), the
+    /// `name=value` pairs, then the features.
     pub fn label(&self) -> String {
-        let mut parts: Vec<String> = self
-            .params
-            .iter()
-            .map(|(k, v)| format!("{k}={v}"))
+        let graph = self.graph.as_deref().map(|g| {
+            Path::new(g)
+                .file_stem()
+                .map_or_else(|| g.to_string(), |s| s.to_string_lossy().into_owned())
+        });
+        let mut parts: Vec<String> = graph
+            .into_iter()
+            .chain(self.params.iter().map(|(k, v)| format!("{k}={v}")))
             .collect();
         if !self.features.is_empty() {
             parts.push(format!("[{}]", self.features));
@@ -84,17 +95,27 @@ pub enum SweepError {
     },
 }
 
-/// Every point of the product of `params` (name, values) and `feature_sets`
-/// (an empty list means one set with no toggles), in order: the last
-/// parameter varies fastest, feature sets slowest.
-pub fn points(params: &[(String, Vec<String>)], feature_sets: &[String]) -> Vec<SweepPoint> {
+/// Every point of the product of `graphs` (an empty list means the sweep's
+/// one graph), `params` (name, values) and `feature_sets` (an empty list
+/// means one set with no toggles), in order: the last parameter varies
+/// fastest, then graphs, feature sets slowest.
+pub fn points(
+    graphs: &[String],
+    params: &[(String, Vec<String>)],
+    feature_sets: &[String],
+) -> Vec<SweepPoint> {
     let sets: Vec<String> = if feature_sets.is_empty() {
         vec![String::new()]
     } else {
         feature_sets.to_vec()
     };
+    let graphs: Vec<Option<String>> = if graphs.is_empty() {
+        vec![None]
+    } else {
+        graphs.iter().cloned().map(Some).collect()
+    };
     let mut out = Vec::new();
-    for features in &sets {
+    for (features, graph) in sets.iter().flat_map(|f| graphs.iter().map(move |g| (f, g))) {
         let mut partial = vec![BTreeMap::new()];
         for (name, values) in params {
             partial = partial
@@ -109,6 +130,7 @@ pub fn points(params: &[(String, Vec<String>)], feature_sets: &[String]) -> Vec<
                 .collect();
         }
         out.extend(partial.into_iter().map(|params| SweepPoint {
+            graph: graph.clone(),
             params,
             features: features.clone(),
         }));
@@ -116,7 +138,8 @@ pub fn points(params: &[(String, Vec<String>)], feature_sets: &[String]) -> Vec<
     out
 }
 
-/// The CSV header for a sweep over `names`.
+/// The CSV header for a sweep over `names` (the columns before `features`:
+/// [`GRAPH_COLUMN`] in a sweep over graphs, then the parameters).
 pub fn header(names: &[String]) -> String {
     header_with(names, COLUMNS.len())
 }
@@ -131,7 +154,10 @@ fn header_with(names: &[String], columns: usize) -> String {
 pub fn line(row: &SweepRow, names: &[String]) -> String {
     let mut fields: Vec<String> = names
         .iter()
-        .map(|n| row.point.params.get(n).cloned().unwrap_or_default())
+        .map(|n| match n.as_str() {
+            GRAPH_COLUMN => row.point.graph.clone().unwrap_or_default(),
+            _ => row.point.params.get(n).cloned().unwrap_or_default(),
+        })
         .collect();
     fields.push(row.point.features.clone());
     fields.push(format!("{:.6}", row.flip));
@@ -165,8 +191,8 @@ pub fn read_with_form(path: &Path, names: &[String]) -> Result<(Vec<SweepRow>, b
     }
 }
 
-/// A sweep.csv that must exist, with the parameter names its header gives
-/// (the columns before `features`), and its rows.
+/// A sweep.csv that must exist, with the names its header gives (the
+/// columns before `features`), and its rows.
 pub fn read_named(path: &Path) -> Result<(Vec<String>, Vec<SweepRow>), SweepError> {
     let text = weft_io::read_text(path, MAX_CSV_BYTES).map_err(|e| io_error(path, e))?;
     let names: Vec<String> = text
@@ -227,12 +253,15 @@ fn parse(path: &Path, text: &str, names: &[String]) -> Result<(Vec<SweepRow>, bo
                 .map_err(|_| bad(format!("\"{s}\" is not a number")))
         };
         let n = names.len();
+        let named = || names.iter().zip(&fields[..n]);
         rows.push(SweepRow {
             point: SweepPoint {
-                params: names
-                    .iter()
-                    .cloned()
-                    .zip(fields[..n].iter().map(|s| s.to_string()))
+                graph: named()
+                    .find(|(name, _)| *name == GRAPH_COLUMN)
+                    .map(|(_, g)| g.to_string()),
+                params: named()
+                    .filter(|(name, _)| *name != GRAPH_COLUMN)
+                    .map(|(name, v)| (name.clone(), v.to_string()))
                     .collect(),
                 features: fields[n].to_string(),
             },
@@ -271,12 +300,59 @@ mod tests {
                 vec!["x".to_string(), "y".to_string(), "z".to_string()],
             ),
         ];
-        let all = points(&params, &["".into(), "bloom".into()]);
+        let all = points(&[], &params, &["".into(), "bloom".into()]);
         assert_eq!(all.len(), 12);
         assert_eq!(all[0].label(), "a=1 b=x");
         assert_eq!(all[1].label(), "a=1 b=y");
         assert_eq!(all[6].label(), "a=1 b=x [bloom]");
-        assert_eq!(points(&[], &[]).len(), 1);
+        assert_eq!(points(&[], &[], &[]).len(), 1);
+        let graphs = ["graphs/forward.ron".to_string(), "deferred.ron".to_string()];
+        let all = points(&graphs, &params[..1], &["".into(), "bloom".into()]);
+        let labels: Vec<String> = all.iter().map(SweepPoint::label).collect();
+        assert_eq!(
+            labels,
+            [
+                "forward a=1",
+                "forward a=2",
+                "deferred a=1",
+                "deferred a=2",
+                "forward a=1 [bloom]",
+                "forward a=2 [bloom]",
+                "deferred a=1 [bloom]",
+                "deferred a=2 [bloom]"
+            ]
+        );
+        assert_eq!(all[0].graph.as_deref(), Some("graphs/forward.ron"));
+    }
+
+    /// A sweep over graphs writes each point's graph in the first column and
+    /// reads it back as the graph, not as a parameter.
+    #[test]
+    fn the_graph_column_round_trips() {
+        let dir = std::env::temp_dir().join(format!("weft-sweep-graphs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let path = dir.join("sweep.csv");
+        let names = vec![GRAPH_COLUMN.to_string(), "radius".to_string()];
+        let row = SweepRow {
+            point: SweepPoint {
+                graph: Some("graphs/tiled.ron".into()),
+                params: [("radius".to_string(), "2".to_string())].into(),
+                features: String::new(),
+            },
+            flip: 0.5,
+            rmse: 0.25,
+            frame_ms: 3.0,
+            device_bytes: 7,
+            frame_iqr: (2.5, 3.5),
+        };
+        let text = document(&names, [&row]);
+        assert!(
+            text.starts_with("graph,radius,features,flip,rmse,frame_ms,device_bytes,frame_p25,frame_p75\ngraphs/tiled.ron,2,,"),
+            "{text}"
+        );
+        std::fs::write(&path, text).expect("write");
+        assert_eq!(read(&path, &names).expect("read"), [row.clone()]);
+        assert_eq!(read_named(&path).expect("named"), (names, vec![row]));
     }
 
     #[test]
@@ -288,6 +364,7 @@ mod tests {
         assert!(read(&path, &names).expect("missing is empty").is_empty());
         let row = SweepRow {
             point: SweepPoint {
+                graph: None,
                 params: [("radius".to_string(), "3".to_string())].into(),
                 features: "bloom".into(),
             },

@@ -293,3 +293,88 @@ fn a_sweep_writes_its_csv_plot_and_frontier_and_resumes() {
         "{stderr}"
     );
 }
+
+/// `--graphs` sweeps graphs as one more dimension against one reference:
+/// sweep.csv names each point's graph first, and each graph's rows equal a
+/// sweep of that graph alone (same figures but frame time), so the graph
+/// column really chose the graph.
+#[test]
+fn a_sweep_over_graphs_measures_each_graph_as_its_own_sweep_does() {
+    let cache = temp("sweep-graphs-cache");
+    let root = temp("sweep-graphs");
+    let sweep = |graphs: (&str, &str), out: &str| {
+        let out = root.join(out);
+        let run = weft(
+            &[
+                "sweep",
+                "scenes/demo.scene",
+                graphs.0,
+                graphs.1,
+                "--param",
+                "shadows.pcf_radius=0,2",
+                "--size",
+                "48x32",
+                "--spp",
+                "4",
+                "--frames",
+                "1",
+                "--out",
+                &out.to_string_lossy(),
+            ],
+            &cache,
+        );
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        std::fs::read_to_string(out.join("sweep.csv")).expect("sweep.csv")
+    };
+    // The figures a row holds besides frame time: flip, rmse, device bytes.
+    let figures = |line: &str| -> Vec<String> {
+        let fields: Vec<&str> = line.split(',').collect();
+        let n = fields.len();
+        vec![
+            fields[n - 6].into(),
+            fields[n - 5].into(),
+            fields[n - 3].into(),
+        ]
+    };
+    let both = sweep(
+        ("--graphs", "graphs/forward.ron,graphs/deferred.ron"),
+        "both",
+    );
+    let lines: Vec<&str> = both.lines().collect();
+    assert_eq!(
+        lines[0],
+        "graph,shadows.pcf_radius,features,flip,rmse,frame_ms,device_bytes,frame_p25,frame_p75"
+    );
+    let starts: Vec<String> = lines[1..]
+        .iter()
+        .map(|l| l.splitn(3, ',').take(2).collect::<Vec<_>>().join(","))
+        .collect();
+    assert_eq!(
+        starts,
+        [
+            "graphs/forward.ron,0",
+            "graphs/forward.ron,2",
+            "graphs/deferred.ron,0",
+            "graphs/deferred.ron,2"
+        ]
+    );
+    for (k, graph) in ["forward", "deferred"].into_iter().enumerate() {
+        let alone = sweep(("--graph", &format!("graphs/{graph}.ron")), graph);
+        let alone: Vec<Vec<String>> = alone.lines().skip(1).map(figures).collect();
+        let within: Vec<Vec<String>> = lines[1 + 2 * k..3 + 2 * k]
+            .iter()
+            .map(|l| figures(l))
+            .collect();
+        assert_eq!(within, alone, "{graph}\n{both}");
+    }
+    let table = std::fs::read_to_string(root.join("both/sweep.md")).expect("sweep.md");
+    assert!(
+        table.contains("| forward shadows.pcf_radius=0 |")
+            || table.contains("| forward shadows.pcf_radius=2 |"),
+        "{table}"
+    );
+}
