@@ -184,6 +184,52 @@ fn settings_text(args: &SweepRun) -> String {
 /// How `sweep.settings` names a shard.
 const SHARD_LINE: &str = "shard ";
 
+/// The file a sweep run with `--noise-floor` keeps the reference's noise
+/// floor in (`SEED FLIP`), so a resumed or merged sweep still reports it.
+const NOISE_FLOOR_FILE: &str = "noise_floor";
+
+/// The reference's noise floor: the other seed and the HDR-FLIP between the
+/// two renders.
+type NoiseFloor = (u32, f64);
+
+/// The noise floor recorded in `dir`, if a run there measured one.
+fn read_noise_floor(dir: &Path) -> Result<Option<NoiseFloor>> {
+    let path = dir.join(NOISE_FLOOR_FILE);
+    let text = match weft_io::read_text(&path, weft_io::read::MAX_TEXT_BYTES) {
+        Ok(text) => text,
+        Err(weft_io::ReadError::Missing { .. }) => return Ok(None),
+        Err(e) => return Err(e.into_io()).with_context(|| format!("reading {}", path.display())),
+    };
+    let parsed = text
+        .split_once(' ')
+        .and_then(|(seed, flip)| Some((seed.parse().ok()?, flip.trim().parse().ok()?)));
+    parsed
+        .map(Some)
+        .with_context(|| format!("{}: expected `SEED FLIP`, found {text:?}", path.display()))
+}
+
+fn write_noise_floor(dir: &Path, (seed, flip): NoiseFloor) -> Result<()> {
+    let path = dir.join(NOISE_FLOOR_FILE);
+    std::fs::write(&path, format!("{seed} {flip:.6}\n"))
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// sweep.md's paragraph on the noise floor: which points' HDR-FLIP lies
+/// within it of the most accurate point's, so no one ranks them by accuracy.
+fn noise_floor_note((seed, floor): NoiseFloor, labels: &[(String, f64)]) -> String {
+    let best = labels.iter().map(|(_, f)| *f).fold(f64::INFINITY, f64::min);
+    let tied: Vec<&str> = labels
+        .iter()
+        .filter(|(_, f)| *f - best < floor)
+        .map(|(l, _)| l.as_str())
+        .collect();
+    format!(
+        "Reference noise floor: HDR-FLIP {floor:.4} between the reference and its render with seed {seed}. \
+         Points whose HDR-FLIP differs by less are not told apart by this reference; within it of the most accurate ({best:.4}): {}.\n\n",
+        tied.join(", ")
+    )
+}
+
 /// Records the sweep's settings beside its CSV (`sweep.settings`), or, when
 /// resuming, refuses to mix points measured with other settings.
 fn check_settings(args: &SweepRun) -> Result<()> {
@@ -241,7 +287,7 @@ fn write_report(
     out: &Path,
     (scene, graph): (&str, &str),
     rows: &[&SweepRow],
-    budget_ms: Option<f64>,
+    (budget_ms, noise_floor): (Option<f64>, Option<NoiseFloor>),
 ) -> Result<()> {
     let plotted: Vec<Point> = rows
         .iter()
@@ -256,7 +302,7 @@ fn write_report(
     write_plot(
         &plotted,
         &format!("{graph}: HDR-FLIP against frame time"),
-        ("HDR-FLIP", budget_ms),
+        ("HDR-FLIP", budget_ms, noise_floor.map(|(_, flip)| flip)),
         &out.join("pareto.png"),
     )?;
     let mut table = format!("# weft sweep: {scene} through {graph}\n\n");
@@ -274,15 +320,23 @@ fn write_report(
         on.len(),
         rows.len()
     );
+    let mut marked: Vec<(String, f64)> = Vec::new();
     for (rank, &i) in on.iter().enumerate() {
-        table += &table_row(&(rank + 1).to_string(), rows[i]);
+        let mark = format!("#{}", rank + 1);
+        table += &table_row(&mark[1..], rows[i]);
+        marked.push((mark, rows[i].flip));
     }
     let dominated = dominated_marks(&plotted);
     if !dominated.is_empty() {
         table += "\nDominated points (another point is both faster and more accurate):\n\n| mark | setting | HDR-FLIP | RMSE | frame ms: median (IQR) | device (MiB) |\n|---|---|---|---|---|---|\n";
         for (i, mark) in &dominated {
             table += &table_row(mark, rows[*i]);
+            marked.push((mark.clone(), rows[*i].flip));
         }
+    }
+    if let Some(floor) = noise_floor {
+        table += "\n";
+        table += &noise_floor_note(floor, &marked);
     }
     table += "\nThe numbers and letters label the points in `pareto.png`.\n\n![error against time](pareto.png)\n";
     std::fs::write(out.join("sweep.md"), &table)?;
@@ -368,8 +422,13 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
         csv.display()
     );
     let mut exit = ExitCode::SUCCESS;
-    if !todo.is_empty() {
+    let mut noise_floor = read_noise_floor(&args.out)?;
+    if !todo.is_empty() || (common.noise_floor && noise_floor.is_none()) {
         let mut session = Session::open(common, &args.out, graphs)?;
+        if let Some(floor) = &session.info.noise_floor {
+            noise_floor = Some((floor.seed, floor.flip));
+            write_noise_floor(&args.out, (floor.seed, floor.flip))?;
+        }
         if !csv.exists() {
             std::fs::write(&csv, header(&names) + "\n")
                 .with_context(|| format!("writing {}", csv.display()))?;
@@ -424,7 +483,7 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
             &args.graph_names().join(", "),
         ),
         &wanted,
-        common.budget_ms,
+        (common.budget_ms, noise_floor),
     )?;
     Ok(exit)
 }
@@ -526,11 +585,15 @@ fn merge_shards(args: &MergeArgs) -> Result<ExitCode> {
             .to_string()
     };
     println!("{} points from {n} shards", rows.len());
+    let noise_floor = read_noise_floor(&first.dir)?;
+    if let Some(floor) = noise_floor {
+        write_noise_floor(&args.out, floor)?;
+    }
     write_report(
         &args.out,
         (&field("scene "), &field("graph ")),
         &rows,
-        args.budget_ms,
+        (args.budget_ms, noise_floor),
     )?;
     Ok(ExitCode::SUCCESS)
 }

@@ -44,9 +44,6 @@ pub fn frontier(points: &[Point]) -> Vec<usize> {
     on
 }
 
-/// Writes error against time, every point in grey, the frontier in red with
-/// each of its points numbered 1, 2, ... by increasing time, as the frontier
-/// table lists them (axes padded by 10% of their span).
 /// Marks for the points off the frontier, in point order: `a`, `b`, …, `z`,
 /// `aa`, `ab`, … (the frontier's points are numbered by rank), so every
 /// point of a plot can be found in its table.
@@ -73,10 +70,15 @@ fn letters(mut n: usize) -> String {
     String::from_utf8(out).unwrap_or_default()
 }
 
+/// Writes error against time, every point in grey with its frame-time
+/// interquartile range, the frontier in red with each of its points numbered
+/// 1, 2, ... by increasing time as the frontier table lists them, the others
+/// lettered; a budget as a vertical line, and the reference's noise floor as
+/// a band above the best error (errors within it are not told apart).
 pub fn write_plot(
     points: &[Point],
     title: &str,
-    (error_name, budget_ms): (&str, Option<f64>),
+    (error_name, budget_ms, noise_floor): (&str, Option<f64>, Option<f64>),
     path: &Path,
 ) -> Result<(), ImageError> {
     let fail = |e: &dyn std::fmt::Display| ImageError::Write {
@@ -90,17 +92,22 @@ pub fn write_plot(
     if usable.is_empty() {
         return Err(fail(&"no point with a positive time and error to plot"));
     }
-    let range = |f: &dyn Fn(&Point) -> f64| {
+    // Each axis padded by a tenth of its span; the error axis also above by
+    // two fifths, so the legend in the upper right covers no point.
+    let range = |f: &dyn Fn(&Point) -> f64, extra_hi: f64, top: f64| {
         let lo = usable.iter().map(|p| f(p)).fold(f64::INFINITY, f64::min);
-        let hi = usable.iter().map(|p| f(p)).fold(0.0, f64::max);
-        let pad = if hi > lo { 0.1 * (hi - lo) } else { 0.1 * hi };
-        ((lo - pad).max(0.0), hi + pad)
+        let hi = usable.iter().map(|p| f(p)).fold(extra_hi, f64::max);
+        let span = if hi > lo { hi - lo } else { hi };
+        ((lo - 0.1 * span).max(0.0), hi + top * span)
     };
-    let (t0, _) = range(&|p| p.time_iqr.0.min(p.time));
-    let (_, t1) = range(&|p| p.time_iqr.1.max(p.time));
+    let (t0, _) = range(&|p| p.time_iqr.0.min(p.time), 0.0, 0.1);
+    let (_, t1) = range(&|p| p.time_iqr.1.max(p.time), 0.0, 0.1);
     // A budget inside the drawn range is drawn; one beyond it is said in the table.
     let budget = budget_ms.filter(|b| (t0..=t1).contains(b));
-    let (e0, e1) = range(&|p| p.error);
+    let best = usable.iter().map(|p| p.error).fold(f64::INFINITY, f64::min);
+    // The band of errors the reference's own noise cannot tell from the best.
+    let band = noise_floor.filter(|f| *f > 0.0).map(|f| (best, best + f));
+    let (e0, e1) = range(&|p| p.error, band.map_or(0.0, |b| b.1), 0.4);
     let on = frontier(points);
     crate::report::draw_png(900, 600, path, |root| {
         let mut chart = ChartBuilder::on(root)
@@ -117,6 +124,22 @@ pub fn write_plot(
             .label_style((crate::report::FAMILY, 14))
             .draw()
             .map_err(|e| fail(&e))?;
+        if let Some((lo, hi)) = band {
+            let colour = RGBColor(120, 170, 230);
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(t0, lo), (t1, hi)],
+                    colour.mix(0.25).filled(),
+                )))
+                .map_err(|e| fail(&e))?
+                .label(format!(
+                    "within the reference noise ({:.4}) of the best",
+                    hi - lo
+                ))
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 20, y + 5)], colour.mix(0.25).filled())
+                });
+        }
         chart
             .draw_series(usable.iter().map(|p| {
                 PathElement::new(

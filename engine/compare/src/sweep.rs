@@ -351,7 +351,10 @@ mod tests {
             "{text}"
         );
         std::fs::write(&path, text).expect("write");
-        assert_eq!(read(&path, &names).expect("read"), std::slice::from_ref(&row));
+        assert_eq!(
+            read(&path, &names).expect("read"),
+            std::slice::from_ref(&row)
+        );
         assert_eq!(read_named(&path).expect("named"), (names, vec![row]));
     }
 

@@ -302,7 +302,7 @@ fn a_sweep_writes_its_csv_plot_and_frontier_and_resumes() {
 fn a_sweep_over_graphs_measures_each_graph_as_its_own_sweep_does() {
     let cache = temp("sweep-graphs-cache");
     let root = temp("sweep-graphs");
-    let sweep = |graphs: (&str, &str), out: &str| {
+    let sweep = |graphs: (&str, &str), out: &str, noise_floor: bool| {
         let out = root.join(out);
         let run = weft(
             &[
@@ -310,6 +310,11 @@ fn a_sweep_over_graphs_measures_each_graph_as_its_own_sweep_does() {
                 "scenes/demo.scene",
                 graphs.0,
                 graphs.1,
+                if noise_floor {
+                    "--noise-floor"
+                } else {
+                    "--validate"
+                },
                 "--param",
                 "shadows.pcf_radius=0,2",
                 "--size",
@@ -343,6 +348,7 @@ fn a_sweep_over_graphs_measures_each_graph_as_its_own_sweep_does() {
     let both = sweep(
         ("--graphs", "graphs/forward.ron,graphs/deferred.ron"),
         "both",
+        true,
     );
     let lines: Vec<&str> = both.lines().collect();
     assert_eq!(
@@ -363,7 +369,7 @@ fn a_sweep_over_graphs_measures_each_graph_as_its_own_sweep_does() {
         ]
     );
     for (k, graph) in ["forward", "deferred"].into_iter().enumerate() {
-        let alone = sweep(("--graph", &format!("graphs/{graph}.ron")), graph);
+        let alone = sweep(("--graph", &format!("graphs/{graph}.ron")), graph, false);
         let alone: Vec<Vec<String>> = alone.lines().skip(1).map(figures).collect();
         let within: Vec<Vec<String>> = lines[1 + 2 * k..3 + 2 * k]
             .iter()
@@ -377,4 +383,28 @@ fn a_sweep_over_graphs_measures_each_graph_as_its_own_sweep_does() {
             || table.contains("| forward shadows.pcf_radius=2 |"),
         "{table}"
     );
+    // --noise-floor: the floor is kept beside the CSV and sweep.md says
+    // which points lie within it of the most accurate (that one at least).
+    let floor = std::fs::read_to_string(root.join("both/noise_floor")).expect("noise_floor");
+    let (seed, flip) = floor.trim().split_once(' ').expect("SEED FLIP");
+    assert_eq!(seed, "1");
+    let flip: f64 = flip.parse().expect("a number");
+    assert!(flip > 0.0 && flip < 1.0, "{floor}");
+    let note = table
+        .lines()
+        .find(|l| l.starts_with("Reference noise floor: HDR-FLIP "))
+        .expect("the noise floor in sweep.md");
+    assert!(
+        note.contains(&format!(
+            "{flip:.4} between the reference and its render with seed 1"
+        )),
+        "{note}"
+    );
+    // The most accurate point is the frontier's last, and lies within.
+    let last = table
+        .lines()
+        .filter_map(|l| l.split('|').nth(1)?.trim().parse::<u32>().ok())
+        .max()
+        .expect("a frontier");
+    assert!(note.contains(&format!("#{last}")), "{note}\n{table}");
 }
