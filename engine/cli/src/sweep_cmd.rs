@@ -10,7 +10,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_compare::pareto::{dominated_marks, frontier, write_plot, Point};
-use weft_compare::report::within_budget;
+use weft_compare::report::{within_budget, within_noise};
 use weft_compare::sweep::{
     document, header, line, points, read_named, read_with_form, SweepPoint, SweepRow, GRAPH_COLUMN,
 };
@@ -217,12 +217,7 @@ fn write_noise_floor(dir: &Path, (seed, flip): NoiseFloor) -> Result<()> {
 /// sweep.md's paragraph on the noise floor: which points' HDR-FLIP lies
 /// within it of the most accurate point's, so no one ranks them by accuracy.
 fn noise_floor_note((seed, floor): NoiseFloor, labels: &[(String, f64)]) -> String {
-    let best = labels.iter().map(|(_, f)| *f).fold(f64::INFINITY, f64::min);
-    let tied: Vec<&str> = labels
-        .iter()
-        .filter(|(_, f)| *f - best < floor)
-        .map(|(l, _)| l.as_str())
-        .collect();
+    let (best, tied) = within_noise(floor, labels.iter().map(|(l, f)| (l.as_str(), *f)));
     format!(
         "Reference noise floor: HDR-FLIP {floor:.4} between the reference and its render with seed {seed}. \
          Points whose HDR-FLIP differs by less are not told apart by this reference; within it of the most accurate ({best:.4}): {}.\n\n",

@@ -152,6 +152,26 @@ pub fn within_budget<'a>(
     }
 }
 
+/// The most accurate HDR-FLIP among `candidates` (name, HDR-FLIP), and the
+/// names of those within `floor` of it, that one included: what a reference
+/// with that noise floor cannot rank by accuracy.
+pub fn within_noise<'a>(
+    floor: f64,
+    candidates: impl IntoIterator<Item = (&'a str, f64)> + Clone,
+) -> (f64, Vec<&'a str>) {
+    let best = candidates
+        .clone()
+        .into_iter()
+        .map(|(_, flip)| flip)
+        .fold(f64::INFINITY, f64::min);
+    let tied = candidates
+        .into_iter()
+        .filter(|&(_, flip)| flip - best < floor)
+        .map(|(name, _)| name)
+        .collect();
+    (best, tied)
+}
+
 impl Report {
     /// The table of results, as markdown (also what stdout shows), then the
     /// caveats the configurations' graphs declare, numbered in the table's
@@ -280,9 +300,17 @@ impl Report {
             self.frames
         );
         if let Some(floor) = &self.reference.noise_floor {
+            let (best, tied) = within_noise(
+                floor.flip,
+                self.configurations
+                    .iter()
+                    .map(|c| (c.name.as_str(), c.flip)),
+            );
             out += &format!(
-                "Reference noise floor: HDR-FLIP {:.4} between this reference and the same render with seed {}; differences in HDR-FLIP smaller than that are the reference's noise.\n\n",
-                floor.flip, floor.seed
+                "Reference noise floor: HDR-FLIP {:.4} between this reference and the same render with seed {}; differences in HDR-FLIP smaller than that are the reference's noise. Within it of the most accurate ({best:.4}), so not ranked by accuracy: {}.\n\n",
+                floor.flip,
+                floor.seed,
+                tied.join(", ")
             );
         }
         if let Some(verdict) = self.budget_verdict() {
@@ -484,5 +512,20 @@ fn downscale(image: &SrgbImage, step: u32) -> SrgbImage {
         width: w,
         height: h,
         bytes,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Within the floor of the best means a difference strictly below it.
+    #[test]
+    fn within_noise_names_the_best_and_those_less_than_the_floor_above_it() {
+        let candidates = [("a", 0.20), ("b", 0.10), ("c", 0.149), ("d", 0.16)];
+        let (best, tied) = within_noise(0.05, candidates);
+        assert_eq!(best, 0.10);
+        assert_eq!(tied, ["b", "c"]);
+        assert_eq!(within_noise(0.0, candidates).1, Vec::<&str>::new());
     }
 }

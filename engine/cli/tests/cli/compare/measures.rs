@@ -193,6 +193,11 @@ fn the_noise_floor_is_the_flip_between_two_seeds_of_the_reference() {
         markdown.contains(&format!("Reference noise floor: HDR-FLIP {expected:.4} between this reference and the same render with seed 6")),
         "{markdown}"
     );
+    // The one configuration is the most accurate, and so within the floor.
+    assert!(
+        markdown.contains("so not ranked by accuracy: forward."),
+        "{markdown}"
+    );
 }
 
 /// Every configuration frame shows the scene at the reference's time: on a
