@@ -12,6 +12,10 @@ layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
 // The emissive texture's sample (rgb) and the occlusion texture's (a).
 layout(set = 0, binding = 5) uniform sampler2D gbuffer_emission;
 #endif
+#ifdef HAS_AO
+// Ray-traced environment visibility (graphs/rt_ao.ron).
+layout(set = 0, binding = 6) uniform sampler2D ao;
+#endif
 #include "include/deferred.glsl"
 layout(push_constant) uniform Params {
     float emissive_boost;  // graph parameter: scales material emission

@@ -15,7 +15,11 @@ layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
 // The emissive texture's sample (rgb) and the occlusion texture's (a).
 layout(set = 0, binding = 5) uniform sampler2D gbuffer_emission;
 #endif
-layout(std430, set = 0, binding = 6) readonly buffer TileLights { uint words[]; } tile_lights;
+#ifdef HAS_AO
+// Ray-traced environment visibility (graphs/rt_ao.ron).
+layout(set = 0, binding = 6) uniform sampler2D ao;
+#endif
+layout(std430, set = 0, binding = 7) readonly buffer TileLights { uint words[]; } tile_lights;
 layout(push_constant) uniform Push {
     uint max_per_tile;
     float emissive_boost;

@@ -23,13 +23,18 @@ bool read_surface(out Surface s) {
 
 // What multiplies this fragment's emission (rgb) and environment (a): the
 // emissive and occlusion textures' samples where the G-buffer keeps them
-// (HAS_GBUFFER_EMISSION), and no emission where the camera sees a surface's
-// back (albedo alpha 0), as the path tracer's emitters light only their front.
+// (HAS_GBUFFER_EMISSION), the ray-traced visibility of the environment where
+// the graph has it (HAS_AO: graphs/rt_ao.ron, the includer declaring `ao`),
+// and no emission where the camera sees a surface's back (albedo alpha 0), as
+// the path tracer's emitters light only their front.
 vec4 read_emission_occlusion() {
     ivec2 p = ivec2(gl_FragCoord.xy);
     vec4 emission_occlusion = vec4(1.0);
 #ifdef HAS_GBUFFER_EMISSION
     emission_occlusion = texelFetch(gbuffer_emission, p, 0);
+#endif
+#ifdef HAS_AO
+    emission_occlusion.a *= texelFetch(ao, p, 0).r;
 #endif
     emission_occlusion.rgb *= texelFetch(gbuffer_albedo, p, 0).a;
     return emission_occlusion;

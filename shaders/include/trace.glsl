@@ -230,6 +230,13 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
     return hit ? vec2(best_t, uintBitsToFloat(best_tri)) : vec2(-1.0, 0.0);
 }
 
+// Where a ray leaving surface point p on the side of unit normal n starts, so
+// that it does not find the surface it leaves.
+vec3 leave(vec3 p, vec3 n) {
+    float scale = max(1.0, max(max(abs(p.x), abs(p.y)), abs(p.z)));
+    return p + n * (1e-4 * scale);
+}
+
 // The nearest hit with t in (0, t_max): its distance in .x and triangle in .y
 // (as uint bits), or x = -1 when nothing is hit.
 vec2 trace_closest(vec3 origin, vec3 dir, float t_max) {

@@ -82,13 +82,6 @@ float found_weight(bool counted_fully, float bsdf_pdf, float light_pdf) {
     return params.sampling == SAMPLING_NEE ? 0.0 : power_heuristic(bsdf_pdf, light_pdf);
 }
 
-// Where a ray leaving surface point p on the side of unit normal n starts, so
-// that it does not find the surface it leaves.
-vec3 leave(vec3 p, vec3 n) {
-    float scale = max(1.0, max(max(abs(p.x), abs(p.y)), abs(p.z)));
-    return p + n * (1e-4 * scale);
-}
-
 // Whether nothing lies between a point and a light sample `distance` away:
 // no triangle, and no other area light (they block BSDF-sampled rays too).
 bool unoccluded(vec3 origin, vec3 dir, float distance) {

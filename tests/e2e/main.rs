@@ -15,6 +15,7 @@ mod one_physics;
 mod pathtrace;
 mod raycast;
 mod render;
+mod rt_ao;
 mod scripting;
 mod shading;
 mod shadows;

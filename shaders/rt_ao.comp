@@ -1,0 +1,50 @@
+#version 450
+// Ray-traced ambient occlusion (graphs/rt_ao.ron): for each G-buffer pixel,
+// `rays` cosine-weighted directions about the surface normal, each traced
+// for any hit within `radius` (0: unbounded); `ao` gets the fraction that
+// meet nothing. Cosine weighting makes that fraction, times the ambient
+// radiance and the diffuse albedo, the estimate of light from a uniform sky
+// that the path tracer makes at its first bounce: the two agree in
+// expectation. Rays start just off the surface (`leave`, shared with the
+// path tracer); background pixels get 1.
+#include "include/brdf.glsl"
+#include "include/gbuffer.glsl"
+#include "include/trace.glsl"
+#include "pathtrace/random.glsl"
+#include "pathtrace/sampling.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0) uniform sampler2D depth;
+layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
+layout(set = 0, binding = 2, r32f) uniform writeonly image2D ao;
+
+layout(push_constant) uniform Params {
+    uint rays;
+    float radius;
+    uint history_frames;
+} params;
+
+void main() {
+    ivec2 size = imageSize(ao);
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(pixel, size))) {
+        return;
+    }
+    float d = texelFetch(depth, pixel, 0).r;
+    if (d <= 0.0) {
+        imageStore(ao, pixel, vec4(1.0));
+        return;
+    }
+    vec3 p = position_from_depth(vec2(pixel) + 0.5, d);
+    vec3 n = octahedral_decode(texelFetch(gbuffer_normal, pixel, 0).rg);
+    mat3 to_world = basis(n);
+    vec3 origin = leave(p, n);
+    float t_max = params.radius > 0.0 ? params.radius : 3.0e38;
+    Rng rng = rng_start(uvec2(pixel), params.history_frames, 0x6a09e667u);
+    uint open = 0u;
+    for (uint i = 0u; i < params.rays; ++i) {
+        vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
+        open += trace_any(origin, dir, t_max) ? 0u : 1u;
+    }
+    imageStore(ao, pixel, vec4(float(open) / float(max(params.rays, 1u))));
+}
