@@ -25,6 +25,18 @@ fn weft(args: &[&str], cache: &Path) -> Output {
         .expect("weft runs")
 }
 
+/// Runs weft with its user cache in `cache`, and asserts it succeeded (its
+/// stderr shown if not).
+fn weft_ok(args: &[&str], cache: &Path) -> Output {
+    let run = weft(args, cache);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    run
+}
+
 fn report(out: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(out.join("report.json")).expect("report.json");
     serde_json::from_str(&text).expect("report.json is JSON")
@@ -280,7 +292,7 @@ fn a_reference_image_with_non_finite_or_negative_pixels_is_refused() {
 /// Renders `scene` through forward at `size` (`WxH`) into the EXR `path`
 /// with weft itself: a linear image to compare against, or a reference.
 fn render_exr(scene: &str, size: &str, path: &Path, cache: &Path) {
-    let out = weft(
+    let out = weft_ok(
         &[
             "render",
             scene,
@@ -290,10 +302,5 @@ fn render_exr(scene: &str, size: &str, path: &Path, cache: &Path) {
             &path.to_string_lossy(),
         ],
         cache,
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
 }
