@@ -2,7 +2,7 @@
 //! and a budget, one definition of memory, the reference's noise floor and
 //! post effects only when asked.
 
-use super::{render_exr, report, temp, weft, weft_ok};
+use super::{render_exr, report, temp, weft_ok};
 
 /// Timings come with their spread: configurations take turns over
 /// `--rounds`, every measured frame of every round counts (2 rounds × 2
@@ -16,7 +16,7 @@ fn timings_carry_their_spread_and_a_budget_picks_a_configuration() {
     let reference = out.join("reference-given.exr");
     render_exr("scenes/demo.scene", "48x32", &reference, &cache);
     let run = |budget: &str| {
-        let result = weft_ok(
+        weft_ok(
             &[
                 "compare",
                 "scenes/demo.scene",
@@ -88,7 +88,7 @@ fn compare_reports_the_transient_memory_graph_plan_prints_on_the_device() {
     render_exr("scenes/demo.scene", "96x54", &reference, &cache);
     for graph in ["forward", "deferred"] {
         let file = format!("graphs/{graph}.ron");
-        let run = weft_ok(
+        weft_ok(
             &[
                 "compare",
                 "scenes/demo.scene",
@@ -139,7 +139,7 @@ fn compare_reports_the_transient_memory_graph_plan_prints_on_the_device() {
 fn the_noise_floor_is_the_flip_between_two_seeds_of_the_reference() {
     let cache = temp("floor-cache");
     let out = temp("floor");
-    let run = weft_ok(
+    weft_ok(
         &[
             "compare",
             "scenes/demo.scene",
@@ -191,7 +191,7 @@ fn a_graph_against_its_own_render_of_the_same_scene_state_scores_zero() {
     let reference = out.join("forward.exr");
     render_exr("scenes/animation.scene", "48x32", &reference, &cache);
     for frames in ["1", "6"] {
-        let run = weft_ok(
+        weft_ok(
             &[
                 "compare",
                 "scenes/animation.scene",
@@ -250,7 +250,7 @@ fn post_effects_count_as_error_only_when_asked() {
         }
         let out_arg = out.to_string_lossy().into_owned();
         args.extend(["--out", &out_arg]);
-        let run = weft_ok(&args, &cache);
+        weft_ok(&args, &cache);
         let markdown = std::fs::read_to_string(out.join("report.md")).expect("report.md");
         let said = if post {
             "post effects such as bloom included (`--post`)"

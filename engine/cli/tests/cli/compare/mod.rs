@@ -292,7 +292,7 @@ fn a_reference_image_with_non_finite_or_negative_pixels_is_refused() {
 /// Renders `scene` through forward at `size` (`WxH`) into the EXR `path`
 /// with weft itself: a linear image to compare against, or a reference.
 fn render_exr(scene: &str, size: &str, path: &Path, cache: &Path) {
-    let out = weft_ok(
+    weft_ok(
         &[
             "render",
             scene,
