@@ -249,6 +249,7 @@ fn mutable_files() -> Vec<PathBuf> {
         "shaders",
         "shaders/include",
         "shaders/bench",
+        "shaders/pathtrace",
     ] {
         let mut found: Vec<PathBuf> = std::fs::read_dir(root().join(dir))
             .expect("read dir")

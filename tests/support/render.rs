@@ -37,14 +37,12 @@ pub fn graph(name: &str) -> PathBuf {
 pub fn absolute_paths(text: &str) -> String {
     let graphs = root().join("graphs");
     let mut text = text.to_string();
-    for fragment in [
-        "bloom.ron",
-        "debug_views.ron",
-        "gbuffer.ron",
-        "raster_caveats.ron",
-        "scene_shading.ron",
-        "shadows.ron",
-    ] {
+    // Every graph file beside the shipped ones may be included by name.
+    let fragments = std::fs::read_dir(&graphs)
+        .expect("graphs/")
+        .filter_map(|entry| entry.ok()?.file_name().into_string().ok())
+        .filter(|name| name.ends_with(".ron"));
+    for fragment in fragments {
         text = text.replace(
             &format!("(file: \"{fragment}\""),
             &format!("(file: \"{}\"", graphs.join(fragment).display()),

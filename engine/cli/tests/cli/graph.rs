@@ -88,7 +88,7 @@ fn plan_json_has_stats() {
     assert!(aliased < unaliased, "{aliased} < {unaliased}");
     assert!(stats["compile_us"].as_f64().expect("time") > 0.0);
     assert_eq!(json["extent"]["width"], 1920);
-    assert_eq!(json["culled"][14]["name"], "spot_lights");
+    assert_eq!(json["culled"][15]["name"], "spot_lights");
 }
 
 #[test]
@@ -210,10 +210,11 @@ fn plan_with_a_scene_culls_what_the_scene_lacks() {
         "{text}"
     );
     assert!(text.contains("  0. shadow_sun (Raster)"), "{text}");
-    // The variant key: the sun pass compiles the sun loop and Blinn-Phong only.
+    // The variant key: the sun pass compiles the sun loop and Blinn-Phong only
+    // (rt_ao, off, is the sixth feature it may depend on).
     assert!(
         text.contains(
-            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS (variant key; 1 of up to 32 variants: 5 of the 13 features a pass may depend on)\n"
+            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS (variant key; 1 of up to 64 variants: 6 of the 13 features a pass may depend on)\n"
         ),
         "{text}"
     );

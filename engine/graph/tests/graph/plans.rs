@@ -88,30 +88,52 @@ fn plans_match_snapshots_and_pass_the_checker() {
 
 #[test]
 fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
-    let graph = weft_graph::load(&repo_root().join("graphs/forward.ron"));
-    let caveats = |requested: &[&str]| -> Vec<String> {
+    let caveats = |file: &str, requested: &[&str]| -> Vec<String> {
+        let graph = weft_graph::load(&repo_root().join("graphs").join(file));
         let options = CompileOptions {
             features: graph.features(requested),
             ..CompileOptions::default()
         };
-        let plan = weft_graph::compile(&graph, &options).expect("forward compiles");
+        let plan = weft_graph::compile(&graph, &options).expect("compiles");
         plan.caveats
             .iter()
             .map(|c| c.split([' ', ':']).next().unwrap_or_default().to_string())
             .collect()
     };
-    // raster_caveats.ron's unconditional notes; bloom.ron's while bloom is on
-    // (a default feature).
-    assert_eq!(caveats(&[]), ["bloom", "one", "direct"]);
-    assert_eq!(caveats(&["!bloom"]), ["one", "direct"]);
-    // Shadow maps under shadow casters with a sun or a spot, once with both.
+    // forward.ron's own note first (the environment is never traced there),
+    // then raster_caveats.ron's unconditional notes; bloom.ron's while bloom
+    // is on (a default feature).
     assert_eq!(
-        caveats(&["!bloom", "shadow_casters", "area_lights", "point_lights"]),
-        ["one", "direct", "area", "point", "the"]
+        caveats("forward.ron", &[]),
+        ["nothing", "bloom", "one", "direct"]
     );
     assert_eq!(
-        caveats(&["!bloom", "shadow_casters", "suns", "spot_lights"]),
-        ["sun", "one", "direct"]
+        caveats("forward.ron", &["!bloom"]),
+        ["nothing", "one", "direct"]
+    );
+    // Shadow maps under shadow casters with a sun or a spot, once with both.
+    assert_eq!(
+        caveats(
+            "forward.ron",
+            &["!bloom", "shadow_casters", "area_lights", "point_lights"]
+        ),
+        ["nothing", "one", "direct", "area", "point", "the"]
+    );
+    assert_eq!(
+        caveats(
+            "forward.ron",
+            &["!bloom", "shadow_casters", "suns", "spot_lights"]
+        ),
+        ["nothing", "sun", "one", "direct"]
+    );
+    // deferred.ron: rt_ao.ron's note holds until rt_ao traces the environment.
+    assert_eq!(
+        caveats("deferred.ron", &["!bloom"]),
+        ["one", "direct", "nothing"]
+    );
+    assert_eq!(
+        caveats("deferred.ron", &["!bloom", "rt_ao"]),
+        ["one", "direct"]
     );
 }
 
@@ -185,6 +207,7 @@ fn scene_features_cull_passes_and_variants() {
             ("show_mesh_density", "enabled_if [mesh_density] is false"),
             ("show_normals", "enabled_if [normals] is false"),
             ("show_light_count", "enabled_if [light_count] is false"),
+            ("rt_ao", "enabled_if [rt_ao] is false"),
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
             ("area_lights", "enabled_if [area_lights] is false"),
