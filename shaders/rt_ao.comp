@@ -1,8 +1,9 @@
 #version 450
 // Ray-traced ambient occlusion (graphs/rt_ao.ron): for each G-buffer pixel,
 // `rays` cosine-weighted directions about the surface normal, each traced
-// for any hit within `radius` (0: unbounded); `ao` gets the fraction that
-// meet nothing. Cosine weighting makes that fraction, times the ambient
+// for any hit within `radius` (0: unbounded); `ao.r` gets the fraction that
+// meet nothing, averaged with the last frames' (at most `frames` in all,
+// counted in `ao.g`) while `history_frames` says nothing changed. Cosine weighting makes that fraction, times the ambient
 // radiance and the diffuse albedo, the estimate of light from a uniform sky
 // that the path tracer makes at its first bounce: the two agree in
 // expectation. Rays start just off the surface (`leave`, shared with the
@@ -16,11 +17,12 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform sampler2D depth;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
-layout(set = 0, binding = 2, r32f) uniform writeonly image2D ao;
+layout(set = 0, binding = 2, rg32f) uniform image2D ao;
 
 layout(push_constant) uniform Params {
     uint rays;
     float radius;
+    uint frames;
     uint history_frames;
 } params;
 
@@ -32,7 +34,7 @@ void main() {
     }
     float d = texelFetch(depth, pixel, 0).r;
     if (d <= 0.0) {
-        imageStore(ao, pixel, vec4(1.0));
+        imageStore(ao, pixel, vec4(1.0, 1.0, 0.0, 0.0));
         return;
     }
     vec3 p = position_from_depth(vec2(pixel) + 0.5, d);
@@ -46,5 +48,15 @@ void main() {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
         open += trace_any(origin, dir, t_max) ? 0u : 1u;
     }
-    imageStore(ao, pixel, vec4(float(open) / float(max(params.rays, 1u))));
+    float visible = float(open) / float(max(params.rays, 1u));
+    // A running mean over the last frames, its count capped at `frames`, so
+    // older frames fade out rather than weigh forever.
+    float kept = 0.0;
+    float mean = visible;
+    if (params.history_frames > 0u && params.frames > 1u) {
+        vec2 previous = imageLoad(ao, pixel).rg;
+        kept = min(previous.g, float(params.frames - 1u));
+        mean = (previous.r * kept + visible) / (kept + 1.0);
+    }
+    imageStore(ao, pixel, vec4(mean, kept + 1.0, 0.0, 0.0));
 }
