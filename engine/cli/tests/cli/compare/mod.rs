@@ -25,6 +25,9 @@ fn weft(args: &[&str], cache: &Path) -> Output {
         .expect("weft runs")
 }
 
+/// The size, reference samples and frames of a quick measurement.
+const SMALL: [&str; 6] = ["--size", "48x32", "--spp", "4", "--frames", "1"];
+
 /// Runs weft with its user cache in `cache`, and asserts it succeeded (its
 /// stderr shown if not).
 fn weft_ok(args: &[&str], cache: &Path) -> Output {

@@ -1,7 +1,7 @@
 //! `weft sweep`: its CSV, plot and frontier, resuming, every point checked
 //! before work, and shards merged.
 
-use super::{temp, weft, weft_ok};
+use super::{temp, weft, weft_ok, SMALL};
 use crate::harness::{command_in, repo};
 use std::path::{Path, PathBuf};
 
@@ -304,30 +304,17 @@ fn a_sweep_over_graphs_measures_each_graph_as_its_own_sweep_does() {
     let root = temp("sweep-graphs");
     let sweep = |graphs: (&str, &str), out: &str, noise_floor: bool| {
         let out = root.join(out);
-        weft_ok(
-            &[
-                "sweep",
-                "scenes/demo.scene",
-                graphs.0,
-                graphs.1,
-                if noise_floor {
-                    "--noise-floor"
-                } else {
-                    "--validate"
-                },
-                "--param",
-                "shadows.pcf_radius=0,2",
-                "--size",
-                "48x32",
-                "--spp",
-                "4",
-                "--frames",
-                "1",
-                "--out",
-                &out.to_string_lossy(),
-            ],
-            &cache,
-        );
+        let out_arg = out.to_string_lossy().into_owned();
+        let flag = if noise_floor {
+            "--noise-floor"
+        } else {
+            "--validate"
+        };
+        let mut args = vec!["sweep", "scenes/demo.scene", graphs.0, graphs.1, flag];
+        args.extend(["--param", "shadows.pcf_radius=0,2"]);
+        args.extend(SMALL);
+        args.extend(["--out", out_arg.as_str()]);
+        weft_ok(&args, &cache);
         std::fs::read_to_string(out.join("sweep.csv")).expect("sweep.csv")
     };
     // The figures a row holds besides frame time: flip, rmse, device bytes.
