@@ -179,8 +179,8 @@ impl Report {
     pub fn table(&self) -> String {
         let notes = self.caveat_notes();
         let mut out = String::from(
-            "| configuration | HDR-FLIP | LDR-FLIP | RMSE | rel. MSE | PSNR (dB) | luminance ratio | frame ms: median (IQR) | transient (MiB) | device (MiB) | caveats |\n\
-             |---|---|---|---|---|---|---|---|---|---|---|\n",
+            "| configuration | HDR-FLIP | LDR-FLIP | RMSE | rel. MSE | PSNR (dB) | luminance ratio | frame ms: median (IQR) | fastest ms | transient (MiB) | device (MiB) | caveats |\n\
+             |---|---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         for c in &self.configurations {
             let numbers: Vec<String> = c
@@ -190,7 +190,7 @@ impl Report {
                 .map(|i| (i + 1).to_string())
                 .collect();
             out += &format!(
-                "| {} | {:.4} | {:.4} | {:.4e} | {:.4e} | {:.2} | {:.3} | {:.2} ({:.2}–{:.2}) | {:.1} | {:.1} | {} |\n",
+                "| {} | {:.4} | {:.4} | {:.4e} | {:.4e} | {:.2} | {:.3} | {:.2} ({:.2}–{:.2}) | {:.2} | {:.1} | {:.1} | {} |\n",
                 c.name,
                 c.flip,
                 c.flip_ldr,
@@ -201,6 +201,7 @@ impl Report {
                 c.frame_spread.median,
                 c.frame_spread.p25,
                 c.frame_spread.p75,
+                c.frame_spread.min,
                 mib(c.transient_bytes),
                 mib(c.device_bytes),
                 if numbers.is_empty() {

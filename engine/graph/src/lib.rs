@@ -5,6 +5,7 @@
 
 pub mod check;
 pub mod compile;
+pub mod condition;
 pub mod diagnostic;
 pub mod dot;
 pub mod expr;

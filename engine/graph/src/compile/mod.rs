@@ -168,10 +168,7 @@ fn readback_for(graph: &LoadedGraph, asked: &[String], features: &BTreeSet<Strin
 }
 
 pub fn conditions_hold(conditions: &[String], features: &BTreeSet<String>) -> bool {
-    conditions.iter().all(|c| match c.strip_prefix('!') {
-        Some(name) => !features.contains(name),
-        None => features.contains(c),
-    })
+    crate::condition::all_hold(conditions, features)
 }
 
 /// The notes of the graph's caveats whose features hold, each once (a note

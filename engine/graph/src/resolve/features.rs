@@ -13,8 +13,10 @@ pub fn feature_names(ir: &Ir) -> BTreeSet<String> {
             .iter()
             .chain(pass.accesses.iter().flat_map(|a| a.conditions.iter()))
             .chain(pass.defines.iter().flat_map(|d| d.enabled_if.iter()));
-        for c in conditions {
-            names.insert(c.trim_start_matches('!').to_string());
+        for name in conditions.flat_map(|c| crate::condition::names(c)) {
+            if !name.is_empty() {
+                names.insert(name.to_string());
+            }
         }
     }
     names

@@ -124,7 +124,7 @@ impl IrPass {
             .iter()
             .flat_map(|a| a.conditions.iter())
             .chain(self.defines.iter().flat_map(|d| d.enabled_if.iter()))
-            .map(|f| f.trim_start_matches('!'))
+            .flat_map(|c| crate::condition::names(c))
             .collect();
         features.sort_unstable();
         features.dedup();

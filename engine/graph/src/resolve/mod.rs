@@ -231,9 +231,18 @@ impl<'a> Resolver<'a> {
                     .hint = Some("say what differs from the reference and why".into());
             }
             // A fragment's features may be its includer's: checked there.
-            for condition in caveat.enabled_if.iter().filter(|_| !self.graph.is_fragment) {
-                let feature = condition.trim_start_matches('!');
-                if !known.contains(feature) {
+            for condition in &caveat.enabled_if {
+                if let Some(problem) = crate::condition::malformed(condition) {
+                    self.error(*source, &path("enabled_if"), problem);
+                }
+            }
+            let named = caveat
+                .enabled_if
+                .iter()
+                .filter(|_| !self.graph.is_fragment)
+                .flat_map(|c| crate::condition::names(c).map(move |n| (c, n)));
+            for (condition, feature) in named {
+                if !feature.is_empty() && !known.contains(feature) {
                     let hint =
                         crate::diagnostic::nearest(feature, known.iter().map(String::as_str))
                             .map(|n| format!("did you mean \"{n}\"?"));

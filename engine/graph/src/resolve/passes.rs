@@ -60,6 +60,31 @@ impl Resolver<'_> {
         resolved
     }
 
+    /// Every condition of the pass (its own, its reads', its defines') is
+    /// well formed; a malformed one is reported at the pass's `enabled_if`
+    /// when it is the pass's own, else at the pass.
+    fn check_conditions(&mut self, pass: &IrPass) {
+        let own = pass.enabled_if.iter().map(|c| (c, true));
+        let others = pass
+            .accesses
+            .iter()
+            .flat_map(|a| a.conditions.iter())
+            .chain(pass.defines.iter().flat_map(|d| d.enabled_if.iter()))
+            .map(|c| (c, false));
+        let problems: Vec<(String, bool)> = own
+            .chain(others)
+            .filter_map(|(c, is_own)| crate::condition::malformed(c).map(|m| (m, is_own)))
+            .collect();
+        for (problem, is_own) in problems {
+            let field = if is_own { "enabled_if" } else { "name" };
+            self.error(
+                pass.source,
+                &pass_path(pass.index, &[Seg::Field(field)]),
+                problem,
+            );
+        }
+    }
+
     pub(super) fn resolve_pass(
         &mut self,
         p: &Located<PassDecl>,
@@ -239,6 +264,7 @@ impl Resolver<'_> {
             defines: self.check_defines(source, index, decl),
         };
         self.check_pass_shape(&pass, decl, resources);
+        self.check_conditions(&pass);
         let bits = pass.variant_bits();
         if bits > super::ir::MAX_VARIANT_BITS {
             self.error(

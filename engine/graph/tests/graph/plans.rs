@@ -453,3 +453,42 @@ fn parameter_values_are_held_to_their_declared_type_and_range() {
     );
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+/// An `enabled_if` entry of alternatives holds when one of them does: a
+/// pass reading the shadow map "for spots or unless traced" runs in three
+/// of the four combinations, and the graph's feature names include each
+/// alternative's.
+#[test]
+fn alternatives_in_a_condition_decide_culling() {
+    let text = r#"Graph(
+    resources: [Image(name: "map", format: R8G8B8A8_UNORM), Image(name: "ldr", format: R8G8B8A8_SRGB)],
+    passes: [
+        Pass(name: "shadow", kind: Fullscreen, shaders: (fragment: "s.frag"), color: [(image: "map")],
+             enabled_if: ["shadow_casters", "spot_lights|!rt_shadows"]),
+        Pass(name: "shade", kind: Fullscreen, shaders: (fragment: "t.frag"),
+             sampled: [(name: "map", enabled_if: ["shadow_casters", "spot_lights|!rt_shadows"])],
+             color: [(image: "ldr")]),
+    ],
+    output: "ldr",
+)"#;
+    let graph = crate::support::load_files("/g/main.ron", &[("/g/main.ron", text)]);
+    assert_eq!(weft_graph::check(&graph), Vec::new());
+    let prepared = weft_graph::Prepared::new(graph.clone()).expect("prepares");
+    let names = weft_graph::feature_names(prepared.ir());
+    for name in ["shadow_casters", "spot_lights", "rt_shadows"] {
+        assert!(names.contains(name), "{name} in {names:?}");
+    }
+    let runs = |features: &[&str]| {
+        let options = CompileOptions {
+            features: features.iter().map(|f| f.to_string()).collect(),
+            ..CompileOptions::default()
+        };
+        let plan = weft_graph::compile(&graph, &options).expect("compiles");
+        plan.passes.iter().any(|p| p.name == "shadow")
+    };
+    assert!(runs(&["shadow_casters"]));
+    assert!(runs(&["shadow_casters", "spot_lights"]));
+    assert!(runs(&["shadow_casters", "spot_lights", "rt_shadows"]));
+    assert!(!runs(&["shadow_casters", "rt_shadows"]));
+    assert!(!runs(&["spot_lights"]));
+}

@@ -141,6 +141,18 @@ fn a_compare_run_writes_every_file_and_caches_its_reference() {
         }
         let flip = c["flip"].as_f64().expect("flip");
         assert!(flip > 0.0 && flip < 1.0, "{flip}");
+        // The table's `fastest ms` is the fastest measured frame.
+        let fastest = c["frame_spread"]["min"].as_f64().expect("frame_spread.min");
+        let name = c["name"].as_str().expect("name");
+        let row = stdout
+            .lines()
+            .find(|l| l.starts_with(&format!("| {name} |")))
+            .expect("the configuration's row");
+        assert_eq!(
+            row.split('|').nth(9).map(str::trim),
+            Some(format!("{fastest:.2}").as_str()),
+            "{row}"
+        );
         let ratio = c["luminance_ratio"].as_f64().expect("luminance_ratio");
         assert!(ratio.is_finite() && ratio > 0.0, "{ratio}");
         let passes = c["passes"].as_array().expect("passes");

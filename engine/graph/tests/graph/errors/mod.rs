@@ -441,3 +441,27 @@ fn warnings_for_unread_resources_and_culled_passes() {
     );
     assert_eq!(diags.len(), 1);
 }
+
+/// An `enabled_if` entry with an empty alternative is an error (a read's
+/// condition is reported at its pass); alternatives themselves (`a|!b`)
+/// check clean.
+#[test]
+fn a_condition_with_an_empty_alternative() {
+    let read = |condition: &str| {
+        VALID.replace(
+            r#"sampled: ["albedo", "depth"],"#,
+            &format!(r#"sampled: ["albedo", (name: "depth", enabled_if: ["{condition}"])],"#),
+        )
+    };
+    let good = read("spot_lights|!rt");
+    assert!(errors(&good).is_empty(), "{:#?}", errors(&good));
+    let text = read("spot_lights||!rt");
+    let d = only_error(&text);
+    assert!(
+        d.message
+            .starts_with(r#"condition "spot_lights||!rt" has an empty alternative"#),
+        "{}",
+        d.message
+    );
+    assert_eq!(text_at(&text, &d), r#""resolve","#);
+}
