@@ -1,6 +1,7 @@
 //! `weft graph check`: validation across every combination of the features a graph
 //! mentions, so no toggle or scene can produce an invalid configuration.
 
+use crate::compile::cull::unneeded_warning;
 use crate::compile::{compile_ir, CompileOptions};
 use crate::diagnostic::Diagnostic;
 use crate::load::LoadedGraph;
@@ -22,8 +23,10 @@ pub fn check(graph: &LoadedGraph) -> Vec<Diagnostic> {
     if !graph.is_fragment && !diags.iter().any(Diagnostic::is_error) {
         let names: Vec<String> = feature_names(&ir).into_iter().collect();
         let sets = feature_sets(&names);
-        // Each distinct diagnostic with the feature sets it appears under.
+        // Each distinct diagnostic with the feature sets it appears under,
+        // and every pass that runs under some feature set.
         let mut found: Vec<(Diagnostic, Vec<String>)> = Vec::new();
+        let mut ran: BTreeSet<String> = BTreeSet::new();
         for features in &sets {
             let label = describe(&names, features);
             let options = CompileOptions {
@@ -32,7 +35,10 @@ pub fn check(graph: &LoadedGraph) -> Vec<Diagnostic> {
                 ..CompileOptions::default()
             };
             let diagnostics = match compile_ir(graph, &ir, &options) {
-                Ok(plan) => plan.warnings,
+                Ok(plan) => {
+                    ran.extend(plan.passes.iter().map(|p| p.name.clone()));
+                    plan.warnings
+                }
                 Err(errors) => errors,
             };
             for d in diagnostics {
@@ -42,6 +48,12 @@ pub fn check(graph: &LoadedGraph) -> Vec<Diagnostic> {
                 }
             }
         }
+        // A pass culled as unneeded under some feature sets but run under
+        // others is culling doing its job (a shadow map no one reads while
+        // shadows are traced); one that no feature set needs is a mistake.
+        let needed_somewhere =
+            |d: &Diagnostic| ran.iter().any(|name| d.message == unneeded_warning(name));
+        found.retain(|(d, _)| d.is_error() || !needed_somewhere(d));
         for (mut d, labels) in found {
             if d.is_error() && labels.len() < sets.len() {
                 d.message = format!("{} (with features {})", d.message, labels[0]);

@@ -77,6 +77,14 @@ pub(crate) struct Culled {
     pub warnings: Vec<Diagnostic>,
 }
 
+/// Why a live pass is culled when nothing it writes reaches a root.
+pub(crate) const UNNEEDED: &str = "contributes nothing to the output";
+
+/// The warning for live pass `name` culled for [`UNNEEDED`].
+pub(crate) fn unneeded_warning(name: &str) -> String {
+    format!("pass \"{name}\" is culled: it {UNNEEDED}")
+}
+
 /// Keeps the live passes that contribute to a root.
 pub(crate) fn cull(
     graph: &LoadedGraph,
@@ -100,12 +108,9 @@ pub(crate) fn cull(
         } else if !needed[p] {
             let mut d = locate(graph, ir, p, &[Seg::Field("name")]);
             d.severity = Severity::Warning;
-            d.message = format!(
-                "pass \"{}\" is culled: it contributes nothing to the output",
-                pass.name
-            );
+            d.message = unneeded_warning(&pass.name);
             warnings.push(d);
-            "contributes nothing to the output".to_string()
+            UNNEEDED.to_string()
         } else {
             continue;
         };

@@ -5,7 +5,7 @@
 //! transient memory (`memory`), every barrier (`sync`) and the pass descriptions
 //! with their render passes (`passes`), all for one output size.
 
-mod cull;
+pub(crate) mod cull;
 mod lifetimes;
 pub(crate) mod memory;
 pub(crate) mod order;

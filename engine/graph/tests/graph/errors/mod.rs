@@ -465,3 +465,31 @@ fn a_condition_with_an_empty_alternative() {
     );
     assert_eq!(text_at(&text, &d), r#""resolve","#);
 }
+
+/// A pass whose output only a conditional read takes is culled without a
+/// warning where that read is off: another feature set needs it. One that
+/// no feature set needs is still warned about (above).
+#[test]
+fn a_pass_some_feature_set_needs_is_culled_elsewhere_without_a_warning() {
+    let text = VALID
+        .replace(
+            "    ],\n    output:",
+            r#"        Pass(
+            name: "extra_input",
+            kind: Fullscreen,
+            shaders: (fragment: "d.frag"),
+            color: [(image: "scratch")],
+        ),
+    ],
+    output:"#,
+        )
+        .replace(
+            r#"sampled: ["albedo", "depth"],"#,
+            r#"sampled: ["albedo", "depth", (name: "scratch", enabled_if: ["extra"])],"#,
+        )
+        .replace(
+            r#"Image(name: "ldr", format: R8G8B8A8_SRGB),"#,
+            r#"Image(name: "ldr", format: R8G8B8A8_SRGB), Image(name: "scratch", format: R8_UNORM),"#,
+        );
+    assert_eq!(check_text(&text), Vec::<Diagnostic>::new(), "{text}");
+}
