@@ -412,23 +412,32 @@ fn every_error_is_collected_not_just_the_first() {
     );
 }
 
-#[test]
-fn warnings_for_unread_resources_and_culled_passes() {
-    let text = VALID.replace(
-        "    ],\n    output:",
-        r#"        Pass(
-            name: "debug",
+/// The valid graph with one more pass, `name`, writing an image `scratch`
+/// that nothing reads.
+fn with_scratch_writer(name: &str) -> String {
+    VALID
+        .replace(
+            "    ],\n    output:",
+            &format!(
+                r#"        Pass(
+            name: "{name}",
             kind: Fullscreen,
             shaders: (fragment: "d.frag"),
             color: [(image: "scratch")],
         ),
     ],
-    output:"#,
-    )
-    .replace(
-        r#"Image(name: "ldr", format: R8G8B8A8_SRGB),"#,
-        r#"Image(name: "ldr", format: R8G8B8A8_SRGB), Image(name: "scratch", format: R8_UNORM),"#,
-    );
+    output:"#
+            ),
+        )
+        .replace(
+            r#"Image(name: "ldr", format: R8G8B8A8_SRGB),"#,
+            r#"Image(name: "ldr", format: R8G8B8A8_SRGB), Image(name: "scratch", format: R8_UNORM),"#,
+        )
+}
+
+#[test]
+fn warnings_for_unread_resources_and_culled_passes() {
+    let text = with_scratch_writer("debug");
     let diags = check_text(&text);
     let warnings: Vec<String> = diags
         .iter()
@@ -471,25 +480,9 @@ fn a_condition_with_an_empty_alternative() {
 /// no feature set needs is still warned about (above).
 #[test]
 fn a_pass_some_feature_set_needs_is_culled_elsewhere_without_a_warning() {
-    let text = VALID
-        .replace(
-            "    ],\n    output:",
-            r#"        Pass(
-            name: "extra_input",
-            kind: Fullscreen,
-            shaders: (fragment: "d.frag"),
-            color: [(image: "scratch")],
-        ),
-    ],
-    output:"#,
-        )
-        .replace(
-            r#"sampled: ["albedo", "depth"],"#,
-            r#"sampled: ["albedo", "depth", (name: "scratch", enabled_if: ["extra"])],"#,
-        )
-        .replace(
-            r#"Image(name: "ldr", format: R8G8B8A8_SRGB),"#,
-            r#"Image(name: "ldr", format: R8G8B8A8_SRGB), Image(name: "scratch", format: R8_UNORM),"#,
-        );
+    let text = with_scratch_writer("extra_input").replace(
+        r#"sampled: ["albedo", "depth"],"#,
+        r#"sampled: ["albedo", "depth", (name: "scratch", enabled_if: ["extra"])],"#,
+    );
     assert_eq!(check_text(&text), Vec::<Diagnostic>::new(), "{text}");
 }
