@@ -41,8 +41,8 @@ mod tests {
     fn a_given_out_dir_is_used_and_created() {
         let dir = std::env::temp_dir().join(format!("weft-bench-out-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        assert_eq!(out_dir(Some(&dir), "bloom").unwrap(), dir);
+        assert_eq!(out_dir(Some(&dir), "bloom").expect("created"), dir);
         assert!(dir.is_dir());
-        std::fs::remove_dir_all(&dir).unwrap();
+        std::fs::remove_dir_all(&dir).expect("removed");
     }
 }

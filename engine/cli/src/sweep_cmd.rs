@@ -133,11 +133,21 @@ fn value(text: &str) -> ParamValue {
 }
 
 impl SweepRun {
-    /// The graphs swept, as the CSV and settings name them.
+    /// The graphs of `--graphs`, as the CSV names them (none without it).
+    fn swept_graphs(&self) -> Vec<String> {
+        self.graphs
+            .iter()
+            .map(|g| g.display().to_string())
+            .collect()
+    }
+
+    /// The graphs measured, as the settings and reports name them.
     fn graph_names(&self) -> Vec<String> {
-        match self.graphs.as_slice() {
-            [] => vec![self.graph.display().to_string()],
-            many => many.iter().map(|g| g.display().to_string()).collect(),
+        let swept = self.swept_graphs();
+        if swept.is_empty() {
+            vec![self.graph.display().to_string()]
+        } else {
+            swept
         }
     }
 
@@ -378,12 +388,7 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
     if !args.graphs.is_empty() && args.params.iter().any(|(n, _)| n == GRAPH_COLUMN) {
         bail!("--param {GRAPH_COLUMN}=... cannot be swept with --graphs: sweep.csv's `{GRAPH_COLUMN}` column names each point's graph");
     }
-    let graph_names: Vec<String> = if args.graphs.is_empty() {
-        Vec::new()
-    } else {
-        args.graph_names()
-    };
-    let every = points(&graph_names, &args.params, &sets);
+    let every = points(&args.swept_graphs(), &args.params, &sets);
     // The graph loaded with every point's parameters and features before the
     // reference renders: a misspelt parameter or value fails at once.
     let mut graphs = crate::graphs::Loaded::default();

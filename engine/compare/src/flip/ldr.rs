@@ -160,7 +160,6 @@ fn per_pixel<T: Send + Copy + Default>(
     let mut out = vec![T::default(); width * height];
     out.par_chunks_mut(width.max(1))
         .enumerate()
-        .take(height)
         .for_each(|(y, row)| {
             for (x, value) in row.iter_mut().enumerate() {
                 *value = pixel(x, y);
