@@ -45,7 +45,7 @@ pub use context::{DeviceInfo, DeviceKind, Gpu, GpuOptions, MemoryReport};
 pub use draw::{DrawRecorder, NoDraws, RasterContext};
 pub use error::{GpuError, VkCall};
 pub use executor::{FrameOptions, FrameReport, Renderer};
-pub use present::{PresentSource, Presented, Presenter};
+pub use present::{Capture, Overlay, OverlayTarget, PresentSource, Presented, Presenter};
 pub use readback::{Pixels, Readback};
 pub use resources::{image_requirements, memory_requirements, oversized_images, FrameResources};
 pub use sets::{MATERIAL_SET, SCENE_SET};

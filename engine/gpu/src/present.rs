@@ -1,6 +1,8 @@
 //! Putting a rendered image on screen: acquire a swapchain image, blit the
-//! graph's output into it (scaled when the sizes differ), optionally copy the
-//! result back (screenshots of exactly what was shown), and present it.
+//! graph's output into it (scaled when the sizes differ), let an [`Overlay`]
+//! draw over it (the viewer's panel), optionally copy the result back
+//! (screenshots of exactly what was shown, with or without the overlay), and
+//! present it.
 //!
 //! Synchronization: acquire signals a semaphore that the blit waits for at the
 //! blit stage; the blit signals a per-swapchain-image semaphore that presenting
@@ -30,6 +32,41 @@ pub struct PresentSource {
     pub extent: vk::Extent2D,
     /// Its format, to know whether it can be filtered when scaled.
     pub format: vk::Format,
+}
+
+/// Something drawn over the presented image before it is shown (the viewer's
+/// panel), in the presenter's command buffer: [`Overlay::record`] finds the
+/// swapchain image in `COLOR_ATTACHMENT_OPTIMAL` with the blit's writes
+/// visible to colour-attachment reads and writes, and leaves it in that layout
+/// with its own writes made at the colour-attachment-output stage.
+pub trait Overlay {
+    /// Records the overlay's drawing into `cmd`.
+    fn record(&mut self, cmd: vk::CommandBuffer, target: &OverlayTarget) -> Result<(), GpuError>;
+}
+
+/// The swapchain image an [`Overlay`] draws on.
+#[derive(Debug, Clone, Copy)]
+pub struct OverlayTarget {
+    /// The image.
+    pub image: vk::Image,
+    /// Its index in the swapchain (stable until the swapchain is recreated,
+    /// which also changes `image`).
+    pub index: usize,
+    /// Its size in pixels.
+    pub extent: vk::Extent2D,
+    /// Its format.
+    pub format: vk::Format,
+}
+
+/// Whether a presented frame is also copied back, and at which point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Capture {
+    /// Not copied.
+    No,
+    /// The graph's image as blitted, before any overlay.
+    Image,
+    /// What the window shows, overlay included.
+    WithOverlay,
 }
 
 /// What presenting a frame did.
@@ -106,14 +143,16 @@ impl<'g> Presenter<'g> {
         Ok(())
     }
 
-    /// Shows `source` in the window (scaled to the swapchain's size). With
-    /// `capture`, the swapchain image is also copied back. `size` is the
-    /// window's size, used if the swapchain must be recreated.
+    /// Shows `source` in the window (scaled to the swapchain's size) with
+    /// `overlay` drawn over it. With `capture`, the swapchain image is also
+    /// copied back. `size` is the window's size, used if the swapchain must be
+    /// recreated.
     pub fn present(
         &mut self,
         source: PresentSource,
-        capture: bool,
+        capture: Capture,
         size: [u32; 2],
+        overlay: Option<&mut dyn Overlay>,
     ) -> Result<Presented, GpuError> {
         let device = self.gpu.device();
         let slot = self.slot;
@@ -142,10 +181,9 @@ impl<'g> Presenter<'g> {
         };
         let target = self.swapchain.images()[index as usize];
         let extent = self.swapchain.extent();
-        let capture_buffer = if capture {
-            Some(CaptureBuffer::new(self.gpu, extent)?)
-        } else {
-            None
+        let capture_buffer = match capture {
+            Capture::No => None,
+            Capture::Image | Capture::WithOverlay => Some(CaptureBuffer::new(self.gpu, extent)?),
         };
         let cmd = self.commands[slot];
         unsafe {
@@ -164,7 +202,56 @@ impl<'g> Presenter<'g> {
         } else {
             vk::Filter::LINEAR
         };
-        self.record_blit(cmd, source, target, extent, filter, capture_buffer.as_ref());
+        let mut state = self.record_blit(cmd, source, target, extent, filter);
+        let copy = |state: &mut TargetState| {
+            if let Some(buffer) = capture_buffer.as_ref() {
+                state.transition(
+                    self.gpu,
+                    cmd,
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_READ,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                );
+                buffer.record(cmd, target, extent);
+                state.access = vk::AccessFlags2::NONE;
+            }
+        };
+        if capture == Capture::Image || overlay.is_none() {
+            copy(&mut state);
+        }
+        if let Some(overlay) = overlay {
+            state.transition(
+                self.gpu,
+                cmd,
+                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags2::COLOR_ATTACHMENT_READ | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            );
+            state.access = vk::AccessFlags2::COLOR_ATTACHMENT_WRITE;
+            let drawn = overlay.record(
+                cmd,
+                &OverlayTarget {
+                    image: target,
+                    index: index as usize,
+                    extent,
+                    format: self.swapchain.format().format,
+                },
+            );
+            if let Err(err) = drawn {
+                unsafe { device.end_command_buffer(cmd) }.call("vkEndCommandBuffer")?;
+                return Err(err);
+            }
+            if capture == Capture::WithOverlay {
+                copy(&mut state);
+            }
+        }
+        state.transition(
+            self.gpu,
+            cmd,
+            vk::PipelineStageFlags2::NONE,
+            vk::AccessFlags2::NONE,
+            vk::ImageLayout::PRESENT_SRC_KHR,
+        );
         unsafe { device.end_command_buffer(cmd) }.call("vkEndCommandBuffer")?;
         let waits = [vk::SemaphoreSubmitInfo::default()
             .semaphore(self.acquired[slot])
@@ -206,6 +293,8 @@ impl<'g> Presenter<'g> {
         }
     }
 
+    /// Records the blit of `source` into `target`, leaving `target` in
+    /// `TRANSFER_DST_OPTIMAL`; returns that state for the next transition.
     fn record_blit(
         &self,
         cmd: vk::CommandBuffer,
@@ -213,15 +302,21 @@ impl<'g> Presenter<'g> {
         target: vk::Image,
         extent: vk::Extent2D,
         filter: vk::Filter,
-        capture: Option<&CaptureBuffer<'_>>,
-    ) {
+    ) -> TargetState {
         let device = self.gpu.device();
-        let to_dst = image_barrier(target)
-            .src_stage_mask(vk::PipelineStageFlags2::BLIT)
-            .dst_stage_mask(vk::PipelineStageFlags2::BLIT)
-            .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-            .old_layout(vk::ImageLayout::UNDEFINED)
-            .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+        let mut state = TargetState {
+            image: target,
+            stage: vk::PipelineStageFlags2::BLIT,
+            access: vk::AccessFlags2::NONE,
+            layout: vk::ImageLayout::UNDEFINED,
+        };
+        state.transition(
+            self.gpu,
+            cmd,
+            vk::PipelineStageFlags2::BLIT,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+        );
         let region = vk::ImageBlit2::default()
             .src_subresource(color_layers())
             .src_offsets([vk::Offset3D::default(), corner(source.extent)])
@@ -235,54 +330,47 @@ impl<'g> Presenter<'g> {
             .dst_image_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
             .regions(&regions)
             .filter(filter);
+        unsafe { device.cmd_blit_image2(cmd, &blit) };
+        state
+    }
+}
+
+/// Where the swapchain image stands within one frame's commands: the stage
+/// and access of its last use, and its layout.
+struct TargetState {
+    image: vk::Image,
+    stage: vk::PipelineStageFlags2,
+    access: vk::AccessFlags2,
+    layout: vk::ImageLayout,
+}
+
+impl TargetState {
+    /// Records a barrier from the last use to one at `stage` with `access` in
+    /// `layout`, and makes that the last use.
+    fn transition(
+        &mut self,
+        gpu: &Gpu,
+        cmd: vk::CommandBuffer,
+        stage: vk::PipelineStageFlags2,
+        access: vk::AccessFlags2,
+        layout: vk::ImageLayout,
+    ) {
+        let barrier = image_barrier(self.image)
+            .src_stage_mask(self.stage)
+            .src_access_mask(self.access)
+            .dst_stage_mask(stage)
+            .dst_access_mask(access)
+            .old_layout(self.layout)
+            .new_layout(layout);
         unsafe {
-            device.cmd_pipeline_barrier2(
+            gpu.device().cmd_pipeline_barrier2(
                 cmd,
-                &vk::DependencyInfo::default().image_memory_barriers(&[to_dst]),
-            );
-            device.cmd_blit_image2(cmd, &blit);
-        }
-        let (last_stage, last_access, last_layout) = match capture {
-            Some(buffer) => {
-                let to_src = image_barrier(target)
-                    .src_stage_mask(vk::PipelineStageFlags2::BLIT)
-                    .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                    .dst_stage_mask(vk::PipelineStageFlags2::COPY)
-                    .dst_access_mask(vk::AccessFlags2::TRANSFER_READ)
-                    .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-                    .new_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-                unsafe {
-                    device.cmd_pipeline_barrier2(
-                        cmd,
-                        &vk::DependencyInfo::default().image_memory_barriers(&[to_src]),
-                    );
-                }
-                buffer.record(cmd, target, extent);
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::NONE,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                )
-            }
-            None => (
-                vk::PipelineStageFlags2::BLIT,
-                vk::AccessFlags2::TRANSFER_WRITE,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            ),
-        };
-        let to_present = image_barrier(target)
-            .src_stage_mask(last_stage)
-            .src_access_mask(last_access)
-            .dst_stage_mask(vk::PipelineStageFlags2::NONE)
-            .dst_access_mask(vk::AccessFlags2::NONE)
-            .old_layout(last_layout)
-            .new_layout(vk::ImageLayout::PRESENT_SRC_KHR);
-        unsafe {
-            device.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().image_memory_barriers(&[to_present]),
+                &vk::DependencyInfo::default().image_memory_barriers(&[barrier]),
             );
         }
+        self.stage = stage;
+        self.access = access;
+        self.layout = layout;
     }
 }
 

@@ -94,10 +94,13 @@ impl<'g> Swapchain<'g> {
         let format = choose_format(&formats)
             .ok_or(GpuError::Plan("the surface offers no image format".into()))?;
         let extent = choose_extent(&caps, size);
-        let usage = vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC;
+        // Colour attachment: an overlay (the viewer's panel) draws over the blit.
+        let usage = vk::ImageUsageFlags::TRANSFER_DST
+            | vk::ImageUsageFlags::TRANSFER_SRC
+            | vk::ImageUsageFlags::COLOR_ATTACHMENT;
         if !caps.supported_usage_flags.contains(usage) {
             return Err(GpuError::Plan(format!(
-                "swapchain images cannot be blitted to and copied from (usage {:?})",
+                "swapchain images cannot be blitted to, drawn to and copied from (usage {:?})",
                 caps.supported_usage_flags
             )));
         }

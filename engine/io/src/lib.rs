@@ -15,7 +15,7 @@ pub mod paths;
 pub mod read;
 pub mod sources;
 
-pub use read::{open_regular, read_capped, read_text, FileKind, ReadError};
+pub use read::{open_regular, read_capped, read_text, FileKind, ReadError, MAX_TEXT_BYTES};
 
 /// A fresh folder for one unit test, under the system's temporary folder.
 #[cfg(test)]

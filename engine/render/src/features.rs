@@ -138,3 +138,44 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     }
     features
 }
+
+/// Why [`scene_features`] sets `name`, in a phrase a user reads beside it
+/// (the viewer's panel shows scene features read-only with this); `None`
+/// for a name it never sets.
+pub fn scene_feature_reason(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "shadow_casters" => {
+            "a placed mesh casts shadows and a sun, cone spot, area light or emissive mesh casts them"
+        }
+        "emissive" => "a placed mesh glows",
+        "transparent" => "a placed mesh blends",
+        "suns" => "the scene has a sun",
+        "point_lights" => "the scene has a point light",
+        "spot_lights" => "the scene has a spot light",
+        "area_lights" => "the scene has an area light or emissive geometry that lights raster passes",
+        "rect_lights" => "the scene has a rectangle or emissive-polygon light",
+        "disc_lights" => "the scene has a disc light",
+        "punctual_lights" => "the scene has a sun, point or spot light",
+        "glossy" => "a Blinn-Phong material has a specular lobe",
+        "dielectrics" => "a material is glass",
+        "mirrors" => "a material is a mirror (MTL illum 3)",
+        "coated" => "a material has a Fresnel coat (MTL illum 5)",
+        "metallic_roughness" => "a glTF material is placed",
+        "blinn_phong" => "a material shades with Blinn-Phong",
+        "emission_occlusion_maps" => "a material has an emissive or occlusion texture",
+        "normal_maps" => "a material has a normal texture",
+        "textures" => "a material has a texture",
+        _ => return None,
+    })
+}
+
+#[cfg(test)]
+mod reason_tests {
+    #[test]
+    fn every_scene_feature_has_a_reason() {
+        for name in weft_graph::SCENE_FEATURES {
+            assert!(super::scene_feature_reason(name).is_some(), "{name}");
+        }
+        assert_eq!(super::scene_feature_reason("bloom"), None);
+    }
+}

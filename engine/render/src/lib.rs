@@ -61,7 +61,7 @@ mod volumes;
 mod watch;
 
 pub use error::RenderError;
-pub use features::scene_features;
+pub use features::{scene_feature_reason, scene_features};
 pub use frame::{
     compile_for_scene, load_graph, render, render_with_progress, Progress, RenderSettings, Rendered,
 };

@@ -137,6 +137,16 @@ impl<'g> LiveRender<'g> {
         self.frames.samples()
     }
 
+    /// Draw calls recorded by the last frame.
+    pub fn draw_calls(&self) -> u64 {
+        self.frames.draw_calls()
+    }
+
+    /// Per view, meshes drawn and culled by the last frame.
+    pub fn culling(&self) -> &[crate::recorder::ViewCulling] {
+        self.frames.culling()
+    }
+
     /// The settings the live version was built with.
     pub fn settings(&self) -> &RenderSettings {
         &self.settings

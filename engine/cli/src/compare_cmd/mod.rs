@@ -169,7 +169,7 @@ pub(crate) fn tonemap(image: &LinearImage) -> SrgbImage {
 }
 
 /// A readback as linear RGB.
-fn linear(image: &Readback) -> LinearImage {
+pub(crate) fn linear(image: &Readback) -> LinearImage {
     let rgba = image.to_rgba_f32();
     LinearImage {
         width: rgba.width(),
@@ -239,7 +239,7 @@ fn first_readback<'a>(rendered: &'a Rendered, graph: &Path) -> Result<&'a Readba
         })
 }
 
-fn param_text(value: &ParamValue) -> String {
+pub(crate) fn param_text(value: &ParamValue) -> String {
     match value {
         ParamValue::Bool(b) => b.to_string(),
         ParamValue::Number(n) => n.to_string(),

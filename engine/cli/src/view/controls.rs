@@ -37,6 +37,12 @@ pub enum Action {
     Feature(usize),
     /// C: print the flown camera as a `.scene` `camera` block.
     PrintCamera,
+    /// F1: show or hide the panel.
+    Panel,
+    /// L: start or stop the live error against the reference.
+    LiveError,
+    /// B: save the camera as the next bookmark beside the scene.
+    SaveBookmark,
 }
 
 /// The action of a key pressed with or without Shift.
@@ -47,6 +53,9 @@ pub fn action(code: KeyCode, shift: bool) -> Option<Action> {
         KeyCode::Space => Some(Action::Pause),
         KeyCode::KeyR => Some(Action::ResetCamera),
         KeyCode::KeyC => Some(Action::PrintCamera),
+        KeyCode::F1 => Some(Action::Panel),
+        KeyCode::KeyL => Some(Action::LiveError),
+        KeyCode::KeyB => Some(Action::SaveBookmark),
         KeyCode::KeyG => Some(Action::Graph(if shift { -1 } else { 1 })),
         _ => FEATURE_KEYS
             .iter()
@@ -68,7 +77,7 @@ pub fn feature_key(index: usize) -> Option<String> {
 
 /// Parses one `--press` entry, `FRAME:KEY`: the key is pressed before frame
 /// FRAME (counted from 0) renders. KEY is `g`, `G` (Shift+G), `1`-`9`,
-/// `shift+1`-`shift+9`, `f12`, `space`, `r`, `c` or `esc`.
+/// `shift+1`-`shift+9`, `f1`, `f12`, `space`, `r`, `c`, `l`, `b` or `esc`.
 pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
     let (frame, key) = text
         .split_once(':')
@@ -81,6 +90,9 @@ pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
         "g" => (KeyCode::KeyG, false),
         "G" => (KeyCode::KeyG, true),
         "f12" | "F12" => (KeyCode::F12, false),
+        "f1" | "F1" => (KeyCode::F1, false),
+        "l" => (KeyCode::KeyL, false),
+        "b" => (KeyCode::KeyB, false),
         "space" => (KeyCode::Space, false),
         "r" => (KeyCode::KeyR, false),
         "c" => (KeyCode::KeyC, false),
@@ -94,7 +106,7 @@ pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
                 Ok(n @ 1..=9) => (FEATURE_KEYS[n - 1], shift),
                 _ => {
                     return Err(format!(
-                    "unknown key \"{other}\" (use g, G, 1-9, shift+1-9, f12, space, r, c or esc)"
+                    "unknown key \"{other}\" (use g, G, 1-9, shift+1-9, f1, f12, space, r, c, l, b or esc)"
                 ))
                 }
             }
@@ -156,7 +168,8 @@ pub fn sibling_graphs(graph: &Path) -> Vec<PathBuf> {
     graphs
 }
 
-fn same_file(a: &Path, b: &Path) -> bool {
+/// Whether two paths name one file.
+pub fn same_file(a: &Path, b: &Path) -> bool {
     match (a.canonicalize(), b.canonicalize()) {
         (Ok(a), Ok(b)) => a == b,
         _ => a == b,
@@ -302,6 +315,9 @@ mod tests {
         assert_eq!(feature_key(18), None);
         assert_eq!(parse_press(" 7 : f12 "), Ok((7, Action::Screenshot)));
         assert_eq!(parse_press("1:esc"), Ok((1, Action::Quit)));
+        assert_eq!(parse_press("2:f1"), Ok((2, Action::Panel)));
+        assert_eq!(parse_press("2:l"), Ok((2, Action::LiveError)));
+        assert_eq!(parse_press("2:b"), Ok((2, Action::SaveBookmark)));
         assert!(parse_press("1:0").is_err());
         assert!(parse_press("x:g").is_err());
         assert!(parse_press("g").is_err());

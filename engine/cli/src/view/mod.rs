@@ -3,9 +3,14 @@
 //! screenshots, and hot reload of the graph, its shaders and the scene.
 
 mod app;
+mod bookmarks;
 mod camera_block;
 mod controls;
 mod fly;
+mod live_error;
+mod overlay;
+mod panel;
+mod script;
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -29,7 +34,13 @@ Controls:
   1-9, Shift+1-9 toggle the graph's features (listed with their keys when a graph loads)
   Space          pause / resume scene time            R       back to the scene camera
   C              print the camera as a .scene `camera` block (world coordinates)
-  F12            save a screenshot (weft-<time>-<n>.png in --screenshot-dir, path printed)
+  B              save the camera as the next bookmark (<scene>.bookmarks.scene beside the scene)
+  F1             show / hide the panel: graph, features, parameters, pass times,
+                 memory, plan, convergence, reload errors (click to copy), bookmarks
+  L              live error: path-trace the current view in the background and show
+                 the HDR-FLIP map of the frame against it, updating as it converges
+  F12            save a screenshot (weft-<time>-<n>.png in --screenshot-dir, path printed;
+                 the panel only with --screenshot-panel)
   Esc            quit
 The title shows the graph, its features, frame time, samples per pixel for a
 progressive graph such as graphs/pathtrace.ron (it converges while nothing moves;
@@ -87,6 +98,30 @@ pub struct ViewArgs {
     /// the user cache (~/.cache/weft/screenshots); never the current directory.
     #[arg(long)]
     screenshot_dir: Option<PathBuf>,
+    /// Start with the panel shown (F1 shows and hides it).
+    #[arg(long)]
+    panel: bool,
+    /// Drive the panel without a mouse (scripts and tests): FRAME:click:NAME,
+    /// FRAME:text:TEXT or FRAME:enter, before frame FRAME. NAME is a panel
+    /// widget: feature:NAME, param:KEY, graph, graph:FILE, pause, live_error,
+    /// copy_camera, save_bookmark, bookmark:N, error.
+    #[arg(long, value_delimiter = ',', value_parser = script::parse_ui)]
+    ui: Vec<(u32, script::UiStep)>,
+    /// Include the panel and the live error map in screenshots (F12 and
+    /// --screenshot-on-exit); by default they hold the graph's image alone.
+    #[arg(long)]
+    screenshot_panel: bool,
+    /// The progressive graph the live error (L) measures against; by default
+    /// pathtrace.ron beside --graph, else graphs/pathtrace.ron.
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Stop the live error's reference at this many samples per pixel.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    reference_spp: Option<u64>,
+    /// On exit, write the live error's last HDR-FLIP map here (a magma PNG,
+    /// as `weft compare` writes it) and print its mean.
+    #[arg(long)]
+    live_error_out: Option<PathBuf>,
     /// Make every reload's preparation (on the worker thread) sleep this long
     /// first, to see the frame loop keep going during a slow one (tests).
     #[arg(long, hide = true, default_value_t = 0)]

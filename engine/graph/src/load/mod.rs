@@ -23,6 +23,13 @@ pub struct Source {
     pub spans: SpanTree,
     /// The file's parameters after include-site overrides and `$reference` resolution.
     pub params: BTreeMap<String, ParamValue>,
+    /// What values its parameters accept (`param_ranges`), for tools that
+    /// offer them (the viewer's sliders).
+    pub ranges: BTreeMap<String, crate::schema::ParamRange>,
+    /// The name `--param` reaches its parameters by from the root graph: empty
+    /// for the root, the file stem for a file the root includes (`shadows`
+    /// in `shadows.resolution`), `None` for files included deeper.
+    pub qualifier: Option<String>,
 }
 
 /// An item declared in some source file, with where to point diagnostics.
@@ -259,10 +266,17 @@ fn load_file(
         }
     };
     let source = graph.sources.len();
+    let qualifier = match &site {
+        None => Some(String::new()),
+        Some(site) if site.source == 0 => Some(include_stem(path)),
+        Some(_) => None,
+    };
     graph.sources.push(Source {
         file: path.to_path_buf(),
         spans,
         params: BTreeMap::new(),
+        ranges: parsed.param_ranges.clone(),
+        qualifier,
     });
     graph.inputs.push(parsed.inputs.clone());
     if !parsed.fragment && !parsed.inputs.is_empty() {

@@ -5,9 +5,11 @@
 //! camera and presents it.
 
 mod reload;
+mod ui;
 
 use super::controls::{self, Action, Status};
 use super::fly::{self, FlyCamera, FlyInput};
+use super::overlay::EguiOverlay;
 use super::ViewArgs;
 use anyhow::{anyhow, Context, Result};
 use ash::vk;
@@ -17,7 +19,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use weft_gpu::{Gpu, PresentSource, Presented, Presenter, Readback, Swapchain};
+use weft_gpu::{Capture, Gpu, PresentSource, Presented, Presenter, Readback, Swapchain};
 use weft_graph::plan::Extent;
 use weft_render::{FileWatcher, QUIET};
 use weft_render::{LiveRender, ReloadWorker, RenderSettings};
@@ -45,12 +47,14 @@ struct Stats {
     all_ms: Vec<f64>,
 }
 
-/// The viewer's state; the presenter is declared before the window so it is
-/// dropped first (the surface must go before its window).
+/// The viewer's state; the overlay (views of swapchain images) is declared
+/// before the presenter, and the presenter before the window, so each is
+/// dropped before what it uses (the surface must go before its window).
 pub struct Viewer<'g> {
     gpu: &'g Gpu,
     live: LiveRender<'g>,
     watcher: FileWatcher,
+    overlay: Option<EguiOverlay<'g>>,
     presenter: Option<Presenter<'g>>,
     window: Option<Window>,
     start: FlyCamera,
@@ -90,6 +94,10 @@ pub struct Viewer<'g> {
     reload: Option<ReloadProgress>,
     /// A reload committed, until its frame is shown.
     reloaded: Option<(String, ReloadProgress, f64)>,
+    /// The files of the last reload that went live, for the panel.
+    last_reload: Option<String>,
+    /// The panel (F1) and what it needs between frames.
+    ui: ui::UiState<'g>,
 }
 
 /// What the frame loop did while a reload was on its way.
@@ -126,9 +134,11 @@ impl<'g> Viewer<'g> {
         let mut watcher = FileWatcher::new(QUIET)?;
         watcher.watch(&live.sources().all())?;
         let graph = live.settings().graph.clone();
+        let ui = ui::UiState::new(args, &graph)?;
         let mut viewer = Self {
             gpu,
             watcher,
+            overlay: None,
             presenter: None,
             window: None,
             start,
@@ -164,6 +174,8 @@ impl<'g> Viewer<'g> {
             worker: ReloadWorker::spawn(scope, gpu, Duration::from_millis(args.prepare_delay_ms)),
             reload: None,
             reloaded: None,
+            last_reload: None,
+            ui,
             live,
         };
         viewer.print_features();
@@ -177,6 +189,9 @@ impl<'g> Viewer<'g> {
     /// Releases the window, prints how many frames were shown and how long
     /// they took, and reports a failure that stopped the loop.
     pub fn finish(mut self) -> Result<()> {
+        let graph = self.live.settings().graph.clone();
+        let reported = self.ui.report_live_error(&graph);
+        self.overlay = None;
         self.presenter = None;
         self.window = None;
         let mut times = std::mem::take(&mut self.stats.all_ms);
@@ -195,7 +210,7 @@ impl<'g> Viewer<'g> {
         }
         match self.failure.take() {
             Some(err) => Err(err),
-            None => Ok(()),
+            None => reported,
         }
     }
 
@@ -241,7 +256,9 @@ impl<'g> Viewer<'g> {
         // The presenter is dropped before the window (see `finish` and field order).
         let swapchain =
             unsafe { Swapchain::new(self.gpu, display, handle, [size.width, size.height]) }?;
-        self.presenter = Some(Presenter::new(self.gpu, swapchain)?);
+        let presenter = Presenter::new(self.gpu, swapchain)?;
+        self.overlay = Some(EguiOverlay::new(self.gpu, &window, presenter.format())?);
+        self.presenter = Some(presenter);
         self.window = Some(window);
         self.pending_size = Some([size.width, size.height]);
         Ok(())
@@ -256,7 +273,13 @@ impl<'g> Viewer<'g> {
             return;
         }
         self.held.insert(code);
-        if event.repeat {
+        if event.repeat
+            || self.ui.panel.visible
+                && self
+                    .overlay
+                    .as_ref()
+                    .is_some_and(EguiOverlay::wants_keyboard)
+        {
             return;
         }
         if let Some(action) = controls::action(code, self.shift) {
@@ -286,17 +309,22 @@ impl<'g> Viewer<'g> {
                 }
             }
             Action::Feature(index) => self.toggle_feature(index),
-            Action::PrintCamera => print!(
-                "{}",
-                super::camera_block::camera_block(
-                    "flown",
-                    &self.lens,
-                    self.live.scene().origin,
-                    self.camera.position,
-                    self.camera.orientation,
-                )
-            ),
+            Action::PrintCamera => print!("{}", self.camera_block()),
+            Action::Panel => self.ui.panel.visible = !self.ui.panel.visible,
+            Action::LiveError => self.toggle_live_error(),
+            Action::SaveBookmark => self.save_bookmark(),
         }
+    }
+
+    /// The flown camera as a `.scene` `camera` block.
+    fn camera_block(&self) -> String {
+        super::camera_block::camera_block(
+            "flown",
+            &self.lens,
+            self.live.scene().origin,
+            self.camera.position,
+            self.camera.orientation,
+        )
     }
 
     fn toggle_feature(&mut self, index: usize) {
@@ -377,7 +405,14 @@ impl<'g> Viewer<'g> {
             path: Vec::new(),
             ..self.lens.clone()
         };
-        let report = self.live.draw(&camera, self.time, self.frames, false)?;
+        let measure = self.ui.live_error_due(&self.live);
+        let read_views = self.ui.panel.visible && !self.live.plan().views.is_empty();
+        let report = self
+            .live
+            .draw(&camera, self.time, self.frames, measure || read_views)?;
+        self.ui
+            .step_live_error(&camera, self.time, &self.live, measure.then_some(&report))?;
+        self.ui.read_under_cursor(&self.live, &report, self.cursor);
         let restarted = self.live.samples().is_some()
             && self.live.samples() == self.live.plan().samples_per_frame.map(u64::from);
         self.restarts
@@ -400,18 +435,47 @@ impl<'g> Viewer<'g> {
         let last = self.frame_limit.is_some_and(|n| self.frames + 1 >= n)
             || self.stop.load(Ordering::SeqCst);
         let on_exit = last && self.screenshot_on_exit.is_some();
-        let capture = self.screenshot_now || on_exit;
+        let capture = match (self.screenshot_now || on_exit, self.ui.screenshot_panel) {
+            (false, _) => Capture::No,
+            (true, false) => Capture::Image,
+            (true, true) => Capture::WithOverlay,
+        };
+        let actions = self.run_panel()?;
+        let drawn = self.ui.overlay_drawn();
         let presenter = self
             .presenter
             .as_mut()
             .context("no presenter for the window")?;
-        let shown = match presenter.present(source, capture, size)? {
+        let overlay = self
+            .overlay
+            .as_mut()
+            .filter(|_| drawn)
+            .map(|o| o as &mut dyn weft_gpu::Overlay);
+        let presented = presenter.present(source, capture, size, overlay)?;
+        if let Some(overlay) = self.overlay.as_mut() {
+            overlay.after_present()?;
+        }
+        for action in actions {
+            self.apply_panel(action);
+        }
+        let shown = match presented {
             Presented::Shown(pixels) => pixels,
             Presented::Recreated => return Ok(()),
         };
         self.frames += 1;
-        self.timings = report.timings;
         let frame_ms = now.elapsed().as_secs_f64() * 1e3;
+        self.ui.panel.history.push(
+            frame_ms,
+            &report.timings,
+            self.live.samples(),
+            Instant::now(),
+        );
+        self.ui.memory = [
+            report.transient_bytes,
+            report.dedicated_bytes,
+            report.memory.allocated_bytes,
+        ];
+        self.timings = report.timings;
         self.stats.total_ms += frame_ms;
         self.stats.all_ms.push(frame_ms);
         self.stats.frames += 1;
@@ -544,6 +608,9 @@ impl ApplicationHandler for Viewer<'_> {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        if self.panel_took(&event) {
+            return;
+        }
         match event {
             WindowEvent::CloseRequested => self.stop.store(true, Ordering::SeqCst),
             WindowEvent::Resized(size) => self.pending_size = Some([size.width, size.height]),
@@ -555,7 +622,14 @@ impl ApplicationHandler for Viewer<'_> {
                 state,
                 button: MouseButton::Left,
                 ..
-            } => self.dragging = state == ElementState::Pressed,
+            } => {
+                let on_panel = self.ui.panel.visible
+                    && self
+                        .overlay
+                        .as_ref()
+                        .is_some_and(EguiOverlay::wants_pointer);
+                self.dragging = state == ElementState::Pressed && !on_panel;
+            }
             WindowEvent::CursorMoved { position, .. } => {
                 if let (true, Some((x, y))) = (self.dragging, self.cursor) {
                     self.drag += Vec2::new((position.x - x) as f32, (y - position.y) as f32);

@@ -11,6 +11,7 @@ use weft_render::{Committed, RenderSettings};
 impl Viewer<'_> {
     /// Switches the live render to `settings`; a refusal keeps the last good version.
     pub(super) fn reconfigure(&mut self, settings: RenderSettings) -> bool {
+        let settings = self.ui.with_readback(settings);
         let graph_changed = settings.graph != self.live.settings().graph;
         let features_changed = settings.features != self.live.settings().features;
         match self.live.reconfigure(settings) {
@@ -70,6 +71,7 @@ impl Viewer<'_> {
                 if let (false, Some(progress)) = (paths.is_empty(), progress) {
                     let files: Vec<String> =
                         paths.iter().map(|p| p.display().to_string()).collect();
+                    self.last_reload = Some(files.join(", "));
                     self.reloaded = Some((files.join(", "), progress, prepare_ms));
                 }
             }

@@ -5,6 +5,8 @@
 //! own X server on a display number the server picks (`-displayfd`) and stops
 //! it when the test ends, passed or failed.
 
+mod panel;
+
 use crate::harness::{command_in, repo};
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};

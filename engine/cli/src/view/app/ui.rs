@@ -1,0 +1,459 @@
+//! The viewer's side of the panel: what it needs between frames, running it
+//! each frame (with scripted input), applying what it asks for at the frame
+//! boundary, the live error's reference, bookmarks, and the debug-view value
+//! under the cursor.
+
+use super::super::bookmarks::{self, Bookmark};
+use super::super::controls;
+use super::super::live_error::{self, LiveError};
+use super::super::panel::{graph_params, Panel, PanelAction, PanelView};
+use super::super::script::{self, UiStep};
+use super::super::ViewArgs;
+use super::Viewer;
+use anyhow::{bail, Result};
+use std::path::PathBuf;
+use weft_gpu::readback::Pixels;
+use weft_gpu::FrameReport;
+use weft_render::{LiveRender, RenderSettings};
+use weft_scene::Camera;
+use winit::event::{ElementState, WindowEvent};
+
+/// Frames a scripted click waits for its widget to scroll into view.
+const CLICK_WAIT_FRAMES: u32 = 10;
+
+/// What the panel needs between frames.
+pub(super) struct UiState<'g> {
+    /// The panel itself.
+    pub panel: Panel,
+    /// Screenshots include the overlay (`--screenshot-panel`).
+    pub screenshot_panel: bool,
+    /// The last frame's transient, dedicated and allocated device bytes.
+    pub memory: [u64; 3],
+    /// `--ui` steps not yet taken, by frame.
+    script: Vec<(u32, UiStep)>,
+    /// Scripted presses to release at the next frame.
+    releases: Vec<egui::Pos2>,
+    /// Scripted clicks waiting for their widget to be scrolled into view:
+    /// the widget, and the last frame to wait for.
+    presses: Vec<(String, u32)>,
+    /// Scripted typing waiting for a field to have the keyboard, with the
+    /// last frame to wait for.
+    typing: Vec<(UiStep, u32)>,
+    live_error: Option<LiveError<'g>>,
+    reference: PathBuf,
+    reference_spp: Option<u64>,
+    live_error_out: Option<PathBuf>,
+    /// The live error map on screen: the samples and mean it shows, and its texture.
+    map: Option<(u64, f64, egui::TextureHandle)>,
+    bookmarks: Vec<Bookmark>,
+    /// Where bookmarks are saved; `None` when the file there could not be
+    /// read (it is never overwritten unread).
+    bookmarks_file: Option<PathBuf>,
+    bookmarks_path: PathBuf,
+    /// A debug view's value under the cursor.
+    under_cursor: Option<String>,
+    /// Whether the overlay draws this frame.
+    drawn: bool,
+    scene: PathBuf,
+}
+
+impl<'g> UiState<'g> {
+    /// The panel's state for a viewer started with `args` on `graph`.
+    pub fn new(args: &ViewArgs, graph: &std::path::Path) -> Result<Self> {
+        let bookmarks_path = bookmarks::file_for(&args.scene);
+        let (bookmarks, bookmarks_file) = match bookmarks::load(&bookmarks_path) {
+            Ok(marks) => (marks, Some(bookmarks_path.clone())),
+            Err(err) => {
+                eprintln!("warning: {err:#}; bookmarks will not be saved over it");
+                (Vec::new(), None)
+            }
+        };
+        Ok(Self {
+            panel: Panel::new(args.panel),
+            screenshot_panel: args.screenshot_panel,
+            memory: [0; 3],
+            script: args.ui.clone(),
+            releases: Vec::new(),
+            presses: Vec::new(),
+            typing: Vec::new(),
+            live_error: None,
+            reference: args
+                .reference
+                .clone()
+                .unwrap_or_else(|| live_error::default_reference(graph)),
+            reference_spp: args.reference_spp,
+            live_error_out: args.live_error_out.clone(),
+            map: None,
+            bookmarks,
+            bookmarks_file,
+            bookmarks_path,
+            under_cursor: None,
+            drawn: false,
+            scene: args.scene.clone(),
+        })
+    }
+
+    /// Whether the overlay draws over this frame.
+    pub fn overlay_drawn(&self) -> bool {
+        self.drawn
+    }
+
+    /// `settings` with the live image read back when the live error needs it
+    /// (the graph's `readback` list), and nothing read back otherwise.
+    pub fn with_readback(&mut self, settings: RenderSettings) -> RenderSettings {
+        let extra_readback = match &mut self.live_error {
+            Some(live_error) => {
+                let names = weft_graph::load(&settings.graph).readback_names();
+                live_error.set_problem(names.is_empty().then(|| {
+                    format!(
+                        "{} reads back no linear image (`readback: [\"hdr\"]`), so it cannot be measured",
+                        settings.graph.display()
+                    )
+                }));
+                names
+            }
+            None => Vec::new(),
+        };
+        RenderSettings {
+            extra_readback,
+            ..settings
+        }
+    }
+
+    /// Whether this frame is read back to be measured by the live error.
+    pub fn live_error_due(&self, live: &LiveRender<'_>) -> bool {
+        !live.settings().extra_readback.is_empty()
+            && self.live_error.as_ref().is_some_and(LiveError::due)
+    }
+
+    /// Adds the reference's samples for this frame, and measures `report`
+    /// (read back because [`UiState::live_error_due`] said so).
+    pub fn step_live_error(
+        &mut self,
+        camera: &Camera,
+        time: f64,
+        live: &LiveRender<'_>,
+        report: Option<&FrameReport>,
+    ) -> Result<()> {
+        if let Some(live_error) = &mut self.live_error {
+            let graph = live.settings().graph.as_path();
+            live_error.step(
+                (camera, time, live.settings().extent),
+                report.map(|r| (r, graph)),
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Reads the first debug view's value at `cursor` (window pixels) from
+    /// `report`, when the panel shows and the frame was read back.
+    pub fn read_under_cursor(
+        &mut self,
+        live: &LiveRender<'_>,
+        report: &FrameReport,
+        cursor: Option<(f64, f64)>,
+    ) {
+        self.under_cursor = None;
+        let plan = live.plan();
+        let (Some(view), Some((x, y)), true) = (plan.views.first(), cursor, self.panel.visible)
+        else {
+            return;
+        };
+        let name = &plan.resources[view.image].name;
+        let Some((_, image)) = report.readbacks.iter().find(|(n, _)| n == name) else {
+            return;
+        };
+        let (px, py) = (x.max(0.0) as usize, y.max(0.0) as usize);
+        if px >= image.width as usize || py >= image.height as usize {
+            return;
+        }
+        let at = py * image.width as usize + px;
+        let value = match &image.pixels {
+            Pixels::CountU32(v) => v.get(at).map(|c| c.to_string()),
+            Pixels::ValueF32(v) => v.get(at).map(|c| format!("{c:.4}")),
+            _ => None,
+        };
+        self.under_cursor = value.map(|v| format!("{} {v} at ({px}, {py})", view.name));
+    }
+
+    /// At exit: the live error's last measure of `graph`, printed, and its
+    /// map written where `--live-error-out` says.
+    pub fn report_live_error(&mut self, graph: &std::path::Path) -> Result<()> {
+        let Some(live_error) = &mut self.live_error else {
+            if let Some(out) = &self.live_error_out {
+                bail!(
+                    "--live-error-out {}: the live error was never on (press L or `--press FRAME:l`)",
+                    out.display()
+                );
+            }
+            return Ok(());
+        };
+        live_error.finish();
+        let Some(measure) = live_error.latest() else {
+            if let Some(out) = &self.live_error_out {
+                bail!(
+                    "--live-error-out {}: no measure finished before the viewer quit (give more --frames)",
+                    out.display()
+                );
+            }
+            return Ok(());
+        };
+        println!(
+            "live error: HDR-FLIP {:.6} against {} at {} spp",
+            measure.flip.mean,
+            live_error.graph().display(),
+            measure.spp
+        );
+        if let Some(out) = &self.live_error_out {
+            // As `weft compare` writes it, labelled by the graph's name as there.
+            let name = graph
+                .file_stem()
+                .map_or_else(|| "graph".into(), |s| s.to_string_lossy().into_owned());
+            weft_compare::report::write_flip_map(&measure.flip, &format!("{name} HDR-FLIP"), out)?;
+            println!("wrote {}", out.display());
+        }
+        Ok(())
+    }
+}
+
+impl Viewer<'_> {
+    /// Passes `event` to the panel; true when the panel took it (a press or
+    /// wheel over the panel, typing into a field), so the viewer ignores it.
+    pub(super) fn panel_took(&mut self, event: &WindowEvent) -> bool {
+        let (Some(overlay), Some(window)) = (self.overlay.as_mut(), self.window.as_ref()) else {
+            return false;
+        };
+        let consumed = overlay.on_window_event(window, event);
+        let press = match event {
+            WindowEvent::KeyboardInput { event, .. } => event.state == ElementState::Pressed,
+            WindowEvent::MouseInput { state, .. } => *state == ElementState::Pressed,
+            WindowEvent::MouseWheel { .. } => true,
+            _ => false,
+        };
+        self.ui.panel.visible && consumed && press
+    }
+
+    /// Runs the panel (and the live error map) for this frame with the
+    /// frame's scripted input; returns what the panel asked for.
+    pub(super) fn run_panel(&mut self) -> Result<Vec<PanelAction>> {
+        let (Some(overlay), Some(window)) = (self.overlay.as_mut(), self.window.as_ref()) else {
+            return Ok(Vec::new());
+        };
+        let mut events: Vec<egui::Event> = self
+            .ui
+            .releases
+            .drain(..)
+            .flat_map(|at| script::pointer(at, false))
+            .collect();
+        let frame = self.frames;
+        let due: Vec<UiStep> = self
+            .ui
+            .script
+            .iter()
+            .filter(|(f, _)| *f == frame)
+            .map(|(_, step)| step.clone())
+            .collect();
+        self.ui.script.retain(|(f, _)| *f != frame);
+        for step in due {
+            match step {
+                // The widget is scrolled into view first, then pressed where
+                // a frame drew it in view.
+                UiStep::Click(name) => {
+                    self.ui.panel.reveal(&name);
+                    self.ui.presses.push((name, frame + CLICK_WAIT_FRAMES));
+                }
+                typed => self.ui.typing.push((typed, frame + CLICK_WAIT_FRAMES)),
+            }
+        }
+        // Typing waits for a field to have the keyboard (a click gives it one
+        // a frame or two after the press) and for earlier clicks.
+        if self.ui.presses.is_empty() && self.ui.releases.is_empty() && overlay.wants_keyboard() {
+            for (typed, _) in self.ui.typing.drain(..) {
+                match typed {
+                    UiStep::Text(text) => events.push(egui::Event::Text(text)),
+                    UiStep::Enter => events.extend(script::enter()),
+                    UiStep::Click(_) => {}
+                }
+            }
+        } else if let Some((typed, _)) = self.ui.typing.iter().find(|(_, last)| frame >= *last) {
+            bail!("--ui {typed:?}: no panel field had the keyboard by frame {frame} (click one first)");
+        }
+        let waiting = std::mem::take(&mut self.ui.presses);
+        for (name, last) in waiting {
+            if let Some(rect) = self.ui.panel.target(&name) {
+                events.extend(script::pointer(rect.center(), true));
+                self.ui.releases.push(rect.center());
+            } else if frame < last {
+                self.ui.presses.push((name, last));
+            } else {
+                bail!(
+                    "--ui click:{name}: the panel showed no widget \"{name}\" in view by frame {frame}{}",
+                    if self.ui.panel.visible {
+                        format!(" (it showed: {})", self.ui.panel.target_names().join(", "))
+                    } else {
+                        " (it is hidden: press F1 first, `--press FRAME:f1` or --panel)".into()
+                    }
+                );
+            }
+        }
+        overlay.inject(events);
+        if let Some(live_error) = &self.ui.live_error {
+            match (live_error.latest(), &self.ui.map) {
+                (Some(m), Some((spp, mean, _))) if m.spp == *spp && m.flip.mean == *mean => {}
+                (Some(m), _) => {
+                    let texture = overlay.context().load_texture(
+                        "live error",
+                        live_error::map_image(&m.flip),
+                        egui::TextureOptions::NEAREST,
+                    );
+                    self.ui.map = Some((m.spp, m.flip.mean, texture));
+                }
+                (None, _) => self.ui.map = None,
+            }
+        }
+        self.ui.drawn = self.ui.panel.visible || self.ui.map.is_some();
+        if !self.ui.drawn {
+            overlay.clear();
+            return Ok(Vec::new());
+        }
+        let params = graph_params(self.live.graph().graph());
+        let camera_block = super::super::camera_block::camera_block(
+            "flown",
+            &self.lens,
+            self.live.scene().origin,
+            self.camera.position,
+            self.camera.orientation,
+        );
+        let live_status = self.ui.live_error.as_ref().map(LiveError::status);
+        let view = PanelView {
+            graph: &self.live.settings().graph,
+            graphs: &self.graphs,
+            features: &self.features,
+            plan: self.live.plan(),
+            params: &params,
+            timings: &self.timings,
+            frame_ms: self.stats.mean_ms,
+            memory: self.ui.memory,
+            draws: self.live.draw_calls(),
+            culling: self.live.culling(),
+            samples: self.live.samples(),
+            animating: self.restarts.animating(),
+            paused: self.paused,
+            error: self.error.as_deref(),
+            reloaded: self.last_reload.as_deref(),
+            camera_block: &camera_block,
+            bookmarks: (&self.ui.bookmarks, &self.ui.bookmarks_path),
+            live_error: live_status.as_ref(),
+            under_cursor: self.ui.under_cursor.as_deref(),
+        };
+        let panel = &mut self.ui.panel;
+        let map = &self.ui.map;
+        overlay.run(window, |ui| {
+            if let Some((spp, mean, texture)) = map {
+                live_error::show_map(ui.ctx(), texture, *mean, *spp);
+            }
+            if panel.visible {
+                panel.show(ui, &view)
+            } else {
+                Vec::new()
+            }
+        })
+    }
+
+    /// Applies what the panel asked for, at the frame boundary.
+    pub(super) fn apply_panel(&mut self, action: PanelAction) {
+        let settings = self.live.settings().clone();
+        match action {
+            PanelAction::Graph(graph) => {
+                self.reconfigure(RenderSettings { graph, ..settings });
+            }
+            PanelAction::Feature(name, on) => {
+                let features = controls::toggle(&settings.features, &name, !on);
+                self.reconfigure(RenderSettings {
+                    features,
+                    ..settings
+                });
+            }
+            PanelAction::Param(key, value) => {
+                let mut params = settings.params.clone();
+                params.insert(key.clone(), value.clone());
+                if self.reconfigure(RenderSettings { params, ..settings }) {
+                    println!(
+                        "parameter {key} = {}",
+                        crate::compare_cmd::param_text(&value)
+                    );
+                }
+            }
+            PanelAction::Pause => self.paused = !self.paused,
+            PanelAction::PrintCamera => print!("{}", self.camera_block()),
+            PanelAction::SaveBookmark => self.save_bookmark(),
+            PanelAction::GoToBookmark(index) => {
+                if let Some(mark) = self.ui.bookmarks.get(index) {
+                    self.camera.position = mark.position(self.live.scene().origin);
+                    self.camera.orientation = mark.orientation;
+                }
+            }
+            PanelAction::LiveError(on) => {
+                if on != self.ui.live_error.is_some() {
+                    self.toggle_live_error();
+                }
+            }
+        }
+    }
+
+    /// Starts the live error (its reference at the viewer's view) or stops it.
+    pub(super) fn toggle_live_error(&mut self) {
+        if self.ui.live_error.take().is_some() {
+            self.ui.map = None;
+            println!("live error off");
+        } else {
+            let started = LiveError::start(
+                self.gpu,
+                &self.ui.scene,
+                &self.ui.reference,
+                self.live.settings(),
+                self.ui.reference_spp,
+            );
+            match started {
+                Ok(live_error) => {
+                    println!(
+                        "live error on: measuring against {}",
+                        live_error.graph().display()
+                    );
+                    self.ui.live_error = Some(live_error);
+                }
+                Err(err) => {
+                    self.report_error(format!("live error: {err:#}"));
+                    return;
+                }
+            }
+        }
+        // The live image is read back for measuring only while the live error is on.
+        let settings = self.live.settings().clone();
+        self.reconfigure(settings);
+    }
+
+    /// Saves the camera as the next bookmark beside the scene.
+    pub(super) fn save_bookmark(&mut self) {
+        let Some(file) = self.ui.bookmarks_file.clone() else {
+            self.report_error(format!(
+                "{} could not be read, so bookmarks are not saved over it",
+                self.ui.bookmarks_path.display()
+            ));
+            return;
+        };
+        let number = self.ui.bookmarks.len() + 1;
+        self.ui.bookmarks.push(Bookmark {
+            name: format!("bookmark {number}"),
+            world: self.live.scene().origin + self.camera.position.as_dvec3(),
+            orientation: self.camera.orientation,
+        });
+        match bookmarks::save(&file, &self.ui.bookmarks, &self.lens) {
+            Ok(()) => println!("saved bookmark {number} to {}", file.display()),
+            Err(err) => {
+                self.ui.bookmarks.pop();
+                self.report_error(format!("{err:#}"));
+            }
+        }
+    }
+}

@@ -1,0 +1,305 @@
+//! The viewer's panel (F1) under Xvfb, driven by `--press` and `--ui`
+//! scripts: it shows and hides without touching screenshots, sets features
+//! and parameters as `weft render` does, measures the live error as `weft
+//! compare` does, saves bookmarks beside the scene, and keeps validation
+//! silent across a resize.
+
+use super::{assert_clean, load, text, Temp, Xvfb};
+use crate::harness::{command_in, repo};
+
+/// Per-channel differences of two images of one size: (mean, p99, max).
+fn differences(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u8, u8) {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let mut diffs: Vec<u8> = a
+        .pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c])))
+        .collect();
+    diffs.sort_unstable();
+    let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;
+    (mean, diffs[diffs.len() * 99 / 100], diffs[diffs.len() - 1])
+}
+
+/// `frames` frames of `weft view` of the demo at 160x90, paused, with
+/// validation, saving the last frame to `shot`; `extra` adds arguments.
+fn view_demo(x: &Xvfb, shot: &std::path::Path, frames: &str, extra: &[&str]) -> String {
+    let mut args = vec![
+        "view",
+        "scenes/demo.scene",
+        "--size",
+        "160x90",
+        "--paused",
+        "--frames",
+        frames,
+        "--validate",
+        "--screenshot-on-exit",
+        shot.to_str().expect("utf-8 path"),
+    ];
+    args.extend_from_slice(extra);
+    let out = x.weft(&args);
+    assert_clean(&out);
+    text(&out.stdout)
+}
+
+#[test]
+fn the_panel_shows_and_hides_and_stays_out_of_screenshots_unless_asked() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("panel-toggle");
+    let plain = tmp.file("plain.png");
+    let hidden_again = tmp.file("hidden-again.png");
+    let shown = tmp.file("shown.png");
+    let shown_captured = tmp.file("shown-captured.png");
+    view_demo(&x, &plain, "5", &[]);
+    view_demo(
+        &x,
+        &hidden_again,
+        "5",
+        &["--press", "1:f1,3:f1", "--screenshot-panel"],
+    );
+    view_demo(&x, &shown, "5", &["--press", "1:f1"]);
+    view_demo(
+        &x,
+        &shown_captured,
+        "5",
+        &["--press", "1:f1", "--screenshot-panel"],
+    );
+    let plain = load(&plain);
+    assert_eq!(
+        load(&hidden_again),
+        plain,
+        "with the panel toggled off the frame is today's image exactly"
+    );
+    assert_eq!(
+        load(&shown),
+        plain,
+        "shown, the panel is left out of screenshots by default"
+    );
+    let with_panel = load(&shown_captured);
+    let changed = with_panel
+        .pixels()
+        .zip(plain.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    let total = (160 * 90) as usize;
+    assert!(
+        changed * 2 > total,
+        "--screenshot-panel shows the panel over most of a 160x90 window: {changed} of {total} pixels changed"
+    );
+}
+
+/// A feature past the ninth key (`tile_depth_mask`, the tiled graph's
+/// twelfth) is switched off and `exposure` typed as 2 through the panel's
+/// own widgets; the next frames equal `weft render` with the same toggle
+/// and `--param`.
+#[test]
+fn a_feature_and_a_parameter_set_in_the_panel_render_as_weft_render_does() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("panel-set");
+    let shown = tmp.file("shown.png");
+    let headless = tmp.file("headless.png");
+    let stdout = view_demo(
+        &x,
+        &shown,
+        "16",
+        &[
+            "--graph",
+            "graphs/tiled.ron",
+            "--panel",
+            "--ui",
+            "1:click:feature:tile_depth_mask,5:click:param:exposure,6:text:2,6:enter",
+        ],
+    );
+    let lists: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
+    assert_eq!(lists.len(), 2, "{stdout}");
+    assert!(
+        lists[0].contains("Shift+3 tile_depth_mask [on]"),
+        "{stdout}"
+    );
+    assert!(
+        lists[1].contains("Shift+3 tile_depth_mask [off]"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("parameter exposure = 2\n"), "{stdout}");
+    let out = x.weft(&[
+        "render",
+        "scenes/demo.scene",
+        "--graph",
+        "graphs/tiled.ron",
+        "--size",
+        "160x90",
+        "--features",
+        "!tile_depth_mask",
+        "--param",
+        "exposure=2",
+        "--out",
+        headless.to_str().expect("utf-8 path"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (mean, p99, max) = differences(&load(&shown), &load(&headless));
+    assert!(
+        mean <= 0.05 && p99 <= 1 && max <= 1,
+        "viewer vs render: mean {mean}, p99 {p99}, max {max}"
+    );
+}
+
+#[test]
+fn a_click_on_a_widget_the_panel_does_not_have_says_which_it_has() {
+    let x = Xvfb::start();
+    let out = x.weft(&[
+        "view",
+        "scenes/cornell.scene",
+        "--size",
+        "64x36",
+        "--frames",
+        "20",
+        "--panel",
+        "--ui",
+        "1:click:feature:no_such_thing",
+    ]);
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("--ui click:feature:no_such_thing: the panel showed no widget")
+            && stderr.contains("feature:bloom"),
+        "{stderr}"
+    );
+}
+
+/// The live error of forward on the Cornell box against a 16-spp
+/// reference is the map and number `weft compare` writes for that view at
+/// 16 spp (same seed, so equal to FLIP's own rounding).
+#[test]
+fn the_live_error_is_the_map_weft_compare_writes() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("panel-live-error");
+    let map = tmp.file("live.png");
+    let out = x.weft(&[
+        "view",
+        "scenes/cornell.scene",
+        "--size",
+        "64x36",
+        "--paused",
+        "--frames",
+        "24",
+        "--validate",
+        "--press",
+        "0:l",
+        "--reference-spp",
+        "16",
+        "--live-error-out",
+        map.to_str().expect("utf-8 path"),
+    ]);
+    assert_clean(&out);
+    let stdout = text(&out.stdout);
+    let live: f64 = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("live error: HDR-FLIP "))
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no live error line: {stdout}"));
+    assert!(stdout.contains("at 16 spp"), "{stdout}");
+    let compared = tmp.file("compare");
+    let out = command_in(
+        &repo(),
+        &[
+            "compare",
+            "scenes/cornell.scene",
+            "--graphs",
+            "graphs/forward.ron",
+            "--size",
+            "64x36",
+            "--spp",
+            "16",
+            "--out",
+            compared.to_str().expect("utf-8 path"),
+        ],
+    )
+    .output()
+    .expect("weft runs");
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(compared.join("report.json")).expect("report.json"))
+            .expect("json");
+    let flip = report["configurations"][0]["flip"]
+        .as_f64()
+        .expect("a flip figure");
+    assert!((live - flip).abs() <= 1e-6, "live {live} vs compare {flip}");
+    assert_eq!(
+        load(&map),
+        load(&compared.join("forward.flip.png")),
+        "the live map, legend and mean included, is compare's"
+    );
+}
+
+/// B saves the flown camera as numbered `camera` blocks in
+/// `<scene>.bookmarks.scene` beside the scene, which reads back as a scene.
+#[test]
+fn b_saves_numbered_bookmarks_beside_the_scene() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("panel-bookmarks");
+    let original = std::fs::read_to_string(repo().join("scenes/cornell.scene")).expect("scene");
+    let assets = repo().join("../shared/assets");
+    let scene = tmp.file("box.scene");
+    std::fs::write(
+        &scene,
+        original.replace("../../shared/assets", assets.to_str().expect("utf-8 path")),
+    )
+    .expect("scene copy");
+    let out = x.weft(&[
+        "view",
+        scene.to_str().expect("utf-8 path"),
+        "--size",
+        "32x18",
+        "--frames",
+        "4",
+        "--validate",
+        "--press",
+        "1:b,2:b",
+    ]);
+    assert_clean(&out);
+    let stdout = text(&out.stdout);
+    let file = tmp.file("box.bookmarks.scene");
+    assert!(
+        stdout.contains(&format!("saved bookmark 2 to {}", file.display())),
+        "{stdout}"
+    );
+    let saved = std::fs::read_to_string(&file).expect("bookmarks file");
+    let block = |n: u32| {
+        format!(
+            "camera \"bookmark {n}\"\n{{\n\tposition 0 1 3.9\n\ttarget 0 1 2.9\n\tfov_deg 40\n\tnear 0.1\n\tfar 20\n}}\n"
+        )
+    };
+    assert_eq!(saved, format!("{}{}", block(1), block(2)));
+    let out = command_in(
+        &repo(),
+        &["scene", "check", file.to_str().expect("utf-8 path")],
+    )
+    .output()
+    .expect("weft runs");
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
+#[test]
+fn the_overlay_and_live_error_stay_silent_across_a_resize() {
+    let x = Xvfb::start();
+    let out = x.weft(&[
+        "view",
+        "scenes/cornell.scene",
+        "--size",
+        "96x54",
+        "--frames",
+        "8",
+        "--resize-to",
+        "120x80",
+        "--panel",
+        "--press",
+        "0:l",
+        "--validate",
+    ]);
+    assert_clean(&out);
+    assert!(
+        text(&out.stdout).contains("live error on"),
+        "{}",
+        text(&out.stdout)
+    );
+}
