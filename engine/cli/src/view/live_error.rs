@@ -287,7 +287,7 @@ pub fn show_map(ctx: &egui::Context, texture: &egui::TextureHandle, mean: f64, s
         .show(ctx, |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| {
                 ui.label(format!(
-                    "HDR-FLIP {mean:.4} against the reference at {spp} spp"
+                    "HDR-FLIP {mean:.4} vs reference, {spp} spp"
                 ));
                 let (rect, _) =
                     ui.allocate_exact_size(egui::vec2(256.0, 12.0), egui::Sense::hover());

@@ -194,6 +194,9 @@ impl<'g> Viewer<'g> {
         self.overlay = None;
         self.presenter = None;
         self.window = None;
+        if let Some(line) = self.ui.cost.summary() {
+            println!("{line}");
+        }
         let mut times = std::mem::take(&mut self.stats.all_ms);
         if let Some(first) = times.first().copied() {
             let steady = if times.len() > 1 {
@@ -440,7 +443,9 @@ impl<'g> Viewer<'g> {
             (true, false) => Capture::Image,
             (true, true) => Capture::WithOverlay,
         };
+        let ui_began = Instant::now();
         let actions = self.run_panel()?;
+        let ui_ms = ui_began.elapsed().as_secs_f64() * 1e3;
         let drawn = self.ui.overlay_drawn();
         let presenter = self
             .presenter
@@ -451,7 +456,10 @@ impl<'g> Viewer<'g> {
             .as_mut()
             .filter(|_| drawn)
             .map(|o| o as &mut dyn weft_gpu::Overlay);
+        let present_began = Instant::now();
         let presented = presenter.present(source, capture, size, overlay)?;
+        let present_ms = present_began.elapsed().as_secs_f64() * 1e3;
+        self.ui.cost.record(drawn, ui_ms, present_ms);
         if let Some(overlay) = self.overlay.as_mut() {
             overlay.after_present()?;
         }

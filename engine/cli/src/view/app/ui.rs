@@ -54,6 +54,8 @@ pub(super) struct UiState<'g> {
     under_cursor: Option<String>,
     /// Whether the overlay draws this frame.
     drawn: bool,
+    /// What the panel costs per frame.
+    pub cost: PanelCost,
     scene: PathBuf,
 }
 
@@ -89,6 +91,7 @@ impl<'g> UiState<'g> {
             bookmarks_path,
             under_cursor: None,
             drawn: false,
+            cost: PanelCost::default(),
             scene: args.scene.clone(),
         })
     }
@@ -164,15 +167,7 @@ impl<'g> UiState<'g> {
             return;
         };
         let (px, py) = (x.max(0.0) as usize, y.max(0.0) as usize);
-        if px >= image.width as usize || py >= image.height as usize {
-            return;
-        }
-        let at = py * image.width as usize + px;
-        let value = match &image.pixels {
-            Pixels::CountU32(v) => v.get(at).map(|c| c.to_string()),
-            Pixels::ValueF32(v) => v.get(at).map(|c| format!("{c:.4}")),
-            _ => None,
-        };
+        let value = value_at(image, px, py);
         self.under_cursor = value.map(|v| format!("{} {v} at ({px}, {py})", view.name));
     }
 
@@ -213,6 +208,62 @@ impl<'g> UiState<'g> {
             println!("wrote {}", out.display());
         }
         Ok(())
+    }
+}
+
+/// The value of a count or measure image at pixel (`x`, `y`); `None` off
+/// the image or for colour images.
+fn value_at(image: &weft_gpu::Readback, x: usize, y: usize) -> Option<String> {
+    if x >= image.width as usize || y >= image.height as usize {
+        return None;
+    }
+    let at = y * image.width as usize + x;
+    match &image.pixels {
+        Pixels::CountU32(v) => v.get(at).map(|c| c.to_string()),
+        Pixels::ValueF32(v) => v.get(at).map(|c| format!("{c:.4}")),
+        _ => None,
+    }
+}
+
+/// The panel's cost per frame, for the exit summary: CPU time to run it
+/// (layout, tessellation, texture uploads), and presenting time (on a CPU
+/// device such as lavapipe the overlay's drawing runs inside it) in frames
+/// with and without the overlay.
+#[derive(Debug, Default)]
+pub(super) struct PanelCost {
+    ui_ms: Vec<f64>,
+    present_with_ms: Vec<f64>,
+    present_without_ms: Vec<f64>,
+}
+
+impl PanelCost {
+    /// Notes one frame: whether the overlay drew, the time to run the UI, to present.
+    pub fn record(&mut self, drawn: bool, ui_ms: f64, present_ms: f64) {
+        if drawn {
+            self.ui_ms.push(ui_ms);
+            self.present_with_ms.push(present_ms);
+        } else {
+            self.present_without_ms.push(present_ms);
+        }
+    }
+
+    /// `panel: shown in N frames, UI median a ms (CPU), present median b ms
+    /// with it, c ms without`; `None` when it never showed.
+    pub fn summary(&self) -> Option<String> {
+        let median = |v: &[f64]| {
+            let mut v = v.to_vec();
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied()
+        };
+        let ui = median(&self.ui_ms)?;
+        let with = median(&self.present_with_ms)?;
+        let without = median(&self.present_without_ms)
+            .map_or_else(|| "no frames".into(), |ms| format!("{ms:.2} ms"));
+        Some(format!(
+            "panel: shown in {} frames, UI median {ui:.2} ms (CPU: layout, tessellation, uploads); \
+             present median {with:.2} ms with it, {without} without",
+            self.ui_ms.len()
+        ))
     }
 }
 
@@ -455,5 +506,48 @@ impl Viewer<'_> {
                 self.report_error(format!("{err:#}"));
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use weft_gpu::Readback;
+
+    #[test]
+    fn the_value_under_the_cursor_is_read_row_by_row() {
+        let counts = Readback {
+            width: 3,
+            height: 2,
+            format: "R32_UINT".into(),
+            pixels: Pixels::CountU32(vec![0, 1, 2, 3, 4, 5]),
+        };
+        assert_eq!(value_at(&counts, 1, 1).as_deref(), Some("4"));
+        assert_eq!(value_at(&counts, 3, 0), None);
+        assert_eq!(value_at(&counts, 0, 2), None);
+        let measures = Readback {
+            pixels: Pixels::ValueF32(vec![0.5; 6]),
+            ..counts
+        };
+        assert_eq!(value_at(&measures, 2, 1).as_deref(), Some("0.5000"));
+    }
+
+    #[test]
+    fn the_cost_summary_compares_presenting_with_and_without_the_panel() {
+        let mut cost = PanelCost::default();
+        assert_eq!(cost.summary(), None);
+        for ms in [10.0, 12.0, 11.0] {
+            cost.record(false, 0.0, ms);
+        }
+        for (ui, ms) in [(1.0, 13.0), (3.0, 14.0), (2.0, 12.5)] {
+            cost.record(true, ui, ms);
+        }
+        assert_eq!(
+            cost.summary().as_deref(),
+            Some(
+                "panel: shown in 3 frames, UI median 2.00 ms (CPU: layout, tessellation, uploads); \
+                 present median 13.00 ms with it, 11.00 ms without"
+            )
+        );
     }
 }
