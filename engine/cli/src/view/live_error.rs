@@ -286,9 +286,7 @@ pub fn show_map(ctx: &egui::Context, texture: &egui::TextureHandle, mean: f64, s
         .anchor(egui::Align2::LEFT_BOTTOM, egui::vec2(8.0, -8.0))
         .show(ctx, |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| {
-                ui.label(format!(
-                    "HDR-FLIP {mean:.4} vs reference, {spp} spp"
-                ));
+                ui.label(format!("HDR-FLIP {mean:.4} vs reference, {spp} spp"));
                 let (rect, _) =
                     ui.allocate_exact_size(egui::vec2(256.0, 12.0), egui::Sense::hover());
                 for step in 0..256 {
