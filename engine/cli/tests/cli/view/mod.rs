@@ -117,6 +117,19 @@ fn load(path: &Path) -> image::RgbaImage {
         .to_rgba8()
 }
 
+/// Per-channel differences of two images of one size: (mean, p99, max).
+fn differences(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u8, u8) {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let mut diffs: Vec<u8> = a
+        .pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c])))
+        .collect();
+    diffs.sort_unstable();
+    let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;
+    (mean, diffs[diffs.len() * 99 / 100], diffs[diffs.len() - 1])
+}
+
 #[test]
 fn opens_renders_presents_and_exits_cleanly() {
     let x = Xvfb::start();
@@ -206,17 +219,7 @@ fn screenshot_matches_the_headless_render() {
         headless.to_str().expect("utf-8 path"),
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    let (a, b) = (load(&shown), load(&headless));
-    assert_eq!(a.dimensions(), b.dimensions());
-    let mut diffs: Vec<u8> = a
-        .pixels()
-        .zip(b.pixels())
-        .flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c])))
-        .collect();
-    diffs.sort_unstable();
-    let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;
-    let p99 = diffs[diffs.len() * 99 / 100];
-    let max = diffs[diffs.len() - 1];
+    let (mean, p99, max) = differences(&load(&shown), &load(&headless));
     eprintln!("screenshot vs headless: mean {mean:.4}, p99 {p99}, max {max}");
     assert!(
         mean <= 0.05 && p99 <= 1 && max <= 1,

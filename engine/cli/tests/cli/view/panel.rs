@@ -4,21 +4,8 @@
 //! compare` does, saves bookmarks beside the scene, and keeps validation
 //! silent across a resize.
 
-use super::{assert_clean, load, text, Temp, Xvfb};
+use super::{assert_clean, differences, load, text, Temp, Xvfb};
 use crate::harness::{command_in, repo};
-
-/// Per-channel differences of two images of one size: (mean, p99, max).
-fn differences(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u8, u8) {
-    assert_eq!(a.dimensions(), b.dimensions());
-    let mut diffs: Vec<u8> = a
-        .pixels()
-        .zip(b.pixels())
-        .flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c])))
-        .collect();
-    diffs.sort_unstable();
-    let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;
-    (mean, diffs[diffs.len() * 99 / 100], diffs[diffs.len() - 1])
-}
 
 /// `frames` frames of `weft view` of the demo at 160x90, paused, with
 /// validation, saving the last frame to `shot`; `extra` adds arguments.
