@@ -72,6 +72,7 @@ layout(set = SET_SCENE, binding = BINDING_FRAME) uniform Frame {
     uvec4 counts;          // suns, point lights, spots, all lights but emissive polygons
     vec4 viewport;         // width, height, 1/width, 1/height
     uvec4 emitter_lights;  // x: emissive polygon records after the counts.w others
+    mat4 prev_view_proj;   // view_proj of the frame before (the same on a scene's first)
 } frame;
 
 layout(std430, set = SET_SCENE, binding = BINDING_LIGHTS) readonly buffer Lights { Light lights[]; };

@@ -24,6 +24,10 @@
 // camera does not see that sky (as with Mitsuba's hide_emitters), so the
 // background stays black as in the raster graphs.
 //
+// `accumulate` 1 (the reference) keeps the running mean over frames; 0
+// writes each frame's own `samples_per_frame` samples to `hdr`, the noisy
+// input graphs/pathtrace_denoised.ron filters.
+//
 // `light_choice` 0 picks the light NEE samples uniformly; 1 half uniformly,
 // half by its power (engine/render/src/light_choice.rs).
 //
@@ -65,6 +69,7 @@ layout(push_constant) uniform Params {
     uint fresnel;
     uint nee_through_glass;
     uint light_choice;
+    uint accumulate;
     uint history_frames;
     uint repeat_index;
 } params;
@@ -299,7 +304,9 @@ void main() {
     bool finite = !any(isnan(mean)) && !any(isinf(mean));
     mean = finite ? mean : vec3(0.0);
     float count = 1.0;
-    if (params.history_frames > 0u || params.repeat_index > 0u) {
+    // `accumulate` 0 keeps only this frame's samples (a denoiser's input):
+    // the mean restarts every frame.
+    if ((params.history_frames > 0u && params.accumulate != 0u) || params.repeat_index > 0u) {
         vec4 previous = imageLoad(accumulation, pixel);
         count += previous.a;
         mean = previous.rgb + (mean - previous.rgb) * (1.0 / count);

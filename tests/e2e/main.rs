@@ -4,6 +4,7 @@
 mod bloom;
 mod bsdf_sampling;
 mod debug_views;
+mod denoise;
 mod emissive;
 mod extremes;
 mod light_matrix;

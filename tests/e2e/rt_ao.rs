@@ -15,7 +15,7 @@ const SIZE: u32 = 48;
 
 /// The floor (8 x 8 at y = 0) and a 1 x 2 x 1 box standing on it, both
 /// Lambertian with albedo 0.6, under ambient 1 and nothing else.
-fn scene(dir: &Path) -> PathBuf {
+pub(crate) fn scene(dir: &Path) -> PathBuf {
     std::fs::write(
         dir.join("grey.mtl"),
         "newmtl grey\nKd 0.6 0.6 0.6\nKs 0 0 0\n",

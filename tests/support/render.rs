@@ -219,18 +219,27 @@ pub fn square_settings(
 /// `hdr` image as RGBA floats, row by row.
 pub fn render_hdr_validated(
     scene: &Path,
+    settings: RenderSettings,
+) -> (weft_render::Rendered, Vec<f32>) {
+    render_image_validated(scene, settings, "hdr")
+}
+
+/// [`render_hdr_validated`] reading back the float image `image`.
+pub fn render_image_validated(
+    scene: &Path,
     mut settings: RenderSettings,
+    image: &str,
 ) -> (weft_render::Rendered, Vec<f32>) {
     let scene = weft_scene::load_scene(scene).expect("scene loads");
     let gpu = crate::gpu();
     let log = gpu.validation();
-    settings.extra_readback = vec!["hdr".into()];
+    settings.extra_readback = vec![image.into()];
     let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
     drop(gpu);
     assert_eq!(log.messages(), Vec::new(), "{}", settings.graph.display());
-    let (_, hdr) = &rendered.report.readbacks[0];
-    let weft_gpu::Pixels::RgbaF32(values) = &hdr.pixels else {
-        panic!("hdr is a float image");
+    let (_, read) = &rendered.report.readbacks[0];
+    let weft_gpu::Pixels::RgbaF32(values) = &read.pixels else {
+        panic!("{image} is a float image");
     };
     let values = values.clone();
     (rendered, values)

@@ -268,6 +268,13 @@ pub struct FrameValues {
     /// plan (`history_frames`): how many frames' results history images hold,
     /// 0 when they hold nothing usable. Progressive graphs accumulate with it.
     pub history_frames: u32,
+    /// Frames drawn before this one with the plan's images (`plan_frames`),
+    /// whatever moved between them: history images hold the last frame's
+    /// results when it is above 0, seen from wherever the camera was, and
+    /// nothing defined when it is 0 (a new plan or scene). Passes that
+    /// reproject history across camera motion test it instead of
+    /// `history_frames`.
+    pub plan_frames: u32,
     /// Which of a repeating compute pass's dispatches this is, from 0
     /// (`repeat_index`; always 0 for a pass that does not repeat).
     pub repeat_index: u32,
@@ -276,7 +283,7 @@ pub struct FrameValues {
 /// Packs parameters into the push-constant block; every member must be a
 /// parameter of the pass (declared in the graph, or derived by a provider and
 /// added to the plan's parameters) or one of `time`, `frame`, `extent`,
-/// `history_frames`, `repeat_index`. An
+/// `history_frames`, `plan_frames`, `repeat_index`. An
 /// array member may be given fewer elements than it holds; the rest are zero.
 pub fn pack_push(
     block: &PushBlock,
@@ -308,6 +315,7 @@ pub fn pack_push(
                 "time" => vec![f64::from(frame.time)],
                 "frame" => vec![f64::from(frame.frame)],
                 "history_frames" => vec![f64::from(frame.history_frames)],
+                "plan_frames" => vec![f64::from(frame.plan_frames)],
                 REPEAT_INDEX => vec![f64::from(frame.repeat_index)],
                 "extent" => frame.extent.iter().map(|&v| f64::from(v)).collect(),
                 name => {
@@ -374,7 +382,7 @@ mod tests {
     #[test]
     fn packs_params_and_frame_values_by_name() {
         let block = PushBlock {
-            size: 36,
+            size: 40,
             members: vec![
                 member("tint", 0, ScalarKind::Float, 4),
                 member("radius", 16, ScalarKind::Int, 1),
@@ -382,6 +390,7 @@ mod tests {
                 member("enabled", 24, ScalarKind::Uint, 1),
                 member("history_frames", 28, ScalarKind::Uint, 1),
                 member("repeat_index", 32, ScalarKind::Uint, 1),
+                member("plan_frames", 36, ScalarKind::Uint, 1),
             ],
         };
         let params = BTreeMap::from([
@@ -397,6 +406,7 @@ mod tests {
             frame: 7,
             extent: [4, 4],
             history_frames: 3,
+            plan_frames: 9,
             repeat_index: 5,
         };
         let bytes = pack_push(&block, &params, &frame).expect("packs");
@@ -404,6 +414,7 @@ mod tests {
         assert_eq!(f32::from_ne_bytes(word(8)), 2.0);
         assert_eq!(u32::from_ne_bytes(word(28)), 3);
         assert_eq!(u32::from_ne_bytes(word(32)), 5);
+        assert_eq!(u32::from_ne_bytes(word(36)), 9);
         assert_eq!(i32::from_ne_bytes(word(16)), 21);
         assert_eq!(u32::from_ne_bytes(word(20)), 7);
         assert_eq!(u32::from_ne_bytes(word(24)), 1);

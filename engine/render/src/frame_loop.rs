@@ -26,6 +26,8 @@ pub struct FrameLoop<'g> {
     renderer: Renderer<'g>,
     plan: Arc<Plan>,
     accumulation: Accumulation,
+    /// Frames drawn on the current resources and scene (`plan_frames`).
+    plan_frames: u32,
 }
 
 /// Counts the frames in a row that drew the same inputs, so history images
@@ -92,6 +94,7 @@ impl<'g> FrameLoop<'g> {
             renderer,
             plan,
             accumulation: Accumulation::default(),
+            plan_frames: 0,
         })
     }
 
@@ -111,15 +114,19 @@ impl<'g> FrameLoop<'g> {
             time: request.time as f32,
             frame: request.frame,
             history_frames,
+            plan_frames: self.plan_frames,
         };
-        self.renderer
+        let report = self
+            .renderer
             .execute(
                 &self.plan,
                 &mut self.resources,
                 &mut self.recorder,
                 &options,
             )
-            .map_err(|e| RenderError::at_pass(e, &self.plan))
+            .map_err(|e| RenderError::at_pass(e, &self.plan))?;
+        self.plan_frames = self.plan_frames.saturating_add(1);
+        Ok(report)
     }
 
     /// The scene script's error from `update`, if one failed since the last
@@ -160,6 +167,7 @@ impl<'g> FrameLoop<'g> {
         self.recorder.forget_shadow_tiles();
         self.resources = resources;
         self.plan = plan;
+        self.plan_frames = 0;
     }
 
     /// Draws another scene from the next frame, moved by its own updater.
@@ -167,6 +175,7 @@ impl<'g> FrameLoop<'g> {
         self.accumulation.reset();
         self.recorder = recorder;
         self.updater = updater;
+        self.plan_frames = 0;
     }
 
     /// Drops every shader and pipeline built from the edited source `changed`

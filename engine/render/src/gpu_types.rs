@@ -96,6 +96,9 @@ pub struct GpuFrame {
     pub viewport: Vec4,
     /// x: emissive polygon records after the others (`crate::emitter_lights`).
     pub emitter_lights: UVec4,
+    /// World to clip space of the frame before (the same as `view_proj` on
+    /// a scene's first frame), for passes that reproject last frame's images.
+    pub prev_view_proj: Mat4,
 }
 
 /// The head of the `Shadows` buffer, before the views.
@@ -136,7 +139,7 @@ const _: () = {
     assert!(size_of::<GpuDraw>() == 160);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMaterial>() == 128);
-    assert!(size_of::<GpuFrame>() == 2 * 64 + 5 * 16);
+    assert!(size_of::<GpuFrame>() == 3 * 64 + 5 * 16);
     assert!(size_of::<GpuShadowsHeader>() == 64);
     assert!(size_of::<GpuShadowView>() == 176);
 };

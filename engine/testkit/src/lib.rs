@@ -43,6 +43,7 @@ pub fn render_frames(
             readback: options.readback && frame + 1 == frames.max(1),
             timing: options.timing,
             history_frames: options.history_frames + frame,
+            plan_frames: options.plan_frames + frame,
         };
         last = Some(renderer.execute(plan, &mut resources, draws, &options)?);
     }

@@ -45,6 +45,9 @@ pub struct FrameOptions {
     /// For `history_frames` push constants: frames in a row before this one
     /// that drew the same inputs (see [`crate::bind::FrameValues`]).
     pub history_frames: u32,
+    /// For `plan_frames` push constants: frames drawn before this one on the
+    /// same resources (see [`crate::bind::FrameValues`]).
+    pub plan_frames: u32,
 }
 
 /// What a frame produced; serialises (without the image) for `--json`.

@@ -59,6 +59,7 @@ impl<'g> Renderer<'g> {
             frame: options.frame,
             extent: [prep.extent.width, prep.extent.height],
             history_frames: options.history_frames,
+            plan_frames: options.plan_frames,
             repeat_index,
         };
         bind::pack_push(block, &pass.params, &frame).map_err(|problems| GpuError::Pass {

@@ -31,6 +31,7 @@ impl<'g> Renderer<'g> {
             frame: options.frame,
             extent: [prep.extent.width, prep.extent.height],
             history_frames: options.history_frames,
+            plan_frames: options.plan_frames,
             repeat_index: 0,
         };
         let label = Label::begin(self.gpu, cmd, &pass.name);

@@ -126,6 +126,8 @@ pub struct GpuScene<'g> {
     pub camera_position: glam::Vec3,
     /// The camera's world-to-clip matrix at the last update, for culling draws.
     pub view_proj: glam::Mat4,
+    /// Whether an update ran (so `view_proj` is the previous frame's).
+    uploaded: bool,
     /// Light counts by kind (stable over time; animation moves lights only).
     pub light_set: LightSet,
     /// Emissive geometry as polygon lights for raster passes, as placed now.
@@ -303,6 +305,7 @@ impl<'g> GpuScene<'g> {
             ),
             camera_position: glam::Vec3::ZERO,
             view_proj: glam::Mat4::IDENTITY,
+            uploaded: false,
             light_set,
             emitter_lights,
             warnings,
@@ -446,6 +449,12 @@ impl<'g> GpuScene<'g> {
         let camera = at.camera(camera);
         let [w, h] = [extent[0].max(1) as f32, extent[1].max(1) as f32];
         let view_proj = camera.view_projection(time, w / h);
+        let prev_view_proj = if self.uploaded {
+            self.view_proj
+        } else {
+            view_proj
+        };
+        self.uploaded = true;
         let eye = camera.pose_at(time).0;
         self.camera_position = eye;
         self.view_proj = view_proj;
@@ -468,6 +477,7 @@ impl<'g> GpuScene<'g> {
             ),
             viewport: Vec4::new(w, h, 1.0 / w, 1.0 / h),
             emitter_lights: UVec4::new(lights.emitter_polygons, 0, 0, 0),
+            prev_view_proj,
         };
         self.frame.write(bytes_of(&[frame]))?;
         if let Some(changed) = changed_records(&self.light_set.records, &lights.records) {
@@ -479,7 +489,13 @@ impl<'g> GpuScene<'g> {
             }
         }
         let mut inputs = std::collections::hash_map::DefaultHasher::new();
-        std::hash::Hash::hash(bytes_of(&[frame]), &mut inputs);
+        // What this frame shows, not how the last one differed: a still
+        // camera's frames hash alike even right after it moved.
+        let shown = GpuFrame {
+            prev_view_proj: view_proj,
+            ..frame
+        };
+        std::hash::Hash::hash(bytes_of(&[shown]), &mut inputs);
         std::hash::Hash::hash(bytes_of(&lights.records), &mut inputs);
         std::hash::Hash::hash(bytes_of(&self.transforms), &mut inputs);
         for overrides in &self.overrides {

@@ -1,0 +1,81 @@
+#version 450
+// What the denoiser's filters are guided by (graphs/pathtrace_denoised.ron):
+// one ray per pixel through its centre, and at the surface it meets first the
+// shading normal facing the camera, the distance along the ray, the world
+// position, and the albedo the path tracer's radiance is divided by so the
+// filters blur illumination, not texture: Lambert albedo plus the specular
+// lobe's reflectance (both from the path tracer's own `bsdf_of`), 1 for
+// glass and where the ray meets a light or nothing (those are not divided).
+// Lights (area-light panels, emissive surfaces) get distance -1 and the
+// background 0: the filters mix those only with pixels of their own kind.
+#include "../include/hdr.glsl"
+#include "../include/brdf.glsl"
+#include "../include/area_light.glsl"
+#include "../include/surface.glsl"
+#include "../include/punctual.glsl"
+#include "../include/trace.glsl"
+#include "random.glsl"
+#include "sampling.glsl"
+#include "dielectric.glsl"
+#include "bsdf.glsl"
+#include "lights.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+// xyz: unit normal facing the camera, w: distance along the ray (-1: a light, 0: nothing met).
+layout(set = 0, binding = 0, rgba32f) uniform writeonly image2D guide_normal;
+// xyz: world position, w: 1 where a surface was met, 0 elsewhere.
+layout(set = 0, binding = 1, rgba32f) uniform writeonly image2D guide_position;
+layout(set = 0, binding = 2, rgba16f) uniform writeonly image2D albedo;
+
+void main() {
+    ivec2 size = imageSize(albedo);
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(pixel, size))) {
+        return;
+    }
+    vec3 eye = frame.camera_position.xyz;
+    vec2 ndc = (vec2(pixel) + 0.5) / vec2(size) * 2.0 - 1.0;
+    vec4 on_near = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+    vec3 dir = normalize(on_near.xyz / on_near.w - eye);
+    vec2 found = trace_closest(eye, dir, 1e30);
+    float t = found.x < 0.0 ? 1e30 : found.x;
+    if (hit_area_light(eye, dir, t) >= 0 || found.x < 0.0) {
+        // A light's panel or the background: not divided, and filtered only
+        // with their own kind (distance -1 and 0), though a panel is
+        // reprojected where it is.
+        bool panel = t < 1e30;
+        imageStore(guide_normal, pixel, vec4(-dir, panel ? -1.0 : 0.0));
+        imageStore(guide_position, pixel, vec4(eye + dir * t, panel ? 1.0 : 0.0));
+        imageStore(albedo, pixel, vec4(1.0));
+        return;
+    }
+    TraceSurface s = trace_surface(floatBitsToUint(found.y), eye, dir, t);
+    Material m = materials[s.material];
+#ifdef SCENE_EMISSIVE
+    if (any(greaterThan(m.emissive.rgb, vec3(0.0)))) {
+        // Emitters are lights too: their radiance is no illumination to
+        // filter, and blurring a bright light into what surrounds it would
+        // move its energy.
+        imageStore(guide_normal, pixel, vec4(-dir, -1.0));
+        imageStore(guide_position, pixel, vec4(s.position, 1.0));
+        imageStore(albedo, pixel, vec4(1.0));
+        return;
+    }
+#endif
+    vec3 ng = dot(s.geometric_normal, dir) > 0.0 ? -s.geometric_normal : s.geometric_normal;
+#ifdef SCENE_TEXTURES
+    uvec4 slots = material_textures[s.material];
+    if (slots.z != NO_TEXTURE && m.ambient.w != 0.0) {
+        s.normal = bent_normal(s.normal, s.tangent, trace_texel(slots.z, false, s.uv).rgb, m.ambient.w);
+    }
+    Bsdf b = bsdf_of(m, trace_texel(slots.x, true, s.uv).rgb, trace_texel(slots.y, false, s.uv));
+#else
+    Bsdf b = bsdf_of(m, vec3(1.0), vec4(1.0));
+#endif
+    vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
+    vec3 reflectance = min(b.diffuse + b.specular, vec3(1.0));
+    bool glass = m.optics.x > 0.0;
+    imageStore(guide_normal, pixel, vec4(n, t));
+    imageStore(guide_position, pixel, vec4(s.position, 1.0));
+    imageStore(albedo, pixel, vec4(glass ? vec3(1.0) : reflectance, 1.0));
+}
