@@ -250,6 +250,7 @@ fn mutable_files() -> Vec<PathBuf> {
         "shaders/include",
         "shaders/bench",
         "shaders/pathtrace",
+        "shaders/denoise",
     ] {
         let mut found: Vec<PathBuf> = std::fs::read_dir(root().join(dir))
             .expect("read dir")
@@ -308,6 +309,13 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
     if file.starts_with("shaders/include") {
         return roots.to_vec();
     }
+    // The denoiser's files run in the denoised path tracer only; its
+    // shaders' many variants make it too slow a root for every shared file.
+    if file.starts_with("shaders/denoise")
+        || ["denoise.ron", "pathtrace_denoised.ron", "guides.comp"].contains(&name.as_str())
+    {
+        return vec!["pathtrace_denoised.ron"];
+    }
     let text_of =
         |f: &str| std::fs::read_to_string(root().join("graphs").join(f)).unwrap_or_default();
     roots
@@ -328,6 +336,8 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
                 ("debug_views.ron", "debug_views.ron"),
                 ("raster_caveats.ron", "raster_caveats.ron"),
                 ("scene_shading.ron", "scene_shading.ron"),
+                ("path_tracer.ron", "path_tracer.ron"),
+                ("denoise.ron", "denoise.ron"),
             ] {
                 if text.contains(named) {
                     text.push_str(&text_of(fragment));

@@ -81,8 +81,8 @@ fn plans_match_snapshots_and_pass_the_checker() {
         }
     }
     assert_eq!(
-        compared, 12,
-        "forward, deferred, tiled and pathtrace, three feature sets each"
+        compared, 15,
+        "forward, deferred, tiled, pathtrace and pathtrace_denoised, three feature sets each"
     );
 }
 
