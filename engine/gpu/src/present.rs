@@ -420,14 +420,17 @@ fn image_barrier(image: vk::Image) -> vk::ImageMemoryBarrier2<'static> {
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .image(image)
-        .subresource_range(vk::ImageSubresourceRange {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            base_mip_level: 0,
-            level_count: 1,
-            base_array_layer: 0,
-            layer_count: 1,
-        })
+        .subresource_range(SWAPCHAIN_RANGE)
 }
+
+/// A swapchain image's one mip and layer, colour aspect.
+pub const SWAPCHAIN_RANGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
+    aspect_mask: vk::ImageAspectFlags::COLOR,
+    base_mip_level: 0,
+    level_count: 1,
+    base_array_layer: 0,
+    layer_count: 1,
+};
 
 /// The name `readback::decode` knows a swapchain format by.
 fn format_name(format: vk::Format) -> Option<&'static str> {

@@ -291,13 +291,7 @@ fn make_target(
         .image(target.image)
         .view_type(vk::ImageViewType::TYPE_2D)
         .format(target.format)
-        .subresource_range(vk::ImageSubresourceRange {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            base_mip_level: 0,
-            level_count: 1,
-            base_array_layer: 0,
-            layer_count: 1,
-        });
+        .subresource_range(weft_gpu::present::SWAPCHAIN_RANGE);
     let view =
         unsafe { gpu.device().create_image_view(&view_info, None) }.call("vkCreateImageView")?;
     let views = [view];
