@@ -26,6 +26,9 @@ pub struct Source {
     /// What values its parameters accept (`param_ranges`), for tools that
     /// offer them (the viewer's sliders).
     pub ranges: BTreeMap<String, crate::schema::ParamRange>,
+    /// Its parameters the include site sets to a `$reference` of the
+    /// includer's: they follow that parameter, and tools offer that one.
+    pub follows: std::collections::BTreeSet<String>,
     /// The name `--param` reaches its parameters by from the root graph: empty
     /// for the root, the file stem for a file the root includes (`shadows`
     /// in `shadows.resolution`), `None` for files included deeper.
@@ -170,6 +173,8 @@ fn load_overridden(
 struct IncludeSite {
     source: usize,
     index: usize,
+    /// Parameters the site sets to a `$reference` of the includer's.
+    follows: std::collections::BTreeSet<String>,
 }
 
 fn ron_options() -> ron::Options {
@@ -276,6 +281,7 @@ fn load_file(
         spans,
         params: BTreeMap::new(),
         ranges: parsed.param_ranges.clone(),
+        follows: site.as_ref().map(|s| s.follows.clone()).unwrap_or_default(),
         qualifier,
     });
     graph.inputs.push(parsed.inputs.clone());
@@ -370,12 +376,22 @@ fn load_file(
         if let Some(given) = qualified.remove(&include_stem(Path::new(&include.file))) {
             child_overrides.extend(given);
         }
+        let follows = include
+            .params
+            .iter()
+            .filter(|(_, v)| matches!(v, ParamValue::Reference(_)))
+            .map(|(name, _)| name.clone())
+            .collect();
         load_file(
             graph,
             read,
             &dir.join(&include.file),
             child_overrides,
-            Some(IncludeSite { source, index }),
+            Some(IncludeSite {
+                source,
+                index,
+                follows,
+            }),
             stack,
         );
     }

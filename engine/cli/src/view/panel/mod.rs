@@ -105,7 +105,9 @@ pub struct Panel {
     /// Plotted history.
     pub history: History,
     /// Values being edited, by parameter key, until committed.
-    edits: HashMap<String, ParamValue>,
+    /// Per parameter key: the live value last seen, and the value being
+    /// edited (it follows the live value whenever a reload changes that).
+    edits: HashMap<String, (ParamValue, ParamValue)>,
     /// Where each named widget was last drawn, for scripted clicks (`--ui`).
     targets: HashMap<String, egui::Rect>,
     /// A widget to scroll into view (a scripted click's target).
@@ -170,11 +172,13 @@ impl Panel {
             );
             self.reveal = None;
         }
-        // Only a widget wholly in view can be clicked where it was drawn.
-        if response.ctx.content_rect().contains_rect(response.rect)
-            && response.interact_rect == response.rect
+        // A widget can be clicked where it shows: the middle of its part in
+        // view, once its middle is in view.
+        let shown = response.interact_rect;
+        if shown.contains(response.rect.center())
+            && response.ctx.content_rect().contains_rect(shown)
         {
-            self.targets.insert(name, response.rect);
+            self.targets.insert(name, shown);
         } else {
             self.targets.remove(&name);
             self.hidden.insert(name);
@@ -322,15 +326,12 @@ impl Panel {
                     ui.label("this graph declares none");
                 }
                 for entry in view.params {
-                    let value = self
+                    let (seen, value) = self
                         .edits
                         .entry(entry.key.clone())
-                        .or_insert_with(|| entry.value.clone());
-                    if !ui.memory(|m| m.has_focus(egui::Id::new(("param", &entry.key))))
-                        && !ui
-                            .ctx()
-                            .is_being_dragged(egui::Id::new(("param", &entry.key)))
-                    {
+                        .or_insert_with(|| (entry.value.clone(), entry.value.clone()));
+                    if *seen != entry.value {
+                        *seen = entry.value.clone();
                         *value = entry.value.clone();
                     }
                     let (response, commit) = ui
@@ -454,33 +455,34 @@ fn param_widget(
     let id = egui::Id::new(("param", key));
     match value {
         ParamValue::Number(x) => {
-            let response = match (range.min, range.max) {
+            // A bounded number gets a slider, and every number a field to
+            // drag or click and type into (the widget scripts name).
+            let slid = match (range.min, range.max) {
                 (Some(min), Some(max)) => {
-                    let mut slider = egui::Slider::new(x, min..=max);
+                    let mut slider = egui::Slider::new(x, min..=max).show_value(false);
                     if range.integer {
                         slider = slider.integer();
                     }
-                    ui.add(slider)
+                    Some(ui.add(slider))
                 }
-                _ => {
-                    let speed = 0.01 * x.abs().max(1.0);
-                    let mut drag = egui::DragValue::new(x).speed(speed);
-                    if range.min.is_some() || range.max.is_some() {
-                        drag = drag
-                            .range(range.min.unwrap_or(f64::MIN)..=range.max.unwrap_or(f64::MAX));
-                    }
-                    if range.integer {
-                        drag = drag.fixed_decimals(0).speed(1.0);
-                    }
-                    ui.push_id(id, |ui| ui.add(drag)).inner
-                }
+                _ => None,
             };
+            let speed = 0.01 * x.abs().max(1.0);
+            let mut drag = egui::DragValue::new(x).speed(speed);
+            if range.min.is_some() || range.max.is_some() {
+                drag = drag.range(range.min.unwrap_or(f64::MIN)..=range.max.unwrap_or(f64::MAX));
+            }
+            if range.integer {
+                drag = drag.fixed_decimals(0).speed(1.0);
+            }
+            let response = ui.push_id(id, |ui| ui.add(drag)).inner;
+            let complete = |r: &egui::Response| {
+                r.drag_stopped() || (r.changed() && !r.dragged()) || r.lost_focus()
+            };
+            let done = complete(&response) || slid.as_ref().is_some_and(complete);
             if !range.one_of.is_empty() {
                 *x = nearest(&range.one_of, *x);
             }
-            let done = response.drag_stopped()
-                || (response.changed() && !response.dragged())
-                || response.lost_focus();
             (response, done)
         }
         ParamValue::Bool(b) => {

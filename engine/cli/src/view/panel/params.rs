@@ -17,8 +17,9 @@ pub struct ParamEntry {
 }
 
 /// The parameters of `graph` reachable by `--param`, root first, then each
-/// directly included file's as `stem.name`; a value that is a `$reference`
-/// is left out (it follows the parameter it names).
+/// directly included file's as `stem.name`; one whose value follows another
+/// parameter (a `$reference` in its file or at its include site) is left out:
+/// the one it follows is offered.
 pub fn graph_params(graph: &LoadedGraph) -> Vec<ParamEntry> {
     let mut entries: Vec<ParamEntry> = Vec::new();
     for source in &graph.sources {
@@ -26,7 +27,7 @@ pub fn graph_params(graph: &LoadedGraph) -> Vec<ParamEntry> {
             continue;
         };
         for (name, value) in &source.params {
-            if matches!(value, ParamValue::Reference(_)) {
+            if matches!(value, ParamValue::Reference(_)) || source.follows.contains(name) {
                 continue;
             }
             let key = if qualifier.is_empty() {
@@ -66,9 +67,32 @@ mod tests {
             .find(|p| p.key.ends_with(".pcf_radius") || p.key == "pcf_radius")
             .unwrap_or_else(|| panic!("no pcf_radius in {keys:?}"));
         assert!(pcf.range.min.is_some() || pcf.range.integer, "{pcf:?}");
+        assert!(
+            keys.contains(&"shadows.resolution"),
+            "a fragment's parameter its include site sets to a number stays: {keys:?}"
+        );
         let mut unique = keys.clone();
         unique.sort_unstable();
         unique.dedup();
         assert_eq!(unique.len(), keys.len(), "{keys:?}");
+    }
+
+    #[test]
+    fn a_fragment_parameter_that_follows_the_roots_is_offered_once_as_the_roots() {
+        let graph = weft_graph::load(std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../graphs/pathtrace.ron"
+        )));
+        let keys: Vec<String> = graph_params(&graph).into_iter().map(|p| p.key).collect();
+        assert!(keys.contains(&"max_depth".to_string()), "{keys:?}");
+        let fragment: Vec<&String> = keys
+            .iter()
+            .filter(|k| k.starts_with("path_tracer."))
+            .collect();
+        assert_eq!(
+            fragment,
+            vec!["path_tracer.accumulate"],
+            "path_tracer.ron's parameters follow pathtrace.ron's `$max_depth`, ...; only the one its include sets to a number stays"
+        );
     }
 }
