@@ -271,7 +271,7 @@ pub fn default_reference(graph: &Path) -> PathBuf {
     }
 }
 
-/// Draws `measure`'s map over the whole window (behind the panel) with its
+/// Draws a measure's map (`texture`) over the whole window, behind the panel, with its
 /// number and a magma legend at the bottom left.
 pub fn show_map(ctx: &egui::Context, texture: &egui::TextureHandle, mean: f64, spp: u64) {
     let screen = ctx.content_rect();
