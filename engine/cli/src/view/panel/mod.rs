@@ -291,25 +291,35 @@ impl Panel {
                     });
                 self.remember("graph".into(), &combo.response);
                 let on = |f: &str| view.plan.features.iter().any(|x| x == f);
-                for feature in view.features {
-                    if let Some(reason) = weft_render::scene_feature_reason(feature) {
-                        let mut state = on(feature);
-                        let text = if state {
-                            format!("{feature}: on, {reason}")
-                        } else {
-                            format!("{feature}: off")
-                        };
-                        ui.add_enabled(false, egui::Checkbox::new(&mut state, text))
-                            .on_disabled_hover_text("set from what the scene holds");
-                    } else {
-                        let mut state = on(feature);
-                        let check = ui.checkbox(&mut state, feature.as_str());
-                        if check.changed() {
-                            actions.push(PanelAction::Feature(feature.clone(), state));
-                        }
-                        self.remember(format!("feature:{feature}"), &check);
+                let (scene, own): (Vec<&String>, Vec<&String>) = view
+                    .features
+                    .iter()
+                    .partition(|f| weft_render::scene_feature_reason(f).is_some());
+                for feature in own {
+                    let mut state = on(feature);
+                    let check = ui.checkbox(&mut state, feature.as_str());
+                    if check.changed() {
+                        actions.push(PanelAction::Feature(feature.clone(), state));
                     }
+                    self.remember(format!("feature:{feature}"), &check);
                 }
+                let lit = scene.iter().filter(|f| on(f)).count();
+                egui::CollapsingHeader::new(format!("set by the scene ({lit} of {} on)", scene.len()))
+                    .show(ui, |ui| {
+                        for feature in scene {
+                            let reason = weft_render::scene_feature_reason(feature).unwrap_or("");
+                            let mut state = on(feature);
+                            let text = if state {
+                                format!("{feature}: on, {reason}")
+                            } else {
+                                format!("{feature}: off")
+                            };
+                            ui.add_enabled(false, egui::Checkbox::new(&mut state, text))
+                                .on_disabled_hover_text(
+                                    "set from what the scene holds (keys 1-9 and Shift+1-9 still toggle it)",
+                                );
+                        }
+                    });
             });
     }
 
