@@ -6,6 +6,7 @@
 use crate::compare_cmd::{Common, Session, Timings};
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -60,7 +61,8 @@ struct SweepRun {
     graph: PathBuf,
     /// Several graphs swept as one more dimension (comma-separated), every
     /// point of each against the same reference, on one frontier; sweep.csv
-    /// names each point's graph in its first column.
+    /// names each point's graph in its first column. Each graph is swept over
+    /// the --param parameters it has.
     #[arg(long, value_delimiter = ',')]
     graphs: Vec<PathBuf>,
     /// A parameter and its values, NAME=v1,v2,...; repeatable (the points are
@@ -388,7 +390,38 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
     if !args.graphs.is_empty() && args.params.iter().any(|(n, _)| n == GRAPH_COLUMN) {
         bail!("--param {GRAPH_COLUMN}=... cannot be swept with --graphs: sweep.csv's `{GRAPH_COLUMN}` column names each point's graph");
     }
-    let every = points(&args.swept_graphs(), &args.params, &sets);
+    // Over several graphs, each is swept over the parameters it has.
+    let settable: BTreeMap<String, BTreeSet<String>> = args
+        .swept_graphs()
+        .into_iter()
+        .map(|g| {
+            let names = weft_graph::load(Path::new(&g)).settable_params();
+            (g, names)
+        })
+        .collect();
+    if !settable.is_empty() {
+        if let Some((name, _)) = args
+            .params
+            .iter()
+            .find(|(name, _)| !settable.values().any(|names| names.contains(name)))
+        {
+            bail!(
+                "--param {name}: none of the swept graphs has this parameter ({})",
+                settable
+                    .iter()
+                    .map(|(g, names)| format!(
+                        "{g}: {}",
+                        names.iter().cloned().collect::<Vec<_>>().join(" ")
+                    ))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            );
+        }
+    }
+    let takes = |graph: Option<&str>, name: &str| {
+        graph.is_none_or(|g| settable.get(g).is_some_and(|names| names.contains(name)))
+    };
+    let every = points(&args.swept_graphs(), &args.params, &sets, &takes);
     // The graph loaded with every point's parameters and features before the
     // reference renders: a misspelt parameter or value fails at once.
     let mut graphs = crate::graphs::Loaded::default();

@@ -98,11 +98,14 @@ pub enum SweepError {
 /// Every point of the product of `graphs` (an empty list means the sweep's
 /// one graph), `params` (name, values) and `feature_sets` (an empty list
 /// means one set with no toggles), in order: the last parameter varies
-/// fastest, then graphs, feature sets slowest.
+/// fastest, then graphs, feature sets slowest. Each graph is swept over the
+/// parameters `takes(graph, name)` says it has (`None`: the sweep's one
+/// graph), so graphs with different parameters share one sweep.
 pub fn points(
     graphs: &[String],
     params: &[(String, Vec<String>)],
     feature_sets: &[String],
+    takes: &dyn Fn(Option<&str>, &str) -> bool,
 ) -> Vec<SweepPoint> {
     let sets: Vec<String> = if feature_sets.is_empty() {
         vec![String::new()]
@@ -117,7 +120,10 @@ pub fn points(
     let mut out = Vec::new();
     for (features, graph) in sets.iter().flat_map(|f| graphs.iter().map(move |g| (f, g))) {
         let mut partial = vec![BTreeMap::new()];
-        for (name, values) in params {
+        for (name, values) in params
+            .iter()
+            .filter(|(name, _)| takes(graph.as_deref(), name))
+        {
             partial = partial
                 .into_iter()
                 .flat_map(|p: BTreeMap<String, String>| {
@@ -259,8 +265,9 @@ fn parse(path: &Path, text: &str, names: &[String]) -> Result<(Vec<SweepRow>, bo
                 graph: named()
                     .find(|(name, _)| *name == GRAPH_COLUMN)
                     .map(|(_, g)| g.to_string()),
+                // An empty cell: a parameter this point's graph does not have.
                 params: named()
-                    .filter(|(name, _)| *name != GRAPH_COLUMN)
+                    .filter(|(name, v)| *name != GRAPH_COLUMN && !v.is_empty())
                     .map(|(name, v)| (name.clone(), v.to_string()))
                     .collect(),
                 features: fields[n].to_string(),
@@ -300,14 +307,15 @@ mod tests {
                 vec!["x".to_string(), "y".to_string(), "z".to_string()],
             ),
         ];
-        let all = points(&[], &params, &["".into(), "bloom".into()]);
+        let every = |_: Option<&str>, _: &str| true;
+        let all = points(&[], &params, &["".into(), "bloom".into()], &every);
         assert_eq!(all.len(), 12);
         assert_eq!(all[0].label(), "a=1 b=x");
         assert_eq!(all[1].label(), "a=1 b=y");
         assert_eq!(all[6].label(), "a=1 b=x [bloom]");
-        assert_eq!(points(&[], &[], &[]).len(), 1);
+        assert_eq!(points(&[], &[], &[], &every).len(), 1);
         let graphs = ["graphs/forward.ron".to_string(), "deferred.ron".to_string()];
-        let all = points(&graphs, &params[..1], &["".into(), "bloom".into()]);
+        let all = points(&graphs, &params[..1], &["".into(), "bloom".into()], &every);
         let labels: Vec<String> = all.iter().map(SweepPoint::label).collect();
         assert_eq!(
             labels,
@@ -323,6 +331,36 @@ mod tests {
             ]
         );
         assert_eq!(all[0].graph.as_deref(), Some("graphs/forward.ron"));
+    }
+
+    /// A graph is swept over the parameters it has, once when it has none
+    /// of them; its CSV cells for the others are empty and read back absent.
+    #[test]
+    fn each_graph_is_swept_over_the_parameters_it_has() {
+        let params = vec![("spf".to_string(), vec!["1".to_string(), "4".to_string()])];
+        let graphs = ["forward.ron".to_string(), "denoised.ron".to_string()];
+        let takes =
+            |graph: Option<&str>, name: &str| graph == Some("denoised.ron") && name == "spf";
+        let all = points(&graphs, &params, &[], &takes);
+        let labels: Vec<String> = all.iter().map(SweepPoint::label).collect();
+        assert_eq!(labels, ["forward", "denoised spf=1", "denoised spf=4"]);
+        let names = vec![GRAPH_COLUMN.to_string(), "spf".to_string()];
+        let rows: Vec<SweepRow> = all
+            .iter()
+            .map(|point| SweepRow {
+                point: point.clone(),
+                flip: 0.5,
+                rmse: 0.25,
+                frame_ms: 2.0,
+                device_bytes: 7,
+                frame_iqr: (1.5, 2.5),
+            })
+            .collect();
+        let text = document(&names, &rows);
+        assert!(text.contains("\nforward.ron,,,0.500000,"), "{text}");
+        let (read, old) = parse(Path::new("sweep.csv"), &text, &names).expect("parses");
+        assert!(!old);
+        assert_eq!(read, rows);
     }
 
     /// A sweep over graphs writes each point's graph in the first column and

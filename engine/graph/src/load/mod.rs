@@ -94,6 +94,24 @@ impl LoadedGraph {
         }
     }
 
+    /// The parameter names `--param` reaches: the root file's own, and as
+    /// `stem.name` those of the files it includes directly.
+    pub fn settable_params(&self) -> std::collections::BTreeSet<String> {
+        self.sources
+            .iter()
+            .filter_map(|s| s.qualifier.as_ref().map(|q| (q, s)))
+            .flat_map(|(q, s)| {
+                s.params.keys().map(move |name| {
+                    if q.is_empty() {
+                        name.clone()
+                    } else {
+                        format!("{q}.{name}")
+                    }
+                })
+            })
+            .collect()
+    }
+
     /// Every file the graph was built from, for hot reload.
     pub fn files(&self) -> Vec<PathBuf> {
         self.sources.iter().map(|s| s.file.clone()).collect()

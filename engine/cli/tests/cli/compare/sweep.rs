@@ -390,3 +390,55 @@ fn a_sweep_over_graphs_measures_each_graph_as_its_own_sweep_does() {
         .expect("a frontier");
     assert!(note.contains(&format!("#{last}")), "{note}\n{table}");
 }
+
+/// Graphs with different parameters share one sweep: each is swept over
+/// the parameters it has (forward once, the denoised path tracer at each
+/// `samples_per_frame`), its cells for the others left empty; a parameter
+/// no swept graph has is an error naming each graph's.
+#[test]
+fn a_sweep_over_graphs_sweeps_each_over_the_parameters_it_has() {
+    let cache = temp("sweep-graph-params-cache");
+    let out = temp("sweep-graph-params");
+    let out_arg = out.to_string_lossy().into_owned();
+    let graphs = "graphs/forward.ron,graphs/pathtrace_denoised.ron";
+    let mut args = vec!["sweep", "scenes/cornell.scene", "--graphs", graphs];
+    args.extend(["--param", "samples_per_frame=1,2", "--validate"]);
+    args.extend(SMALL);
+    args.extend(["--out", out_arg.as_str()]);
+    weft_ok(&args, &cache);
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).expect("sweep.csv");
+    let starts: Vec<String> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.splitn(3, ',').take(2).collect::<Vec<_>>().join(","))
+        .collect();
+    assert_eq!(
+        starts,
+        [
+            "graphs/forward.ron,",
+            "graphs/pathtrace_denoised.ron,1",
+            "graphs/pathtrace_denoised.ron,2"
+        ],
+        "{csv}"
+    );
+    // Run again: every point is found in sweep.csv, empty cells included.
+    let again = weft_ok(&args, &cache);
+    assert!(
+        String::from_utf8_lossy(&again.stdout).contains("3 points, 3 already in"),
+        "{}",
+        String::from_utf8_lossy(&again.stdout)
+    );
+    let mut wrong = vec!["sweep", "scenes/cornell.scene", "--graphs", graphs];
+    wrong.extend(["--param", "max_dpeth=1,2"]);
+    wrong.extend(SMALL);
+    wrong.extend(["--out", out_arg.as_str()]);
+    let run = weft(&wrong, &cache);
+    assert!(!run.status.success());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("--param max_dpeth: none of the swept graphs has this parameter")
+            && stderr.contains("graphs/pathtrace_denoised.ron: ")
+            && stderr.contains(" max_depth "),
+        "{stderr}"
+    );
+}
