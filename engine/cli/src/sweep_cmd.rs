@@ -306,9 +306,18 @@ fn write_report(
         })
         .collect();
     let on = frontier(&plotted);
+    // The plot's title names graphs by file stem, as its points are labelled.
+    let stems: Vec<String> = graph
+        .split(", ")
+        .map(|g| {
+            Path::new(g)
+                .file_stem()
+                .map_or_else(|| g.to_string(), |s| s.to_string_lossy().into_owned())
+        })
+        .collect();
     write_plot(
         &plotted,
-        &format!("{graph}: HDR-FLIP against frame time"),
+        &format!("{}: HDR-FLIP against frame time", stems.join(", ")),
         ("HDR-FLIP", budget_ms, noise_floor.map(|(_, flip)| flip)),
         &out.join("pareto.png"),
     )?;
