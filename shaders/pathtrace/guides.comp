@@ -18,6 +18,7 @@
 #include "sampling.glsl"
 #include "dielectric.glsl"
 #include "bsdf.glsl"
+#include "surface_bsdf.glsl"
 #include "lights.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -63,15 +64,8 @@ void main() {
     }
 #endif
     vec3 ng = dot(s.geometric_normal, dir) > 0.0 ? -s.geometric_normal : s.geometric_normal;
-#ifdef SCENE_TEXTURES
-    uvec4 slots = material_textures[s.material];
-    if (slots.z != NO_TEXTURE && m.ambient.w != 0.0) {
-        s.normal = bent_normal(s.normal, s.tangent, trace_texel(slots.z, false, s.uv).rgb, m.ambient.w);
-    }
-    Bsdf b = bsdf_of(m, trace_texel(slots.x, true, s.uv).rgb, trace_texel(slots.y, false, s.uv));
-#else
-    Bsdf b = bsdf_of(m, vec3(1.0), vec4(1.0));
-#endif
+    s.normal = mapped_normal(s, m);
+    Bsdf b = surface_bsdf(s, m);
     vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
     vec3 reflectance = min(b.diffuse + b.specular, vec3(1.0));
     bool glass = m.optics.x > 0.0;

@@ -54,6 +54,7 @@
 #include "sampling.glsl"
 #include "dielectric.glsl"
 #include "bsdf.glsl"
+#include "surface_bsdf.glsl"
 #include "lights.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -182,12 +183,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         Material m = materials[s.material];
         vec3 wo = -dir;
         vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
-#ifdef SCENE_TEXTURES
-        uvec4 slots = material_textures[s.material];
-        if (slots.z != NO_TEXTURE && m.ambient.w != 0.0) {
-            s.normal = bent_normal(s.normal, s.tangent, trace_texel(slots.z, false, s.uv).rgb, m.ambient.w);
-        }
-#endif
+        s.normal = mapped_normal(s, m);
         vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
 #ifdef SCENE_EMISSIVE
         if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
@@ -235,11 +231,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
             continue;
         }
 #endif
-#ifdef SCENE_TEXTURES
-        Bsdf b = bsdf_of(m, trace_texel(slots.x, true, s.uv).rgb, trace_texel(slots.y, false, s.uv));
-#else
-        Bsdf b = bsdf_of(m, vec3(1.0), vec4(1.0));
-#endif
+        Bsdf b = surface_bsdf(s, m);
         vec3 from = leave(s.position, ng);
         vec4 u_pick = rng_next(rng);
         vec4 u_point = rng_next(rng);

@@ -56,14 +56,8 @@ pub(super) fn reference(
     let graph = weft_render::load_graph(&settings)?;
     // `--features` are for the configurations; the reference takes the
     // toggles it knows (`!textures`), not raster ones (`!bloom`).
-    let features = common
-        .features
-        .iter()
-        .filter(|t| graph.unknown_features(&[t.as_str()]).is_empty())
-        .cloned()
-        .collect();
     let settings = RenderSettings {
-        features,
+        features: graph.known_toggles(&common.features),
         extra_readback: graph.graph().readback_names(),
         ..settings
     };

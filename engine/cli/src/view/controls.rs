@@ -79,13 +79,7 @@ pub fn feature_key(index: usize) -> Option<String> {
 /// FRAME (counted from 0) renders. KEY is `g`, `G` (Shift+G), `1`-`9`,
 /// `shift+1`-`shift+9`, `f1`, `f12`, `space`, `r`, `c`, `l`, `b` or `esc`.
 pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
-    let (frame, key) = text
-        .split_once(':')
-        .ok_or_else(|| format!("expected FRAME:KEY, found \"{text}\""))?;
-    let frame = frame
-        .trim()
-        .parse::<u32>()
-        .map_err(|_| format!("\"{frame}\" is not a frame number"))?;
+    let (frame, key) = split_frame(text, "KEY")?;
     let (code, shift) = match key.trim() {
         "g" => (KeyCode::KeyG, false),
         "G" => (KeyCode::KeyG, true),
@@ -114,6 +108,19 @@ pub fn parse_press(text: &str) -> Result<(u32, Action), String> {
     };
     let action = action(code, shift).ok_or_else(|| format!("no action for \"{key}\""))?;
     Ok((frame, action))
+}
+
+/// A scripted entry `FRAME:REST` (`--press`, `--ui`): the frame number and
+/// the rest; `what` names the rest in the error.
+pub fn split_frame<'t>(text: &'t str, what: &str) -> Result<(u32, &'t str), String> {
+    let (frame, rest) = text
+        .split_once(':')
+        .ok_or_else(|| format!("expected FRAME:{what}, found \"{text}\""))?;
+    let frame = frame
+        .trim()
+        .parse::<u32>()
+        .map_err(|_| format!("\"{frame}\" is not a frame number"))?;
+    Ok((frame, rest))
 }
 
 /// The features a user of `graph` can switch (names in its conditions and

@@ -247,14 +247,8 @@ fn reference_settings(reference: &Path, viewer: &RenderSettings) -> Result<Rende
             reference.display()
         ));
     }
-    let features = viewer
-        .features
-        .iter()
-        .filter(|t| graph.unknown_features(&[t.as_str()]).is_empty())
-        .cloned()
-        .collect();
     Ok(RenderSettings {
-        features,
+        features: graph.known_toggles(&viewer.features),
         extra_readback: graph.graph().readback_names(),
         ..settings
     })

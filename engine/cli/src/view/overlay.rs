@@ -171,18 +171,19 @@ impl<'g> EguiOverlay<'g> {
         if self.targets.len() <= target.index {
             self.targets.resize_with(target.index + 1, || None);
         }
-        let current = self.targets[target.index]
-            .as_ref()
-            .is_some_and(|t| t.image == target.image && t.extent == target.extent);
-        if !current {
-            if let Some(old) = self.targets[target.index].take() {
-                destroy_target(self.gpu, old);
+        let slot = &mut self.targets[target.index];
+        match slot {
+            Some(t) if t.image == target.image && t.extent == target.extent => Ok(t.framebuffer),
+            _ => {
+                if let Some(old) = slot.take() {
+                    destroy_target(self.gpu, old);
+                }
+                let made = make_target(self.gpu, self.render_pass, target)?;
+                let framebuffer = made.framebuffer;
+                *slot = Some(made);
+                Ok(framebuffer)
             }
-            self.targets[target.index] = Some(make_target(self.gpu, self.render_pass, target)?);
         }
-        Ok(self.targets[target.index]
-            .as_ref()
-            .map_or(vk::Framebuffer::null(), |t| t.framebuffer))
     }
 
     fn destroy_targets(&mut self) {

@@ -17,13 +17,7 @@ pub enum UiStep {
 /// Parses one `--ui` entry, `FRAME:click:NAME`, `FRAME:text:TEXT` or
 /// `FRAME:enter`: the step happens before frame FRAME (counted from 0).
 pub fn parse_ui(text: &str) -> Result<(u32, UiStep), String> {
-    let (frame, step) = text
-        .split_once(':')
-        .ok_or_else(|| format!("expected FRAME:STEP, found \"{text}\""))?;
-    let frame = frame
-        .trim()
-        .parse::<u32>()
-        .map_err(|_| format!("\"{frame}\" is not a frame number"))?;
+    let (frame, step) = super::controls::split_frame(text, "STEP")?;
     let step = match step.split_once(':') {
         Some(("click", name)) if !name.is_empty() => UiStep::Click(name.to_string()),
         Some(("text", typed)) => UiStep::Text(typed.to_string()),

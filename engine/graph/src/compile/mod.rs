@@ -84,6 +84,17 @@ impl Prepared {
         &self.ir
     }
 
+    /// The toggles of `requested` that name a feature of this graph, the
+    /// rest dropped: the toggles meant for other graphs left out (a raster
+    /// graph's `!bloom` given to the reference as well).
+    pub fn known_toggles(&self, requested: &[String]) -> Vec<String> {
+        requested
+            .iter()
+            .filter(|t| self.unknown_features(&[t.as_str()]).is_empty())
+            .cloned()
+            .collect()
+    }
+
     /// The toggles a user typed (`name` on, `!name` off) that name no feature
     /// of this graph — neither one its passes test nor a default — each as a
     /// message with the nearest known name as a hint.

@@ -94,22 +94,29 @@ impl LoadedGraph {
         }
     }
 
-    /// The parameter names `--param` reaches: the root file's own, and as
-    /// `stem.name` those of the files it includes directly.
-    pub fn settable_params(&self) -> std::collections::BTreeSet<String> {
+    /// The parameters `--param` reaches, in source order: each as its
+    /// `--param` name (the root file's own, and as `stem.name` those of the
+    /// files it includes directly), the file it is declared in, and its name
+    /// there.
+    pub fn settable(&self) -> impl Iterator<Item = (String, &Source, &str)> {
         self.sources
             .iter()
             .filter_map(|s| s.qualifier.as_ref().map(|q| (q, s)))
             .flat_map(|(q, s)| {
                 s.params.keys().map(move |name| {
-                    if q.is_empty() {
+                    let key = if q.is_empty() {
                         name.clone()
                     } else {
                         format!("{q}.{name}")
-                    }
+                    };
+                    (key, s, name.as_str())
                 })
             })
-            .collect()
+    }
+
+    /// The names of [`LoadedGraph::settable`].
+    pub fn settable_params(&self) -> std::collections::BTreeSet<String> {
+        self.settable().map(|(key, ..)| key).collect()
     }
 
     /// Every file the graph was built from, for hot reload.

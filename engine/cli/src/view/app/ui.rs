@@ -46,10 +46,10 @@ pub(super) struct UiState<'g> {
     /// The live error map on screen: the samples and mean it shows, and its texture.
     map: Option<(u64, f64, egui::TextureHandle)>,
     bookmarks: Vec<Bookmark>,
-    /// Where bookmarks are saved; `None` when the file there could not be
-    /// read (it is never overwritten unread).
-    bookmarks_file: Option<PathBuf>,
+    /// Where bookmarks are saved.
     bookmarks_path: PathBuf,
+    /// Whether that file could be read (it is never overwritten unread).
+    bookmarks_readable: bool,
     /// A debug view's value under the cursor.
     under_cursor: Option<String>,
     /// Whether the overlay draws this frame.
@@ -63,11 +63,11 @@ impl<'g> UiState<'g> {
     /// The panel's state for a viewer started with `args` on `graph`.
     pub fn new(args: &ViewArgs, graph: &std::path::Path) -> Result<Self> {
         let bookmarks_path = bookmarks::file_for(&args.scene);
-        let (bookmarks, bookmarks_file) = match bookmarks::load(&bookmarks_path) {
-            Ok(marks) => (marks, Some(bookmarks_path.clone())),
+        let (bookmarks, bookmarks_readable) = match bookmarks::load(&bookmarks_path) {
+            Ok(marks) => (marks, true),
             Err(err) => {
                 eprintln!("warning: {err:#}; bookmarks will not be saved over it");
-                (Vec::new(), None)
+                (Vec::new(), false)
             }
         };
         Ok(Self {
@@ -87,7 +87,7 @@ impl<'g> UiState<'g> {
             live_error_out: args.live_error_out.clone(),
             map: None,
             bookmarks,
-            bookmarks_file,
+            bookmarks_readable,
             bookmarks_path,
             under_cursor: None,
             drawn: false,
@@ -287,7 +287,7 @@ impl Viewer<'_> {
     /// Runs the panel (and the live error map) for this frame with the
     /// frame's scripted input; returns what the panel asked for.
     pub(super) fn run_panel(&mut self) -> Result<Vec<PanelAction>> {
-        let (Some(overlay), Some(window)) = (self.overlay.as_mut(), self.window.as_ref()) else {
+        let (Some(overlay), Some(_)) = (self.overlay.as_mut(), self.window.as_ref()) else {
             return Ok(Vec::new());
         };
         let mut events: Vec<egui::Event> = self
@@ -367,14 +367,11 @@ impl Viewer<'_> {
             overlay.clear();
             return Ok(Vec::new());
         }
+        let camera_block = self.camera_block();
+        let (Some(overlay), Some(window)) = (self.overlay.as_mut(), self.window.as_ref()) else {
+            return Ok(Vec::new());
+        };
         let params = graph_params(self.live.graph().graph());
-        let camera_block = super::super::camera_block::camera_block(
-            "flown",
-            &self.lens,
-            self.live.scene().origin,
-            self.camera.position,
-            self.camera.orientation,
-        );
         let live_status = self.ui.live_error.as_ref().map(LiveError::status);
         let view = PanelView {
             graph: &self.live.settings().graph,
@@ -486,13 +483,14 @@ impl Viewer<'_> {
 
     /// Saves the camera as the next bookmark beside the scene.
     pub(super) fn save_bookmark(&mut self) {
-        let Some(file) = self.ui.bookmarks_file.clone() else {
+        let file = self.ui.bookmarks_path.clone();
+        if !self.ui.bookmarks_readable {
             self.report_error(format!(
                 "{} could not be read, so bookmarks are not saved over it",
-                self.ui.bookmarks_path.display()
+                file.display()
             ));
             return;
-        };
+        }
         let number = self.ui.bookmarks.len() + 1;
         self.ui.bookmarks.push(Bookmark {
             name: format!("bookmark {number}"),

@@ -22,28 +22,17 @@ pub struct ParamEntry {
 /// the one it follows is offered.
 pub fn graph_params(graph: &LoadedGraph) -> Vec<ParamEntry> {
     let mut entries: Vec<ParamEntry> = Vec::new();
-    for source in &graph.sources {
-        let Some(qualifier) = &source.qualifier else {
+    for (key, source, name) in graph.settable() {
+        let value = &source.params[name];
+        let follows = matches!(value, ParamValue::Reference(_)) || source.follows.contains(name);
+        if follows || entries.iter().any(|e| e.key == key) {
             continue;
-        };
-        for (name, value) in &source.params {
-            if matches!(value, ParamValue::Reference(_)) || source.follows.contains(name) {
-                continue;
-            }
-            let key = if qualifier.is_empty() {
-                name.clone()
-            } else {
-                format!("{qualifier}.{name}")
-            };
-            if entries.iter().any(|e| e.key == key) {
-                continue;
-            }
-            entries.push(ParamEntry {
-                key,
-                value: value.clone(),
-                range: source.ranges.get(name).cloned().unwrap_or_default(),
-            });
         }
+        entries.push(ParamEntry {
+            key,
+            value: value.clone(),
+            range: source.ranges.get(name).cloned().unwrap_or_default(),
+        });
     }
     entries
 }
