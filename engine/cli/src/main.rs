@@ -58,7 +58,19 @@ fn die_quietly_on_closed_pipes() {
     }
 }
 
+/// Turns off backtraces of library errors unless the user chose otherwise:
+/// spirq (shader reflection) builds an `anyhow` error on every successful
+/// lookup, and with `RUST_BACKTRACE` set each captured a backtrace, which
+/// made reflecting a shader about five times slower. Panics still follow
+/// `RUST_BACKTRACE`. Runs first, before any thread exists.
+fn quiet_library_backtraces() {
+    if std::env::var_os("RUST_LIB_BACKTRACE").is_none() {
+        std::env::set_var("RUST_LIB_BACKTRACE", "0");
+    }
+}
+
 fn main() -> ExitCode {
+    quiet_library_backtraces();
     die_quietly_on_closed_pipes();
     let cli = Cli::parse();
     weft_scene::outside::allow_outside(cli.allow_outside);
