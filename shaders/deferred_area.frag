@@ -10,10 +10,12 @@ layout(set = 0, binding = 3) uniform sampler2D depth;
 // Area lights with a view in the shadow atlas cast soft shadows (shadows.glsl).
 layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
 #endif
-#include "include/deferred.glsl"
 layout(push_constant) uniform Params {
     uint area_samples;  // graph parameter: 0 analytic (LTC), n: n x n quadrature
+    uint shadow_rays;   // graph parameter: rt_shadows' rays per pixel and light
 } params;
+#define RT_SHADOW_RAYS params.shadow_rays
+#include "include/deferred.glsl"
 
 layout(location = 0) in vec2 uv;
 layout(location = 0) out vec4 color;

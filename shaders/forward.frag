@@ -7,6 +7,12 @@
 #ifdef HAS_SHADOW_MAP
 layout(set = 0, binding = 0) uniform sampler2DShadow shadow_map;
 #endif
+layout(push_constant) uniform Params {
+    float emissive_boost;  // graph parameter: scales material emission
+    uint area_samples;     // graph parameter: 0 analytic area lights, n: n x n quadrature
+    uint shadow_rays;      // graph parameter: rt_shadows' rays per pixel and area light
+} params;
+#define RT_SHADOW_RAYS params.shadow_rays
 #include "include/bindings.glsl"
 #include "include/lighting.glsl"
 #ifdef HAS_VIEW_OVERSHADING
@@ -19,11 +25,6 @@ layout(set = 0, binding = 6, r32ui) uniform uimage2D view_overshading;
 layout(std430, set = 0, binding = 7) buffer ViewOvershadingTotals { uint words[4]; } view_overshading_totals;
 #include "include/view_counts.glsl"
 #endif
-
-layout(push_constant) uniform Params {
-    float emissive_boost;  // graph parameter: scales material emission
-    uint area_samples;     // graph parameter: 0 analytic area lights, n: n x n quadrature
-} params;
 
 layout(set = SET_MATERIAL, binding = MATERIAL_BASE_COLOR) uniform sampler2D base_color;
 layout(set = SET_MATERIAL, binding = MATERIAL_METALLIC_ROUGHNESS) uniform sampler2D metallic_roughness;

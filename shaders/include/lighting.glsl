@@ -290,7 +290,8 @@ vec3 shade_suns(Surface s, Material m) {
 }
 
 // `area_samples` is the graph parameter of that name: 0 integrates analytically
-// (LTC), n > 0 by n x n quadrature.
+// (LTC), n > 0 by n x n quadrature. Under RT_SHADOWS the includer defines
+// RT_SHADOW_RAYS, the shadow rays per pixel and area light.
 vec3 shade_area_lights(Surface s, Material m, uint area_samples) {
     vec3 c = vec3(0.0);
 #ifdef SCENE_AREA_LIGHTS
@@ -302,6 +303,11 @@ vec3 shade_area_lights(Surface s, Material m, uint area_samples) {
 #ifdef HAS_SHADOW_MAP
         if (any(greaterThan(light, vec3(0.0)))) {
             light *= area_visibility(i, s.position, s.normal, o);
+        }
+#endif
+#ifdef RT_SHADOWS
+        if (any(greaterThan(light, vec3(0.0)))) {
+            light *= rt_area_visibility(i, o, s.position, s.normal, RT_SHADOW_RAYS);
         }
 #endif
         c += light;

@@ -2,7 +2,9 @@
 // (lighting.glsl) and the path tracer's next-event estimation
 // (pathtrace/lights.glsl) both read it. With HAS_SHADOW_MAP (raster passes
 // that read the shadow atlas; the includer declares `shadow_map` first) suns
-// and spot cones look up their shadows.
+// and spot cones look up their shadows; with RT_SHADOWS (feature
+// `rt_shadows`) every sun, point and spot traces one shadow ray instead
+// (rt_shadows.glsl).
 #ifndef WEFT_PUNCTUAL_GLSL
 #define WEFT_PUNCTUAL_GLSL
 #include "surface.glsl"
@@ -19,6 +21,9 @@ float attenuate(uint index, float d) {
 #ifdef HAS_SHADOW_MAP
 #include "shadows.glsl"
 #endif
+#ifdef RT_SHADOWS
+#include "rt_shadows.glsl"
+#endif
 
 // Radiance arriving at the surface from light `index` of each punctual type,
 // and the unit direction towards it; zero beyond the light's cutoff range or
@@ -32,6 +37,11 @@ vec3 incoming_sun(uint index, Surface s, out vec3 l) {
     // Surfaces facing away get no light anyway: skip their shadow lookups.
     if (index == 0u && dot(s.normal, l) > 0.0) {
         visible = sun_visibility(s.position, s.normal);
+    }
+#endif
+#ifdef RT_SHADOWS
+    if (dot(s.normal, l) > 0.0) {
+        visible = rt_visibility(s.position, s.normal, l, RT_SUN_DISTANCE);
     }
 #endif
     return lights[index].color_exponent.rgb * visible;
@@ -58,6 +68,11 @@ vec3 incoming_point(uint index, Surface s, out vec3 l) {
     if (!point_reaches(index, d)) {
         return vec3(0.0);
     }
+#ifdef RT_SHADOWS
+    if (dot(s.normal, l) > 0.0 && rt_visibility(s.position, s.normal, l, d) == 0.0) {
+        return vec3(0.0);
+    }
+#endif
     return lights[index].color_exponent.rgb * attenuate(index, d);
 }
 
@@ -74,6 +89,11 @@ vec3 incoming_spot(uint index, Surface s, out vec3 l) {
 #ifdef HAS_SHADOW_MAP
     if (lights[index].direction_type.w == LIGHT_SPOT_CONE && dot(s.normal, l) > 0.0) {
         spot *= spot_visibility(index, s.position, s.normal, d);
+    }
+#endif
+#ifdef RT_SHADOWS
+    if (dot(s.normal, l) > 0.0) {
+        spot *= rt_visibility(s.position, s.normal, l, d);
     }
 #endif
     return lights[index].color_exponent.rgb * spot * attenuate(index, d);

@@ -17,6 +17,7 @@ mod pathtrace;
 mod raycast;
 mod render;
 mod rt_ao;
+mod rt_shadows;
 mod scripting;
 mod shading;
 mod shadows;

@@ -170,7 +170,12 @@ pub fn scene_pass_problems(
                 )
             }),
     );
-    problems.extend(scene_set_problems(scene, &merged, true, false));
+    problems.extend(scene_set_problems(
+        scene,
+        &merged,
+        true,
+        (scene.traces)(pass),
+    ));
     problems.extend(vertex_input_problems(scene, pass, vs));
     if fs.is_some() {
         problems.extend(link_problems(&merged));

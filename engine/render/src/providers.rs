@@ -12,7 +12,8 @@
 //!   view's index (see `shadows/`).
 //! - `RayTracing()`: the scene's world-space triangles, their corners'
 //!   normals and UVs, their materials, and a BVH over them (`bvh.rs`), built
-//!   on first use and bound in set 1 of the compute pass.
+//!   on first use and bound in set 1 of the pass (compute, fullscreen or
+//!   scene-drawing: raster lighting traces its shadow rays in place).
 
 use crate::gaussian::{self, GaussianTaps};
 use crate::shadows::{ShadowSettings, MAX_AREA_SHADOWS, MAX_CASCADES, MAX_PCF_RADIUS};
@@ -105,11 +106,13 @@ pub const SHADOW_ATLAS: ProviderSpec = ProviderSpec {
 pub const SHADOW_VIEW: &str = "shadow_view";
 
 /// The ray-tracing provider: the scene's world-space triangles and a BVH over
-/// them, bound in set 1 (`shaders/include/trace.glsl`) of a compute pass.
+/// them, bound in set 1 (`shaders/include/trace.glsl`) of a compute,
+/// fullscreen or scene-drawing pass. A variant whose shaders read none of it
+/// (a feature turned off) builds no BVH.
 pub const RAY_TRACING: ProviderSpec = ProviderSpec {
     name: "RayTracing",
-    summary: "the scene's triangles and their BVH for compute shaders that trace rays",
-    kinds: &[PassKind::Compute],
+    summary: "the scene's triangles and their BVH for shaders that trace rays",
+    kinds: &[PassKind::Compute, PassKind::Fullscreen, PassKind::Raster],
     args: &[],
     supplies: &[
         "Triangles",

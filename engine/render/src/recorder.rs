@@ -120,14 +120,15 @@ impl<'g> SceneRecorder<'g> {
         self.shadow_tiles.clear();
     }
 
-    /// Binds the scene set, the shared vertex and index buffers and the
-    /// unmirrored front face for a scene pipeline the context bound.
-    fn bind(&self, cmd: vk::CommandBuffer, p: &Pipeline) {
-        let commands = Commands::new(self.gpu.device(), cmd);
-        let point = vk::PipelineBindPoint::GRAPHICS;
-        commands.bind_sets(point, p.layout, SCENE_SET, &[self.scene.raster_set()]);
+    /// Binds the scene set of the pipeline's layout (with the ray tracer's
+    /// bindings for shaders that trace), the shared vertex and index buffers
+    /// and the unmirrored front face for a scene pipeline the context bound.
+    fn bind(&mut self, ctx: &RasterContext<'_>, p: &Pipeline) -> Result<(), GpuError> {
+        self.bind_scene(ctx, p)?;
+        let commands = Commands::new(self.gpu.device(), ctx.cmd);
         commands.bind_geometry(self.scene.vertices.buffer, self.scene.indices.buffer);
         commands.set_front_face(front_face(false));
+        Ok(())
     }
 
     /// Draws meshes one indexed draw each (the draw record as `firstInstance`),
@@ -211,7 +212,7 @@ impl<'g> SceneRecorder<'g> {
         if !by_model {
             let defines = ctx.pass().defines.clone();
             let p = ctx.bind_variant(&defines, state)?;
-            self.bind(ctx.cmd, &p);
+            self.bind(ctx, &p)?;
             return Ok(self.draw_meshes(ctx.cmd, &p, draws.iter()));
         }
         if !blends_transparency(&ctx.pass_state()) {
@@ -226,7 +227,7 @@ impl<'g> SceneRecorder<'g> {
             let end = start + models[start..].iter().take_while(|m| **m == model).count();
             let defines = ctx.pass().defines_for(model);
             let p = ctx.bind_variant(&defines, state)?;
-            self.bind(ctx.cmd, &p);
+            self.bind(ctx, &p)?;
             calls += self.draw_meshes(ctx.cmd, &p, draws[start..end].iter());
             start = end;
         }
@@ -392,7 +393,7 @@ impl DrawRecorder for SceneRecorder<'_> {
             Draw::Meshes(filter) => match &shadow_atlas {
                 Some(settings) => {
                     let p = ctx.bind_variant(&defines, &state)?;
-                    self.bind(ctx.cmd, &p);
+                    self.bind(ctx, &p)?;
                     calls += self.draw_shadow_views(ctx, &p, filter, settings)?;
                 }
                 None => {
@@ -402,7 +403,7 @@ impl DrawRecorder for SceneRecorder<'_> {
             },
             Draw::LightVolumes(kind) => {
                 let p = ctx.bind_variant(&defines, &state)?;
-                self.bind(ctx.cmd, &p);
+                self.bind(ctx, &p)?;
                 let g = &self.scene.geometry;
                 let lights = &self.scene.light_set;
                 let groups = match kind {

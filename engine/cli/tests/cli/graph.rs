@@ -211,10 +211,11 @@ fn plan_with_a_scene_culls_what_the_scene_lacks() {
     );
     assert!(text.contains("  0. shadow_sun (Raster)"), "{text}");
     // The variant key: the sun pass compiles the sun loop and Blinn-Phong only
-    // (rt_ao, off, is the sixth feature it may depend on).
+    // (rt_ao and rt_shadows, off, are the sixth and seventh features it may
+    // depend on).
     assert!(
         text.contains(
-            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS (variant key; 1 of up to 64 variants: 6 of the 13 features a pass may depend on)\n"
+            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS (variant key; 1 of up to 128 variants: 7 of the 14 features a pass may depend on)\n"
         ),
         "{text}"
     );

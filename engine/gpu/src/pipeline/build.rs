@@ -188,7 +188,9 @@ pub(super) fn build_graphics(
 }
 
 /// A pipeline drawing from the scene's vertex buffer with `state`: sets 1
-/// and 2 the scene's, whatever the shaders declare of them.
+/// and 2 the scene's, whatever the shaders declare of them; set 1 with the
+/// ray tracer's bindings when the shaders read them (a pass that declares
+/// `RayTracing`, checked before this is built).
 pub(super) fn build_scene(
     device: &ash::Device,
     (vs, fs): (&ShaderModule, Option<&ShaderModule>),
@@ -198,9 +200,22 @@ pub(super) fn build_scene(
     let layouts = &scene.layouts;
     let mut modules = vec![vs];
     modules.extend(fs);
+    let reads_tracing = modules.iter().any(|m| {
+        m.interface.bindings.iter().any(|b| {
+            b.set == SCENE_SET
+                && scene
+                    .interface
+                    .scene_binding(b.binding)
+                    .is_some_and(|s| s.tracing)
+        })
+    });
     let shared = SharedSets {
         layouts,
-        scene: SceneSet::Raster,
+        scene: if reads_tracing {
+            SceneSet::Traced
+        } else {
+            SceneSet::Raster
+        },
         material: true,
     };
     let pipeline = with_layout(

@@ -111,7 +111,9 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
         caveats("forward.ron", &["!bloom"]),
         ["nothing", "one", "direct"]
     );
-    // Shadow maps under shadow casters with a sun or a spot, once with both.
+    // Shadow maps under shadow casters with a sun or a spot, once with both;
+    // none of their notes once `rt_shadows` traces every light's shadows,
+    // and the area lights' note says how.
     assert_eq!(
         caveats(
             "forward.ron",
@@ -124,7 +126,34 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
             "forward.ron",
             &["!bloom", "shadow_casters", "suns", "spot_lights"]
         ),
-        ["nothing", "sun", "one", "direct"]
+        ["nothing", "one", "direct", "sun"]
+    );
+    let traced = caveats(
+        "forward.ron",
+        &[
+            "!bloom",
+            "shadow_casters",
+            "suns",
+            "spot_lights",
+            "point_lights",
+            "area_lights",
+            "rt_shadows",
+        ],
+    );
+    assert_eq!(traced, ["nothing", "one", "direct", "area", "the"]);
+    let graph = weft_graph::load(&repo_root().join("graphs/forward.ron"));
+    let options = CompileOptions {
+        features: graph.features(&["area_lights", "rt_shadows"]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    assert!(
+        plan.caveats
+            .iter()
+            .any(|c| c
+                .starts_with("area lights and emissive surfaces shadow by the traced fraction")),
+        "{:?}",
+        plan.caveats
     );
     // deferred.ron: rt_ao.ron's note holds until rt_ao traces the environment.
     assert_eq!(

@@ -403,11 +403,6 @@ impl<'g> GpuScene<'g> {
         self.bvh_cache = dir;
     }
 
-    /// Set 1 with the raster bindings, which scene pipelines bind.
-    pub fn raster_set(&self) -> vk::DescriptorSet {
-        self.scene_set
-    }
-
     /// Set 1 of the layout `kind`: the raster bindings, or with the ray
     /// tracer's too (its BVH built and its buffers uploaded on first use).
     pub fn scene_set(&mut self, kind: SceneSet) -> Result<vk::DescriptorSet, GpuError> {

@@ -612,23 +612,18 @@ fn c_prints_the_camera_as_a_scene_block() {
 }
 
 /// Features past the ninth are reached with Shift: on the forward graph over
-/// the Cornell box, the graph's own nine take 1-9 and the scene's follow,
-/// `shadow_casters` at Shift+9, which turns it off.
+/// the Cornell box, the graph's own ten take 1-9 and Shift+1 and the scene's
+/// follow, `rect_lights` (the box's emissive quad) at Shift+9, which turns it
+/// off.
 #[test]
 fn shift_and_a_digit_toggle_the_features_past_the_ninth() {
     let stdout = cornell_pressing("1:shift+9");
     let lists: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
     assert_eq!(lists.len(), 2, "{stdout}");
+    assert!(lists[0].contains(", Shift+9 rect_lights [on]"), "{stdout}");
+    assert!(lists[1].contains(", Shift+9 rect_lights [off]"), "{stdout}");
     assert!(
-        lists[0].contains(", Shift+9 shadow_casters [on]"),
-        "{stdout}"
-    );
-    assert!(
-        lists[1].contains(", Shift+9 shadow_casters [off]"),
-        "{stdout}"
-    );
-    assert!(
-        lists[0].contains("9 screen_space_tangents [off]"),
+        lists[0].contains("9 rt_shadows [off], Shift+1 screen_space_tangents [off]"),
         "{stdout}"
     );
 }
