@@ -15,6 +15,7 @@ layout(push_constant) uniform Params {
     uint shadow_rays;   // graph parameter: rt_shadows' rays per pixel and light
 } params;
 #define RT_SHADOW_RAYS params.shadow_rays
+#define RT_FOOTPRINT_RAYS 1u
 #include "include/deferred.glsl"
 
 layout(location = 0) in vec2 uv;

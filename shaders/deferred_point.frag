@@ -5,6 +5,11 @@ layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
 layout(set = 0, binding = 3) uniform sampler2D depth;
+layout(push_constant) uniform Params {
+    uint footprint_rays;  // graph parameter: rt_shadows' rays per pixel and point light
+} params;
+#define RT_FOOTPRINT_RAYS params.footprint_rays
+#define RT_SHADOW_RAYS 1u
 #include "include/deferred.glsl"
 
 layout(location = 0) flat in uint light_index;

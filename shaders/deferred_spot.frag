@@ -8,6 +8,11 @@ layout(set = 0, binding = 3) uniform sampler2D depth;
 #ifdef HAS_SHADOW_MAP
 layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
 #endif
+layout(push_constant) uniform Params {
+    uint footprint_rays;  // graph parameter: rt_shadows' rays per pixel and spot
+} params;
+#define RT_FOOTPRINT_RAYS params.footprint_rays
+#define RT_SHADOW_RAYS 1u
 #include "include/deferred.glsl"
 
 layout(location = 0) flat in uint light_index;

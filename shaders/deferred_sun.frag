@@ -16,10 +16,13 @@ layout(set = 0, binding = 5) uniform sampler2D gbuffer_emission;
 // Ray-traced environment visibility (graphs/rt_ao.ron).
 layout(set = 0, binding = 6) uniform sampler2D ao;
 #endif
-#include "include/deferred.glsl"
 layout(push_constant) uniform Params {
     float emissive_boost;  // graph parameter: scales material emission
+    uint footprint_rays;   // graph parameter: rt_shadows' rays per pixel and sun
 } params;
+#define RT_FOOTPRINT_RAYS params.footprint_rays
+#define RT_SHADOW_RAYS 1u
+#include "include/deferred.glsl"
 
 layout(location = 0) in vec2 uv;
 layout(location = 0) out vec4 color;

@@ -11,8 +11,10 @@ layout(push_constant) uniform Params {
     float emissive_boost;  // graph parameter: scales material emission
     uint area_samples;     // graph parameter: 0 analytic area lights, n: n x n quadrature
     uint shadow_rays;      // graph parameter: rt_shadows' rays per pixel and area light
+    uint footprint_rays;   // graph parameter: rt_shadows' rays per pixel and sun, point or spot
 } params;
 #define RT_SHADOW_RAYS params.shadow_rays
+#define RT_FOOTPRINT_RAYS params.footprint_rays
 #include "include/bindings.glsl"
 #include "include/lighting.glsl"
 #ifdef HAS_VIEW_OVERSHADING

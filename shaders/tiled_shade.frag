@@ -23,7 +23,10 @@ layout(std430, set = 0, binding = 7) readonly buffer TileLights { uint words[]; 
 layout(push_constant) uniform Push {
     uint max_per_tile;
     float emissive_boost;
+    uint footprint_rays;  // graph parameter: rt_shadows' rays per pixel and sun, point or spot
 } pc;
+#define RT_FOOTPRINT_RAYS pc.footprint_rays
+#define RT_SHADOW_RAYS 1u
 #include "include/deferred.glsl"
 #include "include/tiles.glsl"
 // The tile lists are this pass's input: a variant for a feature set without

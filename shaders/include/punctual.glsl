@@ -3,7 +3,7 @@
 // (pathtrace/lights.glsl) both read it. With HAS_SHADOW_MAP (raster passes
 // that read the shadow atlas; the includer declares `shadow_map` first) suns
 // and spot cones look up their shadows; with RT_SHADOWS (feature
-// `rt_shadows`) every sun, point and spot traces one shadow ray instead
+// `rt_shadows`) every sun, point and spot traces shadow rays instead
 // (rt_shadows.glsl).
 #ifndef WEFT_PUNCTUAL_GLSL
 #define WEFT_PUNCTUAL_GLSL
@@ -41,7 +41,7 @@ vec3 incoming_sun(uint index, Surface s, out vec3 l) {
 #endif
 #ifdef RT_SHADOWS
     if (dot(s.normal, l) > 0.0) {
-        visible = rt_visibility(s.position, s.normal, l, RT_SUN_DISTANCE);
+        visible = rt_punctual_visibility(s.position, s.normal, vec4(l, 0.0), RT_FOOTPRINT_RAYS);
     }
 #endif
     return lights[index].color_exponent.rgb * visible;
@@ -68,12 +68,14 @@ vec3 incoming_point(uint index, Surface s, out vec3 l) {
     if (!point_reaches(index, d)) {
         return vec3(0.0);
     }
+    float visible = 1.0;
 #ifdef RT_SHADOWS
-    if (dot(s.normal, l) > 0.0 && rt_visibility(s.position, s.normal, l, d) == 0.0) {
-        return vec3(0.0);
+    if (dot(s.normal, l) > 0.0) {
+        visible = rt_punctual_visibility(s.position, s.normal,
+                                         vec4(lights[index].position_range.xyz, 1.0), RT_FOOTPRINT_RAYS);
     }
 #endif
-    return lights[index].color_exponent.rgb * attenuate(index, d);
+    return lights[index].color_exponent.rgb * (visible * attenuate(index, d));
 }
 
 // Spot: cut off beyond `range` along the axis and outside the cone.
@@ -93,7 +95,8 @@ vec3 incoming_spot(uint index, Surface s, out vec3 l) {
 #endif
 #ifdef RT_SHADOWS
     if (dot(s.normal, l) > 0.0) {
-        spot *= rt_visibility(s.position, s.normal, l, d);
+        spot *= rt_punctual_visibility(s.position, s.normal,
+                                       vec4(lights[index].position_range.xyz, 1.0), RT_FOOTPRINT_RAYS);
     }
 #endif
     return lights[index].color_exponent.rgb * spot * attenuate(index, d);
