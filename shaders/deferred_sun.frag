@@ -16,6 +16,10 @@ layout(set = 0, binding = 5) uniform sampler2D gbuffer_emission;
 // Ray-traced environment visibility (graphs/rt_ao.ron).
 layout(set = 0, binding = 6) uniform sampler2D ao;
 #endif
+#ifdef HAS_GI
+// Ray-traced one-bounce light from the surroundings (graphs/gi.ron).
+layout(set = 0, binding = 8) uniform sampler2D gi;
+#endif
 layout(push_constant) uniform Params {
     float emissive_boost;  // graph parameter: scales material emission
     uint footprint_rays;   // graph parameter: rt_shadows' rays per pixel and sun
@@ -35,6 +39,6 @@ void main() {
     }
     Material m = materials[s.material];
     vec4 emission_occlusion = read_emission_occlusion();
-    vec3 ambient = shade_ambient_emissive(s, m, params.emissive_boost, emission_occlusion.rgb, emission_occlusion.a);
+    vec3 ambient = shade_ambient_emissive(s, m, surroundings(), params.emissive_boost, emission_occlusion.rgb, emission_occlusion.a);
     color = vec4(hdr_output(ambient + shade_suns(s, m)), 1.0);
 }

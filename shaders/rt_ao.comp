@@ -40,13 +40,12 @@ void main() {
     vec3 p = position_from_depth(vec2(pixel) + 0.5, d);
     vec3 n = octahedral_decode(texelFetch(gbuffer_normal, pixel, 0).rg);
     mat3 to_world = basis(n);
-    vec3 origin = leave(p, n);
     float t_max = params.radius > 0.0 ? params.radius : 3.0e38;
     Rng rng = rng_start(uvec2(pixel), params.history_frames, 0x6a09e667u);
     uint open = 0u;
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
-        open += trace_any(origin, dir, t_max) ? 0u : 1u;
+        open += trace_any(leave(p, n) + dir * leave_distance(p), dir, t_max) ? 0u : 1u;
     }
     float visible = float(open) / float(max(params.rays, 1u));
     // A running mean over the last frames, its count capped at `frames`, so

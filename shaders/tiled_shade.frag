@@ -19,6 +19,10 @@ layout(set = 0, binding = 5) uniform sampler2D gbuffer_emission;
 // Ray-traced environment visibility (graphs/rt_ao.ron).
 layout(set = 0, binding = 6) uniform sampler2D ao;
 #endif
+#ifdef HAS_GI
+// Ray-traced one-bounce light from the surroundings (graphs/gi.ron).
+layout(set = 0, binding = 8) uniform sampler2D gi;
+#endif
 layout(std430, set = 0, binding = 7) readonly buffer TileLights { uint words[]; } tile_lights;
 layout(push_constant) uniform Push {
     uint max_per_tile;
@@ -47,7 +51,7 @@ void main() {
     }
     Material m = materials[s.material];
     vec4 emission_occlusion = read_emission_occlusion();
-    vec3 c = shade_ambient_emissive(s, m, pc.emissive_boost, emission_occlusion.rgb, emission_occlusion.a)
+    vec3 c = shade_ambient_emissive(s, m, surroundings(), pc.emissive_boost, emission_occlusion.rgb, emission_occlusion.a)
         + shade_suns(s, m);
     uint record = tile_record(tile_of(ivec2(gl_FragCoord.xy)), pc.max_per_tile);
     uint slots = record + TILE_HEADER;

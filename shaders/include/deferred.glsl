@@ -40,4 +40,15 @@ vec4 read_emission_occlusion() {
     return emission_occlusion;
 }
 
+// The radiance this fragment's surroundings send, as the ambient term takes
+// it: the suns' ambient sky, or what ray-traced one-bounce GI found (HAS_GI:
+// graphs/gi.ron, the includer declaring `gi`).
+vec3 surroundings() {
+#ifdef HAS_GI
+    return texelFetch(gi, ivec2(gl_FragCoord.xy), 0).rgb;
+#else
+    return frame.ambient.rgb;
+#endif
+}
+
 #endif

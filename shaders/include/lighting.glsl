@@ -334,7 +334,9 @@ vec3 shade_all_lights(Surface s, Material m, uint area_samples) {
 
 // What the surface shows without any direct light: the environment (the
 // suns' summed ambient A, a constant radiance from every direction; scenes/
-// FORMAT.md, "Units") reflected by the material's directional albedo, times
+// FORMAT.md, "Units"; with ray-traced GI, what gi.comp traced from this
+// pixel: `surroundings`, the radiance taken as arriving from every
+// direction) reflected by the material's directional albedo, times
 // the occlusion texture's sample `occlusion` (glTF occlusionTexture, red; 1
 // without one), plus its emission scaled by `emissive_boost` (the graph
 // parameter of that name, so glowing materials can be pushed over the bloom
@@ -361,10 +363,11 @@ vec3 environment_albedo(Surface s, Material m) {
     return albedo;
 }
 
-vec3 shade_ambient_emissive(Surface s, Material m, float emissive_boost, vec3 emission_texel, float occlusion) {
+vec3 shade_ambient_emissive(Surface s, Material m, vec3 surroundings, float emissive_boost, vec3 emission_texel,
+                            float occlusion) {
     vec3 environment = vec3(0.0);
-    if (any(greaterThan(frame.ambient.rgb, vec3(0.0)))) {
-        environment = frame.ambient.rgb * environment_albedo(s, m) * occlusion;
+    if (any(greaterThan(surroundings, vec3(0.0)))) {
+        environment = surroundings * environment_albedo(s, m) * occlusion;
     }
     return environment + m.emissive.rgb * emission_texel * emissive_boost;
 }

@@ -2,7 +2,8 @@
 // RT_SHADOWS; the pass declares `derive: [RayTracing()]`, and the includer
 // defines RT_FOOTPRINT_RAYS and RT_SHADOW_RAYS, its `footprint_rays` and
 // `shadow_rays` parameters). Shadow rays walk the path tracer's BVH from the
-// shaded point (`leave`, the offset the path tracer's own shadow rays use)
+// shaded point (`leave`, the path tracer's offset, and as far again along the
+// ray, which clears the other face at a concave edge)
 // towards the light. A sun, point or spot gets `footprint_rays` rays: one
 // from the pixel centre's point gives the exact hard shadow there; more
 // start from stratified points of the pixel's footprint on the surface's
@@ -34,13 +35,6 @@
 // How far a sun is: beyond any scene.
 #define RT_SUN_DISTANCE 3.0e38
 
-// 1 when nothing lies between surface point `p` (unit normal `n`, facing the
-// light) and a point `d` away along unit direction `l` (RT_SUN_DISTANCE for a
-// sun), else 0.
-float rt_visibility(vec3 p, vec3 n, vec3 l, float d) {
-    return trace_any(leave(p, n), l, d * (1.0 - RT_SHADOW_SHORTEN)) ? 0.0 : 1.0;
-}
-
 // Where the ray through this fragment's pixel, `offset` pixels from its
 // centre, meets the plane through `p` with unit normal `n`: a point of the
 // surface the pixel covers. `p` itself where that ray runs along the plane
@@ -68,10 +62,11 @@ float rt_towards(vec3 x, vec3 n, vec4 light, float skip) {
     vec3 to = light.w == 0.0 ? light.xyz : light.xyz - x;
     float d = light.w == 0.0 ? RT_SUN_DISTANCE : length(to);
     vec3 l = to / max(length(to), 1e-30);
-    if (skip >= d) {
+    float start = skip + leave_distance(x);
+    if (start >= d) {
         return 1.0;
     }
-    return trace_any(leave(x, n) + l * skip, l, (d - skip) * (1.0 - RT_SHADOW_SHORTEN)) ? 0.0 : 1.0;
+    return trace_any(leave(x, n) + l * start, l, (d - start) * (1.0 - RT_SHADOW_SHORTEN)) ? 0.0 : 1.0;
 }
 
 // The visible fraction of a sun, point or spot (`light` as rt_towards takes
@@ -108,7 +103,7 @@ float rt_area_visibility(uint index, AreaOutline o, vec3 p, vec3 n, uint rays) {
     float step = 2.0 / float(side);
     Rng rng = rng_start(uvec2(gl_FragCoord.xy), index, 0x5bd1e995u);
     vec3 facing = -normalize(o.winding);
-    vec3 origin = leave(p, n);
+    float start = leave_distance(p);
     float seen = 0.0;
     float total = 0.0;
     for (uint j = 0u; j < side; ++j) {
@@ -122,7 +117,7 @@ float rt_area_visibility(uint index, AreaOutline o, vec3 p, vec3 n, uint rays) {
             float weight = max(dot(n, l), 0.0) * max(cos_light, 0.0) / max(d * d, 1e-30);
             if (weight > 0.0) {
                 total += weight;
-                if (!trace_any(origin, l, d * (1.0 - RT_SHADOW_SHORTEN))) {
+                if (d <= start || !trace_any(leave(p, n) + l * start, l, (d - start) * (1.0 - RT_SHADOW_SHORTEN))) {
                     seen += weight;
                 }
             }

@@ -230,11 +230,19 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
     return hit ? vec2(best_t, uintBitsToFloat(best_tri)) : vec2(-1.0, 0.0);
 }
 
+// How far a ray leaving surface point p starts from it (`leave`), scaled
+// with p's magnitude as float rounding is.
+float leave_distance(vec3 p) {
+    return 1e-4 * max(1.0, max(max(abs(p.x), abs(p.y)), abs(p.z)));
+}
+
 // Where a ray leaving surface point p on the side of unit normal n starts, so
-// that it does not find the surface it leaves.
+// that it does not find the surface it leaves. A ray from a rasterized point
+// (a G-buffer's or a fragment's) also starts leave_distance(p) along itself:
+// such a point can lie on a concave edge within rounding, on the far side of
+// the other face, whose plane the ray would cross at once.
 vec3 leave(vec3 p, vec3 n) {
-    float scale = max(1.0, max(max(abs(p.x), abs(p.y)), abs(p.z)));
-    return p + n * (1e-4 * scale);
+    return p + n * leave_distance(p);
 }
 
 // The nearest hit with t in (0, t_max): its distance in .x and triangle in .y

@@ -7,6 +7,7 @@ mod debug_views;
 mod denoise;
 mod emissive;
 mod extremes;
+mod gi;
 mod light_matrix;
 mod lights;
 mod mirrored;

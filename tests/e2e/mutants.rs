@@ -297,6 +297,7 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
         "forward.ron",
         "deferred.ron",
         "tiled.ron",
+        "hybrid.ron",
         "bench/forward_floors.ron",
         "bench/deferred_floors.ron",
         "bench/tiled_floors.ron",
@@ -323,11 +324,13 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
         .filter(|r| {
             let mut text = text_of(r);
             // Included files as the including text names them, and where they
-            // are: the bench graphs include a shipped graph and the floors.
+            // are: the bench graphs include a shipped graph and the floors,
+            // hybrid.ron includes deferred.ron beside it.
             for (named, fragment) in [
                 ("../forward.ron", "forward.ron"),
                 ("../deferred.ron", "deferred.ron"),
                 ("../tiled.ron", "tiled.ron"),
+                ("\"deferred.ron\"", "deferred.ron"),
                 ("\"mesh_floor.ron", "bench/mesh_floor.ron"),
                 ("\"gbuffer_floor.ron", "bench/gbuffer_floor.ron"),
                 ("shadows.ron", "shadows.ron"),
@@ -336,6 +339,8 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
                 ("debug_views.ron", "debug_views.ron"),
                 ("raster_caveats.ron", "raster_caveats.ron"),
                 ("scene_shading.ron", "scene_shading.ron"),
+                ("rt_ao.ron", "rt_ao.ron"),
+                ("gi.ron", "gi.ron"),
                 ("path_tracer.ron", "path_tracer.ron"),
                 ("denoise.ron", "denoise.ron"),
             ] {

@@ -100,16 +100,16 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
             .map(|c| c.split([' ', ':']).next().unwrap_or_default().to_string())
             .collect()
     };
-    // forward.ron's own note first (the environment is never traced there),
-    // then raster_caveats.ron's unconditional notes; bloom.ron's while bloom
-    // is on (a default feature).
+    // forward.ron's own notes first (it traces neither the environment nor
+    // bounces), bloom.ron's while bloom is on (a default feature), then
+    // raster_caveats.ron's unconditional note.
     assert_eq!(
         caveats("forward.ron", &[]),
-        ["nothing", "bloom", "one", "direct"]
+        ["nothing", "direct", "bloom", "one"]
     );
     assert_eq!(
         caveats("forward.ron", &["!bloom"]),
-        ["nothing", "one", "direct"]
+        ["nothing", "direct", "one"]
     );
     // Shadow maps under shadow casters with a sun or a spot, once with both;
     // none of their notes once `rt_shadows` traces every light's shadows,
@@ -119,14 +119,14 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
             "forward.ron",
             &["!bloom", "shadow_casters", "area_lights", "point_lights"]
         ),
-        ["nothing", "one", "direct", "area", "point", "the"]
+        ["nothing", "direct", "one", "area", "point", "the"]
     );
     assert_eq!(
         caveats(
             "forward.ron",
             &["!bloom", "shadow_casters", "suns", "spot_lights"]
         ),
-        ["nothing", "one", "direct", "sun"]
+        ["nothing", "direct", "one", "sun"]
     );
     let traced = caveats(
         "forward.ron",
@@ -140,7 +140,7 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
             "rt_shadows",
         ],
     );
-    assert_eq!(traced, ["nothing", "one", "direct", "area", "the"]);
+    assert_eq!(traced, ["nothing", "direct", "one", "area", "the"]);
     let graph = weft_graph::load(&repo_root().join("graphs/forward.ron"));
     let options = CompileOptions {
         features: graph.features(&["area_lights", "rt_shadows"]),
@@ -155,15 +155,18 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
         "{:?}",
         plan.caveats
     );
-    // deferred.ron: rt_ao.ron's note holds until rt_ao traces the environment.
+    // deferred.ron: rt_ao.ron's note holds until rt_ao or gi traces the
+    // environment, gi.ron's "direct light only" until gi adds a bounce, and
+    // its one-bounce note then.
     assert_eq!(
         caveats("deferred.ron", &["!bloom"]),
-        ["one", "direct", "nothing"]
+        ["one", "nothing", "direct"]
     );
     assert_eq!(
         caveats("deferred.ron", &["!bloom", "rt_ao"]),
         ["one", "direct"]
     );
+    assert_eq!(caveats("deferred.ron", &["!bloom", "gi"]), ["one", "one"]);
 }
 
 #[test]
@@ -237,6 +240,7 @@ fn scene_features_cull_passes_and_variants() {
             ("show_normals", "enabled_if [normals] is false"),
             ("show_light_count", "enabled_if [light_count] is false"),
             ("rt_ao", "enabled_if [rt_ao] is false"),
+            ("gi", "enabled_if [gi] is false"),
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
             ("area_lights", "enabled_if [area_lights] is false"),
