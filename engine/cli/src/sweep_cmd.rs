@@ -13,7 +13,8 @@ use std::process::ExitCode;
 use weft_compare::pareto::{dominated_marks, frontier, write_plot, Point};
 use weft_compare::report::{within_budget, within_noise};
 use weft_compare::sweep::{
-    document, header, line, points, read_named, read_with_form, SweepPoint, SweepRow, GRAPH_COLUMN,
+    document, header, line, points, read_named, read_with_form, Setting, SweepPoint, SweepRow,
+    GRAPH_COLUMN,
 };
 use weft_graph::schema::ParamValue;
 use weft_render::RenderSettings;
@@ -62,7 +63,8 @@ struct SweepRun {
     /// Several graphs swept as one more dimension (comma-separated), every
     /// point of each against the same reference, on one frontier; sweep.csv
     /// names each point's graph in its first column. Each graph is swept over
-    /// the --param parameters it has.
+    /// the --param parameters it has and the --features-set sets whose every
+    /// toggle names one of its features.
     #[arg(long, value_delimiter = ',')]
     graphs: Vec<PathBuf>,
     /// A parameter and its values, NAME=v1,v2,...; repeatable (the points are
@@ -280,6 +282,41 @@ fn point_settings(args: &SweepRun, point: &SweepPoint) -> RenderSettings {
     }
 }
 
+/// For each of the swept `graphs`, the `toggles` of the sweep's feature
+/// sets that name one of its features; an error for a toggle none knows (a
+/// misspelt feature). Empty for a sweep of one graph, which checks its
+/// toggles when it loads each point.
+fn known_toggles(
+    graphs: &[String],
+    toggles: &BTreeSet<String>,
+) -> Result<BTreeMap<String, BTreeSet<String>>> {
+    let mut known = BTreeMap::new();
+    for graph in graphs {
+        let prepared = weft_render::load_graph(&RenderSettings {
+            graph: PathBuf::from(graph),
+            ..RenderSettings::default()
+        })?;
+        let requested: Vec<String> = toggles.iter().cloned().collect();
+        known.insert(
+            graph.clone(),
+            prepared
+                .known_toggles(&requested)
+                .into_iter()
+                .collect::<BTreeSet<_>>(),
+        );
+    }
+    if let Some(unknown) = toggles
+        .iter()
+        .find(|t| !graphs.is_empty() && !known.values().any(|k: &BTreeSet<String>| k.contains(*t)))
+    {
+        bail!(
+            "--features-set: none of the swept graphs has the feature in `{unknown}` ({})",
+            graphs.join(", ")
+        );
+    }
+    Ok(known)
+}
+
 /// Runs `weft sweep` or `weft sweep merge`.
 pub fn run(args: SweepArgs) -> Result<ExitCode> {
     match args.command {
@@ -399,7 +436,8 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
     if !args.graphs.is_empty() && args.params.iter().any(|(n, _)| n == GRAPH_COLUMN) {
         bail!("--param {GRAPH_COLUMN}=... cannot be swept with --graphs: sweep.csv's `{GRAPH_COLUMN}` column names each point's graph");
     }
-    // Over several graphs, each is swept over the parameters it has.
+    // Over several graphs, each is swept over the parameters it has and the
+    // feature sets whose toggles it knows.
     let settable: BTreeMap<String, BTreeSet<String>> = args
         .swept_graphs()
         .into_iter()
@@ -427,8 +465,18 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
             );
         }
     }
-    let takes = |graph: Option<&str>, name: &str| {
-        graph.is_none_or(|g| settable.get(g).is_some_and(|names| names.contains(name)))
+    let toggles: BTreeSet<String> = sets
+        .iter()
+        .flat_map(|set| set.split_whitespace().map(str::to_string))
+        .collect();
+    let known = known_toggles(&args.swept_graphs(), &toggles)?;
+    let takes = |graph: Option<&str>, setting: Setting| match setting {
+        Setting::Param(name) => {
+            graph.is_none_or(|g| settable.get(g).is_some_and(|names| names.contains(name)))
+        }
+        Setting::Toggle(toggle) => {
+            graph.is_none_or(|g| known.get(g).is_some_and(|names| names.contains(toggle)))
+        }
     };
     let every = points(&args.swept_graphs(), &args.params, &sets, &takes);
     // The graph loaded with every point's parameters and features before the

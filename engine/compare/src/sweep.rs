@@ -95,17 +95,28 @@ pub enum SweepError {
     },
 }
 
+/// What a point gives a graph, which `points` asks a graph has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Setting<'a> {
+    /// A parameter, by name.
+    Param(&'a str),
+    /// A feature toggle (`name` on, `!name` off).
+    Toggle(&'a str),
+}
+
 /// Every point of the product of `graphs` (an empty list means the sweep's
 /// one graph), `params` (name, values) and `feature_sets` (an empty list
-/// means one set with no toggles), in order: the last parameter varies
-/// fastest, then graphs, feature sets slowest. Each graph is swept over the
-/// parameters `takes(graph, name)` says it has (`None`: the sweep's one
-/// graph), so graphs with different parameters share one sweep.
+/// means one set with no toggles; each set's toggles space-separated), in
+/// order: the last parameter varies fastest, then graphs, feature sets
+/// slowest. Each graph is swept over what `takes(graph, setting)` says it
+/// has (`None`: the sweep's one graph): the parameters it has, and the
+/// feature sets whose every toggle names one of its features, so graphs with
+/// different parameters and features share one sweep.
 pub fn points(
     graphs: &[String],
     params: &[(String, Vec<String>)],
     feature_sets: &[String],
-    takes: &dyn Fn(Option<&str>, &str) -> bool,
+    takes: &dyn Fn(Option<&str>, Setting<'_>) -> bool,
 ) -> Vec<SweepPoint> {
     let sets: Vec<String> = if feature_sets.is_empty() {
         vec![String::new()]
@@ -119,10 +130,16 @@ pub fn points(
     };
     let mut out = Vec::new();
     for (features, graph) in sets.iter().flat_map(|f| graphs.iter().map(move |g| (f, g))) {
+        if !features
+            .split_whitespace()
+            .all(|t| takes(graph.as_deref(), Setting::Toggle(t)))
+        {
+            continue;
+        }
         let mut partial = vec![BTreeMap::new()];
         for (name, values) in params
             .iter()
-            .filter(|(name, _)| takes(graph.as_deref(), name))
+            .filter(|(name, _)| takes(graph.as_deref(), Setting::Param(name)))
         {
             partial = partial
                 .into_iter()
@@ -307,7 +324,7 @@ mod tests {
                 vec!["x".to_string(), "y".to_string(), "z".to_string()],
             ),
         ];
-        let every = |_: Option<&str>, _: &str| true;
+        let every = |_: Option<&str>, _: Setting| true;
         let all = points(&[], &params, &["".into(), "bloom".into()], &every);
         assert_eq!(all.len(), 12);
         assert_eq!(all[0].label(), "a=1 b=x");
@@ -339,8 +356,9 @@ mod tests {
     fn each_graph_is_swept_over_the_parameters_it_has() {
         let params = vec![("spf".to_string(), vec!["1".to_string(), "4".to_string()])];
         let graphs = ["forward.ron".to_string(), "denoised.ron".to_string()];
-        let takes =
-            |graph: Option<&str>, name: &str| graph == Some("denoised.ron") && name == "spf";
+        let takes = |graph: Option<&str>, setting: Setting| {
+            graph == Some("denoised.ron") && setting == Setting::Param("spf")
+        };
         let all = points(&graphs, &params, &[], &takes);
         let labels: Vec<String> = all.iter().map(SweepPoint::label).collect();
         assert_eq!(labels, ["forward", "denoised spf=1", "denoised spf=4"]);
@@ -361,6 +379,35 @@ mod tests {
         let (read, old) = parse(Path::new("sweep.csv"), &text, &names).expect("parses");
         assert!(!old);
         assert_eq!(read, rows);
+    }
+
+    /// A feature set is swept on the graphs that know each of its toggles:
+    /// the empty set on every graph, `!gi` only where `gi` is a feature.
+    #[test]
+    fn each_graph_is_swept_over_the_feature_sets_it_knows() {
+        let graphs = ["forward.ron".to_string(), "hybrid.ron".to_string()];
+        let sets = [
+            "".to_string(),
+            "!gi".to_string(),
+            "!gi rt_shadows".to_string(),
+        ];
+        let takes = |graph: Option<&str>, setting: Setting| match setting {
+            Setting::Toggle(t) => graph == Some("hybrid.ron") || t == "rt_shadows",
+            Setting::Param(_) => true,
+        };
+        let labels: Vec<String> = points(&graphs, &[], &sets, &takes)
+            .iter()
+            .map(SweepPoint::label)
+            .collect();
+        assert_eq!(
+            labels,
+            [
+                "forward",
+                "hybrid",
+                "hybrid [!gi]",
+                "hybrid [!gi rt_shadows]"
+            ]
+        );
     }
 
     /// A sweep over graphs writes each point's graph in the first column and

@@ -441,4 +441,17 @@ fn a_sweep_over_graphs_sweeps_each_over_the_parameters_it_has() {
             && stderr.contains(" max_depth "),
         "{stderr}"
     );
+    // A feature set is swept on the graphs that know its toggles (forward
+    // has no `denoise`); a toggle no graph knows is refused before rendering.
+    let mut unknown = vec!["sweep", "scenes/cornell.scene", "--graphs", graphs];
+    unknown.extend(["--features-set", ";!denoise;!denoize"]);
+    unknown.extend(SMALL);
+    unknown.extend(["--out", out_arg.as_str()]);
+    let run = weft(&unknown, &cache);
+    assert!(!run.status.success());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("--features-set: none of the swept graphs has the feature in `!denoize` (graphs/forward.ron, graphs/pathtrace_denoised.ron)"),
+        "{stderr}"
+    );
 }
