@@ -110,12 +110,19 @@ void main() {
         sum += bounce(leave(p, n) + dir * leave_distance(p), dir, rng);
     }
     vec3 radiance = sum / float(max(params.rays, 1u));
-    // A running mean over the last frames, its count capped at `frames`.
+    // A running mean over the last frames, its count capped at `frames`;
+    // this frame's rays alone where a denoiser follows (GI_EACH_FRAME): its
+    // temporal filter averages frames itself, and its variance must see each
+    // frame's own noise, which a running mean would hide.
+    uint frames = params.frames;
+#ifdef GI_EACH_FRAME
+    frames = 1u;
+#endif
     float kept = 0.0;
     vec3 mean = radiance;
-    if (params.history_frames > 0u && params.frames > 1u) {
+    if (params.history_frames > 0u && frames > 1u) {
         vec4 previous = imageLoad(gi, pixel);
-        kept = min(previous.a, float(params.frames - 1u));
+        kept = min(previous.a, float(frames - 1u));
         mean = (previous.rgb * kept + radiance) / (kept + 1.0);
     }
     imageStore(gi, pixel, vec4(mean, kept + 1.0));

@@ -16,7 +16,7 @@
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = 0, rgba32f) uniform readonly image2D radiance;
+layout(set = 0, binding = 0) uniform sampler2D radiance;
 layout(set = 0, binding = 1, rgba16f) uniform readonly image2D albedo;
 layout(set = 0, binding = 2, rgba32f) uniform readonly image2D guide_normal;
 layout(set = 0, binding = 3, rgba32f) uniform readonly image2D guide_position;
@@ -36,12 +36,12 @@ layout(push_constant) uniform Params {
 } params;
 
 void main() {
-    ivec2 size = imageSize(radiance);
+    ivec2 size = textureSize(radiance, 0);
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(pixel, size))) {
         return;
     }
-    vec3 colour = imageLoad(radiance, pixel).rgb;
+    vec3 colour = texelFetch(radiance, pixel, 0).rgb;
     vec3 illum = demodulate(colour, imageLoad(albedo, pixel).rgb);
     float l = denoise_luminance(illum);
     vec4 n = imageLoad(guide_normal, pixel);

@@ -310,10 +310,17 @@ fn roots_using(file: &Path) -> Vec<&'static str> {
     if file.starts_with("shaders/include") {
         return roots.to_vec();
     }
-    // The denoiser's files run in the denoised path tracer only; its
-    // shaders' many variants make it too slow a root for every shared file.
+    // The denoiser's files are rendered through the denoised path tracer
+    // (the raster graphs run them too, under `denoise`); its shaders' many
+    // variants make it too slow a root for every shared file.
     if file.starts_with("shaders/denoise")
-        || ["denoise.ron", "pathtrace_denoised.ron", "guides.comp"].contains(&name.as_str())
+        || [
+            "denoise.ron",
+            "denoise_guides.ron",
+            "pathtrace_denoised.ron",
+            "guides.comp",
+        ]
+        .contains(&name.as_str())
     {
         return vec!["pathtrace_denoised.ron"];
     }

@@ -249,7 +249,12 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         crate::graphs::check_features(graph, &args.features)?;
     }
     settings.extra_readback = readback_names(&args, loaded.as_ref().ok());
-    let exr_image = settings.extra_readback.first().filter(|_| exr).cloned();
+    // An EXR file gets the first of these the frame reads back.
+    let exr_images: Vec<String> = if exr {
+        settings.extra_readback.clone()
+    } else {
+        Vec::new()
+    };
     if args.watch && (args.spp.is_some() || args.time_limit.is_some()) {
         bail!("--spp and --time-limit render once; use them without --watch (`weft view` shows a progressive graph converging)");
     }
@@ -257,7 +262,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         return crate::watch_cmd::run(crate::watch_cmd::WatchRequest {
             scene: &args.scene,
             out: &out,
-            image: exr_image.as_deref(),
+            images: &exr_images,
             graph: loaded.ok(),
             settings,
             gpu: GpuOptions {
@@ -304,9 +309,9 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             .find(|(name, _)| name == wanted)
             .map(|(_, image)| image)
     };
-    let output = exr_image
-        .as_deref()
-        .and_then(read_back)
+    let output = rendered
+        .report
+        .first_read_back(&exr_images)
         .or(rendered.report.output.as_ref())
         .context("the frame produced no output image")?;
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {

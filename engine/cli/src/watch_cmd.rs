@@ -23,8 +23,9 @@ pub struct WatchRequest<'a> {
     pub scene: &'a Path,
     /// The image to keep replacing.
     pub out: &'a Path,
-    /// The read-back image to save instead of the output (`hdr` for EXR files).
-    pub image: Option<&'a str>,
+    /// Read-back images to save instead of the output, the first the frame
+    /// reads back (`hdr` for EXR files); none for the output.
+    pub images: &'a [String],
     /// Graph, size, camera, features and timing.
     pub settings: RenderSettings,
     /// `settings.graph` as the command loaded it, for the first attempt;
@@ -49,7 +50,7 @@ pub fn run(mut request: WatchRequest) -> Result<ExitCode> {
         return Ok(exit_code(report_validation(&log)));
     };
     let started = Instant::now();
-    write_frame(&mut live, request.out, request.image).map_err(|e| anyhow!("{e}"))?;
+    write_frame(&mut live, request.out, request.images).map_err(|e| anyhow!("{e}"))?;
     watcher.watch(&live.sources().all())?;
     println!(
         "wrote {} in {:.1} ms; watching {} files (Ctrl-C to stop)",
@@ -63,7 +64,7 @@ pub fn run(mut request: WatchRequest) -> Result<ExitCode> {
         if changed.is_empty() {
             continue;
         }
-        let line = reload(&mut live, &changed, request.out, request.image, &graph);
+        let line = reload(&mut live, &changed, request.out, request.images, &graph);
         // Watch the new set before saying so: an edit made on seeing the line is caught.
         if let Err(err) = watcher.watch(&live.sources().all()) {
             println!("error: {err} (still watching the other files)");
@@ -129,7 +130,7 @@ fn reload(
     live: &mut LiveRender<'_>,
     changed: &BTreeSet<PathBuf>,
     out: &Path,
-    image: Option<&str>,
+    images: &[String],
     graph: &Path,
 ) -> String {
     let started = Instant::now();
@@ -137,7 +138,7 @@ fn reload(
         Ok(paths) => paths,
         Err(e) => return format!("error: {e} (kept last good)"),
     };
-    match write_frame(live, out, image) {
+    match write_frame(live, out, images) {
         Ok(frame_ms) => format!(
             "reloaded {} in {:.1} ms (frame {frame_ms:.1} ms)",
             paths
@@ -153,16 +154,15 @@ fn reload(
 
 /// Renders a frame and replaces `out` with it; returns the frame's milliseconds
 /// (render and readback, without the file write).
-fn write_frame(live: &mut LiveRender<'_>, out: &Path, image: Option<&str>) -> Result<f64> {
+fn write_frame(live: &mut LiveRender<'_>, out: &Path, images: &[String]) -> Result<f64> {
     let started = Instant::now();
     let report = live.frame()?;
     if let Some(error) = live.take_script_error() {
         eprintln!("error: {error} (the lights of the last good step kept)");
     }
     let frame_ms = started.elapsed().as_secs_f64() * 1e3;
-    let picked = image
-        .and_then(|name| report.readbacks.iter().find(|(n, _)| n == name))
-        .map(|(_, readback)| readback)
+    let picked = report
+        .first_read_back(images)
         .or(report.output.as_ref())
         .context("the frame produced no output image")?;
     replace_atomically(out, |tmp| Ok(picked.save(tmp)?))?;

@@ -74,6 +74,21 @@ pub struct FrameReport {
     pub memory: MemoryReport,
 }
 
+impl FrameReport {
+    /// The first of `names` that this frame read back: the image an EXR file
+    /// gets. A graph may list images it reads back only under some features
+    /// (`readback: [(name: "denoised", enabled_if: ["denoise"]), "hdr"]`),
+    /// and those the compile left out are skipped.
+    pub fn first_read_back(&self, names: &[String]) -> Option<&Readback> {
+        names.iter().find_map(|name| {
+            self.readbacks
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, image)| image)
+        })
+    }
+}
+
 /// What recording and running a frame gave back.
 struct Recorded {
     timings: Vec<PassTiming>,

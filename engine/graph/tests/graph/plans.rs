@@ -81,8 +81,8 @@ fn plans_match_snapshots_and_pass_the_checker() {
         }
     }
     assert_eq!(
-        compared, 15,
-        "forward, deferred, tiled, pathtrace and pathtrace_denoised, three feature sets each"
+        compared, 18,
+        "forward, deferred, tiled, hybrid, pathtrace and pathtrace_denoised, three feature sets each"
     );
 }
 
@@ -241,6 +241,19 @@ fn scene_features_cull_passes_and_variants() {
             ("show_light_count", "enabled_if [light_count] is false"),
             ("rt_ao", "enabled_if [rt_ao] is false"),
             ("gi", "enabled_if [gi] is false"),
+            ("guides", "enabled_if [denoise] is false"),
+            ("denoise_temporal", "enabled_if [denoise] is false"),
+            ("denoise_variance", "enabled_if [denoise] is false"),
+            ("denoise_atrous_1", "enabled_if [denoise] is false"),
+            ("denoise_atrous_2", "enabled_if [denoise] is false"),
+            ("denoise_atrous_4", "enabled_if [denoise] is false"),
+            ("denoise_atrous_8", "enabled_if [denoise] is false"),
+            ("denoise_atrous_16", "enabled_if [denoise] is false"),
+            ("denoise_modulate", "enabled_if [denoise] is false"),
+            ("keep_normal", "enabled_if [denoise] is false"),
+            ("keep_position", "enabled_if [denoise] is false"),
+            ("keep_illumination", "enabled_if [denoise] is false"),
+            ("keep_moments", "enabled_if [denoise] is false"),
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
             ("area_lights", "enabled_if [area_lights] is false"),
