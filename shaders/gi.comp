@@ -38,6 +38,7 @@ layout(push_constant) uniform Params {
     uint frames;
     uint light_choice;
     uint history_frames;
+    uint frame;
 } params;
 
 // The radiance a ray from `origin` along `dir` brings back after at most one
@@ -103,7 +104,10 @@ void main() {
     vec3 p = position_from_depth(vec2(pixel) + 0.5, d);
     vec3 n = octahedral_decode(texelFetch(gbuffer_normal, pixel, 0).rg);
     mat3 to_world = basis(n);
-    Rng rng = rng_start(uvec2(pixel), params.history_frames, 0x3c6ef372u);
+    // New rays every frame, numbered by the frame: `history_frames` restarts
+    // at every change, and rays repeated frame after frame in a moving scene
+    // would show a denoiser no noise to filter.
+    Rng rng = rng_start(uvec2(pixel), params.frame, 0x3c6ef372u);
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);

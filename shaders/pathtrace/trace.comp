@@ -73,6 +73,7 @@ layout(push_constant) uniform Params {
     uint accumulate;
     uint history_frames;
     uint repeat_index;
+    uint frame;
 } params;
 
 const uint SAMPLING_MIS = 0u;
@@ -285,7 +286,13 @@ void main() {
     }
     vec3 eye = frame.camera_position.xyz;
     uint spf = max(params.samples_per_frame, 1u);
-    Rng rng = rng_start(uvec2(pixel), params.history_frames * spf + params.repeat_index, params.seed);
+    // The reference numbers its samples from the last change, so a seed
+    // gives the same image; each frame's own samples (`accumulate` 0) are
+    // numbered by the frame, so frames differ even where the scene moves
+    // (`history_frames` is 0 after every change) and a denoiser sees noise,
+    // not one frame's samples over and over.
+    uint sample_frame = params.accumulate != 0u ? params.history_frames : params.frame;
+    Rng rng = rng_start(uvec2(pixel), sample_frame * spf + params.repeat_index, params.seed);
     vec2 jitter = rng_next(rng).xy;
     vec2 ndc = (vec2(pixel) + jitter) / vec2(size) * 2.0 - 1.0;
     vec4 on_near = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
