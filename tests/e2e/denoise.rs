@@ -171,6 +171,22 @@ fn reprojection_keeps_what_a_pure_translation_keeps_in_view() {
     );
 }
 
+/// `graph` (to `samples` per pixel where given) at 48 x 48 and `max_depth`
+/// 3, after `frames` frames `frame_time` apart, with `features`: the image
+/// `read`, validated.
+fn traced(
+    scene: &Path,
+    (graph, samples): (&str, Option<u64>),
+    (frames, frame_time): (u32, f64),
+    (features, read): (&[&str], &str),
+) -> LinearImage {
+    let mut settings =
+        weft_tests::render::square_settings(graph, 48, samples, &[("max_depth", 3.0)], features);
+    settings.frames = frames;
+    settings.frame_time = frame_time;
+    weft_tests::render::linear_image_validated(scene, settings, read)
+}
+
 /// The box on a floor under an ambient sky (tests/e2e/rt_ao.rs's scene),
 /// path traced at one sample per pixel a frame, against a 512-spp
 /// reference: the denoised frame's relative MSE is a fourth of the raw
@@ -182,24 +198,9 @@ fn reprojection_keeps_what_a_pure_translation_keeps_in_view() {
 fn on_path_traced_frames_the_error_falls_fourfold_and_the_mean_holds() {
     let dir = TempDir::new("denoise-noisy");
     let scene = crate::rt_ao::scene(&dir.0);
-    let image =
-        |graph: &str, samples: Option<u64>, frames: u32, (features, read): (&[&str], &str)| {
-            let mut settings = weft_tests::render::square_settings(
-                graph,
-                48,
-                samples,
-                &[("max_depth", 3.0)],
-                features,
-            );
-            settings.frames = frames;
-            settings.frame_time = 0.0;
-            let (_, values) = weft_tests::render::render_image_validated(&scene, settings, read);
-            LinearImage {
-                width: 48,
-                height: 48,
-                pixels: values.chunks(4).map(|p| [p[0], p[1], p[2]]).collect(),
-            }
-        };
+    let image = |graph: &str, samples: Option<u64>, frames: u32, toggles_read| {
+        traced(&scene, (graph, samples), (frames, 0.0), toggles_read)
+    };
     let reference = image("pathtrace.ron", Some(512), 1, (&[], "hdr"));
     let mean = |i: &LinearImage| i.pixels.iter().map(|p| f64::from(p[1])).sum::<f64>();
     for frames in [1, 4] {
@@ -248,27 +249,20 @@ fn in_a_moving_scene_each_frame_draws_new_samples_and_is_denoised() {
          \tkey 0  3 3.5 4  0 0.5 0\n\tkey 10  3.01 3.5 4  0.01 0.5 0\n}\n",
     )
     .expect("scene");
-    let image = |samples: Option<u64>, frames: u32, (features, read): (&[&str], &str)| {
-        let graph = if samples.is_some() {
-            "pathtrace.ron"
-        } else {
-            "pathtrace_denoised.ron"
-        };
-        let mut settings = weft_tests::render::square_settings(
-            graph,
-            48,
-            samples,
-            &[("max_depth", 3.0)],
-            features,
-        );
-        settings.frames = frames;
-        settings.frame_time = if samples.is_some() { 0.0 } else { 1.0 / 60.0 };
-        let (_, values) = weft_tests::render::render_image_validated(&scene, settings, read);
-        LinearImage {
-            width: 48,
-            height: 48,
-            pixels: values.chunks(4).map(|p| [p[0], p[1], p[2]]).collect(),
-        }
+    // The reference at one time; the denoised graph's frames 1/60 s apart.
+    let image = |samples: Option<u64>, frames: u32, toggles_read| match samples {
+        Some(_) => traced(
+            &scene,
+            ("pathtrace.ron", samples),
+            (frames, 0.0),
+            toggles_read,
+        ),
+        None => traced(
+            &scene,
+            ("pathtrace_denoised.ron", None),
+            (frames, 1.0 / 60.0),
+            toggles_read,
+        ),
     };
     let reference = image(Some(512), 1, (&[], "hdr"));
     let first = image(None, 1, (&["!denoise"], "hdr"));

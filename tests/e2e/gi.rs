@@ -103,11 +103,8 @@ fn render(
     params: &[(&str, f64)],
     features: &[&str],
 ) -> LinearImage {
-    let features: Vec<&str> = ["!bloom"]
-        .into_iter()
-        .chain(features.iter().copied())
-        .collect();
-    let mut settings = weft_tests::render::square_settings(graph, SIZE, samples, params, &features);
+    let mut settings =
+        weft_tests::render::square_settings_without_bloom(graph, SIZE, samples, params, features);
     settings.frames = frames;
     settings.frame_time = 0.0;
     // The lit image, or the denoiser's output where it runs.
@@ -116,12 +113,7 @@ fn render(
     } else {
         "hdr"
     };
-    let (_, values) = weft_tests::render::render_image_validated(scene, settings, image);
-    LinearImage {
-        width: SIZE,
-        height: SIZE,
-        pixels: values.chunks(4).map(|p| [p[0], p[1], p[2]]).collect(),
-    }
+    weft_tests::render::linear_image_validated(scene, settings, image)
 }
 
 /// Mean of every channel over the pixels whose reference value is lit and
@@ -213,13 +205,7 @@ fn gi_on_an_open_floor_is_the_ambient_sky_exactly() {
 }
 
 fn rmse(a: &LinearImage, b: &LinearImage) -> f64 {
-    let sum: f64 = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .flat_map(|(p, q)| (0..3).map(move |c| f64::from(p[c] - q[c]).powi(2)))
-        .sum();
-    (sum / (3 * a.pixels.len()) as f64).sqrt()
+    weft_compare::rmse(&a.pixels, &b.pixels)
 }
 
 /// With `gi.frames` 8, eight still frames of 4 rays average like one frame

@@ -84,17 +84,9 @@ fn render(
     params: &[(&str, f64)],
     features: &[&str],
 ) -> LinearImage {
-    let features: Vec<&str> = ["!bloom"]
-        .into_iter()
-        .chain(features.iter().copied())
-        .collect();
-    let settings = weft_tests::render::square_settings(graph, SIZE, samples, params, &features);
-    let (_, values) = weft_tests::render::render_hdr_validated(scene, settings);
-    LinearImage {
-        width: SIZE,
-        height: SIZE,
-        pixels: values.chunks(4).map(|p| [p[0], p[1], p[2]]).collect(),
-    }
+    let settings =
+        weft_tests::render::square_settings_without_bloom(graph, SIZE, samples, params, features);
+    weft_tests::render::linear_image_validated(scene, settings, "hdr")
 }
 
 fn mean(image: &LinearImage) -> f64 {
@@ -167,31 +159,20 @@ fn rt_ao_makes_the_raster_ambient_term_the_references() {
 /// The HDR image of the box scene through deferred with `rt_ao` after
 /// `frames` frames at one fixed time (so nothing changes between them).
 fn render_frames(scene: &Path, frames: u32, params: &[(&str, f64)]) -> LinearImage {
-    let mut settings = weft_tests::render::square_settings(
+    let mut settings = weft_tests::render::square_settings_without_bloom(
         "deferred.ron",
         SIZE,
         None,
         params,
-        &["!bloom", "rt_ao"],
+        &["rt_ao"],
     );
     settings.frames = frames;
     settings.frame_time = 0.0;
-    let (_, values) = weft_tests::render::render_hdr_validated(scene, settings);
-    LinearImage {
-        width: SIZE,
-        height: SIZE,
-        pixels: values.chunks(4).map(|p| [p[0], p[1], p[2]]).collect(),
-    }
+    weft_tests::render::linear_image_validated(scene, settings, "hdr")
 }
 
 fn rmse(a: &LinearImage, b: &LinearImage) -> f64 {
-    let sum: f64 = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .flat_map(|(p, q)| (0..3).map(move |c| f64::from(p[c] - q[c]).powi(2)))
-        .sum();
-    (sum / (3 * a.pixels.len()) as f64).sqrt()
+    weft_compare::rmse(&a.pixels, &b.pixels)
 }
 
 /// With `rt_ao.frames` 8, eight still frames of 8 rays average like one

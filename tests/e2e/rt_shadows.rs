@@ -66,13 +66,9 @@ fn render(
     params: &[(&str, f64)],
     features: &[&str],
 ) -> Vec<[f32; 3]> {
-    let features: Vec<&str> = ["!bloom"]
-        .into_iter()
-        .chain(features.iter().copied())
-        .collect();
-    let settings = weft_tests::render::square_settings(graph, SIZE, samples, params, &features);
-    let (_, values) = weft_tests::render::render_hdr_validated(scene, settings);
-    values.chunks(4).map(|p| [p[0], p[1], p[2]]).collect()
+    let settings =
+        weft_tests::render::square_settings_without_bloom(graph, SIZE, samples, params, features);
+    weft_tests::render::linear_image_validated(scene, settings, "hdr").pixels
 }
 
 /// A light the hard-shadow test casts towards from a floor point: the unit

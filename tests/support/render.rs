@@ -244,3 +244,35 @@ pub fn render_image_validated(
     let values = values.clone();
     (rendered, values)
 }
+
+/// [`render_image_validated`] as a linear RGB image, its size taken from
+/// `settings`.
+pub fn linear_image_validated(
+    scene: &Path,
+    settings: RenderSettings,
+    image: &str,
+) -> weft_compare::LinearImage {
+    let (width, height) = (settings.extent.width, settings.extent.height);
+    let (_, values) = render_image_validated(scene, settings, image);
+    weft_compare::LinearImage {
+        width,
+        height,
+        pixels: values.chunks(4).map(|p| [p[0], p[1], p[2]]).collect(),
+    }
+}
+
+/// [`square_settings`] with bloom off, as the comparisons against the path
+/// tracer want it (the reference models no post effects).
+pub fn square_settings_without_bloom(
+    graph: &str,
+    size: u32,
+    samples: Option<u64>,
+    params: &[(&str, f64)],
+    features: &[&str],
+) -> RenderSettings {
+    let features: Vec<&str> = ["!bloom"]
+        .into_iter()
+        .chain(features.iter().copied())
+        .collect();
+    square_settings(graph, size, samples, params, &features)
+}
