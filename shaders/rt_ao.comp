@@ -24,6 +24,7 @@ layout(push_constant) uniform Params {
     float radius;
     uint frames;
     uint history_frames;
+    uint frame;
 } params;
 
 void main() {
@@ -41,7 +42,9 @@ void main() {
     vec3 n = octahedral_decode(texelFetch(gbuffer_normal, pixel, 0).rg);
     mat3 to_world = basis(n);
     float t_max = params.radius > 0.0 ? params.radius : 3.0e38;
-    Rng rng = rng_start(uvec2(pixel), params.history_frames, 0x6a09e667u);
+    // New rays every frame, numbered by the frame (`history_frames` restarts
+    // at every change, and a moving scene would repeat the same rays).
+    Rng rng = rng_start(uvec2(pixel), params.frame, 0x6a09e667u);
     uint open = 0u;
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
