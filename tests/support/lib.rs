@@ -65,6 +65,7 @@ pub fn compile(
         features: graph.graph().features(features),
         memory: &memory,
         readback,
+        readback_asked: true,
     };
     weft_render::compile_plan(&graph, &options)
         .unwrap_or_else(|d| panic!("{} does not compile: {d:?}", path.display()))

@@ -234,6 +234,7 @@ pub fn render_image_validated(
     let gpu = crate::gpu();
     let log = gpu.validation();
     settings.extra_readback = vec![image.into()];
+    settings.readback_asked = true;
     let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
     drop(gpu);
     assert_eq!(log.messages(), Vec::new(), "{}", settings.graph.display());

@@ -151,6 +151,7 @@ fn measure(
         features: prepared.graph().features(features),
         memory: &memory,
         readback: vec!["bloom".into()],
+        readback_asked: true,
     };
     let plan = match weft_render::compile_plan(&prepared, &options) {
         Ok(plan) => plan,

@@ -185,6 +185,7 @@ pub fn run(args: TilesArgs) -> Result<ExitCode> {
                 .chain(["light_heatmap".to_string()])
                 .collect(),
             extra_readback: vec!["light_counts".into()],
+            readback_asked: true,
             ..RenderSettings::default()
         };
         let counts = render(&gpu, &scene, &counted)

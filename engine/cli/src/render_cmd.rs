@@ -249,6 +249,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         crate::graphs::check_features(graph, &args.features)?;
     }
     settings.extra_readback = readback_names(&args, loaded.as_ref().ok());
+    settings.readback_asked = !args.readback.is_empty();
     // An EXR file gets the first of these the frame reads back.
     let exr_images: Vec<String> = if exr {
         settings.extra_readback.clone()

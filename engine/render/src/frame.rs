@@ -39,6 +39,10 @@ pub struct RenderSettings {
     pub readback: bool,
     /// Other images to copy back with the output (e.g. `hdr` for EXR files).
     pub extra_readback: Vec<String>,
+    /// `extra_readback` names images a user asked for (`--readback`), kept
+    /// whatever features the graph reads them back under; otherwise it is
+    /// the graph's own list, whose conditional entries the compile filters.
+    pub readback_asked: bool,
     /// Values for the graph's top-level parameters, replacing those in the file
     /// (`--param exposure=2`), so a sweep needs no edited copies of the graph.
     pub params: BTreeMap<String, ParamValue>,
@@ -70,6 +74,7 @@ impl Default for RenderSettings {
             timing: TimingMode::Off,
             readback: true,
             extra_readback: Vec::new(),
+            readback_asked: false,
             params: BTreeMap::new(),
             samples: None,
             time_limit: None,
@@ -171,6 +176,7 @@ pub fn compile_for_scene(
         features: loaded.features(&requested),
         memory: &memory,
         readback: settings.extra_readback.clone(),
+        readback_asked: settings.readback_asked,
     };
     let plan = crate::providers::compile(graph, &options).map_err(RenderError::Graph)?;
     if let Some((image, size)) = weft_gpu::oversized_images(gpu, &plan).into_iter().next() {

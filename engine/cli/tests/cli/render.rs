@@ -227,6 +227,59 @@ fn readback_images_are_written_beside_the_output_and_the_first_is_the_exr() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A graph that reads `hdr` back only without `denoise` and `denoised` with
+/// it (hybrid.ron, `denoise` on): its own list gives the EXR `denoised`, and
+/// `--readback hdr` still reads `hdr` back, as asked, whatever the graph's
+/// conditions.
+#[test]
+fn read_backs_asked_by_name_are_kept_whatever_the_graphs_conditions() {
+    let dir = std::env::temp_dir().join(format!("weft-readback-asked-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("--out's folder must exist");
+    let out = dir.join("o.exr");
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "render",
+            "scenes/cornell.scene",
+            "--graph",
+            "graphs/hybrid.ron",
+            "--size",
+            "16x16",
+            "--out",
+            out.to_str().expect("utf-8"),
+        ];
+        a.extend_from_slice(extra);
+        weft(&a)
+    };
+    let done = args(&["--readback", "hdr,denoised"]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let first = std::fs::read(&out).expect("exr");
+    assert_eq!(
+        first,
+        std::fs::read(dir.join("o.hdr.exr")).expect("hdr"),
+        "the first asked is the EXR"
+    );
+    let denoised = std::fs::read(dir.join("o.denoised.exr")).expect("denoised");
+    assert_ne!(first, denoised, "the lit image and the denoised one differ");
+    std::fs::remove_file(&out).expect("remove");
+    let done = args(&[]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert_eq!(
+        std::fs::read(&out).expect("exr"),
+        denoised,
+        "the graph's own list: `denoised` under `denoise`"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Renders the Cornell box through the path tracer to `spp` samples per pixel
 /// with `seed`; returns the JSON summary and the PNG's bytes.
 fn path_traced(name: &str, spp: &str, seed: &str, extra: &[&str]) -> (serde_json::Value, Vec<u8>) {

@@ -31,7 +31,13 @@ pub struct CompileOptions<'a> {
     pub memory: &'a dyn Fn(&ImageDesc) -> MemoryRequirements,
     /// Images to keep readable after the frame besides the output (e.g. the HDR
     /// buffer for EXR output): never aliased, left in `TRANSFER_SRC_OPTIMAL`.
+    /// Those the graph lists as read back only under features (`(name:
+    /// "denoised", enabled_if: ["denoise"])`) are dropped where the features
+    /// do not hold, unless `readback_asked`.
     pub readback: Vec<String>,
+    /// `readback` is what a user asked for by name (`--readback`), not the
+    /// graph's own list: every name is kept, whatever the graph's conditions.
+    pub readback_asked: bool,
 }
 
 impl Default for CompileOptions<'_> {
@@ -44,6 +50,7 @@ impl Default for CompileOptions<'_> {
             features: BTreeSet::new(),
             memory: &memory::estimate_requirements,
             readback: Vec::new(),
+            readback_asked: false,
         }
     }
 }
@@ -231,7 +238,11 @@ pub fn compile_ir(
         .iter()
         .filter(|v| conditions_hold(&v.enabled_if, &options.features))
         .collect();
-    let mut readback = readback_for(graph, &options.readback, &options.features);
+    let mut readback = if options.readback_asked {
+        options.readback.clone()
+    } else {
+        readback_for(graph, &options.readback, &options.features)
+    };
     for view in &active_views {
         let name = &ir.resources[view.image].name;
         if !readback.contains(name) {
