@@ -104,6 +104,9 @@ void main() {
     vec3 p = position_from_depth(vec2(pixel) + 0.5, d);
     vec3 n = octahedral_decode(texelFetch(gbuffer_normal, pixel, 0).rg);
     mat3 to_world = basis(n);
+    // Rays leave the surface, and step as far along themselves (trace.glsl).
+    vec3 origin = leave(p, n);
+    float step = leave_distance(p);
     // New rays every frame, numbered by the frame: `history_frames` restarts
     // at every change, and rays repeated frame after frame in a moving scene
     // would show a denoiser no noise to filter.
@@ -111,7 +114,7 @@ void main() {
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
-        sum += bounce(leave(p, n) + dir * leave_distance(p), dir, rng);
+        sum += bounce(origin + dir * step, dir, rng);
     }
     vec3 radiance = sum / float(max(params.rays, 1u));
     // A running mean over the last frames, its count capped at `frames`;

@@ -41,6 +41,9 @@ void main() {
     vec3 p = position_from_depth(vec2(pixel) + 0.5, d);
     vec3 n = octahedral_decode(texelFetch(gbuffer_normal, pixel, 0).rg);
     mat3 to_world = basis(n);
+    // Rays leave the surface, and step as far along themselves (trace.glsl).
+    vec3 origin = leave(p, n);
+    float step = leave_distance(p);
     float t_max = params.radius > 0.0 ? params.radius : 3.0e38;
     // New rays every frame, numbered by the frame (`history_frames` restarts
     // at every change, and a moving scene would repeat the same rays).
@@ -48,7 +51,7 @@ void main() {
     uint open = 0u;
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
-        open += trace_any(leave(p, n) + dir * leave_distance(p), dir, t_max) ? 0u : 1u;
+        open += trace_any(origin + dir * step, dir, t_max) ? 0u : 1u;
     }
     float visible = float(open) / float(max(params.rays, 1u));
     // A running mean over the last frames, its count capped at `frames`, so

@@ -103,6 +103,7 @@ float rt_area_visibility(uint index, AreaOutline o, vec3 p, vec3 n, uint rays) {
     float step = 2.0 / float(side);
     Rng rng = rng_start(uvec2(gl_FragCoord.xy), index, 0x5bd1e995u);
     vec3 facing = -normalize(o.winding);
+    vec3 origin = leave(p, n);
     float start = leave_distance(p);
     float seen = 0.0;
     float total = 0.0;
@@ -117,7 +118,7 @@ float rt_area_visibility(uint index, AreaOutline o, vec3 p, vec3 n, uint rays) {
             float weight = max(dot(n, l), 0.0) * max(cos_light, 0.0) / max(d * d, 1e-30);
             if (weight > 0.0) {
                 total += weight;
-                if (d <= start || !trace_any(leave(p, n) + l * start, l, (d - start) * (1.0 - RT_SHADOW_SHORTEN))) {
+                if (d <= start || !trace_any(origin + l * start, l, (d - start) * (1.0 - RT_SHADOW_SHORTEN))) {
                     seen += weight;
                 }
             }

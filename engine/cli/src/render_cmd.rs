@@ -302,14 +302,6 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     })?;
     bar.finish_and_clear();
     drop(gpu);
-    let read_back = |wanted: &str| {
-        rendered
-            .report
-            .readbacks
-            .iter()
-            .find(|(name, _)| name == wanted)
-            .map(|(_, image)| image)
-    };
     let output = rendered
         .report
         .first_read_back(&exr_images)
@@ -320,7 +312,10 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     }
     output.save(&out)?;
     for name in &args.readback {
-        let image = read_back(name).with_context(|| format!("--readback {name}: not read back"))?;
+        let image = rendered
+            .report
+            .first_read_back(std::slice::from_ref(name))
+            .with_context(|| format!("--readback {name}: not read back"))?;
         let path = readback_path(&out, name);
         image.save(&path)?;
         if !args.json {

@@ -282,39 +282,45 @@ fn point_settings(args: &SweepRun, point: &SweepPoint) -> RenderSettings {
     }
 }
 
-/// For each of the swept `graphs`, the `toggles` of the sweep's feature
-/// sets that name one of its features; an error for a toggle none knows (a
-/// misspelt feature). Empty for a sweep of one graph, which checks its
-/// toggles when it loads each point.
-fn known_toggles(
-    graphs: &[String],
-    toggles: &BTreeSet<String>,
-) -> Result<BTreeMap<String, BTreeSet<String>>> {
-    let mut known = BTreeMap::new();
+/// What one swept graph takes: the parameters `--param` reaches and the
+/// sweep's feature toggles that name one of its features.
+struct Takes {
+    params: BTreeSet<String>,
+    toggles: BTreeSet<String>,
+}
+
+/// Each of the swept `graphs`, loaded once, with what it takes of the
+/// sweep's `toggles`; an error for a toggle no graph knows (a misspelt
+/// feature). Empty for a sweep of one graph, which checks its parameters
+/// and toggles when it loads each point.
+fn graph_takes(graphs: &[String], toggles: &[String]) -> Result<BTreeMap<String, Takes>> {
+    let mut takes = BTreeMap::new();
     for graph in graphs {
         let prepared = weft_render::load_graph(&RenderSettings {
             graph: PathBuf::from(graph),
             ..RenderSettings::default()
         })?;
-        let requested: Vec<String> = toggles.iter().cloned().collect();
-        known.insert(
+        takes.insert(
             graph.clone(),
-            prepared
-                .known_toggles(&requested)
-                .into_iter()
-                .collect::<BTreeSet<_>>(),
+            Takes {
+                params: prepared.graph().settable_params(),
+                toggles: prepared.known_toggles(toggles).into_iter().collect(),
+            },
         );
+    }
+    if takes.is_empty() {
+        return Ok(takes);
     }
     if let Some(unknown) = toggles
         .iter()
-        .find(|t| !graphs.is_empty() && !known.values().any(|k: &BTreeSet<String>| k.contains(*t)))
+        .find(|t| !takes.values().any(|k: &Takes| k.toggles.contains(*t)))
     {
         bail!(
             "--features-set: none of the swept graphs has the feature in `{unknown}` ({})",
             graphs.join(", ")
         );
     }
-    Ok(known)
+    Ok(takes)
 }
 
 /// Runs `weft sweep` or `weft sweep merge`.
@@ -438,45 +444,39 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
     }
     // Over several graphs, each is swept over the parameters it has and the
     // feature sets whose toggles it knows.
-    let settable: BTreeMap<String, BTreeSet<String>> = args
-        .swept_graphs()
+    let toggles: Vec<String> = sets
+        .iter()
+        .flat_map(|set| set.split_whitespace().map(str::to_string))
+        .collect::<BTreeSet<_>>()
         .into_iter()
-        .map(|g| {
-            let names = weft_graph::load(Path::new(&g)).settable_params();
-            (g, names)
-        })
         .collect();
-    if !settable.is_empty() {
+    let offered = graph_takes(&args.swept_graphs(), &toggles)?;
+    if !offered.is_empty() {
         if let Some((name, _)) = args
             .params
             .iter()
-            .find(|(name, _)| !settable.values().any(|names| names.contains(name)))
+            .find(|(name, _)| !offered.values().any(|t| t.params.contains(name)))
         {
             bail!(
                 "--param {name}: none of the swept graphs has this parameter ({})",
-                settable
+                offered
                     .iter()
-                    .map(|(g, names)| format!(
+                    .map(|(g, t)| format!(
                         "{g}: {}",
-                        names.iter().cloned().collect::<Vec<_>>().join(" ")
+                        t.params.iter().cloned().collect::<Vec<_>>().join(" ")
                     ))
                     .collect::<Vec<_>>()
                     .join("; ")
             );
         }
     }
-    let toggles: BTreeSet<String> = sets
-        .iter()
-        .flat_map(|set| set.split_whitespace().map(str::to_string))
-        .collect();
-    let known = known_toggles(&args.swept_graphs(), &toggles)?;
-    let takes = |graph: Option<&str>, setting: Setting| match setting {
-        Setting::Param(name) => {
-            graph.is_none_or(|g| settable.get(g).is_some_and(|names| names.contains(name)))
-        }
-        Setting::Toggle(toggle) => {
-            graph.is_none_or(|g| known.get(g).is_some_and(|names| names.contains(toggle)))
-        }
+    let takes = |graph: Option<&str>, setting: Setting| {
+        graph.is_none_or(|g| {
+            offered.get(g).is_some_and(|t| match setting {
+                Setting::Param(name) => t.params.contains(name),
+                Setting::Toggle(toggle) => t.toggles.contains(toggle),
+            })
+        })
     };
     let every = points(&args.swept_graphs(), &args.params, &sets, &takes);
     // The graph loaded with every point's parameters and features before the

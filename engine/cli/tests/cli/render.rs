@@ -174,26 +174,30 @@ fn more_light_volumes_than_the_limit_are_refused_at_the_pass() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `weft render SCENE --graph GRAPH --size 16x16 --out OUT` and `extra`.
+fn render_exr((scene, graph): (&str, &str), out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut a = vec![
+        "render",
+        scene,
+        "--graph",
+        graph,
+        "--size",
+        "16x16",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ];
+    a.extend_from_slice(extra);
+    weft(&a)
+}
+
 #[test]
 fn readback_images_are_written_beside_the_output_and_the_first_is_the_exr() {
     let dir = std::env::temp_dir().join(format!("weft-readback-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("--out's folder must exist");
     let out = dir.join("o.exr");
-    let args = |extra: &[&str]| {
-        let mut a = vec![
-            "render",
-            "scenes/demo.scene",
-            "--graph",
-            "graphs/deferred.ron",
-            "--size",
-            "16x16",
-            "--out",
-            out.to_str().expect("utf-8"),
-        ];
-        a.extend_from_slice(extra);
-        weft(&a)
-    };
+    let args =
+        |extra: &[&str]| render_exr(("scenes/demo.scene", "graphs/deferred.ron"), &out, extra);
     let done = args(&["--readback", "hdr,gbuffer_albedo"]);
     assert!(
         done.status.success(),
@@ -237,20 +241,8 @@ fn read_backs_asked_by_name_are_kept_whatever_the_graphs_conditions() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("--out's folder must exist");
     let out = dir.join("o.exr");
-    let args = |extra: &[&str]| {
-        let mut a = vec![
-            "render",
-            "scenes/cornell.scene",
-            "--graph",
-            "graphs/hybrid.ron",
-            "--size",
-            "16x16",
-            "--out",
-            out.to_str().expect("utf-8"),
-        ];
-        a.extend_from_slice(extra);
-        weft(&a)
-    };
+    let args =
+        |extra: &[&str]| render_exr(("scenes/cornell.scene", "graphs/hybrid.ron"), &out, extra);
     let done = args(&["--readback", "hdr,denoised"]);
     assert!(
         done.status.success(),
