@@ -1,6 +1,7 @@
 #version 450
-// Deferred sun pass (fullscreen): ambient, emission and every sun for each
-// covered pixel; background pixels stay black like forward's clear.
+// Deferred sun pass (fullscreen): ambient, emission, ray-traced specular
+// (under rt_specular) and every sun for each covered pixel; background
+// pixels stay black like forward's clear.
 layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
@@ -19,6 +20,10 @@ layout(set = 0, binding = 6) uniform sampler2D ao;
 #ifdef HAS_GI
 // Ray-traced one-bounce light from the surroundings (graphs/gi.ron).
 layout(set = 0, binding = 8) uniform sampler2D gi;
+#endif
+#ifdef HAS_RT_SPECULAR
+// Light through mirrors, coats and glass, ray-traced (graphs/rt_specular.ron).
+layout(set = 0, binding = 9) uniform sampler2D rt_specular;
 #endif
 layout(push_constant) uniform Params {
     float emissive_boost;  // graph parameter: scales material emission
@@ -40,5 +45,5 @@ void main() {
     Material m = materials[s.material];
     vec4 emission_occlusion = read_emission_occlusion();
     vec3 ambient = shade_ambient_emissive(s, m, surroundings(), params.emissive_boost, emission_occlusion.rgb, emission_occlusion.a);
-    color = vec4(hdr_output(ambient + shade_suns(s, m)), 1.0);
+    color = vec4(hdr_output(ambient + traced_specular() + shade_suns(s, m)), 1.0);
 }

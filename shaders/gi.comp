@@ -4,7 +4,7 @@
 // radiance it brings back: the suns' ambient sky where it escapes, and
 // where it meets a surface the light that surface reflects towards it:
 // direct light by the path tracer's own next-event estimation (one light
-// sample, one shadow ray; pathtrace/lights.glsl, bsdf.glsl,
+// sample, one shadow ray; pathtrace/next_event.glsl, lights.glsl, bsdf.glsl,
 // surface_bsdf.glsl) plus the sky along one ray sampled from its BSDF. A
 // ray that meets a light with area brings nothing, and a surface's own
 // emission is left out: that light is the raster passes' direct light.
@@ -27,6 +27,7 @@
 #include "pathtrace/bsdf.glsl"
 #include "pathtrace/surface_bsdf.glsl"
 #include "pathtrace/lights.glsl"
+#include "pathtrace/next_event.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform sampler2D depth;
@@ -60,20 +61,7 @@ vec3 bounce(vec3 origin, vec3 dir, inout Rng rng) {
     vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
     Bsdf b = surface_bsdf(s, m);
     vec3 from = leave(s.position, ng);
-    vec3 radiance = vec3(0.0);
-    vec4 u_pick = rng_next(rng);
-    vec4 u_point = rng_next(rng);
-    LightSample ls;
-    if (sample_light(s.position, n, u_pick, u_point, params.light_choice != 0u, ls)
-        && dot(ls.direction, ng) > 0.0) {
-        float pdf;
-        vec3 f = bsdf_eval(b, n, wo, ls.direction, pdf);
-        float reach = ls.distance * (1.0 - 1e-3);
-        if (any(greaterThan(f, vec3(0.0))) && hit_area_light(from, ls.direction, reach) < 0
-            && !trace_any(from, ls.direction, reach)) {
-            radiance += f * ls.value;
-        }
-    }
+    vec3 radiance = next_event(s.position, n, ng, wo, b, from, params.light_choice != 0u, rng);
     // The sky the hit reflects: one ray sampled from its BSDF that escapes.
     // (Where it meets a light, next-event estimation above counted it.)
     if (any(greaterThan(frame.ambient.rgb, vec3(0.0)))) {

@@ -23,6 +23,10 @@ layout(set = 0, binding = 6) uniform sampler2D ao;
 // Ray-traced one-bounce light from the surroundings (graphs/gi.ron).
 layout(set = 0, binding = 8) uniform sampler2D gi;
 #endif
+#ifdef HAS_RT_SPECULAR
+// Light through mirrors, coats and glass, ray-traced (graphs/rt_specular.ron).
+layout(set = 0, binding = 9) uniform sampler2D rt_specular;
+#endif
 layout(std430, set = 0, binding = 7) readonly buffer TileLights { uint words[]; } tile_lights;
 layout(push_constant) uniform Push {
     uint max_per_tile;
@@ -52,6 +56,7 @@ void main() {
     Material m = materials[s.material];
     vec4 emission_occlusion = read_emission_occlusion();
     vec3 c = shade_ambient_emissive(s, m, surroundings(), pc.emissive_boost, emission_occlusion.rgb, emission_occlusion.a)
+        + traced_specular()
         + shade_suns(s, m);
     uint record = tile_record(tile_of(ivec2(gl_FragCoord.xy)), pc.max_per_tile);
     uint slots = record + TILE_HEADER;

@@ -51,4 +51,16 @@ vec3 surroundings() {
 #endif
 }
 
+// The light this fragment's mirror, coat or glass sends through its delta
+// lobes, which raster shading leaves out (HAS_RT_SPECULAR:
+// graphs/rt_specular.ron, the includer declaring `rt_specular`); black
+// without it.
+vec3 traced_specular() {
+#ifdef HAS_RT_SPECULAR
+    return texelFetch(rt_specular, ivec2(gl_FragCoord.xy), 0).rgb;
+#else
+    return vec3(0.0);
+#endif
+}
+
 #endif

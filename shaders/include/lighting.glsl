@@ -66,6 +66,28 @@
 #define SCENE_SUNS
 #endif
 
+// Under ray-traced specular (RT_SPECULAR: graphs/rt_specular.ron, which
+// adds what it traces), raster shading leaves out the lobes that pass
+// traces: a mirror's and a coat's highlight (delta lobes to the path
+// tracer), and glass's share of the surface (optics.x); emission stays.
+#ifdef RT_SPECULAR
+vec3 highlight_colour(Material m) {
+    return m.emissive.w == SHADING_MIRROR || m.emissive.w == SHADING_COATED ? vec3(0.0) : m.specular.rgb;
+}
+
+float opaque_share(Material m) {
+    return 1.0 - m.optics.x;
+}
+#else
+vec3 highlight_colour(Material m) {
+    return m.specular.rgb;
+}
+
+float opaque_share(Material m) {
+    return 1.0;
+}
+#endif
+
 // Area lights and the environment read the LTC tables' lobe integrals.
 #include "ltc.glsl"
 // The surface point, and the light arriving from punctual lights, as the path
@@ -111,7 +133,7 @@ vec3 blinn_phong(Material m, Surface s, vec3 l, vec3 radiance) {
     vec3 v = normalize(frame.camera_position.xyz - s.position);
     vec3 h = normalize(l + v);
     float ndh = max(dot(s.normal, h), 0.0);
-    vec3 specular = m.specular.rgb * blinn_phong_highlight(ndh, m.specular.w);
+    vec3 specular = highlight_colour(m) * blinn_phong_highlight(ndh, m.specular.w);
     return radiance * (m.diffuse.rgb * s.texel * ndl + specular * ndl);
 }
 
@@ -122,6 +144,7 @@ vec3 blinn_phong(Material m, Surface s, vec3 l, vec3 radiance) {
 // of albedo Kd shows Kd C and every model returns pi f cos(theta) C, f its
 // BSDF; the path tracer (pathtrace/lights.glsl) uses the same rule.
 vec3 reflected(Material m, Surface s, vec3 l, vec3 radiance) {
+    radiance *= opaque_share(m);
 #ifdef SCENE_METALLIC_ROUGHNESS
 #ifdef SCENE_BLINN_PHONG
     if (m.emissive.w != SHADING_METALLIC_ROUGHNESS) {
@@ -203,7 +226,7 @@ vec3 area_ltc_blinn_phong(Surface s, Material m, float ndv, mat3 local, float di
         vec2 scale;
         mat3 inverse = ltc_lookup(LTC_BLINN_PHONG, pow(2.0 / (shininess + 2.0), 0.25), ndv, scale);
         float highlight = ltc_integral(inverse * local, o, side);
-        result += m.specular.rgb * (scale.x / PI) * highlight;
+        result += highlight_colour(m) * (scale.x / PI) * highlight;
     }
     return result;
 }
@@ -246,7 +269,7 @@ vec3 shade_area_ltc(uint index, AreaOutline o, Surface s, Material m) {
 #else
     vec3 result = area_ltc_blinn_phong(s, m, ndv, local, diffuse, o, side);
 #endif
-    return result * lights[index].color_exponent.rgb;
+    return result * (opaque_share(m) * lights[index].color_exponent.rgb);
 }
 #endif
 
@@ -350,7 +373,7 @@ vec3 environment_albedo(Surface s, Material m) {
     float ndv = clamp(dot(s.normal, v), 1e-3, 1.0);
 #ifdef SCENE_METALLIC_ROUGHNESS
     if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
-        return ggx_directional_albedo(m.diffuse.rgb * s.texel, s.metal_rough, ndv);
+        return ggx_directional_albedo(m.diffuse.rgb * s.texel, s.metal_rough, ndv) * opaque_share(m);
     }
 #endif
     vec3 albedo = m.diffuse.rgb * s.texel;
@@ -358,9 +381,9 @@ vec3 environment_albedo(Surface s, Material m) {
     if (shininess > 0.0) {
         vec2 scale;
         ltc_lookup(LTC_BLINN_PHONG, pow(2.0 / (shininess + 2.0), 0.25), ndv, scale);
-        albedo += m.specular.rgb * (scale.x / PI);
+        albedo += highlight_colour(m) * (scale.x / PI);
     }
-    return albedo;
+    return albedo * opaque_share(m);
 }
 
 vec3 shade_ambient_emissive(Surface s, Material m, vec3 surroundings, float emissive_boost, vec3 emission_texel,

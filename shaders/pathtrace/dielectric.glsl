@@ -94,4 +94,39 @@ vec3 thin_scatter(vec3 dir, vec3 n_out, float ior, vec3 reflection, vec3 transmi
     return refracted ? dir : reflect(dir, n);
 }
 
+#ifdef WEFT_SCENE_GLSL
+// One delta event where a ray travelling along `dir` meets the glass of
+// material `m` (its shading normal `normal` and geometric normal
+// `geometric_normal` at the hit, `u` picking reflection or refraction):
+// returns the new direction, with the throughput factor in `weight` and in
+// `side` the geometric normal's side the new ray leaves from. A refracted
+// ray keeps going the way it went through the surface's plane; a reflected
+// one turns back; where the shading normal (or rounding, for refraction
+// grazing the surface) sends the ray to the wrong side, it is reflected about
+// the geometric normal. `medium` becomes the Beer-Lambert coefficient of
+// where the ray now travels. The path tracer (trace.comp) and ray-traced
+// specular (rt_specular.comp) scatter through glass by this.
+vec3 glass_event(vec3 dir, vec3 normal, vec3 geometric_normal, Material m, float u, bool schlick,
+                 inout vec3 medium, out vec3 weight, out vec3 side) {
+    vec3 n_out = dot(normal, geometric_normal) < 0.0 ? -normal : normal;
+    bool refracted;
+    vec3 next = m.optics.y > 0.0
+        ? thin_scatter(dir, n_out, m.transmission.w, m.reflection.rgb, m.transmission.rgb, u, schlick, weight,
+            refracted)
+        : dielectric_scatter(dir, n_out, m.transmission.w, m.reflection.rgb, m.transmission.rgb, u, schlick,
+            weight, refracted);
+    if (refracted != (dot(dir, geometric_normal) * dot(next, geometric_normal) > 0.0)) {
+        next = reflect(dir, geometric_normal);
+        weight = m.reflection.rgb;
+        refracted = false;
+    }
+    side = dot(next, geometric_normal) > 0.0 ? geometric_normal : -geometric_normal;
+    if (refracted && m.optics.y == 0.0) {
+        bool entering = dot(dir, geometric_normal) < 0.0;
+        medium = entering ? m.absorption.rgb : vec3(0.0);
+    }
+    return next;
+}
+#endif
+
 #endif

@@ -202,32 +202,12 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         // opaque shading model below.
         vec4 u_glass = rng_next(rng);
         if (u_glass.x < m.optics.x) {
-            vec3 n_out = dot(s.normal, s.geometric_normal) < 0.0 ? -s.normal : s.normal;
             vec3 weight;
-            bool refracted;
-            bool schlick = params.fresnel != 0u;
-            vec3 next = m.optics.y > 0.0
-                ? thin_scatter(dir, n_out, m.transmission.w, m.reflection.rgb, m.transmission.rgb, u_glass.y,
-                    schlick, weight, refracted)
-                : dielectric_scatter(dir, n_out, m.transmission.w, m.reflection.rgb, m.transmission.rgb, u_glass.y,
-                    schlick, weight, refracted);
-            // A refracted ray keeps going the way it went through the surface's
-            // plane; a reflected one turns back. Where the shading normal (or
-            // rounding, for refraction grazing the surface) sends the ray to
-            // the wrong side, it is reflected about the geometric normal.
-            if (refracted != (dot(dir, s.geometric_normal) * dot(next, s.geometric_normal) > 0.0)) {
-                next = reflect(dir, s.geometric_normal);
-                weight = m.reflection.rgb;
-                refracted = false;
-            }
-            vec3 side = dot(next, s.geometric_normal) > 0.0 ? s.geometric_normal : -s.geometric_normal;
-            if (refracted && m.optics.y == 0.0) {
-                bool entering = dot(dir, s.geometric_normal) < 0.0;
-                medium = entering ? m.absorption.rgb : vec3(0.0);
-            }
+            vec3 side;
+            dir = glass_event(dir, s.normal, s.geometric_normal, m, u_glass.y, params.fresnel != 0u, medium, weight,
+                side);
             throughput *= weight;
             origin = leave(s.position, side);
-            dir = next;
             counted_fully = true;
             continue;
         }

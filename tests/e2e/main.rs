@@ -19,6 +19,7 @@ mod raycast;
 mod render;
 mod rt_ao;
 mod rt_shadows;
+mod rt_specular;
 mod scripting;
 mod shading;
 mod shadows;

@@ -241,6 +241,10 @@ fn scene_features_cull_passes_and_variants() {
             ("show_light_count", "enabled_if [light_count] is false"),
             ("rt_ao", "enabled_if [rt_ao] is false"),
             ("gi", "enabled_if [gi] is false"),
+            (
+                "rt_specular",
+                "enabled_if [rt_specular, mirrors|coated|dielectrics] is false",
+            ),
             ("guides", "enabled_if [denoise] is false"),
             ("denoise_temporal", "enabled_if [denoise] is false"),
             ("denoise_variance", "enabled_if [denoise] is false"),
