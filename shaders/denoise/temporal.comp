@@ -2,11 +2,12 @@
 // The denoiser's temporal step (graphs/denoise.ron, SVGF's "temporal
 // accumulation"): this frame's radiance, divided by the albedo, joins the
 // illumination history reprojected from the last frame, and so do its
-// luminance moments. Each pixel's surface point is projected with the last
-// frame's view-projection; of the four history texels around that point
-// (bilinear weights), those whose surface was the same — the position
-// within `position_tolerance` times the distance from the camera, the normal
-// within about 25 degrees — count; where none does (disocclusion, the first
+// luminance moments. Where each pixel's surface point was at the last frame
+// (`guide_previous_position`: its mesh's motion undone) is projected with
+// the last frame's view-projection; of the four history texels around that
+// point (bilinear weights), those whose surface was the same — the position
+// within `position_tolerance` times the distance from the camera of where
+// the point was, the normal within about 25 degrees — count; where none does (disocclusion, the first
 // frame on these images: `plan_frames` 0) the history starts again.
 // A still pixel averages its last `history_max` frames equally (a running
 // mean: still frames converge); the variance kept with it is that of the
@@ -28,6 +29,7 @@ layout(set = 0, binding = 7, rgba32f) uniform readonly image2D moments_prev;
 layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D illumination;
 // x, y: luminance mean and mean square, z: frames averaged.
 layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D moments;
+layout(set = 0, binding = 10, rgba32f) uniform readonly image2D guide_previous_position;
 
 layout(push_constant) uniform Params {
     uint history_max;
@@ -49,8 +51,9 @@ void main() {
     vec3 history = vec3(0.0);
     vec3 moments_history = vec3(0.0);
     float weights = 0.0;
+    vec3 was = imageLoad(guide_previous_position, pixel).xyz;
     if (p.w > 0.0 && params.plan_frames > 0u) {
-        vec4 clip = frame.prev_view_proj * vec4(p.xyz, 1.0);
+        vec4 clip = frame.prev_view_proj * vec4(was, 1.0);
         if (clip.w > 0.0) {
             vec2 at = (clip.xy / clip.w * 0.5 + 0.5) * vec2(size) - 0.5;
             ivec2 base = ivec2(floor(at));
@@ -64,7 +67,7 @@ void main() {
                 }
                 vec4 pq = imageLoad(position_prev, q);
                 vec4 nq = imageLoad(normal_prev, q);
-                bool same = pq.w > 0.0 && distance(pq.xyz, p.xyz) <= tolerance && dot(nq.xyz, n.xyz) > 0.9;
+                bool same = pq.w > 0.0 && distance(pq.xyz, was) <= tolerance && dot(nq.xyz, n.xyz) > 0.9;
                 if (same) {
                     history += w * imageLoad(illumination_prev, q).rgb;
                     moments_history += w * imageLoad(moments_prev, q).xyz;

@@ -18,7 +18,7 @@
 #define BINDING_BVH_LEAF_TRIANGLES      7 // the BVH's leaf triangles
 #define BINDING_TRIANGLE_NORMALS        8 // the corners' normals
 #define BINDING_TRIANGLE_UVS            9 // the corners' UVs
-#define BINDING_TRIANGLE_MATERIALS     10 // the triangles' materials
+#define BINDING_TRIANGLE_MATERIALS     10 // the triangles' materials and draws
 #define BINDING_EMITTERS               11 // the emissive triangles
 #define BINDING_TRACE_COLOUR_256       12 // the 256-texel colour texture array
 #define BINDING_TRACE_COLOUR_512       13 // the 512-texel colour texture array

@@ -62,6 +62,7 @@ struct Draw {
     mat4 normal;     // inverse transpose of model
     uvec4 material;  // x: index into materials; y: first index, z: vertex offset (mesh_data.glsl)
     vec4 uv_box;     // the mesh's UVs: xy smallest, zw size (vertex UVs are fractions of it)
+    mat4 previous;   // world now to world at the frame before (identity while still)
 };
 
 layout(set = SET_SCENE, binding = BINDING_FRAME) uniform Frame {

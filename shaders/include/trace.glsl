@@ -36,8 +36,9 @@ layout(std430, set = SET_SCENE, binding = BINDING_BVH_NODES) readonly buffer Bvh
 layout(std430, set = SET_SCENE, binding = BINDING_BVH_LEAF_TRIANGLES) readonly buffer BvhLeafTriangles { LeafTriangle leaf_triangles[]; };
 layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_NORMALS) readonly buffer TriangleNormals { vec4 corner_normals[]; };
 layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_UVS) readonly buffer TriangleUvs { vec2 corner_uvs[]; };
-// Per triangle: index into the Materials buffer (scene.glsl, binding 3).
-layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_MATERIALS) readonly buffer TriangleMaterials { uint triangle_materials[]; };
+// Per triangle: x the index into the Materials buffer (scene.glsl, binding
+// 3), y the draw record that placed it (Draws, binding 2).
+layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_MATERIALS) readonly buffer TriangleMaterials { uvec2 triangle_materials[]; };
 // The emissive triangles as an alias table over emitted power
 // (engine/render/src/emitters.rs): emitter_info = (count, bits of the sum of
 // luminance x area, 0, 0); per emitter (triangle, alias, bits of the keep
@@ -265,6 +266,7 @@ struct TraceSurface {
     vec2 uv;
     uint material;
     vec4 tangent;  // interpolated, w the bitangent's sign; zero without tangents
+    uint draw;     // the draw record that placed the triangle
 };
 
 // The surface of triangle `tri` where the ray reaches it at distance `t`.
@@ -294,7 +296,8 @@ TraceSurface trace_surface(uint tri, vec3 origin, vec3 dir, float t) {
     s.tangent = vec4(w * corner_tangents[3u * tri].xyz + u * corner_tangents[3u * tri + 1u].xyz
             + v * corner_tangents[3u * tri + 2u].xyz,
         corner_tangents[3u * tri].w);
-    s.material = triangle_materials[tri];
+    s.material = triangle_materials[tri].x;
+    s.draw = triangle_materials[tri].y;
     return s;
 }
 

@@ -27,6 +27,10 @@ layout(set = 0, binding = 0, rgba32f) uniform writeonly image2D guide_normal;
 // xyz: world position, w: 1 where a surface was met, 0 elsewhere.
 layout(set = 0, binding = 1, rgba32f) uniform writeonly image2D guide_position;
 layout(set = 0, binding = 2, rgba16f) uniform writeonly image2D albedo;
+// xyz: where the surface point was at the frame before (world space: its
+// placement's motion undone, Draw.previous), so history follows moving
+// meshes; the position itself where nothing moved or nothing was met.
+layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D guide_previous_position;
 
 void main() {
     ivec2 size = imageSize(albedo);
@@ -47,11 +51,13 @@ void main() {
         bool panel = t < 1e30;
         imageStore(guide_normal, pixel, vec4(-dir, panel ? -1.0 : 0.0));
         imageStore(guide_position, pixel, vec4(eye + dir * t, panel ? 1.0 : 0.0));
+        imageStore(guide_previous_position, pixel, vec4(eye + dir * t, panel ? 1.0 : 0.0));
         imageStore(albedo, pixel, vec4(1.0));
         return;
     }
     TraceSurface s = trace_surface(floatBitsToUint(found.y), eye, dir, t);
     Material m = materials[s.material];
+    imageStore(guide_previous_position, pixel, vec4((draws[s.draw].previous * vec4(s.position, 1.0)).xyz, 1.0));
 #ifdef SCENE_EMISSIVE
     if (any(greaterThan(m.emissive.rgb, vec3(0.0)))) {
         // Emitters are lights too: their radiance is no illumination to

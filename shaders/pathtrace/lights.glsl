@@ -122,7 +122,7 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
     ls.distance = sqrt(d2);
     ls.direction = to_light / max(ls.distance, 1e-20);
     float cos_light = -dot(ls.direction, ng);
-    uint material = triangle_materials[tri];
+    uint material = triangle_materials[tri].x;
     if (cos_light <= 0.0 || d2 <= 0.0) {
         return false;
     }

@@ -63,7 +63,7 @@ pub const BVH_LEAF_TRIANGLES_BINDING: u32 = 7;
 pub const TRIANGLE_NORMALS_BINDING: u32 = 8;
 /// Binding of the corners' UVs (`TriangleUvs`, a vec2 each).
 pub const TRIANGLE_UVS_BINDING: u32 = 9;
-/// Binding of each triangle's material index (`TriangleMaterials`).
+/// Binding of each triangle's material index and draw record (`TriangleMaterials`).
 pub const TRIANGLE_MATERIALS_BINDING: u32 = 10;
 /// Binding of the emissive triangles' alias table (`Emitters`,
 /// [`crate::emitters::EmitterTable`]).
@@ -195,7 +195,7 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 16] = [
         "TRIANGLE_MATERIALS",
         TRIANGLE_MATERIALS_BINDING,
         DescriptorKind::StorageBuffer,
-        "the triangles' materials",
+        "the triangles' materials and draws",
     ),
     tracing(
         "EMITTERS",

@@ -102,6 +102,9 @@ pub struct TraceMesh {
     pub uvs: Vec<[Vec2; 3]>,
     /// Index into [`SceneGeometry::materials`].
     pub materials: Vec<u32>,
+    /// The draw record the triangle was placed by (its `previous` says where
+    /// it was at the frame before).
+    pub draws: Vec<u32>,
     /// World-space unit tangents at the corners, w the bitangent's sign
     /// (mirrored instances flip it); zero where the mesh has none.
     pub tangents: Vec<[Vec4; 3]>,
@@ -247,6 +250,7 @@ impl SceneGeometry {
                         0,
                     ),
                     uv_box,
+                    previous: Mat4::IDENTITY,
                 });
                 g.draws.push(DrawItem {
                     range,
@@ -272,7 +276,8 @@ impl SceneGeometry {
 
     /// Moves every scene instance whose transform in `transforms` differs
     /// from the one in `placed` (which is updated to match): its draw records
-    /// and their world boxes. Pushes the moved draws' world boxes, before and
+    /// (with where it was, `previous`) and their world boxes; an instance
+    /// still again after moving has its records' `previous` reset. Pushes the moved draws' world boxes, before and
     /// after, onto `moved`, and returns the draw ids rewritten as one range
     /// (`None` when nothing moved), the span of the draw buffer to write.
     pub fn place_instances(
@@ -283,13 +288,29 @@ impl SceneGeometry {
     ) -> Option<std::ops::Range<u32>> {
         let mut changed: Option<std::ops::Range<u32>> = None;
         for (instance, (new, old)) in transforms.iter().zip(placed.iter_mut()).enumerate() {
-            if new == old {
-                continue;
-            }
-            *old = *new;
             let Some(ids) = self.instance_draws.get(instance).cloned() else {
+                *old = *new;
                 continue;
             };
+            if new == old {
+                // Still now: a placement that moved at the frame before is
+                // where it was then, so its records say so again.
+                let was_moving = ids
+                    .clone()
+                    .any(|id| self.draw_records[id as usize].previous != Mat4::IDENTITY);
+                if was_moving {
+                    for id in ids.clone() {
+                        self.draw_records[id as usize].previous = Mat4::IDENTITY;
+                    }
+                    changed = Some(match changed {
+                        Some(c) => c.start.min(ids.start)..c.end.max(ids.end),
+                        None => ids,
+                    });
+                }
+                continue;
+            }
+            let previous = *old * new.inverse();
+            *old = *new;
             moved.extend(self.boxes(ids.clone()));
             let normal = new.inverse().transpose();
             let mirrored = new.determinant() < 0.0;
@@ -297,6 +318,7 @@ impl SceneGeometry {
                 let record = &mut self.draw_records[id as usize];
                 record.model = *new;
                 record.normal = normal;
+                record.previous = previous;
                 let (local, slot) = self.draw_places[id as usize];
                 let draw = &mut self.draws[slot];
                 draw.bounds = local.transformed(new);
@@ -489,6 +511,7 @@ impl SceneGeometry {
                 }));
                 out.uvs.push(corners.map(|v| self.uvs[v]));
                 out.materials.push(d.material);
+                out.draws.push(d.draw_id);
             }
         }
         out

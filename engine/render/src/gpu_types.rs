@@ -37,6 +37,9 @@ pub struct GpuDraw {
     /// The mesh's UV box: xy its smallest UV, zw its size; a vertex's UV is
     /// `xy + zw * uv` with `uv` its 16-bit fractions.
     pub uv_box: Vec4,
+    /// World now to world at the frame before: where a point of this mesh
+    /// was then, for reprojecting history (identity while it stays put).
+    pub previous: Mat4,
 }
 
 /// `struct Light`. Area lights reuse the fields (see `scene.glsl`).
@@ -136,7 +139,7 @@ pub struct GpuShadowView {
 const _: () = {
     use std::mem::size_of;
     assert!(size_of::<GpuVertex>() == 20);
-    assert!(size_of::<GpuDraw>() == 160);
+    assert!(size_of::<GpuDraw>() == 224);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMaterial>() == 128);
     assert!(size_of::<GpuFrame>() == 3 * 64 + 5 * 16);
@@ -170,11 +173,13 @@ mod tests {
             normal: Mat4::IDENTITY,
             material: UVec4::new(5, 0, 0, 0),
             uv_box: Vec4::new(0.25, 0.5, 2.0, 4.0),
+            previous: Mat4::from_translation(glam::Vec3::new(-1.0, 0.0, 0.0)),
         };
         let words: &[u32] = bytemuck::cast_slice(std::slice::from_ref(&draw));
         assert_eq!(f32::from_bits(words[12]), 9.0, "column-major translation");
         assert_eq!(words[32], 5, "material index after two mat4s");
         assert_eq!(f32::from_bits(words[38]), 2.0, "uv_box after the material");
+        assert_eq!(f32::from_bits(words[52]), -1.0, "previous after uv_box");
         let vertex = GpuVertex {
             position: [1.0, 2.0, 3.0],
             frame: 0xDEAD_BEEF,

@@ -1,6 +1,6 @@
 //! The ray tracer's scene data on the device, built when a pass first traces:
 //! world-space triangles, the BVH over them (in its 4-wide form), per-corner normals, tangents and
-//! UVs, per-triangle materials, the emitters' alias table, the lights' choice
+//! UVs, per-triangle materials and draws, the emitters' alias table, the lights' choice
 //! table and the texture arrays (set 1's tracing-only bindings,
 //! [`crate::bindings::TRACE_SET_BINDINGS`]).
 
@@ -74,6 +74,13 @@ impl<'g> TraceBuffers<'g> {
         let choices = light_choices(lights, emitter_power, scene_radius);
         let trace_textures = crate::trace_textures::gather(&geometry.materials);
         warnings.extend(trace_textures.warnings.iter().cloned());
+        // Each triangle's material and the draw record that placed it.
+        let material_draws: Vec<[u32; 2]> = mesh
+            .materials
+            .iter()
+            .zip(&mesh.draws)
+            .map(|(&m, &d)| [m, d])
+            .collect();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         Ok(Self {
             triangles: Buffer::device_local(gpu, "trace triangles", bytes_of(&corners), storage)?,
@@ -94,8 +101,8 @@ impl<'g> TraceBuffers<'g> {
             uvs: Buffer::device_local(gpu, "trace uvs", bytes_of(&uvs), storage)?,
             materials: Buffer::device_local(
                 gpu,
-                "trace materials",
-                bytes_of(&mesh.materials),
+                "trace materials and draws",
+                bytes_of(&material_draws),
                 storage,
             )?,
             emitters: Buffer::device_local(gpu, "emitters", &emitters.bytes(), storage)?,
