@@ -1,13 +1,14 @@
 #version 450
 // One-bounce diffuse global illumination (graphs/gi.ron). For each G-buffer
 // pixel, `rays` cosine-weighted rays leave the surface; each returns the
-// radiance it brings back: the suns' ambient sky where it escapes, and
-// where it meets a surface the light that surface reflects towards it:
-// direct light by the path tracer's own next-event estimation (one light
-// sample, one shadow ray; pathtrace/next_event.glsl, lights.glsl, bsdf.glsl,
-// surface_bsdf.glsl) plus the sky along one ray sampled from its BSDF. A
-// ray that meets a light with area brings nothing, and a surface's own
-// emission is left out: that light is the raster passes' direct light.
+// radiance it brings back (one_bounce, pathtrace/next_event.glsl): the
+// suns' ambient sky where it escapes, and where it meets a surface the
+// light that surface reflects towards it: direct light by the path
+// tracer's own next-event estimation (one light sample, one shadow ray;
+// lights.glsl, bsdf.glsl, surface_bsdf.glsl) plus the sky along one ray
+// sampled from its BSDF. A ray that meets a light with area brings nothing,
+// and a surface's own emission is left out: that light is the raster
+// passes' direct light.
 // With cosine-weighted directions, the mean radiance is the irradiance over
 // pi that a Lambertian surface turns into reflected light by multiplying
 // with its albedo; the lighting pass multiplies it with the environment
@@ -42,42 +43,6 @@ layout(push_constant) uniform Params {
     uint frame;
 } params;
 
-// The radiance a ray from `origin` along `dir` brings back after at most one
-// bounce, with the light at the bounce found by next-event estimation.
-vec3 bounce(vec3 origin, vec3 dir, inout Rng rng) {
-    vec2 found = trace_closest(origin, dir, 1e30);
-    float t = found.x < 0.0 ? 1e30 : found.x;
-    if (hit_area_light(origin, dir, t) >= 0) {
-        return vec3(0.0);
-    }
-    if (found.x < 0.0) {
-        return frame.ambient.rgb;
-    }
-    TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
-    Material m = materials[s.material];
-    vec3 wo = -dir;
-    vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
-    s.normal = mapped_normal(s, m);
-    vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
-    Bsdf b = surface_bsdf(s, m);
-    vec3 from = leave(s.position, ng);
-    vec3 radiance = next_event(s.position, n, ng, wo, b, from, params.light_choice != 0u, rng);
-    // The sky the hit reflects: one ray sampled from its BSDF that escapes.
-    // (Where it meets a light, next-event estimation above counted it.)
-    if (any(greaterThan(frame.ambient.rgb, vec3(0.0)))) {
-        vec3 wi;
-        vec3 weight;
-        float pdf;
-        bool delta;
-        float far = 1e30;
-        if (bsdf_sample(b, n, wo, rng_next(rng).xyz, wi, weight, pdf, delta) && dot(wi, ng) > 0.0
-            && hit_area_light(from, wi, far) < 0 && !trace_any(from, wi, far)) {
-            radiance += weight * frame.ambient.rgb;
-        }
-    }
-    return radiance;
-}
-
 void main() {
     ivec2 size = imageSize(gi);
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
@@ -102,7 +67,7 @@ void main() {
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
-        sum += bounce(origin + dir * step, dir, rng);
+        sum += one_bounce(origin + dir * step, dir, params.light_choice != 0u, rng);
     }
     vec3 radiance = sum / float(max(params.rays, 1u));
     // A running mean over the last frames, its count capped at `frames`;

@@ -1,7 +1,9 @@
 #version 450
 // Ray-traced specular (graphs/rt_specular.ron): for each G-buffer pixel whose
 // material has a delta lobe (a mirror's Ks, a coat's reflection, glass), the
-// light that reaches the camera through it, which raster passes cannot draw.
+// light that reaches the camera through it, which raster passes cannot draw;
+// and for glossy lobes (GGX highlights, Blinn-Phong Ks lobes) the light they
+// reflect from the scene, where raster passes take a constant environment.
 // The pixel's camera ray is traced through its centre to the surface the
 // G-buffer holds; there the delta lobes scatter it with their expected
 // weights (glass over `optics.x` of the surface by Fresnel's odds, the
@@ -16,7 +18,12 @@
 // events start at the camera's first hit and that end in direct light, with
 // at most `max_depth` segments counted as the tracer counts them (the camera
 // ray is 1). Light bouncing diffusely more than once after the chain is
-// left out (gi adds one bounce to what the raster passes see directly).
+// left out (gi adds one bounce to what the raster passes see directly). A
+// glossy lobe gets one ray sampled from it alone (glossy_sample), bringing
+// back what one_bounce does (next_event.glsl: the sky, or the direct light
+// of the surface it meets, lights themselves left to the raster passes'
+// highlights); the raster passes leave that lobe out of their environment
+// term.
 // The raster lighting passes leave out what this pass traces (RT_SPECULAR in
 // include/lighting.glsl) and add its result (`rt_specular`).
 //
@@ -52,9 +59,13 @@ layout(push_constant) uniform Params {
 } params;
 
 // Whether `m` has a lobe this pass traces: glass over part of the surface,
-// or a mirror's or a coat's reflection.
+// a mirror's or a coat's reflection, or a glossy lobe (every
+// metallic-roughness surface's GGX highlight, a Blinn-Phong material's Ks
+// lobe with an exponent).
 bool traced(Material m) {
-    return m.optics.x > 0.0 || m.emissive.w == SHADING_MIRROR || m.emissive.w == SHADING_COATED;
+    bool glossy = m.emissive.w == SHADING_METALLIC_ROUGHNESS
+        || (m.emissive.w == SHADING_BLINN_PHONG && m.specular.w > 0.0 && any(greaterThan(m.specular.rgb, vec3(0.0))));
+    return glossy || m.optics.x > 0.0 || m.emissive.w == SHADING_MIRROR || m.emissive.w == SHADING_COATED;
 }
 
 // The light that reaches `origin` back along `dir`, the ray's segment
@@ -133,9 +144,9 @@ vec3 chain(vec3 origin, vec3 dir, uint depth, vec3 medium, inout Rng rng) {
     return radiance;
 }
 
-// One estimate of the light reaching the camera through the delta lobes of
+// One estimate of the light reaching the camera through the traced lobes of
 // the surface `s` (material `m`) that the camera ray along `dir` meets.
-vec3 through_delta_lobes(TraceSurface s, Material m, vec3 dir, inout Rng rng) {
+vec3 through_traced_lobes(TraceSurface s, Material m, vec3 dir, inout Rng rng) {
     vec3 wo = -dir;
     vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
     s.normal = mapped_normal(s, m);
@@ -167,6 +178,16 @@ vec3 through_delta_lobes(TraceSurface s, Material m, vec3 dir, inout Rng rng) {
     if (glass < 1.0 && any(greaterThan(reflectance, vec3(0.0)))) {
         radiance += (1.0 - glass) * reflectance * chain(leave(s.position, ng), reflect(dir, n), 2u, vec3(0.0), rng);
     }
+#if defined(SCENE_GLOSSY) || defined(SCENE_METALLIC_ROUGHNESS)
+    // A glossy lobe: one ray sampled from it brings back the sky or the
+    // light of the surface it meets (the raster passes draw the lights'
+    // highlights themselves, so a light it meets brings nothing).
+    vec3 wi;
+    vec3 weight;
+    if (glass < 1.0 && glossy_sample(surface_bsdf(s, m), n, wo, rng_next(rng).xy, wi, weight) && dot(wi, ng) > 0.0) {
+        radiance += (1.0 - glass) * weight * one_bounce(leave(s.position, ng), wi, params.light_choice != 0u, rng);
+    }
+#endif
     return radiance;
 }
 
@@ -190,7 +211,7 @@ void main() {
             Material m = materials[s.material];
             Rng rng = rng_start(uvec2(pixel), params.frame, 0x6a09e667u);
             for (uint i = 0u; i < params.rays; ++i) {
-                radiance += through_delta_lobes(s, m, dir, rng);
+                radiance += through_traced_lobes(s, m, dir, rng);
             }
             radiance /= float(max(params.rays, 1u));
         }

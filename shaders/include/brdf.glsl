@@ -87,6 +87,17 @@ vec3 ggx_directional_albedo(vec3 base, vec2 mr, float ndv) {
     return mix(dielectric + base * (1.0 - dielectric), metal, mr.x);
 }
 
+// The part of ggx_directional_albedo that single scattering off the
+// microfacets gives (the GGX highlight with Schlick's Fresnel, no multiple
+// scattering, no diffuse base): what ray-traced specular traces for a
+// metallic-roughness surface, so raster passes leave it out of the
+// environment term then (lighting.glsl, RT_SPECULAR).
+vec3 ggx_single_albedo(vec3 base, vec2 mr, float ndv) {
+    vec4 t = ggx_albedo(max(mr.y, MIN_ROUGHNESS), ndv);
+    vec3 f0 = mix(vec3(DIELECTRIC_F0), base, mr.x);
+    return f0 * (t.x - t.y) + t.y;
+}
+
 // The lobes that are separable in view and light, multiple scattering and
 // the dielectric's diffuse, times pi, for a view with albedo entries `tv`
 // and a light with `tl`: a light over a solid angle of form factor F (the

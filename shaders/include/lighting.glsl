@@ -67,9 +67,11 @@
 #endif
 
 // Under ray-traced specular (RT_SPECULAR: graphs/rt_specular.ron, which
-// adds what it traces), raster shading leaves out the lobes that pass
-// traces: a mirror's and a coat's highlight (delta lobes to the path
-// tracer), and glass's share of the surface (optics.x); emission stays.
+// adds what it traces), raster shading leaves out what that pass traces: a
+// mirror's and a coat's highlight (delta lobes to the path tracer), glass's
+// share of the surface (optics.x), and the glossy lobes' reflection of the
+// environment (RT_GLOSSY: environment_albedo); emission, and the highlights
+// lights draw, stay.
 #ifdef RT_SPECULAR
 vec3 highlight_colour(Material m) {
     return m.emissive.w == SHADING_MIRROR || m.emissive.w == SHADING_COATED ? vec3(0.0) : m.specular.rgb;
@@ -78,6 +80,7 @@ vec3 highlight_colour(Material m) {
 float opaque_share(Material m) {
     return 1.0 - m.optics.x;
 }
+#define RT_GLOSSY
 #else
 vec3 highlight_colour(Material m) {
     return m.specular.rgb;
@@ -373,11 +376,20 @@ vec3 environment_albedo(Surface s, Material m) {
     float ndv = clamp(dot(s.normal, v), 1e-3, 1.0);
 #ifdef SCENE_METALLIC_ROUGHNESS
     if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
-        return ggx_directional_albedo(m.diffuse.rgb * s.texel, s.metal_rough, ndv) * opaque_share(m);
+        vec3 base = m.diffuse.rgb * s.texel;
+        vec3 albedo = ggx_directional_albedo(base, s.metal_rough, ndv);
+#ifdef RT_GLOSSY
+        albedo -= ggx_single_albedo(base, s.metal_rough, ndv);
+#endif
+        return albedo * opaque_share(m);
     }
 #endif
     vec3 albedo = m.diffuse.rgb * s.texel;
     float shininess = m.specular.w;
+#ifdef RT_GLOSSY
+    // The lobe's reflection of the environment is traced.
+    shininess = 0.0;
+#endif
     if (shininess > 0.0) {
         vec2 scale;
         ltc_lookup(LTC_BLINN_PHONG, pow(2.0 / (shininess + 2.0), 0.25), ndv, scale);

@@ -210,4 +210,49 @@ bool bsdf_sample(Bsdf b, vec3 n, vec3 wo, vec3 u, out vec3 wi, out vec3 weight, 
     return true;
 }
 
+// Samples the glossy lobe alone: a metallic-roughness surface's GGX
+// single-scattering highlight (visible normals), or a Blinn-Phong
+// material's Ks lobe. `weight` is that lobe's f cos over the density wi was
+// picked with. False where the surface has no such lobe, or the sample goes
+// below it. Ray-traced specular (rt_specular.comp) traces this lobe for the
+// light that raster passes take from a constant environment.
+bool glossy_sample(Bsdf b, vec3 n, vec3 wo, vec2 u, out vec3 wi, out vec3 weight) {
+    weight = vec3(0.0);
+    wi = n;
+    float cos_o = dot(n, wo);
+    if (cos_o <= 0.0) {
+        return false;
+    }
+    mat3 frame = basis(n);
+#ifdef SCENE_METALLIC_ROUGHNESS
+    if (b.model == SHADING_METALLIC_ROUGHNESS) {
+        vec3 h = frame * sample_ggx_visible(transpose(frame) * wo, b.alpha, u);
+        wi = reflect(-wo, h);
+        float cos_i = dot(n, wi);
+        if (cos_i <= 0.0) {
+            return false;
+        }
+        // D Vis F cos_i over G1(o) D / (4 cos_o).
+        vec3 fresnel = b.specular + (1.0 - b.specular) * pow(1.0 - max(dot(wo, h), 0.0), 5.0);
+        weight = fresnel * (4.0 * cos_i * cos_o * ggx_visibility(cos_i, cos_o, b.alpha) / ggx_g1(cos_o, b.alpha));
+        return true;
+    }
+#endif
+#ifdef SCENE_GLOSSY
+    if (b.model == SHADING_BLINN_PHONG && b.exponent > 0.0) {
+        vec3 h = frame * sample_phong_half(u, b.exponent);
+        wi = reflect(-wo, h);
+        float cos_i = dot(n, wi);
+        float cos_oh = dot(wo, h);
+        if (cos_i <= 0.0 || cos_oh <= 0.0) {
+            return false;
+        }
+        // Ks lobe cos_i / pi over (n + 1) / (2 pi) lobe / (4 wo.h).
+        weight = b.specular * (8.0 * cos_i * cos_oh / (b.exponent + 1.0));
+        return any(greaterThan(weight, vec3(0.0)));
+    }
+#endif
+    return false;
+}
+
 #endif

@@ -4,8 +4,10 @@
 // rt_specular.comp): one light picked and one point on it sampled
 // (lights.glsl), one shadow ray, so each light is counted once. In
 // expectation it is the path tracer's direct light at that vertex
-// (`sampling` 1, NEE only, converges to the same image as its MIS). Needs
-// trace.glsl, random.glsl, bsdf.glsl and lights.glsl.
+// (`sampling` 1, NEE only, converges to the same image as its MIS). And the
+// one bounce ray-traced GI and glossy reflections bring back. Needs
+// trace.glsl, random.glsl, sampling.glsl, bsdf.glsl, surface_bsdf.glsl and
+// lights.glsl.
 #ifndef WEFT_PT_NEXT_EVENT_GLSL
 #define WEFT_PT_NEXT_EVENT_GLSL
 
@@ -25,6 +27,47 @@ vec3 next_event(vec3 position, vec3 n, vec3 ng, vec3 wo, Bsdf b, vec3 from, bool
     bool lit = any(greaterThan(f, vec3(0.0))) && hit_area_light(from, ls.direction, reach) < 0
         && !trace_any(from, ls.direction, reach);
     return lit ? f * ls.value : vec3(0.0);
+}
+
+// The radiance a ray from `origin` along `dir` brings back after at most one
+// bounce, for the raster graphs' traced rungs (gi.comp, rt_specular.comp's
+// glossy lobes), whose lighting passes draw the lights themselves: the
+// suns' ambient sky where it escapes; where it meets a surface, the direct
+// light that surface reflects (next_event) and the sky along one ray
+// sampled from its BSDF that escapes (where that ray meets a light,
+// next-event estimation counted it). A ray that meets a light with area
+// brings nothing, and a surface's own emission is left out: that light is
+// the raster passes' direct light.
+vec3 one_bounce(vec3 origin, vec3 dir, bool by_power, inout Rng rng) {
+    vec2 found = trace_closest(origin, dir, 1e30);
+    float t = found.x < 0.0 ? 1e30 : found.x;
+    if (hit_area_light(origin, dir, t) >= 0) {
+        return vec3(0.0);
+    }
+    if (found.x < 0.0) {
+        return frame.ambient.rgb;
+    }
+    TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
+    Material m = materials[s.material];
+    vec3 wo = -dir;
+    vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
+    s.normal = mapped_normal(s, m);
+    vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
+    Bsdf b = surface_bsdf(s, m);
+    vec3 from = leave(s.position, ng);
+    vec3 radiance = next_event(s.position, n, ng, wo, b, from, by_power, rng);
+    if (any(greaterThan(frame.ambient.rgb, vec3(0.0)))) {
+        vec3 wi;
+        vec3 weight;
+        float pdf;
+        bool delta;
+        float far = 1e30;
+        if (bsdf_sample(b, n, wo, rng_next(rng).xyz, wi, weight, pdf, delta) && dot(wi, ng) > 0.0
+            && hit_area_light(from, wi, far) < 0 && !trace_any(from, wi, far)) {
+            radiance += weight * frame.ambient.rgb;
+        }
+    }
+    return radiance;
 }
 
 #endif

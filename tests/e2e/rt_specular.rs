@@ -10,7 +10,10 @@
 //! ending in the sun's direct light at the wall: what `rt_specular` traces.
 //! So at those pixels the raster image equals the reference in expectation
 //! (its Blinn-Phong highlight of `Ks 1` left out), and at the same number of
-//! paths it is no noisier than the path tracer.
+//! paths it is no noisier than the path tracer. A glossy floor (Blinn-Phong,
+//! `Kd 0`) under the same wall reflects it through its lobe: the sun's
+//! highlight is the raster passes', the wall's light the traced ray's, and
+//! together they are the path tracer's image at three segments.
 
 use std::path::{Path, PathBuf};
 use weft_compare::LinearImage;
@@ -20,8 +23,8 @@ const SIZE: u32 = 64;
 const MAX_DEPTH: f64 = 4.0;
 
 /// The scene described above, written to `dir` (the glass ball's model
-/// copied beside it).
-fn scene(dir: &Path) -> PathBuf {
+/// copied beside it); `floor` is the floor's material.
+fn scene(dir: &Path, floor: &str) -> PathBuf {
     let models = weft_tests::repo().join("scenes/models");
     for file in ["glass_sphere.obj", "glass_sphere.mtl"] {
         std::fs::copy(models.join(file), dir.join(file)).expect("glass ball model");
@@ -29,7 +32,8 @@ fn scene(dir: &Path) -> PathBuf {
     std::fs::write(
         dir.join("room.mtl"),
         "newmtl white\nKd 0.8 0.8 0.8\nKs 0 0 0\n\
-         newmtl mirror\nKd 0 0 0\nKs 1 1 1\nillum 3\n",
+         newmtl mirror\nKd 0 0 0\nKs 1 1 1\nillum 3\n\
+         newmtl glossy\nKd 0 0 0\nKs 0.8 0.8 0.8\nNs 40\n",
     )
     .expect("mtl");
     std::fs::write(
@@ -38,7 +42,8 @@ fn scene(dir: &Path) -> PathBuf {
          v -4 -1 -1.5\nv 4 -1 -1.5\nv 4 4 -1.5\nv -4 4 -1.5\n\
          v -2 0 2\nv 2 0 2\nv 2 0 -1.4\nv -2 0 -1.4\n\
          usemtl white\nf 1 2 3\nf 1 3 4\n\
-         usemtl mirror\nf 5 6 7\nf 5 7 8\n",
+         usemtl FLOOR\nf 5 6 7\nf 5 7 8\n"
+            .replace("FLOOR", floor),
     )
     .expect("obj");
     let path = dir.join("room.scene");
@@ -111,7 +116,7 @@ fn relative_rmse(a: &LinearImage, b: &LinearImage, pixels: &[usize]) -> f64 {
 #[test]
 fn mirrors_and_glass_equal_the_path_tracers_delta_chains() {
     let dir = TempDir::new("rt-specular");
-    let scene = scene(&dir.0);
+    let scene = scene(&dir.0, "mirror");
     let depth = [("max_depth", MAX_DEPTH)];
     let reference = render(&scene, "pathtrace.ron", Some(1024), &depth, &[], "hdr");
     let traced_16 = render(&scene, "pathtrace.ron", Some(16), &depth, &[], "hdr");
@@ -164,6 +169,64 @@ fn mirrors_and_glass_equal_the_path_tracers_delta_chains() {
         assert!((ratio - 1.0).abs() < 0.01, "{report:#?}");
         assert!(error < 0.05, "{report:#?}");
         assert!(noise_16 < 1.1 * path_tracer_16, "{report:#?}");
+    }
+    println!("{report:#?}");
+}
+
+#[test]
+fn a_glossy_floor_reflects_the_scene_as_the_path_tracer_does() {
+    let dir = TempDir::new("rt-glossy");
+    let scene = scene(&dir.0, "glossy");
+    // Floor, wall, sun: three segments hold every path from the floor.
+    let reference = render(
+        &scene,
+        "pathtrace.ron",
+        Some(1024),
+        &[("max_depth", 3.0)],
+        &[],
+        "hdr",
+    );
+    let mut report = Vec::new();
+    for graph in ["deferred.ron", "tiled.ron"] {
+        let params = [("rt_specular.rays", 256.0), ("rt_specular.frames", 1.0)];
+        let traced = render(
+            &scene,
+            graph,
+            None,
+            &params,
+            &["rt_specular", "rt_shadows"],
+            "rt_specular",
+        );
+        let lit = render(
+            &scene,
+            graph,
+            None,
+            &params,
+            &["rt_specular", "rt_shadows"],
+            "hdr",
+        );
+        let raster = render(&scene, graph, None, &[], &["rt_shadows"], "hdr");
+        // The floor below the ball, where it reflects the wall.
+        let pixels: Vec<usize> = traced_interior(&traced, &reference)
+            .into_iter()
+            .filter(|&i| i / SIZE as usize > 40)
+            .collect();
+        let sum = |image: &LinearImage| {
+            pixels
+                .iter()
+                .map(|&i| luminance(image.pixels[i]))
+                .sum::<f64>()
+        };
+        let (ratio, without) = (sum(&lit) / sum(&reference), sum(&raster) / sum(&reference));
+        let error = relative_rmse(&lit, &reference, &pixels);
+        report.push(format!(
+            "{graph}: {} floor pixels, mean ratio {ratio:.4} (raster alone {without:.4}), rel. RMSE {error:.4}",
+            pixels.len()
+        ));
+        assert!(pixels.len() > 300, "{report:#?}");
+        assert!(without < 0.8, "{report:#?}");
+        assert!((ratio - 1.0).abs() < 0.015, "{report:#?}");
+        assert!(error < 0.1, "{report:#?}");
     }
     println!("{report:#?}");
 }

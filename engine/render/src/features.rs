@@ -22,7 +22,8 @@ use weft_scene::{AreaShape, Light, Scene};
 /// specular lobe (Ks and Ns above 0), `mirrors` for MTL `illum` 3,
 /// `coated` for MTL `illum` 5 (a Fresnel coat over Lambert), `dielectrics`
 /// for glass (MTL `illum` 4, 6 or 7, the dissolve rule, glTF transmission),
-/// `metallic_roughness` for glTF materials; `textures` when a placed mesh has a
+/// `metallic_roughness` for glTF materials, `specular_lobes` for any of the
+/// last five (the lobes ray-traced specular traces); `textures` when a placed mesh has a
 /// base colour, metallic-roughness, normal or emissive texture, `normal_maps` when one
 /// has a normal texture with a non-zero scale, `emission_occlusion_maps` when
 /// one has an emissive or occlusion texture.
@@ -119,6 +120,19 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     if placed().any(|m| m.shading == ShadingModel::MetallicRoughness) {
         set(&mut features, "metallic_roughness");
     }
+    // What ray-traced specular traces (graphs/rt_specular.ron), as one
+    // feature: a pass keyed on the five above would have 32 times the
+    // variants where one bit does.
+    let traced = [
+        "glossy",
+        "dielectrics",
+        "mirrors",
+        "coated",
+        "metallic_roughness",
+    ];
+    if features.iter().any(|f| traced.contains(&f.as_str())) {
+        set(&mut features, "specular_lobes");
+    }
     if placed().any(|m| m.shading != ShadingModel::MetallicRoughness) {
         set(&mut features, "blinn_phong");
     }
@@ -161,6 +175,7 @@ pub fn scene_feature_reason(name: &str) -> Option<&'static str> {
         "mirrors" => "a material is a mirror (MTL illum 3)",
         "coated" => "a material has a Fresnel coat (MTL illum 5)",
         "metallic_roughness" => "a glTF material is placed",
+        "specular_lobes" => "a material is glossy, a mirror, coated, glass or glTF (lobes rt_specular traces)",
         "blinn_phong" => "a material shades with Blinn-Phong",
         "emission_occlusion_maps" => "a material has an emissive or occlusion texture",
         "normal_maps" => "a material has a normal texture",

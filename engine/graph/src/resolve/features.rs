@@ -25,7 +25,7 @@ pub fn feature_names(ir: &Ir) -> BTreeSet<String> {
 /// The features the engine sets from what a scene holds (weft-render's
 /// `scene_features`, which sets no other): a graph may test them without any
 /// pass of its own doing so (a fragment's caveat, say).
-pub const SCENE_FEATURES: [&str; 19] = [
+pub const SCENE_FEATURES: [&str; 20] = [
     "shadow_casters",
     "emissive",
     "transparent",
@@ -41,6 +41,7 @@ pub const SCENE_FEATURES: [&str; 19] = [
     "mirrors",
     "coated",
     "metallic_roughness",
+    "specular_lobes",
     "blinn_phong",
     "emission_occlusion_maps",
     "normal_maps",

@@ -243,7 +243,7 @@ fn scene_features_cull_passes_and_variants() {
             ("gi", "enabled_if [gi] is false"),
             (
                 "rt_specular",
-                "enabled_if [rt_specular, mirrors|coated|dielectrics] is false",
+                "enabled_if [rt_specular, specular_lobes] is false",
             ),
             ("guides", "enabled_if [denoise] is false"),
             ("denoise_temporal", "enabled_if [denoise] is false"),
