@@ -166,8 +166,39 @@ impl SweepRun {
     }
 }
 
-/// What every point of a sweep shares; a resumed sweep must share it too.
-fn settings_text(args: &SweepRun) -> String {
+/// A fingerprint of the contents of every file the sweep's points are
+/// rendered from: the scene and its includes, and each measured graph's
+/// files, shaders and their includes ([`weft_render::graph_source_files`]).
+/// A resumed sweep must match it, so an edited shader or graph never mixes
+/// old points with new ones; a missing file hashes as missing.
+fn sources_fingerprint(args: &SweepRun) -> Result<String> {
+    let mut files = weft_render::scene_path_files(args.common.scene());
+    for graph in args.graph_names() {
+        let prepared = weft_render::load_graph(&RenderSettings {
+            graph: PathBuf::from(&graph),
+            ..RenderSettings::default()
+        })?;
+        files.extend(weft_render::graph_source_files(&prepared));
+    }
+    let mut hasher = weft_io::hash::Hasher::new();
+    for file in &files {
+        hasher.field(file.to_string_lossy().as_bytes());
+        match std::fs::read(file) {
+            Ok(bytes) => hasher.field(b"present").field(&bytes),
+            Err(_) => hasher.field(b"missing"),
+        };
+    }
+    Ok(format!(
+        "{} ({} files)",
+        weft_io::hash::hex(hasher.finish()),
+        files.len()
+    ))
+}
+
+/// What every point of a sweep shares; a resumed sweep must share it too:
+/// the settings, and `sources`, the fingerprint of the files the points
+/// are rendered from ([`sources_fingerprint`]).
+fn settings_text(args: &SweepRun, sources: &str) -> String {
     let c = &args.common;
     let reference = match &c.reference_image {
         Some(image) => format!("image {}", image.display()),
@@ -180,7 +211,7 @@ fn settings_text(args: &SweepRun) -> String {
         ),
     };
     format!(
-        "scene {}\ngraph {}\nsize {}x{}\ncamera {}\nreference {reference}\nfeatures {}\nframes {}\n",
+        "scene {}\ngraph {}\nsize {}x{}\ncamera {}\nreference {reference}\nfeatures {}\nframes {}\nsources {sources}\n",
         c.scene().display(),
         args.graph_names().join(","),
         c.size.width,
@@ -193,6 +224,20 @@ fn settings_text(args: &SweepRun) -> String {
         .map(|s| format!("{SHARD_LINE}{}/{}\n", s.k, s.n))
         .unwrap_or_default()
         .as_str()
+}
+
+/// The `sources` line's fingerprint in a `sweep.settings` text.
+fn sources_line(settings: &str) -> Option<&str> {
+    settings.lines().find_map(|l| l.strip_prefix("sources "))
+}
+
+/// A `sweep.settings` text without its `sources` line.
+fn without_sources(settings: &str) -> String {
+    settings
+        .lines()
+        .filter(|l| !l.starts_with("sources "))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// How `sweep.settings` names a shard.
@@ -243,9 +288,15 @@ fn noise_floor_note((seed, floor): NoiseFloor, labels: &[(String, f64)]) -> Stri
 /// resuming, refuses to mix points measured with other settings.
 fn check_settings(args: &SweepRun) -> Result<()> {
     let path = args.out.join("sweep.settings");
-    let wanted = settings_text(args);
+    let wanted = settings_text(args, &sources_fingerprint(args)?);
     match weft_io::read_text(&path, weft_io::read::MAX_TEXT_BYTES) {
         Ok(found) if found == wanted => Ok(()),
+        Ok(found) if without_sources(&found) == without_sources(&wanted) => bail!(
+            "{} holds points measured from other sources: a graph, shader or scene file has changed since (sources {}, now {}); use another --out or remove the folder",
+            args.out.display(),
+            sources_line(&found).unwrap_or("not recorded"),
+            sources_line(&wanted).unwrap_or("not recorded"),
+        ),
         Ok(found) => bail!(
             "{} holds points measured with other settings:\n{found}this sweep:\n{wanted}use another --out or remove the folder",
             args.out.display()

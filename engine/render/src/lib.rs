@@ -89,5 +89,7 @@ pub use lights::{area_shape, pack_lights, AreaGeometry, LightSet};
 pub use materials::matches as material_matches;
 pub use providers::{check as check_providers, compile as compile_plan};
 pub use sanitize::RADIANCE_MAX;
-pub use sources::{normalize as normalize_path, scene_files, shader_files};
+pub use sources::{
+    graph_source_files, normalize as normalize_path, scene_files, scene_path_files, shader_files,
+};
 pub use trace_textures::gather as gather_trace_textures;

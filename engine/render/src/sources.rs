@@ -12,6 +12,9 @@ use weft_scene::Scene;
 /// How deep scene `include`s are followed (the loader's own limit).
 const MAX_SCENE_INCLUDE_DEPTH: usize = 32;
 
+/// How deep shader `#include`s are followed by [`graph_source_files`].
+const MAX_SHADER_INCLUDE_DEPTH: usize = 32;
+
 /// The files behind a live render, as absolute paths (canonical where they exist),
 /// grouped by what a change to them means.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -87,6 +90,49 @@ pub fn shader_files(
     Ok(files)
 }
 
+/// Every file a graph is built from, found without compiling it: its graph
+/// files, every pass's shaders whatever the features, and the files they
+/// `#include`, read from their `#include "FILE"` lines (relative to the
+/// including file, as the compiler resolves them). For what must notice an
+/// edit to any of them (a resumed sweep).
+pub fn graph_source_files(graph: &weft_graph::Prepared) -> BTreeSet<PathBuf> {
+    let mut files: BTreeSet<PathBuf> = graph.graph().files().iter().map(|f| normalize(f)).collect();
+    for pass in graph.ir().passes.iter() {
+        let stages = [
+            &pass.shaders.vertex,
+            &pass.shaders.fragment,
+            &pass.shaders.compute,
+        ];
+        for shader in stages.into_iter().flatten() {
+            shader_includes(shader, 0, &mut files);
+        }
+    }
+    files
+}
+
+/// Adds the shader `path` and, recursively, the files its `#include` lines name.
+fn shader_includes(path: &Path, depth: usize, files: &mut BTreeSet<PathBuf>) {
+    if !files.insert(normalize(path)) || depth >= MAX_SHADER_INCLUDE_DEPTH {
+        return;
+    }
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return;
+    };
+    let base = path.parent().unwrap_or(Path::new(""));
+    for line in text.lines() {
+        let included = line
+            .trim()
+            .strip_prefix("#include")
+            .map(str::trim)
+            .and_then(|rest| rest.strip_prefix('"'))
+            .and_then(|rest| rest.split_once('"'))
+            .map(|(name, _)| name);
+        if let Some(name) = included {
+            shader_includes(&base.join(name), depth + 1, files);
+        }
+    }
+}
+
 /// The files a loaded scene was read from. The scene loader does not record its
 /// `include`s, so they are found again by reading each `include "FILE"` line;
 /// models list what they read themselves (`Model::sources`).
@@ -147,6 +193,34 @@ fn scene_includes(path: &Path, depth: usize, files: &mut BTreeSet<PathBuf>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A shipped graph's files: the graph and the fragments it includes,
+    /// their passes' shaders, and those shaders' includes two levels down
+    /// (gi.comp includes pathtrace/next_event.glsl; include/trace.glsl
+    /// includes bindings.glsl), whatever the features (gi is off by default).
+    #[test]
+    fn a_graph_is_built_from_its_files_shaders_and_their_includes() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let graph =
+            weft_graph::Prepared::load(&root.join("graphs/deferred.ron"), Default::default())
+                .expect("graphs/deferred.ron loads");
+        let files = graph_source_files(&graph);
+        for expected in [
+            "graphs/deferred.ron",
+            "graphs/gi.ron",
+            "graphs/scene_shading.ron",
+            "shaders/gi.comp",
+            "shaders/pathtrace/next_event.glsl",
+            "shaders/include/trace.glsl",
+            "shaders/include/bindings.glsl",
+        ] {
+            assert!(
+                files.contains(&normalize(&root.join(expected))),
+                "{expected} in {files:#?}"
+            );
+        }
+        assert!(files.iter().all(|f| f.is_file()), "{files:#?}");
+    }
 
     #[test]
     fn follows_scene_includes() {

@@ -284,6 +284,28 @@ fn a_sweep_writes_its_csv_plot_and_frontier_and_resumes() {
         assert_eq!(new, format!("{old},{median},{median}"));
     }
 
+    // Points measured from other sources (a graph, shader or scene file
+    // edited since: its fingerprint in sweep.settings differs) are refused.
+    let settings = std::fs::read_to_string(out.join("sweep.settings")).expect("settings");
+    let recorded = settings
+        .lines()
+        .find_map(|l| l.strip_prefix("sources "))
+        .expect("a sources line")
+        .to_string();
+    assert!(recorded.ends_with(" files)"), "{recorded}");
+    let edited = settings.replace(&recorded, "0123 (1 files)");
+    std::fs::write(out.join("sweep.settings"), edited).expect("settings");
+    let stale = sweep("4");
+    assert!(!stale.status.success());
+    let stderr = String::from_utf8_lossy(&stale.stderr);
+    assert!(
+        stderr.contains(&format!(
+            "holds points measured from other sources: a graph, shader or scene file has changed since (sources 0123 (1 files), now {recorded})"
+        )),
+        "{stderr}"
+    );
+    std::fs::write(out.join("sweep.settings"), &settings).expect("settings");
+
     // Other settings in the same folder are refused, not mixed in.
     let other = sweep("8");
     assert!(!other.status.success());
