@@ -121,21 +121,18 @@ fn render(
 /// differs by more than a quarter), so the raster graphs' unfiltered edges
 /// do not count.
 fn interior_mean(reference: &LinearImage, image: &LinearImage) -> (f64, f64) {
-    let (w, h) = (reference.width as i64, reference.height as i64);
-    let lum = |img: &LinearImage, x: i64, y: i64| -> f64 {
-        let p = img.pixels[(y * w + x) as usize];
+    let (w, h) = (reference.width, reference.height);
+    let lum = |img: &LinearImage, i: usize| {
+        let p = img.pixels[i];
         f64::from(p[0] + p[1] + p[2])
     };
     let (mut sum_ref, mut sum_img) = (0.0, 0.0);
     for y in 1..h - 1 {
         for x in 1..w - 1 {
-            let centre = lum(reference, x, y);
-            let flat = (-1..=1)
-                .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
-                .all(|(dx, dy)| (lum(reference, x + dx, y + dy) - centre).abs() <= 0.25 * centre);
-            if centre > 0.0 && flat {
-                sum_ref += centre;
-                sum_img += lum(image, x, y);
+            let i = (y * w + x) as usize;
+            if lum(reference, i) > 0.0 && weft_tests::render::flat_at(reference, x, y, 0.25) {
+                sum_ref += lum(reference, i);
+                sum_img += lum(image, i);
             }
         }
     }

@@ -78,27 +78,19 @@ fn luminance(p: [f32; 3]) -> f64 {
     f64::from(p[0] + p[1] + p[2])
 }
 
-/// The pixels `rt_specular` lit whose 3 x 3 neighbourhood in the reference
-/// holds no edge (no neighbour differs by more than a fifth), so the
-/// reference's box-filtered edges, which the pixel-centre paths of the
-/// raster graph do not average, do not count.
+/// The pixels `rt_specular` lit that lie away from the reference's edges
+/// (`flat_at`, within a fifth), so the reference's box-filtered edges, which
+/// the pixel-centre paths of the raster graph do not average, do not count.
 fn traced_interior(traced: &LinearImage, reference: &LinearImage) -> Vec<usize> {
-    let (w, h) = (reference.width as i64, reference.height as i64);
-    let lum = |x: i64, y: i64| luminance(reference.pixels[(y * w + x) as usize]);
-    let mut pixels = Vec::new();
-    for y in 1..h - 1 {
-        for x in 1..w - 1 {
-            let i = (y * w + x) as usize;
-            let centre = lum(x, y);
-            let flat = (-1..=1)
-                .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
-                .all(|(dx, dy)| (lum(x + dx, y + dy) - centre).abs() <= 0.2 * centre);
-            if luminance(traced.pixels[i]) > 0.0 && centre > 0.0 && flat {
-                pixels.push(i);
-            }
-        }
-    }
-    pixels
+    let (w, h) = (reference.width, reference.height);
+    let lit = |i: usize| luminance(traced.pixels[i]) > 0.0 && luminance(reference.pixels[i]) > 0.0;
+    (1..h - 1)
+        .flat_map(|y| (1..w - 1).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            lit((y * w + x) as usize) && weft_tests::render::flat_at(reference, x, y, 0.2)
+        })
+        .map(|(x, y)| (y * w + x) as usize)
+        .collect()
 }
 
 /// Root-mean-square difference of `a` from `b` over `pixels`, relative to

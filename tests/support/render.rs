@@ -277,3 +277,19 @@ pub fn square_settings_without_bloom(
         .collect();
     square_settings(graph, size, samples, params, &features)
 }
+
+/// Whether pixel (`x`, `y`) of `image` (not on its border) lies away from
+/// edges: no pixel of its 3 x 3 neighbourhood differs from it in RGB sum by
+/// more than `tolerance` times its own. Comparisons of raster images, whose
+/// pixels are sampled at their centres, against the path tracer's
+/// box-filtered ones keep to such pixels.
+pub fn flat_at(image: &weft_compare::LinearImage, x: u32, y: u32, tolerance: f64) -> bool {
+    let sum = |x: u32, y: u32| {
+        let p = image.pixels[(y * image.width + x) as usize];
+        f64::from(p[0] + p[1] + p[2])
+    };
+    let centre = sum(x, y);
+    (y - 1..=y + 1)
+        .flat_map(|ny| (x - 1..=x + 1).map(move |nx| (nx, ny)))
+        .all(|(nx, ny)| (sum(nx, ny) - centre).abs() <= tolerance * centre)
+}
