@@ -28,6 +28,13 @@
 // writes each frame's own `samples_per_frame` samples to `hdr`, the noisy
 // input graphs/pathtrace_denoised.ron filters.
 //
+// `coherent_lanes` 1 trades uncorrelated noise for speed: the 8 lanes of
+// each SIMD group share each sample's random numbers past the pixel jitter,
+// so their paths diverge less (coherent_pixel regroups the pixels every
+// sample).
+// Each pixel's estimate is as before in distribution; neighbours' errors
+// correlate (docs/pathtrace.md measures both).
+//
 // `light_choice` 0 picks the light NEE samples uniformly; 1 half uniformly,
 // half by its power (engine/render/src/light_choice.rs).
 //
@@ -71,6 +78,7 @@ layout(push_constant) uniform Params {
     uint nee_through_glass;
     uint light_choice;
     uint accumulate;
+    uint coherent_lanes;
     uint history_frames;
     uint repeat_index;
     uint frame;
@@ -258,13 +266,20 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
     return radiance;
 }
 
+// Under `coherent_lanes`: the invocation of local index `l` (0..63) in its 8 x 8
+// work group takes the tile's pixel whose index is `l`'s 6 bits rotated by
+// a number the sample picks, so each sample groups the tile's pixels into
+// the 8-lane SIMD groups (lanes l >> 3 alike) differently: rows, columns,
+// strided blocks.
+ivec2 coherent_pixel(uint sample_index) {
+    uint l = gl_LocalInvocationIndex;
+    uint r = pcg4d(uvec4(sample_index, params.seed, 0x27d4eb2fu, 0u)).x % 6u;
+    uint p = ((l << r) | (l >> (6u - r))) & 63u;
+    return ivec2(gl_WorkGroupID.xy * 8u + uvec2(p & 7u, p >> 3u));
+}
+
 void main() {
     ivec2 size = imageSize(hdr);
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(pixel, size))) {
-        return;
-    }
-    vec3 eye = frame.camera_position.xyz;
     uint spf = max(params.samples_per_frame, 1u);
     // The reference numbers its samples from the last change, so a seed
     // gives the same image; each frame's own samples (`accumulate` 0) are
@@ -272,8 +287,22 @@ void main() {
     // (`history_frames` is 0 after every change) and a denoiser sees noise,
     // not one frame's samples over and over.
     uint sample_frame = params.accumulate != 0u ? params.history_frames : params.frame;
-    Rng rng = rng_start(uvec2(pixel), sample_frame * spf + params.repeat_index, params.seed);
+    uint sample_index = sample_frame * spf + params.repeat_index;
+    ivec2 pixel = params.coherent_lanes != 0u ? coherent_pixel(sample_index) : ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(pixel, size))) {
+        return;
+    }
+    vec3 eye = frame.camera_position.xyz;
+    Rng rng = rng_start(uvec2(pixel), sample_index, params.seed);
     vec2 jitter = rng_next(rng).xy;
+    if (params.coherent_lanes != 0u) {
+        // Past the pixel's own jitter, the SIMD group's lanes share the
+        // sample's numbers, so their paths take the same turns: each
+        // pixel's samples stay independent and its estimate unbiased, but
+        // the errors of pixels grouped together correlate.
+        uint group = gl_LocalInvocationIndex >> 3u;
+        rng = rng_start(uvec2(gl_WorkGroupID.x * 8u + group, gl_WorkGroupID.y), sample_index, params.seed ^ 0x85ebca6bu);
+    }
     vec2 ndc = (vec2(pixel) + jitter) / vec2(size) * 2.0 - 1.0;
     vec4 on_near = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
     vec3 dir = normalize(on_near.xyz / on_near.w - eye);
