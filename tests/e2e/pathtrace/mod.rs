@@ -425,7 +425,7 @@ fn lights_chosen_by_power_add_up_to_each_light_alone() {
 /// group's lanes sharing their numbers agrees with the default one within
 /// noise. Their means agree within 0.5% per channel, and
 /// the squared difference between the two 256-spp images is no more than
-/// the sum of each one's own (their errors against a 2,048-spp image; two
+/// the sum of each one's own (their errors against a 1,024-spp image; two
 /// independent unbiased images differ by exactly that in expectation).
 /// The pixels it regroups every sample are the tile's own: each pixel gets
 /// its 256 samples (the image is complete, nothing is left black).
@@ -437,7 +437,7 @@ fn coherent_lanes_estimate_the_same_image() {
         let params = [("coherent_lanes", coherent), ("seed", seed)];
         render_hdr(&scene, "pathtrace.ron", SIZE, Some(spp), &params, &[])
     };
-    let reference = render(2048, 0.0, 7.0);
+    let reference = render(1024, 0.0, 7.0);
     let default = render(256, 0.0, 1.0);
     // Another seed, so the two share no pixel jitter either.
     let coherent = render(256, 1.0, 2.0);
