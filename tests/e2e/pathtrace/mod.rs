@@ -423,10 +423,11 @@ fn lights_chosen_by_power_add_up_to_each_light_alone() {
 /// `coherent_lanes` changes which random numbers a pixel's samples draw,
 /// not what they estimate: on the Cornell box, the image with the SIMD
 /// group's lanes sharing their numbers agrees with the default one within
-/// noise. Their means agree within 0.5% per channel, and
-/// the squared difference between the two 256-spp images is no more than
-/// the sum of each one's own (their errors against a 1,024-spp image; two
-/// independent unbiased images differ by exactly that in expectation).
+/// noise. Their mean luminances agree within 0.5%, and the squared
+/// difference between the two 256-spp images (relative to the reference's
+/// value) is no more than the sum of each one's own (their errors against a
+/// 1,024-spp image; two independent unbiased images differ by that, less
+/// the reference's own noise, in expectation).
 /// The pixels it regroups every sample are the tile's own: each pixel gets
 /// its 256 samples (the image is complete, nothing is left black).
 #[test]
