@@ -202,3 +202,86 @@ fn rt_ao_accumulates_over_still_frames() {
     assert!(eight_of_8 < 0.5 * one_of_8, "{report}");
     assert!((eighth_alone / one_of_8 - 1.0).abs() < 0.25, "{report}");
 }
+
+/// Two planes meeting at a right angle, a floor and a wall 2 km wide and
+/// 1 km high, Lambertian (albedo 0.6) under ambient 1 alone. Every point of
+/// either sees the other fill exactly the half of its hemisphere on the
+/// other's side of its own plane's normal (the other plane is, as far as
+/// the rays go, infinite), and the cosine weighting is symmetric about it:
+/// the visible fraction is 1/2 everywhere, in the corner as far from it.
+/// So each pixel shows 0.6 x 1/2 under `rt_ao` (the mean over the image
+/// within 1%); and the floor alone, with nothing above it, sees all of its
+/// sky: the image is the one without `rt_ao`.
+#[test]
+fn rt_ao_is_one_half_in_a_right_angle_corner_and_one_on_a_plane() {
+    let dir = TempDir::new("rt-ao-corner");
+    std::fs::write(
+        dir.0.join("grey.mtl"),
+        "newmtl grey\nKd 0.6 0.6 0.6\nKs 0 0 0\n",
+    )
+    .expect("mtl");
+    let floor = "v -1000 0 0\nv 1000 0 0\nv 1000 0 1000\nv -1000 0 1000\nvn 0 1 0\nf 1//1 3//1 2//1\nf 1//1 4//1 3//1\n";
+    let wall = "v -1000 0 0\nv 1000 0 0\nv 1000 1000 0\nv -1000 1000 0\nvn 0 0 1\nf 5//2 6//2 7//2\nf 5//2 7//2 8//2\n";
+    let write = |name: &str, geometry: &str| {
+        std::fs::write(
+            dir.0.join(format!("{name}.obj")),
+            format!("mtllib grey.mtl\nusemtl grey\n{geometry}"),
+        )
+        .expect("obj");
+        let path = dir.0.join(format!("{name}.scene"));
+        std::fs::write(
+            &path,
+            format!(
+                "model\n{{\n\tfile \"{name}.obj\"\n}}\n\
+                 sunlight\n{{\n\tdirection 0 -1 0\n\tcolor 0 0 0\n\tambient 1 1 1\n}}\n\
+                 camera\n{{\n\tposition 2 2.5 5\n\ttarget 0 0.6 0\n\tfov_deg 50\n}}\n"
+            ),
+        )
+        .expect("scene");
+        path
+    };
+    let corner = write("corner", &format!("{floor}{wall}"));
+    let plane = write("plane", floor);
+    let params = [("rt_ao.rays", 256.0)];
+    let mut report = Vec::new();
+    for graph in ["deferred.ron", "tiled.ron"] {
+        // The visible fraction each pixel (its centre) shows, where it
+        // shows a surface: a pixel on the edge line is on one plane or the
+        // other, and a point in the corner sees half its sky too.
+        let visible = |scene: &Path| -> Vec<f64> {
+            let image = render(scene, graph, None, &params, &["rt_ao"]);
+            image
+                .pixels
+                .iter()
+                .map(|p| f64::from(p[1]) / 0.6)
+                .filter(|&v| v > 0.0)
+                .collect()
+        };
+        let in_corner = visible(&corner);
+        // The plane: every ray escapes, so the image is the one without
+        // `rt_ao`, bit for bit (visibility exactly 1; the half-float image
+        // holds 0.6 to 4e-4).
+        let on_plane = render(&plane, graph, None, &params, &["rt_ao"]);
+        let unoccluded = render(&plane, graph, None, &[], &[]);
+        let plane_lit = on_plane.pixels.iter().filter(|p| p[1] > 0.0).count();
+        let mean = in_corner.iter().sum::<f64>() / in_corner.len() as f64;
+        let worst = in_corner
+            .iter()
+            .map(|v| (v - 0.5).abs())
+            .fold(0.0, f64::max);
+        report.push(format!(
+            "{graph}: corner mean {mean:.4} over {} pixels (worst {worst:.3}); plane: {plane_lit} pixels",
+            in_corner.len(),
+        ));
+        assert!(
+            in_corner.len() == (SIZE * SIZE) as usize && plane_lit > 600,
+            "{report:#?}"
+        );
+        // 256 rays: each pixel's estimate has a standard deviation of
+        // 1/32; the mean over the pixels, far less.
+        assert!((mean - 0.5).abs() < 0.005, "{report:#?}");
+        assert!(worst < 0.15, "{report:#?}");
+        assert_eq!(on_plane.pixels, unoccluded.pixels, "{report:#?}");
+    }
+    println!("{report:#?}");
+}
