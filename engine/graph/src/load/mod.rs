@@ -5,7 +5,7 @@ mod params;
 
 pub(crate) use params::non_finite;
 pub use params::resolve_value;
-use params::{resolve_params, split_qualified};
+use params::{report_not_taken, resolve_params, split_qualified};
 
 use crate::diagnostic::Diagnostic;
 use crate::schema::{GraphFile, ParamValue, PassDecl, ResourceDecl};
@@ -30,9 +30,12 @@ pub struct Source {
     /// includer's: they follow that parameter, and tools offer that one.
     pub follows: std::collections::BTreeSet<String>,
     /// The name `--param` reaches its parameters by from the root graph: empty
-    /// for the root, the file stem for a file the root includes (`shadows`
-    /// in `shadows.resolution`), `None` for files included deeper.
+    /// for the root and a whole graph it builds on (hybrid.ron's deferred.ron),
+    /// the file stem for a file either includes (`shadows` in
+    /// `shadows.resolution`), `None` for files included deeper.
     pub qualifier: Option<String>,
+    /// A whole graph (not a fragment) another includes, to build on it.
+    pub built_on: bool,
 }
 
 /// An item declared in some source file, with where to point diagnostics.
@@ -200,6 +203,12 @@ struct IncludeSite {
     index: usize,
     /// Parameters the site sets to a `$reference` of the includer's.
     follows: std::collections::BTreeSet<String>,
+    /// `--param` values the includer, the root or a graph built on like it,
+    /// does not take itself (`name`, or `fragment.name` for a fragment it
+    /// does not include): a whole graph included here takes them as a root
+    /// would (hybrid.ron passes `gi.rays` to deferred.ron, whose fragment
+    /// gi.ron it is); a fragment ignores them.
+    passed_on: BTreeMap<String, ParamValue>,
 }
 
 fn ron_options() -> ron::Options {
@@ -296,10 +305,18 @@ fn load_file(
         }
     };
     let source = graph.sources.len();
+    // The root, and a whole graph another root-like graph builds on, take
+    // `--param` values as the root does: their own by name, their includes'
+    // as `stem.name`.
+    let root_like = site.as_ref().is_none_or(|s| {
+        !parsed.fragment && graph.sources[s.source].qualifier.as_deref() == Some("")
+    });
     let qualifier = match &site {
-        None => Some(String::new()),
-        Some(site) if site.source == 0 => Some(include_stem(path)),
-        Some(_) => None,
+        _ if root_like => Some(String::new()),
+        Some(s) if graph.sources[s.source].qualifier.as_deref() == Some("") => {
+            Some(include_stem(path))
+        }
+        _ => None,
     };
     graph.sources.push(Source {
         file: path.to_path_buf(),
@@ -308,6 +325,7 @@ fn load_file(
         ranges: parsed.param_ranges.clone(),
         follows: site.as_ref().map(|s| s.follows.clone()).unwrap_or_default(),
         qualifier,
+        built_on: site.is_some() && !parsed.fragment,
     });
     graph.inputs.push(parsed.inputs.clone());
     if !parsed.fragment && !parsed.inputs.is_empty() {
@@ -352,11 +370,19 @@ fn load_file(
         }
     }
     // At the root, `fragment.name` overrides (`--param shadows.resolution=1024`)
-    // reach the parameter `name` of the include whose file stem is `fragment`.
-    let (overrides, mut qualified) = if site.is_none() {
-        split_qualified(graph, source, &parsed.include, overrides)
+    // reach the parameter `name` of the include whose file stem is `fragment`;
+    // what the root does not take is passed on to the whole graphs it
+    // includes (build_on), which take it as a root would.
+    let mut overrides = overrides;
+    if root_like {
+        if let Some(site) = &site {
+            overrides.extend(site.passed_on.clone());
+        }
+    }
+    let (overrides, mut qualified, mut passed_on) = if root_like {
+        split_qualified(&parsed, overrides)
     } else {
-        (overrides, BTreeMap::new())
+        (overrides, BTreeMap::new(), BTreeMap::new())
     };
     let params = resolve_params(
         graph,
@@ -407,6 +433,7 @@ fn load_file(
             .filter(|(_, v)| matches!(v, ParamValue::Reference(_)))
             .map(|(name, _)| name.clone())
             .collect();
+        let children = graph.sources.len();
         load_file(
             graph,
             read,
@@ -416,11 +443,28 @@ fn load_file(
                 source,
                 index,
                 follows,
+                passed_on: if root_like {
+                    passed_on.clone()
+                } else {
+                    BTreeMap::new()
+                },
             }),
             stack,
         );
+        // A whole graph built on here took what was passed on (and reported
+        // what it could not take).
+        if graph
+            .sources
+            .get(children)
+            .is_some_and(|child| child.built_on)
+        {
+            passed_on.clear();
+        }
     }
     stack.pop();
+    if root_like {
+        report_not_taken(graph, source, &parsed, passed_on);
+    }
 
     for (index, resource) in parsed.resources.into_iter().enumerate() {
         graph.resources.push(Located {

@@ -9,49 +9,86 @@ use crate::spans::Seg;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Splits the root's overrides into its own and, by include file stem, those
-/// qualified as `fragment.name`; a qualifier that names no include is an error
-/// with the nearest include's name.
-#[allow(clippy::type_complexity)]
-pub(super) fn split_qualified(
-    graph: &mut LoadedGraph,
-    source: usize,
-    includes: &[crate::schema::Include],
-    overrides: BTreeMap<String, ParamValue>,
-) -> (
+/// What a root-like graph does with the `--param` values it is given:
+/// (its own, by include file stem those qualified as `fragment.name` for a
+/// fragment it includes, and the rest to pass on to a whole graph it builds
+/// on: names it does not declare, qualifiers that name no include of its).
+type SplitOverrides = (
     BTreeMap<String, ParamValue>,
     BTreeMap<String, BTreeMap<String, ParamValue>>,
-) {
-    let stems: Vec<String> = includes
-        .iter()
-        .map(|i| include_stem(Path::new(&i.file)))
-        .collect();
+    BTreeMap<String, ParamValue>,
+);
+
+/// Splits a root-like graph's overrides ([`SplitOverrides`]).
+pub(super) fn split_qualified(
+    parsed: &crate::schema::GraphFile,
+    overrides: BTreeMap<String, ParamValue>,
+) -> SplitOverrides {
+    let stems = include_stems(parsed);
     let mut own = BTreeMap::new();
     let mut qualified: BTreeMap<String, BTreeMap<String, ParamValue>> = BTreeMap::new();
+    let mut passed_on = BTreeMap::new();
     for (name, value) in overrides {
-        let Some((fragment, param)) = name.split_once('.') else {
-            own.insert(name, value);
-            continue;
-        };
-        if stems.iter().any(|s| s == fragment) {
-            qualified
-                .entry(fragment.to_string())
-                .or_default()
-                .insert(param.to_string(), value);
-        } else {
-            let (file, pos) = graph.locate(source, &[Seg::Field("include")]);
-            let graph_file = file_name(&graph.sources[source].file);
-            graph.diagnostics.push(
+        match name.split_once('.') {
+            Some((fragment, param)) if stems.iter().any(|s| s == fragment) => {
+                qualified
+                    .entry(fragment.to_string())
+                    .or_default()
+                    .insert(param.to_string(), value);
+            }
+            None if parsed.params.contains_key(&name) => {
+                own.insert(name, value);
+            }
+            _ => {
+                passed_on.insert(name, value);
+            }
+        }
+    }
+    (own, qualified, passed_on)
+}
+
+fn include_stems(parsed: &crate::schema::GraphFile) -> Vec<String> {
+    parsed
+        .include
+        .iter()
+        .map(|i| include_stem(Path::new(&i.file)))
+        .collect()
+}
+
+/// Reports the `--param` values a root-like graph passed on that no whole
+/// graph it builds on took: a name it does not declare, or a qualifier that
+/// names no fragment it includes, each with the nearest name.
+pub(super) fn report_not_taken(
+    graph: &mut LoadedGraph,
+    source: usize,
+    parsed: &crate::schema::GraphFile,
+    not_taken: BTreeMap<String, ParamValue>,
+) {
+    let graph_file = file_name(&graph.sources[source].file);
+    let stems = include_stems(parsed);
+    for name in not_taken.into_keys() {
+        let diagnostic = match name.split_once('.') {
+            Some((fragment, _)) => {
+                let (file, pos) = graph.locate(source, &[Seg::Field("include")]);
                 Diagnostic::error(
                     file,
                     pos,
                     format!("parameter \"{name}\": \"{graph_file}\" includes no fragment \"{fragment}\""),
                 )
-                .suggest(fragment, stems.iter().map(String::as_str)),
-            );
-        }
+                .suggest(fragment, stems.iter().map(String::as_str))
+            }
+            None => {
+                let (file, pos) = graph.locate(source, &[Seg::Field("params")]);
+                Diagnostic::error(
+                    file,
+                    pos,
+                    format!("unknown parameter \"{name}\" for \"{graph_file}\""),
+                )
+                .suggest(&name, parsed.params.keys().map(String::as_str))
+            }
+        };
+        graph.diagnostics.push(diagnostic);
     }
-    (own, qualified)
 }
 
 /// Applies include-site overrides to a file's declared parameters and resolves

@@ -426,6 +426,79 @@ fn fragment_parameters_are_set_by_qualified_names() {
     );
 }
 
+/// A graph built on a whole graph (hybrid.ron on deferred.ron) passes on
+/// what it does not take itself: the built-on graph's parameters by name
+/// (`exposure`), its fragments' as `fragment.name` (`gi.rays`), and
+/// `settable` lists them so; a name or qualifier neither graph knows is an
+/// error at the built-on graph, with the nearest name.
+#[test]
+fn a_graph_built_on_another_passes_its_parameters_on() {
+    use std::collections::BTreeMap;
+    use weft_graph::schema::ParamValue;
+    let path = repo_root().join("graphs/hybrid.ron");
+    let set = |pairs: &[(&str, f64)]| {
+        pairs
+            .iter()
+            .map(|(n, v)| (n.to_string(), ParamValue::Number(*v)))
+            .collect::<BTreeMap<_, _>>()
+    };
+    let graph = weft_graph::load_with_params(&path, set(&[("gi.rays", 4.0), ("exposure", 2.0)]));
+    assert!(
+        graph.diagnostics.iter().all(|d| !d.is_error()),
+        "{:?}",
+        graph.diagnostics
+    );
+    let settable = graph.settable_params();
+    for name in [
+        "exposure",
+        "gi.rays",
+        "rt_specular.max_depth",
+        "shadows.resolution",
+    ] {
+        assert!(settable.contains(name), "{name} in {settable:?}");
+    }
+    let options = CompileOptions {
+        features: graph.features(&["!denoise"]),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let param = |pass: &str, name: &str| {
+        plan.passes
+            .iter()
+            .find(|p| p.name == pass)
+            .unwrap_or_else(|| panic!("pass {pass}"))
+            .params[name]
+            .clone()
+    };
+    assert_eq!(param("gi", "rays"), ParamValue::Number(4.0));
+    assert_eq!(param("tonemap", "exposure"), ParamValue::Number(2.0));
+
+    let errors = |name: &str| {
+        weft_graph::load_with_params(&path, set(&[(name, 1.0)]))
+            .diagnostics
+            .into_iter()
+            .filter(|d| d.is_error())
+            .map(|d| (d.file.file_name().map(|f| f.to_owned()), d.message, d.hint))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        errors("exposur"),
+        [(
+            Some("deferred.ron".into()),
+            "unknown parameter \"exposur\" for \"deferred.ron\"".to_string(),
+            Some("did you mean \"exposure\"?".to_string())
+        )]
+    );
+    assert_eq!(
+        errors("gii.rays"),
+        [(
+            Some("deferred.ron".into()),
+            "parameter \"gii.rays\": \"deferred.ron\" includes no fragment \"gii\"".to_string(),
+            Some("did you mean \"gi\"?".to_string())
+        )]
+    );
+}
+
 #[test]
 fn parameter_values_are_held_to_their_declared_type_and_range() {
     use std::collections::BTreeMap;
