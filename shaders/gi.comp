@@ -18,6 +18,7 @@
 // `frames`, counted in `gi.a`) while `history_frames` says nothing changed.
 #include "include/brdf.glsl"
 #include "include/gbuffer.glsl"
+#include "include/running_mean.glsl"
 #include "include/area_light.glsl"
 #include "include/surface.glsl"
 #include "include/punctual.glsl"
@@ -78,12 +79,5 @@ void main() {
 #ifdef GI_EACH_FRAME
     frames = 1u;
 #endif
-    float kept = 0.0;
-    vec3 mean = radiance;
-    if (params.history_frames > 0u && frames > 1u) {
-        vec4 previous = imageLoad(gi, pixel);
-        kept = min(previous.a, float(frames - 1u));
-        mean = (previous.rgb * kept + radiance) / (kept + 1.0);
-    }
-    imageStore(gi, pixel, vec4(mean, kept + 1.0));
+    imageStore(gi, pixel, running_mean(imageLoad(gi, pixel), radiance, frames, params.history_frames > 0u));
 }

@@ -32,6 +32,7 @@
 // denoiser follows (RT_SPECULAR_EACH_FRAME) each frame's rays stand alone.
 #include "include/brdf.glsl"
 #include "include/gbuffer.glsl"
+#include "include/running_mean.glsl"
 #include "include/area_light.glsl"
 #include "include/surface.glsl"
 #include "include/punctual.glsl"
@@ -96,9 +97,9 @@ vec3 chain(vec3 origin, vec3 dir, uint depth, vec3 medium, inout Rng rng) {
         TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
         Material m = materials[s.material];
         vec3 wo = -dir;
-        vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
-        s.normal = mapped_normal(s, m);
-        vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
+        vec3 ng;
+        vec3 n;
+        facing_normals(s, m, dir, ng, n);
 #ifdef SCENE_EMISSIVE
         if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
             radiance += throughput * emitted_at(s.material, s.uv);
@@ -148,9 +149,9 @@ vec3 chain(vec3 origin, vec3 dir, uint depth, vec3 medium, inout Rng rng) {
 // the surface `s` (material `m`) that the camera ray along `dir` meets.
 vec3 through_traced_lobes(TraceSurface s, Material m, vec3 dir, inout Rng rng) {
     vec3 wo = -dir;
-    vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
-    s.normal = mapped_normal(s, m);
-    vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
+    vec3 ng;
+    vec3 n;
+    facing_normals(s, m, dir, ng, n);
     vec3 radiance = vec3(0.0);
     float glass = m.optics.x;
 #ifdef SCENE_DIELECTRICS
@@ -220,12 +221,5 @@ void main() {
 #ifdef RT_SPECULAR_EACH_FRAME
     frames = 1u;
 #endif
-    float kept = 0.0;
-    vec3 mean = radiance;
-    if (params.history_frames > 0u && frames > 1u) {
-        vec4 previous = imageLoad(rt_specular, pixel);
-        kept = min(previous.a, float(frames - 1u));
-        mean = (previous.rgb * kept + radiance) / (kept + 1.0);
-    }
-    imageStore(rt_specular, pixel, vec4(mean, kept + 1.0));
+    imageStore(rt_specular, pixel, running_mean(imageLoad(rt_specular, pixel), radiance, frames, params.history_frames > 0u));
 }

@@ -70,7 +70,7 @@
 // adds what it traces), raster shading leaves out what that pass traces: a
 // mirror's and a coat's highlight (delta lobes to the path tracer), glass's
 // share of the surface (optics.x), and the glossy lobes' reflection of the
-// environment (RT_GLOSSY: environment_albedo); emission, and the highlights
+// environment (environment_albedo); emission, and the highlights
 // lights draw, stay.
 #ifdef RT_SPECULAR
 vec3 highlight_colour(Material m) {
@@ -80,7 +80,6 @@ vec3 highlight_colour(Material m) {
 float opaque_share(Material m) {
     return 1.0 - m.optics.x;
 }
-#define RT_GLOSSY
 #else
 vec3 highlight_colour(Material m) {
     return m.specular.rgb;
@@ -378,7 +377,7 @@ vec3 environment_albedo(Surface s, Material m) {
     if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
         vec3 base = m.diffuse.rgb * s.texel;
         vec3 albedo = ggx_directional_albedo(base, s.metal_rough, ndv);
-#ifdef RT_GLOSSY
+#ifdef RT_SPECULAR
         albedo -= ggx_single_albedo(base, s.metal_rough, ndv);
 #endif
         return albedo * opaque_share(m);
@@ -386,7 +385,7 @@ vec3 environment_albedo(Surface s, Material m) {
 #endif
     vec3 albedo = m.diffuse.rgb * s.texel;
     float shininess = m.specular.w;
-#ifdef RT_GLOSSY
+#ifdef RT_SPECULAR
     // The lobe's reflection of the environment is traced.
     shininess = 0.0;
 #endif

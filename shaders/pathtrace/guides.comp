@@ -69,10 +69,10 @@ void main() {
         return;
     }
 #endif
-    vec3 ng = dot(s.geometric_normal, dir) > 0.0 ? -s.geometric_normal : s.geometric_normal;
-    s.normal = mapped_normal(s, m);
+    vec3 ng;
+    vec3 n;
+    facing_normals(s, m, dir, ng, n);
     Bsdf b = surface_bsdf(s, m);
-    vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
     vec3 reflectance = min(b.diffuse + b.specular, vec3(1.0));
     bool glass = m.optics.x > 0.0;
     imageStore(guide_normal, pixel, vec4(n, t));

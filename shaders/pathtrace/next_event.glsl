@@ -50,9 +50,9 @@ vec3 one_bounce(vec3 origin, vec3 dir, bool by_power, inout Rng rng) {
     TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
     Material m = materials[s.material];
     vec3 wo = -dir;
-    vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
-    s.normal = mapped_normal(s, m);
-    vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
+    vec3 ng;
+    vec3 n;
+    facing_normals(s, m, dir, ng, n);
     Bsdf b = surface_bsdf(s, m);
     vec3 from = leave(s.position, ng);
     vec3 radiance = next_event(s.position, n, ng, wo, b, from, by_power, rng);

@@ -16,6 +16,16 @@ vec3 mapped_normal(TraceSurface s, Material m) {
     return s.normal;
 }
 
+// The normals of `s` as a ray travelling along `dir` meets it: `ng` the
+// geometric normal turned to the side the ray comes from, and `n` the
+// shading normal bent by `m`'s normal map (which `s.normal` becomes) turned
+// to that side too.
+void facing_normals(inout TraceSurface s, Material m, vec3 dir, out vec3 ng, out vec3 n) {
+    ng = dot(s.geometric_normal, -dir) < 0.0 ? -s.geometric_normal : s.geometric_normal;
+    s.normal = mapped_normal(s, m);
+    n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
+}
+
 // `m`'s BSDF at `s`, its base colour and metallic-roughness textures read.
 Bsdf surface_bsdf(TraceSurface s, Material m) {
 #ifdef SCENE_TEXTURES

@@ -191,9 +191,9 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         TraceSurface s = trace_surface(tri, origin, dir, t);
         Material m = materials[s.material];
         vec3 wo = -dir;
-        vec3 ng = dot(s.geometric_normal, wo) < 0.0 ? -s.geometric_normal : s.geometric_normal;
-        s.normal = mapped_normal(s, m);
-        vec3 n = dot(s.normal, ng) < 0.0 ? -s.normal : s.normal;
+        vec3 ng;
+        vec3 n;
+        facing_normals(s, m, dir, ng, n);
 #ifdef SCENE_EMISSIVE
         if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
             float cos_light = dot(s.geometric_normal, wo);

@@ -110,6 +110,15 @@ pub struct TraceMesh {
     pub tangents: Vec<[Vec4; 3]>,
 }
 
+/// Widens `changed` to cover `ids` as well: the one range of draw records to
+/// write.
+fn widen(changed: &mut Option<std::ops::Range<u32>>, ids: std::ops::Range<u32>) {
+    *changed = Some(match changed.take() {
+        Some(c) => c.start.min(ids.start)..c.end.max(ids.end),
+        None => ids,
+    });
+}
+
 /// The flattened scene, ready to upload.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SceneGeometry {
@@ -277,7 +286,8 @@ impl SceneGeometry {
     /// Moves every scene instance whose transform in `transforms` differs
     /// from the one in `placed` (which is updated to match): its draw records
     /// (with where it was, `previous`) and their world boxes; an instance
-    /// still again after moving has its records' `previous` reset. Pushes the moved draws' world boxes, before and
+    /// still again after moving has its records' `previous` reset, and moves
+    /// no box. Pushes the moved draws' world boxes, before and
     /// after, onto `moved`, and returns the draw ids rewritten as one range
     /// (`None` when nothing moved), the span of the draw buffer to write.
     pub fn place_instances(
@@ -302,10 +312,7 @@ impl SceneGeometry {
                     for id in ids.clone() {
                         self.draw_records[id as usize].previous = Mat4::IDENTITY;
                     }
-                    changed = Some(match changed {
-                        Some(c) => c.start.min(ids.start)..c.end.max(ids.end),
-                        None => ids,
-                    });
+                    widen(&mut changed, ids);
                 }
                 continue;
             }
@@ -326,10 +333,7 @@ impl SceneGeometry {
             }
             moved.extend(self.boxes(ids.clone()));
             if !ids.is_empty() {
-                changed = Some(match changed {
-                    Some(c) => c.start.min(ids.start)..c.end.max(ids.end),
-                    None => ids,
-                });
+                widen(&mut changed, ids);
             }
         }
         changed

@@ -308,15 +308,16 @@ fn load_file(
     // The root, and a whole graph another root-like graph builds on, take
     // `--param` values as the root does: their own by name, their includes'
     // as `stem.name`.
-    let root_like = site.as_ref().is_none_or(|s| {
-        !parsed.fragment && graph.sources[s.source].qualifier.as_deref() == Some("")
-    });
-    let qualifier = match &site {
-        _ if root_like => Some(String::new()),
-        Some(s) if graph.sources[s.source].qualifier.as_deref() == Some("") => {
-            Some(include_stem(path))
-        }
-        _ => None,
+    let includer_root_like = site
+        .as_ref()
+        .is_some_and(|s| graph.sources[s.source].qualifier.as_deref() == Some(""));
+    let root_like = site.is_none() || (includer_root_like && !parsed.fragment);
+    let qualifier = if root_like {
+        Some(String::new())
+    } else if includer_root_like {
+        Some(include_stem(path))
+    } else {
+        None
     };
     graph.sources.push(Source {
         file: path.to_path_buf(),

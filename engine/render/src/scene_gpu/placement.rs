@@ -9,7 +9,9 @@ use weft_gpu::GpuError;
 impl GpuScene<'_> {
     /// Moves the placements the script moved: their draw records rewritten
     /// in place as one range, the scene's box refitted (unless declared),
-    /// and the ray tracer's triangles and BVH rebuilt if a pass traces.
+    /// and the ray tracer's triangles and BVH rebuilt if a pass traces. A
+    /// placement still again after moving only has its records rewritten
+    /// (their `previous`): no geometry moved.
     pub(super) fn place_instances(&mut self, transforms: &[glam::Mat4]) -> Result<(), GpuError> {
         self.moved_boxes.clear();
         let Some(ids) =
@@ -18,6 +20,13 @@ impl GpuScene<'_> {
         else {
             return Ok(());
         };
+        self.draws.write_at(
+            ids.start as usize * std::mem::size_of::<crate::gpu_types::GpuDraw>(),
+            bytes_of(&self.geometry.draw_records[ids.start as usize..ids.end as usize]),
+        )?;
+        if self.moved_boxes.is_empty() {
+            return Ok(());
+        }
         self.moved = true;
         if !self.emitter_lights.polygons.is_empty() {
             // The light buffer was sized for the polygons at load: a moved
@@ -27,11 +36,6 @@ impl GpuScene<'_> {
                 self.emitter_lights = moved;
             }
         }
-        let records = &self.geometry.draw_records[ids.start as usize..ids.end as usize];
-        self.draws.write_at(
-            ids.start as usize * std::mem::size_of::<crate::gpu_types::GpuDraw>(),
-            bytes_of(records),
-        )?;
         if self.declared_bounds.is_none() {
             self.bounds = self.geometry.placed_bounds();
         }
