@@ -191,8 +191,11 @@ pub struct PlanPass {
     /// Shader files, resolved relative to the graph file that declared the pass.
     pub shaders: ShaderFiles,
     pub draw: Option<Draw>,
-    /// Work groups for compute passes.
+    /// Work groups for compute passes dispatched with counts known now.
     pub dispatch: Option<[u32; 3]>,
+    /// Where a compute pass dispatched indirectly reads its group counts.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub indirect: Option<IndirectDispatch>,
     /// Dispatches in a row each frame (1 unless the pass declares `repeat`).
     #[serde(skip_serializing_if = "once")]
     pub repeat: u32,
@@ -226,6 +229,14 @@ pub struct PlanPass {
     /// resolved (checked against the registry by `check_providers`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub derive: Vec<ProviderDecl>,
+}
+
+/// An indirect dispatch's source: the `k`-th dispatch of the pass reads the
+/// three u32 group counts at byte `k × stride` of `buffer`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct IndirectDispatch {
+    pub buffer: ResourceId,
+    pub stride: u32,
 }
 
 /// Whether a pass runs once per frame (serialized plans leave `repeat: 1` out).

@@ -103,6 +103,13 @@ pub fn render(plan: &Plan) -> String {
         if let Some(d) = p.dispatch {
             let _ = writeln!(w, "     dispatch {}x{}x{}", d[0], d[1], d[2]);
         }
+        if let Some(d) = p.indirect {
+            let _ = writeln!(
+                w,
+                "     dispatch indirect from {}, a record each {} bytes",
+                plan.resources[d.buffer].name, d.stride
+            );
+        }
         if p.repeat > 1 {
             let _ = writeln!(w, "     repeat {} times, between them:", p.repeat);
             for b in &p.repeat_barriers {

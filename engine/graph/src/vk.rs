@@ -30,6 +30,7 @@ bitflags! {
     /// `VkAccessFlags2`: what kind of memory access happens.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
     pub struct Access: u64 {
+        const INDIRECT_COMMAND_READ = 0x1;
         const UNIFORM_READ = 0x8;
         const SHADER_READ = 0x20;
         const SHADER_WRITE = 0x40;
@@ -80,6 +81,7 @@ bitflags! {
         const TRANSFER_DST = 0x2;
         const UNIFORM = 0x10;
         const STORAGE = 0x20;
+        const INDIRECT = 0x100;
     }
 }
 

@@ -247,6 +247,7 @@ mod tests {
             shaders: Default::default(),
             draw: None,
             dispatch: None,
+            indirect: None,
             repeat: 1,
             repeat_barriers: Vec::new(),
             params: BTreeMap::new(),

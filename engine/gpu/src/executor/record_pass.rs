@@ -13,6 +13,7 @@ use crate::sets::SCENE_SET;
 use ash::vk;
 use weft_graph::id::PassId;
 use weft_graph::plan::{Plan, PlanPass};
+use weft_graph::resolve::INDIRECT_RECORD_BYTES;
 use weft_graph::schema::PassKind;
 
 impl<'g> Renderer<'g> {
@@ -40,10 +41,7 @@ impl<'g> Renderer<'g> {
             PassKind::Copy => record::transfer(self.gpu, cmd, plan, pass, resources, false),
             PassKind::Blit => record::transfer(self.gpu, cmd, plan, pass, resources, true),
             PassKind::Compute => {
-                let dispatch = pass.dispatch.ok_or_else(|| GpuError::Pass {
-                    pass: pass.name.clone(),
-                    message: "compute pass without a dispatch size".into(),
-                })?;
+                let dispatch = dispatch_source(pass, resources)?;
                 self.bind(cmd, prep);
                 // A compute pass that reads scene data (tiled light culling reads the
                 // camera and the lights) gets set 1 from the draw recorder, as a
@@ -152,7 +150,7 @@ impl<'g> Renderer<'g> {
         pass: &PlanPass,
         prep: &Prepared,
         (resources, options): (&FrameResources<'g>, &FrameOptions),
-        groups: [u32; 3],
+        groups: DispatchSource,
     ) -> Result<(), GpuError> {
         let device = self.gpu.device();
         for repeat_index in 0..pass.repeat.max(1) {
@@ -168,7 +166,12 @@ impl<'g> Renderer<'g> {
                     unsafe { device.cmd_push_constants(cmd, p.layout, *stages, 0, &push) };
                 }
             }
-            unsafe { device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+            match groups {
+                DispatchSource::Groups([x, y, z]) => unsafe { device.cmd_dispatch(cmd, x, y, z) },
+                DispatchSource::Indirect(buffer, stride) => unsafe {
+                    device.cmd_dispatch_indirect(cmd, buffer, u64::from(repeat_index * stride))
+                },
+            }
         }
         Ok(())
     }
@@ -187,5 +190,43 @@ impl<'g> Renderer<'g> {
                 device.cmd_push_constants(cmd, p.layout, *stages, 0, &prep.push);
             }
         }
+    }
+}
+
+/// Where a compute pass's work-group counts come from.
+#[derive(Clone, Copy)]
+enum DispatchSource {
+    /// Known when the plan was compiled.
+    Groups([u32; 3]),
+    /// Read by the GPU from a buffer: the `k`-th dispatch at byte `k × stride`.
+    Indirect(vk::Buffer, u32),
+}
+
+/// A compute pass's dispatch, with an indirect one's every record checked to
+/// lie inside its buffer (Vulkan leaves reading past the end undefined).
+fn dispatch_source(
+    pass: &PlanPass,
+    resources: &FrameResources,
+) -> Result<DispatchSource, GpuError> {
+    let fail = |message: String| GpuError::Pass {
+        pass: pass.name.clone(),
+        message,
+    };
+    match (pass.dispatch, pass.indirect) {
+        (Some(groups), _) => Ok(DispatchSource::Groups(groups)),
+        (None, Some(indirect)) => {
+            let buffer = resources.buffer(indirect.buffer)?;
+            let end = u64::from(pass.repeat.max(1) - 1) * u64::from(indirect.stride)
+                + u64::from(INDIRECT_RECORD_BYTES);
+            if end > buffer.desc.size {
+                return Err(fail(format!(
+                    "its {} indirect dispatch(es) read up to byte {end} of a {}-byte buffer",
+                    pass.repeat.max(1),
+                    buffer.desc.size
+                )));
+            }
+            Ok(DispatchSource::Indirect(buffer.buffer, indirect.stride))
+        }
+        (None, None) => Err(fail("compute pass without a dispatch size".into())),
     }
 }

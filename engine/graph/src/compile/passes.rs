@@ -10,8 +10,8 @@ use super::CompileOptions;
 use crate::id::{IdVec, IrPassId, PassId, ResourceId};
 use crate::load::LoadedGraph;
 use crate::plan::{
-    AttachmentDesc, Barrier, Binding, BindingKind, LoadOp, Location, PlanPass, PlanResource,
-    RenderPassDesc, ResourceDesc, StoreOp,
+    AttachmentDesc, Barrier, Binding, BindingKind, IndirectDispatch, LoadOp, Location, PlanPass,
+    PlanResource, RenderPassDesc, ResourceDesc, StoreOp,
 };
 use crate::resolve::{image_extent, Ir, IrDispatch, Usage};
 use crate::schema::{LoadDecl, PassKind, StoreDecl};
@@ -195,17 +195,25 @@ fn plan_pass(
             depth,
         }
     });
-    let dispatch = pass.dispatch.map(|d| match d {
-        IrDispatch::Groups(x, y, z) => [x, y, z],
-        IrDispatch::Output(x, y) => [
+    let dispatch = pass.dispatch.and_then(|d| match d {
+        IrDispatch::Groups(x, y, z) => Some([x, y, z]),
+        IrDispatch::Output(x, y) => Some([
             options.extent.width.div_ceil(x.max(1)),
             options.extent.height.div_ceil(y.max(1)),
             1,
-        ],
+        ]),
         IrDispatch::Image(r, x, y) => {
             let e = image_extent(ir, r, options.extent).unwrap_or(options.extent);
-            [e.width.div_ceil(x.max(1)), e.height.div_ceil(y.max(1)), 1]
+            Some([e.width.div_ceil(x.max(1)), e.height.div_ceil(y.max(1)), 1])
         }
+        IrDispatch::Indirect(..) => None,
+    });
+    let indirect = pass.dispatch.and_then(|d| match d {
+        IrDispatch::Indirect(r, stride) => Some(IndirectDispatch {
+            buffer: lifetimes.plan_index(r),
+            stride,
+        }),
+        _ => None,
     });
     let transfer = if matches!(pass.kind, PassKind::Copy | PassKind::Blit) {
         let find = |want: fn(&Usage) -> bool| {
@@ -233,6 +241,7 @@ fn plan_pass(
         shaders: pass.shaders.clone(),
         draw: pass.draw.clone(),
         dispatch,
+        indirect,
         repeat: pass.repeat,
         repeat_barriers,
         params: pass.params.clone(),

@@ -71,6 +71,8 @@ pub(crate) fn describe(
                         Usage::Depth { .. } => ImageUsage::DEPTH_STENCIL_ATTACHMENT,
                         Usage::TransferSrc => ImageUsage::TRANSFER_SRC,
                         Usage::TransferDst => ImageUsage::TRANSFER_DST,
+                        // Refused by validation: images hold no dispatch records.
+                        Usage::IndirectRead => ImageUsage::empty(),
                     };
                 }
                 if residency == Residency::Output {
@@ -108,6 +110,7 @@ pub(crate) fn describe(
                         Usage::Sampled => BufferUsage::UNIFORM,
                         Usage::TransferSrc => BufferUsage::TRANSFER_SRC,
                         Usage::TransferDst => BufferUsage::TRANSFER_DST,
+                        Usage::IndirectRead => BufferUsage::INDIRECT,
                         _ => BufferUsage::STORAGE,
                     };
                 }

@@ -362,6 +362,11 @@ fn gpu_access(ir: &Ir, pass: IrPassId, u: &PassUse) -> GpuAccess {
                 Access::TRANSFER_WRITE,
                 Layout::TransferDstOptimal,
             ),
+            Usage::IndirectRead => (
+                Stage::DRAW_INDIRECT,
+                Access::INDIRECT_COMMAND_READ,
+                Layout::General,
+            ),
         };
         stage |= s;
         access |= acc;
@@ -391,6 +396,7 @@ mod tests {
     use super::super::fixture::CHAIN;
     use super::super::tests::plan_of;
     use super::*;
+    use crate::vk::BufferUsage;
 
     #[test]
     fn a_sampled_attachment_gets_one_barrier_and_the_output_an_epilogue() {
@@ -477,5 +483,125 @@ mod tests {
         let once = plan_of(&repeating("1"), &[]);
         assert_eq!(once.passes[PassId::new(0)].repeat, 1);
         assert!(once.passes[PassId::new(0)].repeat_barriers.is_empty());
+    }
+
+    /// `count` writes the group counts `work` dispatches by, three times, and
+    /// `work` rewrites them between its dispatches; `again` only dispatches
+    /// by them.
+    const INDIRECT: &str = r#"Graph(
+        output: "out",
+        resources: [
+            Buffer(name: "counts", size: "48"),
+            Image(name: "out", format: R32G32B32A32_SFLOAT),
+        ],
+        passes: [
+            Pass(name: "count", kind: Compute, shaders: (compute: "c.comp"),
+                 storage_write: ["counts"], dispatch: Groups(1, 1, 1)),
+            Pass(name: "work", kind: Compute, shaders: (compute: "w.comp"),
+                 storage_read: ["counts"], storage_write: ["counts", "out"],
+                 dispatch: Indirect("counts", 16), repeat: 3, after: ["count"]),
+            Pass(name: "again", kind: Compute, shaders: (compute: "a.comp"),
+                 storage_read: ["out"], storage_write: ["out"],
+                 dispatch: Indirect("counts", 16), after: ["work"]),
+        ],
+    )"#;
+
+    #[test]
+    fn an_indirect_dispatch_waits_for_its_counts_as_indirect_command_reads() {
+        let plan = plan_of(INDIRECT, &[]);
+        let counts = plan.resource("counts").expect("counts");
+        let work = &plan.passes[PassId::new(1)];
+        assert_eq!(work.dispatch, None);
+        assert_eq!(
+            work.indirect,
+            Some(crate::plan::IndirectDispatch {
+                buffer: counts,
+                stride: 16
+            })
+        );
+        let dst_stage = Stage::COMPUTE_SHADER | Stage::DRAW_INDIRECT;
+        let dst_access = Access::SHADER_STORAGE_READ
+            | Access::SHADER_STORAGE_WRITE
+            | Access::INDIRECT_COMMAND_READ;
+        let before = work
+            .barriers
+            .iter()
+            .find(|b| b.resource == counts)
+            .expect("a barrier on counts");
+        assert_eq!(
+            (before.src_stage, before.src_access),
+            (Stage::COMPUTE_SHADER, Access::SHADER_STORAGE_WRITE)
+        );
+        assert_eq!(
+            (before.dst_stage, before.dst_access),
+            (dst_stage, dst_access)
+        );
+        let between = work
+            .repeat_barriers
+            .iter()
+            .find(|b| b.resource == counts)
+            .expect("a repeat barrier on counts");
+        assert_eq!(
+            (between.dst_stage, between.dst_access),
+            (dst_stage, dst_access)
+        );
+        match &plan.resources[counts].desc {
+            ResourceDesc::Buffer(b) => {
+                assert_eq!(b.usage, BufferUsage::STORAGE | BufferUsage::INDIRECT)
+            }
+            other => panic!("counts is {other:?}"),
+        }
+        // The dispatch's read of the counts binds nothing: only storage
+        // accesses do.
+        let again = &plan.passes[PassId::new(2)];
+        assert!(again.bindings.iter().all(|b| b.resource != counts));
+        let before_again = again
+            .barriers
+            .iter()
+            .find(|b| b.resource == counts)
+            .expect("a barrier on counts before again");
+        assert_eq!(
+            (before_again.dst_stage, before_again.dst_access),
+            (Stage::DRAW_INDIRECT, Access::INDIRECT_COMMAND_READ)
+        );
+    }
+
+    /// A pass that reads and writes a buffer in one scope, then a pass that
+    /// reads it in that scope: the write must still be made visible (the
+    /// walk once took the writer's own scope as covering its write).
+    #[test]
+    fn a_read_after_a_read_write_in_the_same_scope_waits_for_the_write() {
+        let plan = plan_of(
+            r#"Graph(
+            output: "out",
+            resources: [
+                Buffer(name: "buf", size: "64"),
+                Image(name: "out", format: R32G32B32A32_SFLOAT),
+            ],
+            passes: [
+                Pass(name: "clear", kind: Compute, shaders: (compute: "c.comp"),
+                     storage_write: ["buf"], dispatch: Groups(1, 1, 1)),
+                Pass(name: "update", kind: Compute, shaders: (compute: "u.comp"),
+                     storage_read: ["buf"], storage_write: ["buf"], dispatch: Groups(1, 1, 1),
+                     after: ["clear"]),
+                Pass(name: "use", kind: Compute, shaders: (compute: "r.comp"),
+                     storage_read: ["buf"], storage_write: ["out"], dispatch: Output(8, 8)),
+            ],
+        )"#,
+            &[],
+        );
+        let buf = plan.resource("buf").expect("buf");
+        let before_use = &plan.passes[PassId::new(2)].barriers;
+        assert_eq!(
+            before_use.iter().find(|b| b.resource == buf),
+            Some(&Barrier {
+                resource: buf,
+                src_stage: Stage::COMPUTE_SHADER,
+                src_access: Access::SHADER_STORAGE_WRITE,
+                dst_stage: Stage::COMPUTE_SHADER,
+                dst_access: Access::SHADER_STORAGE_READ,
+                layouts: None,
+            })
+        );
     }
 }

@@ -112,6 +112,8 @@ pub enum IrDispatch {
     Output(u32, u32),
     Image(IrResourceId, u32, u32),
     Groups(u32, u32, u32),
+    /// A buffer and the bytes between the records of successive dispatches.
+    Indirect(IrResourceId, u32),
 }
 
 impl IrPass {
@@ -174,13 +176,15 @@ pub enum Usage {
     },
     TransferSrc,
     TransferDst,
+    /// Work-group counts an indirect dispatch reads.
+    IndirectRead,
 }
 
 impl Usage {
     /// Whether the access needs what earlier passes left in the resource.
     pub fn reads_previous(&self) -> bool {
         match self {
-            Usage::Sampled | Usage::StorageRead | Usage::TransferSrc => true,
+            Usage::Sampled | Usage::StorageRead | Usage::TransferSrc | Usage::IndirectRead => true,
             Usage::Color { load, .. } => *load == LoadDecl::Load,
             Usage::Depth {
                 load, read_only, ..
@@ -192,7 +196,7 @@ impl Usage {
     /// Whether the access changes the resource.
     pub fn writes(&self) -> bool {
         match self {
-            Usage::Sampled | Usage::StorageRead | Usage::TransferSrc => false,
+            Usage::Sampled | Usage::StorageRead | Usage::TransferSrc | Usage::IndirectRead => false,
             Usage::Depth { read_only, .. } => !read_only,
             Usage::Color { .. } | Usage::StorageWrite | Usage::TransferDst => true,
         }

@@ -1,8 +1,8 @@
 //! Resolving pass declarations: accesses, shaders, dispatch and fixed-function state.
 
 use super::{
-    pass_path, IrAccess, IrDispatch, IrPass, IrResource, Resolver, Usage, MAX_REPEAT,
-    MAX_WORKGROUP_COUNT,
+    pass_path, IrAccess, IrDispatch, IrPass, IrResource, Resolver, Usage, INDIRECT_RECORD_BYTES,
+    MAX_REPEAT, MAX_WORKGROUP_COUNT,
 };
 use crate::id::{IdVec, IrResourceId};
 use crate::load::Located;
@@ -225,6 +225,20 @@ impl Resolver<'_> {
             Some(Dispatch::Image(name, x, y)) => self
                 .lookup(source, &pass_path(index, &[Seg::Field("dispatch")]), name)
                 .map(|r| IrDispatch::Image(r, *x, *y)),
+            Some(Dispatch::Indirect(name, stride)) => self
+                .lookup(source, &pass_path(index, &[Seg::Field("dispatch")]), name)
+                .map(|r| {
+                    // The dispatch itself reads the buffer, so it is ordered
+                    // and synchronized after whatever wrote the counts.
+                    accesses.push(IrAccess {
+                        resource: r,
+                        usage: Usage::IndirectRead,
+                        conditions: Vec::new(),
+                        field: "dispatch",
+                        item: None,
+                    });
+                    IrDispatch::Indirect(r, *stride)
+                }),
         };
         let repeat = match &decl.repeat {
             None => 1,
@@ -447,6 +461,19 @@ impl Resolver<'_> {
             }
             Some(Dispatch::Groups(x, y, z)) => {
                 (vec![*x, *y, *z], "group counts", MAX_WORKGROUP_COUNT)
+            }
+            Some(Dispatch::Indirect(_, stride)) => {
+                if *stride < INDIRECT_RECORD_BYTES || stride % 4 != 0 {
+                    self.error(
+                        source,
+                        &at,
+                        format!(
+                            "an indirect dispatch's stride must be a multiple of 4 of at least \
+                             {INDIRECT_RECORD_BYTES} bytes (three u32 group counts), found {stride}"
+                        ),
+                    );
+                }
+                return;
             }
         };
         if let Some(bad) = values.iter().find(|v| !(1..=max).contains(*v)) {

@@ -217,6 +217,14 @@ impl Resolver<'_> {
                     IrKind::Image {
                         format, samples, ..
                     } => {
+                        if access.usage == Usage::IndirectRead {
+                            self.error(
+                                source,
+                                &path,
+                                format!("an indirect dispatch reads its group counts from a buffer; \"{rname}\" is an image"),
+                            );
+                            continue;
+                        }
                         let (needed, what): (FormatFeatures, &str) = match &access.usage {
                             Usage::Sampled => (FormatFeatures::SAMPLED, "sampled"),
                             Usage::StorageRead | Usage::StorageWrite => {
@@ -232,7 +240,7 @@ impl Resolver<'_> {
                             Usage::Depth { .. } => {
                                 (FormatFeatures::DEPTH_ATTACHMENT, "a depth attachment")
                             }
-                            Usage::TransferSrc | Usage::TransferDst => {
+                            Usage::TransferSrc | Usage::TransferDst | Usage::IndirectRead => {
                                 (FormatFeatures::empty(), "")
                             }
                         };
@@ -359,6 +367,14 @@ fn compatible_in_one_pass(a: &Usage, b: &Usage) -> bool {
             | (Usage::StorageRead, Usage::StorageWrite)
             | (Usage::StorageWrite, Usage::StorageRead)
             | (
+                Usage::IndirectRead,
+                Usage::StorageRead | Usage::StorageWrite
+            )
+            | (
+                Usage::StorageRead | Usage::StorageWrite,
+                Usage::IndirectRead
+            )
+            | (
                 Usage::Depth {
                     read_only: true,
                     ..
@@ -388,5 +404,6 @@ pub fn usage_name(u: &Usage) -> &'static str {
         Usage::Depth { .. } => "a depth attachment",
         Usage::TransferSrc => "a transfer source",
         Usage::TransferDst => "a transfer destination",
+        Usage::IndirectRead => "an indirect dispatch's group counts",
     }
 }

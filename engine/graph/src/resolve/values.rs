@@ -115,6 +115,10 @@ impl Resolver<'_> {
 /// (`maxComputeWorkGroupCount`'s required minimum).
 pub const MAX_WORKGROUP_COUNT: u32 = 65_535;
 
+/// Bytes of one indirect dispatch's record (`VkDispatchIndirectCommand`:
+/// three u32 group counts).
+pub const INDIRECT_RECORD_BYTES: u32 = 12;
+
 /// The most samples per pixel a progressive graph may add in one frame: more
 /// would make a single frame run for seconds even on a fast GPU.
 pub const MAX_SAMPLES_PER_FRAME: u32 = 4096;

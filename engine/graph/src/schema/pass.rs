@@ -359,4 +359,10 @@ pub enum Dispatch {
     Image(String, u32, u32),
     /// A fixed number of work groups.
     Groups(u32, u32, u32),
+    /// Work-group counts the GPU reads from the named buffer when the
+    /// dispatch runs (`vkCmdDispatchIndirect`): three u32 at byte
+    /// `repeat_index × stride`, so each dispatch of a repeating pass reads its
+    /// own record, one that earlier passes or dispatches wrote (a queue's
+    /// length that only the GPU knows).
+    Indirect(String, u32),
 }

@@ -81,8 +81,8 @@ fn plans_match_snapshots_and_pass_the_checker() {
         }
     }
     assert_eq!(
-        compared, 18,
-        "forward, deferred, tiled, hybrid, pathtrace and pathtrace_denoised, three feature sets each"
+        compared, 21,
+        "forward, deferred, tiled, hybrid, pathtrace, pathtrace_denoised and pathtrace_wavefront, three feature sets each"
     );
 }
 

@@ -114,13 +114,18 @@ impl ResourceState {
                 layouts: self.image.then_some((old, a.layout)),
             });
             if a.writes() {
+                // This write is visible to no one yet, the writer's own
+                // scope included: a later pass reading in that same scope
+                // still needs a barrier.
                 self.write = Some((a.stage, a.access & Access::WRITES));
                 self.reads = Stage::empty();
+                self.visible = Vec::new();
             } else {
+                // A layout transition: the barrier made it visible to `scope`.
                 self.write = Some((scope_stage, Access::empty()));
                 self.reads = a.stage;
+                self.visible = vec![(scope_stage, scope_access)];
             }
-            self.visible = vec![(scope_stage, scope_access)];
             self.layout = a.layout;
             barrier
         } else {

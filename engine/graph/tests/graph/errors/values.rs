@@ -24,7 +24,7 @@ const COMPUTE: &str = r#"Graph(
 /// gives them: each case is (base graph, edit, message, text at the location).
 #[test]
 fn out_of_range_values_are_located_errors() {
-    let cases: [(&str, (&str, &str), &str, &str); 22] = [
+    let cases: [(&str, (&str, &str), &str, &str); 24] = [
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([2.0])"#),
             "a depth clear must be in [0, 1], found 2", "Clear([2.0])"),
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([NaN])"#),
@@ -71,6 +71,10 @@ fn out_of_range_values_are_located_errors() {
             "work-group sizes must be at least 1, found 0", "Output(0, 16)"),
         (COMPUTE, ("Output(8, 8)", "Groups(1, 70000, 1)"),
             "group counts must be from 1 to 65535, found 70000", "Groups("),
+        (COMPUTE, ("Output(8, 8)", r#"Indirect("img", 10)"#),
+            "an indirect dispatch's stride must be a multiple of 4 of at least 12 bytes (three u32 group counts), found 10", "Indirect("),
+        (COMPUTE, ("Output(8, 8)", r#"Indirect("img", 16)"#),
+            "an indirect dispatch reads its group counts from a buffer; \"img\" is an image", "Indirect("),
     ];
     for (base, (from, to), message, at) in cases {
         assert!(base.contains(from), "{from}");
