@@ -351,16 +351,9 @@ fn cuboid(min: [f32; 3], max: [f32; 3], material: &str) -> String {
     text
 }
 
-/// Beer–Lambert: a glass slab 1 unit thick (index 1.5, σ = 0.5 per unit,
-/// set by the `.scene` model's `absorption`) seen head-on in the white
-/// furnace. The light leaving it towards the camera is the furnace's
-/// radiance times R_total + T_total, the sums over every number of internal
-/// reflections: with R = ((n - 1)/(n + 1))^2 and τ = exp(-σd),
-/// T_total = (1 - R)^2 τ / (1 - R^2 τ^2) and
-/// R_total = R + (1 - R)^2 R τ^2 / (1 - R^2 τ^2). The centre 8 x 8 pixels
-/// (at most 1.3 degrees off the normal) must average within 0.5% of it.
-#[test]
-fn a_glass_slab_absorbs_as_beer_and_fresnel_say() {
+/// A glass slab of index 1.5 and `absorption 0.5` (σ = 0.5 per unit, 1 unit
+/// thick) seen head-on inside a white furnace of radiance 1.
+pub(super) fn absorbing_slab_scene() -> PathBuf {
     let dir = temp_dir("slab");
     let mut base = 0;
     std::fs::write(
@@ -391,6 +384,20 @@ fn a_glass_slab_absorbs_as_beer_and_fresnel_say() {
          camera\n{\n\tposition 0 0 4\n\ttarget 0 0 0\n\tfov_deg 10\n}\n",
     )
     .expect("scene");
+    scene
+}
+
+/// Beer–Lambert: a glass slab 1 unit thick (index 1.5, σ = 0.5 per unit,
+/// set by the `.scene` model's `absorption`) seen head-on in the white
+/// furnace. The light leaving it towards the camera is the furnace's
+/// radiance times R_total + T_total, the sums over every number of internal
+/// reflections: with R = ((n - 1)/(n + 1))^2 and τ = exp(-σd),
+/// T_total = (1 - R)^2 τ / (1 - R^2 τ^2) and
+/// R_total = R + (1 - R)^2 R τ^2 / (1 - R^2 τ^2). The centre 8 x 8 pixels
+/// (at most 1.3 degrees off the normal) must average within 0.5% of it.
+#[test]
+fn a_glass_slab_absorbs_as_beer_and_fresnel_say() {
+    let scene = absorbing_slab_scene();
     let image = render_hdr(
         &scene,
         "pathtrace.ron",

@@ -30,6 +30,7 @@ use weft_render::RenderSettings;
 
 mod caustics;
 mod glass;
+mod wavefront;
 
 /// Linear RGB per pixel, row by row.
 struct Hdr {

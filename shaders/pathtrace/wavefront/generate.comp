@@ -1,0 +1,45 @@
+#version 450
+// The wavefront path tracer's first pass (graphs/path_tracer_wavefront.ron):
+// a camera ray per pixel, through the same jittered position the megakernel
+// (trace.comp) takes, into the first half of the path queue in pixel order;
+// segment 1's record counts them all and every later record starts empty.
+#include "../../include/scene.glsl"
+#include "../random.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(push_constant) uniform Params {
+    uint max_depth;
+    uint seed;
+    uint history_frames;
+    uvec2 extent;
+} params;
+
+#include "../path_state.glsl"
+#include "queue.glsl"
+
+void main() {
+    uvec2 size = params.extent;
+    if (gl_GlobalInvocationID.xy == uvec2(0u)) {
+        uint all_paths = size.x * size.y;
+        counts[0] = uvec4((all_paths + WAVE_GROUP - 1u) / WAVE_GROUP, 1u, 1u, all_paths);
+        for (uint k = 1u; k < params.max_depth; ++k) {
+            counts[k] = uvec4(0u, 1u, 1u, 0u);
+        }
+    }
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(pixel, size))) {
+        return;
+    }
+    // As trace.comp numbers the reference's samples, one a frame.
+    uint sample_index = params.history_frames;
+    Rng rng = rng_start(pixel, sample_index, params.seed);
+    vec2 jitter = rng_next(rng).xy;
+    vec3 eye = frame.camera_position.xyz;
+    vec2 ndc = (vec2(pixel) + jitter) / vec2(size) * 2.0 - 1.0;
+    vec4 on_near = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+    vec3 dir = normalize(on_near.xyz / on_near.w - eye);
+    Path p = path_start(eye, dir);
+    uint index = pixel.y * size.x + pixel.x;
+    paths[index] = queued(p, index, rng);
+}
