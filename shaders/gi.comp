@@ -68,7 +68,7 @@ void main() {
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
-        sum += one_bounce(origin + dir * step, dir, params.light_choice != 0u, rng);
+        sum += one_bounce(origin + dir * step, dir, params.light_choice, rng);
     }
     vec3 radiance = sum / float(max(params.rays, 1u));
     // A running mean over the last frames, its count capped at `frames`;

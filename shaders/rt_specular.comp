@@ -76,7 +76,7 @@ bool traced(Material m) {
 vec3 chain(vec3 origin, vec3 dir, uint depth, vec3 medium, inout Rng rng) {
     vec3 radiance = vec3(0.0);
     vec3 throughput = vec3(1.0);
-    bool by_power = params.light_choice != 0u;
+    uint choice = params.light_choice;
     for (; depth <= params.max_depth; ++depth) {
         if (all(equal(throughput, vec3(0.0)))) {
             break;
@@ -86,7 +86,7 @@ vec3 chain(vec3 origin, vec3 dir, uint depth, vec3 medium, inout Rng rng) {
         int area = hit_area_light(origin, dir, t);
         if (area >= 0) {
             float light_pdf;
-            radiance += throughput * area_emitted(uint(area), dir, t, by_power, light_pdf);
+            radiance += throughput * area_emitted(uint(area), origin, dir, t, choice, light_pdf);
             break;
         }
         if (found.x < 0.0) {
@@ -123,7 +123,7 @@ vec3 chain(vec3 origin, vec3 dir, uint depth, vec3 medium, inout Rng rng) {
         // light by next-event estimation, and the sky along the sampled ray.
         Bsdf b = surface_bsdf(s, m);
         vec3 from = leave(s.position, ng);
-        radiance += throughput * next_event(s.position, n, ng, wo, b, from, by_power, rng);
+        radiance += throughput * next_event(s.position, n, ng, wo, b, from, choice, rng);
         vec3 wi;
         vec3 weight;
         float pdf;
@@ -186,7 +186,7 @@ vec3 through_traced_lobes(TraceSurface s, Material m, vec3 dir, inout Rng rng) {
     vec3 wi;
     vec3 weight;
     if (glass < 1.0 && glossy_sample(surface_bsdf(s, m), n, wo, rng_next(rng).xy, wi, weight) && dot(wi, ng) > 0.0) {
-        radiance += (1.0 - glass) * weight * one_bounce(leave(s.position, ng), wi, params.light_choice != 0u, rng);
+        radiance += (1.0 - glass) * weight * one_bounce(leave(s.position, ng), wi, params.light_choice, rng);
     }
 #endif
     return radiance;

@@ -9,8 +9,9 @@
 // colour (times the emissive texture, emitted_at), from their front. A point in a light's plane gets nothing from it. A light is chosen
 // among the scene's lights plus, when the scene has any, the set of emissive
 // triangles: uniformly, or half uniformly and half by power with the graph's
-// `light_choice` 1 (the LightChoices table); within that set a triangle is
-// chosen by power.
+// `light_choice` 1 (the LightChoices table), or with 2 through the light
+// tree (light_tree.glsl) walked at the point the light is chosen for;
+// within the set of emissive triangles a triangle is chosen by power.
 // Area lights are sampled uniformly by area. They are not in the BVH; rays
 // (BSDF-sampled and shadow rays alike) test them one by one, and they are
 // opaque: a light's back and a light between a point and another light
@@ -21,6 +22,12 @@
 // spot) for the kinds present.
 #ifndef WEFT_PT_LIGHTS_GLSL
 #define WEFT_PT_LIGHTS_GLSL
+#include "light_tree.glsl"
+
+// The graph's `light_choice` values.
+const uint LIGHT_CHOICE_UNIFORM = 0u;
+const uint LIGHT_CHOICE_POWER = 1u;
+const uint LIGHT_CHOICE_TREE = 2u;
 
 // Lights are sorted suns, points, spots, areas (engine/render/src/lights.rs).
 uint first_area_light() {
@@ -29,22 +36,31 @@ uint first_area_light() {
 
 // One over the probability next-event estimation picks choice `index`
 // (analytic light `index`, or the emissive triangles at index
-// frame.counts.w): the number of choices when picking uniformly, else from
-// the table (half uniform, half by power).
-float light_choice_odds(uint index, bool by_power) {
-    return by_power ? 1.0 / uintBitsToFloat(light_choice_records[index].z) : float(light_choice_info.x);
+// frame.counts.w) for the point `at`: the number of choices when picking
+// uniformly, from the table (half uniform, half by power), or from the
+// tree's top choice and its walk at `at`; infinite when it never does.
+float light_choice_odds(uint index, vec3 at, uint choice) {
+    if (choice == LIGHT_CHOICE_TREE) {
+        float top = tree_top_probability(index);
+        if (top == 0.0) {
+            top = tree_top_probability(TREE_CHOICE) * tree_pmf(at, index);
+        }
+        return 1.0 / top;
+    }
+    return choice == LIGHT_CHOICE_POWER ? 1.0 / uintBitsToFloat(light_choice_records[index].z)
+                                        : float(light_choice_info.x);
 }
 
-// A choice: the slot u.x falls in; `by_power`, kept while u.y is below its
-// threshold, else its alias.
-uint pick_light(vec2 u, bool by_power) {
+// A choice: the slot u.x falls in; by power (`choice` 1), kept while u.y
+// is below its threshold, else its alias.
+uint pick_light(vec2 u, uint choice) {
     uint count = light_choice_info.x;
     uint slot = min(uint(u.x * float(count)), count - 1u);
-    if (!by_power) {
+    if (choice == LIGHT_CHOICE_UNIFORM) {
         return slot;
     }
-    uvec4 choice = light_choice_records[slot];
-    return u.y < uintBitsToFloat(choice.y) ? slot : choice.x;
+    uvec4 record = light_choice_records[slot];
+    return u.y < uintBitsToFloat(record.y) ? slot : record.x;
 }
 
 struct LightSample {
@@ -133,14 +149,30 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
     return true;
 }
 
-// Picks a light and a point on it for a surface at p with normal n. False
+// Picks a light and a point on it for a surface at p with normal n, the
+// tree (`choice` 2) walked at `at`, where rays leave the surface. False
 // when there is no light or it sends nothing towards p.
-bool sample_light(vec3 p, vec3 n, vec4 u_pick, vec4 u_point, bool by_power, out LightSample ls) {
+bool sample_light(vec3 p, vec3 n, vec3 at, vec4 u_pick, vec4 u_point, uint choice, out LightSample ls) {
     if (light_choice_info.x == 0u) {
         return false;
     }
-    uint pick = pick_light(u_pick.xy, by_power);
-    float p_select = 1.0 / light_choice_odds(pick, by_power);
+    uint pick;
+    float p_select;
+    if (choice == LIGHT_CHOICE_TREE) {
+        uvec4 top = tree_top_pick(u_pick.xy);
+        pick = top.w;
+        p_select = uintBitsToFloat(top.z);
+        if (pick == TREE_CHOICE) {
+            float pmf;
+            if (!tree_sample(at, u_pick.z, pick, pmf)) {
+                return false;
+            }
+            p_select *= pmf;
+        }
+    } else {
+        pick = pick_light(u_pick.xy, choice);
+        p_select = 1.0 / light_choice_odds(pick, at, choice);
+    }
 #ifdef SCENE_EMISSIVE
     if (pick >= frame.counts.w) {
         return sample_emitter(p, u_point, p_select, ls);
@@ -199,12 +231,13 @@ int hit_area_light(vec3 origin, vec3 dir, inout float t) {
     return found;
 }
 
-// Radiance area light `index` sends back along a ray `dir` that met it at
-// distance t, and in `pdf` the density NEE would have picked that point with.
-vec3 area_emitted(uint index, vec3 dir, float t, bool by_power, out float pdf) {
+// Radiance area light `index` sends back along a ray from `origin` along
+// `dir` that met it at distance t, and in `pdf` the density NEE would have
+// picked that point with from there.
+vec3 area_emitted(uint index, vec3 origin, vec3 dir, float t, uint choice, out float pdf) {
     AreaOutline o = area_outline(index, vec3(0.0));
     float cos_light = area_cosine(o, dir);
-    pdf = cos_light > 0.0 ? t * t / (light_choice_odds(index, by_power) * cos_light * outline_area(o)) : 0.0;
+    pdf = cos_light > 0.0 ? t * t / (light_choice_odds(index, origin, choice) * cos_light * outline_area(o)) : 0.0;
     return cos_light > 0.0 ? lights[index].color_exponent.rgb : vec3(0.0);
 }
 

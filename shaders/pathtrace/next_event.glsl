@@ -14,11 +14,11 @@
 // The direct light a surface at `position` reflects towards `wo`: `n` its
 // shading normal and `ng` its geometric normal, both on wo's side, `b` its
 // BSDF, `from` where rays leaving it start (leave).
-vec3 next_event(vec3 position, vec3 n, vec3 ng, vec3 wo, Bsdf b, vec3 from, bool by_power, inout Rng rng) {
+vec3 next_event(vec3 position, vec3 n, vec3 ng, vec3 wo, Bsdf b, vec3 from, uint choice, inout Rng rng) {
     vec4 u_pick = rng_next(rng);
     vec4 u_point = rng_next(rng);
     LightSample ls;
-    if (!sample_light(position, n, u_pick, u_point, by_power, ls) || dot(ls.direction, ng) <= 0.0) {
+    if (!sample_light(position, n, from, u_pick, u_point, choice, ls) || dot(ls.direction, ng) <= 0.0) {
         return vec3(0.0);
     }
     float pdf;
@@ -38,7 +38,7 @@ vec3 next_event(vec3 position, vec3 n, vec3 ng, vec3 wo, Bsdf b, vec3 from, bool
 // next-event estimation counted it). A ray that meets a light with area
 // brings nothing, and a surface's own emission is left out: that light is
 // the raster passes' direct light.
-vec3 one_bounce(vec3 origin, vec3 dir, bool by_power, inout Rng rng) {
+vec3 one_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng) {
     vec2 found = trace_closest(origin, dir, 1e30);
     float t = found.x < 0.0 ? 1e30 : found.x;
     if (hit_area_light(origin, dir, t) >= 0) {
@@ -55,7 +55,7 @@ vec3 one_bounce(vec3 origin, vec3 dir, bool by_power, inout Rng rng) {
     facing_normals(s, m, dir, ng, n);
     Bsdf b = surface_bsdf(s, m);
     vec3 from = leave(s.position, ng);
-    vec3 radiance = next_event(s.position, n, ng, wo, b, from, by_power, rng);
+    vec3 radiance = next_event(s.position, n, ng, wo, b, from, choice, rng);
     if (any(greaterThan(frame.ambient.rgb, vec3(0.0)))) {
         vec3 wi;
         vec3 weight;

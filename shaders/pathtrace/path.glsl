@@ -85,7 +85,7 @@ bool bent_shadow_ray(vec3 origin, vec3 dir, out vec3 through) {
 // Traces the path's segment number `p.depth` and adds what it finds; true
 // when the path goes on (with its next ray in `p`), false when it ends.
 bool path_segment(inout Path p, inout Rng rng) {
-    bool by_power = params.light_choice != 0u;
+    uint choice = params.light_choice;
     // A path whose throughput is zero (a black surface, or absorption
     // that underflowed) can add nothing more: without Russian roulette
     // it would walk on to max_depth and hold its SIMD group there.
@@ -97,7 +97,7 @@ bool path_segment(inout Path p, inout Rng rng) {
     int area = hit_area_light(p.origin, p.dir, t);
     if (area >= 0) {
         float light_pdf;
-        vec3 emitted = area_emitted(uint(area), p.dir, t, by_power, light_pdf);
+        vec3 emitted = area_emitted(uint(area), p.origin, p.dir, t, choice, light_pdf);
         p.radiance += p.throughput * emitted * found_weight(p.counted_fully, p.bsdf_pdf, light_pdf);
         return false;
     }
@@ -119,7 +119,7 @@ bool path_segment(inout Path p, inout Rng rng) {
     if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
         float cos_light = dot(s.geometric_normal, wo);
         float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t
-            / (light_choice_odds(frame.counts.w, by_power) * cos_light);
+            / (light_choice_odds(frame.counts.w, p.origin, choice) * cos_light);
         p.radiance += p.throughput * emitted_at(s.material, s.uv) * found_weight(p.counted_fully, p.bsdf_pdf, light_pdf);
     }
 #endif
@@ -147,7 +147,7 @@ bool path_segment(inout Path p, inout Rng rng) {
     vec4 u_point = rng_next(rng);
     LightSample ls;
     if (b.p_specular < 1.0 || b.model != SHADING_MIRROR) {
-        bool found = sample_light(s.position, n, u_pick, u_point, by_power, ls)
+        bool found = sample_light(s.position, n, from, u_pick, u_point, choice, ls)
             && dot(ls.direction, ng) > 0.0;
         if (found && (ls.pdf == 0.0 || params.sampling != SAMPLING_BSDF)) {
             float pdf;

@@ -14,19 +14,28 @@
 
 use crate::emitters::{alias_table, luminance, table_bytes};
 use crate::gpu_types::GpuLight;
+use crate::light_tree::LightTree;
 use crate::lights::{AREA_DISC, AREA_RECT, POINT, SPOT_CONE, SPOT_SPHERE, SUN};
 use std::f32::consts::PI;
 
 /// Share of the probability spread evenly over the choices.
 const UNIFORM_SHARE: f64 = 0.5;
 
-/// The alias table the shaders read.
+/// The alias table the shaders read, and the light tree after it.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LightChoices {
     /// Per choice: alias, threshold below which the choice itself is kept
     /// (f32 bits), the probability of the choice (f32 bits), 0.
     pub records: Vec<[u32; 4]>,
+    /// What `light_choice` 2 reads (`shaders/pathtrace/light_tree.glsl`): a
+    /// header (top choices, tree nodes, 0, 0), the top choices among the
+    /// suns, the tree and the emissive triangles (alias, threshold bits,
+    /// probability bits, what), then [`LightTree::records`].
+    pub tree: Vec<[u32; 4]>,
 }
+
+/// A top choice that walks the tree (`TREE_CHOICE` in light_tree.glsl).
+pub const TREE_CHOICE: u32 = u32::MAX;
 
 impl LightChoices {
     /// The table over `lights` (the analytic light records, suns to area
@@ -40,33 +49,97 @@ impl LightChoices {
             .map(|p| if p.is_finite() { p } else { 0.0 })
             .collect();
         let probabilities = mixture(&powers);
-        let (threshold, alias) = alias_table(&probabilities);
-        let records = probabilities
-            .iter()
-            .zip(threshold.iter().zip(&alias))
-            .map(|(&p, (&t, &a))| [a, t.to_bits(), (p as f32).to_bits(), 0])
-            .collect();
-        Self { records }
+        let records = alias_records(&probabilities, |i| i as u32);
+        Self {
+            records,
+            tree: tree_records(lights, emitter_power, scene_radius),
+        }
     }
 
-    /// The GPU buffer: a header (choice count, 0, 0, 0), then the records.
+    /// The GPU buffer: a header (choice count, the tree header's index, 0,
+    /// 0), the records, then the tree's.
     pub fn bytes(&self) -> Vec<u8> {
-        table_bytes([self.records.len() as u32, 0, 0, 0], &self.records)
+        let count = self.records.len() as u32;
+        let all: Vec<[u32; 4]> = self.records.iter().chain(&self.tree).copied().collect();
+        table_bytes([count, count, 0, 0], &all)
     }
+}
+
+/// Alias-table records over `probabilities`, each with `what(i)` in w.
+fn alias_records(probabilities: &[f64], what: impl Fn(usize) -> u32) -> Vec<[u32; 4]> {
+    let (threshold, alias) = alias_table(probabilities);
+    probabilities
+        .iter()
+        .zip(threshold.iter().zip(&alias))
+        .enumerate()
+        .map(|(i, (&p, (&t, &a)))| [a, t.to_bits(), (p as f32).to_bits(), what(i)])
+        .collect()
+}
+
+/// The tree's header, its top choices (the suns, the tree as one choice
+/// standing for all its lights, the emissive triangles as one) with the
+/// probabilities the table gives them together, and the tree.
+fn tree_records(
+    lights: &[GpuLight],
+    emitter_power: Option<f32>,
+    scene_radius: f32,
+) -> Vec<[u32; 4]> {
+    let tree = LightTree::build(lights);
+    let finite = |p: f32| {
+        if p.is_finite() {
+            f64::from(p.max(0.0))
+        } else {
+            0.0
+        }
+    };
+    // (what, lights it stands for, their power as the table counts it)
+    let mut top: Vec<(u32, f64, f64)> = lights
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.direction_type.w == SUN)
+        .map(|(i, l)| (i as u32, 1.0, finite(power(l, scene_radius))))
+        .collect();
+    if !tree.nodes.is_empty() {
+        let in_tree = lights
+            .iter()
+            .zip(&tree.trails)
+            .filter(|(_, t)| t.1 != u32::MAX);
+        let (count, phi) = in_tree.fold((0.0, 0.0), |(n, p), (l, _)| {
+            (n + 1.0, p + finite(power(l, scene_radius)))
+        });
+        top.push((TREE_CHOICE, count, phi));
+    }
+    if let Some(p) = emitter_power {
+        top.push((lights.len() as u32, 1.0, finite(p)));
+    }
+    let choices: Vec<(f64, f64)> = top.iter().map(|&(_, n, p)| (n, p)).collect();
+    let probabilities = grouped_mixture(&choices);
+    let mut records = vec![[top.len() as u32, tree.nodes.len() as u32, 0, 0]];
+    records.extend(alias_records(&probabilities, |i| top[i].0));
+    records.extend(tree.records());
+    records
 }
 
 /// Each choice's probability: [`UNIFORM_SHARE`] spread evenly, the rest in
 /// proportion to `powers` (all even when they sum to nothing).
 fn mixture(powers: &[f64]) -> Vec<f64> {
-    let n = powers.len() as f64;
-    let total: f64 = powers.iter().sum();
-    powers
+    let each: Vec<(f64, f64)> = powers.iter().map(|&p| (1.0, p)).collect();
+    grouped_mixture(&each)
+}
+
+/// Each choice's probability when choice i stands for `counts[i]` lights
+/// of total power `powers[i]`: their summed probabilities under
+/// [`mixture`] over the lights themselves.
+fn grouped_mixture(choices: &[(f64, f64)]) -> Vec<f64> {
+    let n: f64 = choices.iter().map(|&(count, _)| count).sum();
+    let total: f64 = choices.iter().map(|&(_, p)| p).sum();
+    choices
         .iter()
-        .map(|&p| {
+        .map(|&(count, p)| {
             if total > 0.0 && total.is_finite() {
-                UNIFORM_SHARE / n + (1.0 - UNIFORM_SHARE) * p / total
+                UNIFORM_SHARE * count / n + (1.0 - UNIFORM_SHARE) * p / total
             } else {
-                1.0 / n
+                count / n
             }
         })
         .collect()

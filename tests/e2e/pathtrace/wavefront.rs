@@ -4,8 +4,8 @@
 //! two images are the same, bit for bit. The scenes cover every part of the
 //! state the queue carries between segments: area lights and MIS weights
 //! (Cornell), glass with Snell-bent NEE and lights chosen by power
-//! (caustics), punctual lights with BSDF sampling alone and Russian roulette
-//! from the second segment (demo), and a medium's absorption carried across
+//! (caustics), punctual lights chosen through the light tree with BSDF
+//! sampling alone and Russian roulette from the second segment (demo), and a medium's absorption carried across
 //! up to 16 segments (the Beer slab).
 
 use super::*;
@@ -27,7 +27,12 @@ fn the_wavefront_traces_the_megakernels_paths_bit_for_bit() {
         (
             "demo",
             repo.join("scenes/demo.scene"),
-            &[("sampling", 2.0), ("rr_depth", 2.0), ("seed", 3.0)],
+            &[
+                ("sampling", 2.0),
+                ("rr_depth", 2.0),
+                ("seed", 3.0),
+                ("light_choice", 2.0),
+            ],
         ),
         (
             "slab",
