@@ -272,8 +272,12 @@ fn mutable_files() -> Vec<PathBuf> {
 struct Tree(PathBuf);
 
 impl Tree {
-    fn new(n: usize) -> Self {
-        let dir = std::env::temp_dir().join(format!("weft-mutant-{}-{n}", std::process::id()));
+    /// One per test at a time, always at the same path for that test
+    /// (`name`): the shaders a mutant leaves alone then preprocess to the
+    /// same text (their `#line` paths included) and come from the SPIR-V
+    /// cache the tests share.
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("weft-mutant-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         for file in mutable_files() {
             let to = dir.join(&file);
@@ -444,7 +448,7 @@ fn every_mutant_check_accepts_renders_clean() {
         }
         let graph = *rng.pick(&roots);
         made += 1;
-        let tree = Tree::new(made);
+        let tree = Tree::new("drawn");
         std::fs::write(tree.0.join(&file), &mutant).expect("write mutant");
         let label = format!(
             "mutant {made}: {} ({what}) through graphs/{graph}",
@@ -515,7 +519,7 @@ fn compute_shaders_asking_more_than_the_device_offers_are_refused() {
         ("1024x16 invocations", sized("1024"), true),
         ("float atomics on shared memory", atomics, true),
     ] {
-        let tree = Tree::new(1000 + mutant.len());
+        let tree = Tree::new("limits");
         std::fs::write(tree.0.join(file), &mutant).expect("write mutant");
         let outcome = run_mutant(&gpu, &scene, &tree.0.join("graphs/tiled.ron"))
             .unwrap_or_else(|problem| panic!("{what}: {problem}"));

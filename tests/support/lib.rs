@@ -13,11 +13,24 @@ use weft_graph::CompileOptions;
 
 /// A context with validation and synchronization validation on.
 pub fn gpu() -> Gpu {
+    share_compiled_shaders();
     Gpu::new(&GpuOptions {
         validation: true,
         device: None,
     })
     .expect("a Vulkan 1.3 device with the validation layer (run tools/setup)")
+}
+
+/// Keeps compiled shaders in `target/e2e-spirv` (weft_gpu::spirv_cache),
+/// so a shader variant the tests compile once is not compiled again by the
+/// next test or graph mutant that uses it: the cache key covers the whole
+/// preprocessed source, defines, target and compiler version, so an edited
+/// shader (a mutant, a hot-reload test's edit) is always compiled afresh.
+fn share_compiled_shaders() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        weft_gpu::spirv_cache::set_dir(Some(repo().join("target").join("e2e-spirv")));
+    });
 }
 
 /// The repository root.
