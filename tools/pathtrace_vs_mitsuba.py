@@ -12,6 +12,7 @@ reference (and against each other), as a markdown table for docs/pathtrace.md.
     pip install mitsuba
     cargo build --release
     python3 tools/pathtrace_vs_mitsuba.py [--spp 64] [--reference-spp 2048] [--out target/pathtrace-vs-mitsuba]
+        [--graph graphs/pathtrace_wavefront.ron]
         [--ball glass|absorbing|coated]
 
 `--ball` adds scenes/models/glass_sphere.obj (radius 0.3, centre 0 0.3 0.3,
@@ -210,6 +211,8 @@ def main():
     parser.add_argument("--out", default=os.path.join(ROOT, "target", "pathtrace-vs-mitsuba"))
     parser.add_argument("--ball", choices=["glass", "absorbing", "coated"])
     parser.add_argument("--max-depth", type=int, help="path length limit (default 8, 16 with a ball)")
+    parser.add_argument("--graph", default="graphs/pathtrace.ron",
+                        help="weft's path-tracing graph (graphs/pathtrace_wavefront.ron: the wavefront form)")
     parser.add_argument("--weft", default=WEFT, help="the weft binary (a debug build times the same "
                         "shaders: the path tracer runs on the Vulkan device)")
     args = parser.parse_args()
@@ -236,7 +239,8 @@ def main():
         mi.util.write_bitmap(mitsuba_path, image, write_async=False)
         samples = args.size * args.size * args.spp
         result = subprocess.run(
-            [args.weft, "bench", "pathtrace", "--scene", weft_scene(args.ball, work), "--size", f"{args.size}x{args.size}",
+            [args.weft, "bench", "pathtrace", "--scene", weft_scene(args.ball, work), "--graph", args.graph,
+             "--size", f"{args.size}x{args.size}",
              "--spp", str(args.spp), "--max-depth", str(max_depth(args.ball)), "--reference", reference_path,
              "--out-dir", args.out, "--image", os.path.join(args.out, f"weft_{args.spp}spp.exr"), "--json"],
             cwd=ROOT, check=True, capture_output=True, text=True)
@@ -258,7 +262,7 @@ def main():
     print("|---|---|---|---|---|")
     print(f"| Mitsuba 3 {mi.__version__} scalar_rgb | CPU | {samples / mitsuba_seconds:,.0f} | "
           f"{mitsuba_error:.4e} | {', '.join(f'{v:.4f}' for v in mean(mitsuba_path))} |")
-    print(f"| weft pathtrace.ron | {weft['device']} | {run['samples_per_second']:,.0f} | "
+    print(f"| weft {os.path.basename(args.graph)} | {weft['device']} | {run['samples_per_second']:,.0f} | "
           f"{run['rel_mse']:.4e} | {', '.join(f'{v:.4f}' for v in mean(weft_path))} |")
     print(f"\nrelative MSE between the two {args.spp}-spp images (over the reference): {between:.4e}, "
           f"{between / (mitsuba_noise + weft_noise):.2f}x the sum of their noise levels "

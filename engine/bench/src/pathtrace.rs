@@ -37,7 +37,8 @@ pub struct PathtraceArgs {
     max_depth: u32,
     /// Samples per pixel per frame (`samples_per_frame`), at most half of
     /// each count so that a frame after the first (which builds pipelines)
-    /// is timed.
+    /// is timed. A graph without that parameter keeps its own (the
+    /// wavefront path tracer: one).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=1024))]
     samples_per_frame: u32,
     /// A converged image of the same scene, camera and size (linear EXR) to
@@ -112,30 +113,39 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
         .with_context(|| format!("loading {}", args.scene.display()))?;
     let gpu = Gpu::new(&GpuOptions::default())?;
     let pixels = f64::from(args.size.width) * f64::from(args.size.height);
+    // A graph with a fixed number of samples a frame (the wavefront path
+    // tracer: one) takes no `samples_per_frame`.
+    let sets_samples_per_frame = weft_graph::load(&args.graph)
+        .settable_params()
+        .contains("samples_per_frame");
     let mut samples = Vec::new();
     let mut last_image = None;
     for &spp in &args.spp {
         // At least two frames where spp allows: the first builds pipelines
         // and the BVH and is not timed, so a one-frame render would time
         // the builds.
-        let per_frame = args
-            .samples_per_frame
-            .min(u32::try_from(spp / 2).unwrap_or(u32::MAX).max(1));
+        let per_frame = if sets_samples_per_frame {
+            args.samples_per_frame
+                .min(u32::try_from(spp / 2).unwrap_or(u32::MAX).max(1))
+        } else {
+            1
+        };
+        let mut params = BTreeMap::from([(
+            "max_depth".into(),
+            ParamValue::Number(args.max_depth.into()),
+        )]);
+        if sets_samples_per_frame {
+            params.insert(
+                "samples_per_frame".into(),
+                ParamValue::Number(per_frame.into()),
+            );
+        }
         let settings = RenderSettings {
             graph: args.graph.clone(),
             extent: args.size,
             samples: Some(spp),
             extra_readback: vec!["hdr".into()],
-            params: BTreeMap::from([
-                (
-                    "max_depth".into(),
-                    ParamValue::Number(args.max_depth.into()),
-                ),
-                (
-                    "samples_per_frame".into(),
-                    ParamValue::Number(per_frame.into()),
-                ),
-            ]),
+            params,
             ..RenderSettings::default()
         };
         let rendered = render(&gpu, &scene, &settings)?;

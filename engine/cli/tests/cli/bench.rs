@@ -44,3 +44,44 @@ fn bench_figures_go_to_the_user_cache_unless_an_out_dir_is_given() {
     assert_eq!(std::fs::read(&committed).expect("docs csv"), before);
     std::fs::remove_dir_all(&cache).expect("remove the test's cache");
 }
+
+/// The wavefront path tracer takes one sample a frame and declares no
+/// `samples_per_frame`: `weft bench pathtrace --graph` benchmarks it all the
+/// same (the bench used to set that parameter on every graph, which the
+/// wavefront graph refused).
+#[test]
+fn the_path_tracer_bench_takes_a_graph_without_samples_per_frame() {
+    let out = std::env::temp_dir().join(format!("weft-cli-bench-wavefront-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let output = command_in(
+        &repo(),
+        &[
+            "bench",
+            "pathtrace",
+            "--graph",
+            "graphs/pathtrace_wavefront.ron",
+            "--size",
+            "8x8",
+            "--spp",
+            "2",
+            "--max-depth",
+            "2",
+            "--out-dir",
+            out.to_str().expect("utf-8 path"),
+        ],
+    )
+    .output()
+    .expect("weft runs");
+    let said = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(output.status.success(), "{said}");
+    let text = std::fs::read_to_string(out.join("pathtrace_bench.csv")).expect("the csv");
+    assert!(
+        text.starts_with("spp,seconds,samples_per_second,rel_mse\n2,"),
+        "{text}"
+    );
+    std::fs::remove_dir_all(&out).expect("remove the test's output");
+}
