@@ -14,6 +14,7 @@
 #include "../include/surface.glsl"
 #include "../include/punctual.glsl"
 #include "../include/trace.glsl"
+#include "../include/camera_ray.glsl"
 #include "random.glsl"
 #include "sampling.glsl"
 #include "dielectric.glsl"
@@ -39,9 +40,7 @@ void main() {
         return;
     }
     vec3 eye = frame.camera_position.xyz;
-    vec2 ndc = (vec2(pixel) + 0.5) / vec2(size) * 2.0 - 1.0;
-    vec4 on_near = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
-    vec3 dir = normalize(on_near.xyz / on_near.w - eye);
+    vec3 dir = camera_ray(vec2(pixel) + 0.5, vec2(size));
     vec2 found = trace_closest(eye, dir, 1e30);
     float t = found.x < 0.0 ? 1e30 : found.x;
     if (hit_area_light(eye, dir, t) >= 0 || found.x < 0.0) {

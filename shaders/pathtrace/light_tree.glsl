@@ -86,6 +86,16 @@ bool tree_is_leaf(uint node) {
     return light_choice_records[tree_node_first() + NODE_RECORDS * node + 3u].w != 0u;
 }
 
+// One step down from inner node `node` at p: its second child, and the
+// probability of its first (node + 1); false when neither can light p.
+bool tree_split(uint node, vec3 p, out uint second, out float p_first) {
+    second = tree_second_child(node);
+    float a = tree_importance(node + 1u, p);
+    float b = tree_importance(second, p);
+    p_first = a + b > 0.0 ? a / (a + b) : 0.0;
+    return a + b > 0.0;
+}
+
 // A light of the tree for p by u, and its probability; false when none can
 // light p.
 bool tree_sample(vec3 p, float u, out uint light, out float pmf) {
@@ -98,13 +108,11 @@ bool tree_sample(vec3 p, float u, out uint light, out float pmf) {
     float chance = 1.0;
     // At most 32 levels (a trail's bits).
     for (uint level = 0u; level < 32u && !tree_is_leaf(node); ++level) {
-        uint second = tree_second_child(node);
-        float a = tree_importance(node + 1u, p);
-        float b = tree_importance(second, p);
-        if (a + b <= 0.0) {
+        uint second;
+        float p_first;
+        if (!tree_split(node, p, second, p_first)) {
             return false;
         }
-        float p_first = a / (a + b);
         if (u < p_first) {
             u = min(u / p_first, 0.99999994);
             chance *= p_first;
@@ -130,20 +138,14 @@ float tree_pmf(vec3 p, uint light) {
     uint node = 0u;
     float chance = 1.0;
     for (uint level = 0u; level < trail.y; ++level) {
-        uint second = tree_second_child(node);
-        float a = tree_importance(node + 1u, p);
-        float b = tree_importance(second, p);
-        if (a + b <= 0.0) {
+        uint second;
+        float p_first;
+        if (!tree_split(node, p, second, p_first)) {
             return 0.0;
         }
-        float p_first = a / (a + b);
-        if (((trail.x >> level) & 1u) == 0u) {
-            chance *= p_first;
-            node = node + 1u;
-        } else {
-            chance *= 1.0 - p_first;
-            node = second;
-        }
+        bool first = ((trail.x >> level) & 1u) == 0u;
+        chance *= first ? p_first : 1.0 - p_first;
+        node = first ? node + 1u : second;
     }
     return chance;
 }

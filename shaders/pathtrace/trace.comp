@@ -57,6 +57,7 @@
 #include "../include/surface.glsl"
 #include "../include/punctual.glsl"
 #include "../include/trace.glsl"
+#include "../include/camera_ray.glsl"
 #include "random.glsl"
 #include "sampling.glsl"
 #include "dielectric.glsl"
@@ -134,9 +135,7 @@ void main() {
         uint group = gl_LocalInvocationIndex >> 3u;
         rng = rng_start(uvec2(gl_WorkGroupID.x * 8u + group, gl_WorkGroupID.y), sample_index, params.seed ^ 0x85ebca6bu);
     }
-    vec2 ndc = (vec2(pixel) + jitter) / vec2(size) * 2.0 - 1.0;
-    vec4 on_near = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
-    vec3 dir = normalize(on_near.xyz / on_near.w - eye);
+    vec3 dir = camera_ray(vec2(pixel) + jitter, vec2(size));
     // `accumulate` 0 keeps only this frame's samples (a denoiser's input):
     // the mean restarts every frame.
     add_sample(pixel, path(eye, dir, rng),

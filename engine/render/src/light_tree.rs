@@ -66,77 +66,63 @@ pub struct LightTree {
 fn bounds_of(light: &GpuLight) -> Option<LightBounds> {
     let kind = light.direction_type.w;
     let centre = light.position_range.truncate();
-    // A spot counts as a point light of its intensity, as in pbrt-v4: its
-    // cone, not a smaller power, says where it shines (a narrow spot is as
-    // bright inside its cone as a point light of its colour).
-    let phi = if kind == SPOT_CONE || kind == SPOT_SPHERE {
-        power(
-            &GpuLight {
-                direction_type: light.direction_type.truncate().extend(POINT),
-                ..*light
-            },
-            1.0,
-        )
-    } else {
-        power(light, 1.0)
-    };
-    let range = light.position_range.w;
-    if kind == POINT {
-        Some(LightBounds {
-            lo: centre,
-            hi: centre,
-            phi,
-            axis: Vec3::Z,
-            cos_theta_o: -1.0,
-            cos_theta_e: 0.0,
-            two_sided: false,
-            range: if range.is_nan() { f32::INFINITY } else { range },
-            falloff: light.attenuation_cos.truncate().max(Vec3::ZERO),
-        })
-    } else if kind == SPOT_CONE || kind == SPOT_SPHERE {
-        let cos_half = light.attenuation_cos.w.clamp(-1.0, 1.0);
-        // The cutoff is along the axis: inside the cone a point at
-        // distance d lies at least d cos(half-angle) along it.
-        let range = if cos_half > 0.0 {
-            range / cos_half
-        } else {
-            f32::INFINITY
-        };
-        Some(LightBounds {
-            lo: centre,
-            hi: centre,
-            phi,
-            axis: light.direction_type.truncate().normalize_or(Vec3::Z),
-            cos_theta_o: cos_half,
-            // Nothing past the cone; a milliradian of slack so rounding at
-            // its edge never rules out a point the shader's test lights.
-            cos_theta_e: SPOT_EDGE_SLACK.cos(),
-            two_sided: false,
-            range: if range.is_nan() { f32::INFINITY } else { range },
-            falloff: light.attenuation_cos.truncate().max(Vec3::ZERO),
-        })
-    } else if kind == AREA_RECT || kind == AREA_DISC {
+    let spot = kind == SPOT_CONE || kind == SPOT_SPHERE;
+    if kind == AREA_RECT || kind == AREA_DISC {
         let (x, y) = (
             light.direction_type.truncate(),
             light.attenuation_cos.truncate(),
         );
         // It emits towards -(x × y) (include/area_light.glsl's winding).
-        let axis = -x.cross(y).normalize_or(Vec3::Z);
         let reach = x.abs() + y.abs();
-        Some(LightBounds {
+        return Some(LightBounds {
             lo: centre - reach,
             hi: centre + reach,
-            phi,
-            axis,
+            phi: power(light, 1.0),
+            axis: -x.cross(y).normalize_or(Vec3::Z),
             cos_theta_o: 1.0,
             cos_theta_e: 0.0,
             two_sided: light.color_exponent.w > 0.5,
             range: f32::INFINITY,
             falloff: Vec3::Z,
-        })
-    } else {
-        None
+        });
     }
+    if kind != POINT && !spot {
+        return None;
+    }
+    // A point light shines all round. A spot counts as a point light of its
+    // intensity, as in pbrt-v4: its cone, not a smaller power, says where it
+    // shines (a narrow spot is as bright inside its cone as a point light of
+    // its colour); its cutoff is along the axis, and inside the cone a point
+    // at distance d lies at least d cos(half-angle) along it.
+    let cos_half = light.attenuation_cos.w.clamp(-1.0, 1.0);
+    let (axis, cos_theta_o, cos_theta_e, range) = if spot {
+        let range = if cos_half > 0.0 {
+            light.position_range.w / cos_half
+        } else {
+            f32::INFINITY
+        };
+        // Nothing past the cone; a milliradian of slack so rounding at its
+        // edge never rules out a point the shader's test lights.
+        let axis = light.direction_type.truncate().normalize_or(Vec3::Z);
+        (axis, cos_half, SPOT_EDGE_SLACK.cos(), range)
+    } else {
+        (Vec3::Z, -1.0, 0.0, light.position_range.w)
+    };
+    let as_point = GpuLight {
+        direction_type: light.direction_type.truncate().extend(POINT),
+        ..*light
+    };
+    Some(LightBounds {
+        lo: centre,
+        hi: centre,
+        phi: power(&as_point, 1.0),
+        axis,
+        cos_theta_o,
+        cos_theta_e,
+        two_sided: false,
+        range: if range.is_nan() { f32::INFINITY } else { range },
+        falloff: light.attenuation_cos.truncate().max(Vec3::ZERO),
+    })
 }
 
 impl LightBounds {

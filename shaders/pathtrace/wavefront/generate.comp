@@ -4,6 +4,7 @@
 // (trace.comp) takes, into the first half of the path queue in pixel order;
 // segment 1's record counts them all and every later record starts empty.
 #include "../../include/scene.glsl"
+#include "../../include/camera_ray.glsl"
 #include "../random.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -35,11 +36,7 @@ void main() {
     uint sample_index = params.history_frames;
     Rng rng = rng_start(pixel, sample_index, params.seed);
     vec2 jitter = rng_next(rng).xy;
-    vec3 eye = frame.camera_position.xyz;
-    vec2 ndc = (vec2(pixel) + jitter) / vec2(size) * 2.0 - 1.0;
-    vec4 on_near = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
-    vec3 dir = normalize(on_near.xyz / on_near.w - eye);
-    Path p = path_start(eye, dir);
+    Path p = path_start(frame.camera_position.xyz, camera_ray(vec2(pixel) + jitter, vec2(size)));
     uint index = pixel.y * size.x + pixel.x;
     paths[index] = queued(p, index, rng);
 }

@@ -26,7 +26,6 @@ layout(local_size_x = 64) in;
 layout(push_constant) uniform Params {
     uint max_depth;
     uint rr_depth;
-    uint seed;
     uint sampling;
     uint fresnel;
     uint nee_through_glass;

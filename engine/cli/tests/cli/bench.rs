@@ -1,6 +1,34 @@
 //! Where `weft bench` writes its figures.
 
 use crate::harness::{command_in, repo};
+use std::path::Path;
+
+/// `weft bench pathtrace` at 8x8, 2 spp, max_depth 2, with `extra`
+/// arguments, run in the repository with `cache` as the user cache: whether
+/// it succeeded, and everything it said.
+fn bench_pathtrace(extra: &[&str], cache: &Path) -> (bool, String) {
+    let mut args = vec![
+        "bench",
+        "pathtrace",
+        "--size",
+        "8x8",
+        "--spp",
+        "2",
+        "--max-depth",
+        "2",
+    ];
+    args.extend_from_slice(extra);
+    let output = command_in(&repo(), &args)
+        .env("WEFT_CACHE_DIR", cache)
+        .output()
+        .expect("weft runs");
+    let said = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    (output.status.success(), said)
+}
 
 /// Without `--out-dir` a benchmark writes into the user cache and says so;
 /// run inside the repository, it leaves the committed figures in `docs/` as
@@ -11,28 +39,8 @@ fn bench_figures_go_to_the_user_cache_unless_an_out_dir_is_given() {
     let _ = std::fs::remove_dir_all(&cache);
     let committed = repo().join("docs/pathtrace_bench.csv");
     let before = std::fs::read(&committed).expect("docs/pathtrace_bench.csv");
-    let output = command_in(
-        &repo(),
-        &[
-            "bench",
-            "pathtrace",
-            "--size",
-            "8x8",
-            "--spp",
-            "2",
-            "--max-depth",
-            "2",
-        ],
-    )
-    .env("WEFT_CACHE_DIR", &cache)
-    .output()
-    .expect("weft runs");
-    let said = format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    );
-    assert!(output.status.success(), "{said}");
+    let (succeeded, said) = bench_pathtrace(&[], &cache);
+    assert!(succeeded, "{said}");
     let csv = cache.join("bench/pathtrace/pathtrace_bench.csv");
     let text =
         std::fs::read_to_string(&csv).unwrap_or_else(|e| panic!("{}: {e}\n{said}", csv.display()));
@@ -53,31 +61,16 @@ fn bench_figures_go_to_the_user_cache_unless_an_out_dir_is_given() {
 fn the_path_tracer_bench_takes_a_graph_without_samples_per_frame() {
     let out = std::env::temp_dir().join(format!("weft-cli-bench-wavefront-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let output = command_in(
-        &repo(),
+    let (succeeded, said) = bench_pathtrace(
         &[
-            "bench",
-            "pathtrace",
             "--graph",
             "graphs/pathtrace_wavefront.ron",
-            "--size",
-            "8x8",
-            "--spp",
-            "2",
-            "--max-depth",
-            "2",
             "--out-dir",
             out.to_str().expect("utf-8 path"),
         ],
-    )
-    .output()
-    .expect("weft runs");
-    let said = format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
+        &out.join("cache"),
     );
-    assert!(output.status.success(), "{said}");
+    assert!(succeeded, "{said}");
     let text = std::fs::read_to_string(out.join("pathtrace_bench.csv")).expect("the csv");
     assert!(
         text.starts_with("spp,seconds,samples_per_second,rel_mse\n2,"),
