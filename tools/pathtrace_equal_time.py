@@ -11,6 +11,10 @@ between budgets on log-log axes.
 - Mitsuba (`scalar_rgb`, all cores) renders chunks of `--chunk` spp with
   successive seeds, averaged, until another chunk would end past the budget
   (the scene is loaded and the thread pool warm before the clock starts).
+  With `--mitsuba-sampler` other than `independent` (`multijitter`,
+  `ldsampler`, ...), whose points are stratified only within one render
+  call, it renders once instead, with the spp its rate in a `--chunk`-spp
+  render just before fits in the budget, and reports the time that took.
 - weft runs `weft render --spp 1000000 --time-limit S` on the progressive
   graph (the time limit ends it long before that count): its clock
   includes the first frame's pipeline builds, not the process start or the
@@ -19,6 +23,7 @@ between budgets on log-log axes.
     pip install mitsuba flip-evaluator
     cargo build --release -p weft-cli
     python3 tools/pathtrace_equal_time.py --budgets 5,20,60 --rounds 2
+    python3 tools/pathtrace_equal_time.py --features independent_sampler --mitsuba-sampler multijitter
 """
 
 import argparse
@@ -73,12 +78,25 @@ def mitsuba_for(seconds, scene, chunk):
     return total / (spp // chunk), spp, time.perf_counter() - started
 
 
-def weft_for(seconds, weft, graph, size, out):
+def mitsuba_once_for(seconds, scene, chunk):
+    """Mitsuba's image from one render call of as many spp as its rate in a
+    `chunk`-spp render fits in `seconds` (for samplers that stratify within
+    a call), its spp and the seconds it took."""
+    started = time.perf_counter()
+    mi.render(scene, spp=chunk, seed=0)
+    rate = chunk / (time.perf_counter() - started)
+    spp = max(1, int(rate * seconds))
+    started = time.perf_counter()
+    image = np.array(mi.render(scene, spp=spp, seed=1))[:, :, :3]
+    return image, spp, time.perf_counter() - started
+
+
+def weft_for(seconds, weft, graph, size, out, features):
     """weft's image after `weft render --time-limit seconds` through `graph`."""
     run = subprocess.run(
         [weft, "render", "scenes/cornell.scene", "--graph", graph, "--size", f"{size}x{size}",
          "--spp", "1000000", "--time-limit", str(seconds), "--param", f"max_depth={side_by_side.max_depth(None)}",
-         "--out", out, "--json"],
+         "--out", out, "--json"] + (["--features", features] if features else []),
         cwd=side_by_side.ROOT, check=True, capture_output=True, text=True)
     report = json.loads(run.stdout)
     return linear(out), report["samples_per_pixel"]
@@ -106,6 +124,10 @@ def main():
     parser.add_argument("--weft", default=side_by_side.WEFT)
     parser.add_argument("--graph", default="graphs/pathtrace.ron",
                         help="weft's progressive graph (a changed copy, to weigh a change of the tracer)")
+    parser.add_argument("--features", default="",
+                        help="weft's --features (independent_sampler: independent random numbers, not Sobol)")
+    parser.add_argument("--mitsuba-sampler", default="independent",
+                        help="Mitsuba's sampler plugin (independent, multijitter, ldsampler, ...)")
     parser.add_argument("--out", default=os.path.join(side_by_side.ROOT, "target", "pathtrace-equal-time"))
     args = parser.parse_args()
     budgets = [float(b) for b in args.budgets.split(",")]
@@ -118,29 +140,34 @@ def main():
             scene = side_by_side.mitsuba_scene(args.reference_spp, args.size, work)
             mi.util.write_bitmap(reference_path, mi.render(scene, spp=args.reference_spp), write_async=False)
         reference = linear(reference_path)
-        scene = side_by_side.mitsuba_scene(args.chunk, args.size, work)
+        scene = side_by_side.mitsuba_scene(args.chunk, args.size, work, sampler=args.mitsuba_sampler)
         mi.render(scene, spp=1)  # warm up the thread pool
         results = {(who, b): [] for who in ("mitsuba", "weft") for b in budgets}
         for round_index in range(args.rounds):
             for budget in budgets:
-                image, spp, took = mitsuba_for(budget, scene, args.chunk)
+                if args.mitsuba_sampler == "independent":
+                    image, spp, took = mitsuba_for(budget, scene, args.chunk)
+                else:
+                    image, spp, took = mitsuba_once_for(budget, scene, args.chunk)
                 results[("mitsuba", budget)].append((spp, took) + errors(image, reference))
                 out = os.path.join(args.out, f"weft_{budget:g}s.exr")
-                image, spp = weft_for(budget, args.weft, args.graph, args.size, out)
+                image, spp = weft_for(budget, args.weft, args.graph, args.size, out, args.features)
                 results[("weft", budget)].append((spp, budget) + errors(image, reference))
                 print(f"round {round_index + 1}/{args.rounds}, {budget:g} s: "
                       f"Mitsuba {results[('mitsuba', budget)][-1]}, weft {results[('weft', budget)][-1]}",
                       file=sys.stderr, flush=True)
     span = lambda xs, f: f"{f(min(xs))}–{f(max(xs))}" if min(xs) != max(xs) else f(xs[0])  # noqa: E731
+    features = args.features or "the graph's"
     print(f"Cornell box, {args.size}x{args.size}, max_depth {side_by_side.max_depth(None)}, weft's {args.graph} "
-          f"against Mitsuba "
+          f"(features: {features}), Mitsuba's {args.mitsuba_sampler} sampler; against Mitsuba "
           f"at {args.reference_spp} spp; ranges over {args.rounds} interleaved rounds\n")
-    print("| budget | Mitsuba scalar_rgb spp | weft spp | Mitsuba HDR-FLIP | weft HDR-FLIP | "
+    print("| budget | Mitsuba scalar_rgb spp | Mitsuba seconds | weft spp | Mitsuba HDR-FLIP | weft HDR-FLIP | "
           "Mitsuba rel. MSE | weft rel. MSE |")
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|")
     for budget in budgets:
         m, w = results[("mitsuba", budget)], results[("weft", budget)]
-        print(f"| {budget:g} s | {span([r[0] for r in m], str)} | {span([r[0] for r in w], str)} | "
+        print(f"| {budget:g} s | {span([r[0] for r in m], str)} | {span([r[1] for r in m], '{:.1f}'.format)} | "
+              f"{span([r[0] for r in w], str)} | "
               f"{span([r[2] for r in m], '{:.4f}'.format)} | {span([r[2] for r in w], '{:.4f}'.format)} | "
               f"{span([r[3] for r in m], '{:.2e}'.format)} | {span([r[3] for r in w], '{:.2e}'.format)} |")
     for who in ("mitsuba", "weft"):

@@ -150,7 +150,7 @@ def mitsuba_ball(ball):
     return shape
 
 
-def mitsuba_scene(spp, size, work, ball=None):
+def mitsuba_scene(spp, size, work, ball=None, sampler="independent"):
     materials = read_materials(MTL)
     scene = {
         "type": "scene",
@@ -162,7 +162,7 @@ def mitsuba_scene(spp, size, work, ball=None):
             "near_clip": 0.1,
             "to_world": mi.ScalarTransform4f().look_at(origin=[0, 1, 3.9], target=[0, 1, 0], up=[0, 1, 0]),
             "film": {"type": "hdrfilm", "width": size, "height": size, "rfilter": {"type": "box"}, "pixel_format": "rgb"},
-            "sampler": {"type": "independent", "sample_count": spp},
+            "sampler": {"type": sampler, "sample_count": spp},
         },
     }
     for name, file in split_by_material(OBJ, work).items():

@@ -14,10 +14,7 @@
 //! direction above the surface with a positive pdf.
 
 use std::collections::BTreeMap;
-use weft_gpu::Pixels;
-use weft_graph::plan::Extent;
 use weft_graph::schema::ParamValue;
-use weft_render::{render, RenderSettings};
 
 const PHI_BINS: usize = 32;
 const COS_BINS: usize = 16;
@@ -122,10 +119,6 @@ const CASES: [Case; 8] = [
 
 /// The two images the fixture graph produces for `case`: samples, density.
 fn run(case: &Case) -> (Vec<f32>, Vec<f32>) {
-    let scene = weft_scene::load_scene(&weft_tests::repo().join("scenes/cornell.scene"))
-        .expect("scene loads");
-    let gpu = weft_tests::gpu();
-    let log = gpu.validation();
     let grey = |v: f64| ParamValue::Vector(vec![v, v, v, 1.0]);
     let params = BTreeMap::from([
         ("model".to_string(), ParamValue::Number(case.model)),
@@ -136,26 +129,7 @@ fn run(case: &Case) -> (Vec<f32>, Vec<f32>) {
         ("roughness".to_string(), ParamValue::Number(case.roughness)),
         ("wo_theta".to_string(), ParamValue::Number(case.wo_theta)),
     ]);
-    let settings = RenderSettings {
-        graph: weft_tests::graph("bsdf_sampling.ron"),
-        extent: Extent {
-            width: 8,
-            height: 8,
-        },
-        extra_readback: vec!["density".into()],
-        params,
-        ..RenderSettings::default()
-    };
-    let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
-    drop(gpu);
-    assert_eq!(log.messages(), Vec::new());
-    let floats = |pixels: &Pixels| match pixels {
-        Pixels::RgbaF32(v) => v.clone(),
-        _ => panic!("RGBA float images"),
-    };
-    let samples = floats(&rendered.report.output.expect("samples").pixels);
-    let density = floats(&rendered.report.readbacks[0].1.pixels);
-    (samples, density)
+    weft_tests::render::fixture_floats("bsdf_sampling.ron", "density", params)
 }
 
 /// erfc(x) for x >= 0 (Abramowitz and Stegun 7.1.26, error under 1.5e-7).

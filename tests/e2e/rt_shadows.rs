@@ -322,19 +322,23 @@ fn area_light_shadows_converge_to_the_path_tracers_direct_light() {
         ),
         &keep,
     );
+    // The yardstick: how far a 1,024-spp path tracer with independent
+    // random numbers lies from the reference (whose Sobol numbers leave it
+    // several times less noisy, so this is mostly the independent one's
+    // noise).
     let again = masked(
         &render(
             &path,
             "pathtrace.ron",
             Some(1024),
             &[("max_depth", 2.0), ("seed", 7.0)],
-            &[],
+            &["independent_sampler"],
         ),
         &keep,
     );
     let noise = hdr_flip(&reference, &again).mean;
     let mut report = vec![format!(
-        "reference against itself (another seed): {noise:.4}"
+        "independently sampled path tracer against the reference: {noise:.4}"
     )];
     for graph in ["forward.ron", "deferred.ron", "tiled.ron"] {
         let mapped = masked(&render(&path, graph, None, &[], &[]), &keep);
@@ -356,11 +360,14 @@ fn area_light_shadows_converge_to_the_path_tracers_direct_light() {
         report.push(format!(
             "{graph}: HDR-FLIP shadow map {flip_mapped:.4}, rt_shadows {flip_traced:.4}; mean ratio {ratio:.4}"
         ));
-        // Measured: reference against itself 0.0079; shadow map 0.030-0.032,
-        // rt_shadows 0.0070 in each graph, mean ratio 1.0002.
+        // Measured: the independently sampled path tracer 0.0062; shadow map
+        // 0.028-0.029, rt_shadows 0.0035 in each graph, mean ratio 1.0002.
+        // (Against an independently sampled reference, its own noise 0.0079,
+        // rt_shadows measured 0.0070.)
         assert!(
             flip_traced <= noise && (ratio - 1.0).abs() < 0.01 && flip_mapped > 3.0 * flip_traced,
-            "rt_shadows must be within the reference's own noise and well below the shadow map's error:\n{}",
+            "rt_shadows must be as close to the reference as a 1,024-spp independently sampled path tracer, \
+             and well below the shadow map's error:\n{}",
             report.join("\n")
         );
     }

@@ -10,7 +10,8 @@
 //! ending in the sun's direct light at the wall: what `rt_specular` traces.
 //! So at those pixels the raster image equals the reference in expectation
 //! (its Blinn-Phong highlight of `Ks 1` left out), and at the same number of
-//! paths it is no noisier than the path tracer. A glossy floor (Blinn-Phong,
+//! paths it is no noisier than the path tracer drawing independent random
+//! numbers as it does (feature `independent_sampler`). A glossy floor (Blinn-Phong,
 //! `Kd 0`) under the same wall reflects it through its lobe: the sun's
 //! highlight is the raster passes', the wall's light the traced ray's, and
 //! together they are the path tracer's image at three segments.
@@ -111,7 +112,14 @@ fn mirrors_and_glass_equal_the_path_tracers_delta_chains() {
     let scene = scene(&dir.0, "mirror");
     let depth = [("max_depth", MAX_DEPTH)];
     let reference = render(&scene, "pathtrace.ron", Some(1024), &depth, &[], "hdr");
-    let traced_16 = render(&scene, "pathtrace.ron", Some(16), &depth, &[], "hdr");
+    let traced_16 = render(
+        &scene,
+        "pathtrace.ron",
+        Some(16),
+        &depth,
+        &["independent_sampler"],
+        "hdr",
+    );
     let mut report = Vec::new();
     for graph in ["deferred.ron", "tiled.ron"] {
         let features = ["rt_specular", "rt_shadows"];

@@ -246,6 +246,32 @@ pub fn render_image_validated(
     (rendered, values)
 }
 
+/// A test fixture graph (`tests/graphs/NAME`) run once at 8x8 over the
+/// Cornell box with `params`, on a validating context: its float output and
+/// its float image `readback`, as RGBA floats row by row.
+pub fn fixture_floats(
+    name: &str,
+    readback: &str,
+    params: std::collections::BTreeMap<String, weft_graph::schema::ParamValue>,
+) -> (Vec<f32>, Vec<f32>) {
+    let settings = RenderSettings {
+        graph: crate::graph(name),
+        extent: Extent {
+            width: 8,
+            height: 8,
+        },
+        params,
+        ..RenderSettings::default()
+    };
+    let (rendered, read) =
+        render_image_validated(&root().join("scenes/cornell.scene"), settings, readback);
+    let output = rendered.report.output.expect("the fixture's output");
+    let weft_gpu::Pixels::RgbaF32(values) = output.pixels else {
+        panic!("{name}: the output is a float image");
+    };
+    (values, read)
+}
+
 /// [`render_image_validated`] as a linear RGB image, its size taken from
 /// `settings`.
 pub fn linear_image_validated(

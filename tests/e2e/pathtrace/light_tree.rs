@@ -5,9 +5,9 @@
 //! reach each point. Two seeds of each at 64 spp give each estimator's
 //! per-pixel variance (half the squared difference of the two images),
 //! and the tree's must be under a tenth of uniform choice's (measured
-//! 53x less). The tree's mean luminance must be within three standard
-//! errors of uniform choice's at 1,024 spp (measured 0.3% apart, the
-//! standard error 1.2%).
+//! 70x less with the Sobol sampler, 53x with independent numbers). The
+//! tree's mean luminance must be within three standard errors of uniform
+//! choice's at 1,024 spp (measured 0.6% apart, the standard error 1.2%).
 
 use super::*;
 

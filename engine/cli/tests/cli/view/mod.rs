@@ -519,7 +519,7 @@ fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
         "G moved on to the next graph in graphs/: {stdout}"
     );
     assert!(
-        graphs[2].contains("pathtrace.ron: features 1 area_lights"),
+        graphs[2].contains("pathtrace.ron: features 1 independent_sampler"),
         "G moved on: {stdout}"
     );
     let first_feature = |line: &str| {
