@@ -126,13 +126,15 @@ def main():
                         help="weft's progressive graph (a changed copy, to weigh a change of the tracer)")
     parser.add_argument("--features", default="",
                         help="weft's --features (independent_sampler: independent random numbers, not Sobol)")
+    parser.add_argument("--variant", default="scalar_rgb",
+                        help="Mitsuba's variant (llvm_ad_rgb: see tools/pathtrace_vs_mitsuba.py --variant)")
     parser.add_argument("--mitsuba-sampler", default="independent",
                         help="Mitsuba's sampler plugin (independent, multijitter, ldsampler, ...)")
     parser.add_argument("--out", default=os.path.join(side_by_side.ROOT, "target", "pathtrace-equal-time"))
     args = parser.parse_args()
     budgets = [float(b) for b in args.budgets.split(",")]
     os.makedirs(args.out, exist_ok=True)
-    mi.set_variant("scalar_rgb")
+    mi.set_variant(args.variant)
     with tempfile.TemporaryDirectory() as work:
         reference_path = os.path.join(args.out, f"mitsuba_{args.size}_{args.reference_spp}spp.exr")
         if not os.path.exists(reference_path):
@@ -141,7 +143,7 @@ def main():
             mi.util.write_bitmap(reference_path, mi.render(scene, spp=args.reference_spp), write_async=False)
         reference = linear(reference_path)
         scene = side_by_side.mitsuba_scene(args.chunk, args.size, work, sampler=args.mitsuba_sampler)
-        mi.render(scene, spp=1)  # warm up the thread pool
+        np.array(mi.render(scene, spp=args.chunk))  # warm up the thread pool (and a JIT variant's kernels)
         results = {(who, b): [] for who in ("mitsuba", "weft") for b in budgets}
         for round_index in range(args.rounds):
             for budget in budgets:
@@ -161,7 +163,7 @@ def main():
     print(f"Cornell box, {args.size}x{args.size}, max_depth {side_by_side.max_depth(None)}, weft's {args.graph} "
           f"(features: {features}), Mitsuba's {args.mitsuba_sampler} sampler; against Mitsuba "
           f"at {args.reference_spp} spp; ranges over {args.rounds} interleaved rounds\n")
-    print("| budget | Mitsuba scalar_rgb spp | Mitsuba seconds | weft spp | Mitsuba HDR-FLIP | weft HDR-FLIP | "
+    print(f"| budget | Mitsuba {args.variant} spp | Mitsuba seconds | weft spp | Mitsuba HDR-FLIP | weft HDR-FLIP | "
           "Mitsuba rel. MSE | weft rel. MSE |")
     print("|---|---|---|---|---|---|---|---|")
     for budget in budgets:

@@ -213,6 +213,9 @@ def main():
     parser.add_argument("--max-depth", type=int, help="path length limit (default 8, 16 with a ball)")
     parser.add_argument("--graph", default="graphs/pathtrace.ron",
                         help="weft's path-tracing graph (graphs/pathtrace_wavefront.ron: the wavefront form)")
+    parser.add_argument("--variant", default="scalar_rgb",
+                        help="Mitsuba's variant: scalar_rgb, or llvm_ad_rgb (its JIT wants LLVM 16 or later: "
+                        "DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so from Debian's libllvm19)")
     parser.add_argument("--weft", default=WEFT, help="the weft binary (a debug build times the same "
                         "shaders: the path tracer runs on the Vulkan device)")
     args = parser.parse_args()
@@ -223,7 +226,7 @@ def main():
     if args.max_depth is not None:
         args.out = os.path.join(args.out, f"depth{args.max_depth}")
     os.makedirs(args.out, exist_ok=True)
-    mi.set_variant("scalar_rgb")
+    mi.set_variant(args.variant)
     with tempfile.TemporaryDirectory() as work:
         reference_path = os.path.join(args.out, f"mitsuba_{args.reference_spp}spp.exr")
         if not os.path.exists(reference_path):
@@ -231,9 +234,14 @@ def main():
             scene = mitsuba_scene(args.reference_spp, args.size, work, args.ball)
             mi.util.write_bitmap(reference_path, mi.render(scene, spp=args.reference_spp), write_async=False)
         scene = mitsuba_scene(args.spp, args.size, work, args.ball)
-        mi.render(scene, spp=1)  # warm up: the first render sets up the thread pool
+        # Warm up: the first render sets up the thread pool (and, in a JIT
+        # variant, compiles the kernels the timed render reuses).
+        dr.eval(mi.render(scene, spp=args.spp, seed=0))
+        dr.sync_thread()
         started = time.perf_counter()
         image = mi.render(scene, spp=args.spp, seed=1)
+        dr.eval(image)
+        dr.sync_thread()
         mitsuba_seconds = time.perf_counter() - started
         mitsuba_path = os.path.join(args.out, f"mitsuba_{args.spp}spp.exr")
         mi.util.write_bitmap(mitsuba_path, image, write_async=False)
@@ -260,7 +268,7 @@ def main():
     print("| renderer | device | samples/s | rel. MSE vs Mitsuba at "
           f"{args.reference_spp} spp | image mean (RGB) |")
     print("|---|---|---|---|---|")
-    print(f"| Mitsuba 3 {mi.__version__} scalar_rgb | CPU | {samples / mitsuba_seconds:,.0f} | "
+    print(f"| Mitsuba 3 {mi.__version__} {args.variant} | CPU | {samples / mitsuba_seconds:,.0f} | "
           f"{mitsuba_error:.4e} | {', '.join(f'{v:.4f}' for v in mean(mitsuba_path))} |")
     print(f"| weft {os.path.basename(args.graph)} | {weft['device']} | {run['samples_per_second']:,.0f} | "
           f"{run['rel_mse']:.4e} | {', '.join(f'{v:.4f}' for v in mean(weft_path))} |")
