@@ -228,7 +228,7 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     mi.set_variant(args.variant)
     with tempfile.TemporaryDirectory() as work:
-        reference_path = os.path.join(args.out, f"mitsuba_{args.reference_spp}spp.exr")
+        reference_path = os.path.join(args.out, f"mitsuba_{args.size}_{args.reference_spp}spp.exr")
         if not os.path.exists(reference_path):
             print(f"Mitsuba reference at {args.reference_spp} spp ...", flush=True)
             scene = mitsuba_scene(args.reference_spp, args.size, work, args.ball)
@@ -243,14 +243,14 @@ def main():
         dr.eval(image)
         dr.sync_thread()
         mitsuba_seconds = time.perf_counter() - started
-        mitsuba_path = os.path.join(args.out, f"mitsuba_{args.spp}spp.exr")
+        mitsuba_path = os.path.join(args.out, f"mitsuba_{args.size}_{args.spp}spp.exr")
         mi.util.write_bitmap(mitsuba_path, image, write_async=False)
         samples = args.size * args.size * args.spp
         result = subprocess.run(
             [args.weft, "bench", "pathtrace", "--scene", weft_scene(args.ball, work), "--graph", args.graph,
              "--size", f"{args.size}x{args.size}",
              "--spp", str(args.spp), "--max-depth", str(max_depth(args.ball)), "--reference", reference_path,
-             "--out-dir", args.out, "--image", os.path.join(args.out, f"weft_{args.spp}spp.exr"), "--json"],
+             "--out-dir", args.out, "--image", os.path.join(args.out, f"weft_{args.size}_{args.spp}spp.exr"), "--json"],
             cwd=ROOT, check=True, capture_output=True, text=True)
     weft = json.loads(result.stdout.strip().splitlines()[-1])
     run = weft["renders"][-1]
