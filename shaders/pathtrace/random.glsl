@@ -8,9 +8,10 @@
 // - SAMPLER_SOBOL (the path tracer's default): each draw is a 4D Sobol
 //   point, Owen-scrambled per pixel and draw, indexed by the sample index,
 //   shuffled per pixel and draw ("padded" as in pbrt-v4's PaddedSobolSampler;
-//   Burley, "Practical Hash-based Owen Scrambling", JCGT 2020). Any 2^k
-//   consecutive samples of a pixel then stratify each draw's first two
-//   numbers as a (0, k, 2)-net and each number alone into 2^k intervals,
+//   Burley, "Practical Hash-based Owen Scrambling", JCGT 2020). Each
+//   aligned block of 2^k samples of a pixel (the first 2^k, the next 2^k,
+//   ...) then stratifies each draw's first two numbers as a (0, k, 2)-net
+//   and each number alone into 2^k intervals,
 //   while different draws, pixels and seeds stay independent. The estimate
 //   is unbiased like independent sampling's, with less variance where the
 //   integrand is smooth (docs/pathtrace.md measures it).
