@@ -13,8 +13,9 @@ between budgets on log-log axes.
   (the scene is loaded and the thread pool warm before the clock starts).
   With `--mitsuba-sampler` other than `independent` (`multijitter`,
   `ldsampler`, ...), whose points are stratified only within one render
-  call, it renders once instead, with the spp its rate in a `--chunk`-spp
-  render just before fits in the budget, and reports the time that took.
+  call, it renders once instead, with the spp its rate in a render of a
+  tenth of the budget just before fits in it, and reports the time that
+  took.
 - weft runs `weft render --spp 1000000 --time-limit S` on the progressive
   graph (the time limit ends it long before that count): its clock
   includes the first frame's pipeline builds, not the process start or the
@@ -79,12 +80,17 @@ def mitsuba_for(seconds, scene, chunk):
 
 
 def mitsuba_once_for(seconds, scene, chunk):
-    """Mitsuba's image from one render call of as many spp as its rate in a
-    `chunk`-spp render fits in `seconds` (for samplers that stratify within
-    a call), its spp and the seconds it took."""
-    started = time.perf_counter()
-    mi.render(scene, spp=chunk, seed=0)
-    rate = chunk / (time.perf_counter() - started)
+    """Mitsuba's image from one render call of as many spp as fit in
+    `seconds` (for samplers that stratify within a call), its spp and the
+    seconds it took. The rate is measured on a render of about a tenth of
+    the budget, after a `chunk`-spp one sizes it: a stratified sampler's
+    cost per sample grows with the count, so a small render overestimates it."""
+    rate = None
+    for spp in (chunk, None):
+        spp = spp or max(chunk, int(rate * seconds / 10))
+        started = time.perf_counter()
+        np.array(mi.render(scene, spp=spp, seed=0))
+        rate = spp / (time.perf_counter() - started)
     spp = max(1, int(rate * seconds))
     started = time.perf_counter()
     image = np.array(mi.render(scene, spp=spp, seed=1))[:, :, :3]
