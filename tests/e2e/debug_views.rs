@@ -22,10 +22,7 @@ const QUADS: usize = 3;
 const SIZE: u32 = 128;
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("weft-views-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    weft_testkit::scratch::scratch(&format!("weft-views-{name}-{}", std::process::id()))
 }
 
 const CAMERA: &str = "camera\n{\n\tposition 0 0 0\n\ttarget 0 0 -1\n\tfov_deg 90\n}\n";

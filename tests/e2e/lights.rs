@@ -19,9 +19,7 @@ use weft_testkit::tiles;
 
 /// A fresh folder under the system temp folder for this test's scene files.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("weft-lights-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    weft_testkit::scratch::scratch_path(&format!("weft-lights-{name}-{}", std::process::id()))
 }
 
 fn golden(name: &str) -> PathBuf {

@@ -1,11 +1,12 @@
 //! Helpers only tests use, kept out of the engine's public APIs: golden-image
-//! comparison, the CPU mirror of tiled light culling, and running a plan for
-//! several frames.
+//! comparison, the CPU mirror of tiled light culling, running a plan for
+//! several frames, and scratch folders removed at exit.
 
 pub mod brdf;
 pub mod golden;
 pub mod light_scene;
 pub mod raytrace;
+pub mod scratch;
 pub mod tiles;
 
 pub use golden::{check_golden, Comparison, GoldenError, Tolerance};

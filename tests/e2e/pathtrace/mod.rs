@@ -142,9 +142,7 @@ fn sphere(centre: [f32; 3], radius: f32, inward: bool, material: &str, base: &mu
 }
 
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("weft-pathtrace-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+    weft_testkit::scratch::scratch(&format!("weft-pathtrace-{name}-{}", std::process::id()))
 }
 
 /// A furnace: a unit sphere of material `object` (MTL statements) inside a

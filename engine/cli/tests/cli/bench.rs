@@ -35,8 +35,8 @@ fn bench_pathtrace(extra: &[&str], cache: &Path) -> (bool, String) {
 /// they are.
 #[test]
 fn bench_figures_go_to_the_user_cache_unless_an_out_dir_is_given() {
-    let cache = std::env::temp_dir().join(format!("weft-cli-bench-cache-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&cache);
+    let cache =
+        crate::harness::scratch_path(&format!("weft-cli-bench-cache-{}", std::process::id()));
     let committed = repo().join("docs/pathtrace_bench.csv");
     let before = std::fs::read(&committed).expect("docs/pathtrace_bench.csv");
     let (succeeded, said) = bench_pathtrace(&[], &cache);
@@ -59,8 +59,8 @@ fn bench_figures_go_to_the_user_cache_unless_an_out_dir_is_given() {
 /// wavefront graph refused).
 #[test]
 fn the_path_tracer_bench_takes_a_graph_without_samples_per_frame() {
-    let out = std::env::temp_dir().join(format!("weft-cli-bench-wavefront-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
+    let out =
+        crate::harness::scratch_path(&format!("weft-cli-bench-wavefront-{}", std::process::id()));
     let (succeeded, said) = bench_pathtrace(
         &[
             "--graph",

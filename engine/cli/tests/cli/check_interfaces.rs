@@ -15,8 +15,7 @@ impl Copy {
         static MADE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
         let n = MADE.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
         let dir =
-            std::env::temp_dir().join(format!("weft-iface-{}-{name}-{n}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+            crate::harness::scratch_path(&format!("weft-iface-{}-{name}-{n}", std::process::id()));
         for sub in [
             "graphs",
             "graphs/bench",

@@ -5,8 +5,7 @@ use crate::harness::{repo, weft};
 use std::path::PathBuf;
 
 fn temp_graph(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("weft-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    let dir = crate::harness::scratch(&format!("weft-cli-{}-{name}", std::process::id()));
     let path = dir.join("g.ron");
     std::fs::write(&path, text).expect("write graph");
     path

@@ -6,21 +6,17 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
+pub use weft_testkit::scratch::{scratch, scratch_path};
 
 /// The repository root.
 pub fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// This process's user cache folder, emptied once when first asked for.
+/// This process's user cache folder, empty when first asked for.
 pub fn user_cache() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let dir = std::env::temp_dir().join(format!("weft-cli-cache-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("temp cache dir");
-        dir
-    })
+    DIR.get_or_init(|| scratch(&format!("weft-cli-cache-{}", std::process::id())))
 }
 
 /// `weft ARGS` run in `dir`, not yet started; `.env("WEFT_CACHE_DIR", ..)` may replace the cache.

@@ -5,9 +5,9 @@ use crate::harness::{repo, weft};
 use std::path::{Path, PathBuf};
 
 fn temp_png(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("weft-render-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
+    static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| crate::harness::scratch(&format!("weft-render-cli-{}", std::process::id())))
+        .join(name)
 }
 
 #[test]
@@ -139,8 +139,7 @@ fn bad_times_frame_counts_and_feature_names_are_refused() {
 
 #[test]
 fn more_light_volumes_than_the_limit_are_refused_at_the_pass() {
-    let dir = std::env::temp_dir().join(format!("weft-volumes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    let dir = crate::harness::scratch(&format!("weft-volumes-{}", std::process::id()));
     let scene = dir.join("many.scene");
     std::fs::write(
         &scene,
@@ -192,9 +191,7 @@ fn render_exr((scene, graph): (&str, &str), out: &Path, extra: &[&str]) -> std::
 
 #[test]
 fn readback_images_are_written_beside_the_output_and_the_first_is_the_exr() {
-    let dir = std::env::temp_dir().join(format!("weft-readback-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("--out's folder must exist");
+    let dir = crate::harness::scratch(&format!("weft-readback-{}", std::process::id()));
     let out = dir.join("o.exr");
     let args =
         |extra: &[&str]| render_exr(("scenes/demo.scene", "graphs/deferred.ron"), &out, extra);
@@ -237,9 +234,7 @@ fn readback_images_are_written_beside_the_output_and_the_first_is_the_exr() {
 /// conditions.
 #[test]
 fn read_backs_asked_by_name_are_kept_whatever_the_graphs_conditions() {
-    let dir = std::env::temp_dir().join(format!("weft-readback-asked-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("--out's folder must exist");
+    let dir = crate::harness::scratch(&format!("weft-readback-asked-{}", std::process::id()));
     let out = dir.join("o.exr");
     let args =
         |extra: &[&str]| render_exr(("scenes/cornell.scene", "graphs/hybrid.ron"), &out, extra);

@@ -99,8 +99,7 @@ fn a_closed_pipe_ends_the_command_quietly() {
 
 #[test]
 fn a_scene_error_shows_the_offending_line() {
-    let dir = std::env::temp_dir().join(format!("weft-scene-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    let dir = crate::harness::scratch(&format!("weft-scene-cli-{}", std::process::id()));
     let path = dir.join("bad.scene");
     std::fs::write(&path, "camera {\n  position 0 0 5\n  fov banana\n}\n").expect("write");
     let out = weft(&["scene", "check", path.to_str().expect("utf-8 path")]);
@@ -121,8 +120,8 @@ fn a_scene_error_shows_the_offending_line() {
 /// warnings included; `--no-cache` writes nothing.
 #[test]
 fn check_uses_the_model_cache_unless_told_not_to() {
-    let cache = std::env::temp_dir().join(format!("weft-scene-cli-cache-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&cache);
+    let cache =
+        crate::harness::scratch_path(&format!("weft-scene-cli-cache-{}", std::process::id()));
     let check = |extra: &[&str]| {
         let mut args = vec![
             "scene",

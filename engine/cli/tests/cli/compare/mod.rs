@@ -11,10 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("weft-compare-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+    crate::harness::scratch(&format!("weft-compare-cli-{name}-{}", std::process::id()))
 }
 
 /// Runs weft with its user cache in `cache`.

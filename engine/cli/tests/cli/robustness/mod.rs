@@ -48,10 +48,7 @@ fn stderr(out: &Output) -> String {
 
 /// A fresh temporary folder for one test.
 fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("weft-robust-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+    crate::harness::scratch(&format!("weft-robust-{name}-{}", std::process::id()))
 }
 
 fn mkfifo(path: &Path) {

@@ -257,8 +257,7 @@ struct Copy(PathBuf);
 
 impl Copy {
     fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("weft-view-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+        let dir = crate::harness::scratch_path(&format!("weft-view-{name}-{}", std::process::id()));
         for folder in ["graphs", "shaders"] {
             copy_dir(&repo().join(folder), &dir.join(folder));
         }

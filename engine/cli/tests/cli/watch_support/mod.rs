@@ -58,8 +58,8 @@ pub struct Fixture {
 impl Fixture {
     /// Copies the graphs and shaders and writes the scene, under a name unique to the test.
     pub fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("weft-watch-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+        let dir =
+            crate::harness::scratch_path(&format!("weft-watch-{name}-{}", std::process::id()));
         copy_dir(&repo().join("graphs"), &dir.join("graphs"));
         copy_dir(&repo().join("shaders"), &dir.join("shaders"));
         std::fs::create_dir_all(dir.join("scenes")).expect("scenes folder");
