@@ -8,7 +8,7 @@ and relative MSE against a converged Mitsuba reference. Budgets run
 interleaved, round by round. The time to HDR-FLIP 0.06 is interpolated
 between budgets on log-log axes.
 
-- Mitsuba (`scalar_rgb`, all cores) renders chunks of `--chunk` spp with
+- Mitsuba (`scalar_rgb` unless `--variant`, all cores) renders chunks of `--chunk` spp with
   successive seeds, averaged, until another chunk would end past the budget
   (the scene is loaded and the thread pool warm before the clock starts).
   With `--mitsuba-sampler` other than `independent` (`multijitter`,
@@ -85,13 +85,13 @@ def mitsuba_once_for(seconds, scene, chunk):
     seconds it took. The rate is measured on a render of about a tenth of
     the budget, after a `chunk`-spp one sizes it: a stratified sampler's
     cost per sample grows with the count, so a small render overestimates it."""
-    rate = None
-    for spp in (chunk, None):
-        spp = spp or max(chunk, int(rate * seconds / 10))
+    def rate(spp):
         started = time.perf_counter()
         np.array(mi.render(scene, spp=spp, seed=0))
-        rate = spp / (time.perf_counter() - started)
-    spp = max(1, int(rate * seconds))
+        return spp / (time.perf_counter() - started)
+
+    calibration = max(chunk, int(rate(chunk) * seconds / 10))
+    spp = max(1, int(rate(calibration) * seconds))
     started = time.perf_counter()
     image = np.array(mi.render(scene, spp=spp, seed=1))[:, :, :3]
     return image, spp, time.perf_counter() - started

@@ -36,35 +36,52 @@ const PAIR_T: [(usize, usize, u32); 6] = [
     (2, 3, 2),
 ];
 
+/// How many of `points` fall in each of `cells` cells, `cell` saying which.
+fn cell_counts(points: &[[f32; 4]], cells: usize, cell: impl Fn(&[f32; 4]) -> usize) -> Vec<u32> {
+    let mut counts = vec![0u32; cells];
+    for p in points {
+        counts[cell(p)] += 1;
+    }
+    counts
+}
+
 /// Where `points` fail to be a (t, k, 2)-net in a pair of their numbers, or
 /// to stratify each number alone, with k = log2 of their count.
 fn net_failures(points: &[[f32; 4]]) -> Vec<String> {
     let k = points.len().trailing_zeros();
-    let cells = 1usize << k;
     let mut failures = Vec::new();
     for (x, y, t) in PAIR_T.into_iter().filter(|&(_, _, t)| t <= k) {
         for a in 0..=k - t {
             let (columns, rows) = (1usize << a, 1usize << (k - t - a));
-            let mut seen = vec![0u32; columns * rows];
-            for p in points {
-                seen[(p[y] * rows as f32) as usize * columns + (p[x] * columns as f32) as usize] +=
-                    1;
-            }
-            if seen.iter().any(|&n| n != 1 << t) {
+            let counts = cell_counts(points, columns * rows, |p| {
+                (p[y] * rows as f32) as usize * columns + (p[x] * columns as f32) as usize
+            });
+            if counts.iter().any(|&n| n != 1 << t) {
                 failures.push(format!("numbers {x} and {y}, boxes {columns}x{rows}"));
             }
         }
     }
+    let cells = points.len();
     for dimension in 0..4 {
-        let mut seen = vec![0u32; cells];
-        for p in points {
-            seen[(p[dimension] * cells as f32) as usize] += 1;
-        }
-        if seen.iter().any(|&n| n != 1) {
+        let counts = cell_counts(points, cells, |p| (p[dimension] * cells as f32) as usize);
+        if counts.iter().any(|&n| n != 1) {
             failures.push(format!("number {dimension} alone"));
         }
     }
     failures
+}
+
+/// Every aligned block of 2^k of `points` (k = 0..8) that fails
+/// [`net_failures`], and how.
+fn block_failures(points: &[[f32; 4]]) -> Vec<String> {
+    (0..=8)
+        .flat_map(|k| points.chunks(1 << k))
+        .flat_map(|block| {
+            net_failures(block)
+                .into_iter()
+                .map(move |f| format!("{} samples: {f}", block.len()))
+        })
+        .collect()
 }
 
 /// Pearson's correlation of two equally long series.
@@ -89,15 +106,8 @@ fn sobol_draws_stratify_every_power_of_two_block_and_stay_independent() {
                 points.iter().flatten().all(|&u| (0.0..1.0).contains(&u)),
                 "numbers in [0, 1)"
             );
-            for k in 0..=8 {
-                for block in points.chunks(1 << k) {
-                    for failure in net_failures(block) {
-                        failures.push(format!(
-                            "{name} draw, pixel {pixel}, {} samples: {failure}",
-                            block.len()
-                        ));
-                    }
-                }
+            for failure in block_failures(&points) {
+                failures.push(format!("{name} draw, pixel {pixel}, {failure}"));
             }
         }
     }
