@@ -31,14 +31,20 @@ struct LeafTriangle {
 
 #define NO_CHILD 0xffffffffu
 
-layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLES) readonly buffer Triangles { vec4 corners[]; };
-layout(std430, set = SET_SCENE, binding = BINDING_BVH_NODES) readonly buffer BvhNodes { WideNode nodes[]; };
-layout(std430, set = SET_SCENE, binding = BINDING_BVH_LEAF_TRIANGLES) readonly buffer BvhLeafTriangles { LeafTriangle leaf_triangles[]; };
-layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_NORMALS) readonly buffer TriangleNormals { vec4 corner_normals[]; };
-layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_UVS) readonly buffer TriangleUvs { vec2 corner_uvs[]; };
+// The tables every ray reads (triangles, BVH, per-corner attributes) are
+// texel buffers of 32-bit words, read by texel fetches: lavapipe loads a
+// storage buffer one component of one lane at a time in a loop, a texel
+// buffer a whole texel per lane at once (docs/pathtrace.md). Per corner, a
+// texel: the world position (w 1), normal and tangent (w the bitangent's
+// sign, zero without tangents), UV (two words).
+layout(set = SET_SCENE, binding = BINDING_TRIANGLES) uniform usamplerBuffer trace_corners;
+layout(set = SET_SCENE, binding = BINDING_BVH_NODES) uniform usamplerBuffer bvh_nodes;
+layout(set = SET_SCENE, binding = BINDING_BVH_LEAF_TRIANGLES) uniform usamplerBuffer bvh_leaf_triangles;
+layout(set = SET_SCENE, binding = BINDING_TRIANGLE_NORMALS) uniform usamplerBuffer trace_normals;
+layout(set = SET_SCENE, binding = BINDING_TRIANGLE_UVS) uniform usamplerBuffer trace_uvs;
 // Per triangle: x the index into the Materials buffer (scene.glsl, binding
 // 3), y the draw record that placed it (Draws, binding 2).
-layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_MATERIALS) readonly buffer TriangleMaterials { uvec2 triangle_materials[]; };
+layout(set = SET_SCENE, binding = BINDING_TRIANGLE_MATERIALS) uniform usamplerBuffer trace_materials;
 // The emissive triangles as an alias table over emitted power
 // (engine/render/src/emitters.rs): emitter_info = (count, bits of the sum of
 // luminance x area, 0, 0); per emitter (triangle, alias, bits of the keep
@@ -68,8 +74,7 @@ layout(set = SET_SCENE, binding = BINDING_TRACE_DATA_256) uniform sampler2DArray
 layout(set = SET_SCENE, binding = BINDING_TRACE_DATA_512) uniform sampler2DArray trace_data_512;
 layout(set = SET_SCENE, binding = BINDING_TRACE_DATA_1024) uniform sampler2DArray trace_data_1024;
 layout(std430, set = SET_SCENE, binding = BINDING_MATERIAL_TEXTURES) readonly buffer MaterialTextures { uvec4 material_textures[]; };
-// Per corner: unit world tangent, w the bitangent's sign (0 without tangents).
-layout(std430, set = SET_SCENE, binding = BINDING_TRIANGLE_TANGENTS) readonly buffer TriangleTangents { vec4 corner_tangents[]; };
+layout(set = SET_SCENE, binding = BINDING_TRIANGLE_TANGENTS) uniform usamplerBuffer trace_tangents;
 
 #define NO_TEXTURE 0xffffffffu
 
@@ -89,6 +94,47 @@ vec4 trace_texel(uint slot, bool colour, vec2 uv) {
     return size_class == 0u ? textureLod(trace_data_256, at, 0.0)
         : size_class == 1u  ? textureLod(trace_data_512, at, 0.0)
                             : textureLod(trace_data_1024, at, 0.0);
+}
+
+// Corner `i`'s world position (the corners of triangle t are 3t, 3t + 1, 3t + 2).
+vec3 corner(uint i) {
+    return uintBitsToFloat(texelFetch(trace_corners, int(i)).xyz);
+}
+
+// Corner `i`'s normal.
+vec3 corner_normal(uint i) {
+    return uintBitsToFloat(texelFetch(trace_normals, int(i)).xyz);
+}
+
+// Corner `i`'s tangent, w the bitangent's sign.
+vec4 corner_tangent(uint i) {
+    return uintBitsToFloat(texelFetch(trace_tangents, int(i)));
+}
+
+// Corner `i`'s UV.
+vec2 corner_uv(uint i) {
+    return uintBitsToFloat(texelFetch(trace_uvs, int(i)).xy);
+}
+
+// Triangle `tri`'s material index (x) and draw record (y).
+uvec2 triangle_material(uint tri) {
+    return texelFetch(trace_materials, int(tri)).xy;
+}
+
+// Node `index` of the wide BVH.
+WideNode wide_node(uint index) {
+    int at = int(index) * 8;
+    return WideNode(uintBitsToFloat(texelFetch(bvh_nodes, at)), uintBitsToFloat(texelFetch(bvh_nodes, at + 1)),
+        uintBitsToFloat(texelFetch(bvh_nodes, at + 2)), uintBitsToFloat(texelFetch(bvh_nodes, at + 3)),
+        uintBitsToFloat(texelFetch(bvh_nodes, at + 4)), uintBitsToFloat(texelFetch(bvh_nodes, at + 5)),
+        texelFetch(bvh_nodes, at + 6), texelFetch(bvh_nodes, at + 7));
+}
+
+// Leaf triangle `slot`.
+LeafTriangle leaf_triangle(uint slot) {
+    int at = int(slot) * 3;
+    return LeafTriangle(uintBitsToFloat(texelFetch(bvh_leaf_triangles, at)),
+        uintBitsToFloat(texelFetch(bvh_leaf_triangles, at + 1)), uintBitsToFloat(texelFetch(bvh_leaf_triangles, at + 2)));
 }
 
 // Most pending nodes the walk's stack holds: up to three per level of the
@@ -150,7 +196,7 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
     uint best_tri = 0u;
     bool hit = false;
     // An empty scene still has a (minimum-size) buffer: fewer than 3 corners.
-    if (uint(corners.length()) < 3u) {
+    if (textureSize(trace_corners) < 3) {
         return vec2(-1.0, 0.0);
     }
     vec3 inv_dir = 1.0 / dir;
@@ -164,7 +210,7 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
         if (entry[top] >= best_t) {
             continue;
         }
-        WideNode node = nodes[stack[top]];
+        WideNode node = wide_node(stack[top]);
         vec4 x0 = (node.lo_x - origin.x) * inv_dir.x;
         vec4 x1 = (node.hi_x - origin.x) * inv_dir.x;
         vec4 y0 = (node.lo_y - origin.y) * inv_dir.y;
@@ -199,7 +245,7 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
                 : j < to2 ? node.child[s1] + (j - to1)
                 : j < to3 ? node.child[s2] + (j - to2)
                           : node.child[s3] + (j - to3);
-            LeafTriangle tri = leaf_triangles[at];
+            LeafTriangle tri = leaf_triangle(at);
             float t = trace_triangle(tri.a.xyz, tri.e1.xyz, tri.e2.xyz, origin, dir);
             if (t > 0.0 && t < best_t) {
                 best_t = t;
@@ -271,9 +317,9 @@ struct TraceSurface {
 
 // The surface of triangle `tri` where the ray reaches it at distance `t`.
 TraceSurface trace_surface(uint tri, vec3 origin, vec3 dir, float t) {
-    vec3 a = corners[3u * tri].xyz;
-    vec3 e1 = corners[3u * tri + 1u].xyz - a;
-    vec3 e2 = corners[3u * tri + 2u].xyz - a;
+    vec3 a = corner(3u * tri);
+    vec3 e1 = corner(3u * tri + 1u) - a;
+    vec3 e2 = corner(3u * tri + 2u) - a;
     vec3 p = origin + t * dir;
     // Barycentrics of p: solve p - a = u e1 + v e2 in the triangle's plane.
     vec3 d = p - a;
@@ -288,16 +334,16 @@ TraceSurface trace_surface(uint tri, vec3 origin, vec3 dir, float t) {
     float w = 1.0 - u - v;
     TraceSurface s;
     s.position = p;
-    vec3 n = w * corner_normals[3u * tri].xyz + u * corner_normals[3u * tri + 1u].xyz
-        + v * corner_normals[3u * tri + 2u].xyz;
+    vec3 n = w * corner_normal(3u * tri) + u * corner_normal(3u * tri + 1u)
+        + v * corner_normal(3u * tri + 2u);
     s.geometric_normal = normalize(cross(e1, e2));
     s.normal = dot(n, n) > 0.0 ? normalize(n) : s.geometric_normal;
-    s.uv = w * corner_uvs[3u * tri] + u * corner_uvs[3u * tri + 1u] + v * corner_uvs[3u * tri + 2u];
-    s.tangent = vec4(w * corner_tangents[3u * tri].xyz + u * corner_tangents[3u * tri + 1u].xyz
-            + v * corner_tangents[3u * tri + 2u].xyz,
-        corner_tangents[3u * tri].w);
-    s.material = triangle_materials[tri].x;
-    s.draw = triangle_materials[tri].y;
+    s.uv = w * corner_uv(3u * tri) + u * corner_uv(3u * tri + 1u) + v * corner_uv(3u * tri + 2u);
+    s.tangent = vec4(w * corner_tangent(3u * tri).xyz + u * corner_tangent(3u * tri + 1u).xyz
+            + v * corner_tangent(3u * tri + 2u).xyz,
+        corner_tangent(3u * tri).w);
+    s.material = triangle_material(tri).x;
+    s.draw = triangle_material(tri).y;
     return s;
 }
 

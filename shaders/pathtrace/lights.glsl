@@ -122,9 +122,9 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
         e = emitters[e.y];
     }
     uint tri = e.x;
-    vec3 a = corners[3u * tri].xyz;
-    vec3 b = corners[3u * tri + 1u].xyz;
-    vec3 c = corners[3u * tri + 2u].xyz;
+    vec3 a = corner(3u * tri);
+    vec3 b = corner(3u * tri + 1u);
+    vec3 c = corner(3u * tri + 2u);
     float su = sqrt(u.z);
     vec3 point = (1.0 - su) * a + (u.w * su) * b + (su - u.w * su) * c;
     vec3 ng = normalize(cross(b - a, c - a));
@@ -138,12 +138,12 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
     ls.distance = sqrt(d2);
     ls.direction = to_light / max(ls.distance, 1e-20);
     float cos_light = -dot(ls.direction, ng);
-    uint material = triangle_materials[tri].x;
+    uint material = triangle_material(tri).x;
     if (cos_light <= 0.0 || d2 <= 0.0) {
         return false;
     }
-    vec2 uv = (1.0 - su) * corner_uvs[3u * tri] + (u.w * su) * corner_uvs[3u * tri + 1u]
-        + (su - u.w * su) * corner_uvs[3u * tri + 2u];
+    vec2 uv = (1.0 - su) * corner_uv(3u * tri) + (u.w * su) * corner_uv(3u * tri + 1u)
+        + (su - u.w * su) * corner_uv(3u * tri + 2u);
     ls.pdf = p_select * emitter_area_pdf(materials[material].emissive.rgb) * d2 / cos_light;
     ls.value = emitted_at(material, uv) / ls.pdf;
     return true;

@@ -161,7 +161,7 @@ fn ray_tracing_data_needs_the_provider_declared() {
     let messages: Vec<&str> = diagnostics.iter().map(|d| d.message.as_str()).collect();
     assert!(
         messages.iter().any(|m| m.contains(
-            "shader binding `BvhNodes` (set 1 binding 6) is ray-tracing scene data, which the engine feeds only to passes that declare `derive: [RayTracing()]`"
+            "shader binding `bvh_nodes` (set 1 binding 6) is ray-tracing scene data, which the engine feeds only to passes that declare `derive: [RayTracing()]`"
         )),
         "{messages:#?}"
     );

@@ -158,3 +158,128 @@ impl Drop for Buffer<'_> {
         }
     }
 }
+
+/// How a [`TexelBuffer`]'s texels are laid out: 32-bit words, read in
+/// GLSL through a `usamplerBuffer` (floats with `uintBitsToFloat`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TexelFormat {
+    /// Four words a texel (`R32G32B32A32_UINT`): a `uvec4` or `vec4`.
+    Words4,
+    /// Two words a texel (`R32G32_UINT`): a `uvec2` or `vec2`.
+    Words2,
+}
+
+impl TexelFormat {
+    /// The Vulkan format.
+    pub fn vk(self) -> vk::Format {
+        match self {
+            Self::Words4 => vk::Format::R32G32B32A32_UINT,
+            Self::Words2 => vk::Format::R32G32_UINT,
+        }
+    }
+
+    /// Bytes of one texel.
+    pub fn bytes(self) -> u64 {
+        match self {
+            Self::Words4 => 16,
+            Self::Words2 => 8,
+        }
+    }
+}
+
+/// A device-local table that shaders read through a `usamplerBuffer` and
+/// `texelFetch`. On lavapipe a texel fetch loads each lane's whole texel
+/// with one vector load, where a storage-buffer read loads every component
+/// of every lane in a loop with a branch per load (docs/pathtrace.md
+/// measures what this buys the ray tracer).
+pub struct TexelBuffer<'g> {
+    buffer: Buffer<'g>,
+    /// The view shaders read the texels through.
+    pub view: vk::BufferView,
+}
+
+impl<'g> TexelBuffer<'g> {
+    /// A texel buffer holding `bytes`, a whole number of `format`'s
+    /// texels, refused when the device's texel buffers cannot hold that
+    /// many.
+    pub fn device_local(
+        gpu: &'g Gpu,
+        name: &str,
+        bytes: &[u8],
+        format: TexelFormat,
+    ) -> Result<Self, GpuError> {
+        texels_within(
+            name,
+            bytes.len(),
+            format,
+            gpu.info().max_texel_buffer_elements,
+        )?;
+        let buffer =
+            Buffer::device_local(gpu, name, bytes, vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER)?;
+        let info = vk::BufferViewCreateInfo::default()
+            .buffer(buffer.buffer)
+            .format(format.vk())
+            .offset(0)
+            .range(vk::WHOLE_SIZE);
+        let view =
+            unsafe { gpu.device().create_buffer_view(&info, None) }.call("vkCreateBufferView")?;
+        Ok(Self { buffer, view })
+    }
+}
+
+impl Drop for TexelBuffer<'_> {
+    fn drop(&mut self) {
+        unsafe {
+            self.buffer
+                .gpu
+                .device()
+                .destroy_buffer_view(self.view, None)
+        };
+    }
+}
+
+/// The texels `len` bytes of `format` make, or the error that names `what`
+/// when they are not whole texels or a texel buffer of the device (`limit`
+/// texels at most) cannot hold them.
+fn texels_within(what: &str, len: usize, format: TexelFormat, limit: u32) -> Result<u64, GpuError> {
+    let texels = len as u64 / format.bytes();
+    if !(len as u64).is_multiple_of(format.bytes()) {
+        return Err(GpuError::Allocation {
+            what: what.to_string(),
+            message: format!("{len} bytes are not whole {}-byte texels", format.bytes()),
+        });
+    }
+    if texels > u64::from(limit) {
+        return Err(GpuError::TooManyTexels {
+            what: what.to_string(),
+            texels,
+            limit,
+        });
+    }
+    Ok(texels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{texels_within, TexelFormat};
+
+    #[test]
+    fn a_table_must_be_whole_texels_within_the_device_limit() {
+        assert_eq!(texels_within("t", 48, TexelFormat::Words4, 3).unwrap(), 3);
+        assert_eq!(texels_within("t", 48, TexelFormat::Words2, 6).unwrap(), 6);
+        assert_eq!(texels_within("t", 0, TexelFormat::Words4, 0).unwrap(), 0);
+        assert_eq!(
+            texels_within("the BVH nodes", 64, TexelFormat::Words4, 3)
+                .unwrap_err()
+                .to_string(),
+            "the BVH nodes needs 4 texels; this device's texel buffers hold at most 3 \
+             (maxTexelBufferElements)"
+        );
+        assert_eq!(
+            texels_within("uvs", 20, TexelFormat::Words2, 100)
+                .unwrap_err()
+                .to_string(),
+            "memory allocation for uvs failed: 20 bytes are not whole 8-byte texels"
+        );
+    }
+}

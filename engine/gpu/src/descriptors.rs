@@ -87,6 +87,7 @@ impl Drop for DescriptorPool<'_> {
 pub struct DescriptorWriter {
     images: Vec<(u32, vk::DescriptorType, [vk::DescriptorImageInfo; 1])>,
     buffers: Vec<(u32, vk::DescriptorType, [vk::DescriptorBufferInfo; 1])>,
+    texel_buffers: Vec<(u32, [vk::BufferView; 1])>,
 }
 
 impl DescriptorWriter {
@@ -124,6 +125,12 @@ impl DescriptorWriter {
         self
     }
 
+    /// A uniform texel buffer's `view` at `binding`.
+    pub fn texel_buffer(&mut self, binding: u32, view: vk::BufferView) -> &mut Self {
+        self.texel_buffers.push((binding, [view]));
+        self
+    }
+
     /// Writes everything collected into `set`, which no pending work may be using.
     pub fn write(&self, gpu: &Gpu, set: vk::DescriptorSet) {
         let images = self.images.iter().map(|(binding, ty, info)| {
@@ -140,7 +147,14 @@ impl DescriptorWriter {
                 .descriptor_type(*ty)
                 .buffer_info(info)
         });
-        let writes: Vec<_> = images.chain(buffers).collect();
+        let texel_buffers = self.texel_buffers.iter().map(|(binding, view)| {
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(*binding)
+                .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
+                .texel_buffer_view(view)
+        });
+        let writes: Vec<_> = images.chain(buffers).chain(texel_buffers).collect();
         if !writes.is_empty() {
             unsafe { gpu.device().update_descriptor_sets(&writes, &[]) };
         }

@@ -37,6 +37,17 @@ pub enum GpuError {
         /// The allocator's reason.
         message: String,
     },
+    /// A table read through a texel buffer is larger than the device's
+    /// texel buffers can be.
+    #[error("{what} needs {texels} texels; this device's texel buffers hold at most {limit} (maxTexelBufferElements)")]
+    TooManyTexels {
+        /// What the table holds.
+        what: String,
+        /// Its size in texels.
+        texels: u64,
+        /// The device's `maxTexelBufferElements`.
+        limit: u32,
+    },
     /// A shader failed to compile or reflect.
     #[error(transparent)]
     Shader(#[from] crate::shader::ShaderError),

@@ -19,6 +19,8 @@ pub enum DescriptorKind {
     UniformBuffer,
     /// `buffer` blocks: storage buffers.
     StorageBuffer,
+    /// `samplerBuffer` and friends: a buffer read through `texelFetch`.
+    UniformTexelBuffer,
 }
 
 impl DescriptorKind {
@@ -29,6 +31,7 @@ impl DescriptorKind {
             Self::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
             Self::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
             Self::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+            Self::UniformTexelBuffer => vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
         }
     }
 }
@@ -177,6 +180,7 @@ impl ShaderInterface {
                         DescriptorType::StorageImage(_) => DescriptorKind::StorageImage,
                         DescriptorType::UniformBuffer() => DescriptorKind::UniformBuffer,
                         DescriptorType::StorageBuffer(_) => DescriptorKind::StorageBuffer,
+                        DescriptorType::UniformTexelBuffer() => DescriptorKind::UniformTexelBuffer,
                         other => {
                             return Err(fail(format!(
                                 "binding {} uses unsupported descriptor type {other:?}",

@@ -52,18 +52,18 @@ pub const MATERIALS_BINDING: u32 = 3;
 /// Binding of the shadow views (`Shadows` in `shaders/include/shadows.glsl`).
 pub const SHADOWS_BINDING: u32 = 4;
 /// Binding of the ray tracer's triangles: three world-space corners per
-/// triangle, each a vec4 (`Triangles` in `shaders/include/trace.glsl`).
+/// triangle, a texel each (`trace_corners` in `shaders/include/trace.glsl`).
 pub const TRIANGLES_BINDING: u32 = 5;
-/// Binding of the ray tracer's 4-wide BVH nodes (`BvhNodes`).
+/// Binding of the ray tracer's 4-wide BVH nodes (`bvh_nodes`, 8 texels each).
 pub const BVH_NODES_BINDING: u32 = 6;
 /// Binding of the BVH's leaf triangles, in leaf order with their edges
-/// (`BvhLeafTriangles`): leaves point into it.
+/// (`bvh_leaf_triangles`, 3 texels each): leaves point into it.
 pub const BVH_LEAF_TRIANGLES_BINDING: u32 = 7;
-/// Binding of the corners' world normals (`TriangleNormals`, a vec4 each).
+/// Binding of the corners' world normals (`trace_normals`, a texel each).
 pub const TRIANGLE_NORMALS_BINDING: u32 = 8;
-/// Binding of the corners' UVs (`TriangleUvs`, a vec2 each).
+/// Binding of the corners' UVs (`trace_uvs`, a two-word texel each).
 pub const TRIANGLE_UVS_BINDING: u32 = 9;
-/// Binding of each triangle's material index and draw record (`TriangleMaterials`).
+/// Binding of each triangle's material index and draw record (`trace_materials`).
 pub const TRIANGLE_MATERIALS_BINDING: u32 = 10;
 /// Binding of the emissive triangles' alias table (`Emitters`,
 /// [`crate::emitters::EmitterTable`]).
@@ -81,7 +81,7 @@ pub const fn is_trace_texture(binding: u32) -> bool {
 
 /// Binding of each material's texture slots (`MaterialTextures`).
 pub const MATERIAL_TEXTURES_BINDING: u32 = 18;
-/// Binding of the corners' world tangents (`TriangleTangents`, a vec4 each,
+/// Binding of the corners' world tangents (`trace_tangents`, a texel each,
 /// w the bitangent's sign).
 pub const TRIANGLE_TANGENTS_BINDING: u32 = 19;
 /// Binding of the LTC tables analytic area lights read (`LtcTables` in
@@ -164,37 +164,37 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 16] = [
     tracing(
         "TRIANGLES",
         TRIANGLES_BINDING,
-        DescriptorKind::StorageBuffer,
+        DescriptorKind::UniformTexelBuffer,
         "the ray tracer's triangles",
     ),
     tracing(
         "BVH_NODES",
         BVH_NODES_BINDING,
-        DescriptorKind::StorageBuffer,
+        DescriptorKind::UniformTexelBuffer,
         "the BVH nodes",
     ),
     tracing(
         "BVH_LEAF_TRIANGLES",
         BVH_LEAF_TRIANGLES_BINDING,
-        DescriptorKind::StorageBuffer,
+        DescriptorKind::UniformTexelBuffer,
         "the BVH's leaf triangles",
     ),
     tracing(
         "TRIANGLE_NORMALS",
         TRIANGLE_NORMALS_BINDING,
-        DescriptorKind::StorageBuffer,
+        DescriptorKind::UniformTexelBuffer,
         "the corners' normals",
     ),
     tracing(
         "TRIANGLE_UVS",
         TRIANGLE_UVS_BINDING,
-        DescriptorKind::StorageBuffer,
+        DescriptorKind::UniformTexelBuffer,
         "the corners' UVs",
     ),
     tracing(
         "TRIANGLE_MATERIALS",
         TRIANGLE_MATERIALS_BINDING,
-        DescriptorKind::StorageBuffer,
+        DescriptorKind::UniformTexelBuffer,
         "the triangles' materials and draws",
     ),
     tracing(
@@ -248,7 +248,7 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 16] = [
     tracing(
         "TRIANGLE_TANGENTS",
         TRIANGLE_TANGENTS_BINDING,
-        DescriptorKind::StorageBuffer,
+        DescriptorKind::UniformTexelBuffer,
         "the corners' tangents",
     ),
     tracing(
@@ -258,6 +258,23 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 16] = [
         "the light choice table",
     ),
 ];
+
+/// How many of set 1's tracing-only bindings are texel buffers (the tables
+/// every ray reads: triangles, BVH, per-corner attributes).
+pub const TRACE_TEXEL_BUFFERS: u32 = {
+    let mut count = 0;
+    let mut i = 0;
+    while i < TRACE_SET_BINDINGS.len() {
+        if matches!(
+            TRACE_SET_BINDINGS[i].kind,
+            DescriptorKind::UniformTexelBuffer
+        ) {
+            count += 1;
+        }
+        i += 1;
+    }
+    count
+};
 /// Set 2 as the engine creates it: a material's textures, in the order of its
 /// texture slots.
 pub const MATERIAL_SET_BINDINGS: [SceneBinding; 5] = [

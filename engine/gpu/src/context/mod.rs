@@ -54,6 +54,9 @@ pub struct DeviceInfo {
     /// The largest width or height of a 2D image (`maxImageDimension2D`):
     /// plans with a larger image are refused before any is created.
     pub max_image_dimension: u32,
+    /// The most texels a texel buffer's view may cover
+    /// (`maxTexelBufferElements`): larger scene tables are refused.
+    pub max_texel_buffer_elements: u32,
 }
 
 /// The physical device type, in preference order.

@@ -159,6 +159,7 @@ pub(super) fn choose_device(
             fragment_stores: f2.fragment_stores_and_atomics == vk::TRUE,
             shaders: ShaderSupport::query(instance, physical),
             max_image_dimension: props.limits.max_image_dimension2_d,
+            max_texel_buffer_elements: props.limits.max_texel_buffer_elements,
         };
         candidates.push((physical, info, family as u32));
     }

@@ -139,6 +139,38 @@ fn reflects_samplers_and_push_constants() {
 }
 
 #[test]
+fn reflects_texel_buffers() {
+    let shader = compiler()
+        .compile_source(
+            "#version 450
+layout(local_size_x = 8) in;
+layout(set = 1, binding = 6) uniform usamplerBuffer nodes;
+layout(set = 0, binding = 0) buffer Out { uvec4 out_texels[]; };
+void main() {
+    out_texels[gl_GlobalInvocationID.x] = texelFetch(nodes, int(gl_GlobalInvocationID.x));
+}
+",
+            &dir().join("texels.comp"),
+            ShaderStage::Compute,
+            &[],
+        )
+        .expect("compiles");
+    let iface = ShaderInterface::reflect(&shader).expect("reflects");
+    let kinds: Vec<(u32, u32, &str, DescriptorKind)> = iface
+        .bindings
+        .iter()
+        .map(|b| (b.set, b.binding, b.name.as_str(), b.kind))
+        .collect();
+    assert_eq!(
+        kinds,
+        vec![
+            (0, 0, "Out", DescriptorKind::StorageBuffer),
+            (1, 6, "nodes", DescriptorKind::UniformTexelBuffer),
+        ]
+    );
+}
+
+#[test]
 fn reflects_vulkan_1_3_compute_storage() {
     let shader = compiler()
         .compile_file(&dir().join("blur.comp"), ShaderStage::Compute, &[])

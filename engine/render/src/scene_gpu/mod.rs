@@ -68,6 +68,10 @@ fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuE
                 (SCENE_SET_BINDINGS.len() + TRACE_SET_BINDINGS.len()) as u32 * scene_sets,
             ),
             (
+                vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
+                TRACE_TEXEL_BUFFERS,
+            ),
+            (
                 vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
                 MATERIAL_SET_BINDINGS.len() as u32 * materials.max(1) + TRACE_TEXTURE_ARRAYS,
             ),
@@ -346,6 +350,9 @@ impl<'g> GpuScene<'g> {
         {
             if let Some(buffer) = self.scene_buffer(b) {
                 writer.buffer(b, kind.vk(), buffer.buffer);
+            }
+            if let Some(view) = self.trace.as_ref().and_then(|t| t.texel_view(b)) {
+                writer.texel_buffer(b, view);
             }
             let texture = self
                 .trace

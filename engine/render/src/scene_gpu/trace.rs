@@ -11,19 +11,20 @@ use crate::light_choice::LightChoices;
 use crate::lights::LightSet;
 use ash::vk;
 use std::path::Path;
-use weft_gpu::buffer::Buffer;
+use weft_gpu::buffer::TexelFormat::{Words2, Words4};
+use weft_gpu::buffer::{Buffer, TexelBuffer};
 use weft_gpu::texture::{Rgba8Image, Texture};
 use weft_gpu::{Gpu, GpuError};
 
 /// The ray tracer's scene data on the device.
 pub(super) struct TraceBuffers<'g> {
-    pub(super) triangles: Buffer<'g>,
-    pub(super) nodes: Buffer<'g>,
-    pub(super) leaf_triangles: Buffer<'g>,
-    pub(super) normals: Buffer<'g>,
-    pub(super) tangents: Buffer<'g>,
-    pub(super) uvs: Buffer<'g>,
-    pub(super) materials: Buffer<'g>,
+    pub(super) triangles: TexelBuffer<'g>,
+    pub(super) nodes: TexelBuffer<'g>,
+    pub(super) leaf_triangles: TexelBuffer<'g>,
+    pub(super) normals: TexelBuffer<'g>,
+    pub(super) tangents: TexelBuffer<'g>,
+    pub(super) uvs: TexelBuffer<'g>,
+    pub(super) materials: TexelBuffer<'g>,
     pub(super) emitters: Buffer<'g>,
     /// Which light NEE samples ([`LightChoices`]), rewritten when lights change.
     pub(super) light_choices: Buffer<'g>,
@@ -83,27 +84,37 @@ impl<'g> TraceBuffers<'g> {
             .collect();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         Ok(Self {
-            triangles: Buffer::device_local(gpu, "trace triangles", bytes_of(&corners), storage)?,
-            nodes: Buffer::device_local(gpu, "bvh nodes", bytes_of(&wide.nodes), storage)?,
-            leaf_triangles: Buffer::device_local(
+            triangles: TexelBuffer::device_local(
                 gpu,
-                "bvh leaf triangles",
+                "the ray tracer's triangles",
+                bytes_of(&corners),
+                Words4,
+            )?,
+            nodes: TexelBuffer::device_local(gpu, "the BVH nodes", bytes_of(&wide.nodes), Words4)?,
+            leaf_triangles: TexelBuffer::device_local(
+                gpu,
+                "the BVH's leaf triangles",
                 bytes_of(&wide.triangles),
-                storage,
+                Words4,
             )?,
-            normals: Buffer::device_local(gpu, "trace normals", bytes_of(&normals), storage)?,
-            tangents: Buffer::device_local(
+            normals: TexelBuffer::device_local(
                 gpu,
-                "trace tangents",
+                "the corners' normals",
+                bytes_of(&normals),
+                Words4,
+            )?,
+            tangents: TexelBuffer::device_local(
+                gpu,
+                "the corners' tangents",
                 bytes_of(&mesh.tangents),
-                storage,
+                Words4,
             )?,
-            uvs: Buffer::device_local(gpu, "trace uvs", bytes_of(&uvs), storage)?,
-            materials: Buffer::device_local(
+            uvs: TexelBuffer::device_local(gpu, "the corners' UVs", bytes_of(&uvs), Words2)?,
+            materials: TexelBuffer::device_local(
                 gpu,
-                "trace materials and draws",
+                "the triangles' materials and draws",
                 bytes_of(&material_draws),
-                storage,
+                Words2,
             )?,
             emitters: Buffer::device_local(gpu, "emitters", &emitters.bytes(), storage)?,
             light_choices: {
@@ -148,16 +159,23 @@ impl<'g> TraceBuffers<'g> {
         self.light_choices.write(&choices.bytes())
     }
 
+    /// The texel buffer view behind a tracing-only set 1 binding.
+    pub(super) fn texel_view(&self, binding: u32) -> Option<vk::BufferView> {
+        match binding {
+            TRIANGLES_BINDING => Some(self.triangles.view),
+            BVH_NODES_BINDING => Some(self.nodes.view),
+            BVH_LEAF_TRIANGLES_BINDING => Some(self.leaf_triangles.view),
+            TRIANGLE_NORMALS_BINDING => Some(self.normals.view),
+            TRIANGLE_TANGENTS_BINDING => Some(self.tangents.view),
+            TRIANGLE_UVS_BINDING => Some(self.uvs.view),
+            TRIANGLE_MATERIALS_BINDING => Some(self.materials.view),
+            _ => None,
+        }
+    }
+
     /// The buffer behind a tracing-only set 1 binding.
     pub(super) fn buffer(&self, binding: u32) -> Option<&Buffer<'g>> {
         match binding {
-            TRIANGLES_BINDING => Some(&self.triangles),
-            BVH_NODES_BINDING => Some(&self.nodes),
-            BVH_LEAF_TRIANGLES_BINDING => Some(&self.leaf_triangles),
-            TRIANGLE_NORMALS_BINDING => Some(&self.normals),
-            TRIANGLE_TANGENTS_BINDING => Some(&self.tangents),
-            TRIANGLE_UVS_BINDING => Some(&self.uvs),
-            TRIANGLE_MATERIALS_BINDING => Some(&self.materials),
             EMITTERS_BINDING => Some(&self.emitters),
             LIGHT_CHOICES_BINDING => Some(&self.light_choices),
             MATERIAL_TEXTURES_BINDING => Some(&self.material_textures),
