@@ -137,10 +137,14 @@ LeafTriangle leaf_triangle(uint slot) {
         uintBitsToFloat(texelFetch(bvh_leaf_triangles, at + 1)), uintBitsToFloat(texelFetch(bvh_leaf_triangles, at + 2)));
 }
 
-// Most pending nodes the walk's stack holds: up to three per level of the
-// wide tree, whose depth is about half the binary tree's (docs/pathtrace.md:
-// 26 binary levels on demo.scene).
-#define TRACE_STACK 64
+// Most pending nodes the walk's stack holds: a step pops one node and pushes
+// up to four, so a tree of L wide levels needs at most 3 (L - 2) + 4
+// (WideBvh::stack_need; the renderer warns of a deeper tree, and GPU_STACK in
+// bvh_wide.rs must equal this). Not a multiple of 32: lavapipe gives each lane
+// its local arrays at a stride of their size, and with the two arrays below
+// at 256, 512 or 768 bytes a lane the Cornell box rendered 1.13-1.17x slower
+// than at 192, 384, 448, 480 or 576 (docs/pathtrace.md).
+#define TRACE_STACK 72
 
 // How far outside a triangle, in barycentric units, a hit still counts, so a
 // ray through an edge two triangles share cannot slip between them

@@ -24,6 +24,11 @@ pub const WIDTH: usize = 4;
 /// `count` of a child slot that holds no child.
 pub const NO_CHILD: u32 = u32::MAX;
 
+/// Pending nodes the GPU walk's stack holds (`TRACE_STACK` in
+/// `shaders/include/trace.glsl`; a test holds the two equal). A deeper tree
+/// than it allows would lose nodes there, so the renderer warns of one.
+pub const GPU_STACK: usize = 72;
+
 /// One node as the shader reads it (`struct WideNode`, std430).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
@@ -140,6 +145,17 @@ impl WideBvh {
             }
         }
         deepest
+    }
+
+    /// At most how many nodes the walk's stack holds at once on this tree:
+    /// a step pops one node and pushes up to four, so a node at depth d
+    /// leaves at most 3 d + 4 pending, and only nodes with inner children,
+    /// two levels above the deepest leaf at most, push.
+    pub fn stack_need(&self) -> usize {
+        match self.depth() {
+            0 | 1 => 1,
+            depth => 3 * (depth - 2) + WIDTH,
+        }
     }
 
     /// [`Bvh::sah_cost`] for the wide tree: a visit, which tests four boxes,
@@ -414,6 +430,51 @@ mod tests {
         assert!(
             hits > 500,
             "the test rays must hit often enough to mean something: {hits}"
+        );
+    }
+
+    /// The most nodes pending when every box is entered (the walk's worst
+    /// case): the stack the walk would hold, simulated.
+    fn pushed_when_every_box_is_entered(wide: &WideBvh) -> usize {
+        let mut stack = vec![0u32];
+        let mut most = 1;
+        while let Some(n) = stack.pop() {
+            let node = &wide.nodes[n as usize];
+            stack.extend(
+                (0..WIDTH)
+                    .filter(|&s| node.count[s] == 0)
+                    .map(|s| node.child[s]),
+            );
+            most = most.max(stack.len());
+        }
+        most
+    }
+
+    #[test]
+    fn the_stack_need_bounds_the_walk_and_the_shader_holds_it() {
+        for (count, seed) in [(1, 1), (40, 2), (3000, 3), (20000, 4)] {
+            let tris = soup(count, seed);
+            let wide = WideBvh::collapse(&Bvh::build(&tris), &tris);
+            let pushed = pushed_when_every_box_is_entered(&wide);
+            assert!(
+                pushed <= wide.stack_need(),
+                "{count}: {pushed} > {}",
+                wide.stack_need()
+            );
+            assert!(
+                wide.stack_need() <= GPU_STACK,
+                "{count}: {}",
+                wide.stack_need()
+            );
+        }
+        let shader = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../shaders/include/trace.glsl"),
+        )
+        .expect("trace.glsl");
+        assert!(
+            shader.contains(&format!("#define TRACE_STACK {GPU_STACK}\n")),
+            "trace.glsl's TRACE_STACK is not GPU_STACK ({GPU_STACK})"
         );
     }
 
