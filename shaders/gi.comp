@@ -39,7 +39,6 @@ layout(set = 0, binding = 2, rgba32f) uniform image2D gi;
 layout(push_constant) uniform Params {
     uint rays;
     uint frames;
-    uint light_choice;
     uint history_frames;
     uint frame;
 } params;
@@ -68,7 +67,7 @@ void main() {
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
-        sum += one_bounce(origin + dir * step, dir, params.light_choice, rng);
+        sum += one_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng);
     }
     vec3 radiance = sum / float(max(params.rays, 1u));
     // A running mean over the last frames, its count capped at `frames`;

@@ -54,7 +54,6 @@ layout(push_constant) uniform Params {
     uint rays;
     uint frames;
     uint max_depth;
-    uint light_choice;
     uint history_frames;
     uint frame;
 } params;
@@ -76,7 +75,7 @@ bool traced(Material m) {
 vec3 chain(vec3 origin, vec3 dir, uint depth, vec3 medium, inout Rng rng) {
     vec3 radiance = vec3(0.0);
     vec3 throughput = vec3(1.0);
-    uint choice = params.light_choice;
+    uint choice = LIGHT_CHOICE;
     for (; depth <= params.max_depth; ++depth) {
         if (all(equal(throughput, vec3(0.0)))) {
             break;
@@ -186,7 +185,7 @@ vec3 through_traced_lobes(TraceSurface s, Material m, vec3 dir, inout Rng rng) {
     vec3 wi;
     vec3 weight;
     if (glass < 1.0 && glossy_sample(surface_bsdf(s, m), n, wo, rng_next(rng).xy, wi, weight) && dot(wi, ng) > 0.0) {
-        radiance += (1.0 - glass) * weight * one_bounce(leave(s.position, ng), wi, params.light_choice, rng);
+        radiance += (1.0 - glass) * weight * one_bounce(leave(s.position, ng), wi, LIGHT_CHOICE, rng);
     }
 #endif
     return radiance;

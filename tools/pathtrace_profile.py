@@ -2,8 +2,8 @@
 """Where the path tracer's time goes, stage by stage (issue 34, docs/pathtrace.md).
 
 lavapipe has no shader profiler and its compute timestamps mean nothing, so
-this measures by doubling: for each stage of `shaders/pathtrace/trace.comp`
-it writes a copy of graphs/ and shaders/ in which every call of that stage is
+this measures by doubling: for each stage of a path segment
+(`shaders/pathtrace/path.glsl`, which the megakernel `trace.comp` calls) it writes a copy of graphs/ and shaders/ in which every call of that stage is
 made twice (the second call's inputs multiplied by an exact 1.0 the compiler
 cannot see through, and the two results merged by a select it cannot fold),
 renders with `weft bench pathtrace`, and takes the extra time as the stage's
@@ -29,8 +29,9 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-KERNEL = Path("shaders/pathtrace/trace.comp")
-# Helpers go after this line: every include and the push constants are above it.
+KERNEL = Path("shaders/pathtrace/path.glsl")
+# Helpers go after this line: every include is above it, and the including
+# kernel declares the push constants before it includes path.glsl.
 ANCHOR = "const uint SAMPLING_BSDF = 2u;\n"
 
 # An exact 1.0 and 0 the compiler cannot know: max_depth is at least 1 and at
@@ -86,10 +87,11 @@ TraceSurface profile_surface(uint tri, vec3 o, vec3 d, float t) {
     "light sample": (
         "sample_light: picking a light and a point on it",
         """
-bool profile_sample_light(vec3 p, vec3 n, vec4 u_pick, vec4 u_point, out LightSample ls) {
+bool profile_sample_light(vec3 p, vec3 n, vec3 at, vec4 u_pick, vec4 u_point, uint choice,
+    out LightSample ls) {
     LightSample other;
-    bool found_other = sample_light(p, n * profile_one(), u_pick, u_point, other);
-    bool found = sample_light(p, n, u_pick, u_point, ls);
+    bool found_other = sample_light(p, n * profile_one(), at, u_pick, u_point, choice, other);
+    bool found = sample_light(p, n, at, u_pick, u_point, choice, ls);
     ls.direction = all(equal(other.direction, ls.direction)) ? ls.direction : other.direction;
     ls.value = all(equal(other.value, ls.value)) ? ls.value : other.value;
     ls.distance = other.distance == ls.distance ? ls.distance : other.distance;

@@ -4,8 +4,9 @@
 // live path and keep the path in a queue between them. Both call
 // path_segment, so a seed gives both the same image, bit for bit.
 //
-// The including shader declares `params` with max_depth, rr_depth, sampling,
-// fresnel, nee_through_glass and light_choice (graphs/path_tracer.ron says
+// The including shader declares `params` with max_depth, rr_depth, sampling
+// and fresnel, and its pass defines LIGHT_CHOICE and NEE_THROUGH_GLASS, the
+// graph's `light_choice` and `nee_through_glass` (graphs/path_tracer.ron says
 // what each means).
 #ifndef WEFT_PT_PATH_GLSL
 #define WEFT_PT_PATH_GLSL
@@ -85,7 +86,7 @@ bool bent_shadow_ray(vec3 origin, vec3 dir, out vec3 through) {
 // Traces the path's segment number `p.depth` and adds what it finds; true
 // when the path goes on (with its next ray in `p`), false when it ends.
 bool path_segment(inout Path p, inout Rng rng) {
-    uint choice = params.light_choice;
+    uint choice = LIGHT_CHOICE;
     // A path whose throughput is zero (a black surface, or absorption
     // that underflowed) can add nothing more: without Russian roulette
     // it would walk on to max_depth and hold its SIMD group there.
@@ -158,7 +159,7 @@ bool path_segment(inout Path p, inout Rng rng) {
                 p.radiance += p.throughput * f * ls.value * w;
             }
 #ifdef SCENE_DIELECTRICS
-            else if (params.nee_through_glass != 0u && ls.pdf > 0.0 && any(greaterThan(f, vec3(0.0)))) {
+            else if (NEE_THROUGH_GLASS != 0 && ls.pdf > 0.0 && any(greaterThan(f, vec3(0.0)))) {
                 vec3 through;
                 if (bent_shadow_ray(from, ls.direction, through)) {
                     p.radiance += p.throughput * f * ls.value * through;

@@ -35,8 +35,9 @@
 // Each pixel's estimate is as before in distribution; neighbours' errors
 // correlate (docs/pathtrace.md measures both).
 //
-// `light_choice` 0 picks the light NEE samples uniformly; 1 half uniformly,
-// half by its power (engine/render/src/light_choice.rs).
+// `light_choice` (the define LIGHT_CHOICE, so only the chosen way is
+// compiled) 0 picks the light NEE samples uniformly; 1 half uniformly, half
+// by its power (engine/render/src/light_choice.rs); 2 by the light tree.
 //
 // `sampling` chooses how lights with area are found: 0 combines NEE and BSDF
 // sampling by MIS; 1 is NEE only (a BSDF-sampled ray that finds such a light
@@ -45,7 +46,8 @@
 // NEE.
 //
 // Glass: `fresnel` 0 uses Fresnel's exact equations, 1 Schlick's
-// approximation. `nee_through_glass` 1 adds the biased "Snell-bent" NEE of
+// approximation. `nee_through_glass` 1 (the define NEE_THROUGH_GLASS) adds the
+// biased "Snell-bent" NEE of
 // docs/pathtrace.md: a shadow ray that meets glass refracts through it (up to
 // 8 surfaces) and counts if it then meets a light with area, with the sampled
 // light point's value, while BSDF-sampled paths through glass still count:
@@ -76,8 +78,6 @@ layout(push_constant) uniform Params {
     uint seed;
     uint sampling;
     uint fresnel;
-    uint nee_through_glass;
-    uint light_choice;
     uint accumulate;
     uint coherent_lanes;
     uint history_frames;

@@ -28,8 +28,6 @@ layout(push_constant) uniform Params {
     uint rr_depth;
     uint sampling;
     uint fresnel;
-    uint nee_through_glass;
-    uint light_choice;
     uint history_frames;
     uint repeat_index;
     uvec2 extent;

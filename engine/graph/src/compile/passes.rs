@@ -116,10 +116,14 @@ fn plan_pass(
     let mut model_defines = Vec::new();
     for define in &pass.defines {
         if super::conditions_hold(&define.enabled_if, &options.features) {
+            let text = match &define.value {
+                Some(crate::schema::ParamValue::Number(n)) => format!("{}={n}", define.name),
+                _ => define.name.clone(),
+            };
             match define.draws {
-                Some(model) => model_defines.push((model, define.name.clone())),
+                Some(model) => model_defines.push((model, text)),
                 None => {
-                    defines.insert(define.name.clone());
+                    defines.insert(text);
                 }
             }
         }
@@ -364,6 +368,25 @@ mod tests {
         let extra = a(&["extra"]);
         assert_eq!(extra.render_pass.as_ref().map(|rp| rp.color.len()), Some(2));
         assert_eq!(extra.defines, ["HAS_TINT"]);
+    }
+
+    #[test]
+    fn a_define_with_a_value_is_name_equals_the_parameter_it_names() {
+        let text = CHAIN
+            .replacen("Graph(", r#"Graph(params: { "choice": 2 },"#, 1)
+            .replace(
+                r#"sampled: ["x"], color: [(image: "out")]"#,
+                r#"sampled: ["x"], color: [(image: "out")],
+                 defines: [(name: "CHOICE", value: "$choice"), (name: "TWELVE", value: 12),
+                           (name: "PLAIN", enabled_if: ["plain"])]"#,
+            );
+        let b = |features: &[&str]| {
+            let plan = plan_of(&text, features);
+            let b = plan.passes.iter().find(|p| p.name == "b").expect("b runs");
+            b.defines.clone()
+        };
+        assert_eq!(b(&[]), ["CHOICE=2", "TWELVE=12"]);
+        assert_eq!(b(&["plain"]), ["CHOICE=2", "PLAIN", "TWELVE=12"]);
     }
 
     #[test]

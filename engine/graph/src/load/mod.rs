@@ -3,8 +3,8 @@
 
 mod params;
 
-pub(crate) use params::non_finite;
 pub use params::resolve_value;
+pub(crate) use params::{non_finite, value_text};
 use params::{report_not_taken, resolve_params, split_qualified};
 
 use crate::diagnostic::Diagnostic;

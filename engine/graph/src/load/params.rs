@@ -285,7 +285,7 @@ fn refusal(
 }
 
 /// A value as a user would type it.
-fn value_text(value: &ParamValue) -> String {
+pub(crate) fn value_text(value: &ParamValue) -> String {
     match value {
         ParamValue::Bool(b) => b.to_string(),
         ParamValue::Number(n) => format!("{n}"),

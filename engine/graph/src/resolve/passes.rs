@@ -322,6 +322,15 @@ impl Resolver<'_> {
                             ..d.clone()
                         };
                         let name = define.name.clone();
+                        if define.value.is_some() {
+                            let path =
+                                pass_path(index, &[Seg::Field("define_sets"), Seg::Index(k)]);
+                            self.error(
+                                source,
+                                &path,
+                                format!("define set \"{set}\" gives \"{name}\" a value; a define with a value belongs to the pass's own `defines`"),
+                            );
+                        }
                         if !add_define(&mut defines, define) {
                             let path =
                                 pass_path(index, &[Seg::Field("define_sets"), Seg::Index(k)]);
@@ -381,7 +390,14 @@ impl Resolver<'_> {
                 )
                 .hint = Some("remove `draws`, or give the pass `draw: Meshes(...)`".into());
             }
-            if !add_define(&mut defines, define.clone()) {
+            let define = crate::schema::DefineDecl {
+                value: define
+                    .value
+                    .as_ref()
+                    .and_then(|value| self.define_value(source, (index, k), name, value)),
+                ..define.clone()
+            };
+            if !add_define(&mut defines, define) {
                 self.error(
                     source,
                     &path,
@@ -391,6 +407,45 @@ impl Resolver<'_> {
             }
         }
         defines
+    }
+
+    /// A define's value as a whole number, its `$parameter` resolved; `None`
+    /// after reporting one that is not a whole number or names no parameter.
+    fn define_value(
+        &mut self,
+        source: usize,
+        (index, k): (usize, usize),
+        name: &str,
+        value: &ParamValue,
+    ) -> Option<ParamValue> {
+        let path = pass_path(
+            index,
+            &[Seg::Field("defines"), Seg::Index(k), Seg::Field("value")],
+        );
+        match crate::load::resolve_value(&self.graph.sources[source].params, value) {
+            Ok(ParamValue::Number(n)) if n.fract() == 0.0 && n.abs() < 2f64.powi(53) => {
+                Some(ParamValue::Number(n))
+            }
+            Ok(other) => {
+                self.error(
+                    source,
+                    &path,
+                    format!(
+                        "define \"{name}\": its value must be a whole number, found {}",
+                        crate::load::value_text(&other)
+                    ),
+                );
+                None
+            }
+            Err(missing) => {
+                self.error(
+                    source,
+                    &path,
+                    format!("define \"{name}\": unknown parameter \"${missing}\""),
+                );
+                None
+            }
+        }
     }
 
     /// A pass's declared fixed-function state, with bias parameters resolved;

@@ -102,6 +102,12 @@ pub struct DefineDecl {
     /// model: the pass's draws are grouped by model, one shader variant each.
     #[serde(default)]
     pub draws: Option<ShadingModel>,
+    /// A whole-number value, given or a graph parameter's (`"$light_choice"`):
+    /// `NAME=VALUE`, so code a parameter switches off is not compiled (on
+    /// lavapipe, which runs both sides of every branch, it would still run).
+    /// Resolved to the number when the graph is resolved.
+    #[serde(default)]
+    pub value: Option<ParamValue>,
 }
 
 /// A material's shading model, as mesh draws are grouped by it.

@@ -153,3 +153,30 @@ fn a_set_define_that_is_no_preprocessor_name_is_an_error_at_the_set() {
         "{text:?}"
     );
 }
+
+#[test]
+fn a_set_define_with_a_value_is_an_error_at_the_pass() {
+    let sets = r#"Graph(fragment: true, params: { "n": 2 },
+        define_sets: { "valued": [(name: "N", value: "$n")] })"#;
+    let main = r#"Graph(
+    include: [(file: "sets.ron")],
+    resources: [Image(name: "ldr", format: R8G8B8A8_UNORM)],
+    passes: [Pass(name: "t", kind: Fullscreen, shaders: (fragment: "t.frag"), color: [(image: "ldr")],
+                  define_sets: ["valued"])],
+    output: "ldr",
+)"#;
+    let text: Vec<String> = weft_graph::check(&load_files(
+        "/g/main.ron",
+        &[("/g/sets.ron", sets), ("/g/main.ron", main)],
+    ))
+    .iter()
+    .map(ToString::to_string)
+    .collect();
+    assert_eq!(text.len(), 1, "{text:?}");
+    assert!(
+        text[0].contains(
+            "define set \"valued\" gives \"N\" a value; a define with a value belongs to the pass's own `defines`"
+        ),
+        "{text:?}"
+    );
+}

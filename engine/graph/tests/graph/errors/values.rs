@@ -195,6 +195,37 @@ fn a_define_must_be_a_preprocessor_name_the_engine_does_not_own() {
 }
 
 #[test]
+fn a_define_value_is_a_whole_number_or_a_parameter_holding_one() {
+    let graph = |value: &str| {
+        VALID
+            .replacen("Graph(", r#"Graph(params: { "choice": 2, "scale": 0.5, "on": true },"#, 1)
+            .replace(
+                r#"draw: Meshes(Opaque),"#,
+                &format!("draw: Meshes(Opaque),\n            defines: [(name: \"CHOICE\", value: {value})],"),
+            )
+    };
+    assert!(errors(&graph("\"$choice\"")).is_empty());
+    assert!(errors(&graph("3")).is_empty());
+    let text = graph("\"$scale\"");
+    let d = only_error(&text);
+    assert_eq!(
+        d.message,
+        "define \"CHOICE\": its value must be a whole number, found 0.5"
+    );
+    assert!(text_at(&text, &d).starts_with("\"$scale\""), "{d:?}");
+    let d = only_error(&graph("\"$on\""));
+    assert_eq!(
+        d.message,
+        "define \"CHOICE\": its value must be a whole number, found true"
+    );
+    let d = only_error(&graph("\"$choise\""));
+    assert_eq!(
+        d.message,
+        "define \"CHOICE\": unknown parameter \"$choise\""
+    );
+}
+
+#[test]
 fn a_define_for_one_shading_model_needs_a_pass_that_draws_meshes() {
     let on_meshes = VALID.replace(
         r#"draw: Meshes(Opaque),"#,
