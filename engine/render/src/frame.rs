@@ -50,8 +50,9 @@ pub struct RenderSettings {
     /// at a fixed time, instead of `frames` frames.
     pub samples: Option<u64>,
     /// Stop before a frame that would end past this many seconds of
-    /// rendering, judged by the latest frame after the first (at least one
-    /// frame is drawn; the first, which builds pipelines, is no measure).
+    /// rendering, counted from after the pipelines are built and judged by
+    /// the latest frame after the first (at least one frame is drawn; the
+    /// first, which uploads the scene's ray-tracing data, is no measure).
     pub time_limit: Option<f64>,
     /// Where derived scene data is cached between runs (the ray tracer's
     /// BVH); `None` caches nothing.
@@ -127,9 +128,9 @@ pub struct Progress {
 }
 
 /// How long the next frame is expected to take, from the frames drawn so far
-/// (`frame_ms`): the latest one after the first, which also compiles shaders,
-/// builds pipelines and the BVH and so says nothing about the frames after it;
-/// 0 when only the first has been drawn.
+/// (`frame_ms`): the latest one after the first, which also builds the BVH
+/// and uploads the ray tracer's tables and so says nothing about the frames
+/// after it; 0 when only the first has been drawn.
 fn typical_frame_seconds(frame_ms: &[f64]) -> f64 {
     frame_ms
         .get(1..)
@@ -254,6 +255,8 @@ pub fn render_with_progress(
     uploaded.cache_bvh_in(settings.cache_dir.clone());
     let warnings = uploaded.warnings.clone();
     let mut frames = FrameLoop::new(gpu, Arc::clone(&plan), (uploaded, updater))?;
+    // Pipelines are built before the clock starts: `time_limit` counts rendering.
+    frames.prepare()?;
     let mut record_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut frame_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut timings = Vec::with_capacity(count.min(4096) as usize);

@@ -98,6 +98,14 @@ impl<'g> FrameLoop<'g> {
         })
     }
 
+    /// Builds the plan's pipelines now instead of in the first frame, so a
+    /// caller timing frames can leave the builds out.
+    pub fn prepare(&mut self) -> Result<(), RenderError> {
+        self.renderer
+            .prepare(&self.plan, &mut self.resources)
+            .map_err(|e| RenderError::at_pass(e, &self.plan))
+    }
+
     /// Draws one frame: the scene moved to the request's time, the plan
     /// recorded and submitted, waited for, read back when asked.
     pub fn draw(&mut self, request: &FrameRequest<'_>) -> Result<FrameReport, RenderError> {

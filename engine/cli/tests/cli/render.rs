@@ -324,6 +324,16 @@ fn a_time_limit_stops_early_and_reports_the_samples_reached() {
 }
 
 #[test]
+fn a_time_limit_counts_rendering_not_pipeline_builds() {
+    // lavapipe builds the path tracer's pipeline in about 165 ms here; a
+    // 24x24 frame takes a few. Were the build counted, a 0.1 s budget would
+    // end after the first frame.
+    let (json, _) = path_traced("pt-quick.png", "100000", "1", &["--time-limit", "0.1"]);
+    let frames = json["frames"].as_u64().expect("frames");
+    assert!(frames >= 3, "{json}");
+}
+
+#[test]
 fn spp_on_a_graph_that_does_not_accumulate_is_refused() {
     let out = weft(&[
         "render",

@@ -299,6 +299,36 @@ impl<'g> Renderer<'g> {
         Ok(Some((key, bindings)))
     }
 
+    /// Builds the plan's pipelines and writes its descriptor sets now rather
+    /// than in the first [`execute`](Self::execute), so a caller that times
+    /// frames (`--time-limit`) can leave the pipeline builds out.
+    pub fn prepare(
+        &mut self,
+        plan: &Plan,
+        resources: &mut FrameResources<'g>,
+    ) -> Result<(), GpuError> {
+        let ready = self.ready_plan(plan, resources)?;
+        self.prepared = Some(ready);
+        Ok(())
+    }
+
+    /// The prepared plan kept from the last frame or [`prepare`](Self::prepare),
+    /// or a new one when the plan's pipelines or its resources changed since.
+    fn ready_plan(
+        &mut self,
+        plan: &Plan,
+        resources: &mut FrameResources<'g>,
+    ) -> Result<PreparedPlan<'g>, GpuError> {
+        match self.prepared.take() {
+            Some(ready)
+                if ready.generation == self.generation && ready.resources == resources.id =>
+            {
+                Ok(ready)
+            }
+            _ => self.prepare_plan(plan, resources),
+        }
+    }
+
     /// Runs one frame of the plan on `resources` (made by `create_resources`
     /// for the same plan); scene draws come from `draws`.
     pub fn execute(
@@ -310,14 +340,7 @@ impl<'g> Renderer<'g> {
     ) -> Result<FrameReport, GpuError> {
         let started = Instant::now();
         draws.begin_frame()?;
-        let mut ready = match self.prepared.take() {
-            Some(ready)
-                if ready.generation == self.generation && ready.resources == resources.id =>
-            {
-                ready
-            }
-            _ => self.prepare_plan(plan, resources)?,
-        };
+        let mut ready = self.ready_plan(plan, resources)?;
         for (pass, prep) in plan.passes.iter().zip(&mut ready.passes) {
             prep.push = self.pack_push(pass, prep, options, 0)?;
         }

@@ -24,7 +24,7 @@ impl<'g> Renderer<'g> {
     ) -> Result<PreparedPlan<'g>, GpuError> {
         let mut passes = Vec::with_capacity(plan.passes.len());
         for pass in &plan.passes {
-            passes.push(self.prepare(plan, pass, resources)?);
+            passes.push(self.prepare_pass(plan, pass, resources)?);
         }
         let pool = descriptor_pool(self.gpu, &passes)?;
         self.write_descriptors(plan, resources, &pool, &mut passes)?;
@@ -68,7 +68,7 @@ impl<'g> Renderer<'g> {
         })
     }
 
-    fn prepare(
+    fn prepare_pass(
         &mut self,
         plan: &Plan,
         pass: &PlanPass,
