@@ -369,6 +369,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             })).collect::<Vec<_>>(),
             "record_ms": record_ms,
             "frame_ms": frame_ms,
+            "prepare_ms": rendered.prepare_ms,
             "timings": timings,
             "statistics": rendered.report.statistics,
             "views": rendered.views
@@ -405,13 +406,15 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             );
         }
         println!(
-            "draw calls: {}; host recording: {record_ms:.3} ms per frame; frame: {frame_ms:.3} ms wall{}",
+            "draw calls: {}; host recording: {record_ms:.3} ms per frame; frame: {frame_ms:.3} ms wall{}; \
+             pipelines and scene data built in {:.0} ms before the first frame",
             rendered.draw_calls,
             if rendered.frame_ms.len() > 1 {
                 " (mean after the first frame)"
             } else {
-                " (one frame, includes pipeline builds)"
-            }
+                " (one frame)"
+            },
+            rendered.prepare_ms
         );
         if !rendered.culling.is_empty() {
             let views: Vec<String> = rendered

@@ -50,9 +50,10 @@ pub struct RenderSettings {
     /// at a fixed time, instead of `frames` frames.
     pub samples: Option<u64>,
     /// Stop before a frame that would end past this many seconds of
-    /// rendering, counted from after the pipelines are built and judged by
-    /// the latest frame after the first (at least one frame is drawn; the
-    /// first, which uploads the scene's ray-tracing data, is no measure).
+    /// rendering, counted from after the pipelines and the ray tracer's data
+    /// are built ([`FrameLoop::prepare`](crate::FrameLoop::prepare)) and
+    /// judged by the latest frame after the first (at least one frame is
+    /// drawn).
     pub time_limit: Option<f64>,
     /// Where derived scene data is cached between runs (the ray tracer's
     /// BVH); `None` caches nothing.
@@ -102,6 +103,10 @@ pub struct Rendered {
     /// Wall-clock milliseconds per frame from starting to record to the GPU
     /// finishing (and the readback, on the last frame), one entry per frame.
     pub frame_ms: Vec<f64>,
+    /// Wall-clock milliseconds before the first frame spent building the
+    /// pipelines and, for a graph that traces, the BVH and the ray tracer's
+    /// tables ([`FrameLoop::prepare`]); not counted against `time_limit`.
+    pub prepare_ms: f64,
     /// Textures that could not be loaded, meshes skipped.
     pub warnings: Vec<String>,
     /// Samples per pixel the output holds, for a progressive graph.
@@ -255,8 +260,11 @@ pub fn render_with_progress(
     uploaded.cache_bvh_in(settings.cache_dir.clone());
     let warnings = uploaded.warnings.clone();
     let mut frames = FrameLoop::new(gpu, Arc::clone(&plan), (uploaded, updater))?;
-    // Pipelines are built before the clock starts: `time_limit` counts rendering.
+    // Pipelines and the ray tracer's data are built before the clock starts:
+    // `time_limit` counts rendering.
+    let preparing = std::time::Instant::now();
     frames.prepare()?;
+    let prepare_ms = preparing.elapsed().as_secs_f64() * 1e3;
     let mut record_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut frame_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut timings = Vec::with_capacity(count.min(4096) as usize);
@@ -312,6 +320,7 @@ pub fn render_with_progress(
         warnings,
         samples,
         timings,
+        prepare_ms,
     })
 }
 

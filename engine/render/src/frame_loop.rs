@@ -11,6 +11,7 @@ use crate::scene_gpu::GpuScene;
 use std::sync::Arc;
 use weft_gpu::pipeline::{ShaderKey, ShaderModule};
 use weft_gpu::resources::GpuImage;
+use weft_gpu::scene::SceneSet;
 use weft_gpu::{FrameOptions, FrameReport, FrameResources, Gpu, GpuError, Renderer, TimingMode};
 use weft_graph::plan::Plan;
 use weft_scene::{Camera, SceneUpdater};
@@ -98,12 +99,17 @@ impl<'g> FrameLoop<'g> {
         })
     }
 
-    /// Builds the plan's pipelines now instead of in the first frame, so a
-    /// caller timing frames can leave the builds out.
+    /// Builds the plan's pipelines, and the ray tracer's BVH and tables when
+    /// a pass traces, now instead of in the first frame, so a caller timing
+    /// frames can leave the builds out.
     pub fn prepare(&mut self) -> Result<(), RenderError> {
         self.renderer
             .prepare(&self.plan, &mut self.resources)
-            .map_err(|e| RenderError::at_pass(e, &self.plan))
+            .map_err(|e| RenderError::at_pass(e, &self.plan))?;
+        if self.plan.passes.iter().any(crate::providers::traces) {
+            self.recorder.scene.scene_set(SceneSet::Traced)?;
+        }
+        Ok(())
     }
 
     /// Draws one frame: the scene moved to the request's time, the plan
