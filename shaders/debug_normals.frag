@@ -31,7 +31,7 @@ void main() {
     n = gl_FrontFacing ? n : -n;
     vec3 mapped = n;
 #ifdef SCENE_NORMAL_MAPS
-    mapped = mapped_normal(n, tangent, world, texcoord, texture(normal_map, texcoord).rgb, materials[material].ambient.w);
+    mapped = mapped_normal(n, tangent, world, texcoord, texture(normal_map, texcoord).rgb, material_record(material).ambient.w);
 #endif
     if (params.normals_mode == 2u) {
         color = tangent.w < 0.0 ? vec4(1.0, 0.0, 1.0, 1.0) : vec4(0.0, 1.0, 0.0, 1.0);

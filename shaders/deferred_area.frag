@@ -26,5 +26,5 @@ void main() {
     if (!read_surface(s)) {
         discard;
     }
-    color = vec4(hdr_output(shade_area_lights(s, materials[s.material], params.area_samples)), 0.0);
+    color = vec4(hdr_output(shade_area_lights(s, material_record(s.material), params.area_samples)), 0.0);
 }

@@ -23,5 +23,5 @@ void main() {
     if (!read_surface(s)) {
         discard;
     }
-    color = vec4(hdr_output(shade_spot(light_index, s, materials[s.material])), 0.0);
+    color = vec4(hdr_output(shade_spot(light_index, s, material_record(s.material))), 0.0);
 }

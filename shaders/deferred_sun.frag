@@ -42,7 +42,7 @@ void main() {
         color = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
-    Material m = materials[s.material];
+    Material m = material_record(s.material);
     vec4 emission_occlusion = read_emission_occlusion();
     vec3 ambient = shade_ambient_emissive(s, m, surroundings(), params.emissive_boost, emission_occlusion.rgb, emission_occlusion.a);
     color = vec4(hdr_output(ambient + traced_specular() + shade_suns(s, m)), 1.0);

@@ -50,7 +50,7 @@ void main() {
 #endif
     vec3 n = normalize(world_normal);
     vec4 texel = texture(base_color, texcoord);
-    Material m = materials[material];
+    Material m = material_record(material);
     vec2 mr = metal_rough(m, texture(metallic_roughness, texcoord));
     // Seen from behind, the normal turns round and, for the bitangent to
     // stay put, so does the handedness.
@@ -72,5 +72,5 @@ void main() {
     vec3 c = shade_ambient_emissive(s, m, frame.ambient.rgb, params.emissive_boost, emission_texel, occlusion)
         + shade_all_lights(s, m, params.area_samples);
     // Alpha matters only where weft-render blends transparent materials.
-    color = vec4(hdr_output(c), materials[material].diffuse.a * texel.a);
+    color = vec4(hdr_output(c), material_record(material).diffuse.a * texel.a);
 }

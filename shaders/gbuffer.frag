@@ -45,7 +45,7 @@ void main() {
     vec3 n = normalize(world_normal);
     // Alpha: whether the camera sees the front, where emitters emit.
     albedo = vec4(texture(base_color, texcoord).rgb, gl_FrontFacing ? 1.0 : 0.0);
-    Material m = materials[material];
+    Material m = material_record(material);
     // Seen from behind, the normal turns round and, for the bitangent to
     // stay put, so does the handedness.
     vec4 tangent = gl_FrontFacing ? world_tangent : vec4(world_tangent.xyz, -world_tangent.w);

@@ -94,7 +94,7 @@ vec3 chain(vec3 origin, vec3 dir, uint depth, vec3 medium, inout Rng rng) {
         }
         throughput *= exp(-medium * t);
         TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
-        Material m = materials[s.material];
+        Material m = material_record(s.material);
         vec3 wo = -dir;
         vec3 ng;
         vec3 n;
@@ -198,7 +198,7 @@ void main() {
         return;
     }
     float d = texelFetch(depth, pixel, 0).r;
-    bool needed = d > 0.0 && traced(materials[decode_material(texelFetch(gbuffer_material, pixel, 0))]);
+    bool needed = d > 0.0 && traced(material_record(decode_material(texelFetch(gbuffer_material, pixel, 0))));
     vec3 radiance = vec3(0.0);
     if (needed) {
         // The camera ray through the pixel's centre, as the G-buffer saw it,
@@ -208,7 +208,7 @@ void main() {
         vec2 found = trace_closest(eye, dir, 1e30);
         if (found.x >= 0.0) {
             TraceSurface s = trace_surface(floatBitsToUint(found.y), eye, dir, found.x);
-            Material m = materials[s.material];
+            Material m = material_record(s.material);
             Rng rng = rng_start(uvec2(pixel), params.frame, 0x6a09e667u);
             for (uint i = 0u; i < params.rays; ++i) {
                 radiance += through_traced_lobes(s, m, dir, rng);

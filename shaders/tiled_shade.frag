@@ -53,7 +53,7 @@ void main() {
         color = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
-    Material m = materials[s.material];
+    Material m = material_record(s.material);
     vec4 emission_occlusion = read_emission_occlusion();
     vec3 c = shade_ambient_emissive(s, m, surroundings(), pc.emissive_boost, emission_occlusion.rgb, emission_occlusion.a)
         + traced_specular()

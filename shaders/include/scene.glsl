@@ -78,6 +78,19 @@ layout(set = SET_SCENE, binding = BINDING_FRAME) uniform Frame {
 
 layout(std430, set = SET_SCENE, binding = BINDING_LIGHTS) readonly buffer Lights { Light lights[]; };
 layout(std430, set = SET_SCENE, binding = BINDING_DRAWS) readonly buffer Draws { Draw draws[]; };
-layout(std430, set = SET_SCENE, binding = BINDING_MATERIALS) readonly buffer Materials { Material materials[]; };
+// The material records, a texel buffer of 8 texels each (32-bit words, floats
+// as their bits): the path tracer reads one at every vertex, and lavapipe
+// reads a storage buffer a component and a lane at a time (docs/pathtrace.md).
+layout(set = SET_SCENE, binding = BINDING_MATERIALS) uniform usamplerBuffer material_table;
+
+// Material `i`'s record.
+Material material_record(uint i) {
+    int at = int(i) * 8;
+    return Material(uintBitsToFloat(texelFetch(material_table, at)),
+        uintBitsToFloat(texelFetch(material_table, at + 1)), uintBitsToFloat(texelFetch(material_table, at + 2)),
+        uintBitsToFloat(texelFetch(material_table, at + 3)), uintBitsToFloat(texelFetch(material_table, at + 4)),
+        uintBitsToFloat(texelFetch(material_table, at + 5)), uintBitsToFloat(texelFetch(material_table, at + 6)),
+        uintBitsToFloat(texelFetch(material_table, at + 7)));
+}
 
 #endif

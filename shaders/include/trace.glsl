@@ -46,21 +46,16 @@ layout(set = SET_SCENE, binding = BINDING_TRIANGLE_UVS) uniform usamplerBuffer t
 // 3), y the draw record that placed it (Draws, binding 2).
 layout(set = SET_SCENE, binding = BINDING_TRIANGLE_MATERIALS) uniform usamplerBuffer trace_materials;
 // The emissive triangles as an alias table over emitted power
-// (engine/render/src/emitters.rs): emitter_info = (count, bits of the sum of
-// luminance x area, 0, 0); per emitter (triangle, alias, bits of the keep
-// threshold, 0).
-layout(std430, set = SET_SCENE, binding = BINDING_EMITTERS) readonly buffer Emitters {
-    uvec4 emitter_info;
-    uvec4 emitters[];
-};
-// Which light next-event estimation picks (engine/render/src/light_choice.rs):
-// light_choice_info = (choices, 0, 0, 0), the analytic lights in record order
-// then, when there are emissive triangles, one choice for them; per choice
-// (alias, bits of the keep threshold, bits of its probability, 0).
-layout(std430, set = SET_SCENE, binding = BINDING_LIGHT_CHOICES) readonly buffer LightChoices {
-    uvec4 light_choice_info;
-    uvec4 light_choice_records[];
-};
+// (engine/render/src/emitters.rs), a texel buffer: emitter_info() = (count,
+// bits of the sum of luminance x area, 0, 0); per emitter (triangle, alias,
+// bits of the keep threshold, 0).
+layout(set = SET_SCENE, binding = BINDING_EMITTERS) uniform usamplerBuffer emitter_table;
+// Which light next-event estimation picks (engine/render/src/light_choice.rs),
+// a texel buffer: light_choice_info() = (choices, 0, 0, 0), the analytic
+// lights in record order then, when there are emissive triangles, one choice
+// for them; per choice (alias, bits of the keep threshold, bits of its
+// probability, 0), the light tree's records after them.
+layout(set = SET_SCENE, binding = BINDING_LIGHT_CHOICES) uniform usamplerBuffer light_choice_table;
 
 // Material textures (engine/render/src/trace_textures.rs): every texture is a
 // layer of one array per size class (256, 512, 1024 texels square), sRGB
@@ -119,6 +114,24 @@ vec2 corner_uv(uint i) {
 // Triangle `tri`'s material index (x) and draw record (y).
 uvec2 triangle_material(uint tri) {
     return texelFetch(trace_materials, int(tri)).xy;
+}
+
+// The emitter table's header, and its record `i`.
+uvec4 emitter_info() {
+    return texelFetch(emitter_table, 0);
+}
+
+uvec4 emitter_record(uint i) {
+    return texelFetch(emitter_table, int(i) + 1);
+}
+
+// The light choice table's header, and its record `i`.
+uvec4 light_choice_info() {
+    return texelFetch(light_choice_table, 0);
+}
+
+uvec4 light_choice_record(uint i) {
+    return texelFetch(light_choice_table, int(i) + 1);
 }
 
 // Node `index` of the wide BVH.

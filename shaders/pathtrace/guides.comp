@@ -55,7 +55,7 @@ void main() {
         return;
     }
     TraceSurface s = trace_surface(floatBitsToUint(found.y), eye, dir, t);
-    Material m = materials[s.material];
+    Material m = material_record(s.material);
     imageStore(guide_previous_position, pixel, vec4((draws[s.draw].previous * vec4(s.position, 1.0)).xyz, 1.0));
 #ifdef SCENE_EMISSIVE
     if (any(greaterThan(m.emissive.rgb, vec3(0.0)))) {

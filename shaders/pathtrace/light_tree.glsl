@@ -5,7 +5,7 @@
 // taking each node's child with probability in proportion to the child's
 // importance at the shading point, so lights near a point, facing it and
 // reaching it get its samples. Stored after the light choice table in the
-// same buffer: light_choice_info.y indexes a header record (top choices,
+// same buffer: light_choice_info().y indexes a header record (top choices,
 // tree nodes, 0, 0), followed by the top choices (alias, threshold bits,
 // probability bits, what: a sun's record, TREE_CHOICE, or frame.counts.w
 // for the emissive triangles), the nodes (five records each: lo and power,
@@ -19,11 +19,11 @@
 #define NODE_RECORDS 5u
 
 uvec4 tree_header() {
-    return light_choice_records[light_choice_info.y];
+    return light_choice_record(light_choice_info().y);
 }
 
 uint tree_top_first() {
-    return light_choice_info.y + 1u;
+    return light_choice_info().y + 1u;
 }
 
 uint tree_node_first() {
@@ -42,11 +42,11 @@ vec2 sub_clamped(vec2 sin_cos_a, vec2 sin_cos_b) {
 // How much light node `node`'s lights can send to p (LightBounds::importance).
 float tree_importance(uint node, vec3 p) {
     uint at = tree_node_first() + NODE_RECORDS * node;
-    uvec4 r0 = light_choice_records[at];
-    uvec4 r1 = light_choice_records[at + 1u];
-    uvec4 r2 = light_choice_records[at + 2u];
-    uvec4 r3 = light_choice_records[at + 3u];
-    vec3 falloff = uintBitsToFloat(light_choice_records[at + 4u].xyz);
+    uvec4 r0 = light_choice_record(at);
+    uvec4 r1 = light_choice_record(at + 1u);
+    uvec4 r2 = light_choice_record(at + 2u);
+    uvec4 r3 = light_choice_record(at + 3u);
+    vec3 falloff = uintBitsToFloat(light_choice_record(at + 4u).xyz);
     vec3 lo = uintBitsToFloat(r0.xyz);
     vec3 hi = uintBitsToFloat(r1.xyz);
     float range = uintBitsToFloat(r1.w);
@@ -79,11 +79,11 @@ float tree_importance(uint node, vec3 p) {
 
 // Inner node `node`'s second child (its first is node + 1).
 uint tree_second_child(uint node) {
-    return light_choice_records[tree_node_first() + NODE_RECORDS * node + 3u].z;
+    return light_choice_record(tree_node_first() + NODE_RECORDS * node + 3u).z;
 }
 
 bool tree_is_leaf(uint node) {
-    return light_choice_records[tree_node_first() + NODE_RECORDS * node + 3u].w != 0u;
+    return light_choice_record(tree_node_first() + NODE_RECORDS * node + 3u).w != 0u;
 }
 
 // One step down from inner node `node` at p: its second child, and the
@@ -123,7 +123,7 @@ bool tree_sample(vec3 p, float u, out uint light, out float pmf) {
             node = second;
         }
     }
-    light = light_choice_records[tree_node_first() + NODE_RECORDS * node + 3u].z;
+    light = light_choice_record(tree_node_first() + NODE_RECORDS * node + 3u).z;
     pmf = chance;
     return true;
 }
@@ -131,7 +131,7 @@ bool tree_sample(vec3 p, float u, out uint light, out float pmf) {
 // The probability tree_sample picks light record `light` for p.
 float tree_pmf(vec3 p, uint light) {
     uvec4 header = tree_header();
-    uvec4 trail = light_choice_records[tree_node_first() + NODE_RECORDS * header.y + light];
+    uvec4 trail = light_choice_record(tree_node_first() + NODE_RECORDS * header.y + light);
     if (header.y == 0u || trail.y == 0xffffffffu || tree_importance(0u, p) <= 0.0) {
         return 0.0;
     }
@@ -154,15 +154,15 @@ float tree_pmf(vec3 p, uint light) {
 uvec4 tree_top_pick(vec2 u) {
     uint count = tree_header().x;
     uint slot = min(uint(u.x * float(count)), count - 1u);
-    uvec4 choice = light_choice_records[tree_top_first() + slot];
-    return u.y < uintBitsToFloat(choice.y) ? choice : light_choice_records[tree_top_first() + choice.x];
+    uvec4 choice = light_choice_record(tree_top_first() + slot);
+    return u.y < uintBitsToFloat(choice.y) ? choice : light_choice_record(tree_top_first() + choice.x);
 }
 
 // The probability of the top choice whose `what` is `what` (0 if none).
 float tree_top_probability(uint what) {
     uint count = tree_header().x;
     for (uint i = 0u; i < count; ++i) {
-        uvec4 choice = light_choice_records[tree_top_first() + i];
+        uvec4 choice = light_choice_record(tree_top_first() + i);
         if (choice.w == what) {
             return uintBitsToFloat(choice.z);
         }

@@ -47,19 +47,19 @@ float light_choice_odds(uint index, vec3 at, uint choice) {
         }
         return 1.0 / top;
     }
-    return choice == LIGHT_CHOICE_POWER ? 1.0 / uintBitsToFloat(light_choice_records[index].z)
-                                        : float(light_choice_info.x);
+    return choice == LIGHT_CHOICE_POWER ? 1.0 / uintBitsToFloat(light_choice_record(index).z)
+                                        : float(light_choice_info().x);
 }
 
 // A choice: the slot u.x falls in; by power (`choice` 1), kept while u.y
 // is below its threshold, else its alias.
 uint pick_light(vec2 u, uint choice) {
-    uint count = light_choice_info.x;
+    uint count = light_choice_info().x;
     uint slot = min(uint(u.x * float(count)), count - 1u);
     if (choice == LIGHT_CHOICE_UNIFORM) {
         return slot;
     }
-    uvec4 record = light_choice_records[slot];
+    uvec4 record = light_choice_record(slot);
     return u.y < uintBitsToFloat(record.y) ? slot : record.x;
 }
 
@@ -103,7 +103,7 @@ bool sample_area(uint index, vec3 p, vec2 u, float p_select, out LightSample ls)
 // (emitter_area_pdf), so a texture changes what a sample carries, not how
 // often it is drawn.
 vec3 emitted_at(uint material, vec2 uv) {
-    vec3 emitted = materials[material].emissive.rgb;
+    vec3 emitted = material_record(material).emissive.rgb;
 #ifdef SCENE_TEXTURES
     emitted *= trace_texel(material_textures[material].w, true, uv).rgb;
 #endif
@@ -112,14 +112,14 @@ vec3 emitted_at(uint material, vec2 uv) {
 
 // The density by area of a point on emissive triangle material `emitted`.
 float emitter_area_pdf(vec3 emitted) {
-    return luminance(emitted) / uintBitsToFloat(emitter_info.y);
+    return luminance(emitted) / uintBitsToFloat(emitter_info().y);
 }
 
 bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
-    uint count = emitter_info.x;
-    uvec4 e = emitters[min(uint(u.x * float(count)), count - 1u)];
+    uint count = emitter_info().x;
+    uvec4 e = emitter_record(min(uint(u.x * float(count)), count - 1u));
     if (u.y >= uintBitsToFloat(e.z)) {
-        e = emitters[e.y];
+        e = emitter_record(e.y);
     }
     uint tri = e.x;
     vec3 a = corner(3u * tri);
@@ -144,7 +144,7 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
     }
     vec2 uv = (1.0 - su) * corner_uv(3u * tri) + (u.w * su) * corner_uv(3u * tri + 1u)
         + (su - u.w * su) * corner_uv(3u * tri + 2u);
-    ls.pdf = p_select * emitter_area_pdf(materials[material].emissive.rgb) * d2 / cos_light;
+    ls.pdf = p_select * emitter_area_pdf(material_record(material).emissive.rgb) * d2 / cos_light;
     ls.value = emitted_at(material, uv) / ls.pdf;
     return true;
 }
@@ -153,7 +153,7 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
 // tree (`choice` 2) walked at `at`, where rays leave the surface. False
 // when there is no light or it sends nothing towards p.
 bool sample_light(vec3 p, vec3 n, vec3 at, vec4 u_pick, vec4 u_point, uint choice, out LightSample ls) {
-    if (light_choice_info.x == 0u) {
+    if (light_choice_info().x == 0u) {
         return false;
     }
     uint pick;

@@ -48,7 +48,7 @@ vec3 one_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng) {
         return frame.ambient.rgb;
     }
     TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
-    Material m = materials[s.material];
+    Material m = material_record(s.material);
     vec3 wo = -dir;
     vec3 ng;
     vec3 n;

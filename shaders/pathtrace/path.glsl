@@ -52,7 +52,7 @@ bool bent_shadow_ray(vec3 origin, vec3 dir, out vec3 through) {
         }
         through *= exp(-medium * t);
         TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
-        Material m = materials[s.material];
+        Material m = material_record(s.material);
 #ifdef SCENE_EMISSIVE
         if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, dir) < 0.0) {
             return true;
@@ -111,7 +111,7 @@ bool path_segment(inout Path p, inout Rng rng) {
 #endif
     uint tri = floatBitsToUint(found.y);
     TraceSurface s = trace_surface(tri, p.origin, p.dir, t);
-    Material m = materials[s.material];
+    Material m = material_record(s.material);
     vec3 wo = -p.dir;
     vec3 ng;
     vec3 n;

@@ -216,6 +216,44 @@ impl<'g> TexelBuffer<'g> {
         )?;
         let buffer =
             Buffer::device_local(gpu, name, bytes, vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER)?;
+        Self::with_view(gpu, buffer, format)
+    }
+
+    /// A host-visible texel buffer holding `bytes`, for a table rewritten
+    /// while the scene runs ([`write`](Self::write)).
+    pub fn host(
+        gpu: &'g Gpu,
+        name: &str,
+        bytes: &[u8],
+        format: TexelFormat,
+    ) -> Result<Self, GpuError> {
+        texels_within(
+            name,
+            bytes.len(),
+            format,
+            gpu.info().max_texel_buffer_elements,
+        )?;
+        let mut buffer = Buffer::host(
+            gpu,
+            name,
+            bytes.len() as u64,
+            vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
+        )?;
+        buffer.write(bytes)?;
+        Self::with_view(gpu, buffer, format)
+    }
+
+    /// Rewrites a host-visible texel buffer from its start.
+    pub fn write(&mut self, bytes: &[u8]) -> Result<(), GpuError> {
+        self.buffer.write(bytes)
+    }
+
+    /// Rewrites part of a host-visible texel buffer, from byte `offset`.
+    pub fn write_at(&mut self, offset: usize, bytes: &[u8]) -> Result<(), GpuError> {
+        self.buffer.write_at(offset, bytes)
+    }
+
+    fn with_view(gpu: &'g Gpu, buffer: Buffer<'g>, format: TexelFormat) -> Result<Self, GpuError> {
         let info = vk::BufferViewCreateInfo::default()
             .buffer(buffer.buffer)
             .format(format.vk())

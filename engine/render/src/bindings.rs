@@ -65,8 +65,8 @@ pub const TRIANGLE_NORMALS_BINDING: u32 = 8;
 pub const TRIANGLE_UVS_BINDING: u32 = 9;
 /// Binding of each triangle's material index and draw record (`trace_materials`).
 pub const TRIANGLE_MATERIALS_BINDING: u32 = 10;
-/// Binding of the emissive triangles' alias table (`Emitters`,
-/// [`crate::emitters::EmitterTable`]).
+/// Binding of the emissive triangles' alias table (`emitter_table`, a texel
+/// buffer; [`crate::emitters::EmitterTable`]).
 pub const EMITTERS_BINDING: u32 = 11;
 /// First of the path tracer's texture arrays (`trace.glsl`): sRGB colour
 /// layers of each size class of [`crate::trace_textures::CLASSES`] at 12, 13,
@@ -93,7 +93,7 @@ pub const VERTICES_BINDING: u32 = 21;
 /// Binding of the index buffer (`Indices` in `shaders/include/mesh_data.glsl`).
 pub const INDICES_BINDING: u32 = 22;
 /// Binding of the table next-event estimation picks a light from
-/// (`LightChoices`, [`crate::light_choice::LightChoices`]).
+/// (`light_choice_table`, a texel buffer; [`crate::light_choice::LightChoices`]).
 pub const LIGHT_CHOICES_BINDING: u32 = 23;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
@@ -128,7 +128,7 @@ pub const SCENE_SET_BINDINGS: [SceneBinding; 8] = [
     raster(
         "MATERIALS",
         MATERIALS_BINDING,
-        DescriptorKind::StorageBuffer,
+        DescriptorKind::UniformTexelBuffer,
         "the materials",
     ),
     raster(
@@ -200,7 +200,7 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 16] = [
     tracing(
         "EMITTERS",
         EMITTERS_BINDING,
-        DescriptorKind::StorageBuffer,
+        DescriptorKind::UniformTexelBuffer,
         "the emissive triangles",
     ),
     tracing(
@@ -254,27 +254,31 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 16] = [
     tracing(
         "LIGHT_CHOICES",
         LIGHT_CHOICES_BINDING,
-        DescriptorKind::StorageBuffer,
+        DescriptorKind::UniformTexelBuffer,
         "the light choice table",
     ),
 ];
 
+/// How many of set 1's raster bindings are texel buffers (the material
+/// records).
+pub const SCENE_TEXEL_BUFFERS: u32 = texel_buffers(&SCENE_SET_BINDINGS);
 /// How many of set 1's tracing-only bindings are texel buffers (the tables
-/// every ray reads: triangles, BVH, per-corner attributes).
-pub const TRACE_TEXEL_BUFFERS: u32 = {
+/// every ray or light sample reads: triangles, BVH, per-corner attributes,
+/// emitters, light choices).
+pub const TRACE_TEXEL_BUFFERS: u32 = texel_buffers(&TRACE_SET_BINDINGS);
+
+/// How many of `bindings` are texel buffers.
+const fn texel_buffers(bindings: &[SceneBinding]) -> u32 {
     let mut count = 0;
     let mut i = 0;
-    while i < TRACE_SET_BINDINGS.len() {
-        if matches!(
-            TRACE_SET_BINDINGS[i].kind,
-            DescriptorKind::UniformTexelBuffer
-        ) {
+    while i < bindings.len() {
+        if matches!(bindings[i].kind, DescriptorKind::UniformTexelBuffer) {
             count += 1;
         }
         i += 1;
     }
     count
-};
+}
 /// Set 2 as the engine creates it: a material's textures, in the order of its
 /// texture slots.
 pub const MATERIAL_SET_BINDINGS: [SceneBinding; 5] = [

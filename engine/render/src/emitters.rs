@@ -10,7 +10,7 @@ pub fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
-/// The table the shaders read (`Emitters` in `shaders/pathtrace/lights.glsl`).
+/// The table the shaders read (`emitter_table` in `shaders/include/trace.glsl`).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct EmitterTable {
     /// Per emitter: triangle index, alias (an index into this list), the

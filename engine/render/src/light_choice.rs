@@ -1,4 +1,4 @@
-//! Which light next-event estimation samples (`LightChoices` in
+//! Which light next-event estimation samples (`light_choice_table` in
 //! `shaders/include/trace.glsl`): one choice per analytic light in record
 //! order, then one for "an emissive triangle" when the scene has any. A
 //! choice is picked with probability half uniform, half in proportion to an

@@ -98,7 +98,7 @@ fn a_scene_binding_the_engine_does_not_write_is_refused_at_check_and_at_render()
     // The forward pass declares `RayTracing` (its shadow rays under
     // `rt_shadows`), so the ray tracer's bindings are offered to it too.
     let expected = format!(
-        "graphs/forward.ron:{pass_line}:19: error: pass \"forward\": shader binding `Materials` (set 1 binding 29) is not scene data the engine binds; set 1 has 0: the Frame block, 1: the lights, 2: the draw records, 3: the materials, 4: the shadow views, 20: the area-light LTC tables, 21: the vertices, 22: the indices, 5: the ray tracer's triangles, 6: the BVH nodes, 7: the BVH's leaf triangles, 8: the corners' normals, 9: the corners' UVs, 10: the triangles' materials and draws, 11: the emissive triangles, 12: the 256-texel colour texture array, 13: the 512-texel colour texture array, 14: the 1024-texel colour texture array, 15: the 256-texel data texture array, 16: the 512-texel data texture array, 17: the 1024-texel data texture array, 18: the materials' texture slots, 19: the corners' tangents, 23: the light choice table (declared at graphs/../shaders/include/scene.glsl:{glsl_line})"
+        "graphs/forward.ron:{pass_line}:19: error: pass \"forward\": shader binding `material_table` (set 1 binding 29) is not scene data the engine binds; set 1 has 0: the Frame block, 1: the lights, 2: the draw records, 3: the materials, 4: the shadow views, 20: the area-light LTC tables, 21: the vertices, 22: the indices, 5: the ray tracer's triangles, 6: the BVH nodes, 7: the BVH's leaf triangles, 8: the corners' normals, 9: the corners' UVs, 10: the triangles' materials and draws, 11: the emissive triangles, 12: the 256-texel colour texture array, 13: the 512-texel colour texture array, 14: the 1024-texel colour texture array, 15: the 256-texel data texture array, 16: the 512-texel data texture array, 17: the 1024-texel data texture array, 18: the materials' texture slots, 19: the corners' tangents, 23: the light choice table (declared at graphs/../shaders/include/scene.glsl:{glsl_line})"
     );
     assert!(err.lines().any(|l| l == expected), "{expected}\n{err}");
     // `weft render` refuses it too, located at the pass, instead of a draw
@@ -122,7 +122,7 @@ fn a_scene_binding_the_engine_does_not_write_is_refused_at_check_and_at_render()
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
         err.contains(&format!(
-            "error: graphs/forward.ron:{pass_line}:19: pass `forward`: shader binding `Materials` (set 1 binding 29) is not scene data"
+            "error: graphs/forward.ron:{pass_line}:19: pass `forward`: shader binding `material_table` (set 1 binding 29) is not scene data"
         )),
         "{err}"
     );

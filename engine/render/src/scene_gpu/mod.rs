@@ -19,7 +19,7 @@ use placement::changed_records;
 use std::collections::HashMap;
 use std::path::PathBuf;
 use trace::TraceBuffers;
-use weft_gpu::buffer::Buffer;
+use weft_gpu::buffer::{Buffer, TexelBuffer, TexelFormat};
 use weft_gpu::descriptors::{DescriptorPool, DescriptorWriter};
 use weft_gpu::samplers::Sampler;
 use weft_gpu::scene::{SceneBinding, SceneLayouts, SceneSet};
@@ -69,7 +69,7 @@ fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuE
             ),
             (
                 vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
-                TRACE_TEXEL_BUFFERS,
+                SCENE_TEXEL_BUFFERS * scene_sets + TRACE_TEXEL_BUFFERS,
             ),
             (
                 vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
@@ -89,7 +89,7 @@ pub struct GpuScene<'g> {
     /// Every index, `u32`.
     pub indices: Buffer<'g>,
     draws: Buffer<'g>,
-    materials: Buffer<'g>,
+    materials: TexelBuffer<'g>,
     frame: Buffer<'g>,
     lights: Buffer<'g>,
     shadows: Buffer<'g>,
@@ -226,12 +226,16 @@ impl<'g> GpuScene<'g> {
             material_records.push(pack_material(m, normal != 0));
             material_texture.push([base, metal_rough, normal, emissive, occlusion]);
         }
-        let materials = rewritable(
-            gpu,
-            "scene materials",
-            bytes_of(&material_records),
-            animates,
-        )?;
+        // A texel buffer: the path tracer reads a record at every vertex, and
+        // lavapipe reads a storage buffer a component and a lane at a time.
+        let materials = {
+            let (name, bytes) = ("the materials", bytes_of(&material_records));
+            if animates {
+                TexelBuffer::host(gpu, name, bytes, TexelFormat::Words4)?
+            } else {
+                TexelBuffer::device_local(gpu, name, bytes, TexelFormat::Words4)?
+            }
+        };
         let normal_mapped = material_texture.iter().map(|slots| slots[2] != 0).collect();
         let frame = Buffer::host(
             gpu,
@@ -351,7 +355,11 @@ impl<'g> GpuScene<'g> {
             if let Some(buffer) = self.scene_buffer(b) {
                 writer.buffer(b, kind.vk(), buffer.buffer);
             }
-            if let Some(view) = self.trace.as_ref().and_then(|t| t.texel_view(b)) {
+            let texels = match b {
+                MATERIALS_BINDING => Some(self.materials.view),
+                _ => self.trace.as_ref().and_then(|t| t.texel_view(b)),
+            };
+            if let Some(view) = texels {
                 writer.texel_buffer(b, view);
             }
             let texture = self
@@ -378,7 +386,6 @@ impl<'g> GpuScene<'g> {
             FRAME_BINDING => Some(&self.frame),
             LIGHTS_BINDING => Some(&self.lights),
             DRAWS_BINDING => Some(&self.draws),
-            MATERIALS_BINDING => Some(&self.materials),
             SHADOWS_BINDING => Some(&self.shadows),
             LTC_TABLES_BINDING => Some(&self.ltc_tables),
             VERTICES_BINDING => Some(&self.vertices),

@@ -25,9 +25,9 @@ pub(super) struct TraceBuffers<'g> {
     pub(super) tangents: TexelBuffer<'g>,
     pub(super) uvs: TexelBuffer<'g>,
     pub(super) materials: TexelBuffer<'g>,
-    pub(super) emitters: Buffer<'g>,
+    pub(super) emitters: TexelBuffer<'g>,
     /// Which light NEE samples ([`LightChoices`]), rewritten when lights change.
-    pub(super) light_choices: Buffer<'g>,
+    pub(super) light_choices: TexelBuffer<'g>,
     /// The emissive triangles' power as one light choice, `None` without any.
     emitter_power: Option<f32>,
     /// Colour arrays by class, then data arrays by class.
@@ -125,13 +125,18 @@ impl<'g> TraceBuffers<'g> {
                 bytes_of(&material_draws),
                 Words2,
             )?,
-            emitters: Buffer::device_local(gpu, "emitters", &emitters.bytes(), storage)?,
-            light_choices: {
-                let bytes = choices.bytes();
-                let mut buffer = Buffer::host(gpu, "light choices", bytes.len() as u64, storage)?;
-                buffer.write(&bytes)?;
-                buffer
-            },
+            emitters: TexelBuffer::device_local(
+                gpu,
+                "the emissive triangles' alias table",
+                &emitters.bytes(),
+                Words4,
+            )?,
+            light_choices: TexelBuffer::host(
+                gpu,
+                "the light choice table",
+                &choices.bytes(),
+                Words4,
+            )?,
             emitter_power,
             textures: trace_textures
                 .colour
@@ -178,6 +183,8 @@ impl<'g> TraceBuffers<'g> {
             TRIANGLE_TANGENTS_BINDING => Some(self.tangents.view),
             TRIANGLE_UVS_BINDING => Some(self.uvs.view),
             TRIANGLE_MATERIALS_BINDING => Some(self.materials.view),
+            EMITTERS_BINDING => Some(self.emitters.view),
+            LIGHT_CHOICES_BINDING => Some(self.light_choices.view),
             _ => None,
         }
     }
@@ -185,8 +192,6 @@ impl<'g> TraceBuffers<'g> {
     /// The buffer behind a tracing-only set 1 binding.
     pub(super) fn buffer(&self, binding: u32) -> Option<&Buffer<'g>> {
         match binding {
-            EMITTERS_BINDING => Some(&self.emitters),
-            LIGHT_CHOICES_BINDING => Some(&self.light_choices),
             MATERIAL_TEXTURES_BINDING => Some(&self.material_textures),
             _ => None,
         }

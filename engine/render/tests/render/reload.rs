@@ -375,7 +375,7 @@ fn shader_edits_the_gpu_would_reject_are_refused_before_commit() {
             "shaders/include/scene.glsl",
             "set = SET_SCENE, binding = BINDING_MATERIALS)",
             "set = SET_SCENE, binding = 29)",
-            "pass `forward`: shader binding `Materials` (set 1 binding 29) is not scene data the engine binds",
+            "pass `forward`: shader binding `material_table` (set 1 binding 29) is not scene data the engine binds",
         ),
         (
             "shaders/tonemap.frag",
