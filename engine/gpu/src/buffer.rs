@@ -208,12 +208,7 @@ impl<'g> TexelBuffer<'g> {
         bytes: &[u8],
         format: TexelFormat,
     ) -> Result<Self, GpuError> {
-        texels_within(
-            name,
-            bytes.len(),
-            format,
-            gpu.info().max_texel_buffer_elements,
-        )?;
+        texels_within(name, bytes.len(), format, gpu)?;
         let buffer =
             Buffer::device_local(gpu, name, bytes, vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER)?;
         Self::with_view(gpu, buffer, format)
@@ -227,12 +222,7 @@ impl<'g> TexelBuffer<'g> {
         bytes: &[u8],
         format: TexelFormat,
     ) -> Result<Self, GpuError> {
-        texels_within(
-            name,
-            bytes.len(),
-            format,
-            gpu.info().max_texel_buffer_elements,
-        )?;
+        texels_within(name, bytes.len(), format, gpu)?;
         let mut buffer = Buffer::host(
             gpu,
             name,
@@ -276,10 +266,20 @@ impl Drop for TexelBuffer<'_> {
     }
 }
 
+/// [`texels_fitting`] under `gpu`'s `maxTexelBufferElements`.
+fn texels_within(what: &str, len: usize, format: TexelFormat, gpu: &Gpu) -> Result<u64, GpuError> {
+    texels_fitting(what, len, format, gpu.info().max_texel_buffer_elements)
+}
+
 /// The texels `len` bytes of `format` make, or the error that names `what`
 /// when they are not whole texels or a texel buffer of the device (`limit`
 /// texels at most) cannot hold them.
-fn texels_within(what: &str, len: usize, format: TexelFormat, limit: u32) -> Result<u64, GpuError> {
+fn texels_fitting(
+    what: &str,
+    len: usize,
+    format: TexelFormat,
+    limit: u32,
+) -> Result<u64, GpuError> {
     let texels = len as u64 / format.bytes();
     if !(len as u64).is_multiple_of(format.bytes()) {
         return Err(GpuError::Allocation {
@@ -299,22 +299,22 @@ fn texels_within(what: &str, len: usize, format: TexelFormat, limit: u32) -> Res
 
 #[cfg(test)]
 mod tests {
-    use super::{texels_within, TexelFormat};
+    use super::{texels_fitting, TexelFormat};
 
     #[test]
     fn a_table_must_be_whole_texels_within_the_device_limit() {
-        assert_eq!(texels_within("t", 48, TexelFormat::Words4, 3).unwrap(), 3);
-        assert_eq!(texels_within("t", 48, TexelFormat::Words2, 6).unwrap(), 6);
-        assert_eq!(texels_within("t", 0, TexelFormat::Words4, 0).unwrap(), 0);
+        assert_eq!(texels_fitting("t", 48, TexelFormat::Words4, 3).unwrap(), 3);
+        assert_eq!(texels_fitting("t", 48, TexelFormat::Words2, 6).unwrap(), 6);
+        assert_eq!(texels_fitting("t", 0, TexelFormat::Words4, 0).unwrap(), 0);
         assert_eq!(
-            texels_within("the BVH nodes", 64, TexelFormat::Words4, 3)
+            texels_fitting("the BVH nodes", 64, TexelFormat::Words4, 3)
                 .unwrap_err()
                 .to_string(),
             "the BVH nodes needs 4 texels; this device's texel buffers hold at most 3 \
              (maxTexelBufferElements)"
         );
         assert_eq!(
-            texels_within("uvs", 20, TexelFormat::Words2, 100)
+            texels_fitting("uvs", 20, TexelFormat::Words2, 100)
                 .unwrap_err()
                 .to_string(),
             "memory allocation for uvs failed: 20 bytes are not whole 8-byte texels"
