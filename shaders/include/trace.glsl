@@ -42,7 +42,7 @@ layout(set = SET_SCENE, binding = BINDING_BVH_NODES) uniform usamplerBuffer bvh_
 layout(set = SET_SCENE, binding = BINDING_BVH_LEAF_TRIANGLES) uniform usamplerBuffer bvh_leaf_triangles;
 layout(set = SET_SCENE, binding = BINDING_TRIANGLE_NORMALS) uniform usamplerBuffer trace_normals;
 layout(set = SET_SCENE, binding = BINDING_TRIANGLE_UVS) uniform usamplerBuffer trace_uvs;
-// Per triangle: x the index into the Materials buffer (scene.glsl, binding
+// Per triangle: x the index into the material records (scene.glsl, binding
 // 3), y the draw record that placed it (Draws, binding 2).
 layout(set = SET_SCENE, binding = BINDING_TRIANGLE_MATERIALS) uniform usamplerBuffer trace_materials;
 // The emissive triangles as an alias table over emitted power
