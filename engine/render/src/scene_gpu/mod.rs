@@ -355,11 +355,7 @@ impl<'g> GpuScene<'g> {
             if let Some(buffer) = self.scene_buffer(b) {
                 writer.buffer(b, kind.vk(), buffer.buffer);
             }
-            let texels = match b {
-                MATERIALS_BINDING => Some(self.materials.view),
-                _ => self.trace.as_ref().and_then(|t| t.texel_view(b)),
-            };
-            if let Some(view) = texels {
+            if let Some(view) = self.scene_texel_view(b) {
                 writer.texel_buffer(b, view);
             }
             let texture = self
@@ -378,6 +374,14 @@ impl<'g> GpuScene<'g> {
             }
         }
         writer.write(self.gpu, set);
+    }
+
+    /// The texel buffer view behind a set 1 binding.
+    fn scene_texel_view(&self, binding: u32) -> Option<vk::BufferView> {
+        match binding {
+            MATERIALS_BINDING => Some(self.materials.view),
+            _ => self.trace.as_ref().and_then(|t| t.texel_view(binding)),
+        }
     }
 
     /// The buffer behind a set 1 binding.

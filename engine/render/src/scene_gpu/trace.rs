@@ -51,12 +51,12 @@ impl<'g> TraceBuffers<'g> {
         let (bvh, cache_warning) = crate::bvh_cache::load_or_build(&mesh.corners, cache);
         warnings.extend(cache_warning);
         let wide = crate::bvh_wide::WideBvh::collapse(&bvh, &mesh.corners);
-        if wide.stack_need() > crate::bvh_wide::GPU_STACK {
+        let stack_need = wide.stack_need();
+        if stack_need > crate::bvh_wide::GPU_STACK {
             warnings.push(format!(
-                "the ray tracer's BVH is {} levels deep and its walk may hold {} pending nodes, \
-                 more than the {} its stack has: rays may miss geometry",
+                "the ray tracer's BVH is {} levels deep and its walk may hold {stack_need} pending \
+                 nodes, more than the {} its stack has: rays may miss geometry",
                 wide.depth(),
-                wide.stack_need(),
                 crate::bvh_wide::GPU_STACK
             ));
         }
