@@ -150,13 +150,13 @@ LeafTriangle leaf_triangle(uint slot) {
         uintBitsToFloat(texelFetch(bvh_leaf_triangles, at + 1)), uintBitsToFloat(texelFetch(bvh_leaf_triangles, at + 2)));
 }
 
-// Most pending nodes the walk's stack holds: a step pops one node and pushes
-// up to four, so a tree of L wide levels needs at most 3 (L - 2) + 4
+// Most groups the walk's stack holds (see trace_walk): one per level below
+// the root, so a tree of L wide levels needs at most L - 1
 // (WideBvh::stack_need; the renderer warns of a deeper tree, and GPU_STACK in
 // bvh_wide.rs must equal this). Not a multiple of 32: lavapipe gives each lane
-// its local arrays at a stride of their size, and with the two arrays below
-// at 256, 512 or 768 bytes a lane the Cornell box rendered 1.13-1.17x slower
-// than at 192, 384, 448, 480 or 576 (docs/pathtrace.md).
+// its local arrays at a stride of their size, and with the walk's arrays at
+// 256, 512 or 768 bytes a lane the Cornell box once rendered 1.13-1.17x
+// slower (docs/pathtrace.md).
 #define TRACE_STACK 72
 
 // How far outside a triangle, in barycentric units, a hit still counts, so a
@@ -201,13 +201,41 @@ uint trace_tests(WideNode node, uint slot, float d, float best_t) {
     return (d < best_t && count != NO_CHILD) ? count : 0u;
 }
 
-// Walks the wide BVH: each step pops a node, measures where the ray enters
-// its four child boxes, orders them nearest first, tests the triangles of
-// the leaves among them and pushes the inner ones, the nearest last. A hit
-// with t in (0, t_max): its distance in .x and triangle in .y (as uint bits),
-// or x = -1 when nothing is hit. With `first_hit` it stops at the first hit
-// found (shadow rays); otherwise it returns the nearest. WideBvh::walk in
-// bvh_wide.rs is its CPU mirror, step for step.
+#define TRACE_FAR uintBitsToFloat(0x7f800000u)
+
+// A stack entry packs a group (see trace_walk): its first node in the low
+// TRACE_GROUP_BITS bits (WideBvh::MAX_NODES), the offsets of the nodes left,
+// two bits each, the next lowest, in the six above, and how many are left in
+// the top two.
+#define TRACE_GROUP_BITS 24u
+#define TRACE_GROUP_BASE 0xffffffu
+
+// Adds the child in `slot`, entered at distance d, to the front of a group
+// of the node's inner children whose first node is `base`, when it is an
+// inner node the ray enters before best_t.
+void trace_group(WideNode node, uint slot, float d, float best_t, uint base, inout uint order, inout uint count,
+    inout vec4 entries) {
+    bool add = d < best_t && node.count[slot] == 0u;
+    order = add ? (order << 2u) | (node.child[slot] - base) : order;
+    entries = add ? vec4(d, entries.xyz) : entries;
+    count += add ? 1u : 0u;
+}
+
+// Walks the wide BVH: each step takes the next node of the current group,
+// measures where the ray enters its four child boxes, orders them nearest
+// first and tests the triangles of the leaves among them; its inner children
+// the ray enters become the current group, nearest first, and the group they
+// replace goes on the stack when it has nodes left. A node's inner children
+// are consecutive (WideBvh::collapse), so a group is its first node, each
+// node's offset from it and the nodes' entry distances; on the stack only the
+// next node's distance, which bounds the others' from below. So a step writes
+// and reads the stack once at most: lavapipe writes a local array lane by
+// lane, and pushing each child on its own made the Cornell box 1.35x slower
+// (docs/pathtrace.md). A hit with t in (0, t_max): its distance in .x and
+// triangle in .y (as uint bits), or x = -1 when nothing is hit. With
+// `first_hit` it stops at the first hit found (shadow rays); otherwise it
+// returns the nearest. WideBvh::walk in bvh_wide.rs is its CPU mirror, step
+// for step.
 vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
     float best_t = t_max;
     uint best_tri = 0u;
@@ -217,17 +245,35 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
         return vec2(-1.0, 0.0);
     }
     vec3 inv_dir = 1.0 / dir;
-    uint stack[TRACE_STACK];
-    float entry[TRACE_STACK];
-    stack[0] = 0u;
-    entry[0] = 0.0;
-    int top = 1;
-    while (top > 0) {
-        --top;
-        if (entry[top] >= best_t) {
+    uint stack_group[TRACE_STACK];
+    float stack_entry[TRACE_STACK];
+    int top = 0;
+    // The current group: the root alone.
+    uint base = 0u;
+    uint order = 0u;
+    uint count = 1u;
+    vec4 entries = vec4(0.0, TRACE_FAR, TRACE_FAR, TRACE_FAR);
+    while (true) {
+        if (count == 0u) {
+            if (top == 0) {
+                break;
+            }
+            --top;
+            uint group = stack_group[top];
+            base = group & TRACE_GROUP_BASE;
+            order = (group >> TRACE_GROUP_BITS) & 63u;
+            count = group >> (TRACE_GROUP_BITS + 6u);
+            entries = vec4(stack_entry[top]);
+        }
+        uint index = base + (order & 3u);
+        float entry = entries.x;
+        order >>= 2u;
+        --count;
+        entries = vec4(entries.yzw, TRACE_FAR);
+        if (entry >= best_t) {
             continue;
         }
-        WideNode node = wide_node(stack[top]);
+        WideNode node = wide_node(index);
         vec4 x0 = (node.lo_x - origin.x) * inv_dir.x;
         vec4 x1 = (node.hi_x - origin.x) * inv_dir.x;
         vec4 y0 = (node.lo_y - origin.y) * inv_dir.y;
@@ -238,7 +284,7 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
         vec4 far = min(min(max(x0, x1), max(y0, y1)), max(z0, z1));
         bvec4 meets = bvec4(uvec4(lessThanEqual(near, far)) & uvec4(lessThan(near, vec4(best_t)))
             & uvec4(notEqual(node.count, uvec4(NO_CHILD))));
-        near = mix(vec4(uintBitsToFloat(0x7f800000u)), near, meets);
+        near = mix(vec4(TRACE_FAR), near, meets);
         float d0 = near.x, d1 = near.y, d2 = near.z, d3 = near.w;
         uint s0 = 0u, s1 = 1u, s2 = 2u, s3 = 3u;
         trace_order(d0, s0, d1, s1);
@@ -273,22 +319,26 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
         if (hit && first_hit) {
             break;
         }
-        // Inner children, the farthest pushed first.
-        if (d3 < best_t && node.count[s3] == 0u && top < TRACE_STACK) {
-            stack[top] = node.child[s3];
-            entry[top++] = d3;
-        }
-        if (d2 < best_t && node.count[s2] == 0u && top < TRACE_STACK) {
-            stack[top] = node.child[s2];
-            entry[top++] = d2;
-        }
-        if (d1 < best_t && node.count[s1] == 0u && top < TRACE_STACK) {
-            stack[top] = node.child[s1];
-            entry[top++] = d1;
-        }
-        if (d0 < best_t && node.count[s0] == 0u && top < TRACE_STACK) {
-            stack[top] = node.child[s0];
-            entry[top++] = d0;
+        // The inner children as the next group, added farthest first.
+        uvec4 inner_child = mix(uvec4(TRACE_GROUP_BASE), node.child, equal(node.count, uvec4(0u)));
+        uint child_base = min(min(inner_child.x, inner_child.y), min(inner_child.z, inner_child.w));
+        uint child_order = 0u;
+        uint children = 0u;
+        vec4 child_entries = vec4(TRACE_FAR);
+        trace_group(node, s3, d3, best_t, child_base, child_order, children, child_entries);
+        trace_group(node, s2, d2, best_t, child_base, child_order, children, child_entries);
+        trace_group(node, s1, d1, best_t, child_base, child_order, children, child_entries);
+        trace_group(node, s0, d0, best_t, child_base, child_order, children, child_entries);
+        if (children > 0u) {
+            if (count > 0u && top < TRACE_STACK) {
+                stack_group[top] = base | (order << TRACE_GROUP_BITS) | (count << (TRACE_GROUP_BITS + 6u));
+                stack_entry[top] = entries.x;
+                ++top;
+            }
+            base = child_base;
+            order = child_order;
+            count = children;
+            entries = child_entries;
         }
     }
     return hit ? vec2(best_t, uintBitsToFloat(best_tri)) : vec2(-1.0, 0.0);

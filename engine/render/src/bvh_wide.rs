@@ -24,10 +24,17 @@ pub const WIDTH: usize = 4;
 /// `count` of a child slot that holds no child.
 pub const NO_CHILD: u32 = u32::MAX;
 
-/// Pending nodes the GPU walk's stack holds (`TRACE_STACK` in
+/// Groups the GPU walk's stack holds (`TRACE_STACK` in
 /// `shaders/include/trace.glsl`; a test holds the two equal). A deeper tree
 /// than it allows would lose nodes there, so the renderer warns of one.
 pub const GPU_STACK: usize = 72;
+
+/// Most nodes a tree may have: the walk's stack entries hold a node index in
+/// 24 bits (`TRACE_GROUP_BITS` in `trace.glsl`).
+pub const MAX_NODES: usize = 1 << GROUP_BITS;
+
+/// Bits of a stack entry that hold its group's first node.
+const GROUP_BITS: u32 = 24;
 
 /// One node as the shader reads it (`struct WideNode`, std430).
 #[repr(C)]
@@ -147,15 +154,12 @@ impl WideBvh {
         deepest
     }
 
-    /// At most how many nodes the walk's stack holds at once on this tree:
-    /// a step pops one node and pushes up to four, so a node at depth d
-    /// leaves at most 3 d + 4 pending, and only nodes with inner children,
-    /// two levels above the deepest leaf at most, push.
+    /// At most how many groups the walk's stack holds at once on this tree:
+    /// a group goes on it when the walk steps down from its level, so it
+    /// holds at most one per level between the root's and the deepest inner
+    /// node's.
     pub fn stack_need(&self) -> usize {
-        match self.depth() {
-            0 | 1 => 1,
-            depth => 3 * (depth - 2) + WIDTH,
-        }
+        self.depth().saturating_sub(1)
     }
 
     /// [`Bvh::sah_cost`] for the wide tree: a visit, which tests four boxes,
@@ -200,10 +204,11 @@ impl WideBvh {
         self.walk(origin, dir, t_max, true).is_some()
     }
 
-    /// `trace_walk`: pops a node, measures the ray's entry into its four
-    /// boxes, orders them nearest first, tests the triangles of the leaves
-    /// the ray enters before the nearest hit so far, in that order, and
-    /// pushes the inner children, the nearest last.
+    /// `trace_walk`: takes the next node of the current group, measures the
+    /// ray's entry into its four boxes, orders them nearest first, tests the
+    /// triangles of the leaves the ray enters before the nearest hit so far,
+    /// in that order, and makes the inner children it enters the current
+    /// group, putting the one they replace on the stack when it has nodes left.
     fn walk(&self, origin: Vec3, dir: Vec3, t_max: f32, first_hit: bool) -> Option<(f32, u32)> {
         if self.triangles.is_empty() {
             return None;
@@ -211,8 +216,16 @@ impl WideBvh {
         let inv = dir.recip();
         let mut best: Option<(f32, u32)> = None;
         let mut limit = t_max;
-        let mut stack = vec![(0u32, 0.0f32)];
-        while let Some((n, entry)) = stack.pop() {
+        let mut group = Group::ROOT;
+        let mut stack: Vec<(u32, f32)> = Vec::new();
+        loop {
+            if group.count == 0 {
+                match stack.pop() {
+                    Some((packed, entry)) => group = Group::unpack(packed, entry),
+                    None => break,
+                }
+            }
+            let (n, entry) = group.take();
             if entry >= limit {
                 continue;
             }
@@ -254,13 +267,112 @@ impl WideBvh {
             if first_hit && best.is_some() {
                 return best;
             }
-            for k in (0..WIDTH).rev() {
-                if near[k] < limit && node.count[slot[k]] == 0 {
-                    stack.push((node.child[slot[k]], near[k]));
+            let children = Group::of_children(node, &near, &slot, limit);
+            if children.count > 0 {
+                if group.count > 0 {
+                    stack.push(group.pack());
                 }
+                group = children;
             }
         }
         best
+    }
+}
+
+/// Nodes the walk visits next (`trace_walk`'s current group): some inner
+/// children of one node, nearest first. A node's inner children are
+/// consecutive ([`WideBvh::collapse`] numbers them in turn), so a group is
+/// the first of them and each node's offset from it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Group {
+    /// The node the offsets count from.
+    base: u32,
+    /// The nodes' offsets from `base`, two bits each, the next lowest.
+    order: u32,
+    /// How many nodes are left.
+    count: u32,
+    /// Where the ray enters each node, the next first (lower bounds once
+    /// the group has been on the stack).
+    entries: [f32; WIDTH],
+}
+
+impl Group {
+    /// The walk's first group: the root alone.
+    const ROOT: Group = Group {
+        base: 0,
+        order: 0,
+        count: 1,
+        entries: [0.0, f32::INFINITY, f32::INFINITY, f32::INFINITY],
+    };
+
+    /// The inner children of `node` the ray enters before `limit`, given
+    /// their entries `near` in order with their `slot`s.
+    fn of_children(
+        node: &GpuWideNode,
+        near: &[f32; WIDTH],
+        slot: &[usize; WIDTH],
+        limit: f32,
+    ) -> Group {
+        let base = (0..WIDTH)
+            .filter(|&s| node.count[s] == 0)
+            .map(|s| node.child[s])
+            .min()
+            .unwrap_or(0);
+        let mut group = Group {
+            base,
+            order: 0,
+            count: 0,
+            entries: [f32::INFINITY; WIDTH],
+        };
+        for k in (0..WIDTH).rev() {
+            if near[k] < limit && node.count[slot[k]] == 0 {
+                group.order = group.order << 2 | (node.child[slot[k]] - base);
+                group.entries = [
+                    near[k],
+                    group.entries[0],
+                    group.entries[1],
+                    group.entries[2],
+                ];
+                group.count += 1;
+            }
+        }
+        group
+    }
+
+    /// Takes the next node: its index and where the ray enters it.
+    fn take(&mut self) -> (u32, f32) {
+        let next = (self.base + (self.order & 3), self.entries[0]);
+        self.order >>= 2;
+        self.count -= 1;
+        self.entries = [
+            self.entries[1],
+            self.entries[2],
+            self.entries[3],
+            f32::INFINITY,
+        ];
+        next
+    }
+
+    /// The stack entry: the group packed in one word (`stack_group` in
+    /// `trace_walk`, with at most three nodes left) and its next node's
+    /// entry.
+    fn pack(&self) -> (u32, f32) {
+        debug_assert!(self.count < WIDTH as u32 && (self.base as usize) < MAX_NODES);
+        (
+            self.base | self.order << GROUP_BITS | self.count << (GROUP_BITS + 6),
+            self.entries[0],
+        )
+    }
+
+    /// The group of a stack entry; every node's entry is bounded by the
+    /// next's.
+    fn unpack(packed: u32, entry: f32) -> Group {
+        Group {
+            base: packed & (MAX_NODES as u32 - 1),
+            order: packed >> GROUP_BITS & 63,
+            count: packed >> (GROUP_BITS + 6),
+            entries: [entry; WIDTH],
+        }
     }
 }
 
@@ -433,21 +545,69 @@ mod tests {
         );
     }
 
-    /// The most nodes pending when every box is entered (the walk's worst
-    /// case): the stack the walk would hold, simulated.
+    /// The most groups on the stack when every box is entered (the walk's
+    /// worst case): the walk's groups and stack, simulated.
     fn pushed_when_every_box_is_entered(wide: &WideBvh) -> usize {
-        let mut stack = vec![0u32];
-        let mut most = 1;
-        while let Some(n) = stack.pop() {
-            let node = &wide.nodes[n as usize];
-            stack.extend(
-                (0..WIDTH)
-                    .filter(|&s| node.count[s] == 0)
-                    .map(|s| node.child[s]),
-            );
-            most = most.max(stack.len());
+        let entered = [0.0; WIDTH];
+        let mut group = Group::ROOT;
+        let mut stack = Vec::new();
+        let mut most = 0;
+        loop {
+            if group.count == 0 {
+                match stack.pop() {
+                    Some((packed, entry)) => group = Group::unpack(packed, entry),
+                    None => return most,
+                }
+            }
+            let node = &wide.nodes[group.take().0 as usize];
+            let children = Group::of_children(node, &entered, &[0, 1, 2, 3], f32::INFINITY);
+            if children.count > 0 {
+                if group.count > 0 {
+                    stack.push(group.pack());
+                    most = most.max(stack.len());
+                }
+                group = children;
+            }
         }
-        most
+    }
+
+    #[test]
+    fn a_group_packs_into_one_word_and_back() {
+        let group = Group {
+            base: MAX_NODES as u32 - 1,
+            order: 0b10_01_11,
+            count: 3,
+            entries: [1.5, 2.0, 3.0, f32::INFINITY],
+        };
+        let (packed, entry) = group.pack();
+        assert_eq!(entry, 1.5);
+        assert_eq!(
+            Group::unpack(packed, entry),
+            Group {
+                entries: [1.5; WIDTH],
+                ..group
+            }
+        );
+        let mut back = Group::unpack(packed, entry);
+        assert_eq!(back.take().0, MAX_NODES as u32 - 1 + 3);
+        assert_eq!(back.take().0, MAX_NODES as u32 - 1 + 1);
+        assert_eq!(back.take().0, MAX_NODES as u32 - 1 + 2);
+        assert_eq!(back.count, 0);
+    }
+
+    #[test]
+    fn a_nodes_inner_children_are_consecutive() {
+        let tris = soup(3000, 5);
+        let wide = WideBvh::collapse(&Bvh::build(&tris), &tris);
+        for node in &wide.nodes {
+            let inner: Vec<u32> = (0..WIDTH)
+                .filter(|&s| node.count[s] == 0)
+                .map(|s| node.child[s])
+                .collect();
+            for pair in inner.windows(2) {
+                assert_eq!(pair[1], pair[0] + 1, "{inner:?}");
+            }
+        }
     }
 
     #[test]

@@ -51,11 +51,21 @@ impl<'g> TraceBuffers<'g> {
         let (bvh, cache_warning) = crate::bvh_cache::load_or_build(&mesh.corners, cache);
         warnings.extend(cache_warning);
         let wide = crate::bvh_wide::WideBvh::collapse(&bvh, &mesh.corners);
+        if wide.nodes.len() > crate::bvh_wide::MAX_NODES {
+            return Err(GpuError::Allocation {
+                what: "the BVH nodes".into(),
+                message: format!(
+                    "{} nodes, more than the {} the walk's stack entries can name",
+                    wide.nodes.len(),
+                    crate::bvh_wide::MAX_NODES
+                ),
+            });
+        }
         let stack_need = wide.stack_need();
         if stack_need > crate::bvh_wide::GPU_STACK {
             warnings.push(format!(
-                "the ray tracer's BVH is {} levels deep and its walk may hold {stack_need} pending \
-                 nodes, more than the {} its stack has: rays may miss geometry",
+                "the ray tracer's BVH is {} levels deep and its walk may hold {stack_need} groups \
+                 of nodes, more than the {} its stack has: rays may miss geometry",
                 wide.depth(),
                 crate::bvh_wide::GPU_STACK
             ));
