@@ -183,21 +183,25 @@ float trace_triangle(vec3 a, vec3 e1, vec3 e2, vec3 origin, vec3 dir) {
     return (outside || t <= 0.0) ? -1.0 : t;
 }
 
-// Puts the pair (da, sa), (db, sb) in order of distance.
-void trace_order(inout float da, inout uint sa, inout float db, inout uint sb) {
+// Puts the children (da, ca, na) and (db, cb, nb) in order of distance:
+// each an entry distance, a child index and a count (WideNode's).
+void trace_order(inout float da, inout uint ca, inout uint na, inout float db, inout uint cb, inout uint nb) {
     bool swap = db < da;
     float d = swap ? db : da;
-    uint s = swap ? sb : sa;
+    uint c = swap ? cb : ca;
+    uint n = swap ? nb : na;
     db = swap ? da : db;
-    sb = swap ? sa : sb;
+    cb = swap ? ca : cb;
+    nb = swap ? na : nb;
     da = d;
-    sa = s;
+    ca = c;
+    na = n;
 }
 
-// How many triangles to test in the child in `slot`: a leaf's count when the
-// ray enters it at distance d before the nearest hit so far, else 0.
-uint trace_tests(WideNode node, uint slot, float d, float best_t) {
-    uint count = node.count[slot];
+// How many triangles to test in a child with `count` (WideNode's): a leaf's
+// count when the ray enters it at distance d before the nearest hit so far,
+// else 0.
+uint trace_tests(uint count, float d, float best_t) {
     return (d < best_t && count != NO_CHILD) ? count : 0u;
 }
 
@@ -213,10 +217,10 @@ uint trace_tests(WideNode node, uint slot, float d, float best_t) {
 // Adds the child in `slot`, entered at distance d, to the front of a group
 // of the node's inner children whose first node is `base`, when it is an
 // inner node the ray enters before best_t.
-void trace_group(WideNode node, uint slot, float d, float best_t, uint base, inout uint order, inout uint count,
+void trace_group(uint child, uint child_count, float d, float best_t, uint base, inout uint order, inout uint count,
     inout vec4 entries) {
-    bool add = d < best_t && node.count[slot] == 0u;
-    order = add ? (order << 2u) | (node.child[slot] - base) : order;
+    bool add = d < best_t && child_count == 0u;
+    order = add ? (order << 2u) | (child - base) : order;
     entries = add ? vec4(d, entries.xyz) : entries;
     count += add ? 1u : 0u;
 }
@@ -286,28 +290,26 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
             & uvec4(notEqual(node.count, uvec4(NO_CHILD))));
         near = mix(vec4(TRACE_FAR), near, meets);
         float d0 = near.x, d1 = near.y, d2 = near.z, d3 = near.w;
-        uint s0 = 0u, s1 = 1u, s2 = 2u, s3 = 3u;
-        trace_order(d0, s0, d1, s1);
-        trace_order(d2, s2, d3, s3);
-        trace_order(d0, s0, d2, s2);
-        trace_order(d1, s1, d3, s3);
-        trace_order(d1, s1, d2, s2);
+        uint c0 = node.child.x, c1 = node.child.y, c2 = node.child.z, c3 = node.child.w;
+        uint k0 = node.count.x, k1 = node.count.y, k2 = node.count.z, k3 = node.count.w;
+        trace_order(d0, c0, k0, d1, c1, k1);
+        trace_order(d2, c2, k2, d3, c3, k3);
+        trace_order(d0, c0, k0, d2, c2, k2);
+        trace_order(d1, c1, k1, d3, c3, k3);
+        trace_order(d1, c1, k1, d2, c2, k2);
         // The leaves' triangles in one loop, nearest leaf first: one loop
         // costs a SIMD group the most tests any lane makes, where a loop per
         // leaf cost the sum of each leaf's most.
-        uint n0 = trace_tests(node, s0, d0, best_t);
-        uint n1 = trace_tests(node, s1, d1, best_t);
-        uint n2 = trace_tests(node, s2, d2, best_t);
-        uint n3 = trace_tests(node, s3, d3, best_t);
+        uint n0 = trace_tests(k0, d0, best_t);
+        uint n1 = trace_tests(k1, d1, best_t);
+        uint n2 = trace_tests(k2, d2, best_t);
+        uint n3 = trace_tests(k3, d3, best_t);
         uint to1 = n0;
         uint to2 = to1 + n1;
         uint to3 = to2 + n2;
         uint tests = to3 + n3;
         for (uint j = 0u; j < tests; ++j) {
-            uint at = j < to1 ? node.child[s0] + j
-                : j < to2 ? node.child[s1] + (j - to1)
-                : j < to3 ? node.child[s2] + (j - to2)
-                          : node.child[s3] + (j - to3);
+            uint at = j < to1 ? c0 + j : j < to2 ? c1 + (j - to1) : j < to3 ? c2 + (j - to2) : c3 + (j - to3);
             LeafTriangle tri = leaf_triangle(at);
             float t = trace_triangle(tri.a.xyz, tri.e1.xyz, tri.e2.xyz, origin, dir);
             if (t > 0.0 && t < best_t) {
@@ -325,10 +327,10 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
         uint child_order = 0u;
         uint children = 0u;
         vec4 child_entries = vec4(TRACE_FAR);
-        trace_group(node, s3, d3, best_t, child_base, child_order, children, child_entries);
-        trace_group(node, s2, d2, best_t, child_base, child_order, children, child_entries);
-        trace_group(node, s1, d1, best_t, child_base, child_order, children, child_entries);
-        trace_group(node, s0, d0, best_t, child_base, child_order, children, child_entries);
+        trace_group(c3, k3, d3, best_t, child_base, child_order, children, child_entries);
+        trace_group(c2, k2, d2, best_t, child_base, child_order, children, child_entries);
+        trace_group(c1, k1, d1, best_t, child_base, child_order, children, child_entries);
+        trace_group(c0, k0, d0, best_t, child_base, child_order, children, child_entries);
         if (children > 0u) {
             if (count > 0u && top < TRACE_STACK) {
                 stack_group[top] = base | (order << TRACE_GROUP_BITS) | (count << (TRACE_GROUP_BITS + 6u));
