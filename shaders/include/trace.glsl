@@ -214,9 +214,10 @@ uint trace_tests(uint count, float d, float best_t) {
 #define TRACE_GROUP_BITS 24u
 #define TRACE_GROUP_BASE 0xffffffu
 
-// Adds the child in `slot`, entered at distance d, to the front of a group
-// of the node's inner children whose first node is `base`, when it is an
-// inner node the ray enters before best_t.
+// Adds `child` (its index and count as WideNode holds them), entered at
+// distance d, to the front of a group of the node's inner children whose
+// first node is `base`, when it is an inner node the ray enters before
+// best_t.
 void trace_group(uint child, uint child_count, float d, float best_t, uint base, inout uint order, inout uint count,
     inout vec4 entries) {
     bool add = d < best_t && child_count == 0u;
