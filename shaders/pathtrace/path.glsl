@@ -1,8 +1,9 @@
 // One path of the path tracer (docs/pathtrace.md), a segment at a time: the
 // megakernel (trace.comp) runs a pixel's whole path in one invocation, the
 // wavefront passes (wavefront/*.comp) run one segment per dispatch for every
-// live path and keep the path in a queue between them. Both call
-// path_segment, so a seed gives both the same image, bit for bit.
+// live path and keep the path in a queue between them. Both run the same
+// path_hit and path_scatter in the same order (the wavefront through
+// path_segment), so a seed gives both the same image, bit for bit.
 //
 // The including shader declares `params` with max_depth, rr_depth, sampling
 // and fresnel, and its pass defines LIGHT_CHOICE and NEE_THROUGH_GLASS, the
@@ -83,9 +84,11 @@ bool bent_shadow_ray(vec3 origin, vec3 dir, out vec3 through) {
 }
 #endif
 
-// Traces the path's segment number `p.depth` and adds what it finds; true
-// when the path goes on (with its next ray in `p`), false when it ends.
-bool path_segment(inout Path p, inout Rng rng) {
+// Traces the ray of the path's segment number `p.depth` and adds the light it
+// finds: a light with area, the sky, or an emissive surface. True when the
+// ray met a surface the path can scatter at (`s` and `m` then describe it),
+// false when the path ends there.
+bool path_hit(inout Path p, out TraceSurface s, out Material m) {
     uint choice = LIGHT_CHOICE;
     // A path whose throughput is zero (a black surface, or absorption
     // that underflowed) can add nothing more: without Russian roulette
@@ -109,14 +112,10 @@ bool path_segment(inout Path p, inout Rng rng) {
 #ifdef SCENE_DIELECTRICS
     p.throughput *= exp(-p.medium * t);
 #endif
-    uint tri = floatBitsToUint(found.y);
-    TraceSurface s = trace_surface(tri, p.origin, p.dir, t);
-    Material m = material_record(s.material);
-    vec3 wo = -p.dir;
-    vec3 ng;
-    vec3 n;
-    facing_normals(s, m, p.dir, ng, n);
+    s = trace_surface(floatBitsToUint(found.y), p.origin, p.dir, t);
+    m = material_record(s.material);
 #ifdef SCENE_EMISSIVE
+    vec3 wo = -p.dir;
     if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
         float cos_light = dot(s.geometric_normal, wo);
         float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t
@@ -124,9 +123,19 @@ bool path_segment(inout Path p, inout Rng rng) {
         p.radiance += p.throughput * emitted_at(s.material, s.uv) * found_weight(p.counted_fully, p.bsdf_pdf, light_pdf);
     }
 #endif
-    if (p.depth == params.max_depth) {
-        return false;
-    }
+    return true;
+}
+
+// Scatters the path at surface `s` (material `m`) that its segment's ray met:
+// next-event estimation towards a light, then the next ray by sampling the
+// BSDF, and Russian roulette. True when the path goes on (with its next ray
+// in `p`), false when it ends.
+bool path_scatter(inout Path p, inout Rng rng, TraceSurface s, Material m) {
+    uint choice = LIGHT_CHOICE;
+    vec3 wo = -p.dir;
+    vec3 ng;
+    vec3 n;
+    facing_normals(s, m, p.dir, ng, n);
 #ifdef SCENE_DIELECTRICS
     // Glass covers the share optics.x of the surface; the rest is the
     // opaque shading model below.
@@ -185,6 +194,15 @@ bool path_segment(inout Path p, inout Rng rng) {
         p.throughput /= q;
     }
     return true;
+}
+
+// Traces the path's segment number `p.depth` and adds what it finds; true
+// when the path goes on (with its next ray in `p`), false when it ends: at
+// `max_depth` it only looks.
+bool path_segment(inout Path p, inout Rng rng) {
+    TraceSurface s;
+    Material m;
+    return path_hit(p, s, m) && p.depth < params.max_depth && path_scatter(p, rng, s, m);
 }
 
 #endif
