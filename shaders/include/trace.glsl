@@ -9,7 +9,9 @@
 // A node of the 4-wide BVH (engine/render/src/bvh_wide.rs): its children's
 // boxes per axis, one child per component; per child, an inner node's index
 // (count 0), or a leaf's first slot in leaf_triangles and its triangle count,
-// or no child (count NO_CHILD).
+// or no child (count NO_CHILD). The buffer holds a node in seven texels: the
+// six planes, then per child a link, its child in the low 24 bits and its
+// count in the 8 above (GpuWideNode): every texel is a lavapipe call.
 struct WideNode {
     vec4 lo_x;
     vec4 lo_y;
@@ -29,7 +31,7 @@ struct LeafTriangle {
     vec4 e2;
 };
 
-#define NO_CHILD 0xffffffffu
+#define NO_CHILD 0xffu
 
 // The tables every ray reads (triangles, BVH, per-corner attributes) are
 // texel buffers of 32-bit words, read by texel fetches: lavapipe loads a
@@ -136,11 +138,12 @@ uvec4 light_choice_record(uint i) {
 
 // Node `index` of the wide BVH.
 WideNode wide_node(uint index) {
-    int at = int(index) * 8;
+    int at = int(index) * 7;
+    uvec4 link = texelFetch(bvh_nodes, at + 6);
     return WideNode(uintBitsToFloat(texelFetch(bvh_nodes, at)), uintBitsToFloat(texelFetch(bvh_nodes, at + 1)),
         uintBitsToFloat(texelFetch(bvh_nodes, at + 2)), uintBitsToFloat(texelFetch(bvh_nodes, at + 3)),
         uintBitsToFloat(texelFetch(bvh_nodes, at + 4)), uintBitsToFloat(texelFetch(bvh_nodes, at + 5)),
-        texelFetch(bvh_nodes, at + 6), texelFetch(bvh_nodes, at + 7));
+        link & 0xffffffu, link >> 24u);
 }
 
 // Leaf triangle `slot`.

@@ -21,7 +21,7 @@ use glam::Vec3;
 /// Children per node.
 pub const WIDTH: usize = 4;
 
-/// `count` of a child slot that holds no child.
+/// [`GpuWideNode::count`] of a child slot that holds no child.
 pub const NO_CHILD: u32 = u32::MAX;
 
 /// Groups the GPU walk's stack holds (`TRACE_STACK` in
@@ -29,14 +29,26 @@ pub const NO_CHILD: u32 = u32::MAX;
 /// than it allows would lose nodes there, so the renderer warns of one.
 pub const GPU_STACK: usize = 72;
 
-/// Most nodes a tree may have: the walk's stack entries hold a node index in
-/// 24 bits (`TRACE_GROUP_BITS` in `trace.glsl`).
+/// Most nodes a tree may have: the walk's stack entries and a node's links
+/// hold a node index in 24 bits (`TRACE_GROUP_BITS` in `trace.glsl`).
 pub const MAX_NODES: usize = 1 << GROUP_BITS;
+
+/// Most leaf triangles a tree may have: a node's links hold a leaf's first
+/// slot in 24 bits.
+pub const MAX_LEAF_TRIANGLES: usize = 1 << LINK_BITS;
 
 /// Bits of a stack entry that hold its group's first node.
 const GROUP_BITS: u32 = 24;
 
-/// One node as the shader reads it (`struct WideNode`, std430).
+/// Bits of a link that hold its child's index (node or leaf slot); the
+/// count is in the 8 above.
+const LINK_BITS: u32 = 24;
+
+/// The link of a slot that holds no child (count 255).
+const EMPTY_LINK: u32 = u32::MAX;
+
+/// One node as the shader reads it (`struct WideNode`): seven texels, so a
+/// node costs lavapipe seven texel-fetch calls (docs/pathtrace.md).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuWideNode {
@@ -44,23 +56,40 @@ pub struct GpuWideNode {
     pub lo: [[f32; WIDTH]; 3],
     /// Upper corners of the children's boxes, per axis then per child.
     pub hi: [[f32; WIDTH]; 3],
-    /// An inner child's node index, or a leaf's first slot in
-    /// [`WideBvh::triangles`].
-    pub child: [u32; WIDTH],
-    /// 0 for an inner child, the triangle count of a leaf, or [`NO_CHILD`].
-    pub count: [u32; WIDTH],
+    /// Per child slot, its [`child`](Self::child) in the low 24 bits and
+    /// its [`count`](Self::count) in the 8 above; all ones for no child.
+    pub link: [u32; WIDTH],
 }
 
-const _: () = assert!(std::mem::size_of::<GpuWideNode>() == 128);
+const _: () = assert!(std::mem::size_of::<GpuWideNode>() == 112);
 
 impl GpuWideNode {
     /// A node whose slots are all empty.
     const EMPTY: GpuWideNode = GpuWideNode {
         lo: [[0.0; WIDTH]; 3],
         hi: [[0.0; WIDTH]; 3],
-        child: [0; WIDTH],
-        count: [NO_CHILD; WIDTH],
+        link: [EMPTY_LINK; WIDTH],
     };
+
+    /// Slot `slot`'s inner node index, or its leaf's first slot in
+    /// [`WideBvh::triangles`].
+    pub fn child(&self, slot: usize) -> u32 {
+        self.link[slot] & ((1 << LINK_BITS) - 1)
+    }
+
+    /// 0 for an inner child, the triangle count of a leaf, or [`NO_CHILD`].
+    pub fn count(&self, slot: usize) -> u32 {
+        match self.link[slot] {
+            EMPTY_LINK => NO_CHILD,
+            link => link >> LINK_BITS,
+        }
+    }
+
+    /// Links slot `slot` to `child` with `count` (0 for an inner node).
+    fn link(&mut self, slot: usize, child: u32, count: u32) {
+        debug_assert!(child < 1 << LINK_BITS && (count as usize) <= crate::bvh::MAX_LEAF);
+        self.link[slot] = child | count << LINK_BITS;
+    }
 }
 
 /// A leaf triangle as the shader reads it (`struct LeafTriangle`): its first
@@ -117,13 +146,11 @@ impl WideBvh {
                     nodes[wide].hi[axis][slot] = child.max[axis];
                 }
                 if child.count > 0 {
-                    nodes[wide].child[slot] = child.first;
-                    nodes[wide].count[slot] = child.count;
+                    nodes[wide].link(slot, child.first, child.count);
                 } else {
                     let index = nodes.len();
                     nodes.push(GpuWideNode::EMPTY);
-                    nodes[wide].child[slot] = index as u32;
-                    nodes[wide].count[slot] = 0;
+                    nodes[wide].link(slot, index as u32, 0);
                     pending.push((index, c));
                 }
             }
@@ -144,8 +171,8 @@ impl WideBvh {
         while let Some((n, d)) = stack.pop() {
             let node = &self.nodes[n];
             for slot in 0..WIDTH {
-                match node.count[slot] {
-                    0 => stack.push((node.child[slot] as usize, d + 1)),
+                match node.count(slot) {
+                    0 => stack.push((node.child(slot) as usize, d + 1)),
                     NO_CHILD => {}
                     _ => deepest = deepest.max(d),
                 }
@@ -170,7 +197,7 @@ impl WideBvh {
             return 0.0;
         }
         let root = &self.nodes[0];
-        let slots = || (0..WIDTH).filter(|&s| root.count[s] != NO_CHILD);
+        let slots = || (0..WIDTH).filter(|&s| root.count(s) != NO_CHILD);
         let lo = slots().fold(Vec3::INFINITY, |m, s| {
             m.min(Vec3::new(root.lo[0][s], root.lo[1][s], root.lo[2][s]))
         });
@@ -183,7 +210,7 @@ impl WideBvh {
             .nodes
             .iter()
             .flat_map(|n| (0..WIDTH).map(move |s| (n, s)))
-            .map(|(n, s)| match n.count[s] {
+            .map(|(n, s)| match n.count(s) {
                 NO_CHILD => 0.0,
                 0 => TRAVERSAL_COST * slot_area(n, s) / area,
                 count => count as f32 * slot_area(n, s) / area,
@@ -241,15 +268,15 @@ impl WideBvh {
             // Which leaves to test is settled before any of them is: the
             // shader tests them in one loop.
             let tests = std::array::from_fn::<_, WIDTH, _>(|k| {
-                let count = node.count[slot[k]];
+                let count = node.count(slot[k]);
                 if near[k] < limit && count != NO_CHILD {
                     count as usize
                 } else {
                     0
                 }
             });
-            for k in 0..WIDTH {
-                let first = node.child[slot[k]] as usize;
+            for k in (0..WIDTH).filter(|&k| tests[k] > 0) {
+                let first = node.child(slot[k]) as usize;
                 for tri in &self.triangles[first..first + tests[k]] {
                     let hit = intersect_edges(
                         Vec3::from(tri.a),
@@ -314,8 +341,8 @@ impl Group {
         limit: f32,
     ) -> Group {
         let base = (0..WIDTH)
-            .filter(|&s| node.count[s] == 0)
-            .map(|s| node.child[s])
+            .filter(|&s| node.count(s) == 0)
+            .map(|s| node.child(s))
             .min()
             .unwrap_or(0);
         let mut group = Group {
@@ -325,8 +352,8 @@ impl Group {
             entries: [f32::INFINITY; WIDTH],
         };
         for k in (0..WIDTH).rev() {
-            if near[k] < limit && node.count[slot[k]] == 0 {
-                group.order = group.order << 2 | (node.child[slot[k]] - base);
+            if near[k] < limit && node.count(slot[k]) == 0 {
+                group.order = group.order << 2 | (node.child(slot[k]) - base);
                 group.entries = [
                     near[k],
                     group.entries[0],
@@ -386,7 +413,7 @@ fn entries(node: &GpuWideNode, origin: Vec3, inv: Vec3, limit: f32) -> [f32; WID
         let t1 = (hi - origin) * inv;
         let near = t0.min(t1).max_element().max(0.0);
         let far = t0.max(t1).min_element();
-        let meets = near <= far && near < limit && node.count[slot] != NO_CHILD;
+        let meets = near <= far && near < limit && node.count(slot) != NO_CHILD;
         if meets {
             near
         } else {
@@ -463,23 +490,23 @@ mod tests {
         while let Some((n, outer)) = stack.pop() {
             visited += 1;
             let node = &wide.nodes[n];
-            let children = node.count.iter().filter(|&&c| c != NO_CHILD).count();
+            let children = (0..WIDTH).filter(|&s| node.count(s) != NO_CHILD).count();
             assert!(children >= 2, "node {n} has {children} children");
             for slot in 0..WIDTH {
-                if node.count[slot] == NO_CHILD {
+                if node.count(slot) == NO_CHILD {
                     continue;
                 }
                 let (lo, hi) = slot_box(node, slot);
                 if let Some((olo, ohi)) = outer {
                     assert!(lo.cmpge(olo).all() && hi.cmple(ohi).all());
                 }
-                if node.count[slot] == 0 {
-                    stack.push((node.child[slot] as usize, Some((lo, hi))));
+                if node.count(slot) == 0 {
+                    stack.push((node.child(slot) as usize, Some((lo, hi))));
                     continue;
                 }
-                assert!(node.count[slot] as usize <= crate::bvh::MAX_LEAF);
-                let first = node.child[slot] as usize;
-                for leaf in &wide.triangles[first..first + node.count[slot] as usize] {
+                assert!(node.count(slot) as usize <= crate::bvh::MAX_LEAF);
+                let first = node.child(slot) as usize;
+                for leaf in &wide.triangles[first..first + node.count(slot) as usize] {
                     seen[leaf.triangle as usize] += 1;
                     for p in tris[leaf.triangle as usize] {
                         assert!(p.cmpge(lo).all() && p.cmple(hi).all());
@@ -572,6 +599,26 @@ mod tests {
     }
 
     #[test]
+    fn a_link_holds_its_child_and_count_and_an_empty_slot_reads_as_none() {
+        let mut node = GpuWideNode::EMPTY;
+        node.link(
+            0,
+            (MAX_LEAF_TRIANGLES - 1) as u32,
+            crate::bvh::MAX_LEAF as u32,
+        );
+        node.link(1, (MAX_NODES - 1) as u32, 0);
+        node.link(2, 0, 1);
+        assert_eq!(node.child(0), (MAX_LEAF_TRIANGLES - 1) as u32);
+        assert_eq!(node.count(0), crate::bvh::MAX_LEAF as u32);
+        assert_eq!((node.child(1), node.count(1)), ((MAX_NODES - 1) as u32, 0));
+        assert_eq!((node.child(2), node.count(2)), (0, 1));
+        assert_eq!(node.count(3), NO_CHILD);
+        // The shader reads the same words: count 255 is no child there.
+        assert_eq!(node.link[3] >> LINK_BITS, 0xff);
+        assert_eq!(node.link[0], 0x04ff_ffff);
+    }
+
+    #[test]
     fn a_group_packs_into_one_word_and_back() {
         let group = Group {
             base: MAX_NODES as u32 - 1,
@@ -601,8 +648,8 @@ mod tests {
         let wide = WideBvh::collapse(&Bvh::build(&tris), &tris);
         for node in &wide.nodes {
             let inner: Vec<u32> = (0..WIDTH)
-                .filter(|&s| node.count[s] == 0)
-                .map(|s| node.child[s])
+                .filter(|&s| node.count(s) == 0)
+                .map(|s| node.child(s))
                 .collect();
             for pair in inner.windows(2) {
                 assert_eq!(pair[1], pair[0] + 1, "{inner:?}");
@@ -658,7 +705,8 @@ mod tests {
         assert_eq!(Bvh::build(&one).sah_cost(), 1.0);
         assert_eq!(wide.sah_cost(), 2.0);
         assert_eq!(wide.nodes.len(), 1);
-        assert_eq!(wide.nodes[0].count, [1, NO_CHILD, NO_CHILD, NO_CHILD]);
+        let counts: Vec<u32> = (0..WIDTH).map(|s| wide.nodes[0].count(s)).collect();
+        assert_eq!(counts, [1, NO_CHILD, NO_CHILD, NO_CHILD]);
         assert_eq!(
             wide.closest_hit(Vec3::ZERO, Vec3::X, f32::INFINITY),
             Some((1.0, 0))

@@ -61,6 +61,16 @@ impl<'g> TraceBuffers<'g> {
                 ),
             });
         }
+        if wide.triangles.len() > crate::bvh_wide::MAX_LEAF_TRIANGLES {
+            return Err(GpuError::Allocation {
+                what: "the BVH's leaf triangles".into(),
+                message: format!(
+                    "{} triangles, more than the {} a node's links can name",
+                    wide.triangles.len(),
+                    crate::bvh_wide::MAX_LEAF_TRIANGLES
+                ),
+            });
+        }
         let stack_need = wide.stack_need();
         if stack_need > crate::bvh_wide::GPU_STACK {
             warnings.push(format!(
