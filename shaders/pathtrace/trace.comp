@@ -149,7 +149,16 @@ void main() {
     // not one frame's samples over and over.
     uint sample_frame = params.accumulate != 0u ? params.history_frames : params.frame;
     uint sample_index = sample_frame * spf + params.repeat_index;
-    ivec2 pixel = params.coherent_lanes != 0u ? coherent_pixel(sample_index) : ivec2(gl_GlobalInvocationID.xy);
+    // lavapipe splits a dispatch's work groups, in order, into one
+    // contiguous block per thread: the first half of the work-group rows
+    // takes the image's even tile rows and the second half the odd ones, so
+    // two threads each get rows from the whole image, not one half each
+    // where the costly half (a glass ball on the floor) made the other wait.
+    uint half_rows = (gl_NumWorkGroups.y + 1u) / 2u;
+    uint r = gl_WorkGroupID.y;
+    uint tile_row = r < half_rows ? 2u * r : 2u * (r - half_rows) + 1u;
+    ivec2 pixel = params.coherent_lanes != 0u ? coherent_pixel(sample_index)
+        : ivec2(gl_GlobalInvocationID.x, tile_row * 8u + gl_LocalInvocationID.y);
     if (any(greaterThanEqual(pixel, size))) {
         return;
     }
