@@ -51,25 +51,23 @@ impl<'g> TraceBuffers<'g> {
         let (bvh, cache_warning) = crate::bvh_cache::load_or_build(&mesh.corners, cache);
         warnings.extend(cache_warning);
         let wide = crate::bvh_wide::WideBvh::collapse(&bvh, &mesh.corners);
-        if wide.nodes.len() > crate::bvh_wide::MAX_NODES {
-            return Err(GpuError::Allocation {
-                what: "the BVH nodes".into(),
-                message: format!(
-                    "{} nodes, more than the {} the walk's stack entries can name",
-                    wide.nodes.len(),
-                    crate::bvh_wide::MAX_NODES
-                ),
-            });
-        }
-        if wide.triangles.len() > crate::bvh_wide::MAX_LEAF_TRIANGLES {
-            return Err(GpuError::Allocation {
-                what: "the BVH's leaf triangles".into(),
-                message: format!(
-                    "{} triangles, more than the {} a node's links can name",
-                    wide.triangles.len(),
-                    crate::bvh_wide::MAX_LEAF_TRIANGLES
-                ),
-            });
+        // The walk names nodes and leaf slots in 24 bits.
+        let tables = [
+            (
+                "the BVH nodes",
+                wide.nodes.len(),
+                crate::bvh_wide::MAX_NODES,
+                "nodes",
+            ),
+            (
+                "the BVH's leaf triangles",
+                wide.triangles.len(),
+                crate::bvh_wide::MAX_LEAF_TRIANGLES,
+                "triangles",
+            ),
+        ];
+        for (what, len, limit, unit) in tables {
+            within_index(what, len, limit, unit)?;
         }
         let stack_need = wide.stack_need();
         if stack_need > crate::bvh_wide::GPU_STACK {
@@ -226,4 +224,35 @@ fn light_choices(lights: &LightSet, emitter_power: Option<f32>, scene_radius: f3
         emitter_power,
         scene_radius,
     )
+}
+
+/// Refuses a BVH table of `len` `unit` when more than `limit`, the most the
+/// walk's 24-bit indices can name.
+fn within_index(what: &str, len: usize, limit: usize, unit: &str) -> Result<(), GpuError> {
+    if len <= limit {
+        return Ok(());
+    }
+    Err(GpuError::Allocation {
+        what: what.into(),
+        message: format!("{len} {unit}, more than the {limit} the walk's 24-bit indices can name"),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_table_beyond_the_walks_indices_is_refused_with_its_size_and_limit() {
+        assert!(within_index("the BVH nodes", 16, 16, "nodes").is_ok());
+        let refused = within_index("the BVH's leaf triangles", 17, 16, "triangles");
+        let Err(GpuError::Allocation { what, message }) = refused else {
+            panic!("17 triangles under a limit of 16 were accepted: {refused:?}");
+        };
+        assert_eq!(what, "the BVH's leaf triangles");
+        assert_eq!(
+            message,
+            "17 triangles, more than the 16 the walk's 24-bit indices can name"
+        );
+    }
 }
