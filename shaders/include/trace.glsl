@@ -31,6 +31,10 @@ struct LeafTriangle {
     vec4 e2;
 };
 
+// A link's child in its low TRACE_LINK_BITS bits, its count above them
+// (bvh_wide.rs LINK_BITS); NO_CHILD is the count of an empty slot.
+#define TRACE_LINK_BITS 24u
+#define TRACE_LINK_CHILD 0xffffffu
 #define NO_CHILD 0xffu
 
 // The tables every ray reads (triangles, BVH, per-corner attributes) are
@@ -143,7 +147,7 @@ WideNode wide_node(uint index) {
     return WideNode(uintBitsToFloat(texelFetch(bvh_nodes, at)), uintBitsToFloat(texelFetch(bvh_nodes, at + 1)),
         uintBitsToFloat(texelFetch(bvh_nodes, at + 2)), uintBitsToFloat(texelFetch(bvh_nodes, at + 3)),
         uintBitsToFloat(texelFetch(bvh_nodes, at + 4)), uintBitsToFloat(texelFetch(bvh_nodes, at + 5)),
-        link & 0xffffffu, link >> 24u);
+        link & TRACE_LINK_CHILD, link >> TRACE_LINK_BITS);
 }
 
 // Leaf triangle `slot`.

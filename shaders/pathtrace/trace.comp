@@ -127,6 +127,19 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
     return p.radiance;
 }
 
+// The invocation's pixel with the image's tile rows interleaved: lavapipe
+// splits a dispatch's work groups, in order, into one contiguous block per
+// thread, so the first half of the work-group rows takes the even tile rows
+// and the second half the odd ones. Two threads then each get rows from the
+// whole image, not one half each where the costly half (a glass ball on the
+// floor) made the other wait.
+ivec2 interleaved_pixel() {
+    uint half_rows = (gl_NumWorkGroups.y + 1u) / 2u;
+    uint r = gl_WorkGroupID.y;
+    uint tile_row = r < half_rows ? 2u * r : 2u * (r - half_rows) + 1u;
+    return ivec2(gl_GlobalInvocationID.x, tile_row * 8u + gl_LocalInvocationID.y);
+}
+
 // Under `coherent_lanes`: the invocation of local index `l` (0..63) in its 8 x 8
 // work group takes the tile's pixel whose index is `l`'s 6 bits rotated by
 // a number the sample picks, so each sample groups the tile's pixels into
@@ -149,16 +162,7 @@ void main() {
     // not one frame's samples over and over.
     uint sample_frame = params.accumulate != 0u ? params.history_frames : params.frame;
     uint sample_index = sample_frame * spf + params.repeat_index;
-    // lavapipe splits a dispatch's work groups, in order, into one
-    // contiguous block per thread: the first half of the work-group rows
-    // takes the image's even tile rows and the second half the odd ones, so
-    // two threads each get rows from the whole image, not one half each
-    // where the costly half (a glass ball on the floor) made the other wait.
-    uint half_rows = (gl_NumWorkGroups.y + 1u) / 2u;
-    uint r = gl_WorkGroupID.y;
-    uint tile_row = r < half_rows ? 2u * r : 2u * (r - half_rows) + 1u;
-    ivec2 pixel = params.coherent_lanes != 0u ? coherent_pixel(sample_index)
-        : ivec2(gl_GlobalInvocationID.x, tile_row * 8u + gl_LocalInvocationID.y);
+    ivec2 pixel = params.coherent_lanes != 0u ? coherent_pixel(sample_index) : interleaved_pixel();
     if (any(greaterThanEqual(pixel, size))) {
         return;
     }

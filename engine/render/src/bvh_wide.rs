@@ -21,8 +21,9 @@ use glam::Vec3;
 /// Children per node.
 pub const WIDTH: usize = 4;
 
-/// [`GpuWideNode::count`] of a child slot that holds no child.
-pub const NO_CHILD: u32 = u32::MAX;
+/// [`GpuWideNode::count`] of a child slot that holds no child: the count
+/// bits of [`EMPTY_LINK`] (`NO_CHILD` in `trace.glsl`).
+pub const NO_CHILD: u32 = EMPTY_LINK >> LINK_BITS;
 
 /// Groups the GPU walk's stack holds (`TRACE_STACK` in
 /// `shaders/include/trace.glsl`; a test holds the two equal). A deeper tree
@@ -44,7 +45,7 @@ const GROUP_BITS: u32 = 24;
 /// count is in the 8 above.
 const LINK_BITS: u32 = 24;
 
-/// The link of a slot that holds no child (count 255).
+/// The link of a slot that holds no child (count [`NO_CHILD`]).
 const EMPTY_LINK: u32 = u32::MAX;
 
 /// One node as the shader reads it (`struct WideNode`): seven texels, so a
@@ -79,10 +80,7 @@ impl GpuWideNode {
 
     /// 0 for an inner child, the triangle count of a leaf, or [`NO_CHILD`].
     pub fn count(&self, slot: usize) -> u32 {
-        match self.link[slot] {
-            EMPTY_LINK => NO_CHILD,
-            link => link >> LINK_BITS,
-        }
+        self.link[slot] >> LINK_BITS
     }
 
     /// Links slot `slot` to `child` with `count` (0 for an inner node).
@@ -598,6 +596,15 @@ mod tests {
         }
     }
 
+    /// The shader the walk's constants must agree with.
+    fn trace_glsl() -> String {
+        std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../shaders/include/trace.glsl"),
+        )
+        .expect("trace.glsl")
+    }
+
     #[test]
     fn a_link_holds_its_child_and_count_and_an_empty_slot_reads_as_none() {
         let mut node = GpuWideNode::EMPTY;
@@ -614,7 +621,14 @@ mod tests {
         assert_eq!((node.child(2), node.count(2)), (0, 1));
         assert_eq!(node.count(3), NO_CHILD);
         // The shader reads the same words: count 255 is no child there.
-        assert_eq!(node.link[3] >> LINK_BITS, 0xff);
+        assert_eq!(NO_CHILD, 0xff);
+        let shader = trace_glsl();
+        for define in [
+            format!("#define TRACE_LINK_BITS {LINK_BITS}u\n"),
+            format!("#define NO_CHILD {NO_CHILD:#x}u\n"),
+        ] {
+            assert!(shader.contains(&define), "trace.glsl lacks {define:?}");
+        }
         assert_eq!(node.link[0], 0x04ff_ffff);
     }
 
@@ -674,11 +688,7 @@ mod tests {
                 wide.stack_need()
             );
         }
-        let shader = std::fs::read_to_string(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../../shaders/include/trace.glsl"),
-        )
-        .expect("trace.glsl");
+        let shader = trace_glsl();
         assert!(
             shader.contains(&format!("#define TRACE_STACK {GPU_STACK}\n")),
             "trace.glsl's TRACE_STACK is not GPU_STACK ({GPU_STACK})"
