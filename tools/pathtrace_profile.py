@@ -137,7 +137,7 @@ bool profile_bsdf_sample(Bsdf b, vec3 n, vec3 wo, vec3 u, out vec3 wi, out vec3 
         "profile_bsdf_sample(",
     ),
     "random numbers": (
-        "rng_next: one PCG4D hash per draw",
+        "rng_next: one draw of four numbers (a Sobol point; PCG4D with independent_sampler)",
         """
 vec4 profile_rng_next(inout Rng rng) {
     Rng copy = rng;

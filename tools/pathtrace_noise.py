@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""Noise per sample: weft's path tracer beside Mitsuba 3 at equal spp (issue 34).
+
+Renders the Cornell box of tools/pathtrace_vs_mitsuba.py `--seeds` times in
+each renderer, each time with another seed, at `--spp` samples per pixel and
+each max_depth of `--depths`, and compares the per-pixel variance across the
+seeds: its mean over pixels and channels relative to the squared converged
+value, var / (mean^2 + 0.01), the mean taken over both renderers' renders.
+A ratio below 1 means weft's estimate of a pixel is less noisy at that
+spp. "Outside the light" leaves out the pixels that see the light (Mitsuba
+at max_depth 1 shows them) and those within two pixels of them, whose noise
+is the pixel filter's coverage of the light's edge.
+
+weft's sampler is the graph's (padded Owen-scrambled Sobol, or independent
+numbers with `--features independent_sampler`); Mitsuba's is `--mitsuba-sampler`
+(`independent`, `multijitter`, ...). Both render with Russian roulette from
+their own `rr_depth` 5, which weft counts one segment earlier
+(docs/pathtrace.md, "Paths").
+
+    pip install mitsuba
+    cargo build --release -p weft-cli
+    python3 tools/pathtrace_noise.py --mitsuba-sampler multijitter
+    python3 tools/pathtrace_noise.py --features independent_sampler --mitsuba-sampler independent
+"""
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pathtrace_vs_mitsuba as side_by_side  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+mi = side_by_side.mi
+
+
+def linear(path):
+    """An EXR's linear RGB as a float32 HxWx3 array."""
+    bitmap = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
+    return np.array(bitmap)
+
+
+def weft_renders(args, depth, work):
+    """weft's image for each seed."""
+    images = []
+    for seed in range(args.seeds):
+        out = os.path.join(work, f"weft_{depth}_{seed}.exr")
+        subprocess.run(
+            [args.weft, "render", "scenes/cornell.scene", "--graph", "graphs/pathtrace.ron",
+             "--size", f"{args.size}x{args.size}", "--spp", str(args.spp), "--param", f"max_depth={depth}",
+             "--seed", str(seed), "--out", out] + (["--features", args.features] if args.features else []),
+            cwd=side_by_side.ROOT, check=True, capture_output=True)
+        images.append(linear(out))
+    return np.array(images)
+
+
+def mitsuba_renders(args, depth, work, sampler):
+    """Mitsuba's image for each seed."""
+    side_by_side.MAX_DEPTH = depth
+    scene = side_by_side.mitsuba_scene(args.spp, args.size, work, sampler=sampler)
+    return np.array([np.array(mi.render(scene, spp=args.spp, seed=seed + 1))[:, :, :3] for seed in range(args.seeds)])
+
+
+def light_mask(args, work):
+    """True for pixels that see the light or lie within two pixels of one."""
+    direct = mitsuba_renders(argparse.Namespace(**{**vars(args), "seeds": 1}), 1, work, "independent")[0]
+    sees = direct.max(axis=-1) > 0.0
+    near = sees.copy()
+    for dy in range(-2, 3):
+        for dx in range(-2, 3):
+            near |= np.roll(np.roll(sees, dy, axis=0), dx, axis=1)
+    return near
+
+
+def relative_variance(images, converged):
+    """Per pixel, the variance across renders over (converged^2 + 0.01), averaged over channels."""
+    return (images.var(axis=0, ddof=1) / (converged ** 2 + 0.01)).mean(axis=-1)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--depths", default="2,3,8", help="max_depth values, comma-separated")
+    parser.add_argument("--seeds", type=int, default=24)
+    parser.add_argument("--spp", type=int, default=64)
+    parser.add_argument("--size", type=int, default=128)
+    parser.add_argument("--weft", default=side_by_side.WEFT)
+    parser.add_argument("--features", default="", help="weft's --features (independent_sampler)")
+    parser.add_argument("--mitsuba-sampler", default="multijitter")
+    args = parser.parse_args()
+    mi.set_variant("scalar_rgb")
+    rows = []
+    with tempfile.TemporaryDirectory() as work:
+        outside = ~light_mask(args, work)
+        for depth in (int(d) for d in args.depths.split(",")):
+            weft = weft_renders(args, depth, work)
+            mitsuba = mitsuba_renders(args, depth, work, args.mitsuba_sampler)
+            converged = (weft.mean(axis=0) + mitsuba.mean(axis=0)) / 2
+            w, m = relative_variance(weft, converged), relative_variance(mitsuba, converged)
+            rows.append((depth, w.mean(), m.mean(), w.mean() / m.mean(), w[outside].mean() / m[outside].mean()))
+            print(f"max_depth {depth}: weft {rows[-1][1]:.3e}, Mitsuba {rows[-1][2]:.3e}", file=sys.stderr, flush=True)
+    features = args.features or "the graph's sampler"
+    print(f"Cornell box, {args.size}x{args.size}, {args.spp} spp, {args.seeds} seeds; weft ({features}) beside "
+          f"Mitsuba scalar_rgb ({args.mitsuba_sampler})\n")
+    print("| max_depth | weft rel. variance | Mitsuba rel. variance | weft / Mitsuba | outside the light |")
+    print("|---:|---:|---:|---:|---:|")
+    for depth, w, m, ratio, ratio_outside in rows:
+        print(f"| {depth} | {w:.3e} | {m:.3e} | {ratio:.2f} | {ratio_outside:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
