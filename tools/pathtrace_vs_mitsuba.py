@@ -5,7 +5,7 @@ Renders ../shared/assets/cornell/CornellBox-Original.obj with the camera of
 scenes/cornell.scene in both renderers: same geometry (triangulated fans, face
 normals), Lambert reflectances (MTL Kd), the emissive quad as a one-sided area
 emitter of radiance Ke, a box pixel filter, path tracing with max_depth 8 and
-Russian roulette from depth 5. It reports each renderer's samples per second
+Russian roulette that may first cut segment 6 in both (RR_DEPTH below). It reports each renderer's samples per second
 at the same spp, and each image's relative MSE against a high-spp Mitsuba
 reference (and against each other), as a markdown table for docs/pathtrace.md.
 
@@ -99,6 +99,13 @@ def split_by_material(path, out_dir):
     return files
 
 
+# Russian roulette as weft's graphs default to it: segment 6 is the first it
+# may cut. Mitsuba's `path` counts as weft does (its first cut segment is
+# rr_depth + 1); `volpath` tests `depth > rr_depth` before tracing, so its
+# first cut segment is rr_depth + 2, and it gets one less.
+RR_DEPTH = 5
+VOLPATH_RR_DEPTH = RR_DEPTH - 1
+
 # --max-depth, when given, replaces the scene's own path length limit.
 MAX_DEPTH = None
 
@@ -154,7 +161,8 @@ def mitsuba_scene(spp, size, work, ball=None, sampler="independent"):
     materials = read_materials(MTL)
     scene = {
         "type": "scene",
-        "integrator": {"type": "volpath" if ball else "path", "max_depth": max_depth(ball), "rr_depth": 5},
+        "integrator": {"type": "volpath" if ball else "path", "max_depth": max_depth(ball),
+                       "rr_depth": VOLPATH_RR_DEPTH if ball else RR_DEPTH},
         "camera": {
             "type": "perspective",
             "fov": 40.0,

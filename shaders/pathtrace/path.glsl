@@ -186,7 +186,9 @@ bool path_scatter(inout Path p, inout Rng rng, TraceSurface s, Material m) {
     p.throughput *= weight;
     p.counted_fully = delta;
     p.origin = from;
-    if (p.depth + 1u >= params.rr_depth) {
+    // Russian roulette at the rr_depth-th vertex and after, so the first
+    // segment it may cut is rr_depth + 1, as in Mitsuba's `path`.
+    if (p.depth >= params.rr_depth) {
         float q = min(max(max(p.throughput.r, p.throughput.g), p.throughput.b), 0.95);
         if (u.w >= q) {
             return false;

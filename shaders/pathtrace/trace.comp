@@ -17,7 +17,8 @@
 // Paths: primary rays through uniformly jittered positions in the pixel (a
 // box filter); next-event estimation at every non-mirror vertex, combined
 // with BSDF sampling by the power heuristic, so each light is counted once;
-// delta lights only through NEE; Russian roulette from `rr_depth`; at most
+// delta lights only through NEE; Russian roulette from the rr_depth-th vertex
+// (the first segment it may cut is rr_depth + 1, as in Mitsuba); at most
 // `max_depth` segments, counting the camera ray as 1 (Mitsuba's max_depth).
 // A ray that leaves the scene sees the suns' ambient as uniform sky radiance,
 // which gives unoccluded diffuse surfaces the raster path's ambient term; the
@@ -96,7 +97,7 @@ layout(push_constant) uniform Params {
 // scatters at what it met scatters, masked, after the segment that ends the
 // last of the group's paths whenever that path ends at what its ray meets
 // (a miss, a light, max_depth) rather than in the scattering (Russian
-// roulette, absorption). Without Russian roulette (MAX_DEPTH < RR_DEPTH,
+// roulette, absorption). Without Russian roulette (MAX_DEPTH <= RR_DEPTH,
 // `max_depth` and `rr_depth` compiled in), the loop is turned so that an
 // iteration scatters and then traces: it ends right after the last ray any
 // lane traces, and at max_depth 1 there is no loop (1.6-1.9x the samples a
@@ -105,7 +106,7 @@ layout(push_constant) uniform Params {
 // the ray walk cost 1-2%.
 vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
     Path p = path_start(origin, dir);
-#if MAX_DEPTH < RR_DEPTH
+#if MAX_DEPTH <= RR_DEPTH
     TraceSurface s;
     Material m;
     bool scatters = path_hit(p, s, m);
