@@ -36,6 +36,7 @@ use weft_render::RenderSettings;
 mod caustics;
 mod glass;
 mod light_tree;
+mod roulette;
 mod sampler;
 mod wavefront;
 

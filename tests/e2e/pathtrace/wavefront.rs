@@ -5,7 +5,7 @@
 //! state the queue carries between segments: area lights and MIS weights
 //! (Cornell), glass with Snell-bent NEE and lights chosen by power
 //! (caustics), punctual lights chosen through the light tree with BSDF
-//! sampling alone and Russian roulette from the second segment (demo), and a medium's absorption carried across
+//! sampling alone and Russian roulette from the third segment (demo, `rr_depth` 2), and a medium's absorption carried across
 //! up to 16 segments (the Beer slab).
 
 use super::*;
