@@ -21,9 +21,16 @@ their own `rr_depth` 5, which weft counts one segment earlier
     cargo build --release -p weft-cli
     python3 tools/pathtrace_noise.py --mitsuba-sampler multijitter
     python3 tools/pathtrace_noise.py --features independent_sampler --mitsuba-sampler independent
+    python3 tools/pathtrace_noise.py --weft-param rr_depth=4,5 --depths 8
+
+With `--weft-param NAME=A,B,...` it renders weft alone with each value of
+the graph parameter and reports each one's relative variance, its render
+time (the frames' time, pipeline builds left out) and their product: lower
+is more efficient.
 """
 
 import argparse
+import json
 import os
 import subprocess
 import sys
@@ -43,18 +50,36 @@ def linear(path):
     return np.array(bitmap)
 
 
-def weft_renders(args, depth, work):
-    """weft's image for each seed."""
-    images = []
+def weft_renders(args, depth, work, params=()):
+    """weft's image for each seed, and the seconds its frames took in all."""
+    images, seconds = [], 0.0
     for seed in range(args.seeds):
         out = os.path.join(work, f"weft_{depth}_{seed}.exr")
-        subprocess.run(
+        run = subprocess.run(
             [args.weft, "render", "scenes/cornell.scene", "--graph", "graphs/pathtrace.ron",
              "--size", f"{args.size}x{args.size}", "--spp", str(args.spp), "--param", f"max_depth={depth}",
-             "--seed", str(seed), "--out", out] + (["--features", args.features] if args.features else []),
-            cwd=side_by_side.ROOT, check=True, capture_output=True)
+             "--seed", str(seed), "--out", out, "--json"]
+            + [a for p in params for a in ("--param", p)]
+            + (["--features", args.features] if args.features else []),
+            cwd=side_by_side.ROOT, check=True, capture_output=True, text=True)
+        report = json.loads(run.stdout)
+        seconds += report["frame_ms"] * report["frames"] / 1e3
         images.append(linear(out))
-    return np.array(images)
+    return np.array(images), seconds
+
+
+def compare_weft_params(args, work):
+    """Relative variance, render seconds and their product for each value of --weft-param."""
+    name, values = args.weft_param.split("=", 1)
+    print(f"Cornell box, {args.size}x{args.size}, {args.spp} spp, {args.seeds} seeds; weft with each {name}\n")
+    print(f"| max_depth | {name} | rel. variance | seconds | rel. variance x seconds |")
+    print("|---:|---:|---:|---:|---:|")
+    for depth in (int(d) for d in args.depths.split(",")):
+        runs = {v: weft_renders(args, depth, work, [f"{name}={v}"]) for v in values.split(",")}
+        converged = sum(images.mean(axis=0) for images, _ in runs.values()) / len(runs)
+        for value, (images, seconds) in runs.items():
+            v = relative_variance(images, converged).mean()
+            print(f"| {depth} | {value} | {v:.3e} | {seconds:.2f} | {v * seconds:.3e} |")
 
 
 def mitsuba_renders(args, depth, work, sampler):
@@ -89,13 +114,19 @@ def main():
     parser.add_argument("--weft", default=side_by_side.WEFT)
     parser.add_argument("--features", default="", help="weft's --features (independent_sampler)")
     parser.add_argument("--mitsuba-sampler", default="multijitter")
+    parser.add_argument("--weft-param", default="",
+                        help="NAME=A,B,...: weft alone with each value of a graph parameter, no Mitsuba")
     args = parser.parse_args()
     mi.set_variant("scalar_rgb")
     rows = []
+    if args.weft_param:
+        with tempfile.TemporaryDirectory() as work:
+            compare_weft_params(args, work)
+        return
     with tempfile.TemporaryDirectory() as work:
         outside = ~light_mask(args, work)
         for depth in (int(d) for d in args.depths.split(",")):
-            weft = weft_renders(args, depth, work)
+            weft, _ = weft_renders(args, depth, work)
             mitsuba = mitsuba_renders(args, depth, work, args.mitsuba_sampler)
             converged = (weft.mean(axis=0) + mitsuba.mean(axis=0)) / 2
             w, m = relative_variance(weft, converged), relative_variance(mitsuba, converged)
