@@ -50,8 +50,7 @@ mi = side_by_side.mi
 
 def linear(path):
     """An EXR's linear RGB as a float32 HxWx3 array."""
-    bitmap = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
-    return np.array(bitmap)
+    return np.array(side_by_side.rgb(path))
 
 
 def errors(image, reference):

@@ -44,12 +44,6 @@ import numpy as np  # noqa: E402
 mi = side_by_side.mi
 
 
-def linear(path):
-    """An EXR's linear RGB as a float32 HxWx3 array."""
-    bitmap = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
-    return np.array(bitmap)
-
-
 def weft_renders(args, depth, work, params=()):
     """weft's image for each seed, and the seconds its frames took in all."""
     images, seconds = [], 0.0
@@ -64,7 +58,7 @@ def weft_renders(args, depth, work, params=()):
             cwd=side_by_side.ROOT, check=True, capture_output=True, text=True)
         report = json.loads(run.stdout)
         seconds += report["frame_ms"] * report["frames"] / 1e3
-        images.append(linear(out))
+        images.append(np.array(side_by_side.rgb(out)))
     return np.array(images), seconds
 
 
@@ -82,16 +76,17 @@ def compare_weft_params(args, work):
             print(f"| {depth} | {value} | {v:.3e} | {seconds:.2f} | {v * seconds:.3e} |")
 
 
-def mitsuba_renders(args, depth, work, sampler):
-    """Mitsuba's image for each seed."""
+def mitsuba_renders(args, depth, work, sampler, seeds=None):
+    """Mitsuba's image for each of `seeds` seeds (`--seeds` by default)."""
     side_by_side.MAX_DEPTH = depth
     scene = side_by_side.mitsuba_scene(args.spp, args.size, work, sampler=sampler)
-    return np.array([np.array(mi.render(scene, spp=args.spp, seed=seed + 1))[:, :, :3] for seed in range(args.seeds)])
+    return np.array([np.array(mi.render(scene, spp=args.spp, seed=seed + 1))[:, :, :3]
+                     for seed in range(args.seeds if seeds is None else seeds)])
 
 
 def light_mask(args, work):
     """True for pixels that see the light or lie within two pixels of one."""
-    direct = mitsuba_renders(argparse.Namespace(**{**vars(args), "seeds": 1}), 1, work, "independent")[0]
+    direct = mitsuba_renders(args, 1, work, "independent", seeds=1)[0]
     sees = direct.max(axis=-1) > 0.0
     near = sees.copy()
     for dy in range(-2, 3):
@@ -118,11 +113,11 @@ def main():
                         help="NAME=A,B,...: weft alone with each value of a graph parameter, no Mitsuba")
     args = parser.parse_args()
     mi.set_variant("scalar_rgb")
-    rows = []
     if args.weft_param:
         with tempfile.TemporaryDirectory() as work:
             compare_weft_params(args, work)
         return
+    rows = []
     with tempfile.TemporaryDirectory() as work:
         outside = ~light_mask(args, work)
         for depth in (int(d) for d in args.depths.split(",")):

@@ -51,6 +51,23 @@ impl Hdr {
         self.pixels[(y * self.width + x) as usize]
     }
 
+    /// Pixels with any channel above zero.
+    fn lit_pixels(&self) -> usize {
+        self.pixels
+            .iter()
+            .filter(|p| p.iter().any(|&v| v > 0.0))
+            .count()
+    }
+
+    /// Pixels whose value is not bit for bit `other`'s.
+    fn pixels_differing_from(&self, other: &Hdr) -> usize {
+        self.pixels
+            .iter()
+            .zip(&other.pixels)
+            .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
+            .count()
+    }
+
     fn mean(&self) -> [f64; 3] {
         block_mean(
             self,

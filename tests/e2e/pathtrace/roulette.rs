@@ -23,26 +23,15 @@ fn russian_roulette_first_cuts_segment_rr_depth_plus_one() {
             &[],
         )
     };
-    let differing = |a: &Hdr, b: &Hdr| {
-        a.pixels
-            .iter()
-            .zip(&b.pixels)
-            .filter(|(x, y)| x.map(f32::to_bits) != y.map(f32::to_bits))
-            .count()
-    };
     let without = render(100.0);
     let at_max_depth = render(4.0);
     let one_less = render(3.0);
-    let lit = without
-        .pixels
-        .iter()
-        .filter(|p| p.iter().any(|&v| v > 0.0))
-        .count();
-    let cut = differing(&without, &one_less);
+    let lit = without.lit_pixels();
+    let cut = without.pixels_differing_from(&one_less);
     println!("{lit} lit pixels; rr_depth 3 changes {cut}");
     assert!(lit > (SIZE * SIZE / 2) as usize, "{lit} lit pixels");
     assert_eq!(
-        differing(&without, &at_max_depth),
+        without.pixels_differing_from(&at_max_depth),
         0,
         "rr_depth = max_depth cut a segment"
     );

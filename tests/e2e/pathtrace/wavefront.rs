@@ -50,17 +50,8 @@ fn the_wavefront_traces_the_megakernels_paths_bit_for_bit() {
             params,
             &[],
         );
-        let lit = megakernel
-            .pixels
-            .iter()
-            .filter(|p| p.iter().any(|&v| v > 0.0))
-            .count();
-        let differing = megakernel
-            .pixels
-            .iter()
-            .zip(&wavefront.pixels)
-            .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
-            .count();
+        let lit = megakernel.lit_pixels();
+        let differing = megakernel.pixels_differing_from(&wavefront);
         println!("{name}: {lit} lit pixels, {differing} differ");
         assert!(lit > (SIZE * SIZE / 4) as usize, "{name}: {lit} lit pixels");
         assert_eq!(differing, 0, "{name}: pixels that differ");
