@@ -135,7 +135,7 @@ def weft_for(seconds, weft, graph, size, out, features, seed):
          "--seed", str(seed), "--out", out, "--json"] + (["--features", features] if features else []),
         cwd=side_by_side.ROOT, check=True, capture_output=True, text=True)
     report = json.loads(run.stdout)
-    return linear(out), report["samples_per_pixel"], report["frame_ms"] * report["frames"] / 1000.0
+    return linear(out), report["samples_per_pixel"], side_by_side.render_seconds(report)
 
 
 def crossing(points, target):

@@ -13,9 +13,8 @@ is the pixel filter's coverage of the light's edge.
 
 weft's sampler is the graph's (padded Owen-scrambled Sobol, or independent
 numbers with `--features independent_sampler`); Mitsuba's is `--mitsuba-sampler`
-(`independent`, `multijitter`, ...). Both render with Russian roulette from
-their own `rr_depth` 5, which weft counts one segment earlier
-(docs/pathtrace.md, "Paths").
+(`independent`, `multijitter`, ...). Both render with Russian roulette that
+may first cut segment 6 (tools/pathtrace_vs_mitsuba.py, RR_DEPTH).
 
     pip install mitsuba
     cargo build --release -p weft-cli
@@ -57,7 +56,7 @@ def weft_renders(args, depth, work, params=()):
             + (["--features", args.features] if args.features else []),
             cwd=side_by_side.ROOT, check=True, capture_output=True, text=True)
         report = json.loads(run.stdout)
-        seconds += report["frame_ms"] * report["frames"] / 1e3
+        seconds += side_by_side.render_seconds(report)
         images.append(np.array(side_by_side.rgb(out)))
     return np.array(images), seconds
 

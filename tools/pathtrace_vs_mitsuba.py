@@ -5,9 +5,10 @@ Renders ../shared/assets/cornell/CornellBox-Original.obj with the camera of
 scenes/cornell.scene in both renderers: same geometry (triangulated fans, face
 normals), Lambert reflectances (MTL Kd), the emissive quad as a one-sided area
 emitter of radiance Ke, a box pixel filter, path tracing with max_depth 8 and
-Russian roulette that may first cut segment 6 in both (RR_DEPTH below). It reports each renderer's samples per second
-at the same spp, and each image's relative MSE against a high-spp Mitsuba
-reference (and against each other), as a markdown table for docs/pathtrace.md.
+Russian roulette that may first cut segment 6 in both (RR_DEPTH below). It
+reports each renderer's samples per second at the same spp, and each image's
+relative MSE against a high-spp Mitsuba reference (and against each other),
+as a markdown table for docs/pathtrace.md.
 
     pip install mitsuba
     cargo build --release
@@ -193,6 +194,12 @@ def rgb(path):
     """An EXR's linear RGB channels (weft writes RGBA)."""
     bitmap = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
     return mi.TensorXf(bitmap)
+
+
+def render_seconds(report):
+    """The seconds a `weft render --json` report's frames took (frame time x
+    frames): the render's own time, without the scene load."""
+    return report["frame_ms"] * report["frames"] / 1000.0
 
 
 def write_png(exr):
