@@ -3,6 +3,7 @@
 mod compare_cmd;
 mod graph_cmd;
 mod graphs;
+mod progress;
 mod render_cmd;
 mod scene_cmd;
 mod sweep_cmd;

@@ -1,6 +1,7 @@
 //! `weft render`: a scene through a graph to an image, with validation,
 //! per-pass timings and a JSON summary.
 
+use crate::progress::Progress;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
@@ -165,21 +166,17 @@ fn default_out(scene: &Path) -> PathBuf {
     Path::new("out").join(format!("{stem}.png"))
 }
 
-/// A progress bar on stderr for renders to a sample count or a time limit
-/// (hidden when stderr is not a terminal, and with --json).
-fn progress_bar(args: &RenderArgs) -> indicatif::ProgressBar {
+/// Progress on stderr for renders to a sample count or a time limit: a bar
+/// on a terminal, a line every 10 s or tenth elsewhere (none with --json).
+fn progress_bar(args: &RenderArgs) -> Progress {
     if args.json || (args.spp.is_none() && args.time_limit.is_none()) {
-        return indicatif::ProgressBar::hidden();
+        return Progress::hidden();
     }
-    let bar = indicatif::ProgressBar::new(0);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:30}] frame {pos}/{len} {msg} (ETA {eta})",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-        .progress_chars("=> "),
-    );
-    bar
+    Progress::new(
+        "render",
+        "frame",
+        "{elapsed_precise} [{bar:30}] frame {pos}/{len} {msg} (ETA {eta})",
+    )
 }
 
 /// The render settings the arguments ask for.
@@ -240,6 +237,11 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             out.display(),
             dir.display()
         );
+    }
+    weft_io::check_output(&out).with_context(|| format!("--out {}", out.display()))?;
+    for name in &args.readback {
+        let path = readback_path(&out, name);
+        weft_io::check_output(&path).with_context(|| format!("--readback {name}"))?;
     }
     let mut settings = settings(&args, Vec::new());
     // Loaded once: a render --watch waits for a graph that does not load yet;

@@ -150,9 +150,9 @@ impl LinearImage {
     /// Writes the image as an RGB OpenEXR file.
     pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
         let bytes = self.encode_exr(path)?;
-        std::fs::write(path, bytes).map_err(|e| ImageError::Write {
+        weft_io::write_output(path, &bytes).map_err(|e| ImageError::Write {
             path: path.to_path_buf(),
-            message: e.to_string(),
+            message: e.reason(),
         })
     }
 
@@ -179,16 +179,16 @@ impl LinearImage {
 impl SrgbImage {
     /// Writes the image as a PNG file.
     pub fn write_png(&self, path: &Path) -> Result<(), ImageError> {
+        let write = |message: String| ImageError::Write {
+            path: path.to_path_buf(),
+            message,
+        };
+        let mut bytes = std::io::Cursor::new(Vec::new());
         image::RgbImage::from_raw(self.width, self.height, self.bytes.clone())
-            .ok_or_else(|| ImageError::Write {
-                path: path.to_path_buf(),
-                message: "pixel count does not match the size".into(),
-            })?
-            .save_with_format(path, image::ImageFormat::Png)
-            .map_err(|e| ImageError::Write {
-                path: path.to_path_buf(),
-                message: e.to_string(),
-            })
+            .ok_or_else(|| write("pixel count does not match the size".into()))?
+            .write_to(&mut bytes, image::ImageFormat::Png)
+            .map_err(|e| write(e.to_string()))?;
+        weft_io::write_output(path, bytes.get_ref()).map_err(|e| write(e.reason()))
     }
 }
 

@@ -210,17 +210,20 @@ impl Readback {
         let rgba: Vec<[f32; 4]> = self.to_rgba_f32().pixels().map(|p| p.0).collect();
         let bytes = weft_io::exr::encode_rgba(self.width, self.height, &rgba)
             .map_err(|e| write(e.to_string()))?;
-        std::fs::write(path, bytes).map_err(|e| write(e.to_string()))
+        weft_io::write_output(path, &bytes).map_err(|e| write(e.reason()))
     }
 
     /// Saves the 8-bit image as PNG.
     pub fn save_png(&self, path: &Path) -> Result<(), ReadbackError> {
+        let write = |message: String| ReadbackError::Write {
+            path: path.display().to_string(),
+            message,
+        };
+        let mut bytes = std::io::Cursor::new(Vec::new());
         self.to_rgba8()
-            .save_with_format(path, image::ImageFormat::Png)
-            .map_err(|e| ReadbackError::Write {
-                path: path.display().to_string(),
-                message: e.to_string(),
-            })
+            .write_to(&mut bytes, image::ImageFormat::Png)
+            .map_err(|e| write(e.to_string()))?;
+        weft_io::write_output(path, bytes.get_ref()).map_err(|e| write(e.reason()))
     }
 }
 

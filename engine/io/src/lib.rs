@@ -7,6 +7,8 @@
 //! [`hash`] is the one stable hasher; [`entry`] frames cache entries so a
 //! damaged, swapped or foreign entry is a miss, never a wrong answer.
 //! [`exr`] is the one OpenEXR writer (scanline float files every reader reads).
+//! [`write`] is the one rule for outputs: regular files only, written whole
+//! and renamed into place.
 
 pub mod entry;
 pub mod exr;
@@ -14,8 +16,10 @@ pub mod hash;
 pub mod paths;
 pub mod read;
 pub mod sources;
+pub mod write;
 
 pub use read::{open_regular, read_capped, read_text, FileKind, ReadError, MAX_TEXT_BYTES};
+pub use write::{check_output, write_output, WriteError};
 
 /// A fresh folder for one unit test, under the system's temporary folder.
 #[cfg(test)]

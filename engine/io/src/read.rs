@@ -19,7 +19,7 @@ pub enum FileKind {
 }
 
 impl FileKind {
-    fn of(meta: &std::fs::Metadata) -> Self {
+    pub(crate) fn of(meta: &std::fs::Metadata) -> Self {
         use std::os::unix::fs::FileTypeExt;
         let kind = meta.file_type();
         if kind.is_dir() {

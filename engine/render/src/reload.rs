@@ -88,7 +88,7 @@ impl<'g> LiveRender<'g> {
         let fail = |e: GpuError| ReloadError::gpu(e, &settings.graph);
         let mut cache = PipelineCache::new().map_err(fail)?;
         check_shaders(gpu, &mut cache, &plan, &settings.graph)?;
-        let updater = SceneUpdater::new(&scene).map_err(|e| ReloadError::scene(&e))?;
+        let updater = SceneUpdater::live(&scene).map_err(|e| ReloadError::scene(&e))?;
         let mut uploaded = GpuScene::new(gpu, &scene, updater.animates())
             .map_err(|e| ReloadError::render(e, scene_path))?;
         uploaded.cache_bvh_in(settings.cache_dir.clone());
@@ -242,7 +242,7 @@ impl<'g> LiveRender<'g> {
         let fail = |e: GpuError| ReloadError::gpu(e, &graph);
         let new_recorder = match &prepared.scene {
             Some(s) => {
-                let updater = SceneUpdater::new(s).map_err(|e| ReloadError::scene(&e))?;
+                let updater = SceneUpdater::live(s).map_err(|e| ReloadError::scene(&e))?;
                 let mut uploaded = GpuScene::new(self.gpu, s, updater.animates())
                     .map_err(|e| ReloadError::render(e, &self.scene_path))?;
                 uploaded.cache_bvh_in(prepared.settings.cache_dir.clone());

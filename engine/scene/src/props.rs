@@ -148,12 +148,23 @@ impl<'a> Props<'a> {
         }
     }
 
-    /// The last `name` as three numbers.
-    pub(crate) fn vec3(&mut self, name: &str) -> Result<Option<Vec3>, SceneError> {
-        match self.last(name) {
-            Some(p) => Ok(Some(Vec3::from_slice(&self.exactly(p, 3)?))),
-            None => Ok(None),
+    /// The last `name` as a colour: three numbers, none negative (a negative
+    /// channel would subtract light).
+    pub(crate) fn colour(&mut self, name: &str) -> Result<Option<Vec3>, SceneError> {
+        let Some(p) = self.last(name) else {
+            return Ok(None);
+        };
+        let v = Vec3::from_slice(&self.exactly(p, 3)?);
+        if v.min_element() < 0.0 {
+            return Err(self.error(
+                p,
+                format!(
+                    "'{name}' channels must not be negative (a light or surface cannot take light away), found {} {} {}",
+                    v.x, v.y, v.z
+                ),
+            ));
         }
+        Ok(Some(v))
     }
 
     /// The last `name` as a non-zero direction, normalised.

@@ -55,11 +55,30 @@ pub struct SceneUpdater {
 }
 
 impl SceneUpdater {
-    /// An updater for `scene`, with its script's runtime (the script loads
-    /// again and runs `init`).
+    /// An updater for `scene` in a render of bounded length, with its
+    /// script's runtime (the script loads again and runs `init`) under the
+    /// default [`Limits`]: its `update` steps may run 10 s a frame and 120 s
+    /// in all.
     pub fn new(scene: &Scene) -> Result<Self, SceneError> {
+        Self::with_limits(scene, &Limits::default())
+    }
+
+    /// An updater for a live view or `--watch`, which runs until it is
+    /// closed: each frame's steps keep their limit, the whole run has none.
+    pub fn live(scene: &Scene) -> Result<Self, SceneError> {
+        Self::with_limits(
+            scene,
+            &Limits {
+                render_seconds: f64::INFINITY,
+                ..Limits::default()
+            },
+        )
+    }
+
+    /// An updater whose script runs under `limits`.
+    pub fn with_limits(scene: &Scene, limits: &Limits) -> Result<Self, SceneError> {
         let script = match &scene.script {
-            Some(script) => Some(ScriptRuntime::new(script, scene, &Limits::default())?),
+            Some(script) => Some(ScriptRuntime::new(script, scene, limits)?),
             None => None,
         };
         Ok(Self {

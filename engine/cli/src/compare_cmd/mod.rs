@@ -191,16 +191,15 @@ fn srgb(image: &Readback) -> SrgbImage {
     }
 }
 
-fn bar(label: &str) -> indicatif::ProgressBar {
-    let bar = indicatif::ProgressBar::new(0);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(&format!(
+/// Progress of one render labelled `label` (`reference`, a graph's name).
+fn bar(label: &str) -> crate::progress::Progress {
+    crate::progress::Progress::new(
+        label,
+        "frame",
+        &format!(
             "{label:>12} [{{bar:30}}] frame {{pos}}/{{len}} {{msg}} ({{elapsed}}, ETA {{eta}})"
-        ))
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-        .progress_chars("=> "),
-    );
-    bar
+        ),
+    )
 }
 
 /// Renders with a progress bar labelled `label`.
@@ -216,7 +215,8 @@ fn render(
         bar.set_length(p.planned_frames.into());
         bar.set_position(p.frames.into());
         if let Some(samples) = p.samples {
-            bar.set_message(format!("{samples} spp"));
+            let rate = samples as f64 / p.elapsed.max(1e-9);
+            bar.set_message(format!("{samples} spp, {rate:.1} spp/s"));
         }
     })
     .with_context(|| format!("rendering {}", settings.graph.display()))?;

@@ -4,7 +4,7 @@
 mod params;
 
 pub use params::resolve_value;
-pub(crate) use params::{non_finite, value_text};
+pub(crate) use params::{non_finite, not_f32, value_text};
 use params::{report_not_taken, resolve_params, split_qualified};
 
 use crate::diagnostic::Diagnostic;

@@ -180,11 +180,9 @@ pub(super) fn resolve_params(
     for (name, value) in &params {
         if let Some(bad) = non_finite(value) {
             let (file, pos) = graph.locate(source, &[Seg::Field("params"), Seg::Key(name)]);
-            graph.diagnostics.push(Diagnostic::error(
-                file,
-                pos,
-                format!("parameter \"{name}\" must be finite, found {bad}"),
-            ));
+            graph
+                .diagnostics
+                .push(Diagnostic::error(file, pos, not_f32(name, bad)));
         }
     }
     let snapshot = params.clone();
@@ -201,13 +199,26 @@ pub(super) fn resolve_params(
     params
 }
 
-/// The first NaN or infinite number in a parameter value, if any.
+/// The first number in a parameter value that a shader's 32-bit float
+/// cannot hold (NaN, infinite, or beyond ±3.4e38, which would arrive as
+/// infinity), if any.
 pub(crate) fn non_finite(value: &ParamValue) -> Option<f64> {
+    let bad = |n: &f64| !(n.is_finite() && n.abs() <= f64::from(f32::MAX));
     match value {
-        ParamValue::Number(n) => Some(*n).filter(|n| !n.is_finite()),
-        ParamValue::Vector(v) => v.iter().copied().find(|n| !n.is_finite()),
+        ParamValue::Number(n) => Some(*n).filter(bad),
+        ParamValue::Vector(v) => v.iter().copied().find(bad),
         ParamValue::Bool(_) | ParamValue::Reference(_) => None,
     }
+}
+
+/// The error for parameter `name` whose value holds `bad` ([`non_finite`]).
+pub(crate) fn not_f32(name: &str, bad: f64) -> String {
+    let shown = if bad.is_finite() {
+        format!("{bad:e}")
+    } else {
+        format!("{bad}")
+    };
+    format!("parameter \"{name}\" must be a finite 32-bit float (at most 3.4e38 in size), found {shown}")
 }
 
 /// Resolves a `"$name"` reference (one level; parameters may not chain) to its value.
@@ -249,6 +260,17 @@ fn check_ranges_name_params(
                 )
                 .suggest(name, names),
             );
+        } else if let Some(bad) = [range.min, range.max]
+            .into_iter()
+            .flatten()
+            .chain(range.one_of.iter().copied())
+            .find(|b| b.is_nan())
+        {
+            graph.diagnostics.push(Diagnostic::error(
+                file,
+                pos,
+                format!("the range of \"{name}\" has a bound of {bad}: bounds are numbers"),
+            ));
         } else if range.min.zip(range.max).is_some_and(|(min, max)| min > max) {
             graph.diagnostics.push(Diagnostic::error(
                 file,

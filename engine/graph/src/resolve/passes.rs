@@ -36,11 +36,7 @@ impl Resolver<'_> {
             match crate::load::resolve_value(&self.graph.sources[source].params, value) {
                 Ok(v) => {
                     if let Some(bad) = crate::load::non_finite(&v) {
-                        self.error(
-                            source,
-                            &path,
-                            format!("parameter \"{name}\" must be finite, found {bad}"),
-                        );
+                        self.error(source, &path, crate::load::not_f32(name, bad));
                     }
                     resolved.insert(name.clone(), v);
                 }
@@ -423,7 +419,9 @@ impl Resolver<'_> {
             &[Seg::Field("defines"), Seg::Index(k), Seg::Field("value")],
         );
         match crate::load::resolve_value(&self.graph.sources[source].params, value) {
-            Ok(ParamValue::Number(n)) if n.fract() == 0.0 && n.abs() < 2f64.powi(53) => {
+            Ok(ParamValue::Number(n))
+                if n.fract() == 0.0 && (f64::from(i32::MIN)..=f64::from(i32::MAX)).contains(&n) =>
+            {
                 Some(ParamValue::Number(n))
             }
             Ok(other) => {
@@ -431,7 +429,9 @@ impl Resolver<'_> {
                     source,
                     &path,
                     format!(
-                        "define \"{name}\": its value must be a whole number, found {}",
+                        "define \"{name}\": its value must be a whole number from {} to {} (a GLSL int), found {}",
+                        i32::MIN,
+                        i32::MAX,
                         crate::load::value_text(&other)
                     ),
                 );

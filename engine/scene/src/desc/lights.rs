@@ -39,7 +39,7 @@ pub(super) fn sunlight(
     diag: &mut Diagnostics,
 ) -> Result<SunLight, SceneError> {
     let direction = props.direction("direction")?.unwrap_or(Vec3::NEG_Y);
-    let color = props.vec3("color")?.unwrap_or(Vec3::ONE);
+    let color = props.colour("color")?.unwrap_or(Vec3::ONE);
     warn_if_beyond_half(props, "color", color, diag);
     let ambient = match props.last("ambient") {
         Some(p) => match props.numbers(p)?.as_slice() {
@@ -60,6 +60,15 @@ pub(super) fn sunlight(
         },
         None => Vec3::ZERO,
     };
+    if let Some(p) = props
+        .last("ambient")
+        .filter(|_| ambient.min_element() < 0.0)
+    {
+        return Err(props.error(
+            p,
+            format!("'ambient' must not be negative, found {ambient}"),
+        ));
+    }
     let motion = match props.last("motion") {
         Some(p) => {
             let v = props.exactly(p, 4)?;
@@ -168,7 +177,7 @@ pub(super) fn spotlight(
             "within 0..180 degrees",
         )?
         .unwrap_or(45.0);
-    let color = props.vec3("color")?.unwrap_or(Vec3::ONE);
+    let color = props.colour("color")?.unwrap_or(Vec3::ONE);
     warn_if_beyond_half(props, "color", color, diag);
     Ok(SpotLight {
         position,
@@ -229,7 +238,7 @@ pub(super) fn pointlight(
     props: &mut Props<'_>,
     diag: &mut Diagnostics,
 ) -> Result<PointLight, SceneError> {
-    let color = props.vec3("color")?.unwrap_or(Vec3::ONE);
+    let color = props.colour("color")?.unwrap_or(Vec3::ONE);
     warn_if_beyond_half(props, "color", color, diag);
     let att = attenuation(props)?.unwrap_or(Attenuation::NONE);
     let threshold = positive(props, "threshold")?.unwrap_or(DEFAULT_LUMINANCE_THRESHOLD);
@@ -287,7 +296,7 @@ pub(super) fn arealight(
         Some(v) => v != 0.0,
         None => false,
     };
-    let emission = props.vec3("emission")?.unwrap_or(Vec3::ONE);
+    let emission = props.colour("emission")?.unwrap_or(Vec3::ONE);
     warn_if_beyond_half(props, "emission", emission, diag);
     Ok(AreaLight {
         shape,
@@ -310,8 +319,8 @@ pub(super) fn generate(props: &mut Props<'_>) -> Result<Vec<PointLight>, SceneEr
     let seed = props.f32("seed")?.unwrap_or(0.0);
     let min = props.point_or("min", DVec3::splat(-1.0))?;
     let max = props.point_or("max", DVec3::ONE)?;
-    let color_min = props.vec3("color_min")?.unwrap_or(Vec3::ONE);
-    let color_max = props.vec3("color_max")?.unwrap_or(color_min);
+    let color_min = props.colour("color_min")?.unwrap_or(Vec3::ONE);
+    let color_max = props.colour("color_max")?.unwrap_or(color_min);
     let radius_range = positive_pair(props, "radius", Order::Increasing)?;
     let velocity_range = pair(props, "velocity")?.unwrap_or((0.0, 0.0));
     let amplitude = props.f32("amplitude")?.unwrap_or(1.0);

@@ -160,10 +160,58 @@ fn read_into(
             message: format!("includes nest deeper than {MAX_INCLUDE_DEPTH}"),
         });
     }
+    // An include outside the top-level scene's folder tree, or a system file,
+    // may be anything (`/proc/self/environ`, `/etc/passwd`): its errors and
+    // warnings name its file and line, never its text.
+    let private = match stack.first().and_then(|root| root.parent()) {
+        Some(root) => !weft_io::paths::is_within(path, root) || weft_io::paths::is_system(path),
+        None => weft_io::paths::is_system(path),
+    };
+    if private {
+        weft_io::sources::forget(path);
+    }
     stack.push(key);
-    let result = interpret(&text, path, desc, stack, diag);
+    let result = if private {
+        interpret_private(&text, path, desc, stack, diag)
+    } else {
+        interpret(&text, path, desc, stack, diag)
+    };
     stack.pop();
     result
+}
+
+/// What an error or warning about a private file says in place of its own
+/// text.
+const PRIVATE: &str = "the file is outside the scene's folder, so its content is not shown";
+
+/// [`interpret`] for a file whose content must not be echoed: a message
+/// located in `path` itself is replaced by its kind and [`PRIVATE`].
+fn interpret_private(
+    text: &str,
+    path: &Path,
+    desc: &mut SceneDesc,
+    stack: &mut Vec<PathBuf>,
+    diag: &mut Diagnostics,
+) -> Result<(), SceneError> {
+    let mut own = Diagnostics::default();
+    let result = interpret(text, path, desc, stack, &mut own);
+    for mut warning in own.warnings {
+        if warning.at.file == path {
+            warning.message = format!("a warning ({PRIVATE})");
+        }
+        diag.warnings.push(warning);
+    }
+    result.map_err(|error| match error {
+        SceneError::Syntax { at, .. } if at.file == path => SceneError::Syntax {
+            at,
+            message: format!("not a .scene file, or a syntax error ({PRIVATE})"),
+        },
+        SceneError::Model { at, .. } if at.file == path => SceneError::Model {
+            at,
+            message: format!("an error ({PRIVATE})"),
+        },
+        other => other,
+    })
 }
 
 /// Interprets the text of one file; the top-level one (the only file on
@@ -394,25 +442,11 @@ fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placeme
     }))
 }
 
-/// A `model` block's material overrides: colours of three finite numbers of
-/// at least 0, roughness and metallic in [0, 1].
+/// A `model` block's material overrides: colours of three numbers of at
+/// least 0, roughness and metallic in [0, 1].
 fn material_override(props: &mut Props<'_>) -> Result<MaterialOverride, SceneError> {
-    let mut colour = |name: &str| -> Result<Option<Vec3>, SceneError> {
-        let Some(p) = props.last(name) else {
-            return Ok(None);
-        };
-        let v = Vec3::from_slice(&props.exactly(p, 3)?);
-        if v.is_finite() && v.min_element() >= 0.0 {
-            Ok(Some(v))
-        } else {
-            Err(props.error(
-                p,
-                format!("'{name}' must be 3 finite numbers of at least 0, found {v}"),
-            ))
-        }
-    };
-    let color = colour("color")?;
-    let emission = colour("emission")?;
+    let color = props.colour("color")?;
+    let emission = props.colour("emission")?;
     let unit = |v: f32| (0.0..=1.0).contains(&v);
     Ok(MaterialOverride {
         color,
@@ -432,7 +466,12 @@ fn camera(
     let target = props.point("target")?;
     let orientation = match (props.last("orientation"), target) {
         (Some(p), None) => rotation(props, p)?,
-        (None, Some(t)) => look_at_rotation(position, t),
+        (None, Some(t)) => {
+            if let Some(p) = props.last("target") {
+                no_view_direction(props, p, position, t)?;
+            }
+            look_at_rotation(position, t)
+        }
         (None, None) => Quat::IDENTITY,
         (Some(p), Some(_)) => {
             return Err(props.error(p, "give 'orientation' or 'target', not both"))
@@ -467,10 +506,12 @@ fn camera(
     for p in props.all("key") {
         let v = props.exactly(p, 7)?;
         let key_position = props.point_at(p, 1)?;
+        let key_target = props.point_at(p, 4)?;
+        no_view_direction(props, p, key_position, key_target)?;
         path.push(CameraKey {
             time: v[0],
             position: key_position,
-            orientation: look_at_rotation(key_position, props.point_at(p, 4)?),
+            orientation: look_at_rotation(key_position, key_target),
         });
         if path.len() > 1 && path[path.len() - 2].time >= v[0] {
             return Err(props.error(p, "camera 'key' times must increase"));
@@ -486,6 +527,26 @@ fn camera(
         path,
         origin: CameraOrigin::Scene,
     })
+}
+
+/// Refuses a camera `target` that is its position: there is no direction to
+/// look in (the image would be black).
+fn no_view_direction(
+    props: &Props<'_>,
+    at: &Prop,
+    position: Vec3,
+    target: Vec3,
+) -> Result<(), SceneError> {
+    if (target - position).try_normalize().is_some() {
+        return Ok(());
+    }
+    Err(props.error(
+        at,
+        format!(
+            "the camera's target is its position ({} {} {}): there is no direction to look in",
+            position.x, position.y, position.z
+        ),
+    ))
 }
 
 /// A clip distance under its new or its 15-462 name (the last one given wins).

@@ -2,8 +2,11 @@
 //! transforms baked in, metallic-roughness materials with the emissive-strength,
 //! transmission, IOR and volume extensions, KHR_lights_punctual lights and cameras.
 
+mod checks;
 mod materials;
 
+use checks::{check_accessor_bounds, check_glb_header, check_node_graph};
+pub use checks::{MAX_EXPANDED_TRIANGLES, MAX_NODE_INSTANCES};
 use materials::{image_sources, material};
 
 use crate::bounds::Aabb;
@@ -32,6 +35,7 @@ pub fn load_gltf(
         at: Location::file(path),
         message,
     };
+    check_glb_header(&bytes).map_err(model_error)?;
     let gltf = gltf::Gltf::from_slice(&bytes)
         .map_err(|e| model_error(format!("glTF does not parse: {e}")))?;
     check_version(&gltf.document.as_json().asset).map_err(model_error)?;
@@ -52,8 +56,35 @@ pub fn load_gltf(
     };
     let roots: Vec<gltf::Node<'_>> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
-        None => doc.nodes().collect(),
+        // No scene: every node that is no other node's child is a root.
+        None => {
+            let children: std::collections::HashSet<usize> = doc
+                .nodes()
+                .flat_map(|n| n.children().map(|c| c.index()).collect::<Vec<_>>())
+                .collect();
+            doc.nodes()
+                .filter(|n| !children.contains(&n.index()))
+                .collect()
+        }
     };
+    // Every triangle primitive's accessors within their views, before the
+    // node graph is counted or any mesh read.
+    for mesh in doc.meshes() {
+        for (i, primitive) in mesh.primitives().enumerate() {
+            if primitive.mode() != gltf::mesh::Mode::Triangles {
+                continue;
+            }
+            let accessors = primitive.attributes().map(|(_, a)| a);
+            accessors
+                .chain(primitive.indices())
+                .try_for_each(|a| check_accessor_bounds(&a, &buffers))
+                .map_err(|m| {
+                    let name = mesh.name().unwrap_or("mesh");
+                    model_error(format!("primitive '{name}#{i}': {m}"))
+                })?;
+        }
+    }
+    check_node_graph(doc, &roots, path, diag).map_err(model_error)?;
     // Depth-first in document order: children are pushed reversed so the first pops first.
     let mut stack: Vec<(gltf::Node<'_>, Mat4, usize)> = roots
         .into_iter()

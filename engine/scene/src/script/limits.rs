@@ -25,6 +25,13 @@ pub struct Limits {
     /// step. It bounds what the operation count cannot: Rhai re-measures an
     /// array after every push, so growing one is quadratic in its length.
     pub call_seconds: f64,
+    /// Wall-clock seconds the `update` steps of one frame may run together:
+    /// a frame asking for time T runs every step up to T.
+    pub frame_seconds: f64,
+    /// Wall-clock seconds every `update` step of one runtime may run in all:
+    /// a render's frames together. Infinite for the live viewer and
+    /// `--watch`, which run until they are closed.
+    pub render_seconds: f64,
 }
 
 impl Default for Limits {
@@ -38,15 +45,42 @@ impl Default for Limits {
             map_len: 1 << 16,
             objects: 100_000,
             call_seconds: 30.0,
+            frame_seconds: 10.0,
+            render_seconds: 120.0,
         }
     }
 }
 
-/// Starts the clock of one call ([`Limits::call_seconds`]).
-pub(super) fn start_call(state: &Shared, limits_seconds: f64) {
-    lock(state).deadline = std::time::Instant::now().checked_add(
-        std::time::Duration::from_secs_f64(limits_seconds.clamp(0.0, 1e9)),
-    );
+/// Starts the clock of one call ([`Limits::call_seconds`]), or of one
+/// `update` step that must also end by `frame_end` (the earlier of the
+/// frame's and the render's deadlines, with what the script is told then).
+pub(super) fn start_call(
+    state: &Shared,
+    limits_seconds: f64,
+    frame_end: Option<(std::time::Instant, String)>,
+) {
+    let call = std::time::Instant::now()
+        .checked_add(std::time::Duration::from_secs_f64(
+            limits_seconds.clamp(0.0, 1e9),
+        ))
+        .map(|at| {
+            (
+                at,
+                format!("the script ran past its limit of {limits_seconds} s for one call (the load, init or one update step)"),
+            )
+        });
+    lock(state).deadline = match (call, frame_end) {
+        (Some(call), Some(frame)) => Some(if frame.0 < call.0 { frame } else { call }),
+        (call, frame) => call.or(frame),
+    };
+}
+
+/// `seconds` from `start`, or `None` when that is beyond any clock.
+pub(super) fn after(start: std::time::Instant, seconds: f64) -> Option<std::time::Instant> {
+    if !(0.0..1e9).contains(&seconds) {
+        return None;
+    }
+    start.checked_add(std::time::Duration::from_secs_f64(seconds))
 }
 
 /// `value` checked against the string, array and map size limits. The

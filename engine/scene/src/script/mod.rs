@@ -90,14 +90,14 @@ fn engine_for(
     engine.set_module_resolver(FolderResolver::new(root, script, imports.clone()));
     engine.on_print(|_| {});
     engine.on_debug(|_, _, _| {});
-    let (watched, seconds) = (state.clone(), limits.call_seconds);
+    let watched = state.clone();
     engine.on_progress(move |operations| {
-        let deadline = (operations % 1024 == 0).then(|| lock(&watched).deadline)??;
-        (std::time::Instant::now() > deadline).then(|| {
-            Dynamic::from(format!(
-                "the script ran past its limit of {seconds} s for one call (the load, init or one update step)"
-            ))
-        })
+        if operations % 1024 != 0 {
+            return None;
+        }
+        let s = lock(&watched);
+        let (deadline, reason) = s.deadline.as_ref()?;
+        (std::time::Instant::now() > *deadline).then(|| Dynamic::from(reason.clone()))
     });
     {
         let mut s = lock(state);
@@ -158,7 +158,7 @@ pub fn run_load(
     let imports = Arc::new(Mutex::new(Vec::new()));
     let engine = engine_for(script, &state, desc.origin, limits, &imports);
     let ast = compile(&engine, script)?;
-    start_call(&state, limits.call_seconds);
+    start_call(&state, limits.call_seconds, None);
     run_top_level(&engine, &ast, script)?;
     script_ref.imports = std::mem::take(&mut *lock(&imports));
     let mut s = lock(&state);

@@ -45,8 +45,11 @@ pub struct ScriptRuntime {
     this: Dynamic,
     /// Update steps run since time 0.
     steps: u64,
-    /// [`Limits::call_seconds`].
-    call_seconds: f64,
+    /// The limits each call, frame and the whole run are held to.
+    limits: Limits,
+    /// Wall-clock seconds the `update` steps have run in all
+    /// ([`Limits::render_seconds`]).
+    spent: f64,
 }
 
 impl ScriptRuntime {
@@ -80,7 +83,7 @@ impl ScriptRuntime {
         let state: Shared = Arc::new(Mutex::new(loading));
         let engine = engine_for(script, &state, origin, limits, &Arc::default());
         let ast = compile(&engine, script)?;
-        start_call(&state, limits.call_seconds);
+        start_call(&state, limits.call_seconds, None);
         run_top_level(&engine, &ast, script)?;
         {
             let mut s = lock(&state);
@@ -88,20 +91,32 @@ impl ScriptRuntime {
             loaded.rng = s.rng.clone();
         }
         let has = |name: &str, params: usize| {
-            ast.iter_functions()
-                .any(|f| f.name == name && f.params.len() == params)
+            let arities: Vec<usize> = ast
+                .iter_functions()
+                .filter(|f| f.name == name)
+                .map(|f| f.params.len())
+                .collect();
+            match arities.as_slice() {
+                [] => Ok(false),
+                found if found.contains(&params) => Ok(true),
+                [found, ..] => Err(SceneError::Syntax {
+                    at: first_mention(script, &format!("fn {name}")),
+                    message: wrong_arity(name, *found),
+                }),
+            }
         };
         let mut runtime = Self {
             script: script.to_path_buf(),
-            has_init: has("init", 0),
-            has_update: has("update", 2),
+            has_init: has("init", 0)?,
+            has_update: has("update", 2)?,
             engine,
             ast,
             state,
             loaded,
             this: Dynamic::UNIT,
             steps: 0,
-            call_seconds: limits.call_seconds,
+            limits: *limits,
+            spent: 0.0,
         };
         runtime.restart()?;
         if runtime.has_update {
@@ -128,7 +143,7 @@ impl ScriptRuntime {
             s.camera_set = vec![false; self.loaded.cameras.len()];
         }
         self.steps = 0;
-        start_call(&self.state, self.call_seconds);
+        start_call(&self.state, self.limits.call_seconds, None);
         self.this = if self.has_init {
             self.engine
                 .call_fn_with_options::<Dynamic>(
@@ -148,6 +163,41 @@ impl ScriptRuntime {
             &self.this,
             ("the state `init` returned", "fn init"),
         )
+    }
+
+    /// When the steps of a frame started at `started` (reaching `time`, step
+    /// `target`) must end: the earlier of [`Limits::frame_seconds`] from
+    /// `started` and what is left of [`Limits::render_seconds`], with what
+    /// the script is told then.
+    fn frame_end(
+        &self,
+        started: std::time::Instant,
+        time: f64,
+        target: u64,
+    ) -> Option<(std::time::Instant, String)> {
+        let steps = target.saturating_sub(self.steps);
+        let frame = after(started, self.limits.frame_seconds).map(|at| {
+            (
+                at,
+                format!(
+                    "the script's update steps for one frame ran past the frame's limit of {} s ({steps} steps of 1/60 s to reach t = {time} s)",
+                    self.limits.frame_seconds
+                ),
+            )
+        });
+        let render = after(started, (self.limits.render_seconds - self.spent).max(0.0)).map(|at| {
+            (
+                at,
+                format!(
+                    "the script's update steps ran past their limit of {} s in all for this render (at t = {time} s)",
+                    self.limits.render_seconds
+                ),
+            )
+        });
+        match (frame, render) {
+            (Some(f), Some(r)) => Some(if r.0 < f.0 { r } else { f }),
+            (f, r) => f.or(r),
+        }
     }
 
     /// Whether the script animates anything (has `fn update(t, dt)`).
@@ -177,10 +227,12 @@ impl ScriptRuntime {
                 ),
             });
         }
+        let frame_started = std::time::Instant::now();
+        let frame_end = self.frame_end(frame_started, time, target);
         while self.has_update && self.steps < target {
             self.steps += 1;
             let t = self.steps as f64 * STEP;
-            start_call(&self.state, self.call_seconds);
+            start_call(&self.state, self.limits.call_seconds, frame_end.clone());
             let result = self.engine.call_fn_with_options::<Dynamic>(
                 CallFnOptions::new()
                     .eval_ast(false)
@@ -204,10 +256,12 @@ impl ScriptRuntime {
                     )
                 });
             if let Err(e) = checked {
+                self.spent += frame_started.elapsed().as_secs_f64();
                 self.steps = u64::MAX;
                 return Err(e);
             }
         }
+        self.spent += frame_started.elapsed().as_secs_f64();
         let s = lock(&self.state);
         Ok(ScriptFrame {
             lights: s
@@ -234,6 +288,18 @@ impl ScriptRuntime {
                 .collect(),
         })
     }
+}
+
+/// Why a function named `name` with `found` parameters is never called.
+fn wrong_arity(name: &str, found: usize) -> String {
+    let (wanted, count) = match name {
+        "init" => ("fn init()", 0),
+        _ => ("fn update(t, dt)", 2),
+    };
+    format!(
+        "`fn {name}` takes {found} parameter{}; weft calls {wanted} with {count}, so it would never run",
+        if found == 1 { "" } else { "s" }
+    )
 }
 
 /// `light` giving no light.

@@ -41,8 +41,11 @@ pub(super) struct State {
     /// Objects the load has added, and how many it may ([`Limits::objects`]).
     pub(super) objects_added: usize,
     pub(super) object_limit: usize,
-    /// When the call running now must end ([`Limits::call_seconds`]).
-    pub(super) deadline: Option<std::time::Instant>,
+    /// When the call running now must end, and what the script is told
+    /// then: the earliest of the call's, the frame's and the render's limits
+    /// ([`Limits::call_seconds`], [`Limits::frame_seconds`],
+    /// [`Limits::render_seconds`]).
+    pub(super) deadline: Option<(std::time::Instant, String)>,
 }
 
 impl State {

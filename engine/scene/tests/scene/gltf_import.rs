@@ -293,7 +293,7 @@ fn second_uv_set_and_vertex_colours() {
 
 /// A one-triangle glTF whose POSITION accessor has `position_type`, indices
 /// of `index_type` (a component type), and `asset` as its asset object.
-fn triangle_gltf(asset: &str, position_type: &str, index_type: u32) -> String {
+pub(crate) fn triangle_gltf(asset: &str, position_type: &str, index_type: u32) -> String {
     // 3 float VEC3 positions (36 bytes), then 3 u32 indices (12 bytes).
     let mut bytes: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
         .iter()
@@ -310,7 +310,7 @@ fn triangle_gltf(asset: &str, position_type: &str, index_type: u32) -> String {
     )
 }
 
-fn base64(bytes: &[u8]) -> String {
+pub(crate) fn base64(bytes: &[u8]) -> String {
     const TABLE: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::new();
     for chunk in bytes.chunks(3) {

@@ -5,6 +5,7 @@ mod common;
 
 mod cache;
 mod fuzz;
+mod gltf_hostile;
 mod gltf_import;
 mod large_models;
 mod obj_import;

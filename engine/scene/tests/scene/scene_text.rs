@@ -82,6 +82,16 @@ fn extension_errors_are_located() {
         ("spotlight\n{\n swivel 0 -1 0 1 0 0 -2\n}\n", "t.scene:3: 'swivel' period must be > 0"),
         ("model\n{\n orientation 1 0 0 0\n}\n", "t.scene:3: 'orientation' has a zero rotation axis"),
         ("model\n{\n orientation 1 2\n}\n", "t.scene:3: 'orientation' expects 3 numbers (pitch yaw roll, degrees) or 4 (angle in radians, axis x y z), found 2"),
+        // A camera that looks at its own position has no direction to look in.
+        ("camera\n{\n position 1 2 3\n target 1 2 3\n}\n", "t.scene:4: the camera's target is its position (1 2 3): there is no direction to look in"),
+        ("camera\n{\n key 0 1 2 3 1 2 3\n}\n", "t.scene:3: the camera's target is its position (1 2 3): there is no direction to look in"),
+        // Light is not taken away: no negative colour, emission or ambient.
+        ("pointlight\n{\n color 1 -0.5 1\n}\n", "t.scene:3: 'color' channels must not be negative (a light or surface cannot take light away), found 1 -0.5 1"),
+        ("spotlight\n{\n color -1 0 0\n}\n", "t.scene:3: 'color' channels must not be negative (a light or surface cannot take light away), found -1 0 0"),
+        ("sunlight\n{\n color 0 0 -2\n}\n", "t.scene:3: 'color' channels must not be negative (a light or surface cannot take light away), found 0 0 -2"),
+        ("sunlight\n{\n ambient -0.1\n}\n", "t.scene:3: 'ambient' must not be negative, found [-0.1, -0.1, -0.1]"),
+        ("arealight\n{\n emission 1 1 -1\n}\n", "t.scene:3: 'emission' channels must not be negative (a light or surface cannot take light away), found 1 1 -1"),
+        ("pointlights\n{\n color_min -1 0 0\n}\n", "t.scene:3: 'color_min' channels must not be negative (a light or surface cannot take light away), found -1 0 0"),
     ];
     for (text, expected) in cases {
         assert_eq!(error(text), expected, "{text}");
@@ -306,7 +316,7 @@ fn model_material_overrides_are_read_and_checked_at_their_line() {
     for (property, message) in [
         (
             "color -1 0 0",
-            "'color' must be 3 finite numbers of at least 0, found [-1, 0, 0]",
+            "'color' channels must not be negative (a light or surface cannot take light away), found -1 0 0",
         ),
         ("color 1 0", "'color' expects 3 numbers, found 2"),
         (

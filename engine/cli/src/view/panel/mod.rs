@@ -478,7 +478,9 @@ fn param_widget(
                 _ => None,
             };
             let speed = 0.01 * x.abs().max(1.0);
-            let mut drag = egui::DragValue::new(x).speed(speed);
+            let mut drag = egui::DragValue::new(x)
+                .speed(speed)
+                .custom_parser(finite_number);
             if range.min.is_some() || range.max.is_some() {
                 drag = drag.range(range.min.unwrap_or(f64::MIN)..=range.max.unwrap_or(f64::MAX));
             }
@@ -506,7 +508,13 @@ fn param_widget(
             let mut last = None;
             for (i, c) in components.iter_mut().enumerate() {
                 let response = ui
-                    .push_id((id, i), |ui| ui.add(egui::DragValue::new(c).speed(0.01)))
+                    .push_id((id, i), |ui| {
+                        ui.add(
+                            egui::DragValue::new(c)
+                                .speed(0.01)
+                                .custom_parser(finite_number),
+                        )
+                    })
                     .inner;
                 done |= response.drag_stopped()
                     || (response.changed() && !response.dragged())
@@ -525,6 +533,15 @@ fn param_widget(
             (response, false)
         }
     }
+}
+
+/// A typed parameter value: a number a shader's 32-bit float holds. Text
+/// that is not one (`nan`, `inf`, `1e39`) leaves the value as it was.
+fn finite_number(text: &str) -> Option<f64> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && v.abs() <= f64::from(f32::MAX))
 }
 
 fn nearest(values: &[f64], x: f64) -> f64 {

@@ -24,7 +24,7 @@ const COMPUTE: &str = r#"Graph(
 /// gives them: each case is (base graph, edit, message, text at the location).
 #[test]
 fn out_of_range_values_are_located_errors() {
-    let cases: [(&str, (&str, &str), &str, &str); 24] = [
+    let cases: [(&str, (&str, &str), &str, &str); 25] = [
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([2.0])"#),
             "a depth clear must be in [0, 1], found 2", "Clear([2.0])"),
         (VALID, (r#"load: Clear([0.0])"#, r#"load: Clear([NaN])"#),
@@ -44,9 +44,11 @@ fn out_of_range_values_are_located_errors() {
         (VALID, (r#"format: R8G8B8A8_UNORM)"#, r#"format: R8G8B8A8_UNORM, size: Scale(16.0, 16.0))"#),
             "\"albedo\" would be 30720x17280 at output size 1920x1080, over the 16384 pixels an image side may have", "Scale("),
         (VALID, ("draw: Meshes(Opaque),", r#"draw: Meshes(Opaque), params: { "bias": NaN },"#),
-            "parameter \"bias\" must be finite, found NaN", "NaN },"),
+            "parameter \"bias\" must be a finite 32-bit float (at most 3.4e38 in size), found NaN", "NaN },"),
         (VALID, ("Graph(", r#"Graph(params: { "scale": [1.0, inf] },"#),
-            "parameter \"scale\" must be finite, found inf", "[1.0, inf] },"),
+            "parameter \"scale\" must be a finite 32-bit float (at most 3.4e38 in size), found inf", "[1.0, inf] },"),
+        (VALID, ("Graph(", r#"Graph(params: { "boost": 1e39 },"#),
+            "parameter \"boost\" must be a finite 32-bit float (at most 3.4e38 in size), found 1e39", "1e39 },"),
         (VALID, ("draw: Meshes(Opaque),", r#"draw: Meshes(Opaque), raster: (depth_bias: (NaN, 1.0)),"#),
             "a depth bias must be a finite number, found NaN", "(NaN, 1.0)"),
         (VALID, ("kind: Fullscreen,", "kind: Fullscreen, raster: (cull: Back),"),
@@ -210,13 +212,20 @@ fn a_define_value_is_a_whole_number_or_a_parameter_holding_one() {
     let d = only_error(&text);
     assert_eq!(
         d.message,
-        "define \"CHOICE\": its value must be a whole number, found 0.5"
+        "define \"CHOICE\": its value must be a whole number from -2147483648 to 2147483647 (a GLSL int), found 0.5"
     );
     assert!(text_at(&text, &d).starts_with("\"$scale\""), "{d:?}");
     let d = only_error(&graph("\"$on\""));
     assert_eq!(
         d.message,
-        "define \"CHOICE\": its value must be a whole number, found true"
+        "define \"CHOICE\": its value must be a whole number from -2147483648 to 2147483647 (a GLSL int), found true"
+    );
+    // A whole number past a GLSL int would reach the compiler as "numeric
+    // literal too big".
+    let d = only_error(&graph("4294967296"));
+    assert_eq!(
+        d.message,
+        "define \"CHOICE\": its value must be a whole number from -2147483648 to 2147483647 (a GLSL int), found 4294967296"
     );
     let d = only_error(&graph("\"$choise\""));
     assert_eq!(

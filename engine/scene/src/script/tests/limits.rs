@@ -154,3 +154,92 @@ fn maps_grown_by_indexing_are_held_to_the_size_limit() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A script whose `update` step spins for about `ms` milliseconds.
+fn slow_update(name: &str, ms: u32) -> PathBuf {
+    folder(
+        name,
+        &[(
+            "scene.rhai",
+            &format!(
+                "point_light(#{{ position: [0, 1, 0], color: [1, 1, 1] }});\nfn update(t, dt) {{\n    let n = 0;\n    for i in 0..{} {{ n += i; }}\n}}\n",
+                ms * 2_000
+            ),
+        )],
+    )
+}
+
+#[test]
+fn a_frames_update_steps_share_one_time_limit_and_a_render_another() {
+    // Each step is cheap enough for the per-call limit; a frame asking for
+    // 5 s of scene time runs 300 of them, past the frame's limit.
+    let dir = slow_update("frame-limit", 20);
+    let path = dir.join("scene.rhai");
+    let scene = crate::load_scene(&path).unwrap();
+    let limits = Limits {
+        frame_seconds: 0.3,
+        ..Limits::default()
+    };
+    let mut runtime = ScriptRuntime::new(scene.script.as_ref().unwrap(), &scene, &limits).unwrap();
+    let started = std::time::Instant::now();
+    let error = runtime
+        .frame_at(5.0)
+        .expect_err("past the frame's limit")
+        .to_string();
+    let took = started.elapsed();
+    assert!(took < std::time::Duration::from_secs(3), "{took:?}");
+    assert!(
+        error.starts_with(&format!("{}:", path.display()))
+            && error.ends_with("the script's update steps for one frame ran past the frame's limit of 0.3 s (300 steps of 1/60 s to reach t = 5 s)"),
+        "{error}"
+    );
+    // Frames that each stay within their limit still add up to the render's.
+    let limits = Limits {
+        render_seconds: 0.4,
+        ..Limits::default()
+    };
+    let mut runtime = ScriptRuntime::new(scene.script.as_ref().unwrap(), &scene, &limits).unwrap();
+    let started = std::time::Instant::now();
+    let mut frame = 0;
+    let error = loop {
+        frame += 1;
+        match runtime.frame_at(f64::from(frame) * STEP) {
+            Ok(_) => assert!(frame < 200, "never stopped"),
+            Err(e) => break e.to_string(),
+        }
+    };
+    assert!(
+        started.elapsed() < std::time::Duration::from_secs(3),
+        "{:?}",
+        started.elapsed()
+    );
+    assert!(
+        error.contains(
+            "the script's update steps ran past their limit of 0.4 s in all for this render"
+        ),
+        "{error}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn init_and_update_of_the_wrong_arity_are_refused_where_they_are_declared() {
+    for (name, body, expected) in [
+        (
+            "update-arity",
+            "point_light(#{ position: [0, 1, 0], color: [1, 1, 1] });\n\nfn update(t) {\n    set_light(0, #{ color: [t, 0, 0] });\n}\n",
+            ":3:1: `fn update` takes 1 parameter; weft calls fn update(t, dt) with 2, so it would never run",
+        ),
+        (
+            "init-arity",
+            "fn init(seed) {\n    #{}\n}\n",
+            ":1:1: `fn init` takes 1 parameter; weft calls fn init() with 0, so it would never run",
+        ),
+    ] {
+        let dir = folder(name, &[("scene.rhai", body)]);
+        let path = dir.join("scene.rhai");
+        let error = try_runtime(&path).err().expect("refused").to_string();
+        assert_eq!(error, format!("{}{expected}", path.display()));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

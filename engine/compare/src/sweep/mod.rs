@@ -6,12 +6,16 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+mod grid;
+
+pub use grid::{check_rows, grid_document, read_grid, Owned, GRID_FILE};
+
 /// The CSV column naming each point's graph, in a sweep over several graphs
 /// (first, before the parameters); a single-graph sweep has none.
 pub const GRAPH_COLUMN: &str = "graph";
 
 /// One setting of a sweep.
-#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct SweepPoint {
     /// The graph's path as given, in a sweep over several graphs.
     pub graph: Option<String>,
@@ -173,16 +177,43 @@ fn header_with(names: &[String], columns: usize) -> String {
     all.join(",")
 }
 
-/// One CSV line.
-pub fn line(row: &SweepRow, names: &[String]) -> String {
+/// A point's cells: one per name (its graph, its parameters' values, empty
+/// for a parameter its graph does not have), then its features.
+fn cells(point: &SweepPoint, names: &[String]) -> Vec<String> {
     let mut fields: Vec<String> = names
         .iter()
         .map(|n| match n.as_str() {
-            GRAPH_COLUMN => row.point.graph.clone().unwrap_or_default(),
-            _ => row.point.params.get(n).cloned().unwrap_or_default(),
+            GRAPH_COLUMN => point.graph.clone().unwrap_or_default(),
+            _ => point.params.get(n).cloned().unwrap_or_default(),
         })
         .collect();
-    fields.push(row.point.features.clone());
+    fields.push(point.features.clone());
+    fields
+}
+
+/// The point whose [`cells`] are `fields` (its names' cells, then features).
+fn point_of(names: &[String], fields: &[&str]) -> SweepPoint {
+    let named = || names.iter().zip(fields);
+    SweepPoint {
+        graph: named()
+            .find(|(name, _)| *name == GRAPH_COLUMN)
+            .map(|(_, g)| g.to_string()),
+        // An empty cell: a parameter this point's graph does not have.
+        params: named()
+            .filter(|(name, v)| *name != GRAPH_COLUMN && !v.is_empty())
+            .map(|(name, v)| (name.clone(), v.to_string()))
+            .collect(),
+        features: fields
+            .get(names.len())
+            .copied()
+            .unwrap_or_default()
+            .to_string(),
+    }
+}
+
+/// One CSV line.
+pub fn line(row: &SweepRow, names: &[String]) -> String {
+    let mut fields = cells(&row.point, names);
     fields.push(format!("{:.6}", row.flip));
     fields.push(format!("{:.6e}", row.rmse));
     fields.push(format!("{:.3}", row.frame_ms));
@@ -271,24 +302,16 @@ fn parse(path: &Path, text: &str, names: &[String]) -> Result<(Vec<SweepRow>, bo
                 names.len() + columns
             )));
         }
-        let number = |s: &str| {
-            s.parse::<f64>()
-                .map_err(|_| bad(format!("\"{s}\" is not a number")))
+        // A measure is a finite number of at least 0: NaN or a negative
+        // time would sort anywhere on the frontier.
+        let number = |s: &str| match s.parse::<f64>() {
+            Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+            Ok(_) => Err(bad(format!("\"{s}\" is not a finite number of at least 0"))),
+            Err(_) => Err(bad(format!("\"{s}\" is not a number"))),
         };
         let n = names.len();
-        let named = || names.iter().zip(&fields[..n]);
         rows.push(SweepRow {
-            point: SweepPoint {
-                graph: named()
-                    .find(|(name, _)| *name == GRAPH_COLUMN)
-                    .map(|(_, g)| g.to_string()),
-                // An empty cell: a parameter this point's graph does not have.
-                params: named()
-                    .filter(|(name, v)| *name != GRAPH_COLUMN && !v.is_empty())
-                    .map(|(name, v)| (name.clone(), v.to_string()))
-                    .collect(),
-                features: fields[n].to_string(),
-            },
+            point: point_of(names, &fields),
             flip: number(fields[n + 1])?,
             rmse: number(fields[n + 2])?,
             frame_ms: number(fields[n + 3])?,
