@@ -370,21 +370,39 @@ enum Outcome {
     Rendered,
 }
 
-/// Checks the mutant's `graph`; when accepted, renders the demo under no
-/// features and under all, and returns an error naming anything wrong.
-fn run_mutant(gpu: &Gpu, scene: &weft_scene::Scene, graph: &Path) -> Result<Outcome, String> {
+/// What went wrong with a mutant check accepted.
+enum Failure {
+    /// The render refused it (or failed): "check said ok, render refused".
+    RenderRefused(String),
+    /// Anything else: a validation message, a check that could not run.
+    Other(String),
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::RenderRefused(m) | Self::Other(m) => f.write_str(m),
+        }
+    }
+}
+
+/// Checks the mutant's `graph`; when accepted, renders the demo with the
+/// scene's own features, under no features and under all, and names
+/// anything wrong.
+fn run_mutant(gpu: &Gpu, scene: &weft_scene::Scene, graph: &Path) -> Result<Outcome, Failure> {
     let loaded = weft_graph::load(graph);
     let diags = check_graph_and_shaders(&loaded, &ShaderTarget::of(gpu))
-        .map_err(|e| format!("check failed: {e}"))?;
+        .map_err(|e| Failure::Other(format!("check failed: {e}")))?;
     if diags.iter().any(weft_graph::Diagnostic::is_error) {
         return Ok(Outcome::Refused);
     }
-    let prepared = weft_graph::Prepared::new(loaded).map_err(|d| format!("{d:?}"))?;
+    let prepared =
+        weft_graph::Prepared::new(loaded).map_err(|d| Failure::RenderRefused(format!("{d:?}")))?;
     let mut names: BTreeSet<String> = feature_names(prepared.ir());
     names.extend(prepared.graph().default_features.iter().cloned());
     let none: Vec<String> = names.iter().map(|n| format!("!{n}")).collect();
     let all: Vec<String> = names.iter().cloned().collect();
-    for features in [none, all] {
+    for features in [Vec::new(), none, all] {
         let before = gpu.validation().messages().len();
         let settings = RenderSettings {
             graph: graph.to_path_buf(),
@@ -402,16 +420,16 @@ fn run_mutant(gpu: &Gpu, scene: &weft_scene::Scene, graph: &Path) -> Result<Outc
             .map(|m| format!("{}: {}", m.id, m.text))
             .collect();
         if let Err(e) = result {
-            return Err(format!(
+            return Err(Failure::RenderRefused(format!(
                 "accepted by check, but rendering with {features:?} failed: {e}"
-            ));
+            )));
         }
         if !new.is_empty() {
-            return Err(format!(
+            return Err(Failure::Other(format!(
                 "accepted by check, but rendering with {features:?} gave {} validation message(s):\n{}",
                 new.len(),
                 new.join("\n")
-            ));
+            )));
         }
     }
     Ok(Outcome::Rendered)
@@ -432,6 +450,8 @@ fn every_mutant_check_accepts_renders_clean() {
     let files = mutable_files();
     let mut rng = Rng::new(seed);
     let (mut refused, mut rendered, mut failures) = (0, 0, Vec::new());
+    // Mutants `graph check --shaders` accepted and a render then refused.
+    let mut check_ok_render_refused = 0;
     let mut made = 0;
     while made < count {
         let file = rng.pick(&files).clone();
@@ -462,11 +482,21 @@ fn every_mutant_check_accepts_renders_clean() {
         match outcome {
             Ok(Ok(Outcome::Refused)) => refused += 1,
             Ok(Ok(Outcome::Rendered)) => rendered += 1,
-            Ok(Err(problem)) => failures.push(format!("{label}: {problem}")),
+            Ok(Err(Failure::RenderRefused(problem))) => {
+                check_ok_render_refused += 1;
+                failures.push(format!("{label}: {problem}"));
+            }
+            Ok(Err(Failure::Other(problem))) => failures.push(format!("{label}: {problem}")),
             Err(_) => failures.push(format!("{label}: panicked")),
         }
     }
-    eprintln!("{count} mutants (seed {seed:#x}): {refused} refused by check, {rendered} accepted and rendered clean, {} failed", failures.len());
+    eprintln!("{count} mutants (seed {seed:#x}): {refused} refused by check, {rendered} accepted and rendered clean, {} failed, {check_ok_render_refused} of them check said ok and render refused", failures.len());
+    assert_eq!(
+        check_ok_render_refused,
+        0,
+        "check said ok, render refused:\n{}",
+        failures.join("\n\n")
+    );
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
     assert!(
         refused > 0 && rendered > 0,
@@ -524,5 +554,51 @@ fn compute_shaders_asking_more_than_the_device_offers_are_refused() {
         let outcome = run_mutant(&gpu, &scene, &tree.0.join("graphs/tiled.ron"))
             .unwrap_or_else(|problem| panic!("{what}: {problem}"));
         assert_eq!(matches!(outcome, Outcome::Refused), refused, "{what}");
+    }
+}
+
+/// Two mutants `check --shaders` once accepted and a render then refused
+/// (issue 60): a binding moved in a pass that runs only when the scene has
+/// spot lights and shadow casters and shadows are not traced, and an
+/// `Absolute` size on the denoiser's history, which its copy meets only at
+/// render. Both are refused by check now, located at their pass.
+#[test]
+fn passes_under_scene_features_and_copies_of_unequal_sizes_are_refused_by_check() {
+    let gpu = weft_tests::gpu();
+    let scene = weft_scene::load_scene(&demo_scene()).expect("demo scene");
+    for (file, from, to, graph, expected) in [
+        (
+            "shaders/deferred_spot.frag",
+            "layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;",
+            "layout(set = 0, binding = 0) uniform sampler2DShadow shadow_map;",
+            "deferred.ron",
+            "pass \"spot_lights\": graph resource `gbuffer_albedo` is bound to nothing",
+        ),
+        (
+            "graphs/denoise.ron",
+            r#"Image(name: "moments_prev", format: R32G32B32A32_SFLOAT, history: true),"#,
+            r#"Image(name: "moments_prev", format: R32G32B32A32_SFLOAT, history: true, size: Absolute(64, 64)),"#,
+            "pathtrace_denoised.ron",
+            "copy pass \"keep_moments\": `moments` is 1280x720 and `moments_prev` 64x64 at output size 1280x720; a copy needs equal sizes (a Blit scales)",
+        ),
+    ] {
+        let text = std::fs::read_to_string(root().join(file)).expect("read");
+        assert!(text.contains(from), "{file} changed");
+        let tree = Tree::new("scene-features");
+        std::fs::write(tree.0.join(file), text.replacen(from, to, 1)).expect("write mutant");
+        let loaded = weft_graph::load(&tree.0.join("graphs").join(graph));
+        let diags = check_graph_and_shaders(&loaded, &ShaderTarget::of(&gpu)).expect("check runs");
+        let errors: Vec<&str> = diags
+            .iter()
+            .filter(|d| d.is_error())
+            .map(|d| d.message.as_str())
+            .collect();
+        assert!(
+            errors.iter().any(|m| m.starts_with(expected)),
+            "{file}: {errors:?}"
+        );
+        let outcome = run_mutant(&gpu, &scene, &tree.0.join("graphs").join(graph))
+            .unwrap_or_else(|problem| panic!("{file}: {problem}"));
+        assert!(matches!(outcome, Outcome::Refused), "{file}");
     }
 }

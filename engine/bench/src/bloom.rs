@@ -259,8 +259,7 @@ pub fn run(args: BloomArgs) -> Result<ExitCode> {
     let _ = std::fs::remove_dir_all(&dir);
     let out_dir = crate::output::out_dir(args.out_dir.as_deref(), "bloom")?;
     let csv_path = out_dir.join("bloom_bench.csv");
-    std::fs::write(&csv_path, csv(&samples))
-        .with_context(|| format!("writing {}", csv_path.display()))?;
+    weft_io::write_output(&csv_path, csv(&samples).as_bytes())?;
     let footprint = |s: &Sample| f64::from(2 * s.radius + 1);
     let chart = LinePlot {
         title: format!(

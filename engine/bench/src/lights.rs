@@ -250,8 +250,7 @@ pub fn run(args: LightsArgs) -> Result<ExitCode> {
     }
     let out_dir = crate::output::out_dir(args.out_dir.as_deref(), "lights")?;
     let csv_path = out_dir.join("lights_bench.csv");
-    std::fs::write(&csv_path, csv(&samples))
-        .with_context(|| format!("writing {}", csv_path.display()))?;
+    weft_io::write_output(&csv_path, csv(&samples).as_bytes())?;
     let png_path = out_dir.join("lights_bench.png");
     let chart = LinePlot {
         title: format!(

@@ -181,8 +181,7 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
     }
     let out_dir = crate::output::out_dir(args.out_dir.as_deref(), "pathtrace")?;
     let csv_path = out_dir.join("pathtrace_bench.csv");
-    std::fs::write(&csv_path, csv(&samples))
-        .with_context(|| format!("writing {}", csv_path.display()))?;
+    weft_io::write_output(&csv_path, csv(&samples).as_bytes())?;
     if let Some(path) = &args.image {
         last_image.context("at least one render")?.save(path)?;
     }

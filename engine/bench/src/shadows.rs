@@ -326,7 +326,7 @@ pub fn run(args: ShadowsArgs) -> Result<ExitCode> {
     let _ = std::fs::remove_dir_all(&work);
     let out_dir = crate::output::out_dir(args.out_dir.as_deref(), "shadows")?;
     let csv_path = out_dir.join("shadows_bench.csv");
-    std::fs::write(&csv_path, csv(&samples))?;
+    weft_io::write_output(&csv_path, csv(&samples).as_bytes())?;
     let series = |y: &dyn Fn(&Sample) -> f64| -> Vec<Series> {
         args.radii
             .iter()

@@ -221,25 +221,37 @@ pub fn check_with(
 ) -> Vec<ShaderProblem> {
     let mut problems = Vec::new();
     for pass in &plan.passes {
-        let found = match pass_shaders(pass) {
-            Ok(Some(shaders)) => own_pass_problems(cache, plan, pass, &shaders, scene),
-            Ok(None) => match scene {
-                Some(scene) => scene_pass_shader_problems(cache, scene, plan, pass),
-                None => Ok(Vec::new()),
-            },
-            Err(e) => Err(e),
-        };
-        for message in problem_messages(found) {
-            let problem = ShaderProblem {
-                pass: pass.name.clone(),
-                message,
-            };
+        for problem in check_pass(cache, plan, pass, scene) {
             if !problems.contains(&problem) {
                 problems.push(problem);
             }
         }
     }
     problems
+}
+
+/// [`check_with`] for one pass of `plan`.
+pub fn check_pass(
+    cache: &mut PipelineCache,
+    plan: &Plan,
+    pass: &PlanPass,
+    scene: Option<&SceneInterface>,
+) -> Vec<ShaderProblem> {
+    let found = match pass_shaders(pass) {
+        Ok(Some(shaders)) => own_pass_problems(cache, plan, pass, &shaders, scene),
+        Ok(None) => match scene {
+            Some(scene) => scene_pass_shader_problems(cache, scene, plan, pass),
+            None => Ok(Vec::new()),
+        },
+        Err(e) => Err(e),
+    };
+    problem_messages(found)
+        .into_iter()
+        .map(|message| ShaderProblem {
+            pass: pass.name.clone(),
+            message,
+        })
+        .collect()
 }
 
 /// A fullscreen or compute pass's problems, located in its shaders.

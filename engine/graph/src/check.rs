@@ -5,13 +5,21 @@ use crate::compile::cull::unneeded_warning;
 use crate::compile::{compile_ir, CompileOptions};
 use crate::diagnostic::Diagnostic;
 use crate::load::LoadedGraph;
-use crate::resolve::feature_names;
+use crate::plan::Extent;
 use crate::resolve::resolve;
+use crate::resolve::{feature_names, pass_feature_names, Ir};
 use std::collections::BTreeSet;
 
 /// Feature sets tried exhaustively up to this many feature names; beyond it, all-off,
 /// all-on and each feature alone.
 const EXHAUSTIVE_FEATURES: usize = 10;
+
+/// The second output size every feature set is compiled at: odd and not
+/// 16:9, so sizes that match only at the default 1280x720 differ here.
+const ODD_EXTENT: Extent = Extent {
+    width: 997,
+    height: 541,
+};
 
 /// Every error and warning of a graph, deduplicated, errors first.
 pub fn check(graph: &LoadedGraph) -> Vec<Diagnostic> {
@@ -34,13 +42,29 @@ pub fn check(graph: &LoadedGraph) -> Vec<Diagnostic> {
                 readback: graph.readback_names(),
                 ..CompileOptions::default()
             };
-            let diagnostics = match compile_ir(graph, &ir, &options) {
+            let mut diagnostics = match compile_ir(graph, &ir, &options) {
                 Ok(plan) => {
                     ran.extend(plan.passes.iter().map(|p| p.name.clone()));
                     plan.warnings
                 }
                 Err(errors) => errors,
             };
+            // Size rules that agree at one output size only are found at
+            // a second, odd one.
+            let odd = CompileOptions {
+                extent: ODD_EXTENT,
+                ..options
+            };
+            if let Err(errors) = compile_ir(graph, &ir, &odd) {
+                for e in errors {
+                    if !diagnostics
+                        .iter()
+                        .any(|d| d.file == e.file && d.pos == e.pos)
+                    {
+                        diagnostics.push(e);
+                    }
+                }
+            }
             for d in diagnostics {
                 match found.iter_mut().find(|(seen, _)| *seen == d) {
                     Some((_, labels)) => labels.push(label.clone()),
@@ -89,13 +113,31 @@ pub fn feature_sets(names: &[String]) -> Vec<BTreeSet<String>> {
 
 /// The feature sets shader checks compile variants under (each set is a
 /// shader compile per pass whose defines it changes): every combination of up
-/// to ten features, else none, all and each alone.
-pub fn variant_sets(names: &[String]) -> Vec<BTreeSet<String>> {
+/// to ten features; beyond that none, all and each alone, and for each pass
+/// every combination of the features that decide whether it runs and what it
+/// reads and writes, so a pass that runs only under three features together
+/// (spot lights, shadow casters, no traced shadows) is compiled and checked
+/// with every set of bindings it can have.
+pub fn variant_sets(ir: &Ir) -> Vec<BTreeSet<String>> {
+    let names: Vec<String> = feature_names(ir).into_iter().collect();
     if names.len() <= EXHAUSTIVE_FEATURES {
-        return every_combination(names);
+        return every_combination(&names);
     }
     let mut sets = vec![BTreeSet::new(), names.iter().cloned().collect()];
     sets.extend(names.iter().map(|n| BTreeSet::from([n.clone()])));
+    for pass in &ir.passes {
+        let own: Vec<String> = pass_feature_names(pass, false).into_iter().collect();
+        let combinations = if own.len() <= EXHAUSTIVE_FEATURES {
+            every_combination(&own)
+        } else {
+            feature_sets(&own)
+        };
+        for set in combinations {
+            if !sets.contains(&set) {
+                sets.push(set);
+            }
+        }
+    }
     sets
 }
 

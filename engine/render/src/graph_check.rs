@@ -3,11 +3,12 @@
 //! and the engine's scene bindings, under every feature set the graph check
 //! enumerates (features change the shader variants through defines).
 
-use weft_gpu::check::check_with;
+use std::collections::HashSet;
+use weft_gpu::check::check_pass;
 use weft_gpu::pipeline::PipelineCache;
 use weft_gpu::{Gpu, GpuError, ShaderProblem, ShaderSupport};
 use weft_graph::check::variant_sets;
-use weft_graph::feature_names;
+use weft_graph::plan::PlanPass;
 use weft_graph::{CompileOptions, Diagnostic, LoadedGraph, Prepared};
 
 /// The device shaders are checked for: its name and what it offers.
@@ -58,10 +59,10 @@ pub fn check_graph_and_shaders(
             return Ok(diags);
         }
     };
-    let names: Vec<String> = feature_names(prepared.ir()).into_iter().collect();
     let mut cache = PipelineCache::new()?;
     let scene = crate::bindings::scene_interface();
-    for features in variant_sets(&names) {
+    let mut checked: HashSet<String> = HashSet::new();
+    for features in variant_sets(prepared.ir()) {
         let options = CompileOptions {
             features,
             readback: graph.readback_names(),
@@ -78,8 +79,15 @@ pub fn check_graph_and_shaders(
             }
             continue;
         }
-        let mut problems = check_with(&mut cache, &plan, Some(&scene));
-        problems.extend(unoffered(&mut cache, &plan, target));
+        // A pass whose shaders, defines and bound resources are as under a
+        // set checked before gives the same problems: checked once.
+        let mut problems = Vec::new();
+        for pass in plan.passes.iter() {
+            if checked.insert(pass_signature(&plan, pass)) {
+                problems.extend(check_pass(&mut cache, &plan, pass, Some(&scene)));
+                problems.extend(unoffered(&mut cache, pass, target));
+            }
+        }
         for ShaderProblem { pass, message } in problems {
             let at = plan
                 .passes
@@ -96,32 +104,45 @@ pub fn check_graph_and_shaders(
     Ok(diags)
 }
 
-/// Each shader of `plan` that needs what `target` does not offer, as a
-/// problem of its pass.
+/// What a pass's shader check depends on: the pass as planned less its
+/// barriers (which other passes decide), and every resource of the plan by
+/// name and description (bindings and attachments name them by index).
+fn pass_signature(plan: &weft_graph::plan::Plan, pass: &PlanPass) -> String {
+    let mut pass = pass.clone();
+    pass.barriers.clear();
+    pass.repeat_barriers.clear();
+    let resources: Vec<(&str, &weft_graph::plan::ResourceDesc)> = plan
+        .resources
+        .iter()
+        .map(|r| (r.name.as_str(), &r.desc))
+        .collect();
+    format!("{pass:?}{resources:?}")
+}
+
+/// Each shader of `pass` that needs what `target` does not offer, as a
+/// problem of the pass.
 fn unoffered(
     cache: &mut PipelineCache,
-    plan: &weft_graph::plan::Plan,
+    pass: &PlanPass,
     target: &ShaderTarget,
 ) -> Vec<ShaderProblem> {
+    let keys = match weft_gpu::check::pass_shaders(pass) {
+        Ok(Some(shaders)) => shaders.keys().into_iter().cloned().collect(),
+        Ok(None) => crate::sources::scene_pass_keys(pass),
+        Err(_) => return Vec::new(), // reported by `check_pass`
+    };
     let mut problems = Vec::new();
-    for pass in &plan.passes {
-        let keys = match weft_gpu::check::pass_shaders(pass) {
-            Ok(Some(shaders)) => shaders.keys().into_iter().cloned().collect(),
-            Ok(None) => crate::sources::scene_pass_keys(pass),
-            Err(_) => continue, // reported by `check_with`
+    for key in keys {
+        let Ok(module) = cache.shader(&key) else {
+            continue; // reported by `check_pass`
         };
-        for key in keys {
-            let Ok(module) = cache.shader(&key) else {
-                continue; // reported by `check_with`
+        if let Some(refusal) = target.support.refusal(&target.device, &module.compiled) {
+            let problem = ShaderProblem {
+                pass: pass.name.clone(),
+                message: format!("{} {refusal}", key.path.display()),
             };
-            if let Some(refusal) = target.support.refusal(&target.device, &module.compiled) {
-                let problem = ShaderProblem {
-                    pass: pass.name.clone(),
-                    message: format!("{} {refusal}", key.path.display()),
-                };
-                if !problems.contains(&problem) {
-                    problems.push(problem);
-                }
+            if !problems.contains(&problem) {
+                problems.push(problem);
             }
         }
     }

@@ -414,11 +414,11 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         flip: Some(&m.flip),
     }));
     write_contact_sheet(&columns, &args.out.join("contact_sheet.png"))?;
-    std::fs::write(
-        args.out.join("report.json"),
-        serde_json::to_string_pretty(&report)? + "\n",
+    weft_io::write_output(
+        &args.out.join("report.json"),
+        (serde_json::to_string_pretty(&report)? + "\n").as_bytes(),
     )?;
-    std::fs::write(args.out.join("report.md"), report.markdown())?;
+    weft_io::write_output(&args.out.join("report.md"), report.markdown().as_bytes())?;
     print!("{}", report.table());
     println!("wrote {}", args.out.display());
     Ok(session.finish(common.validate))

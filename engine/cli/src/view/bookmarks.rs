@@ -65,7 +65,8 @@ pub fn save(path: &Path, bookmarks: &[Bookmark], lens: &Camera) -> Result<()> {
             super::camera_block::camera_block(&b.name, lens, b.world, Vec3::ZERO, b.orientation)
         })
         .collect();
-    std::fs::write(path, text).with_context(|| format!("writing bookmarks {}", path.display()))
+    weft_io::write_output(path, text.as_bytes())
+        .with_context(|| format!("writing bookmarks {}", path.display()))
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@ pub(crate) mod order;
 mod passes;
 mod resources;
 pub(crate) mod sync;
+mod transfers;
 
 use crate::diagnostic::Diagnostic;
 use crate::id::IrPassId;
@@ -282,6 +283,7 @@ pub fn compile_ir(
         sync.pass_barriers,
         sync.repeat_barriers,
     );
+    transfers::check(&passes, &resources, options.extent)?;
     Ok(Plan {
         name: graph.name.clone(),
         file: root_file(graph),

@@ -9,7 +9,7 @@ mod resources;
 mod rules;
 mod values;
 
-pub use features::{feature_names, SCENE_FEATURES};
+pub use features::{feature_names, pass_feature_names, SCENE_FEATURES};
 pub use ir::*;
 pub use rules::{access_path, usage_name};
 pub(crate) use values::oversized_image;
