@@ -1,13 +1,19 @@
 # Entry points: `make demo`, `make test`, `make bench`. Each runs tools/setup first.
 CARGO ?= cargo
 
-.PHONY: setup build demo test bench lint fuzz ltc-tables
+.PHONY: setup build demo test bench lint fuzz ltc-tables install
+
+# Where `make install` puts weft: PREFIX/bin/weft, PREFIX/share/weft/{graphs,shaders}.
+PREFIX ?= /usr/local
 
 setup:
 	@bash tools/setup
 
 build: setup
 	$(CARGO) build --release -p weft-cli
+
+install: build
+	@bash tools/install "$(PREFIX)" target/release/weft
 
 demo: build
 	@mkdir -p out

@@ -13,7 +13,7 @@ use weft_graph::{CompileOptions, Diagnostic, Extent};
 pub enum GraphCommand {
     /// Validate graph files; exit 1 on any error (messages on stderr).
     Check {
-        #[arg(required = true)]
+        #[arg(required = true, value_parser = crate::graphs::graph_path)]
         files: Vec<PathBuf>,
         /// Also compile and reflect every pass's shaders and cross-check them with
         /// the graph: bindings, push constants, outputs.
@@ -26,6 +26,7 @@ pub enum GraphCommand {
     },
     /// Compile a graph and print its plan: pass order, culled passes, barriers, render-pass ops.
     Plan {
+        #[arg(value_parser = crate::graphs::graph_path)]
         file: PathBuf,
         #[command(flatten)]
         target: Target,
@@ -35,6 +36,7 @@ pub enum GraphCommand {
     },
     /// Print the graph as Graphviz DOT (culled passes greyed).
     Dot {
+        #[arg(value_parser = crate::graphs::graph_path)]
         file: PathBuf,
         #[command(flatten)]
         target: Target,

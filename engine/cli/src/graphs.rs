@@ -52,3 +52,12 @@ impl Loaded {
 fn params_key(params: &BTreeMap<String, ParamValue>) -> String {
     format!("{params:?}")
 }
+
+/// A graph path as the command line gives it, found on weft's search path
+/// (`$WEFT_HOME`, the install's share folder, the current folder:
+/// [`weft_io::home`]); a path found nowhere stays as given, and loading it
+/// says where it was looked for.
+pub(crate) fn graph_path(text: &str) -> Result<PathBuf, String> {
+    let given = PathBuf::from(text);
+    Ok(weft_io::home::locate(&given).unwrap_or(given))
+}

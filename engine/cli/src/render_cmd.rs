@@ -26,7 +26,7 @@ pub struct RenderArgs {
     /// The scene file.
     scene: PathBuf,
     /// The render graph.
-    #[arg(long, default_value = "graphs/forward.ron")]
+    #[arg(long, default_value = "graphs/forward.ron", value_parser = crate::graphs::graph_path)]
     graph: PathBuf,
     /// Output size, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = clap::value_parser!(Extent))]

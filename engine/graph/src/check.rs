@@ -176,10 +176,43 @@ mod tests {
         (0..n).map(|i| format!("f{i}")).collect()
     }
 
+    /// A graph whose pass `p{i}` runs under feature `f{i}`, `n` of them, and
+    /// whose pass `spot` runs under `spot` and reads `shadow` only under
+    /// `casters` and not `traced`.
+    fn graph_of(n: usize) -> Ir {
+        let passes: String = (0..n)
+            .map(|i| {
+                format!(
+                    r#"Pass(name: "p{i}", kind: Fullscreen, shaders: (fragment: "p.frag"),
+                         color: [(image: "out", load: Load)], enabled_if: ["f{i}"]),"#
+                )
+            })
+            .collect();
+        let text = format!(
+            r#"Graph(
+            output: "out",
+            resources: [
+                Image(name: "out", format: R8G8B8A8_UNORM),
+                Image(name: "shadow", format: R8G8B8A8_UNORM),
+            ],
+            passes: [
+                Pass(name: "s", kind: Fullscreen, shaders: (fragment: "s.frag"), color: [(image: "shadow")]),
+                Pass(name: "base", kind: Fullscreen, shaders: (fragment: "b.frag"), color: [(image: "out")]),
+                {passes}
+                Pass(name: "spot", kind: Fullscreen, shaders: (fragment: "spot.frag"),
+                     sampled: [(name: "shadow", enabled_if: ["casters", "!traced"])],
+                     color: [(image: "out", load: Load)], enabled_if: ["spot"]),
+            ],
+        )"#
+        );
+        crate::compile::fixture::resolved(&text).1
+    }
+
     #[test]
     fn up_to_ten_features_every_combination_is_tried() {
         assert_eq!(feature_sets(&names(10)).len(), 1024);
-        assert_eq!(variant_sets(&names(3)).len(), 8);
+        // f0, casters, spot, traced.
+        assert_eq!(variant_sets(&graph_of(1)).len(), 16);
     }
 
     #[test]
@@ -196,7 +229,26 @@ mod tests {
                 assert!(sets.contains(&(&all - &pair)), "all but {pair:?}");
             }
         }
-        // Shader variants stay at none, all and each alone.
-        assert_eq!(variant_sets(&n).len(), 2 + 12);
+    }
+
+    #[test]
+    fn beyond_ten_each_pass_is_compiled_under_every_combination_of_its_own_features() {
+        // 12 passes of one feature each, and `spot`'s three.
+        let sets = variant_sets(&graph_of(12));
+        for casters in [false, true] {
+            for traced in [false, true] {
+                let mut want = BTreeSet::from(["spot".to_string()]);
+                if casters {
+                    want.insert("casters".into());
+                }
+                if traced {
+                    want.insert("traced".into());
+                }
+                assert!(sets.contains(&want), "{want:?}");
+            }
+        }
+        // None, all, 15 alone, then what the passes add: `spot`'s 8
+        // combinations less the none and 3 singles already there.
+        assert_eq!(sets.len(), 2 + 15 + 4);
     }
 }

@@ -7,12 +7,14 @@
 //! [`hash`] is the one stable hasher; [`entry`] frames cache entries so a
 //! damaged, swapped or foreign entry is a miss, never a wrong answer.
 //! [`exr`] is the one OpenEXR writer (scanline float files every reader reads).
-//! [`write`] is the one rule for outputs: regular files only, written whole
+//! [`home`] is where the graphs and shaders weft ships are found from any
+//! folder. [`write`] is the one rule for outputs: regular files only, written whole
 //! and renamed into place.
 
 pub mod entry;
 pub mod exr;
 pub mod hash;
+pub mod home;
 pub mod paths;
 pub mod read;
 pub mod sources;

@@ -56,7 +56,8 @@ pub struct Common {
     #[arg(
         long,
         default_value = "graphs/pathtrace.ron",
-        conflicts_with = "reference_image"
+        conflicts_with = "reference_image",
+        value_parser = crate::graphs::graph_path
     )]
     pub reference: PathBuf,
     /// Samples per pixel of the reference render.
@@ -123,7 +124,7 @@ pub struct CompareArgs {
     #[command(flatten)]
     common: Common,
     /// The configurations: graph files, comma-separated.
-    #[arg(long, value_delimiter = ',', required = true)]
+    #[arg(long, value_delimiter = ',', required = true, value_parser = crate::graphs::graph_path)]
     graphs: Vec<PathBuf>,
     /// A parameter for every configuration, NAME=VALUE; repeatable.
     #[arg(long = "param", value_parser = crate::render_cmd::parse_param)]

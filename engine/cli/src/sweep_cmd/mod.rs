@@ -61,14 +61,19 @@ struct SweepRun {
     #[command(flatten)]
     common: Common,
     /// The graph swept.
-    #[arg(long, default_value = "graphs/forward.ron", conflicts_with = "graphs")]
+    #[arg(
+        long,
+        default_value = "graphs/forward.ron",
+        conflicts_with = "graphs",
+        value_parser = crate::graphs::graph_path
+    )]
     graph: PathBuf,
     /// Several graphs swept as one more dimension (comma-separated), every
     /// point of each against the same reference, on one frontier; sweep.csv
     /// names each point's graph in its first column. Each graph is swept over
     /// the --param parameters it has and the --features-set sets whose every
     /// toggle names one of its features.
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', value_parser = crate::graphs::graph_path)]
     graphs: Vec<PathBuf>,
     /// A parameter and its values, NAME=v1,v2,...; repeatable (the points are
     /// every combination).

@@ -1,6 +1,8 @@
-//! Camera bookmarks: poses saved while flying, kept beside the scene as a
-//! `.scene` file of `camera` blocks (`demo.bookmarks.scene` for
-//! `demo.scene`), so a bookmark can also be pasted into the scene itself.
+//! Camera bookmarks: poses saved while flying, kept as a `.scene` file of
+//! `camera` blocks (`demo-1a2b3c4d.bookmarks.scene` for `demo.scene`) in the
+//! user's data folder, never in the scene's (a repository's working tree),
+//! unless `--bookmarks FILE` names one; a bookmark can be pasted into the
+//! scene itself.
 
 use anyhow::{Context, Result};
 use glam::{DVec3, Quat, Vec3};
@@ -25,12 +27,26 @@ impl Bookmark {
     }
 }
 
-/// The bookmarks file for `scene`: its stem with `.bookmarks.scene`, in its folder.
-pub fn file_for(scene: &Path) -> PathBuf {
+/// The bookmarks file for `scene`: in `data` (the user's data folder,
+/// `~/.local/share` by XDG's rule) under `weft/bookmarks`, named by the
+/// scene's stem and a hash of its full path, so scenes of one name in
+/// different folders keep their own; beside the scene only when there is no
+/// data folder.
+pub fn file_for(scene: &Path, data: Option<PathBuf>) -> PathBuf {
     let stem = scene
         .file_stem()
         .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
-    scene.with_file_name(format!("{stem}.bookmarks.scene"))
+    let Some(data) = data else {
+        return scene.with_file_name(format!("{stem}.bookmarks.scene"));
+    };
+    let full = scene.canonicalize().unwrap_or_else(|_| scene.to_path_buf());
+    let mut hasher = weft_io::hash::Hasher::new();
+    hasher.field(full.to_string_lossy().as_bytes());
+    let hash = weft_io::hash::hex(hasher.finish());
+    data.join("weft").join("bookmarks").join(format!(
+        "{stem}-{}.bookmarks.scene",
+        &hash[..8.min(hash.len())]
+    ))
 }
 
 /// The bookmarks saved in `path`; none when it does not exist. An unreadable
@@ -74,9 +90,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn bookmarks_sit_beside_the_scene() {
+    fn bookmarks_go_to_the_data_folder_named_by_scene_and_path() {
+        let data = Some(PathBuf::from("/data"));
+        let demo = file_for(Path::new("scenes/demo.scene"), data.clone());
+        assert_eq!(demo.parent(), Some(Path::new("/data/weft/bookmarks")));
+        let name = demo.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(
+            name.starts_with("demo-") && name.ends_with(".bookmarks.scene"),
+            "{name}"
+        );
+        // Another folder's demo.scene keeps its own file.
+        assert_ne!(file_for(Path::new("other/demo.scene"), data), demo);
+        // Without a data folder, beside the scene.
         assert_eq!(
-            file_for(Path::new("scenes/demo.scene")),
+            file_for(Path::new("scenes/demo.scene"), None),
             PathBuf::from("scenes/demo.bookmarks.scene")
         );
     }

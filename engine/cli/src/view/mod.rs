@@ -34,7 +34,7 @@ Controls:
   1-9, Shift+1-9 toggle the graph's features (listed with their keys when a graph loads)
   Space          pause / resume scene time            R       back to the scene camera
   C              print the camera as a .scene `camera` block (world coordinates)
-  B              save the camera as the next bookmark (<scene>.bookmarks.scene beside the scene)
+  B              save the camera as the next bookmark (--bookmarks FILE, or the user's data folder)
   F1             show / hide the panel: graph, features, parameters, pass times,
                  memory, plan, convergence, reload errors (click to copy), bookmarks
   L              live error: path-trace the current view in the background and show
@@ -55,7 +55,7 @@ pub struct ViewArgs {
     /// The scene file.
     scene: PathBuf,
     /// The render graph.
-    #[arg(long, default_value = "graphs/forward.ron")]
+    #[arg(long, default_value = "graphs/forward.ron", value_parser = crate::graphs::graph_path)]
     graph: PathBuf,
     /// Window size, WIDTHxHEIGHT (the graph renders at the window's size).
     #[arg(long, default_value = "1280x720", value_parser = clap::value_parser!(Extent))]
@@ -111,9 +111,14 @@ pub struct ViewArgs {
     /// --screenshot-on-exit); by default they hold the graph's image alone.
     #[arg(long)]
     screenshot_panel: bool,
+    /// Where B saves camera bookmarks (a `.scene` file of cameras). Default:
+    /// the user's data folder (XDG `DATA_HOME`, e.g.
+    /// ~/.local/share/weft/bookmarks/demo-1a2b3c4d.bookmarks.scene).
+    #[arg(long)]
+    bookmarks: Option<PathBuf>,
     /// The progressive graph the live error (L) measures against; by default
     /// pathtrace.ron beside --graph, else graphs/pathtrace.ron.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::graphs::graph_path)]
     reference: Option<PathBuf>,
     /// Stop the live error's reference at this many samples per pixel.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]

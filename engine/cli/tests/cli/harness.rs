@@ -26,7 +26,8 @@ pub fn command_in(dir: &Path, args: &[&str]) -> Command {
         .args(args)
         .current_dir(dir)
         .env("WEFT_CACHE_DIR", user_cache())
-        .env("XDG_CONFIG_HOME", user_cache().join("xdg-config"));
+        .env("XDG_CONFIG_HOME", user_cache().join("xdg-config"))
+        .env("XDG_DATA_HOME", user_cache().join("xdg-data"));
     command
 }
 

@@ -274,14 +274,25 @@ fn load_file(
         }
         Err(err) => {
             let (file, pos) = site_location(graph);
-            let message = match &site {
-                Some(_) => format!("included file \"{}\" cannot be read: {err}", path.display()),
-                None => format!("cannot read graph file: {err}"),
+            let diagnostic = match &site {
+                Some(_) => Diagnostic::error(
+                    file,
+                    pos,
+                    format!("included file \"{}\" cannot be read: {err}", path.display()),
+                )
+                .with_hint("include paths are relative to the including file"),
+                None if !path.exists() => Diagnostic::error(
+                    file,
+                    pos,
+                    format!(
+                        "cannot read graph file: no such file; looked in {}",
+                        weft_io::home::looked_in(path)
+                    ),
+                )
+                .with_hint("run weft from its repository, set WEFT_HOME to it, or `make install`"),
+                None => Diagnostic::error(file, pos, format!("cannot read graph file: {err}")),
             };
-            graph.diagnostics.push(
-                Diagnostic::error(file, pos, message)
-                    .with_hint("include paths are relative to the including file"),
-            );
+            graph.diagnostics.push(diagnostic);
             return;
         }
     };

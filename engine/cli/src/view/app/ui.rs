@@ -62,7 +62,10 @@ pub(super) struct UiState<'g> {
 impl<'g> UiState<'g> {
     /// The panel's state for a viewer started with `args` on `graph`.
     pub fn new(args: &ViewArgs, graph: &std::path::Path) -> Result<Self> {
-        let bookmarks_path = bookmarks::file_for(&args.scene);
+        let bookmarks_path = args
+            .bookmarks
+            .clone()
+            .unwrap_or_else(|| bookmarks::file_for(&args.scene, dirs::data_dir()));
         let (bookmarks, bookmarks_readable) = match bookmarks::load(&bookmarks_path) {
             Ok(marks) => (marks, true),
             Err(err) => {
@@ -481,7 +484,7 @@ impl Viewer<'_> {
         self.reconfigure(settings);
     }
 
-    /// Saves the camera as the next bookmark beside the scene.
+    /// Saves the camera as the next bookmark in the bookmarks file.
     pub(super) fn save_bookmark(&mut self) {
         let file = self.ui.bookmarks_path.clone();
         if !self.ui.bookmarks_readable {

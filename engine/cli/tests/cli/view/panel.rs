@@ -6,6 +6,7 @@
 
 use super::{assert_clean, differences, load, text, Temp, Xvfb};
 use crate::harness::{command_in, repo};
+use std::path::PathBuf;
 
 /// `frames` frames of `weft view` of the demo at 160x90, paused, with
 /// validation, saving the last frame to `shot`; `extra` adds arguments.
@@ -218,10 +219,11 @@ fn the_live_error_is_the_map_weft_compare_writes() {
     );
 }
 
-/// B saves the flown camera as numbered `camera` blocks in
-/// `<scene>.bookmarks.scene` beside the scene, which reads back as a scene.
+/// B saves the flown camera as numbered `camera` blocks in the user's data
+/// folder (never beside the scene, in a working tree), or in `--bookmarks
+/// FILE`, which reads back as a scene.
 #[test]
-fn b_saves_numbered_bookmarks_beside_the_scene() {
+fn b_saves_numbered_bookmarks_in_the_data_folder_or_the_file_named() {
     let x = Xvfb::start();
     let tmp = Temp::new("panel-bookmarks");
     let original = std::fs::read_to_string(repo().join("scenes/cornell.scene")).expect("scene");
@@ -232,25 +234,52 @@ fn b_saves_numbered_bookmarks_beside_the_scene() {
         original.replace("../../shared/assets", assets.to_str().expect("utf-8 path")),
     )
     .expect("scene copy");
-    let out = x.weft(&[
-        "view",
-        scene.to_str().expect("utf-8 path"),
-        "--size",
-        "32x18",
-        "--frames",
-        "4",
-        "--validate",
-        "--press",
-        "1:b,2:b",
-    ]);
+    let data = tmp.file("data");
+    let out = x
+        .command(
+            &[
+                "view",
+                scene.to_str().expect("utf-8 path"),
+                "--size",
+                "32x18",
+                "--frames",
+                "4",
+                "--validate",
+                "--press",
+                "1:b,2:b",
+            ],
+            &repo(),
+        )
+        .env("XDG_DATA_HOME", &data)
+        .output()
+        .expect("weft runs");
     assert_clean(&out);
     let stdout = text(&out.stdout);
-    let file = tmp.file("box.bookmarks.scene");
+    let saved_in: Vec<PathBuf> = std::fs::read_dir(data.join("weft/bookmarks"))
+        .expect("the data folder's bookmarks")
+        .map(|e| e.expect("entry").path())
+        .collect();
+    let [file] = saved_in.as_slice() else {
+        panic!("one bookmarks file: {saved_in:?}");
+    };
+    let name = file
+        .file_name()
+        .expect("name")
+        .to_string_lossy()
+        .into_owned();
+    assert!(
+        name.starts_with("box-") && name.ends_with(".bookmarks.scene"),
+        "{name}"
+    );
     assert!(
         stdout.contains(&format!("saved bookmark 2 to {}", file.display())),
         "{stdout}"
     );
-    let saved = std::fs::read_to_string(&file).expect("bookmarks file");
+    assert!(
+        !tmp.file("box.bookmarks.scene").exists(),
+        "nothing written beside the scene"
+    );
+    let saved = std::fs::read_to_string(file).expect("bookmarks file");
     let block = |n: u32| {
         format!(
             "camera \"bookmark {n}\"\n{{\n\tposition 0 1 3.9\n\ttarget 0 1 2.9\n\tfov_deg 40\n\tnear 0.1\n\tfar 20\n}}\n"
@@ -264,6 +293,25 @@ fn b_saves_numbered_bookmarks_beside_the_scene() {
     .output()
     .expect("weft runs");
     assert!(out.status.success(), "{}", text(&out.stderr));
+    // --bookmarks names the file instead.
+    let named = tmp.file("marks.scene");
+    let out = x.weft(&[
+        "view",
+        scene.to_str().expect("utf-8 path"),
+        "--size",
+        "32x18",
+        "--frames",
+        "2",
+        "--bookmarks",
+        named.to_str().expect("utf-8 path"),
+        "--press",
+        "1:b",
+    ]);
+    assert_clean(&out);
+    assert_eq!(
+        std::fs::read_to_string(&named).expect("named bookmarks file"),
+        block(1)
+    );
 }
 
 #[test]
