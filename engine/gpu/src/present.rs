@@ -22,6 +22,10 @@ use gpu_allocator::MemoryLocation;
 /// Frame slots: acquire semaphores, fences and command buffers cycle through them.
 const FRAMES_IN_FLIGHT: usize = 2;
 
+/// Where the first write to an acquired swapchain image waits for it: the
+/// transfer stages (the clear beside a docked panel, the blit).
+const ACQUIRE_WAIT: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::ALL_TRANSFER;
+
 /// The image to show: the graph's output, in `TRANSFER_SRC_OPTIMAL` with blit
 /// reads made visible (what the plan's epilogue leaves it in).
 #[derive(Debug, Clone, Copy)]
@@ -32,6 +36,10 @@ pub struct PresentSource {
     pub extent: vk::Extent2D,
     /// Its format, to know whether it can be filtered when scaled.
     pub format: vk::Format,
+    /// The part of the window it fills, from the top-left corner (the
+    /// whole window, or what a panel docked on the right leaves); the rest
+    /// is cleared for the overlay to draw on.
+    pub area: vk::Extent2D,
 }
 
 /// Something drawn over the presented image before it is shown (the viewer's
@@ -181,9 +189,19 @@ impl<'g> Presenter<'g> {
         };
         let target = self.swapchain.images()[index as usize];
         let extent = self.swapchain.extent();
+        let area = vk::Extent2D {
+            width: source.area.width.clamp(1, extent.width),
+            height: source.area.height.clamp(1, extent.height),
+        };
+        // The graph's image alone is its area; with the overlay, the window.
+        let captured = if capture == Capture::Image {
+            area
+        } else {
+            extent
+        };
         let capture_buffer = match capture {
             Capture::No => None,
-            Capture::Image | Capture::WithOverlay => Some(CaptureBuffer::new(self.gpu, extent)?),
+            Capture::Image | Capture::WithOverlay => Some(CaptureBuffer::new(self.gpu, captured)?),
         };
         let cmd = self.commands[slot];
         unsafe {
@@ -197,12 +215,12 @@ impl<'g> Presenter<'g> {
                 .begin_command_buffer(cmd, &begin)
                 .call("vkBeginCommandBuffer")?;
         }
-        let filter = if source.extent == extent || !self.gpu.linear_filter(source.format.as_raw()) {
+        let filter = if source.extent == area || !self.gpu.linear_filter(source.format.as_raw()) {
             vk::Filter::NEAREST
         } else {
             vk::Filter::LINEAR
         };
-        let mut state = self.record_blit(cmd, source, target, extent, filter);
+        let mut state = self.record_blit(cmd, source, target, (extent, area), filter);
         let copy = |state: &mut TargetState| {
             if let Some(buffer) = capture_buffer.as_ref() {
                 state.transition(
@@ -212,7 +230,7 @@ impl<'g> Presenter<'g> {
                     vk::AccessFlags2::TRANSFER_READ,
                     vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                 );
-                buffer.record(cmd, target, extent);
+                buffer.record(cmd, target, buffer.extent);
                 state.access = vk::AccessFlags2::NONE;
             }
         };
@@ -255,7 +273,7 @@ impl<'g> Presenter<'g> {
         unsafe { device.end_command_buffer(cmd) }.call("vkEndCommandBuffer")?;
         let waits = [vk::SemaphoreSubmitInfo::default()
             .semaphore(self.acquired[slot])
-            .stage_mask(vk::PipelineStageFlags2::BLIT)];
+            .stage_mask(ACQUIRE_WAIT)];
         let signals = [vk::SemaphoreSubmitInfo::default()
             .semaphore(self.rendered[index as usize])
             .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
@@ -293,35 +311,65 @@ impl<'g> Presenter<'g> {
         }
     }
 
-    /// Records the blit of `source` into `target`, leaving `target` in
-    /// `TRANSFER_DST_OPTIMAL`; returns that state for the next transition.
+    /// Records the blit of `source` into `area` of `target` (whose size is
+    /// `extent`; the rest cleared first when `area` is smaller), leaving
+    /// `target` in `TRANSFER_DST_OPTIMAL`; returns that state for the next
+    /// transition.
     fn record_blit(
         &self,
         cmd: vk::CommandBuffer,
         source: PresentSource,
         target: vk::Image,
-        extent: vk::Extent2D,
+        (extent, area): (vk::Extent2D, vk::Extent2D),
         filter: vk::Filter,
     ) -> TargetState {
         let device = self.gpu.device();
+        // The clear and the blit are transfer stages, after the acquire
+        // semaphore's wait ([`ACQUIRE_WAIT`]).
         let mut state = TargetState {
             image: target,
-            stage: vk::PipelineStageFlags2::BLIT,
+            stage: ACQUIRE_WAIT,
             access: vk::AccessFlags2::NONE,
             layout: vk::ImageLayout::UNDEFINED,
         };
         state.transition(
             self.gpu,
             cmd,
-            vk::PipelineStageFlags2::BLIT,
+            ACQUIRE_WAIT,
             vk::AccessFlags2::TRANSFER_WRITE,
             vk::ImageLayout::TRANSFER_DST_OPTIMAL,
         );
+        if area != extent {
+            // The panel's background where the image does not reach.
+            let clear = vk::ClearColorValue {
+                float32: [0.106, 0.106, 0.106, 1.0],
+            };
+            let ranges = [vk::ImageSubresourceRange::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .level_count(1)
+                .layer_count(1)];
+            unsafe {
+                device.cmd_clear_color_image(
+                    cmd,
+                    target,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &clear,
+                    &ranges,
+                );
+            }
+            state.transition(
+                self.gpu,
+                cmd,
+                vk::PipelineStageFlags2::BLIT,
+                vk::AccessFlags2::TRANSFER_WRITE,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            );
+        }
         let region = vk::ImageBlit2::default()
             .src_subresource(color_layers())
             .src_offsets([vk::Offset3D::default(), corner(source.extent)])
             .dst_subresource(color_layers())
-            .dst_offsets([vk::Offset3D::default(), corner(extent)]);
+            .dst_offsets([vk::Offset3D::default(), corner(area)]);
         let regions = [region];
         let blit = vk::BlitImageInfo2::default()
             .src_image(source.image)

@@ -131,6 +131,10 @@ pub struct ViewArgs {
     /// first, to see the frame loop keep going during a slow one (tests).
     #[arg(long, hide = true, default_value_t = 0)]
     prepare_delay_ms: u64,
+    /// Make every frame take at least this long, as a slow machine's or a
+    /// large image's would (tests of input on slow frames).
+    #[arg(long, hide = true, default_value_t = 0)]
+    frame_delay_ms: u64,
 }
 
 /// Runs `weft view`.

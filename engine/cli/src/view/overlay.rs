@@ -43,6 +43,11 @@ impl<'g> EguiOverlay<'g> {
     /// Sets egui up for `window`, drawing onto swapchain images of `format`.
     pub fn new(gpu: &'g Gpu, window: &Window, format: vk::Format) -> Result<Self> {
         let ctx = egui::Context::default();
+        // A click is a press and a release without moving away, however
+        // long the frames between them take: egui measures a press in frame
+        // times, and at 1-2 s a frame (a large image on a CPU device) its
+        // default 0.8 s would turn every click into a long press, lost.
+        ctx.options_mut(|o| o.input_options.max_click_duration = f64::INFINITY);
         let state = egui_winit::State::new(
             ctx.clone(),
             egui::ViewportId::ROOT,
@@ -89,6 +94,11 @@ impl<'g> EguiOverlay<'g> {
     /// the panel, typing into a field), so the viewer should not act on it.
     pub fn on_window_event(&mut self, window: &Window, event: &WindowEvent) -> bool {
         self.state.on_window_event(window, event).consumed
+    }
+
+    /// Window pixels per egui point, as the last run laid the UI out.
+    pub fn pixels_per_point(&self) -> f32 {
+        self.pixels_per_point
     }
 
     /// The egui context (to load textures the UI shows).

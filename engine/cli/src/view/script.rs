@@ -5,13 +5,24 @@
 /// One scripted step.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum UiStep {
-    /// Press the primary button on the widget with this name
-    /// (`feature:normals`, `param:exposure`), released the next frame.
+    /// Press and release the primary button on the widget with this name
+    /// (`feature:normals`, `param:exposure`), in one frame's input.
     Click(String),
     /// Type text into the focused field.
     Text(String),
     /// Press and release Enter.
     Enter,
+}
+
+/// As `--ui` spells it: `click:NAME`, `text:TEXT`, `enter`.
+impl std::fmt::Display for UiStep {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Click(name) => write!(f, "click:{name}"),
+            Self::Text(text) => write!(f, "text:{text}"),
+            Self::Enter => f.write_str("enter"),
+        }
+    }
 }
 
 /// Parses one `--ui` entry, `FRAME:click:NAME`, `FRAME:text:TEXT` or

@@ -70,6 +70,8 @@ pub struct Viewer<'g> {
     last_frame: Option<Instant>,
     frames: u32,
     frame_limit: Option<u32>,
+    /// The least time a frame takes (`--frame-delay-ms`, tests).
+    frame_delay: Duration,
     resize_to: Option<Extent>,
     pending_size: Option<[u32; 2]>,
     screenshot_on_exit: Option<PathBuf>,
@@ -154,6 +156,7 @@ impl<'g> Viewer<'g> {
             last_frame: None,
             frames: 0,
             frame_limit: args.frames,
+            frame_delay: Duration::from_millis(args.frame_delay_ms),
             resize_to: args.resize_to,
             pending_size: None,
             screenshot_on_exit: args.screenshot_on_exit.clone(),
@@ -213,7 +216,7 @@ impl<'g> Viewer<'g> {
         }
         match self.failure.take() {
             Some(err) => Err(err),
-            None => reported,
+            None => reported.and(self.ui.no_steps_left(self.frames)),
         }
     }
 
@@ -366,6 +369,7 @@ impl<'g> Viewer<'g> {
     /// One frame: reload, resize, move, render, present, screenshot.
     fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         let began = Instant::now();
+        std::thread::sleep(self.frame_delay);
         self.hot_reload()?;
         let due: Vec<Action> = self
             .presses
@@ -398,7 +402,9 @@ impl<'g> Viewer<'g> {
         self.camera.update(&input, dt);
         let camera_moved =
             self.camera.position != position || self.camera.orientation != orientation;
-        if !self.paused {
+        // The live error holds scene time while it accumulates: an
+        // animated scene would restart its reference every frame.
+        if !self.paused && !self.ui.holds_time() {
             self.time += f64::from(dt);
         }
         let camera = Camera {
@@ -427,13 +433,17 @@ impl<'g> Viewer<'g> {
             eprintln!("error: {error} (the lights of the last good step kept)");
         }
         let output = self.live.output()?;
-        let source = PresentSource {
+        let mut source = PresentSource {
             image: output.image,
             extent: vk::Extent2D {
                 width: output.desc.extent.width,
                 height: output.desc.extent.height,
             },
             format: vk::Format::from_raw(output.desc.format_raw),
+            area: vk::Extent2D {
+                width: size[0],
+                height: size[1],
+            },
         };
         let last = self.frame_limit.is_some_and(|n| self.frames + 1 >= n)
             || self.stop.load(Ordering::SeqCst);
@@ -446,6 +456,12 @@ impl<'g> Viewer<'g> {
         let ui_began = Instant::now();
         let actions = self.run_panel()?;
         let ui_ms = ui_began.elapsed().as_secs_f64() * 1e3;
+        // The 3D view fills what the panel, docked on the right, leaves.
+        let view = self.view_extent(size);
+        source.area = vk::Extent2D {
+            width: view.width,
+            height: view.height,
+        };
         let drawn = self.ui.overlay_drawn();
         let presenter = self
             .presenter
@@ -465,6 +481,12 @@ impl<'g> Viewer<'g> {
         }
         for action in actions {
             self.apply_panel(action);
+        }
+        if self.live.settings().extent != view {
+            self.reconfigure(RenderSettings {
+                extent: view,
+                ..self.live.settings().clone()
+            });
         }
         let shown = match presented {
             Presented::Shown(pixels) => pixels,
@@ -527,10 +549,7 @@ impl<'g> Viewer<'g> {
                 presenter.resize(size)?;
             }
         }
-        let extent = Extent {
-            width: size[0],
-            height: size[1],
-        };
+        let extent = self.view_extent(size);
         if self.live.settings().extent != extent {
             let settings = RenderSettings {
                 extent,
@@ -541,6 +560,20 @@ impl<'g> Viewer<'g> {
         Ok(())
     }
 
+    /// Saves an F12 screenshot when one was asked for (a failure is
+    /// reported and the viewer goes on: a key press never closes it), and
+    /// the `--screenshot-on-exit` one (whose failure fails the command).
+    /// The 3D view's size in a window of `size` pixels: the window less the
+    /// panel docked on its right, at least one pixel wide.
+    fn view_extent(&self, size: [u32; 2]) -> Extent {
+        let ppp = self.overlay.as_ref().map_or(1.0, |o| o.pixels_per_point());
+        let docked = (self.ui.panel.width() * ppp).round() as u32;
+        Extent {
+            width: size[0].saturating_sub(docked).max(1),
+            height: size[1],
+        }
+    }
+
     fn save_screenshots(&mut self, pixels: &Readback, on_exit: bool) -> Result<()> {
         if self.screenshot_now {
             self.screenshot_now = false;
@@ -548,11 +581,18 @@ impl<'g> Viewer<'g> {
             let stamp = std::time::SystemTime::now()
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0, |d| d.as_secs());
-            let dir = self.screenshot_dir.as_ref().context(
-                "no folder for screenshots: give --screenshot-dir (there is no pictures folder, WEFT_CACHE_DIR or HOME)",
-            )?;
-            let path = dir.join(format!("weft-{stamp}-{}.png", self.screenshots));
-            save(pixels, &path)?;
+            let saved = self
+                .screenshot_dir
+                .as_ref()
+                .context(
+                    "no folder for screenshots: give --screenshot-dir (there is no pictures folder, WEFT_CACHE_DIR or HOME)",
+                )
+                .and_then(|dir| {
+                    save(pixels, &dir.join(format!("weft-{stamp}-{}.png", self.screenshots)))
+                });
+            if let Err(err) = saved {
+                eprintln!("error: screenshot not saved: {err:#} (the viewer goes on)");
+            }
         }
         if on_exit {
             if let Some(path) = self.screenshot_on_exit.clone() {

@@ -31,8 +31,6 @@ pub(super) struct UiState<'g> {
     pub memory: [u64; 3],
     /// `--ui` steps not yet taken, by frame.
     script: Vec<(u32, UiStep)>,
-    /// Scripted presses to release at the next frame.
-    releases: Vec<egui::Pos2>,
     /// Scripted clicks waiting for their widget to be scrolled into view:
     /// the widget, and the last frame to wait for.
     presses: Vec<(String, u32)>,
@@ -78,7 +76,6 @@ impl<'g> UiState<'g> {
             screenshot_panel: args.screenshot_panel,
             memory: [0; 3],
             script: args.ui.clone(),
-            releases: Vec::new(),
             presses: Vec::new(),
             typing: Vec::new(),
             live_error: None,
@@ -102,6 +99,41 @@ impl<'g> UiState<'g> {
     /// Whether the overlay draws over this frame.
     pub fn overlay_drawn(&self) -> bool {
         self.drawn
+    }
+
+    /// Whether scene time stands still: while the live error measures, so
+    /// its reference converges instead of restarting with every step.
+    pub fn holds_time(&self) -> bool {
+        self.live_error.is_some()
+    }
+
+    /// An error naming every `--ui` step that never ran in the `frames`
+    /// presented (a step for a later frame, a click or typing still
+    /// waiting): a script that did not run is not a success.
+    pub fn no_steps_left(&self, frames: u32) -> Result<()> {
+        let mut left: Vec<String> = self
+            .script
+            .iter()
+            .map(|(f, step)| format!("{f}:{step}"))
+            .collect();
+        left.extend(
+            self.presses
+                .iter()
+                .map(|(name, _)| format!("click:{name} (waiting for its widget)")),
+        );
+        left.extend(
+            self.typing
+                .iter()
+                .map(|(step, _)| format!("{step} (waiting for a field with the keyboard)")),
+        );
+        if left.is_empty() {
+            return Ok(());
+        }
+        bail!(
+            "--ui: {} step(s) never ran in the {frames} frames shown: {}; give more --frames",
+            left.len(),
+            left.join(", ")
+        )
     }
 
     /// `settings` with the live image read back when the live error needs it
@@ -293,12 +325,7 @@ impl Viewer<'_> {
         let (Some(overlay), Some(_)) = (self.overlay.as_mut(), self.window.as_ref()) else {
             return Ok(Vec::new());
         };
-        let mut events: Vec<egui::Event> = self
-            .ui
-            .releases
-            .drain(..)
-            .flat_map(|at| script::pointer(at, false))
-            .collect();
+        let mut events: Vec<egui::Event> = Vec::new();
         let frame = self.frames;
         let due: Vec<UiStep> = self
             .ui
@@ -321,7 +348,7 @@ impl Viewer<'_> {
         }
         // Typing waits for a field to have the keyboard (a click gives it one
         // a frame or two after the press) and for earlier clicks.
-        if self.ui.presses.is_empty() && self.ui.releases.is_empty() && overlay.wants_keyboard() {
+        if self.ui.presses.is_empty() && overlay.wants_keyboard() {
             for (typed, _) in self.ui.typing.drain(..) {
                 match typed {
                     UiStep::Text(text) => events.push(egui::Event::Text(text)),
@@ -334,9 +361,12 @@ impl Viewer<'_> {
         }
         let waiting = std::mem::take(&mut self.ui.presses);
         for (name, last) in waiting {
+            // A click is its press and its release, delivered together as
+            // the events they are: however long a frame takes, they are
+            // never split across two frames.
             if let Some(rect) = self.ui.panel.target(&name) {
                 events.extend(script::pointer(rect.center(), true));
-                self.ui.releases.push(rect.center());
+                events.extend(script::pointer(rect.center(), false));
             } else if frame < last {
                 self.ui.presses.push((name, last));
             } else {
@@ -468,8 +498,9 @@ impl Viewer<'_> {
             match started {
                 Ok(live_error) => {
                     println!(
-                        "live error on: measuring against {}",
-                        live_error.graph().display()
+                        "live error on: measuring against {}; scene time held at {:.3} s while it measures (L again lets it run)",
+                        live_error.graph().display(),
+                        self.time
                     );
                     self.ui.live_error = Some(live_error);
                 }

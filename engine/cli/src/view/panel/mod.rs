@@ -9,6 +9,7 @@ mod history;
 mod params;
 
 pub use history::History;
+use params::param_widget;
 pub use params::{graph_params, ParamEntry};
 
 use super::bookmarks::Bookmark;
@@ -114,6 +115,8 @@ pub struct Panel {
     reveal: Option<String>,
     /// Widgets drawn out of view in the last frame.
     hidden: std::collections::HashSet<String>,
+    /// The width it took in the last frame it showed, in points.
+    width: f32,
 }
 
 impl Panel {
@@ -143,14 +146,28 @@ impl Panel {
         names
     }
 
-    /// Draws the panel on the right of the window; returns what was asked.
+    /// The width the panel docks beside the 3D view with, in points: 0
+    /// while hidden.
+    pub fn width(&self) -> f32 {
+        if self.visible {
+            self.width
+        } else {
+            0.0
+        }
+    }
+
+    /// Draws the panel docked on the right of the window, at most three
+    /// quarters of it (the 3D view renders in the rest); returns what was
+    /// asked.
     pub fn show(&mut self, ui: &mut Ui, view: &PanelView<'_>) -> Vec<PanelAction> {
         self.targets.clear();
         self.hidden.clear();
         let mut actions = Vec::new();
-        egui::Panel::right("weft panel")
+        let most = ui.ctx().content_rect().width() * 0.75;
+        let shown = egui::Panel::right("weft panel")
             .resizable(true)
-            .default_size(380.0)
+            .default_size(380.0_f32.min(most))
+            .max_size(most)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     self.status(ui, view, &mut actions);
@@ -161,6 +178,7 @@ impl Panel {
                     self.camera_section(ui, view, &mut actions);
                 });
             });
+        self.width = shown.response.rect.width();
         actions
     }
 
@@ -425,131 +443,37 @@ impl Panel {
         view: &PanelView<'_>,
         actions: &mut Vec<PanelAction>,
     ) {
-        egui::CollapsingHeader::new("camera and bookmarks").show(ui, |ui| {
-            ui.horizontal(|ui| {
-                let copy = ui.button("copy as .scene block (C)");
-                if copy.clicked() {
-                    ui.ctx().copy_text(view.camera_block.to_string());
-                    actions.push(PanelAction::PrintCamera);
-                }
-                self.remember("copy_camera".into(), &copy);
-                let save = ui.button("save bookmark (B)");
-                if save.clicked() {
-                    actions.push(PanelAction::SaveBookmark);
-                }
-                self.remember("save_bookmark".into(), &save);
-            });
-            let (marks, file) = view.bookmarks;
-            ui.label(format!("saved in {}", file.display()));
-            for (i, mark) in marks.iter().enumerate() {
-                let go = ui.button(format!("go to {}", mark.name));
-                if go.clicked() {
-                    actions.push(PanelAction::GoToBookmark(i));
-                }
-                self.remember(format!("bookmark:{}", i + 1), &go);
-            }
+        // Opened when a scripted click reveals one of its widgets.
+        let revealed = self.reveal.as_deref().is_some_and(|r| {
+            r == "copy_camera" || r == "save_bookmark" || r.starts_with("bookmark:")
         });
-    }
-}
-
-/// A parameter's editor: a slider for a bounded number, a drag field for an
-/// unbounded one, a checkbox for a switch, a field per component for a
-/// vector. Returns the widget's response and whether an edit is complete
-/// (a typed value entered, a drag let go, a click).
-fn param_widget(
-    ui: &mut Ui,
-    key: &str,
-    value: &mut ParamValue,
-    range: &ParamRange,
-) -> (egui::Response, bool) {
-    let id = egui::Id::new(("param", key));
-    match value {
-        ParamValue::Number(x) => {
-            // A bounded number gets a slider, and every number a field to
-            // drag or click and type into (the widget scripts name).
-            let slid = match (range.min, range.max) {
-                (Some(min), Some(max)) => {
-                    let mut slider = egui::Slider::new(x, min..=max).show_value(false);
-                    if range.integer {
-                        slider = slider.integer();
+        egui::CollapsingHeader::new("camera and bookmarks")
+            .open(revealed.then_some(true))
+            .show(ui, |ui| {
+                ui.horizontal(|ui| {
+                    let copy = ui.button("copy as .scene block (C)");
+                    if copy.clicked() {
+                        ui.ctx().copy_text(view.camera_block.to_string());
+                        actions.push(PanelAction::PrintCamera);
                     }
-                    Some(ui.add(slider))
+                    self.remember("copy_camera".into(), &copy);
+                    let save = ui.button("save bookmark (B)");
+                    if save.clicked() {
+                        actions.push(PanelAction::SaveBookmark);
+                    }
+                    self.remember("save_bookmark".into(), &save);
+                });
+                let (marks, file) = view.bookmarks;
+                ui.label(format!("saved in {}", file.display()));
+                for (i, mark) in marks.iter().enumerate() {
+                    let go = ui.button(format!("go to {}", mark.name));
+                    if go.clicked() {
+                        actions.push(PanelAction::GoToBookmark(i));
+                    }
+                    self.remember(format!("bookmark:{}", i + 1), &go);
                 }
-                _ => None,
-            };
-            let speed = 0.01 * x.abs().max(1.0);
-            let mut drag = egui::DragValue::new(x)
-                .speed(speed)
-                .custom_parser(finite_number);
-            if range.min.is_some() || range.max.is_some() {
-                drag = drag.range(range.min.unwrap_or(f64::MIN)..=range.max.unwrap_or(f64::MAX));
-            }
-            if range.integer {
-                drag = drag.fixed_decimals(0).speed(1.0);
-            }
-            let response = ui.push_id(id, |ui| ui.add(drag)).inner;
-            let complete = |r: &egui::Response| {
-                r.drag_stopped() || (r.changed() && !r.dragged()) || r.lost_focus()
-            };
-            let done = complete(&response) || slid.as_ref().is_some_and(complete);
-            if !range.one_of.is_empty() {
-                *x = nearest(&range.one_of, *x);
-            }
-            (response, done)
-        }
-        ParamValue::Bool(b) => {
-            let response = ui.checkbox(b, "");
-            let done = response.changed();
-            (response, done)
-        }
-        ParamValue::Vector(components) => {
-            let mut done = false;
-            let mut rect: Option<egui::Rect> = None;
-            let mut last = None;
-            for (i, c) in components.iter_mut().enumerate() {
-                let response = ui
-                    .push_id((id, i), |ui| {
-                        ui.add(
-                            egui::DragValue::new(c)
-                                .speed(0.01)
-                                .custom_parser(finite_number),
-                        )
-                    })
-                    .inner;
-                done |= response.drag_stopped()
-                    || (response.changed() && !response.dragged())
-                    || response.lost_focus();
-                rect = Some(rect.map_or(response.rect, |r| r.union(response.rect)));
-                last = Some(response);
-            }
-            let response = match last {
-                Some(r) => r.with_new_rect(rect.unwrap_or(egui::Rect::NOTHING)),
-                None => ui.label("(empty)"),
-            };
-            (response, done)
-        }
-        ParamValue::Reference(name) => {
-            let response = ui.label(format!("follows {name}"));
-            (response, false)
-        }
+            });
     }
-}
-
-/// A typed parameter value: a number a shader's 32-bit float holds. Text
-/// that is not one (`nan`, `inf`, `1e39`) leaves the value as it was.
-fn finite_number(text: &str) -> Option<f64> {
-    text.trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|v| v.is_finite() && v.abs() <= f64::from(f32::MAX))
-}
-
-fn nearest(values: &[f64], x: f64) -> f64 {
-    values
-        .iter()
-        .copied()
-        .min_by(|a, b| (a - x).abs().total_cmp(&(b - x).abs()))
-        .unwrap_or(x)
 }
 
 fn range_text(range: &ParamRange) -> String {

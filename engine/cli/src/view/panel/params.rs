@@ -1,6 +1,7 @@
 //! The graph parameters a user can set (`--param` and the panel), with their
 //! current values and declared ranges.
 
+use egui::Ui;
 use weft_graph::schema::{ParamRange, ParamValue};
 use weft_graph::LoadedGraph;
 
@@ -35,6 +36,106 @@ pub fn graph_params(graph: &LoadedGraph) -> Vec<ParamEntry> {
         });
     }
     entries
+}
+
+/// A parameter's editor: a slider for a bounded number, a drag field for an
+/// unbounded one, a checkbox for a switch, a field per component for a
+/// vector. Returns the widget's response and whether an edit is complete
+/// (a typed value entered, a drag let go, a click).
+pub(super) fn param_widget(
+    ui: &mut Ui,
+    key: &str,
+    value: &mut ParamValue,
+    range: &ParamRange,
+) -> (egui::Response, bool) {
+    let id = egui::Id::new(("param", key));
+    match value {
+        ParamValue::Number(x) => {
+            // A bounded number gets a slider, and every number a field to
+            // drag or click and type into (the widget scripts name).
+            let slid = match (range.min, range.max) {
+                (Some(min), Some(max)) => {
+                    let mut slider = egui::Slider::new(x, min..=max).show_value(false);
+                    if range.integer {
+                        slider = slider.integer();
+                    }
+                    Some(ui.add(slider))
+                }
+                _ => None,
+            };
+            let speed = 0.01 * x.abs().max(1.0);
+            let mut drag = egui::DragValue::new(x)
+                .speed(speed)
+                .custom_parser(finite_number);
+            if range.min.is_some() || range.max.is_some() {
+                drag = drag.range(range.min.unwrap_or(f64::MIN)..=range.max.unwrap_or(f64::MAX));
+            }
+            if range.integer {
+                drag = drag.fixed_decimals(0).speed(1.0);
+            }
+            let response = ui.push_id(id, |ui| ui.add(drag)).inner;
+            let complete = |r: &egui::Response| {
+                r.drag_stopped() || (r.changed() && !r.dragged()) || r.lost_focus()
+            };
+            let done = complete(&response) || slid.as_ref().is_some_and(complete);
+            if !range.one_of.is_empty() {
+                *x = nearest(&range.one_of, *x);
+            }
+            (response, done)
+        }
+        ParamValue::Bool(b) => {
+            let response = ui.checkbox(b, "");
+            let done = response.changed();
+            (response, done)
+        }
+        ParamValue::Vector(components) => {
+            let mut done = false;
+            let mut rect: Option<egui::Rect> = None;
+            let mut last = None;
+            for (i, c) in components.iter_mut().enumerate() {
+                let response = ui
+                    .push_id((id, i), |ui| {
+                        ui.add(
+                            egui::DragValue::new(c)
+                                .speed(0.01)
+                                .custom_parser(finite_number),
+                        )
+                    })
+                    .inner;
+                done |= response.drag_stopped()
+                    || (response.changed() && !response.dragged())
+                    || response.lost_focus();
+                rect = Some(rect.map_or(response.rect, |r| r.union(response.rect)));
+                last = Some(response);
+            }
+            let response = match last {
+                Some(r) => r.with_new_rect(rect.unwrap_or(egui::Rect::NOTHING)),
+                None => ui.label("(empty)"),
+            };
+            (response, done)
+        }
+        ParamValue::Reference(name) => {
+            let response = ui.label(format!("follows {name}"));
+            (response, false)
+        }
+    }
+}
+
+/// A typed parameter value: a number a shader's 32-bit float holds. Text
+/// that is not one (`nan`, `inf`, `1e39`) leaves the value as it was.
+fn finite_number(text: &str) -> Option<f64> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && v.abs() <= f64::from(f32::MAX))
+}
+
+fn nearest(values: &[f64], x: f64) -> f64 {
+    values
+        .iter()
+        .copied()
+        .min_by(|a, b| (a - x).abs().total_cmp(&(b - x).abs()))
+        .unwrap_or(x)
 }
 
 #[cfg(test)]

@@ -5,6 +5,7 @@
 //! own X server on a display number the server picks (`-displayfd`) and stops
 //! it when the test ends, passed or failed.
 
+mod input;
 mod panel;
 
 use crate::harness::{command_in, repo};

@@ -1,21 +1,28 @@
 //! The viewer's panel (F1) under Xvfb, driven by `--press` and `--ui`
-//! scripts: it shows and hides without touching screenshots, sets features
-//! and parameters as `weft render` does, measures the live error as `weft
-//! compare` does, saves bookmarks beside the scene, and keeps validation
-//! silent across a resize.
+//! scripts: it docks beside the 3D view (which renders in the rest of the
+//! window) and stays out of screenshots, sets features and parameters as
+//! `weft render` does, measures the live error as `weft compare` does,
+//! saves bookmarks in the user's data folder, and keeps validation silent
+//! across a resize.
 
 use super::{assert_clean, differences, load, text, Temp, Xvfb};
 use crate::harness::{command_in, repo};
 use std::path::PathBuf;
 
-/// `frames` frames of `weft view` of the demo at 160x90, paused, with
-/// validation, saving the last frame to `shot`; `extra` adds arguments.
-fn view_demo(x: &Xvfb, shot: &std::path::Path, frames: &str, extra: &[&str]) -> String {
+/// `frames` frames of `weft view` of the demo in a window of `size`,
+/// paused, with validation, saving the last frame to `shot`; `extra` adds
+/// arguments.
+fn view_demo(
+    x: &Xvfb,
+    (shot, size): (&std::path::Path, &str),
+    frames: &str,
+    extra: &[&str],
+) -> String {
     let mut args = vec![
         "view",
         "scenes/demo.scene",
         "--size",
-        "160x90",
+        size,
         "--paused",
         "--frames",
         frames,
@@ -30,24 +37,25 @@ fn view_demo(x: &Xvfb, shot: &std::path::Path, frames: &str, extra: &[&str]) -> 
 }
 
 #[test]
-fn the_panel_shows_and_hides_and_stays_out_of_screenshots_unless_asked() {
+fn the_panel_docks_beside_the_view_and_stays_out_of_screenshots_unless_asked() {
     let x = Xvfb::start();
     let tmp = Temp::new("panel-toggle");
     let plain = tmp.file("plain.png");
     let hidden_again = tmp.file("hidden-again.png");
     let shown = tmp.file("shown.png");
     let shown_captured = tmp.file("shown-captured.png");
-    view_demo(&x, &plain, "5", &[]);
+    let narrow = tmp.file("narrow.png");
+    view_demo(&x, (&plain, "160x90"), "5", &[]);
     view_demo(
         &x,
-        &hidden_again,
+        (&hidden_again, "160x90"),
         "5",
         &["--press", "1:f1,3:f1", "--screenshot-panel"],
     );
-    view_demo(&x, &shown, "5", &["--press", "1:f1"]);
+    view_demo(&x, (&shown, "160x90"), "5", &["--press", "1:f1"]);
     view_demo(
         &x,
-        &shown_captured,
+        (&shown_captured, "160x90"),
         "5",
         &["--press", "1:f1", "--screenshot-panel"],
     );
@@ -55,23 +63,44 @@ fn the_panel_shows_and_hides_and_stays_out_of_screenshots_unless_asked() {
     assert_eq!(
         load(&hidden_again),
         plain,
-        "with the panel toggled off the frame is today's image exactly"
+        "with the panel toggled off the view has the whole window again"
     );
-    assert_eq!(
-        load(&shown),
-        plain,
-        "shown, the panel is left out of screenshots by default"
-    );
-    let with_panel = load(&shown_captured);
-    let changed = with_panel
-        .pixels()
-        .zip(plain.pixels())
-        .filter(|(a, b)| a != b)
-        .count();
-    let total = (160 * 90) as usize;
+    // Shown, the panel docks on the right (at most three quarters of the
+    // window) and the 3D view renders at the width it leaves, which the
+    // screenshot holds alone: the view a window that narrow shows.
+    let shown = load(&shown);
+    let (width, height) = shown.dimensions();
     assert!(
-        changed * 2 > total,
-        "--screenshot-panel shows the panel over most of a 160x90 window: {changed} of {total} pixels changed"
+        (40..160).contains(&width) && height == 90,
+        "{width}x{height}"
+    );
+    let out = x.weft(&[
+        "view",
+        "scenes/demo.scene",
+        "--size",
+        &format!("{width}x90"),
+        "--paused",
+        "--frames",
+        "5",
+        "--screenshot-on-exit",
+        narrow.to_str().expect("utf-8 path"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (mean, p99, max) = differences(&shown, &load(&narrow));
+    assert!(
+        mean <= 0.05 && p99 <= 1 && max <= 1,
+        "docked view vs a window that wide: mean {mean}, p99 {p99}, max {max}"
+    );
+    // With --screenshot-panel the window is captured whole: the same view
+    // on the left, the panel beside it, not over it.
+    let with_panel = load(&shown_captured);
+    assert_eq!(with_panel.dimensions(), (160, 90));
+    let left = image::imageops::crop_imm(&with_panel, 0, 0, width, 90).to_image();
+    assert_eq!(left, shown, "the panel does not cover the view");
+    let right = image::imageops::crop_imm(&with_panel, width, 0, 160 - width, 90).to_image();
+    assert!(
+        right.pixels().any(|p| p != &image::Rgba([0, 0, 0, 255])),
+        "the panel is drawn beside it"
     );
 }
 
@@ -87,7 +116,7 @@ fn a_feature_and_a_parameter_set_in_the_panel_render_as_weft_render_does() {
     let headless = tmp.file("headless.png");
     let stdout = view_demo(
         &x,
-        &shown,
+        (&shown, "640x360"),
         "16",
         &[
             "--graph",
@@ -97,6 +126,9 @@ fn a_feature_and_a_parameter_set_in_the_panel_render_as_weft_render_does() {
             "1:click:feature:tile_depth_mask,5:click:param:exposure,6:text:2,6:enter",
         ],
     );
+    // The view renders beside the docked panel: compared at its size.
+    let (width, height) = load(&shown).dimensions();
+    assert!(width < 640 && height == 360, "{width}x{height}");
     let lists: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
     assert_eq!(lists.len(), 2, "{stdout}");
     assert!(
@@ -114,7 +146,7 @@ fn a_feature_and_a_parameter_set_in_the_panel_render_as_weft_render_does() {
         "--graph",
         "graphs/tiled.ron",
         "--size",
-        "160x90",
+        &format!("{width}x{height}"),
         "--features",
         "!tile_depth_mask",
         "--param",
@@ -304,6 +336,7 @@ fn b_saves_numbered_bookmarks_in_the_data_folder_or_the_file_named() {
         "2",
         "--bookmarks",
         named.to_str().expect("utf-8 path"),
+        "--validate",
         "--press",
         "1:b",
     ]);
