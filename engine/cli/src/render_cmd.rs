@@ -149,6 +149,28 @@ fn readback_names(args: &RenderArgs, graph: Option<&weft_graph::Prepared>) -> Ve
     }
 }
 
+/// The image `--readback NAME` asks for: one the plan read back, or the
+/// graph's output (read back every frame as the PNG's source); else why not.
+fn read_back<'a>(
+    rendered: &'a weft_render::Rendered,
+    name: &str,
+) -> Result<&'a weft_gpu::Readback> {
+    if let Some(image) = rendered.report.first_read_back(&[name.to_string()]) {
+        return Ok(image);
+    }
+    let plan = &rendered.plan;
+    if plan.resources[plan.output].name == name {
+        return rendered
+            .report
+            .output
+            .as_ref()
+            .with_context(|| format!("--readback {name}: the frame produced no output image"));
+    }
+    bail!(
+        "--readback {name}: no pass wrote \"{name}\" in the last frame, so there is nothing to read back (its passes are culled under these features; `weft graph plan` lists them)"
+    )
+}
+
 /// `out` with `.NAME.exr` in place of its extension: where `--readback NAME` goes.
 fn readback_path(out: &Path, name: &str) -> PathBuf {
     let stem = out
@@ -314,10 +336,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     }
     output.save(&out)?;
     for name in &args.readback {
-        let image = rendered
-            .report
-            .first_read_back(std::slice::from_ref(name))
-            .with_context(|| format!("--readback {name}: not read back"))?;
+        let image = read_back(&rendered, name)?;
         let path = readback_path(&out, name);
         image.save(&path)?;
         if !args.json {

@@ -258,7 +258,6 @@ pub fn render_with_progress(
     let updater = weft_scene::SceneUpdater::new(scene)?;
     let mut uploaded = GpuScene::new(gpu, scene, updater.animates())?;
     uploaded.cache_bvh_in(settings.cache_dir.clone());
-    let warnings = uploaded.warnings.clone();
     let mut frames = FrameLoop::new(gpu, Arc::clone(&plan), (uploaded, updater))?;
     // Pipelines and the ray tracer's data are built before the clock starts:
     // `time_limit` counts rendering.
@@ -305,6 +304,7 @@ pub fn render_with_progress(
         last.ok_or_else(|| RenderError::Gpu(weft_gpu::GpuError::Plan("no frame".into())))?;
     let draw_calls = frames.draw_calls();
     let culling = frames.culling().to_vec();
+    let warnings = frames.warnings().to_vec();
     drop(frames);
     let plan = Arc::try_unwrap(plan).unwrap_or_else(|shared| (*shared).clone());
     let views = crate::view_summary::plan_views(&plan, &report.readbacks);

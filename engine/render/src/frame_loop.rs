@@ -149,6 +149,13 @@ impl<'g> FrameLoop<'g> {
         self.updater.take_error()
     }
 
+    /// What went wrong on the way that did not stop the frames (a texture
+    /// downscaled, a damaged BVH cache entry built again), so far: the
+    /// ray tracer's data is built when a frame first needs it.
+    pub fn warnings(&self) -> &[String] {
+        &self.recorder.scene.warnings
+    }
+
     /// The plan that runs.
     pub fn plan(&self) -> &Arc<Plan> {
         &self.plan

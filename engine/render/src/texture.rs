@@ -35,12 +35,21 @@ pub fn decode(source: &TextureSource, max_side: u32) -> Result<Decoded, RenderEr
             (id.into(), std::borrow::Cow::from(&bytes[..]))
         }
     };
-    let img = image::load_from_memory(&bytes)
-        .map_err(|e| RenderError::Texture {
-            path: name.clone(),
-            message: e.to_string(),
-        })?
-        .to_rgba8();
+    let failed = |message: String| RenderError::Texture {
+        path: name.clone(),
+        message,
+    };
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+        .with_guessed_format()
+        .map_err(|e| failed(e.to_string()))?;
+    // Up to the bytes `weft scene check` accepts, so the two agree.
+    reader.limits(weft_scene::material::texture_decode_limits());
+    let decoded = reader.decode().map_err(|e| failed(e.to_string()))?;
+    let (width, height) = (decoded.width(), decoded.height());
+    if let Some(refusal) = weft_scene::material::decode_refusal(width, height, 0) {
+        return Err(failed(refusal));
+    }
+    let img = decoded.to_rgba8();
     let (width, height) = img.dimensions();
     let (fit_width, fit_height) = weft_scene::material::fit_within(width, height, max_side);
     let (img, warning) = if (fit_width, fit_height) == (width, height) {

@@ -296,16 +296,48 @@ pub fn fit_within(width: u32, height: u32, max_side: u32) -> (u32, u32) {
     (scale(width), scale(height))
 }
 
-/// The width and height an image file or embedded image declares, read from
-/// its header alone (a file is opened through weft's one reader's checks, so
+/// The most bytes one texture's decoded pixels may take (a 16384x16384
+/// texture of 16-bit RGBA channels is 2 GiB): `weft scene check` reports a
+/// texture over it as dropped, and the renderer decodes up to it and no
+/// further, so the two agree.
+pub const MAX_TEXTURE_DECODE_BYTES: u64 = 4 << 30;
+
+/// The limits an image decoder runs under for a texture: at most
+/// [`MAX_TEXTURE_DECODE_BYTES`] allocated.
+pub fn texture_decode_limits() -> image::Limits {
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(MAX_TEXTURE_DECODE_BYTES);
+    limits
+}
+
+/// Why a texture of `width`×`height` whose decoder needs `decoded` bytes
+/// cannot be decoded, if it cannot: its pixels, or the RGBA8 copy uploaded,
+/// are over [`MAX_TEXTURE_DECODE_BYTES`].
+pub fn decode_refusal(width: u32, height: u32, decoded: u64) -> Option<String> {
+    let rgba8 = u64::from(width) * u64::from(height) * 4;
+    let needed = decoded.max(rgba8);
+    (needed > MAX_TEXTURE_DECODE_BYTES).then(|| {
+        format!(
+            "texture is {width}x{height}: decoding it needs {:.2} GiB, over the {} GiB weft decodes; it is dropped (the material keeps its factors)",
+            needed as f64 / f64::from(1u32 << 30),
+            MAX_TEXTURE_DECODE_BYTES >> 30
+        )
+    })
+}
+
+/// The width and height an image file or embedded image declares, and the
+/// bytes its decoded pixels take, read from its header alone (a file is opened through weft's one reader's checks, so
 /// a FIFO is refused); `None` when it cannot be read or decoded.
-pub fn declared_size(source: &TextureSource) -> Option<(u32, u32)> {
-    fn header<R: std::io::BufRead + std::io::Seek>(reader: R) -> Option<(u32, u32)> {
-        image::ImageReader::new(reader)
+pub fn declared_size(source: &TextureSource) -> Option<(u32, u32, u64)> {
+    fn header<R: std::io::BufRead + std::io::Seek>(reader: R) -> Option<(u32, u32, u64)> {
+        use image::ImageDecoder;
+        let decoder = image::ImageReader::new(reader)
             .with_guessed_format()
             .ok()?
-            .into_dimensions()
-            .ok()
+            .into_decoder()
+            .ok()?;
+        let (width, height) = decoder.dimensions();
+        Some((width, height, decoder.total_bytes()))
     }
     match source {
         TextureSource::File(path) => {

@@ -4,7 +4,9 @@ use crate::bounds::Aabb;
 use crate::error::{Location, SceneError, Warning};
 use crate::light::{energy_cut_share, Light, RadiusSource};
 use crate::load::load_scene_with;
-use crate::material::{declared_size, fit_within, TextureSource, MAX_TEXTURE_SIDE};
+use crate::material::{
+    declared_size, decode_refusal, fit_within, TextureSource, MAX_TEXTURE_SIDE,
+};
 use crate::model_file::LoadOptions;
 use crate::scene::Scene;
 use serde::Serialize;
@@ -211,15 +213,19 @@ fn oversized_textures(scene: &Scene) -> Vec<Warning> {
         if !seen.insert(texture_key(&texture.source)) {
             continue;
         }
-        let Some((width, height)) = declared_size(&texture.source) else {
+        let Some((width, height, decoded)) = declared_size(&texture.source) else {
             continue;
         };
+        let at = match &texture.source {
+            TextureSource::File(path) => Location::file(path),
+            TextureSource::Embedded { id, .. } => Location::file(Path::new(id)),
+        };
+        if let Some(message) = decode_refusal(width, height, decoded) {
+            warnings.push(Warning { at, message });
+            continue;
+        }
         let (fit_width, fit_height) = fit_within(width, height, MAX_TEXTURE_SIDE);
         if (fit_width, fit_height) != (width, height) {
-            let at = match &texture.source {
-                TextureSource::File(path) => Location::file(path),
-                TextureSource::Embedded { id, .. } => Location::file(Path::new(id)),
-            };
             warnings.push(Warning {
                 at,
                 message: format!(

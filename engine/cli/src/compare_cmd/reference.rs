@@ -100,8 +100,12 @@ pub(super) fn reference(
     let rendered = render(gpu, scene, &graph, &settings, "reference")?;
     let image = linear(first_readback(&rendered, &common.reference)?);
     let seconds = started.elapsed().as_secs_f64();
+    // A cache that cannot be written (read-only, full) costs a render next
+    // time, as `weft render`'s caches do: a warning, never the comparison.
     if let (Some(cache), Some(digest)) = (&cache, &digest) {
-        cache.store(digest, &image)?;
+        if let Err(e) = cache.store(digest, &image) {
+            eprintln!("warning: {e}; the reference is not cached (it is rendered again next time)");
+        }
     }
     image.write_exr(path)?;
     Ok((image, info(false, path.to_path_buf(), seconds)))

@@ -200,3 +200,38 @@ fn textures_over_the_device_limit_are_downscaled_with_a_warning() {
     }
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+/// A valid 11600x11600 texture (513 MiB of RGBA8, within the device's
+/// 16384 a side): `scene check` accepts it and `render` decodes and draws it
+/// (the image decoder's default 512 MiB limit once dropped it there).
+#[test]
+fn a_large_valid_texture_is_checked_and_drawn_alike() {
+    let dir = temp("full-texture");
+    let scene = textured_quad(&dir, 11600, 11600);
+    let check = weft_within(&repo(), &["scene", "check", &scene.to_string_lossy()], 120);
+    let report = String::from_utf8_lossy(&check.stdout).into_owned();
+    assert!(check.status.success(), "{}", stderr(&check));
+    assert!(!report.contains("wide.png"), "no warning about the texture: {report}");
+    let png = dir.join("out.png");
+    let out = weft_within(
+        &repo(),
+        &[
+            "render",
+            &scene.to_string_lossy(),
+            "--size",
+            "16x16",
+            "--out",
+            &png.to_string_lossy(),
+        ],
+        300,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let centre = *image::open(&png).expect("png").to_rgba8().get_pixel(8, 8);
+    assert!(
+        centre[0] > centre[1] && centre[1] > centre[2],
+        "textured, not white: {centre:?}"
+    );
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
