@@ -4,9 +4,7 @@ use crate::bounds::Aabb;
 use crate::error::{Location, SceneError, Warning};
 use crate::light::{energy_cut_share, Light, RadiusSource};
 use crate::load::load_scene_with;
-use crate::material::{
-    declared_size, decode_refusal, fit_within, TextureSource, MAX_TEXTURE_SIDE,
-};
+use crate::material::{declared_size, decode_refusal, fit_within, TextureSource, MAX_TEXTURE_SIDE};
 use crate::model_file::LoadOptions;
 use crate::scene::Scene;
 use serde::Serialize;

@@ -5,6 +5,7 @@
 
 mod measures;
 mod sweep;
+mod sweep_folders;
 
 use crate::harness::{command_in, repo};
 use std::path::{Path, PathBuf};

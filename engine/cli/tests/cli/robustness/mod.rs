@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+mod bounds;
 mod cache;
 mod damage;
 mod inputs;
@@ -211,7 +212,10 @@ fn a_large_valid_texture_is_checked_and_drawn_alike() {
     let check = weft_within(&repo(), &["scene", "check", &scene.to_string_lossy()], 120);
     let report = String::from_utf8_lossy(&check.stdout).into_owned();
     assert!(check.status.success(), "{}", stderr(&check));
-    assert!(!report.contains("wide.png"), "no warning about the texture: {report}");
+    assert!(
+        !report.contains("wide.png"),
+        "no warning about the texture: {report}"
+    );
     let png = dir.join("out.png");
     let out = weft_within(
         &repo(),
