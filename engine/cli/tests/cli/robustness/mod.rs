@@ -13,6 +13,7 @@ use std::time::{Duration, Instant};
 mod bounds;
 mod cache;
 mod damage;
+mod first_use;
 mod inputs;
 
 /// `weft ARGS` in `dir`, killed (and the test failed) after `seconds`.
