@@ -4,8 +4,15 @@
 # Run:    docker run --rm -v "$PWD/../shared:/weft/shared:ro" -v /scratch:/out weft \
 #             sweep scenes/demo.scene --param shadows.resolution=512,1024 --out /out/sweep
 # docs/compare.md ("Many machines") has the Slurm and Kubernetes recipes.
+# Without a registry (only Debian's mirrors reachable), build the two base
+# images from Debian with tools/container_bases.sh and name them:
+#   podman build --build-arg RUST_IMAGE=localhost/weft-rust:bookworm \
+#       --build-arg RUNTIME_IMAGE=localhost/weft-debian:bookworm -t weft .
 
-FROM rust:1-bookworm AS build
+ARG RUST_IMAGE=rust:1-bookworm
+ARG RUNTIME_IMAGE=debian:bookworm-slim
+
+FROM ${RUST_IMAGE} AS build
 # The build's own packages: the Vulkan loader's headers and the static
 # shaderc the gpu crate links (tools/setup's list, less the test tools).
 RUN apt-get update \
@@ -15,7 +22,7 @@ WORKDIR /weft/repo
 COPY . .
 RUN cargo build --release --locked -p weft-cli
 
-FROM debian:bookworm-slim
+FROM ${RUNTIME_IMAGE}
 # The Vulkan loader and Mesa's drivers (lavapipe among them); nothing else
 # is loaded at run time (the binary links shaderc statically).
 RUN apt-get update \

@@ -41,7 +41,8 @@ enum Command {
     /// One graph over every combination of parameter values and feature sets
     /// against one reference: CSV, Pareto plot and frontier table.
     Sweep(sweep_cmd::SweepArgs),
-    /// Benchmarks that write figures and plots (into docs/ by default).
+    /// Benchmarks that write figures and plots (into --out-dir, by default
+    /// the user cache's bench/ folder, e.g. ~/.cache/weft/bench/NAME).
     #[command(subcommand)]
     Bench(weft_bench::BenchCommand),
     /// Show a scene in a window: fly around, switch graphs and features, hot reload.

@@ -86,7 +86,8 @@ pub struct ViewArgs {
     #[arg(long, value_parser = clap::value_parser!(Extent), requires = "frames")]
     resize_to: Option<Extent>,
     /// Press keys without a keyboard (for scripts and tests): FRAME:KEY,... where KEY
-    /// is g, G (Shift+G), 1-9, shift+1-9, f12, space, r, c or esc, pressed before frame FRAME.
+    /// is g, G (Shift+G), 1-9, shift+1-9, f1, f12, space, r, c, l, b or esc, pressed
+    /// before frame FRAME.
     #[arg(long, value_delimiter = ',', value_parser = controls::parse_press)]
     press: Vec<(u32, controls::Action)>,
     /// Save the last presented frame, as shown in the window, to this PNG on exit
