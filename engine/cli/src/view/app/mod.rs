@@ -4,10 +4,11 @@
 //! (all-or-nothing, at the frame boundary), renders the live graph from the fly
 //! camera and presents it.
 
+mod output;
 mod reload;
 mod ui;
 
-use super::controls::{self, Action, Status};
+use super::controls::{self, Action};
 use super::fly::{self, FlyCamera, FlyInput};
 use super::overlay::EguiOverlay;
 use super::ViewArgs;
@@ -15,11 +16,11 @@ use anyhow::{anyhow, Context, Result};
 use ash::vk;
 use glam::Vec2;
 use std::collections::HashSet;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use weft_gpu::{Capture, Gpu, PresentSource, Presented, Presenter, Readback, Swapchain};
+use weft_gpu::{Capture, Gpu, PresentSource, Presented, Presenter, Swapchain};
 use weft_graph::plan::Extent;
 use weft_render::{FileWatcher, QUIET};
 use weft_render::{LiveRender, ReloadWorker, RenderSettings};
@@ -32,8 +33,6 @@ use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
-/// How often the title's times are refreshed.
-const TITLE_EVERY: Duration = Duration::from_millis(500);
 /// Pixels of scrolling that count as one wheel notch (touchpads).
 const PIXELS_PER_NOTCH: f64 = 40.0;
 
@@ -161,7 +160,7 @@ impl<'g> Viewer<'g> {
             pending_size: None,
             screenshot_on_exit: args.screenshot_on_exit.clone(),
             screenshot_dir: args.screenshot_dir.clone().or_else(|| {
-                screenshot_folder(dirs::picture_dir(), weft_scene::cache::user_cache_dir())
+                output::screenshot_folder(dirs::picture_dir(), weft_scene::cache::user_cache_dir())
             }),
             screenshot_now: false,
             screenshots: 0,
@@ -218,28 +217,6 @@ impl<'g> Viewer<'g> {
             Some(err) => Err(err),
             None => reported.and(self.ui.no_steps_left(self.frames)),
         }
-    }
-
-    fn print_features(&self) {
-        let on = &self.live.plan().features;
-        let list: Vec<String> = self
-            .features
-            .iter()
-            .enumerate()
-            .filter_map(|(i, f)| {
-                let state = if on.contains(f) { "on" } else { "off" };
-                controls::feature_key(i).map(|key| format!("{key} {f} [{state}]"))
-            })
-            .collect();
-        println!(
-            "graph {}: features {}",
-            self.live.settings().graph.display(),
-            if list.is_empty() {
-                "none".to_string()
-            } else {
-                list.join(", ")
-            }
-        );
     }
 
     fn fail(&mut self, event_loop: &ActiveEventLoop, err: anyhow::Error) {
@@ -540,110 +517,6 @@ impl<'g> Viewer<'g> {
         }
         Ok(())
     }
-
-    /// Rebuilds the swapchain and the plan for a window of `size` pixels.
-    fn resize(&mut self, size: [u32; 2]) -> Result<()> {
-        if let Some(presenter) = self.presenter.as_mut() {
-            let current = presenter.extent();
-            if [current.width, current.height] != size {
-                presenter.resize(size)?;
-            }
-        }
-        let extent = self.view_extent(size);
-        if self.live.settings().extent != extent {
-            let settings = RenderSettings {
-                extent,
-                ..self.live.settings().clone()
-            };
-            self.reconfigure(settings);
-        }
-        Ok(())
-    }
-
-    /// Saves an F12 screenshot when one was asked for (a failure is
-    /// reported and the viewer goes on: a key press never closes it), and
-    /// the `--screenshot-on-exit` one (whose failure fails the command).
-    /// The 3D view's size in a window of `size` pixels: the window less the
-    /// panel docked on its right, at least one pixel wide.
-    fn view_extent(&self, size: [u32; 2]) -> Extent {
-        let ppp = self.overlay.as_ref().map_or(1.0, |o| o.pixels_per_point());
-        let docked = (self.ui.panel.width() * ppp).round() as u32;
-        Extent {
-            width: size[0].saturating_sub(docked).max(1),
-            height: size[1],
-        }
-    }
-
-    fn save_screenshots(&mut self, pixels: &Readback, on_exit: bool) -> Result<()> {
-        if self.screenshot_now {
-            self.screenshot_now = false;
-            self.screenshots += 1;
-            let stamp = std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
-                .map_or(0, |d| d.as_secs());
-            let saved = self
-                .screenshot_dir
-                .as_ref()
-                .context(
-                    "no folder for screenshots: give --screenshot-dir (there is no pictures folder, WEFT_CACHE_DIR or HOME)",
-                )
-                .and_then(|dir| {
-                    save(pixels, &dir.join(format!("weft-{stamp}-{}.png", self.screenshots)))
-                });
-            if let Err(err) = saved {
-                eprintln!("error: screenshot not saved: {err:#} (the viewer goes on)");
-            }
-        }
-        if on_exit {
-            if let Some(path) = self.screenshot_on_exit.clone() {
-                save(pixels, &path)?;
-            }
-        }
-        Ok(())
-    }
-
-    fn update_title(&mut self, now: bool) {
-        let since = *self.stats.since.get_or_insert_with(Instant::now);
-        if !now && since.elapsed() < TITLE_EVERY {
-            return;
-        }
-        if self.stats.frames > 0 {
-            self.stats.mean_ms = self.stats.total_ms / f64::from(self.stats.frames);
-        }
-        self.stats.total_ms = 0.0;
-        self.stats.frames = 0;
-        self.stats.since = Some(Instant::now());
-        let title = controls::title(&Status {
-            graph: &self.live.settings().graph,
-            features: &self.live.plan().features,
-            frame_ms: self.stats.mean_ms,
-            timings: &self.timings,
-            error: self.error.as_deref(),
-            samples: self.live.samples(),
-            animating: self.restarts.animating(),
-        });
-        if let Some(window) = &self.window {
-            window.set_title(&title);
-        }
-    }
-}
-
-/// The default screenshot folder: `weft` in the user's pictures folder when
-/// there is one, else `screenshots` in the user cache.
-fn screenshot_folder(pictures: Option<PathBuf>, cache: Option<PathBuf>) -> Option<PathBuf> {
-    pictures
-        .map(|p| p.join("weft"))
-        .or_else(|| cache.map(|c| c.join("screenshots")))
-}
-
-/// Writes a screenshot and says where.
-fn save(pixels: &Readback, path: &Path) -> Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    pixels.save(path)?;
-    println!("wrote {}", path.display());
-    Ok(())
 }
 
 impl ApplicationHandler for Viewer<'_> {
@@ -710,25 +583,5 @@ impl ApplicationHandler for Viewer<'_> {
             _ if self.stop.load(Ordering::SeqCst) => event_loop.exit(),
             _ => {}
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn screenshots_go_to_the_pictures_folder_else_the_user_cache() {
-        let pictures = Some(PathBuf::from("/home/u/Pictures"));
-        let cache = Some(PathBuf::from("/home/u/.cache/weft"));
-        assert_eq!(
-            screenshot_folder(pictures, cache.clone()),
-            Some(PathBuf::from("/home/u/Pictures/weft"))
-        );
-        assert_eq!(
-            screenshot_folder(None, cache),
-            Some(PathBuf::from("/home/u/.cache/weft/screenshots"))
-        );
-        assert_eq!(screenshot_folder(None, None), None);
     }
 }

@@ -76,25 +76,9 @@ fn a_second_sweep_into_a_folder_being_written_fails_at_once() {
     );
     assert!(!out.join("sweep.csv").exists(), "nothing written");
     drop(held);
-    weft_ok(
-        &[
-            "sweep",
-            "scenes/cornell.scene",
-            "--graph",
-            "graphs/forward.ron",
-            "--param",
-            "exposure=1,2",
-            "--size",
-            "16x16",
-            "--spp",
-            "2",
-            "--frames",
-            "1",
-            "--out",
-            &out.to_string_lossy(),
-        ],
-        &cache,
-    );
+    // Released, the folder takes the sweep.
+    let run = sweep(&out, &cache, None, None);
+    assert!(run.status.success(), "{}", stderr(&run));
 }
 
 /// A resumed sweep refuses a point measured twice and a row whose numbers

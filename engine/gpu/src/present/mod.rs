@@ -11,13 +11,14 @@
 //! Before returning, the submission is waited for, because the executor writes
 //! the output image again next frame and runs one frame at a time itself.
 
+mod capture;
+
 use crate::context::Gpu;
 use crate::error::{GpuError, VkCall};
-use crate::readback::{self, Readback};
+use crate::readback::Readback;
 use crate::swapchain::Swapchain;
 use ash::vk;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
-use gpu_allocator::MemoryLocation;
+use capture::CaptureBuffer;
 
 /// Frame slots: acquire semaphores, fences and command buffers cycle through them.
 const FRAMES_IN_FLIGHT: usize = 2;
@@ -446,7 +447,7 @@ fn semaphore(gpu: &Gpu) -> Result<vk::Semaphore, GpuError> {
     .call("vkCreateSemaphore")
 }
 
-fn color_layers() -> vk::ImageSubresourceLayers {
+pub(super) fn color_layers() -> vk::ImageSubresourceLayers {
     vk::ImageSubresourceLayers {
         aspect_mask: vk::ImageAspectFlags::COLOR,
         mip_level: 0,
@@ -479,128 +480,3 @@ pub const SWAPCHAIN_RANGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange
     base_array_layer: 0,
     layer_count: 1,
 };
-
-/// The name `readback::decode` knows a swapchain format by.
-fn format_name(format: vk::Format) -> Option<&'static str> {
-    match format {
-        vk::Format::B8G8R8A8_SRGB => Some("B8G8R8A8_SRGB"),
-        vk::Format::B8G8R8A8_UNORM => Some("B8G8R8A8_UNORM"),
-        vk::Format::R8G8B8A8_SRGB => Some("R8G8B8A8_SRGB"),
-        vk::Format::R8G8B8A8_UNORM => Some("R8G8B8A8_UNORM"),
-        _ => None,
-    }
-}
-
-/// A host-visible buffer a presented image is copied into.
-struct CaptureBuffer<'g> {
-    gpu: &'g Gpu,
-    buffer: vk::Buffer,
-    allocation: Option<Allocation>,
-    extent: vk::Extent2D,
-}
-
-impl<'g> CaptureBuffer<'g> {
-    fn new(gpu: &'g Gpu, extent: vk::Extent2D) -> Result<Self, GpuError> {
-        let size = u64::from(extent.width) * u64::from(extent.height) * 4;
-        let info = vk::BufferCreateInfo::default()
-            .size(size)
-            .usage(vk::BufferUsageFlags::TRANSFER_DST)
-            .sharing_mode(vk::SharingMode::EXCLUSIVE);
-        let buffer = unsafe { gpu.device().create_buffer(&info, None) }.call("vkCreateBuffer")?;
-        let mut this = Self {
-            gpu,
-            buffer,
-            allocation: None,
-            extent,
-        };
-        let requirements = unsafe { gpu.device().get_buffer_memory_requirements(buffer) };
-        let allocation = gpu
-            .allocator()
-            .allocate(&AllocationCreateDesc {
-                name: "screenshot",
-                requirements,
-                location: MemoryLocation::GpuToCpu,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .map_err(|e| GpuError::Allocation {
-                what: "the screenshot buffer".into(),
-                message: e.to_string(),
-            })?;
-        unsafe {
-            gpu.device()
-                .bind_buffer_memory(buffer, allocation.memory(), allocation.offset())
-        }
-        .call("vkBindBufferMemory")?;
-        this.allocation = Some(allocation);
-        Ok(this)
-    }
-
-    /// Copies `image` (in `TRANSFER_SRC_OPTIMAL`) and makes it visible to the host.
-    fn record(&self, cmd: vk::CommandBuffer, image: vk::Image, extent: vk::Extent2D) {
-        let regions = [vk::BufferImageCopy2::default()
-            .image_subresource(color_layers())
-            .image_extent(vk::Extent3D {
-                width: extent.width,
-                height: extent.height,
-                depth: 1,
-            })];
-        let copy = vk::CopyImageToBufferInfo2::default()
-            .src_image(image)
-            .src_image_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-            .dst_buffer(self.buffer)
-            .regions(&regions);
-        let host = [vk::BufferMemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::COPY)
-            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-            .dst_access_mask(vk::AccessFlags2::HOST_READ)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .buffer(self.buffer)
-            .offset(0)
-            .size(vk::WHOLE_SIZE)];
-        let device = self.gpu.device();
-        unsafe {
-            device.cmd_copy_image_to_buffer2(cmd, &copy);
-            device.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().buffer_memory_barriers(&host),
-            );
-        }
-    }
-
-    /// The copied pixels as RGBA (after the submission finished).
-    fn read(&self, format: vk::Format) -> Result<Readback, GpuError> {
-        let name = format_name(format).ok_or_else(|| {
-            GpuError::Plan(format!("cannot read back swapchain format {format:?}"))
-        })?;
-        let size = self.extent.width as usize * self.extent.height as usize * 4;
-        let bytes = self
-            .allocation
-            .as_ref()
-            .and_then(|a| a.mapped_slice())
-            .and_then(|s| s.get(..size))
-            .ok_or_else(|| GpuError::Allocation {
-                what: "the screenshot buffer".into(),
-                message: "memory is not host-mapped".into(),
-            })?;
-        let pixels = readback::decode(name, bytes).map_err(|e| GpuError::Plan(e.to_string()))?;
-        Ok(Readback {
-            width: self.extent.width,
-            height: self.extent.height,
-            format: name.to_string(),
-            pixels,
-        })
-    }
-}
-
-impl Drop for CaptureBuffer<'_> {
-    fn drop(&mut self) {
-        unsafe { self.gpu.device().destroy_buffer(self.buffer, None) };
-        if let Some(a) = self.allocation.take() {
-            // Freeing only fails for allocations this allocator did not make.
-            let _ = self.gpu.allocator().free(a);
-        }
-    }
-}
