@@ -349,7 +349,19 @@ pub fn declared_size(source: &TextureSource) -> Option<(u32, u32, u64)> {
 
 #[cfg(test)]
 mod fit_tests {
-    use super::fit_within;
+    use super::{decode_refusal, fit_within};
+
+    #[test]
+    fn textures_decode_up_to_four_gibibytes() {
+        // 16384 a side in 16-bit RGBA: 2 GiB decoded, 1 GiB as RGBA8.
+        assert_eq!(decode_refusal(16384, 16384, 2 << 30), None);
+        assert_eq!(
+            decode_refusal(32768, 32768, 8 << 30).as_deref(),
+            Some("texture is 32768x32768: decoding it needs 8.00 GiB, over the 4 GiB weft decodes; it is dropped (the material keeps its factors)")
+        );
+        // The RGBA8 copy counts even when the decoder's pixels are smaller.
+        assert!(decode_refusal(40000, 40000, 1 << 30).is_some());
+    }
 
     #[test]
     fn oversized_images_fit_keeping_their_aspect() {
