@@ -10,9 +10,9 @@ mod lifetimes;
 pub(crate) mod memory;
 pub(crate) mod order;
 mod passes;
+mod recordable;
 mod resources;
 pub(crate) mod sync;
-mod transfers;
 
 use crate::diagnostic::Diagnostic;
 use crate::id::IrPassId;
@@ -283,7 +283,7 @@ pub fn compile_ir(
         sync.pass_barriers,
         sync.repeat_barriers,
     );
-    transfers::check(&passes, &resources, options.extent)?;
+    recordable::check(&passes, &resources, options.extent)?;
     Ok(Plan {
         name: graph.name.clone(),
         file: root_file(graph),

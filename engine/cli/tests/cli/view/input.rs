@@ -121,3 +121,41 @@ fn the_live_error_holds_an_animated_scene_still_while_it_measures() {
         .unwrap_or_else(|| panic!("no live error line: {stdout}"));
     assert_eq!(spp, 4, "the reference accumulated {spp} spp: {stdout}");
 }
+
+/// Text a 32-bit float cannot hold, typed into a parameter's field, leaves
+/// the parameter as it was (it once set 1.797e308); a number it can hold is
+/// taken.
+#[test]
+fn a_parameter_field_takes_only_finite_32_bit_numbers() {
+    let x = Xvfb::start();
+    for (typed, taken) in [
+        ("nan", false),
+        ("1e39", false),
+        ("inf", false),
+        ("2.5", true),
+    ] {
+        let steps = format!("1:click:param:exposure,2:text:{typed},3:enter");
+        let out = x.weft(&[
+            "view",
+            "scenes/cornell.scene",
+            "--size",
+            "320x180",
+            "--panel",
+            "--frames",
+            "6",
+            "--validate",
+            "--ui",
+            &steps,
+        ]);
+        assert_clean(&out);
+        let stdout = text(&out.stdout);
+        assert_eq!(
+            stdout.contains("parameter exposure = "),
+            taken,
+            "{typed}: {stdout}"
+        );
+        if taken {
+            assert!(stdout.contains("parameter exposure = 2.5\n"), "{stdout}");
+        }
+    }
+}
