@@ -35,3 +35,26 @@ pub fn command_in(dir: &Path, args: &[&str]) -> Command {
 pub fn weft(args: &[&str]) -> Output {
     command_in(&repo(), args).output().expect("weft runs")
 }
+
+/// Runs `command`, killing it (and failing the test) after `seconds`.
+pub fn finish_within(command: &mut Command, seconds: u64) -> Output {
+    let mut child = command
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("weft runs");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(seconds);
+    while child.try_wait().expect("wait").is_none() {
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            let out = child.wait_with_output().expect("output");
+            panic!(
+                "{command:?} still ran after {seconds} s: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().expect("output")
+}

@@ -3,8 +3,22 @@
 //! given rows outside the grid or told to write over a shard, and a sweep
 //! whose every point matches the reference exactly.
 
-use super::{temp, weft, weft_ok};
+use super::temp;
+use crate::harness::{command_in, finish_within, repo};
 use std::path::Path;
+use std::process::Output;
+
+/// `weft ARGS` with its user cache in `cache`, failed if it runs past 5 min.
+fn weft(args: &[&str], cache: &Path) -> Output {
+    finish_within(command_in(&repo(), args).env("WEFT_CACHE_DIR", cache), 300)
+}
+
+/// [`weft`], which must succeed.
+fn weft_ok(args: &[&str], cache: &Path) -> Output {
+    let run = weft(args, cache);
+    assert!(run.status.success(), "{}", stderr(&run));
+    run
+}
 
 /// A two-point sweep of forward's `exposure` (which the HDR image the
 /// reference is compared with does not see) at 16x16 into `out`, as shard

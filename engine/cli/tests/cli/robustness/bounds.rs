@@ -195,3 +195,63 @@ fn a_script_camera_looking_at_its_own_position_is_refused_where_it_is_set() {
     );
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+/// A 2 KB glTF whose 40 nodes each list the next twice as a child
+/// (2⁴⁰ − 1 instances if expanded): `scene check` and `render` refuse it
+/// at once, naming the limit and a node with two parents.
+#[test]
+fn a_gltf_node_graph_that_doubles_at_every_level_is_refused_at_once() {
+    let dir = temp("gltf-bomb");
+    let nodes: Vec<String> = (0..40)
+        .map(|i| {
+            if i == 39 {
+                r#"{"mesh":0}"#.to_string()
+            } else {
+                format!(r#"{{"mesh":0,"children":[{0},{0}]}}"#, i + 1)
+            }
+        })
+        .collect();
+    // One triangle: three positions and no indices, in a data URI.
+    let positions: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    const TABLE: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let data: String = positions
+        .chunks(3)
+        .flat_map(|c| {
+            let n = (u32::from(c[0]) << 16) | (u32::from(c[1]) << 8) | u32::from(c[2]);
+            (0..4).map(move |i| TABLE[(n >> (18 - 6 * i) & 63) as usize] as char)
+        })
+        .collect();
+    let gltf = dir.join("bomb.gltf");
+    std::fs::write(
+        &gltf,
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"data:application/octet-stream;base64,{data}","byteLength":36}}],"bufferViews":[{{"buffer":0,"byteLength":36}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],"nodes":[{}],"scenes":[{{"nodes":[0]}}]}}"#,
+            nodes.join(",")
+        ),
+    )
+    .expect("gltf");
+    let path = gltf.to_string_lossy().into_owned();
+    for args in [
+        vec!["scene", "check", path.as_str()],
+        vec![
+            "render",
+            path.as_str(),
+            "--size",
+            "8x8",
+            "--out",
+            "/tmp/never-written.png",
+        ],
+    ] {
+        let out = weft_within(&repo(), &args, 30);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("bomb.gltf: the node hierarchy expands to 1099511627775 node instances, over the limit of 1000000; node 1 has 2 parents (or is listed twice), where glTF 2.0 allows one"),
+            "{args:?}: {err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}

@@ -5,10 +5,9 @@
 //! silently wrong result. Every child runs under a deadline, so a hang fails
 //! the test instead of stopping the suite.
 
-use crate::harness::{command_in, repo};
+use crate::harness::{command_in, finish_within, repo};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
 
 mod bounds;
 mod cache;
@@ -19,29 +18,6 @@ mod inputs;
 /// `weft ARGS` in `dir`, killed (and the test failed) after `seconds`.
 fn weft_within(dir: &Path, args: &[&str], seconds: u64) -> Output {
     finish_within(&mut command_in(dir, args), seconds)
-}
-
-/// Runs `command`, killing it (and failing the test) after `seconds`.
-fn finish_within(command: &mut Command, seconds: u64) -> Output {
-    let mut child = command
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("weft runs");
-    let deadline = Instant::now() + Duration::from_secs(seconds);
-    while child.try_wait().expect("wait").is_none() {
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            let out = child.wait_with_output().expect("output");
-            panic!(
-                "{command:?} still ran after {seconds} s: {}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.wait_with_output().expect("output")
 }
 
 fn stderr(out: &Output) -> String {

@@ -3,27 +3,39 @@
 //! screenshot that cannot be saved never closes the window, and the live
 //! error holds an animated scene still while it accumulates.
 
-use super::{assert_clean, text, Temp, Xvfb};
+use super::{assert_clean, repo, text, Temp, Xvfb};
+use crate::harness::finish_within;
+use std::process::Output;
+
+/// `weft ARGS` on `x`'s display, failed if it runs past `seconds`: a viewer
+/// that never ends fails the test instead of stopping the suite.
+fn view_within(x: &Xvfb, args: &[&str], seconds: u64) -> Output {
+    finish_within(&mut x.command(args, &repo()), seconds)
+}
 
 /// Frames of 900 ms, more than egui's 0.8 s for a press to count as a
 /// click: the click still sets the parameter.
 #[test]
 fn a_click_on_the_panel_lands_when_frames_are_slow() {
     let x = Xvfb::start();
-    let out = x.weft(&[
-        "view",
-        "scenes/cornell.scene",
-        "--size",
-        "320x180",
-        "--panel",
-        "--frames",
-        "6",
-        "--frame-delay-ms",
-        "900",
-        "--validate",
-        "--ui",
-        "1:click:param:exposure,2:text:2,3:enter",
-    ]);
+    let out = view_within(
+        &x,
+        &[
+            "view",
+            "scenes/cornell.scene",
+            "--size",
+            "320x180",
+            "--panel",
+            "--frames",
+            "6",
+            "--frame-delay-ms",
+            "900",
+            "--validate",
+            "--ui",
+            "1:click:param:exposure,2:text:2,3:enter",
+        ],
+        120,
+    );
     assert_clean(&out);
     let stdout = text(&out.stdout);
     assert!(stdout.contains("parameter exposure = 2\n"), "{stdout}");
@@ -34,17 +46,21 @@ fn a_click_on_the_panel_lands_when_frames_are_slow() {
 #[test]
 fn ui_steps_left_when_the_frames_end_are_an_error() {
     let x = Xvfb::start();
-    let out = x.weft(&[
-        "view",
-        "scenes/cornell.scene",
-        "--size",
-        "320x180",
-        "--panel",
-        "--frames",
-        "3",
-        "--ui",
-        "1:click:pause,7:click:live_error",
-    ]);
+    let out = view_within(
+        &x,
+        &[
+            "view",
+            "scenes/cornell.scene",
+            "--size",
+            "320x180",
+            "--panel",
+            "--frames",
+            "3",
+            "--ui",
+            "1:click:pause,7:click:live_error",
+        ],
+        120,
+    );
     assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
     let stderr = text(&out.stderr);
     assert!(
@@ -62,19 +78,23 @@ fn a_screenshot_that_cannot_be_saved_leaves_the_viewer_running() {
     // A file where the screenshot folder should be.
     let blocked = tmp.file("not-a-folder");
     std::fs::write(&blocked, "x").expect("write");
-    let out = x.weft(&[
-        "view",
-        "scenes/cornell.scene",
-        "--size",
-        "64x36",
-        "--frames",
-        "5",
-        "--screenshot-dir",
-        blocked.to_str().expect("utf-8 path"),
-        "--press",
-        "1:f12",
-        "--validate",
-    ]);
+    let out = view_within(
+        &x,
+        &[
+            "view",
+            "scenes/cornell.scene",
+            "--size",
+            "64x36",
+            "--frames",
+            "5",
+            "--screenshot-dir",
+            blocked.to_str().expect("utf-8 path"),
+            "--press",
+            "1:f12",
+            "--validate",
+        ],
+        120,
+    );
     assert_clean(&out);
     let stderr = text(&out.stderr);
     assert!(
@@ -94,19 +114,23 @@ fn a_screenshot_that_cannot_be_saved_leaves_the_viewer_running() {
 #[test]
 fn the_live_error_holds_an_animated_scene_still_while_it_measures() {
     let x = Xvfb::start();
-    let out = x.weft(&[
-        "view",
-        "scenes/demo.scene",
-        "--size",
-        "48x27",
-        "--frames",
-        "10",
-        "--press",
-        "0:l",
-        "--reference-spp",
-        "4",
-        "--validate",
-    ]);
+    let out = view_within(
+        &x,
+        &[
+            "view",
+            "scenes/demo.scene",
+            "--size",
+            "48x27",
+            "--frames",
+            "10",
+            "--press",
+            "0:l",
+            "--reference-spp",
+            "4",
+            "--validate",
+        ],
+        120,
+    );
     assert_clean(&out);
     let stdout = text(&out.stdout);
     assert!(
@@ -135,18 +159,22 @@ fn a_parameter_field_takes_only_finite_32_bit_numbers() {
         ("2.5", true),
     ] {
         let steps = format!("1:click:param:exposure,2:text:{typed},3:enter");
-        let out = x.weft(&[
-            "view",
-            "scenes/cornell.scene",
-            "--size",
-            "320x180",
-            "--panel",
-            "--frames",
-            "6",
-            "--validate",
-            "--ui",
-            &steps,
-        ]);
+        let out = view_within(
+            &x,
+            &[
+                "view",
+                "scenes/cornell.scene",
+                "--size",
+                "320x180",
+                "--panel",
+                "--frames",
+                "6",
+                "--validate",
+                "--ui",
+                &steps,
+            ],
+            120,
+        );
         assert_clean(&out);
         let stdout = text(&out.stdout);
         assert_eq!(
