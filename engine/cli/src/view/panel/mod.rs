@@ -277,7 +277,9 @@ impl Panel {
                     ),
                     _ => format!("reference at {} spp, measuring…", status.reference_spp),
                 };
-                ui.label(text);
+                ui.label(text).on_hover_text(
+                    "scene time is held while the live error measures; L lets it run",
+                );
             }
         });
         if let Some(value) = view.under_cursor {
