@@ -129,9 +129,19 @@ fn run_top_level(engine: &Engine, ast: &AST, script: &Path) -> Result<(), SceneE
 fn compile(engine: &Engine, script: &Path) -> Result<AST, SceneError> {
     let at = Location::file(script);
     let text = crate::source::read_text(script, &at, crate::source::MAX_SCENE_BYTES)?;
+    // A system file (named with `--allow-outside`) may be anything
+    // (`/proc/self/environ`): its errors give its position, never its text.
+    let system = weft_io::paths::is_system(script);
+    if system {
+        weft_io::sources::forget(script);
+    }
     engine.compile(&text).map_err(|e| SceneError::Syntax {
         at: position_at(script, e.position()),
-        message: e.err_type().to_string(),
+        message: if system {
+            "not a Rhai script (a system file, so its content is not shown)".to_string()
+        } else {
+            e.err_type().to_string()
+        },
     })
 }
 

@@ -76,6 +76,31 @@ fn a_scene_including_a_system_file_names_it_and_never_shows_it() {
             );
         }
     }
+    // A system file named as a script (allowed outside the folder) is
+    // located, never shown.
+    let scene = dir.join("script.scene");
+    std::fs::write(&scene, "script \"/proc/self/environ\"\n").expect("write");
+    let out = command_in(
+        &repo(),
+        &[
+            "scene",
+            "check",
+            "--allow-outside",
+            &scene.to_string_lossy(),
+        ],
+    )
+    .env("WEFT_SECRET_FOR_TEST", "do-not-print-me")
+    .stdin(Stdio::null())
+    .output()
+    .expect("weft runs");
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("error: /proc/self/environ:1:")
+            && err.contains("not a Rhai script (a system file, so its content is not shown)")
+            && !err.contains("do-not-print-me"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
 
