@@ -5,6 +5,7 @@
 
 use super::SweepRun;
 use anyhow::{bail, Context, Result};
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 use weft_compare::sweep::{grid_document, SweepPoint, GRID_FILE};
 use weft_render::RenderSettings;
@@ -19,10 +20,14 @@ const LOCK_FILE: &str = "sweep.lock";
 pub(super) fn lock_folder(dir: &Path) -> Result<std::fs::File> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let path = dir.join(LOCK_FILE);
+    // A FIFO put there would block the open: refused, and opened without
+    // waiting in case one appears in between.
+    weft_io::check_output(&path)?;
     let file = std::fs::OpenOptions::new()
         .create(true)
         .truncate(false)
         .write(true)
+        .custom_flags(libc::O_NONBLOCK)
         .open(&path)
         .with_context(|| format!("opening {}", path.display()))?;
     match file.try_lock() {

@@ -9,8 +9,10 @@ use crate::error::{Diagnostics, Location};
 use std::path::Path;
 
 /// The most node instances one file may expand to (a node placed once per
-/// path from a scene root to it).
-pub const MAX_NODE_INSTANCES: u64 = 1_000_000;
+/// path from a scene root to it). Each becomes meshes weft draws one call
+/// apiece: a file at this many loads in about a second; the real models in
+/// `../shared/assets` have at most a few thousand.
+pub const MAX_NODE_INSTANCES: u64 = 100_000;
 /// The most triangles one file may expand to once every node is placed.
 pub const MAX_EXPANDED_TRIANGLES: u64 = 50_000_000;
 
