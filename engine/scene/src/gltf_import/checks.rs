@@ -48,7 +48,7 @@ pub(super) fn check_accessor_bounds(
     let element = accessor.size() as u64;
     if let Some(view) = accessor.view() {
         let stride = view_within_buffer(&view, buffers, element)?;
-        let end = accessor.offset() as u64 + stride * (count - 1) + element;
+        let end = span(accessor.offset() as u64, stride, count, element);
         if end > view.length() as u64 {
             return Err(format!(
                 "{name} needs {end} bytes of buffer view {} ({count} elements of {element} bytes, stride {stride}, offset {}), which has {}",
@@ -72,7 +72,7 @@ fn view_within_buffer(
     element: u64,
 ) -> Result<u64, String> {
     let buffer = view.buffer();
-    let end = view.offset() as u64 + view.length() as u64;
+    let end = (view.offset() as u64).saturating_add(view.length() as u64);
     let available = buffers.get(buffer.index()).map_or(0, |b| b.len() as u64);
     if end > available.min(buffer.length() as u64) {
         return Err(format!(
@@ -108,7 +108,7 @@ fn check_sparse(
         ));
     }
     let values = sparse.values();
-    let values_end = values.offset() as u64 + sparse_count * element;
+    let values_end = span(values.offset() as u64, element, sparse_count, element);
     view_within_buffer(&values.view(), buffers, element)?;
     if values_end > values.view().length() as u64 {
         return Err(format!(
@@ -121,8 +121,8 @@ fn check_sparse(
     let view = indices.view();
     let size = indices.index_type().size() as u64;
     view_within_buffer(&view, buffers, size)?;
-    let start = view.offset() as u64 + indices.offset() as u64;
-    let end = indices.offset() as u64 + sparse_count * size;
+    let start = (view.offset() as u64).saturating_add(indices.offset() as u64);
+    let end = span(indices.offset() as u64, size, sparse_count, size);
     if end > view.length() as u64 {
         return Err(format!(
             "{name}'s sparse indices need {end} bytes of buffer view {}, which has {}",
@@ -158,6 +158,14 @@ fn check_sparse(
         previous = Some(index);
     }
     Ok(())
+}
+
+/// The end of `count` elements of `element` bytes, `stride` apart, from
+/// `offset` (saturating: a count or offset from a hostile file cannot wrap).
+fn span(offset: u64, stride: u64, count: u64, element: u64) -> u64 {
+    offset
+        .saturating_add(stride.saturating_mul(count.saturating_sub(1)))
+        .saturating_add(element)
 }
 
 /// Node instances and triangles below one node, counted once per node.

@@ -177,3 +177,22 @@ fn a_glb_header_must_give_the_files_length() {
     glb[8..12].copy_from_slice(&total.to_le_bytes());
     assert_eq!(load("right.glb", &glb), Ok(1));
 }
+
+#[test]
+fn offsets_and_counts_at_the_integer_limits_are_refused_not_wrapped() {
+    for (from, to, expected) in [
+        (
+            r#""componentType":5125,"count":3,"type":"SCALAR""#,
+            r#""componentType":5125,"count":3,"type":"SCALAR","byteOffset":18446744073709551610"#,
+            "accessor 1 needs 18446744073709551615 bytes of buffer view 1",
+        ),
+        (
+            r#"{"buffer":0,"byteLength":36}"#,
+            r#"{"buffer":0,"byteLength":36,"byteOffset":18446744073709551610}"#,
+            "buffer view 0 ends at byte 18446744073709551615, past buffer 0's 48 bytes",
+        ),
+    ] {
+        let error = load("limits.gltf", &edited(from, to)).expect_err("refused");
+        assert!(error.contains(expected), "{error}");
+    }
+}
