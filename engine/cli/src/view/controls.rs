@@ -41,7 +41,7 @@ pub enum Action {
     Panel,
     /// L: start or stop the live error against the reference.
     LiveError,
-    /// B: save the camera as the next bookmark beside the scene.
+    /// B: save the camera as the next bookmark (in the bookmarks file).
     SaveBookmark,
 }
 

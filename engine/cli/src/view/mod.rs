@@ -35,10 +35,12 @@ Controls:
   Space          pause / resume scene time            R       back to the scene camera
   C              print the camera as a .scene `camera` block (world coordinates)
   B              save the camera as the next bookmark (--bookmarks FILE, or the user's data folder)
-  F1             show / hide the panel: graph, features, parameters, pass times,
-                 memory, plan, convergence, reload errors (click to copy), bookmarks
+  F1             show / hide the panel, docked on the right (the view renders beside
+                 it): graph, features, parameters, pass times, memory, plan,
+                 convergence, reload errors (click to copy), bookmarks
   L              live error: path-trace the current view in the background and show
-                 the HDR-FLIP map of the frame against it, updating as it converges
+                 the HDR-FLIP map of the frame against it, updating as it converges;
+                 scene time is held while it measures
   F12            save a screenshot (weft-<time>-<n>.png in --screenshot-dir, path printed;
                  the panel only with --screenshot-panel)
   Esc            quit
