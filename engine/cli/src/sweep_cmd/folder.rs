@@ -42,14 +42,22 @@ pub(super) fn lock_folder(dir: &Path) -> Result<std::fs::File> {
     }
 }
 
-/// Writes the whole sweep's grid beside its CSV, and returns its `grid`
-/// line for a shard's settings: the grid's fingerprint and size, so shards
-/// of different grids never merge.
-pub(super) fn write_grid(dir: &Path, names: &[String], every: &[SweepPoint]) -> Result<String> {
+/// The whole sweep's grid as `sweep.grid` holds it, and its `grid` line
+/// for a shard's settings: the grid's fingerprint and size, so shards of
+/// different grids never merge.
+pub(super) fn grid(names: &[String], every: &[SweepPoint]) -> (String, String) {
     let text = grid_document(names, every);
-    let path = dir.join(GRID_FILE);
-    weft_io::write_output(&path, text.as_bytes())?;
-    Ok(grid_line(&text, every.len()))
+    let line = grid_line(&text, every.len());
+    (text, line)
+}
+
+/// Writes `text` as the folder's `sweep.grid`, once its settings are
+/// known to match ([`check_settings`]): a refused sweep leaves it alone.
+pub(super) fn write_grid(dir: &Path, text: &str) -> Result<()> {
+    Ok(weft_io::write_output(
+        &dir.join(GRID_FILE),
+        text.as_bytes(),
+    )?)
 }
 
 /// The `grid` line of a grid file's `text` of `count` points.

@@ -320,8 +320,9 @@ fn run_sweep(args: SweepRun) -> Result<ExitCode> {
     let csv = args.out.join("sweep.csv");
     // Held until the sweep ends: a second sweep into this folder fails at once.
     let _lock = lock_folder(&args.out)?;
-    let grid = write_grid(&args.out, &names, &every)?;
-    check_settings(&args, &grid)?;
+    let (grid_text, grid_line) = folder::grid(&names, &every);
+    check_settings(&args, &grid_line)?;
+    write_grid(&args.out, &grid_text)?;
     let (mut rows, old_form) = read_with_form(&csv, &names)?;
     // A shard's rows are its points of the grid; an unsharded folder may
     // also hold points of a wider grid measured before.

@@ -201,13 +201,15 @@ fn interpret_private(
         }
         diag.warnings.push(warning);
     }
+    // Any error located in the file itself: even a missing include's name
+    // is text from it.
     result.map_err(|error| match error {
         SceneError::Syntax { at, .. } if at.file == path => SceneError::Syntax {
             at,
             message: format!("not a .scene file, or a syntax error ({PRIVATE})"),
         },
-        SceneError::Model { at, .. } if at.file == path => SceneError::Model {
-            at,
+        other if other.location().file == path => SceneError::Syntax {
+            at: other.location().clone(),
             message: format!("an error ({PRIVATE})"),
         },
         other => other,

@@ -13,7 +13,8 @@ use std::path::Path;
 /// apiece: a file at this many loads in about a second; the real models in
 /// `../shared/assets` have at most a few thousand.
 pub const MAX_NODE_INSTANCES: u64 = 100_000;
-/// The most triangles one file may expand to once every node is placed.
+/// The most triangles one file may expand to once every node is placed,
+/// each primitive counted by its largest accessor (vertices or indices).
 pub const MAX_EXPANDED_TRIANGLES: u64 = 50_000_000;
 
 /// A GLB's header: its `length` must be the file's size (glTF 2.0 §4.4.2).
@@ -223,7 +224,7 @@ pub(super) fn check_node_graph(
     }
     if total.triangles > MAX_EXPANDED_TRIANGLES {
         return Err(format!(
-            "the node hierarchy places {} triangles, over the limit of {MAX_EXPANDED_TRIANGLES}{}",
+            "the node hierarchy places {} triangles (each primitive counted by its largest accessor, vertices or indices), over the limit of {MAX_EXPANDED_TRIANGLES}{}",
             shown(total.triangles),
             shared_text()
         ));
@@ -294,18 +295,26 @@ fn expand(
     Ok(memo[node].unwrap_or_default())
 }
 
-/// Triangles of the mesh `node` places (indices, or positions, over three).
+/// The triangles the mesh `node` places, counted by what reading it costs:
+/// per triangle primitive, its largest accessor (indices or any attribute,
+/// each read whole) over three, rounded up. A sparse accessor without a
+/// view may declare any count, and a few indices may index a huge vertex
+/// buffer: both are counted.
 fn own_triangles(node: &gltf::Node<'_>) -> u64 {
     node.mesh().map_or(0, |mesh| {
         mesh.primitives()
+            .filter(|p| p.mode() == gltf::mesh::Mode::Triangles)
             .map(|p| {
-                let corners = p
-                    .indices()
-                    .or_else(|| p.get(&gltf::Semantic::Positions))
-                    .map_or(0, |a| a.count() as u64);
-                corners / 3
+                let largest = p
+                    .attributes()
+                    .map(|(_, a)| a)
+                    .chain(p.indices())
+                    .map(|a| a.count() as u64)
+                    .max()
+                    .unwrap_or(0);
+                largest.div_ceil(3)
             })
-            .sum()
+            .fold(0u64, u64::saturating_add)
     })
 }
 

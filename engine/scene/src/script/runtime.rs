@@ -230,6 +230,20 @@ impl ScriptRuntime {
         let frame_started = std::time::Instant::now();
         let frame_end = self.frame_end(frame_started, time, target);
         while self.has_update && self.steps < target {
+            // Checked between steps too: Rhai counts a call's operations
+            // from zero, so steps too short to reach its progress check
+            // would never meet the frame's or the render's limit.
+            if let Some((_, reason)) = frame_end
+                .as_ref()
+                .filter(|(end, _)| std::time::Instant::now() > *end)
+            {
+                self.spent += frame_started.elapsed().as_secs_f64();
+                self.steps = u64::MAX;
+                return Err(SceneError::Syntax {
+                    at: first_mention(&self.script, "fn update"),
+                    message: reason.clone(),
+                });
+            }
             self.steps += 1;
             let t = self.steps as f64 * STEP;
             start_call(&self.state, self.limits.call_seconds, frame_end.clone());

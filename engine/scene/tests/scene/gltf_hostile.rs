@@ -196,3 +196,21 @@ fn offsets_and_counts_at_the_integer_limits_are_refused_not_wrapped() {
         assert!(error.contains(expected), "{error}");
     }
 }
+
+/// A sparse POSITION accessor with no view may declare any count, and the
+/// reader would make that many vertices: counted before it is read.
+#[test]
+fn a_huge_accessor_without_a_view_is_counted_before_it_is_read() {
+    let text = edited(
+        r#"{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}"#,
+        r#"{"componentType":5126,"count":10000000000,"type":"VEC3","min":[0,0,0],"max":[1,1,0],
+           "sparse":{"count":1,"indices":{"bufferView":1,"componentType":5125},"values":{"bufferView":0}}}"#,
+    );
+    let started = std::time::Instant::now();
+    let error = load("viewless.gltf", &text).expect_err("refused");
+    assert!(started.elapsed() < std::time::Duration::from_secs(5));
+    assert!(
+        error.ends_with("the node hierarchy places 3333333334 triangles (each primitive counted by its largest accessor, vertices or indices), over the limit of 50000000"),
+        "{error}"
+    );
+}

@@ -64,12 +64,15 @@ pub(super) fn param_widget(
                 _ => None,
             };
             let speed = 0.01 * x.abs().max(1.0);
+            // Held to the declared range and to what a 32-bit float holds,
+            // typed or dragged.
+            let most = f64::from(f32::MAX);
+            let low = range.min.unwrap_or(-most).max(-most);
+            let high = range.max.unwrap_or(most).min(most);
             let mut drag = egui::DragValue::new(x)
                 .speed(speed)
-                .custom_parser(finite_number);
-            if range.min.is_some() || range.max.is_some() {
-                drag = drag.range(range.min.unwrap_or(f64::MIN)..=range.max.unwrap_or(f64::MAX));
-            }
+                .custom_parser(finite_number)
+                .range(low..=high);
             if range.integer {
                 drag = drag.fixed_decimals(0).speed(1.0);
             }

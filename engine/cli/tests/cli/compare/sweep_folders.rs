@@ -108,6 +108,36 @@ fn rows_are_checked_on_resume_and_merge_and_exact_sweeps_get_their_table() {
         let run = sweep(dir, &cache, Some(shard), None);
         assert!(run.status.success(), "{}", stderr(&run));
     }
+    // The same shard with another grid is refused, and leaves the grid the
+    // shard was measured with.
+    let grid = std::fs::read(one.join("sweep.grid")).expect("grid");
+    let other_grid = weft(
+        &[
+            "sweep",
+            "scenes/cornell.scene",
+            "--graph",
+            "graphs/forward.ron",
+            "--param",
+            "exposure=1,2,3",
+            "--size",
+            "16x16",
+            "--spp",
+            "2",
+            "--frames",
+            "1",
+            "--shard",
+            "1/2",
+            "--out",
+            &one.to_string_lossy(),
+        ],
+        &cache,
+    );
+    assert!(
+        stderr(&other_grid).contains("holds points measured with other settings"),
+        "{}",
+        stderr(&other_grid)
+    );
+    assert_eq!(std::fs::read(one.join("sweep.grid")).expect("grid"), grid);
     let csv = one.join("sweep.csv");
     let good = std::fs::read_to_string(&csv).expect("csv");
     let lines: Vec<&str> = good.lines().collect();

@@ -243,3 +243,34 @@ fn init_and_update_of_the_wrong_arity_are_refused_where_they_are_declared() {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
+
+#[test]
+fn steps_too_short_for_rhais_progress_check_still_meet_the_frames_limit() {
+    // A handful of operations a step: Rhai's own check (every 1,024
+    // operations of one call) never runs; the loop's check between steps
+    // stops 36,000 of them at the frame's limit.
+    let dir = folder(
+        "short-steps",
+        &[(
+            "scene.rhai",
+            "point_light(#{ position: [0, 1, 0], color: [1, 1, 1] });\nfn update(t, dt) {\n    let x = t * 2.0;\n}\n",
+        )],
+    );
+    let path = dir.join("scene.rhai");
+    let scene = crate::load_scene(&path).unwrap();
+    let limits = Limits {
+        frame_seconds: 0.02,
+        ..Limits::default()
+    };
+    let mut runtime = ScriptRuntime::new(scene.script.as_ref().unwrap(), &scene, &limits).unwrap();
+    let error = runtime
+        .frame_at(600.0)
+        .expect_err("past the frame's limit")
+        .to_string();
+    assert!(
+        error.starts_with(&format!("{}:2:1: ", path.display()))
+            && error.ends_with("the script's update steps for one frame ran past the frame's limit of 0.02 s (36000 steps of 1/60 s to reach t = 600 s)"),
+        "{error}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
