@@ -33,14 +33,9 @@ struct Lines {
 
 impl Progress {
     /// Progress labelled `label` counting `unit`s (`frame`, `point`); on a
-    /// terminal a bar drawn with the indicatif `template`.
+    /// terminal a bar drawn with the indicatif `template`, elsewhere lines.
     pub(crate) fn new(label: &str, unit: &str, template: &str) -> Self {
-        Self::to(std::io::stderr().is_terminal(), label, unit, template)
-    }
-
-    /// Progress shown as a bar (`terminal`) or as log lines.
-    fn to(terminal: bool, label: &str, unit: &str, template: &str) -> Self {
-        if terminal {
+        if std::io::stderr().is_terminal() {
             let bar = indicatif::ProgressBar::new(0);
             bar.set_style(
                 indicatif::ProgressStyle::with_template(template)

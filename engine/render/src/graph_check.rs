@@ -81,9 +81,10 @@ pub fn check_graph_and_shaders(
         }
         // A pass whose shaders, defines and bound resources are as under a
         // set checked before gives the same problems: checked once.
+        let resources = resource_signature(&plan);
         let mut problems = Vec::new();
         for pass in plan.passes.iter() {
-            if checked.insert(pass_signature(&plan, pass)) {
+            if checked.insert(pass_signature(pass, &resources)) {
                 problems.extend(check_pass(&mut cache, &plan, pass, Some(&scene)));
                 problems.extend(unoffered(&mut cache, pass, target));
             }
@@ -104,19 +105,25 @@ pub fn check_graph_and_shaders(
     Ok(diags)
 }
 
-/// What a pass's shader check depends on: the pass as planned less its
-/// barriers (which other passes decide), and every resource of the plan by
-/// name and description (bindings and attachments name them by index).
-fn pass_signature(plan: &weft_graph::plan::Plan, pass: &PlanPass) -> String {
-    let mut pass = pass.clone();
-    pass.barriers.clear();
-    pass.repeat_barriers.clear();
+/// Every resource of `plan` by name and description: bindings and
+/// attachments name them by index, so a pass's signature includes them.
+fn resource_signature(plan: &weft_graph::plan::Plan) -> String {
     let resources: Vec<(&str, &weft_graph::plan::ResourceDesc)> = plan
         .resources
         .iter()
         .map(|r| (r.name.as_str(), &r.desc))
         .collect();
-    format!("{pass:?}{resources:?}")
+    format!("{resources:?}")
+}
+
+/// What a pass's shader check depends on: the pass as planned less its
+/// barriers (which other passes decide), and its plan's `resources`
+/// ([`resource_signature`]).
+fn pass_signature(pass: &PlanPass, resources: &str) -> String {
+    let mut pass = pass.clone();
+    pass.barriers.clear();
+    pass.repeat_barriers.clear();
+    format!("{pass:?}{resources}")
 }
 
 /// Each shader of `pass` that needs what `target` does not offer, as a

@@ -11,7 +11,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use weft_compare::sweep::{
-    check_rows, document, read_grid, read_named, SweepPoint, SweepRow, GRID_FILE,
+    check_rows, document, grid_document, read_grid, read_named, SweepPoint, SweepRow, GRID_FILE,
 };
 
 /// One shard folder of a sharded sweep: its settings (less the shard and
@@ -69,8 +69,8 @@ fn read_shard(dir: &Path) -> Result<ShardFolder> {
 fn shard_grid(first: &ShardFolder) -> Result<Vec<SweepPoint>> {
     let path = first.dir.join(GRID_FILE);
     let grid = read_grid(&path, &first.names)?;
-    let text = weft_io::read_text(&path, 256 << 20)?;
-    if grid_line(&text, grid.len()) != first.grid {
+    // The fingerprint of the grid as read, in the form the sweep wrote it.
+    if grid_line(&grid_document(&first.names, &grid), grid.len()) != first.grid {
         bail!(
             "{} does not match the `{}` its sweep.settings names: the file was changed after the shard measured it",
             path.display(),

@@ -25,7 +25,7 @@ pub(super) struct CaptureBuffer<'g> {
     gpu: &'g Gpu,
     buffer: vk::Buffer,
     allocation: Option<Allocation>,
-    pub(super) extent: vk::Extent2D,
+    extent: vk::Extent2D,
 }
 
 impl<'g> CaptureBuffer<'g> {
@@ -65,8 +65,10 @@ impl<'g> CaptureBuffer<'g> {
         Ok(this)
     }
 
-    /// Copies `image` (in `TRANSFER_SRC_OPTIMAL`) and makes it visible to the host.
-    pub(super) fn record(&self, cmd: vk::CommandBuffer, image: vk::Image, extent: vk::Extent2D) {
+    /// Copies the buffer's extent of `image` (in `TRANSFER_SRC_OPTIMAL`,
+    /// from its top-left corner) and makes it visible to the host.
+    pub(super) fn record(&self, cmd: vk::CommandBuffer, image: vk::Image) {
+        let extent = self.extent;
         let regions = [vk::BufferImageCopy2::default()
             .image_subresource(color_layers())
             .image_extent(vk::Extent3D {

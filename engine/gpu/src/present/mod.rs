@@ -231,7 +231,7 @@ impl<'g> Presenter<'g> {
                     vk::AccessFlags2::TRANSFER_READ,
                     vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                 );
-                buffer.record(cmd, target, buffer.extent);
+                buffer.record(cmd, target);
                 state.access = vk::AccessFlags2::NONE;
             }
         };

@@ -167,9 +167,6 @@ fn read_into(
         Some(root) => !weft_io::paths::is_within(path, root) || weft_io::paths::is_system(path),
         None => weft_io::paths::is_system(path),
     };
-    if private {
-        weft_io::sources::forget(path);
-    }
     stack.push(key);
     let result = if private {
         interpret_private(&text, path, desc, stack, diag)
@@ -184,8 +181,9 @@ fn read_into(
 /// text.
 const PRIVATE: &str = "the file is outside the scene's folder, so its content is not shown";
 
-/// [`interpret`] for a file whose content must not be echoed: a message
-/// located in `path` itself is replaced by its kind and [`PRIVATE`].
+/// [`interpret`] for a file whose content must not be echoed: its text is
+/// dropped from what error printers show, and a message located in `path`
+/// itself is replaced by its kind and [`PRIVATE`].
 fn interpret_private(
     text: &str,
     path: &Path,
@@ -193,6 +191,7 @@ fn interpret_private(
     stack: &mut Vec<PathBuf>,
     diag: &mut Diagnostics,
 ) -> Result<(), SceneError> {
+    weft_io::sources::forget(path);
     let mut own = Diagnostics::default();
     let result = interpret(text, path, desc, stack, &mut own);
     for mut warning in own.warnings {

@@ -176,6 +176,16 @@ struct Expansion {
     triangles: u64,
 }
 
+impl Expansion {
+    /// Both counts added, saturating.
+    fn plus(self, other: Self) -> Self {
+        Self {
+            nodes: self.nodes.saturating_add(other.nodes),
+            triangles: self.triangles.saturating_add(other.triangles),
+        }
+    }
+}
+
 /// Counts what walking the node graph from `roots` would place, before it
 /// is walked: more than [`MAX_NODE_INSTANCES`] nodes or
 /// [`MAX_EXPANDED_TRIANGLES`] triangles, or a cycle, is an error naming a
@@ -212,8 +222,7 @@ pub(super) fn check_node_graph(
     for root in roots {
         let below = expand(root.index(), &nodes, &mut memo, &mut on_path)
             .map_err(|node| format!("the node hierarchy has a cycle through node {node}"))?;
-        total.nodes = total.nodes.saturating_add(below.nodes);
-        total.triangles = total.triangles.saturating_add(below.triangles);
+        total = total.plus(below);
     }
     if total.nodes > MAX_NODE_INSTANCES {
         return Err(format!(
@@ -264,15 +273,14 @@ fn expand(
             continue;
         }
         if children_done {
-            let mut sum = Expansion {
+            let own = Expansion {
                 nodes: 1,
                 triangles: own_triangles(&nodes[at]),
             };
-            for child in nodes[at].children() {
-                let below = memo[child.index()].unwrap_or_default();
-                sum.nodes = sum.nodes.saturating_add(below.nodes);
-                sum.triangles = sum.triangles.saturating_add(below.triangles);
-            }
+            let sum = nodes[at]
+                .children()
+                .map(|child| memo[child.index()].unwrap_or_default())
+                .fold(own, Expansion::plus);
             memo[at] = Some(sum);
             on_path[at] = false;
             continue;

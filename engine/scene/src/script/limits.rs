@@ -54,25 +54,25 @@ impl Default for Limits {
 /// Starts the clock of one call ([`Limits::call_seconds`]), or of one
 /// `update` step that must also end by `frame_end` (the earlier of the
 /// frame's and the render's deadlines, with what the script is told then).
-pub(super) fn start_call(
-    state: &Shared,
-    limits_seconds: f64,
-    frame_end: Option<(std::time::Instant, String)>,
-) {
-    let call = std::time::Instant::now()
-        .checked_add(std::time::Duration::from_secs_f64(
-            limits_seconds.clamp(0.0, 1e9),
-        ))
-        .map(|at| {
-            (
-                at,
-                format!("the script ran past its limit of {limits_seconds} s for one call (the load, init or one update step)"),
-            )
-        });
-    lock(state).deadline = match (call, frame_end) {
-        (Some(call), Some(frame)) => Some(if frame.0 < call.0 { frame } else { call }),
-        (call, frame) => call.or(frame),
-    };
+pub(super) fn start_call(state: &Shared, limits_seconds: f64, frame_end: Option<Deadline>) {
+    let call = after(std::time::Instant::now(), limits_seconds.max(0.0)).map(|at| {
+        (
+            at,
+            format!("the script ran past its limit of {limits_seconds} s for one call (the load, init or one update step)"),
+        )
+    });
+    lock(state).deadline = earlier(call, frame_end);
+}
+
+/// When a script must stop, and what it is told then.
+pub(super) type Deadline = (std::time::Instant, String);
+
+/// The earlier of two deadlines, either of which may be none.
+pub(super) fn earlier(a: Option<Deadline>, b: Option<Deadline>) -> Option<Deadline> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(if b.0 < a.0 { b } else { a }),
+        (a, b) => a.or(b),
+    }
 }
 
 /// `seconds` from `start`, or `None` when that is beyond any clock.

@@ -169,12 +169,7 @@ impl ScriptRuntime {
     /// `target`) must end: the earlier of [`Limits::frame_seconds`] from
     /// `started` and what is left of [`Limits::render_seconds`], with what
     /// the script is told then.
-    fn frame_end(
-        &self,
-        started: std::time::Instant,
-        time: f64,
-        target: u64,
-    ) -> Option<(std::time::Instant, String)> {
+    fn frame_end(&self, started: std::time::Instant, time: f64, target: u64) -> Option<Deadline> {
         let steps = target.saturating_sub(self.steps);
         let frame = after(started, self.limits.frame_seconds).map(|at| {
             (
@@ -194,10 +189,7 @@ impl ScriptRuntime {
                 ),
             )
         });
-        match (frame, render) {
-            (Some(f), Some(r)) => Some(if r.0 < f.0 { r } else { f }),
-            (f, r) => f.or(r),
-        }
+        earlier(frame, render)
     }
 
     /// Whether the script animates anything (has `fn update(t, dt)`).

@@ -45,7 +45,7 @@ pub(super) struct State {
     /// then: the earliest of the call's, the frame's and the render's limits
     /// ([`Limits::call_seconds`], [`Limits::frame_seconds`],
     /// [`Limits::render_seconds`]).
-    pub(super) deadline: Option<(std::time::Instant, String)>,
+    pub(super) deadline: Option<Deadline>,
 }
 
 impl State {

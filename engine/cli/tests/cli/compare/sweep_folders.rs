@@ -29,13 +29,24 @@ fn sweep(
     shard: Option<&str>,
     reference: Option<&Path>,
 ) -> std::process::Output {
+    sweep_over("exposure=1,2", out, cache, shard, reference)
+}
+
+/// [`sweep`] over the `--param` values `values`.
+fn sweep_over(
+    values: &str,
+    out: &Path,
+    cache: &Path,
+    shard: Option<&str>,
+    reference: Option<&Path>,
+) -> std::process::Output {
     let mut args: Vec<String> = [
         "sweep",
         "scenes/cornell.scene",
         "--graph",
         "graphs/forward.ron",
         "--param",
-        "exposure=1,2",
+        values,
         "--size",
         "16x16",
         "--spp",
@@ -111,27 +122,7 @@ fn rows_are_checked_on_resume_and_merge_and_exact_sweeps_get_their_table() {
     // The same shard with another grid is refused, and leaves the grid the
     // shard was measured with.
     let grid = std::fs::read(one.join("sweep.grid")).expect("grid");
-    let other_grid = weft(
-        &[
-            "sweep",
-            "scenes/cornell.scene",
-            "--graph",
-            "graphs/forward.ron",
-            "--param",
-            "exposure=1,2,3",
-            "--size",
-            "16x16",
-            "--spp",
-            "2",
-            "--frames",
-            "1",
-            "--shard",
-            "1/2",
-            "--out",
-            &one.to_string_lossy(),
-        ],
-        &cache,
-    );
+    let other_grid = sweep_over("exposure=1,2,3", &one, &cache, Some("1/2"), None);
     assert!(
         stderr(&other_grid).contains("holds points measured with other settings"),
         "{}",
