@@ -66,14 +66,16 @@ struct Draw {
 };
 
 layout(set = SET_SCENE, binding = BINDING_FRAME) uniform Frame {
-    mat4 view_proj;
-    mat4 inv_view_proj;
+    mat4 view_proj;        // jittered by `jitter` when the graph jitters the camera
+    mat4 inv_view_proj;    // its inverse, jitter included
     vec4 camera_position;
     vec4 ambient;          // sum of the suns' ambient terms
     uvec4 counts;          // suns, point lights, spots, all lights but emissive polygons
     vec4 viewport;         // width, height, 1/width, 1/height
     uvec4 emitter_lights;  // x: emissive polygon records after the counts.w others
-    mat4 prev_view_proj;   // view_proj of the frame before (the same on a scene's first)
+    mat4 prev_view_proj;   // unjittered view_proj of the frame before (the same on a scene's first)
+    mat4 unjittered_view_proj;  // view_proj without this frame's jitter: the history's pixel grid
+    vec4 jitter;           // xy: this frame's sub-pixel jitter in pixels (0: none)
 } frame;
 
 layout(std430, set = SET_SCENE, binding = BINDING_LIGHTS) readonly buffer Lights { Light lights[]; };

@@ -24,4 +24,5 @@ mod scripting;
 mod shading;
 mod shadows;
 mod shipped;
+mod taa;
 mod transparency;

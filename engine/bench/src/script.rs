@@ -112,7 +112,7 @@ fn scene_update_ms(gpu: &Gpu, scene: &weft_scene::Scene, frames: u32) -> Result<
         let t = f64::from(frame + 1) * STEP;
         let started = Instant::now();
         let at = updater.at(t);
-        gpu_scene.update(&at, &camera, t, [1280, 720])?;
+        gpu_scene.update(&at, &camera, t, ([1280, 720], glam::Vec2::ZERO))?;
         if frame >= 10 {
             ms.push(started.elapsed().as_secs_f64() * 1e3);
         }

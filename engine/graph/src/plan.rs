@@ -83,6 +83,9 @@ pub struct Plan {
     /// The graph's known differences from the reference whose features hold
     /// (`caveats` in the file), for `weft compare`.
     pub caveats: Vec<String>,
+    /// Whether the camera's projection moves by a sub-pixel offset each
+    /// frame (`jitter` in the file, its features holding).
+    pub camera_jitter: bool,
     /// Where transient images live.
     pub memory: MemoryPlan,
     /// Barriers after the last pass: the output to `TRANSFER_SRC_OPTIMAL` for presenting or

@@ -38,6 +38,12 @@ pub fn render(plan: &Plan) -> String {
         plan.extent.height,
         plan.features.join(", ")
     );
+    if plan.camera_jitter {
+        let _ = writeln!(
+            w,
+            "camera jittered each frame by a sub-pixel Halton (2, 3) offset"
+        );
+    }
     let _ = writeln!(w, "\nresources:");
     for r in &plan.resources {
         let what = match &r.desc {

@@ -117,10 +117,15 @@ impl<'g> FrameLoop<'g> {
     pub fn draw(&mut self, request: &FrameRequest<'_>) -> Result<FrameReport, RenderError> {
         let extent = [self.plan.extent.width, self.plan.extent.height];
         let at = self.updater.at(request.time);
-        let inputs = self
-            .recorder
-            .scene
-            .update(&at, request.camera, request.time, extent)?;
+        let jitter = if self.plan.camera_jitter {
+            crate::jitter::camera_jitter(self.plan_frames)
+        } else {
+            glam::Vec2::ZERO
+        };
+        let inputs =
+            self.recorder
+                .scene
+                .update(&at, request.camera, request.time, (extent, jitter))?;
         let history_frames = self.accumulation.next(inputs);
         let options = FrameOptions {
             timing: request.timing,

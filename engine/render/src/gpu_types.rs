@@ -85,9 +85,9 @@ pub struct GpuMaterial {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuFrame {
-    /// World to clip space.
+    /// World to clip space, moved by `jitter` when the plan jitters the camera.
     pub view_proj: Mat4,
-    /// Clip to world space.
+    /// Clip to world space (the inverse of `view_proj`, jitter included).
     pub inv_view_proj: Mat4,
     /// xyz the camera's world position, w 1.
     pub camera_position: Vec4,
@@ -102,6 +102,12 @@ pub struct GpuFrame {
     /// World to clip space of the frame before (the same as `view_proj` on
     /// a scene's first frame), for passes that reproject last frame's images.
     pub prev_view_proj: Mat4,
+    /// `view_proj` without this frame's jitter: where a point is on the
+    /// pixel grid the history of accumulating passes lives on.
+    pub unjittered_view_proj: Mat4,
+    /// xy: this frame's sub-pixel jitter of `view_proj` in pixels (0 when
+    /// the plan does not jitter), zw: 0.
+    pub jitter: Vec4,
 }
 
 /// The head of the `Shadows` buffer, before the views.
@@ -142,7 +148,7 @@ const _: () = {
     assert!(size_of::<GpuDraw>() == 224);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMaterial>() == 128);
-    assert!(size_of::<GpuFrame>() == 3 * 64 + 5 * 16);
+    assert!(size_of::<GpuFrame>() == 4 * 64 + 6 * 16);
     assert!(size_of::<GpuShadowsHeader>() == 64);
     assert!(size_of::<GpuShadowView>() == 176);
 };

@@ -39,6 +39,7 @@ mod gaussian;
 mod geometry;
 mod gpu_types;
 mod graph_check;
+mod jitter;
 mod light_choice;
 mod light_tree;
 mod lights;

@@ -362,6 +362,7 @@ mod tests {
             samples_per_frame: None,
             views: Vec::new(),
             caveats: Vec::new(),
+            camera_jitter: false,
             memory: Default::default(),
             epilogue: Vec::new(),
             warnings: Vec::new(),

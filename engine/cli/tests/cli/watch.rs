@@ -136,8 +136,8 @@ fn graph_edit_validation_error_and_fix() {
     );
 
     let typo = brighter.replace(
-        "sampled: [\"hdr\", (name: \"bloom\"",
-        "sampled: [\"hdx\", (name: \"bloom\"",
+        "(name: \"hdr\", enabled_if: [\"!taa\"])",
+        "(name: \"hdx\", enabled_if: [\"!taa\"])",
     );
     assert_ne!(typo, brighter);
     let typo_line = typo

@@ -305,6 +305,10 @@ pub fn compile_ir(
             })
             .collect(),
         caveats: active_caveats(graph, &options.features),
+        camera_jitter: graph
+            .jitter
+            .iter()
+            .any(|(_, j)| conditions_hold(&j.enabled_if, &options.features)),
         resources,
         passes,
         culled,

@@ -67,6 +67,9 @@ pub struct LoadedGraph {
     /// Known differences from the reference, from the graph and its
     /// fragments, with their source.
     pub caveats: Vec<(usize, crate::schema::CaveatDecl)>,
+    /// When the camera is jittered, from the graph and its fragments, with
+    /// their source.
+    pub jitter: Vec<(usize, crate::schema::JitterDecl)>,
     /// Define sets from the graph and its fragments: source, name, defines.
     pub define_sets: Vec<(usize, String, Vec<crate::schema::DefineDecl>)>,
     /// Human-readable name.
@@ -370,6 +373,9 @@ fn load_file(
     graph
         .caveats
         .extend(parsed.caveats.iter().map(|c| (source, c.clone())));
+    graph
+        .jitter
+        .extend(parsed.jitter.iter().map(|j| (source, j.clone())));
     graph.define_sets.extend(
         parsed
             .define_sets

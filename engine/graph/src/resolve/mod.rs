@@ -24,7 +24,7 @@ use crate::load::LoadedGraph;
 use crate::plan::Extent;
 use crate::schema::ResourceDecl;
 use crate::spans::Seg;
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 
 /// An attachment's extent and sample count at one probe size (`None` when unknown).
 type SizeAtProbe = Option<(Extent, u32)>;
@@ -173,6 +173,7 @@ impl<'a> Resolver<'a> {
         self.check_usages(&ir);
         self.check_extents(&ir);
         self.check_caveats(&ir);
+        self.check_jitter(&ir);
         self.check_define_sets();
         ir
     }
@@ -217,39 +218,77 @@ impl<'a> Resolver<'a> {
     /// or the engine sets from scenes: a misspelt feature would silently
     /// never show the caveat.
     fn check_caveats(&mut self, ir: &Ir) {
-        let mut known = feature_names(ir);
-        known.extend(self.graph.default_features.iter().cloned());
-        known.extend(SCENE_FEATURES.iter().map(|f| f.to_string()));
-        for (k, (source, caveat)) in self.graph.caveats.iter().enumerate() {
-            let index = self.graph.caveats[..k]
-                .iter()
-                .filter(|(s, _)| s == source)
-                .count();
+        let known = self.known_features(ir);
+        let caveats = &self.graph.caveats;
+        for (k, (source, caveat)) in caveats.iter().enumerate() {
+            let index = caveats[..k].iter().filter(|(s, _)| s == source).count();
             let path = |field| [Seg::Field("caveats"), Seg::Index(index), Seg::Field(field)];
             if caveat.note.trim().is_empty() {
                 self.error(*source, &path("note"), "a caveat's note is empty".into())
                     .hint = Some("say what differs from the reference and why".into());
             }
-            // A fragment's features may be its includer's: checked there.
-            for condition in &caveat.enabled_if {
-                if let Some(problem) = crate::condition::malformed(condition) {
-                    self.error(*source, &path("enabled_if"), problem);
-                }
+            self.check_declared_conditions(
+                *source,
+                &path("enabled_if"),
+                &caveat.enabled_if,
+                &known,
+                "caveat",
+            );
+        }
+    }
+
+    /// The camera jitter's conditions are well formed and name features the
+    /// graph has or scenes set: a misspelt one would never jitter.
+    fn check_jitter(&mut self, ir: &Ir) {
+        let known = self.known_features(ir);
+        let jitter = &self.graph.jitter;
+        for (k, (source, decl)) in jitter.iter().enumerate() {
+            let index = jitter[..k].iter().filter(|(s, _)| s == source).count();
+            let path = [
+                Seg::Field("jitter"),
+                Seg::Index(index),
+                Seg::Field("enabled_if"),
+            ];
+            self.check_declared_conditions(*source, &path, &decl.enabled_if, &known, "jitter");
+        }
+    }
+
+    /// Features a condition may name: the graph's own, its defaults, and
+    /// those the engine sets from scenes.
+    fn known_features(&self, ir: &Ir) -> BTreeSet<String> {
+        let mut known = feature_names(ir);
+        known.extend(self.graph.default_features.iter().cloned());
+        known.extend(SCENE_FEATURES.iter().map(|f| f.to_string()));
+        known
+    }
+
+    /// Each of a declaration's `enabled_if` conditions is well formed and,
+    /// outside fragments (whose features may be their includer's), names a
+    /// feature in `known`.
+    fn check_declared_conditions(
+        &mut self,
+        source: usize,
+        path: &[Seg],
+        conditions: &[String],
+        known: &BTreeSet<String>,
+        what: &str,
+    ) {
+        for condition in conditions {
+            if let Some(problem) = crate::condition::malformed(condition) {
+                self.error(source, path, problem);
             }
-            let named = caveat
-                .enabled_if
-                .iter()
-                .filter(|_| !self.graph.is_fragment)
-                .flat_map(|c| crate::condition::names(c).map(move |n| (c, n)));
-            for (condition, feature) in named {
+            if self.graph.is_fragment {
+                continue;
+            }
+            for feature in crate::condition::names(condition) {
                 if !feature.is_empty() && !known.contains(feature) {
                     let hint =
                         crate::diagnostic::nearest(feature, known.iter().map(String::as_str))
                             .map(|n| format!("did you mean \"{n}\"?"));
                     self.error(
-                        *source,
-                        &path("enabled_if"),
-                        format!("caveat condition \"{condition}\" names a feature neither this graph nor scenes set"),
+                        source,
+                        path,
+                        format!("{what} condition \"{condition}\" names a feature neither this graph nor scenes set"),
                     )
                     .hint = hint;
                 }

@@ -76,6 +76,22 @@ pub struct GraphFile {
     /// define's `draws` applies where the pass draws meshes.
     #[serde(default)]
     pub define_sets: BTreeMap<String, Vec<DefineDecl>>,
+    /// Moves the camera's projection by a different sub-pixel offset each
+    /// frame (Halton 2, 3) while its features hold, for passes that
+    /// accumulate pixels over frames (`graphs/taa.ron`): `view_proj` in the
+    /// Frame uniform is jittered, the unjittered one kept for motion.
+    /// Fragments may declare it; it holds when any declaration's features do.
+    #[serde(default)]
+    pub jitter: Vec<JitterDecl>,
+}
+
+/// When the camera is jittered (see [`GraphFile::jitter`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JitterDecl {
+    /// Features that must hold (`["taa"]`); empty: always.
+    #[serde(default)]
+    pub enabled_if: Vec<String>,
 }
 
 /// One known difference from the reference (see [`GraphFile::caveats`]).

@@ -102,7 +102,7 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
     };
     // forward.ron's own notes first (it traces neither the environment nor
     // bounces), bloom.ron's while bloom is on (a default feature), then
-    // raster_caveats.ron's unconditional note.
+    // taa.ron's: one sample per pixel, or under `taa` the frames' average.
     assert_eq!(
         caveats("forward.ron", &[]),
         ["nothing", "direct", "bloom", "one"]
@@ -110,6 +110,10 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
     assert_eq!(
         caveats("forward.ron", &["!bloom"]),
         ["nothing", "direct", "one"]
+    );
+    assert_eq!(
+        caveats("forward.ron", &["!bloom", "taa"]),
+        ["nothing", "direct", "temporal"]
     );
     // Shadow maps under shadow casters with a sun or a spot, once with both;
     // none of their notes once `rt_shadows` traces every light's shadows,
@@ -119,14 +123,14 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
             "forward.ron",
             &["!bloom", "shadow_casters", "area_lights", "point_lights"]
         ),
-        ["nothing", "direct", "one", "area", "point", "the"]
+        ["nothing", "direct", "area", "point", "the", "one"]
     );
     assert_eq!(
         caveats(
             "forward.ron",
             &["!bloom", "shadow_casters", "suns", "spot_lights"]
         ),
-        ["nothing", "direct", "one", "sun"]
+        ["nothing", "direct", "sun", "one"]
     );
     let traced = caveats(
         "forward.ron",
@@ -140,7 +144,7 @@ fn caveats_apply_under_their_features_from_the_graph_and_its_fragments() {
             "rt_shadows",
         ],
     );
-    assert_eq!(traced, ["nothing", "direct", "one", "area", "the"]);
+    assert_eq!(traced, ["nothing", "direct", "area", "the", "one"]);
     let graph = weft_graph::load(&repo_root().join("graphs/forward.ron"));
     let options = CompileOptions {
         features: graph.features(&["area_lights", "rt_shadows"]),
@@ -614,4 +618,23 @@ fn alternatives_in_a_condition_decide_culling() {
     assert!(runs(&["shadow_casters", "spot_lights", "rt_shadows"]));
     assert!(!runs(&["shadow_casters", "rt_shadows"]));
     assert!(!runs(&["spot_lights"]));
+}
+
+/// forward.ron jitters the camera under `taa` (taa.ron's `jitter`) and
+/// only then, and its plan text says so.
+#[test]
+fn the_camera_is_jittered_only_under_the_features_that_ask_for_it() {
+    let graph = weft_graph::load(&repo_root().join("graphs/forward.ron"));
+    let plan = |toggles: &[&str]| {
+        let options = CompileOptions {
+            features: graph.features(toggles),
+            ..CompileOptions::default()
+        };
+        weft_graph::compile(&graph, &options).expect("compiles")
+    };
+    assert!(!plan(&[]).camera_jitter);
+    let jittered = plan(&["taa"]);
+    assert!(jittered.camera_jitter);
+    assert!(weft_graph::text::render(&jittered)
+        .contains("\ncamera jittered each frame by a sub-pixel Halton (2, 3) offset\n"));
 }

@@ -440,8 +440,9 @@ impl<'g> GpuScene<'g> {
     /// Uploads the scene as it is at `time` (`at`, from a
     /// [`weft_scene::SceneUpdater`]): lights, moved and recoloured placements,
     /// and `camera` (or the script's camera of its name) for a target of
-    /// `extent`; call it before each frame (the previous frame must have
-    /// finished). Returns a hash of what it uploaded (camera, lights,
+    /// `extent`, its projection moved by `jitter` pixels (zero unless the
+    /// plan jitters the camera); call it before each frame (the previous
+    /// frame must have finished). Returns a hash of what it uploaded (camera, lights,
     /// placements and their colours), so callers can tell whether two frames
     /// see the same inputs.
     pub fn update(
@@ -449,7 +450,7 @@ impl<'g> GpuScene<'g> {
         at: &SceneAt<'_>,
         camera: &Camera,
         time: f64,
-        extent: [u32; 2],
+        (extent, jitter): ([u32; 2], glam::Vec2),
     ) -> Result<u64, GpuError> {
         if let Some(transforms) = at.transforms {
             self.place_instances(transforms)?;
@@ -477,9 +478,10 @@ impl<'g> GpuScene<'g> {
         let bounds = self.bounds;
         let mut lights = pack_lights(at.lights, &bounds);
         lights.add_emitter_polygons(&self.emitter_lights.records());
+        let shown_view_proj = crate::jitter::jittered(view_proj, jitter, glam::Vec2::new(w, h));
         let frame = GpuFrame {
-            view_proj,
-            inv_view_proj: view_proj.inverse(),
+            view_proj: shown_view_proj,
+            inv_view_proj: shown_view_proj.inverse(),
             camera_position: eye.extend(1.0),
             ambient: lights.ambient.extend(0.0),
             counts: UVec4::new(
@@ -491,6 +493,8 @@ impl<'g> GpuScene<'g> {
             viewport: Vec4::new(w, h, 1.0 / w, 1.0 / h),
             emitter_lights: UVec4::new(lights.emitter_polygons, 0, 0, 0),
             prev_view_proj,
+            unjittered_view_proj: view_proj,
+            jitter: jitter.extend(0.0).extend(0.0),
         };
         self.frame.write(bytes_of(&[frame]))?;
         if let Some(changed) = changed_records(&self.light_set.records, &lights.records) {
@@ -502,10 +506,14 @@ impl<'g> GpuScene<'g> {
             }
         }
         let mut inputs = std::collections::hash_map::DefaultHasher::new();
-        // What this frame shows, not how the last one differed: a still
-        // camera's frames hash alike even right after it moved.
+        // What this frame shows, not how the last one differed or where
+        // its jitter fell: a still camera's frames hash alike even right
+        // after it moved, and jittered frames of one view alike.
         let shown = GpuFrame {
+            view_proj,
+            inv_view_proj: view_proj.inverse(),
             prev_view_proj: view_proj,
+            jitter: glam::Vec4::ZERO,
             ..frame
         };
         std::hash::Hash::hash(bytes_of(&[shown]), &mut inputs);

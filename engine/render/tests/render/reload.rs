@@ -87,7 +87,11 @@ fn a_refused_reload_keeps_the_last_good_version_and_the_next_good_one_takes_ever
     let tonemap = dir.join("shaders/tonemap.frag");
     let graph = dir.join("graphs/forward.ron");
     edit(&tonemap, TONEMAP_OUT, "color = vec4(1.0, 0.0, 0.0, 1.0);");
-    edit(&graph, "sampled: [\"hdr\",", "sampled: [\"hdx\",");
+    edit(
+        &graph,
+        "(name: \"hdr\", enabled_if: [\"!taa\"])",
+        "(name: \"hdx\", enabled_if: [\"!taa\"])",
+    );
     let both = BTreeSet::from([normalize(&tonemap), normalize(&graph)]);
     let err = live
         .apply(&both)
@@ -100,7 +104,11 @@ fn a_refused_reload_keeps_the_last_good_version_and_the_next_good_one_takes_ever
         "neither the graph nor the shader edit goes live"
     );
 
-    edit(&graph, "sampled: [\"hdx\",", "sampled: [\"hdr\",");
+    edit(
+        &graph,
+        "(name: \"hdx\", enabled_if: [\"!taa\"])",
+        "(name: \"hdr\", enabled_if: [\"!taa\"])",
+    );
     let reloaded = live
         .apply(&BTreeSet::from([normalize(&graph)]))
         .expect("fixed");

@@ -107,6 +107,16 @@ fn caveats_need_a_note_and_features_the_graph_has() {
             "caveat condition \"blom\" names a feature neither this graph nor scenes set",
             r#"["blom"]"#,
         ),
+        (
+            r#"Graph(jitter: [(enabled_if: ["ta"])],"#,
+            "jitter condition \"ta\" names a feature neither this graph nor scenes set",
+            r#"["ta"]"#,
+        ),
+        (
+            r#"Graph(jitter: [(enabled_if: ["bloom|"])],"#,
+            "condition \"bloom|\" has an empty alternative: write features (`a`), negations (`!a`) and alternatives joined by `|` (`a|!b`)",
+            r#"["bloom|"]"#,
+        ),
     ];
     for (edit, message, at) in cases {
         let text = VALID.replacen("Graph(", edit, 1);
