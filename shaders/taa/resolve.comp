@@ -37,6 +37,12 @@ layout(set = 0, binding = 3, r32f) uniform readonly image2D taa_depth_prev;
 layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D antialiased;
 // Linear depth of the point each pixel saw; 0: the background.
 layout(set = 0, binding = 5, r32f) uniform writeonly image2D taa_depth;
+#ifdef HAS_VIEW_HISTORY_LENGTH
+// Debug view `history_length`: the frames each pixel averages, and the
+// frame's largest in word 0 (debug_view.frag's legend scale).
+layout(set = 0, binding = 6, r32ui) uniform writeonly uimage2D view_history_length;
+layout(std430, set = 0, binding = 7) buffer ViewHistoryLengthTotals { uint words[4]; } view_history_length_totals;
+#endif
 
 layout(push_constant) uniform Params {
     uint history_max;
@@ -203,4 +209,9 @@ void main() {
     }
     imageStore(antialiased, pixel, vec4(mean, frames));
     imageStore(taa_depth, pixel, vec4(z));
+#ifdef HAS_VIEW_HISTORY_LENGTH
+    uint length = uint(frames + 0.5);
+    imageStore(view_history_length, pixel, uvec4(length));
+    atomicMax(view_history_length_totals.words[0], length);
+#endif
 }

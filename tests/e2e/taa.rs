@@ -229,3 +229,41 @@ fn what_an_occluder_uncovers_starts_again_at_once() {
     assert!(uncovered >= 150, "the quad uncovered {uncovered} pixels");
     assert!(kept >= 500, "{kept} pixels of plane kept their history");
 }
+
+/// The debug view `history_length` counts the frames each pixel's average
+/// holds: every pixel of a still camera's third frame holds three, and a
+/// camera moving 2 pixels a frame leaves the two columns entering the view
+/// at one.
+#[test]
+fn the_history_length_view_counts_the_frames_each_pixel_holds() {
+    let (still_dir, moving_dir) = (
+        TempDir::new("taa-history-still"),
+        TempDir::new("taa-history-moving"),
+    );
+    let still = scene(&still_dir.0, QUAD, "");
+    let moving = scene(
+        &moving_dir.0,
+        "",
+        "\tkey 0  0 0 5   0 0 0\n\tkey 1  0.625 0 5   0.625 0 0\n",
+    );
+    let lengths = |scene: &Path, frames: u32| {
+        let settings = RenderSettings {
+            graph: weft_tests::shipped("forward.ron"),
+            extent: Extent {
+                width: 32,
+                height: 32,
+            },
+            frames,
+            frame_time: 1.0,
+            features: vec!["!bloom".into(), "taa".into(), "history_length".into()],
+            ..RenderSettings::default()
+        };
+        let (rendered, _) = render_image_validated(scene, settings, "antialiased");
+        let (name, view) = &rendered.views[0];
+        assert_eq!(name, "history_length");
+        (view.pixels, view.total, view.max)
+    };
+    assert_eq!(lengths(&still, 3), (1024, 3.0 * 1024.0, 3.0));
+    // 30 columns found their history: 2 frames; 2 entered: 1.
+    assert_eq!(lengths(&moving, 2), (1024, (30.0 * 2.0 + 2.0) * 32.0, 2.0));
+}

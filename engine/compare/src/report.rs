@@ -97,8 +97,26 @@ pub struct Configuration {
     /// `caveats` whose features held): error there is a modelling gap, not
     /// the technique's.
     pub caveats: Vec<String>,
+    /// The graph's debug views whose features held (`views` in the file,
+    /// e.g. `history_length`: the frames each pixel's temporal history
+    /// holds), summarised over the last measured frame, by name.
+    pub views: Vec<(String, ViewNumbers)>,
     /// The files written for it.
     pub files: Vec<PathBuf>,
+}
+
+/// A debug view's per-pixel numbers over one frame, as `weft render --json`
+/// gives them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ViewNumbers {
+    /// The mean over the pixels summarised.
+    pub mean: f64,
+    /// The nearest-rank median.
+    pub median: f64,
+    /// The nearest-rank 95th percentile.
+    pub p95: f64,
+    /// The largest value.
+    pub max: f64,
 }
 
 /// Everything a compare run measured.
@@ -212,6 +230,7 @@ impl Report {
             );
         }
         out += &self.timing_note();
+        out += &self.views_note();
         if !notes.is_empty() {
             out += "\nCaveats: where a configuration differs from the reference by design, so part of its error is a modelling gap, not the technique's:\n\n";
             for (i, note) in notes.iter().enumerate() {
@@ -247,6 +266,29 @@ impl Report {
             "\nFrame times: {} has the lowest median, but the interquartile range of {} overlaps its: the timings do not order them.\n",
             fastest.name,
             tied.join(" and ")
+        )
+    }
+
+    /// The configurations' debug views, one line each, when any has one.
+    fn views_note(&self) -> String {
+        let lines: Vec<String> = self
+            .configurations
+            .iter()
+            .flat_map(|c| {
+                c.views.iter().map(move |(name, v)| {
+                    format!(
+                        "- {}: {name} mean {:.2}, median {}, p95 {}, max {}\n",
+                        c.name, v.mean, v.median, v.p95, v.max
+                    )
+                })
+            })
+            .collect();
+        if lines.is_empty() {
+            return String::new();
+        }
+        format!(
+            "\nDebug views, per pixel over the last frame:\n\n{}",
+            lines.concat()
         )
     }
 

@@ -12,7 +12,7 @@ use weft_compare::cache::{ReferenceCache, ReferenceKey};
 use weft_compare::metrics::Spread;
 use weft_compare::report::{
     write_contact_sheet, write_flip_map, Configuration, PassTime, ReferenceInfo, Report,
-    SheetColumn,
+    SheetColumn, ViewNumbers,
 };
 use weft_compare::{
     hdr_flip, ldr_flip, luminance_ratio, psnr, rel_mse, rmse, LinearImage, SrgbImage,

@@ -216,6 +216,19 @@ impl Session {
             transient_bytes,
             device_bytes: rendered.report.memory.allocated_bytes,
             caveats: rendered.plan.caveats.clone(),
+            views: rendered
+                .views
+                .iter()
+                .map(|(name, v)| {
+                    let numbers = ViewNumbers {
+                        mean: v.mean,
+                        median: v.median,
+                        p95: v.p95,
+                        max: v.max,
+                    };
+                    (name.clone(), numbers)
+                })
+                .collect(),
             files: Vec::new(),
         };
         Ok(Measured {

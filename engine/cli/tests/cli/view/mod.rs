@@ -615,18 +615,18 @@ fn c_prints_the_camera_as_a_scene_block() {
 }
 
 /// Features past the ninth are reached with Shift: on the forward graph over
-/// the Cornell box, the graph's own eleven take 1-9, Shift+1 and Shift+2 and
-/// the scene's follow, `area_lights` (the box's emissive quad) at Shift+3,
-/// which turns it off.
+/// the Cornell box, the graph's own twelve take 1-9 and Shift+1 to Shift+3,
+/// and the scene's follow, `area_lights` (the box's emissive quad) at
+/// Shift+4, which turns it off.
 #[test]
 fn shift_and_a_digit_toggle_the_features_past_the_ninth() {
-    let stdout = cornell_pressing("1:shift+3");
+    let stdout = cornell_pressing("1:shift+4");
     let lists: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
     assert_eq!(lists.len(), 2, "{stdout}");
-    assert!(lists[0].contains(", Shift+3 area_lights [on]"), "{stdout}");
-    assert!(lists[1].contains(", Shift+3 area_lights [off]"), "{stdout}");
+    assert!(lists[0].contains(", Shift+4 area_lights [on]"), "{stdout}");
+    assert!(lists[1].contains(", Shift+4 area_lights [off]"), "{stdout}");
     assert!(
-        lists[0].contains("9 rt_shadows [off], Shift+1 screen_space_tangents [off]"),
+        lists[0].contains("9 overshading [off], Shift+1 rt_shadows [off]"),
         "{stdout}"
     );
 }
