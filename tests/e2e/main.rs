@@ -11,6 +11,7 @@ mod gi;
 mod light_matrix;
 mod lights;
 mod mirrored;
+mod msaa;
 mod mutants;
 mod normal_maps;
 mod one_physics;

@@ -47,7 +47,10 @@ pub use error::{GpuError, VkCall};
 pub use executor::{FrameOptions, FrameReport, Renderer};
 pub use present::{Capture, Overlay, OverlayTarget, PresentSource, Presented, Presenter};
 pub use readback::{Pixels, Readback};
-pub use resources::{image_requirements, memory_requirements, oversized_images, FrameResources};
+pub use resources::{
+    image_requirements, memory_requirements, oversized_images, unsupported_sample_counts,
+    FrameResources,
+};
 pub use sets::{MATERIAL_SET, SCENE_SET};
 pub use shader::{CompiledShader, ShaderCompiler, ShaderDiagnostic, ShaderError, ShaderStage};
 pub use statistics::PassStatistics;

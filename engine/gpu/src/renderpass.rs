@@ -16,6 +16,7 @@ pub struct RenderPassKey {
     /// (format, samples, load op, store op, initial, subpass and final layout), as Vulkan values.
     attachments: Vec<(i32, u32, i32, i32, Layout, Layout, Layout)>,
     color: Vec<usize>,
+    resolve: Vec<Option<usize>>,
     depth: Option<usize>,
 }
 
@@ -39,6 +40,7 @@ impl RenderPassKey {
                 })
                 .collect(),
             color: desc.color.clone(),
+            resolve: desc.resolve.clone(),
             depth: desc.depth,
         }
     }
@@ -113,10 +115,25 @@ fn create(device: &ash::Device, desc: &RenderPassDesc) -> Result<vk::RenderPass,
         .iter()
         .map(|&i| reference(i))
         .collect::<Result<_, _>>()?;
+    // One entry per colour attachment: the attachment it resolves into, or
+    // none (VK_ATTACHMENT_UNUSED).
+    let resolve: Vec<_> = desc
+        .resolve
+        .iter()
+        .map(|target| match target {
+            Some(i) => reference(*i),
+            None => Ok(vk::AttachmentReference2::default()
+                .attachment(vk::ATTACHMENT_UNUSED)
+                .layout(vk::ImageLayout::UNDEFINED)),
+        })
+        .collect::<Result<_, _>>()?;
     let depth = desc.depth.map(reference).transpose()?;
     let mut subpass = vk::SubpassDescription2::default()
         .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
         .color_attachments(&color);
+    if desc.resolve.iter().any(Option::is_some) {
+        subpass = subpass.resolve_attachments(&resolve);
+    }
     if let Some(depth) = &depth {
         subpass = subpass.depth_stencil_attachment(depth);
     }

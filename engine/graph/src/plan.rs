@@ -320,6 +320,9 @@ pub struct RenderPassDesc {
     pub attachments: Vec<AttachmentDesc>,
     /// Indices into `attachments`.
     pub color: Vec<usize>,
+    /// Per colour attachment, the index of the attachment it resolves into
+    /// at the end of the pass (`resolve:` in the file), if any.
+    pub resolve: Vec<Option<usize>>,
     pub depth: Option<usize>,
 }
 

@@ -94,10 +94,20 @@ pub fn render(plan: &Plan) -> String {
             let _ = writeln!(w, "     barrier {}", barrier_line(plan, b));
         }
         if let Some(rp) = &p.render_pass {
-            for a in &rp.attachments {
+            for (i, a) in rp.attachments.iter().enumerate() {
+                // A resolve target says which attachment it resolves.
+                let resolves = rp
+                    .resolve
+                    .iter()
+                    .position(|&t| t == Some(i))
+                    .map(|k| {
+                        let from = &plan.resources[rp.attachments[rp.color[k]].resource].name;
+                        format!(" (resolves {from})")
+                    })
+                    .unwrap_or_default();
                 let _ = writeln!(
                     w,
-                    "     attachment {}: load {:?} store {:?}{} layout {}",
+                    "     attachment {}: load {:?} store {:?}{} layout {}{resolves}",
                     plan.resources[a.resource].name,
                     a.load,
                     a.store,

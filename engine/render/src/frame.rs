@@ -193,7 +193,53 @@ pub fn compile_for_scene(
             device: gpu.info().name.clone(),
         });
     }
+    if let Some((image, samples, offered)) = weft_gpu::unsupported_sample_counts(gpu, &plan)
+        .into_iter()
+        .next()
+    {
+        return Err(RenderError::Graph(vec![unsupported_samples(
+            loaded, &image, samples, &offered, gpu,
+        )]));
+    }
     Ok(plan)
+}
+
+/// The error at image `image`'s `samples`: a count the device's
+/// attachments cannot have, and those they can.
+fn unsupported_samples(
+    graph: &weft_graph::LoadedGraph,
+    image: &str,
+    samples: u32,
+    offered: &[u32],
+    gpu: &Gpu,
+) -> weft_graph::Diagnostic {
+    let declared = graph.resources.iter().find(|r| match &r.item {
+        weft_graph::schema::ResourceDecl::Image(i) => i.name == image,
+        weft_graph::schema::ResourceDecl::Buffer(_) => false,
+    });
+    let (file, pos) = declared.map_or_else(Default::default, |r| {
+        graph.locate(
+            r.source,
+            &[
+                weft_graph::spans::Seg::Field("resources"),
+                weft_graph::spans::Seg::Index(r.index),
+                weft_graph::spans::Seg::Field("samples"),
+            ],
+        )
+    });
+    let list: Vec<String> = offered.iter().map(u32::to_string).collect();
+    weft_graph::Diagnostic::error(
+        file,
+        pos,
+        format!(
+            "image \"{image}\" has {samples} samples, which attachments on {} cannot have",
+            gpu.info().name
+        ),
+    )
+    .with_hint(format!(
+        "use one of {} (framebufferColorSampleCounts and framebufferDepthSampleCounts)",
+        list.join(", ")
+    ))
 }
 
 /// Renders `scene` through the graph in `settings` (loaded here; callers

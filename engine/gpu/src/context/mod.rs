@@ -57,6 +57,11 @@ pub struct DeviceInfo {
     /// The most texels a texel buffer's view may cover
     /// (`maxTexelBufferElements`): larger scene tables are refused.
     pub max_texel_buffer_elements: u32,
+    /// Sample counts colour and depth attachments may have, as a mask of
+    /// counts (bit n: 2^n samples; `framebufferColorSampleCounts` and
+    /// `framebufferDepthSampleCounts` together): plans with another count
+    /// are refused before any image is created.
+    pub attachment_sample_counts: u32,
 }
 
 /// The physical device type, in preference order.

@@ -110,13 +110,34 @@ fn warn_unread(
         }
         let touches = &timeline.per_resource[r];
         let written = touches.iter().any(|&(_, p, k)| uses[p][k].writes);
-        // A depth attachment is read by its own depth test.
+        // A depth attachment is read by its own depth test, a colour
+        // attachment with a resolve target (the access after it) by the
+        // resolve.
         let read = touches.iter().any(|&(_, p, k)| {
             let u = &uses[p][k];
+            let accesses = &ir.passes[p].accesses;
+            let resolved = |a: usize| {
+                accesses.get(a + 1).is_some_and(|next| {
+                    matches!(
+                        next.usage,
+                        Usage::Color {
+                            resolve_target: true,
+                            ..
+                        }
+                    )
+                })
+            };
             u.reads_previous
-                || u.accesses
-                    .iter()
-                    .any(|&a| matches!(ir.passes[p].accesses[a].usage, Usage::Depth { .. }))
+                || u.accesses.iter().any(|&a| {
+                    matches!(accesses[a].usage, Usage::Depth { .. })
+                        || (matches!(
+                            accesses[a].usage,
+                            Usage::Color {
+                                resolve_target: false,
+                                ..
+                            }
+                        ) && resolved(a))
+                })
         });
         if written && !read {
             let (file, pos) = graph.locate(

@@ -106,7 +106,14 @@ fn plan_pass(
         }
     }
     for access in active_accesses() {
-        if matches!(access.usage, Usage::Color { .. }) && !access.conditions.is_empty() {
+        if matches!(
+            access.usage,
+            Usage::Color {
+                resolve_target: false,
+                ..
+            }
+        ) && !access.conditions.is_empty()
+        {
             defines.insert(format!(
                 "HAS_{}",
                 ir.resources[access.resource].name.to_ascii_uppercase()
@@ -132,11 +139,14 @@ fn plan_pass(
     let render_pass = matches!(pass.kind, PassKind::Raster | PassKind::Fullscreen).then(|| {
         let mut attachments = Vec::new();
         let mut color = Vec::new();
+        let mut resolve = Vec::new();
         let mut depth = None;
         let mut extent = options.extent;
         for access in active_accesses() {
             let (load, store, blend, read_only, is_depth) = match &access.usage {
-                Usage::Color { load, store, blend } => (load, *store, *blend, false, false),
+                Usage::Color {
+                    load, store, blend, ..
+                } => (load, *store, *blend, false, false),
                 Usage::Depth {
                     load,
                     store,
@@ -173,10 +183,20 @@ fn plan_pass(
                 LoadDecl::DontCare => (LoadOp::DontCare, Vec::new()),
             };
             let index = attachments.len();
-            if is_depth {
-                depth = Some(index);
-            } else {
-                color.push(index);
+            match access.usage {
+                _ if is_depth => depth = Some(index),
+                Usage::Color {
+                    resolve_target: true,
+                    ..
+                } => {
+                    if let Some(last) = resolve.last_mut() {
+                        *last = Some(index);
+                    }
+                }
+                _ => {
+                    color.push(index);
+                    resolve.push(None);
+                }
             }
             attachments.push(AttachmentDesc {
                 resource: r,
@@ -196,6 +216,7 @@ fn plan_pass(
             extent,
             attachments,
             color,
+            resolve,
             depth,
         }
     });

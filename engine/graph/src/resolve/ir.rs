@@ -168,6 +168,9 @@ pub enum Usage {
         load: LoadDecl,
         store: StoreDecl,
         blend: Option<Blend>,
+        /// The single-sample image the colour attachment before it
+        /// resolves into (`resolve:`), not an attachment shaders write.
+        resolve_target: bool,
     },
     Depth {
         load: LoadDecl,

@@ -2,8 +2,10 @@
 //! format, parameter and per-pass rule that does not depend on execution order.
 //! All problems are collected; none stops the others from being found.
 
+mod attachments;
 mod features;
 mod ir;
+mod multisample;
 mod passes;
 mod resources;
 mod rules;
@@ -171,6 +173,7 @@ impl<'a> Resolver<'a> {
             views,
         };
         self.check_usages(&ir);
+        self.check_multisampling(&ir);
         self.check_extents(&ir);
         self.check_caveats(&ir);
         self.check_jitter(&ir);

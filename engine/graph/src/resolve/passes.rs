@@ -8,8 +8,7 @@ use crate::id::{IdVec, IrResourceId};
 use crate::load::Located;
 use crate::plan::ShaderFiles;
 use crate::schema::{
-    AttachmentDecl, Dispatch, Draw, ParamValue, PassDecl, PassKind, ProviderDecl, RasterState,
-    ReadDecl,
+    Dispatch, Draw, ParamValue, PassDecl, PassKind, ProviderDecl, RasterState, ReadDecl,
 };
 use crate::spans::Seg;
 use std::collections::BTreeMap;
@@ -88,47 +87,7 @@ impl Resolver<'_> {
     ) -> IrPass {
         let (source, index) = (p.source, p.index);
         let decl = &p.item;
-        let mut accesses = Vec::new();
-        let mut conditional_before = None;
-        for (i, a) in decl.color.iter().enumerate() {
-            let path = pass_path(
-                index,
-                &[Seg::Field("color"), Seg::Index(i), Seg::Field("image")],
-            );
-            if let Some(r) = self.lookup(source, &path, &a.image) {
-                accesses.push(attachment_access(r, a, false, "color", Some(i)));
-            }
-            match (&conditional_before, a.enabled_if.is_empty()) {
-                (None, false) => conditional_before = Some(a.image.clone()),
-                (Some(earlier), true) => {
-                    self.error(
-                        source,
-                        &path,
-                        format!(
-                            "colour attachment \"{}\" follows the conditional attachment \"{earlier}\": its fragment output location would depend on features",
-                            a.image
-                        ),
-                    )
-                    .hint = Some("list conditional colour attachments last".into());
-                }
-                _ => {}
-            }
-        }
-        if let Some(a) = &decl.depth {
-            let path = pass_path(index, &[Seg::Field("depth"), Seg::Field("image")]);
-            if !a.enabled_if.is_empty() {
-                let at = pass_path(index, &[Seg::Field("depth"), Seg::Field("enabled_if")]);
-                self.error(
-                    source,
-                    &at,
-                    "a depth attachment cannot be conditional: make the pass conditional instead"
-                        .to_string(),
-                );
-            }
-            if let Some(r) = self.lookup(source, &path, &a.image) {
-                accesses.push(attachment_access(r, a, true, "depth", None));
-            }
-        }
+        let mut accesses = self.resolve_attachments(p);
         let read_lists: [(&'static str, &Vec<ReadDecl>, Usage); 3] = [
             ("sampled", &decl.sampled, Usage::Sampled),
             ("storage_read", &decl.storage_read, Usage::StorageRead),
@@ -539,35 +498,6 @@ impl Resolver<'_> {
             };
             self.error(source, &at, format!("{what} must be {range}, found {bad}"));
         }
-    }
-}
-
-fn attachment_access(
-    resource: IrResourceId,
-    a: &AttachmentDecl,
-    depth: bool,
-    field: &'static str,
-    item: Option<usize>,
-) -> IrAccess {
-    let usage = if depth {
-        Usage::Depth {
-            load: a.load.clone(),
-            store: a.store,
-            read_only: a.read_only,
-        }
-    } else {
-        Usage::Color {
-            load: a.load.clone(),
-            store: a.store,
-            blend: a.blend,
-        }
-    };
-    IrAccess {
-        resource,
-        usage,
-        conditions: a.enabled_if.clone(),
-        field,
-        item,
     }
 }
 

@@ -254,6 +254,11 @@ pub struct AttachmentDecl {
     /// Depth attachment used for testing only (no depth writes), so it can be sampled too.
     #[serde(default)]
     pub read_only: bool,
+    /// For a multisampled colour attachment: the single-sample image of its
+    /// size and format its samples are averaged into at the end of the pass
+    /// (a render pass's resolve attachment), for later passes to sample.
+    #[serde(default)]
+    pub resolve: Option<String>,
     /// Features that must all hold for a colour attachment to be attached
     /// (the shaders then see `HAS_<IMAGE>`); conditional attachments come
     /// after every unconditional one, so fragment output locations stay put.

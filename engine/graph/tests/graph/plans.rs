@@ -81,8 +81,8 @@ fn plans_match_snapshots_and_pass_the_checker() {
         }
     }
     assert_eq!(
-        compared, 21,
-        "forward, deferred, tiled, hybrid, pathtrace, pathtrace_denoised and pathtrace_wavefront, three feature sets each"
+        compared, 24,
+        "forward, forward_msaa, deferred, tiled, hybrid, pathtrace, pathtrace_denoised and pathtrace_wavefront, three feature sets each"
     );
 }
 

@@ -31,6 +31,7 @@ fn every_example_scene_loads_without_warnings() {
             "cameras.scene",
             "caustics.scene",
             "cornell.scene",
+            "cornell_pan.scene",
             "day_cycle.scene",
             "demo.scene",
             "flight_helmet.scene",

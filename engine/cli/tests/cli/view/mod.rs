@@ -515,11 +515,11 @@ fn scripted_keys_switch_graph_toggle_a_feature_and_save_a_screenshot() {
     assert_eq!(graphs.len(), 4, "{stdout}");
     assert!(graphs[0].contains("forward.ron: features"), "{stdout}");
     assert!(
-        graphs[1].contains("hybrid.ron: features"),
+        graphs[1].contains("forward_msaa.ron: features"),
         "G moved on to the next graph in graphs/: {stdout}"
     );
     assert!(
-        graphs[2].contains("pathtrace.ron: features 1 independent_sampler"),
+        graphs[2].contains("hybrid.ron: features 1 bloom"),
         "G moved on: {stdout}"
     );
     let first_feature = |line: &str| {

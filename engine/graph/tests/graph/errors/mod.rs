@@ -6,6 +6,7 @@ use crate::support;
 use support::{check_text, load_files};
 use weft_graph::{Diagnostic, Severity};
 
+mod multisample;
 mod values;
 
 /// The text at a diagnostic's position, up to the end of its line.
