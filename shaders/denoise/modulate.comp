@@ -1,19 +1,47 @@
 #version 450
 // The denoiser's last step (graphs/denoise.ron): the filtered illumination
-// times the albedo it was divided by.
+// fades into the temporal mean as the pixel's history grows (the spatial
+// filter's share falls linearly from the first frame to none at
+// `fade_frames` averaged), so a converging still image ends as the plain
+// average of its samples rather than a blur of it; then times the albedo
+// it was divided by. An outlier's excess, which the variance step kept out
+// of the filter, goes back into the filtered value beside a light (the
+// pixel's coverage of it) and elsewhere (a firefly) is left out of it: the
+// image shows a firefly only in the temporal mean's share, so early
+// frames suppress it and the converged image is the unbiased mean.
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = 0, rgba32f) uniform readonly image2D filtered;
+layout(set = 0, binding = 0, rgba32f) uniform readonly image2D filtered_5;
 layout(set = 0, binding = 1, rgba16f) uniform readonly image2D albedo;
 layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D denoised;
+layout(set = 0, binding = 3, rgba32f) uniform readonly image2D spatial_excess;
+layout(set = 0, binding = 4, rgba32f) uniform readonly image2D illumination;
+layout(set = 0, binding = 5, rgba32f) uniform readonly image2D moments;
+
+layout(push_constant) uniform Params {
+    float fade_frames;
+} params;
 
 void main() {
-    ivec2 size = imageSize(filtered);
+    ivec2 size = imageSize(filtered_5);
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(pixel, size))) {
         return;
     }
-    vec3 illum = imageLoad(filtered, pixel).rgb;
+    vec4 excess = imageLoad(spatial_excess, pixel);
+    vec3 spatial = imageLoad(filtered_5, pixel).rgb + excess.a * excess.rgb;
+    vec3 m = imageLoad(moments, pixel).xyz;
+    vec3 temporal = imageLoad(illumination, pixel).rgb;
+    float fade = params.fade_frames > 1.0 ? clamp((m.z - 1.0) / (params.fade_frames - 1.0), 0.0, 1.0) : 0.0;
+    // Shrinkage, once eight frames make the temporal variance a fair
+    // estimate: the squared difference of the two estimates is the spatial
+    // one's bias squared plus the temporal mean's variance; where it
+    // exceeds that variance, the excess is bias the filter added, and the
+    // temporal mean takes the share 1 - variance / difference^2.
+    float variance = max(m.y - m.x * m.x, 0.0) / max(m.z, 1.0);
+    float d = denoise_luminance(spatial) - denoise_luminance(temporal);
+    float bias_share = m.z >= 8.0 && d * d > variance ? 1.0 - variance / (d * d) : 0.0;
+    vec3 illum = mix(spatial, temporal, max(fade, bias_share));
     imageStore(denoised, pixel, vec4(remodulate(illum, imageLoad(albedo, pixel).rgb), 1.0));
 }

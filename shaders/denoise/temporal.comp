@@ -34,8 +34,18 @@ layout(set = 0, binding = 10, rgba32f) uniform readonly image2D guide_previous_p
 layout(push_constant) uniform Params {
     uint history_max;
     float position_tolerance;
+    float gradient_sigma;
     uint plan_frames;
+    uint history_frames;
 } params;
+
+// The luminance of this frame's illumination at `q` (radiance over
+// albedo), and whether `q` shows what kind of pixel `kind` is.
+float illumination_at(ivec2 q, ivec2 size, float kind, out bool same_kind) {
+    q = clamp(q, ivec2(0), size - 1);
+    same_kind = pixel_kind(imageLoad(guide_normal, q).w) == kind;
+    return denoise_luminance(demodulate(texelFetch(radiance, q, 0).rgb, imageLoad(albedo, q).rgb));
+}
 
 void main() {
     ivec2 size = textureSize(radiance, 0);
@@ -52,11 +62,16 @@ void main() {
     vec3 moments_history = vec3(0.0);
     float weights = 0.0;
     vec3 was = imageLoad(guide_previous_position, pixel).xyz;
-    if (p.w > 0.0 && params.plan_frames > 0u) {
-        vec4 clip = frame.prev_view_proj * vec4(was, 1.0);
+    // The history texel nearest where this pixel's point was.
+    ivec2 found = pixel;
+    // The background (nothing met) is reprojected by its direction.
+    bool background = p.w == 0.0;
+    if (params.plan_frames > 0u) {
+        vec4 clip = frame.prev_view_proj * (background ? vec4(-n.xyz, 0.0) : vec4(was, 1.0));
         if (clip.w > 0.0) {
             vec2 at = (clip.xy / clip.w * 0.5 + 0.5) * vec2(size) - 0.5;
             ivec2 base = ivec2(floor(at));
+            found = ivec2(round(at));
             vec2 f = at - vec2(base);
             float tolerance = params.position_tolerance * max(n.w, 1e-6);
             for (int k = 0; k < 4; ++k) {
@@ -67,7 +82,8 @@ void main() {
                 }
                 vec4 pq = imageLoad(position_prev, q);
                 vec4 nq = imageLoad(normal_prev, q);
-                bool same = pq.w > 0.0 && distance(pq.xyz, was) <= tolerance && dot(nq.xyz, n.xyz) > 0.9;
+                bool same = background ? pq.w == 0.0 && dot(nq.xyz, n.xyz) > 0.9
+                    : pq.w > 0.0 && distance(pq.xyz, was) <= tolerance && dot(nq.xyz, n.xyz) > 0.9;
                 if (same) {
                     history += w * imageLoad(illumination_prev, q).rgb;
                     moments_history += w * imageLoad(moments_prev, q).xyz;
@@ -76,12 +92,44 @@ void main() {
             }
         }
     }
+    if (weights > 1e-4) {
+        history /= weights;
+        moments_history /= weights;
+        // Temporal gradient: after a change (`history_frames` 0: the
+        // camera, a light or a placement moved), this frame's 3x3
+        // neighbourhood of pixels of this kind against the history texels
+        // around where the point was, the differences averaged (texture
+        // cancels); beyond `gradient_sigma` standard errors of that mean
+        // and 10% of the history, the light here changed: the history
+        // restarts. The per-sample deviation is the history's (from its
+        // moments) once it holds four frames, before that this frame's
+        // neighbourhood's.
+        if (params.history_frames == 0u && params.gradient_sigma > 0.0) {
+            float change = 0.0;
+            vec2 now = vec2(0.0);
+            float count = 0.0;
+            for (int k = 0; k < 9; ++k) {
+                bool same;
+                ivec2 offset = ivec2(k % 3 - 1, k / 3 - 1);
+                float lq = illumination_at(pixel + offset, size, pixel_kind(n.w), same);
+                vec3 before = imageLoad(illumination_prev, clamp(found + offset, ivec2(0), size - 1)).rgb;
+                change += same ? lq - denoise_luminance(before) : 0.0;
+                now += same ? vec2(lq, lq * lq) : vec2(0.0);
+                count += same ? 1.0 : 0.0;
+            }
+            count = max(count, 1.0);
+            vec2 m = moments_history.z >= 4.0 ? moments_history.xy : now / count;
+            float sigma = sqrt(max(m.y - m.x * m.x, 0.0));
+            float error = params.gradient_sigma * sigma / sqrt(count);
+            if (abs(change / count) > max(error, 0.1 * denoise_luminance(history)) + 1e-6) {
+                weights = 0.0;
+            }
+        }
+    }
     float frames = 1.0;
     vec3 mean = illum;
     vec2 m = vec2(l, l * l);
     if (weights > 1e-4) {
-        history /= weights;
-        moments_history /= weights;
         frames = min(moments_history.z + 1.0, float(max(params.history_max, 1u)));
         float alpha = 1.0 / frames;
         mean = mix(history, illum, alpha);

@@ -4,7 +4,8 @@
 //! keeps every texel a pure camera translation, or a mesh's, keeps in view
 //! and only those,
 //! and on path-traced frames the error falls fourfold while the image's mean
-//! holds.
+//! holds. What makes it converge (no dot grid, no ghost of a switched-off
+//! light, never worse than raw accumulation): `converges.rs`.
 
 use std::path::{Path, PathBuf};
 use weft_compare::{rel_mse, LinearImage};
@@ -12,6 +13,8 @@ use weft_gpu::Pixels;
 use weft_graph::plan::Extent;
 use weft_render::{render, RenderSettings};
 use weft_tests::TempDir;
+
+mod converges;
 
 const SIZE: u32 = 32;
 
@@ -45,6 +48,11 @@ fn plane_scene(dir: &Path, keys: &str) -> PathBuf {
 
 /// The fixture's images after `frames` frames one second apart, validated.
 fn fixture(scene: &Path, frames: u32) -> Images {
+    fixture_with(scene, frames, &[])
+}
+
+/// [`fixture`] with the fixture graph's parameters `params` set.
+fn fixture_with(scene: &Path, frames: u32, params: &[(&str, f64)]) -> Images {
     let scene = weft_scene::load_scene(scene).expect("scene loads");
     let gpu = weft_tests::gpu();
     let log = gpu.validation();
@@ -59,6 +67,10 @@ fn fixture(scene: &Path, frames: u32) -> Images {
         extra_readback: ["hdr", "albedo", "illumination", "moments"]
             .map(String::from)
             .to_vec(),
+        params: params
+            .iter()
+            .map(|(k, v)| (k.to_string(), weft_graph::schema::ParamValue::Number(*v)))
+            .collect(),
         ..RenderSettings::default()
     };
     let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
@@ -212,16 +224,20 @@ fn reprojection_follows_a_moving_mesh() {
 }
 
 /// `graph` (to `samples` per pixel where given) at 48 x 48 and `max_depth`
-/// 3, after `frames` frames `frame_time` apart, with `features`: the image
-/// `read`, validated.
+/// 3, after `frames` frames `frame_time` apart, with `features` and
+/// `params`: the image `read`, validated.
 fn traced(
     scene: &Path,
     (graph, samples): (&str, Option<u64>),
     (frames, frame_time): (u32, f64),
     (features, read): (&[&str], &str),
+    params: &[(&str, f64)],
 ) -> LinearImage {
-    let mut settings =
-        weft_tests::render::square_settings(graph, 48, samples, &[("max_depth", 3.0)], features);
+    let params: Vec<(&str, f64)> = [("max_depth", 3.0)]
+        .into_iter()
+        .chain(params.iter().copied())
+        .collect();
+    let mut settings = weft_tests::render::square_settings(graph, 48, samples, &params, features);
     settings.frames = frames;
     settings.frame_time = frame_time;
     weft_tests::render::linear_image_validated(scene, settings, read)
@@ -239,7 +255,7 @@ fn on_path_traced_frames_the_error_falls_fourfold_and_the_mean_holds() {
     let dir = TempDir::new("denoise-noisy");
     let scene = crate::rt_ao::scene(&dir.0);
     let image = |graph: &str, samples: Option<u64>, frames: u32, toggles_read| {
-        traced(&scene, (graph, samples), (frames, 0.0), toggles_read)
+        traced(&scene, (graph, samples), (frames, 0.0), toggles_read, &[])
     };
     let reference = image("pathtrace.ron", Some(512), 1, (&[], "hdr"));
     let mean = |i: &LinearImage| i.pixels.iter().map(|p| f64::from(p[1])).sum::<f64>();
@@ -296,12 +312,14 @@ fn in_a_moving_scene_each_frame_draws_new_samples_and_is_denoised() {
             ("pathtrace.ron", samples),
             (frames, 0.0),
             toggles_read,
+            &[],
         ),
         None => traced(
             &scene,
             ("pathtrace_denoised.ron", None),
             (frames, 1.0 / 60.0),
             toggles_read,
+            &[],
         ),
     };
     let reference = image(Some(512), 1, (&[], "hdr"));
