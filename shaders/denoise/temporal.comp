@@ -30,6 +30,12 @@ layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D illumination;
 // x, y: luminance mean and mean square, z: frames averaged.
 layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D moments;
 layout(set = 0, binding = 10, rgba32f) uniform readonly image2D guide_previous_position;
+#ifdef HAS_VIEW_DENOISE_HISTORY
+// Debug view `history_length`: the frames each pixel averages, and the
+// frame's largest in word 0 (debug_view.frag's legend scale).
+layout(set = 0, binding = 11, r32ui) uniform writeonly uimage2D view_denoise_history;
+layout(std430, set = 0, binding = 12) buffer ViewDenoiseHistoryTotals { uint words[4]; } view_denoise_history_totals;
+#endif
 
 layout(push_constant) uniform Params {
     uint history_max;
@@ -138,4 +144,8 @@ void main() {
     float variance = max(m.y - m.x * m.x, 0.0) / frames;
     imageStore(illumination, pixel, vec4(mean, variance));
     imageStore(moments, pixel, vec4(m, frames, 0.0));
+#ifdef HAS_VIEW_DENOISE_HISTORY
+    imageStore(view_denoise_history, pixel, uvec4(uint(frames + 0.5)));
+    atomicMax(view_denoise_history_totals.words[0], uint(frames + 0.5));
+#endif
 }

@@ -152,3 +152,25 @@ fn the_denoised_image_is_never_worse_than_raw_accumulation() {
         );
     }
 }
+
+/// The debug view `history_length` counts the frames the denoiser's
+/// temporal mean holds: every pixel of the box scene's third still frame
+/// holds three.
+#[test]
+fn the_history_length_view_counts_the_denoisers_frames() {
+    let dir = TempDir::new("denoise-history-length");
+    let scene = crate::rt_ao::scene(&dir.0);
+    let mut settings = weft_tests::render::square_settings(
+        "pathtrace_denoised.ron",
+        16,
+        None,
+        &[],
+        &["history_length"],
+    );
+    settings.frames = 3;
+    settings.frame_time = 0.0;
+    let (rendered, _) = weft_tests::render::render_image_validated(&scene, settings, "denoised");
+    let (name, view) = &rendered.views[0];
+    assert_eq!(name, "history_length");
+    assert_eq!((view.pixels, view.total, view.max), (256, 3.0 * 256.0, 3.0));
+}

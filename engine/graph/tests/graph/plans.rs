@@ -258,6 +258,10 @@ fn scene_features_cull_passes_and_variants() {
             ("denoise_atrous_8", "enabled_if [denoise] is false"),
             ("denoise_atrous_16", "enabled_if [denoise] is false"),
             ("denoise_modulate", "enabled_if [denoise] is false"),
+            (
+                "clear_denoise_history",
+                "enabled_if [denoise, history_length] is false"
+            ),
             ("keep_normal", "enabled_if [denoise] is false"),
             ("keep_position", "enabled_if [denoise] is false"),
             ("keep_illumination", "enabled_if [denoise] is false"),
