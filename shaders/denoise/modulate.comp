@@ -38,10 +38,22 @@ void main() {
     // estimate: the squared difference of the two estimates is the spatial
     // one's bias squared plus the temporal mean's variance; where it
     // exceeds that variance, the excess is bias the filter added, and the
-    // temporal mean takes the share 1 - variance / difference^2.
-    float variance = max(m.y - m.x * m.x, 0.0) / max(m.z, 1.0);
-    float d = denoise_luminance(spatial) - denoise_luminance(temporal);
-    float bias_share = m.z >= 8.0 && d * d > variance ? 1.0 - variance / (d * d) : 0.0;
+    // temporal mean takes the share 1 - variance / difference^2. Both are
+    // averaged over the 3x3 neighbourhood: one pixel's difference is too
+    // noisy a measure, and a share that jumps from pixel to pixel is noise
+    // of its own.
+    float d2 = 0.0;
+    float v = 0.0;
+    for (int k = 0; k < 9; ++k) {
+        ivec2 q = clamp(pixel + ivec2(k % 3 - 1, k / 3 - 1), ivec2(0), size - 1);
+        vec4 eq = imageLoad(spatial_excess, q);
+        vec3 mq = imageLoad(moments, q).xyz;
+        float dq = denoise_luminance(imageLoad(filtered_5, q).rgb + eq.a * eq.rgb)
+            - denoise_luminance(imageLoad(illumination, q).rgb);
+        d2 += dq * dq;
+        v += max(mq.y - mq.x * mq.x, 0.0) / max(mq.z, 1.0);
+    }
+    float bias_share = m.z >= 8.0 && d2 > v ? 1.0 - v / d2 : 0.0;
     vec3 illum = mix(spatial, temporal, max(fade, bias_share));
     imageStore(denoised, pixel, vec4(remodulate(illum, imageLoad(albedo, pixel).rgb), 1.0));
 }

@@ -7,5 +7,6 @@ mod define_sets;
 mod errors;
 mod fuzz;
 mod includes;
+mod jitter;
 mod plans;
 mod random;

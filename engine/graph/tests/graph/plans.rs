@@ -623,22 +623,3 @@ fn alternatives_in_a_condition_decide_culling() {
     assert!(!runs(&["shadow_casters", "rt_shadows"]));
     assert!(!runs(&["spot_lights"]));
 }
-
-/// forward.ron jitters the camera under `taa` (taa.ron's `jitter`) and
-/// only then, and its plan text says so.
-#[test]
-fn the_camera_is_jittered_only_under_the_features_that_ask_for_it() {
-    let graph = weft_graph::load(&repo_root().join("graphs/forward.ron"));
-    let plan = |toggles: &[&str]| {
-        let options = CompileOptions {
-            features: graph.features(toggles),
-            ..CompileOptions::default()
-        };
-        weft_graph::compile(&graph, &options).expect("compiles")
-    };
-    assert!(!plan(&[]).camera_jitter);
-    let jittered = plan(&["taa"]);
-    assert!(jittered.camera_jitter);
-    assert!(weft_graph::text::render(&jittered)
-        .contains("\ncamera jittered each frame by a sub-pixel Halton (2, 3) offset\n"));
-}

@@ -105,7 +105,7 @@ fn the_panel_docks_beside_the_view_and_stays_out_of_screenshots_unless_asked() {
 }
 
 /// A feature past the ninth key (`tile_depth_mask`, the tiled graph's
-/// fifteenth) is switched off and `exposure` typed as 2 through the panel's
+/// sixteenth) is switched off and `exposure` typed as 2 through the panel's
 /// own widgets; the next frames equal `weft render` with the same toggle
 /// and `--param`.
 #[test]
@@ -132,11 +132,11 @@ fn a_feature_and_a_parameter_set_in_the_panel_render_as_weft_render_does() {
     let lists: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
     assert_eq!(lists.len(), 2, "{stdout}");
     assert!(
-        lists[0].contains("Shift+7 tile_depth_mask [on]"),
+        lists[0].contains("Shift+8 tile_depth_mask [on]"),
         "{stdout}"
     );
     assert!(
-        lists[1].contains("Shift+7 tile_depth_mask [off]"),
+        lists[1].contains("Shift+8 tile_depth_mask [off]"),
         "{stdout}"
     );
     assert!(stdout.contains("parameter exposure = 2\n"), "{stdout}");
