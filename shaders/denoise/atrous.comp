@@ -40,7 +40,10 @@ void main() {
     // which is exactly black in the reference wherever no object is near
     // (all five steps spread the flight helmet's silhouettes into a haze:
     // HDR-FLIP 0.70 against 0.18).
-    if (!surface && step > 2) {
+    // A pixel whose filter has faded out (the variance step marks it with a
+    // negative variance) is passed through: its own output is the temporal
+    // mean, and as a neighbour it is what it is.
+    if ((!surface && step > 2) || centre.a < 0.0) {
         imageStore(target, pixel, centre);
         return;
     }
@@ -50,7 +53,7 @@ void main() {
         for (int x = -1; x <= 1; ++x) {
             ivec2 q = clamp(pixel + ivec2(x, y), ivec2(0), size - 1);
             float w = (x == 0 ? 0.5 : 0.25) * (y == 0 ? 0.5 : 0.25);
-            blurred += w * imageLoad(source, q).a;
+            blurred += w * max(imageLoad(source, q).a, 0.0);
             blur_weights += w;
         }
     }
@@ -79,7 +82,7 @@ void main() {
                             * depth_weight(np.w, nq.w, slope, float(step) * length(vec2(x, y)), params.phi_depth)
                         : 1.0);
             sum += w * cq.rgb;
-            variance += w * w * cq.a;
+            variance += w * w * max(cq.a, 0.0);
             weights += w;
         }
     }

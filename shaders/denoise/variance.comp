@@ -32,6 +32,7 @@ layout(push_constant) uniform Params {
     float phi_normal;
     float phi_depth;
     float outlier_ratio;
+    float fade_frames;
 } params;
 
 // The variance of the mean of a pixel that averaged fewer than four
@@ -73,6 +74,14 @@ void main() {
     }
     vec4 centre = imageLoad(illumination, pixel);
     vec3 mp = imageLoad(moments, pixel).xyz;
+    if (params.fade_frames > 1.0 && mp.z >= params.fade_frames) {
+        // The filter has faded out here (modulate.comp shows the temporal
+        // mean): marked with a negative variance, the à-trous steps pass it
+        // through instead of filtering it.
+        imageStore(spatial_excess, pixel, vec4(0.0));
+        imageStore(filtered_0, pixel, vec4(centre.rgb, -1.0));
+        return;
+    }
     vec4 np = imageLoad(guide_normal, pixel);
     float kind = pixel_kind(np.w);
     float brightest = 0.0;
