@@ -19,6 +19,12 @@ vec3 remodulate(vec3 illumination, vec3 albedo) {
     return illumination * max(albedo, vec3(MIN_ALBEDO));
 }
 
+// The variance of a luminance mean from its moments (x: mean, y: mean
+// square, z: samples averaged).
+float variance_of_mean(vec3 moments) {
+    return max(moments.y - moments.x * moments.x, 0.0) / max(moments.z, 1.0);
+}
+
 // Normals: cos^phi of the angle between them (phi 128 in SVGF).
 float normal_weight(vec3 np, vec3 nq, float phi) {
     return pow(max(dot(np, nq), 0.0), phi);

@@ -42,18 +42,20 @@ void main() {
     // averaged over the 3x3 neighbourhood: one pixel's difference is too
     // noisy a measure, and a share that jumps from pixel to pixel is noise
     // of its own.
-    float d2 = 0.0;
-    float v = 0.0;
-    for (int k = 0; k < 9; ++k) {
-        ivec2 q = clamp(pixel + ivec2(k % 3 - 1, k / 3 - 1), ivec2(0), size - 1);
-        vec4 eq = imageLoad(spatial_excess, q);
-        vec3 mq = imageLoad(moments, q).xyz;
-        float dq = denoise_luminance(imageLoad(filtered_5, q).rgb + eq.a * eq.rgb)
-            - denoise_luminance(imageLoad(illumination, q).rgb);
-        d2 += dq * dq;
-        v += max(mq.y - mq.x * mq.x, 0.0) / max(mq.z, 1.0);
+    float bias_share = 0.0;
+    if (m.z >= 8.0 && fade < 1.0) {
+        float d2 = 0.0;
+        float v = 0.0;
+        for (int k = 0; k < 9; ++k) {
+            ivec2 q = clamp(pixel + ivec2(k % 3 - 1, k / 3 - 1), ivec2(0), size - 1);
+            vec4 eq = imageLoad(spatial_excess, q);
+            float dq = denoise_luminance(imageLoad(filtered_5, q).rgb + eq.a * eq.rgb)
+                - denoise_luminance(imageLoad(illumination, q).rgb);
+            d2 += dq * dq;
+            v += variance_of_mean(imageLoad(moments, q).xyz);
+        }
+        bias_share = d2 > v ? 1.0 - v / d2 : 0.0;
     }
-    float bias_share = m.z >= 8.0 && d2 > v ? 1.0 - v / d2 : 0.0;
     vec3 illum = mix(spatial, temporal, max(fade, bias_share));
     imageStore(denoised, pixel, vec4(remodulate(illum, imageLoad(albedo, pixel).rgb), 1.0));
 }

@@ -141,7 +141,7 @@ void main() {
         mean = mix(history, illum, alpha);
         m = mix(moments_history.xy, m, alpha);
     }
-    float variance = max(m.y - m.x * m.x, 0.0) / frames;
+    float variance = variance_of_mean(vec3(m, frames));
     imageStore(illumination, pixel, vec4(mean, variance));
     imageStore(moments, pixel, vec4(m, frames, 0.0));
 #ifdef HAS_VIEW_DENOISE_HISTORY

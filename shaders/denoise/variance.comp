@@ -63,7 +63,7 @@ float spatial_variance(ivec2 pixel, ivec2 size, vec4 np, float frames) {
         }
     }
     vec2 m = sum / max(weights, 1e-10);
-    return max(m.y - m.x * m.x, 0.0) / frames;
+    return variance_of_mean(vec3(m, frames));
 }
 
 void main() {

@@ -149,6 +149,20 @@ impl<'g> Buffer<'g> {
     }
 }
 
+impl Buffer<'_> {
+    /// The bytes of a host-visible buffer (a read-back buffer after the
+    /// GPU's writes were made visible to the host).
+    pub fn mapped(&self) -> Result<&[u8], GpuError> {
+        self.allocation
+            .as_ref()
+            .and_then(|a| a.mapped_slice())
+            .ok_or_else(|| GpuError::Allocation {
+                what: "a buffer".into(),
+                message: "buffer is not host-visible".into(),
+            })
+    }
+}
+
 impl Drop for Buffer<'_> {
     fn drop(&mut self) {
         unsafe { self.gpu.device().destroy_buffer(self.buffer, None) };

@@ -117,18 +117,14 @@ pub fn oversized_images(gpu: &Gpu, plan: &Plan) -> Vec<(String, [u32; 2])> {
 }
 
 /// The plan's images with a sample count the device's attachments cannot
-/// have: their names and counts, and the counts the device offers.
-pub fn unsupported_sample_counts(gpu: &Gpu, plan: &Plan) -> Vec<(String, u32, Vec<u32>)> {
+/// have (`DeviceInfo::attachment_sample_counts`): their names and counts.
+pub fn unsupported_sample_counts(gpu: &Gpu, plan: &Plan) -> Vec<(String, u32)> {
     let mask = gpu.info().attachment_sample_counts;
-    let offered: Vec<u32> = (0..7)
-        .map(|bit| 1 << bit)
-        .filter(|n| mask & n != 0)
-        .collect();
     plan.resources
         .iter()
         .filter_map(|r| match &r.desc {
             ResourceDesc::Image(desc) if desc.samples > 1 && mask & desc.samples == 0 => {
-                Some((r.name.clone(), desc.samples, offered.clone()))
+                Some((r.name.clone(), desc.samples))
             }
             _ => None,
         })

@@ -193,12 +193,12 @@ pub fn compile_for_scene(
             device: gpu.info().name.clone(),
         });
     }
-    if let Some((image, samples, offered)) = weft_gpu::unsupported_sample_counts(gpu, &plan)
+    if let Some((image, samples)) = weft_gpu::unsupported_sample_counts(gpu, &plan)
         .into_iter()
         .next()
     {
         return Err(RenderError::Graph(vec![unsupported_samples(
-            loaded, &image, samples, &offered, gpu,
+            loaded, &image, samples, gpu,
         )]));
     }
     Ok(plan)
@@ -210,7 +210,6 @@ fn unsupported_samples(
     graph: &weft_graph::LoadedGraph,
     image: &str,
     samples: u32,
-    offered: &[u32],
     gpu: &Gpu,
 ) -> weft_graph::Diagnostic {
     let declared = graph.resources.iter().find(|r| match &r.item {
@@ -227,7 +226,12 @@ fn unsupported_samples(
             ],
         )
     });
-    let list: Vec<String> = offered.iter().map(u32::to_string).collect();
+    let mask = gpu.info().attachment_sample_counts;
+    let offered: Vec<String> = (0..7)
+        .map(|bit| 1u32 << bit)
+        .filter(|n| mask & n != 0)
+        .map(|n| n.to_string())
+        .collect();
     weft_graph::Diagnostic::error(
         file,
         pos,
@@ -238,7 +242,7 @@ fn unsupported_samples(
     )
     .with_hint(format!(
         "use one of {} (framebufferColorSampleCounts and framebufferDepthSampleCounts)",
-        list.join(", ")
+        offered.join(", ")
     ))
 }
 

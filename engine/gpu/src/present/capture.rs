@@ -2,11 +2,11 @@
 //! screenshot, and its bytes read back as a [`Readback`].
 
 use super::color_layers;
+use crate::buffer::Buffer;
 use crate::context::Gpu;
-use crate::error::{GpuError, VkCall};
+use crate::error::GpuError;
 use crate::readback::{self, Readback};
 use ash::vk;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 
 /// The name `readback::decode` knows a swapchain format by.
@@ -23,46 +23,25 @@ fn format_name(format: vk::Format) -> Option<&'static str> {
 /// A host-visible buffer a presented image is copied into.
 pub(super) struct CaptureBuffer<'g> {
     gpu: &'g Gpu,
-    buffer: vk::Buffer,
-    allocation: Option<Allocation>,
+    buffer: Buffer<'g>,
     extent: vk::Extent2D,
 }
 
 impl<'g> CaptureBuffer<'g> {
     pub(super) fn new(gpu: &'g Gpu, extent: vk::Extent2D) -> Result<Self, GpuError> {
         let size = u64::from(extent.width) * u64::from(extent.height) * 4;
-        let info = vk::BufferCreateInfo::default()
-            .size(size)
-            .usage(vk::BufferUsageFlags::TRANSFER_DST)
-            .sharing_mode(vk::SharingMode::EXCLUSIVE);
-        let buffer = unsafe { gpu.device().create_buffer(&info, None) }.call("vkCreateBuffer")?;
-        let mut this = Self {
+        let buffer = Buffer::new(
+            gpu,
+            "the screenshot buffer",
+            size,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        Ok(Self {
             gpu,
             buffer,
-            allocation: None,
             extent,
-        };
-        let requirements = unsafe { gpu.device().get_buffer_memory_requirements(buffer) };
-        let allocation = gpu
-            .allocator()
-            .allocate(&AllocationCreateDesc {
-                name: "screenshot",
-                requirements,
-                location: MemoryLocation::GpuToCpu,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .map_err(|e| GpuError::Allocation {
-                what: "the screenshot buffer".into(),
-                message: e.to_string(),
-            })?;
-        unsafe {
-            gpu.device()
-                .bind_buffer_memory(buffer, allocation.memory(), allocation.offset())
-        }
-        .call("vkBindBufferMemory")?;
-        this.allocation = Some(allocation);
-        Ok(this)
+        })
     }
 
     /// Copies the buffer's extent of `image` (in `TRANSFER_SRC_OPTIMAL`,
@@ -79,7 +58,7 @@ impl<'g> CaptureBuffer<'g> {
         let copy = vk::CopyImageToBufferInfo2::default()
             .src_image(image)
             .src_image_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-            .dst_buffer(self.buffer)
+            .dst_buffer(self.buffer.buffer)
             .regions(&regions);
         let host = [vk::BufferMemoryBarrier2::default()
             .src_stage_mask(vk::PipelineStageFlags2::COPY)
@@ -88,7 +67,7 @@ impl<'g> CaptureBuffer<'g> {
             .dst_access_mask(vk::AccessFlags2::HOST_READ)
             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .buffer(self.buffer)
+            .buffer(self.buffer.buffer)
             .offset(0)
             .size(vk::WHOLE_SIZE)];
         let device = self.gpu.device();
@@ -107,15 +86,7 @@ impl<'g> CaptureBuffer<'g> {
             GpuError::Plan(format!("cannot read back swapchain format {format:?}"))
         })?;
         let size = self.extent.width as usize * self.extent.height as usize * 4;
-        let bytes = self
-            .allocation
-            .as_ref()
-            .and_then(|a| a.mapped_slice())
-            .and_then(|s| s.get(..size))
-            .ok_or_else(|| GpuError::Allocation {
-                what: "the screenshot buffer".into(),
-                message: "memory is not host-mapped".into(),
-            })?;
+        let bytes = &self.buffer.mapped()?[..size];
         let pixels = readback::decode(name, bytes).map_err(|e| GpuError::Plan(e.to_string()))?;
         Ok(Readback {
             width: self.extent.width,
@@ -123,15 +94,5 @@ impl<'g> CaptureBuffer<'g> {
             format: name.to_string(),
             pixels,
         })
-    }
-}
-
-impl Drop for CaptureBuffer<'_> {
-    fn drop(&mut self) {
-        unsafe { self.gpu.device().destroy_buffer(self.buffer, None) };
-        if let Some(a) = self.allocation.take() {
-            // Freeing only fails for allocations this allocator did not make.
-            let _ = self.gpu.allocator().free(a);
-        }
     }
 }

@@ -117,27 +117,15 @@ fn warn_unread(
             let u = &uses[p][k];
             let accesses = &ir.passes[p].accesses;
             let resolved = |a: usize| {
-                accesses.get(a + 1).is_some_and(|next| {
-                    matches!(
-                        next.usage,
-                        Usage::Color {
-                            resolve_target: true,
-                            ..
-                        }
-                    )
-                })
+                accesses[a].usage.is_color_output()
+                    && accesses
+                        .get(a + 1)
+                        .is_some_and(|next| next.usage.is_resolve_target())
             };
             u.reads_previous
-                || u.accesses.iter().any(|&a| {
-                    matches!(accesses[a].usage, Usage::Depth { .. })
-                        || (matches!(
-                            accesses[a].usage,
-                            Usage::Color {
-                                resolve_target: false,
-                                ..
-                            }
-                        ) && resolved(a))
-                })
+                || u.accesses
+                    .iter()
+                    .any(|&a| matches!(accesses[a].usage, Usage::Depth { .. }) || resolved(a))
         });
         if written && !read {
             let (file, pos) = graph.locate(

@@ -106,14 +106,7 @@ fn plan_pass(
         }
     }
     for access in active_accesses() {
-        if matches!(
-            access.usage,
-            Usage::Color {
-                resolve_target: false,
-                ..
-            }
-        ) && !access.conditions.is_empty()
-        {
+        if access.usage.is_color_output() && !access.conditions.is_empty() {
             defines.insert(format!(
                 "HAS_{}",
                 ir.resources[access.resource].name.to_ascii_uppercase()
@@ -183,20 +176,16 @@ fn plan_pass(
                 LoadDecl::DontCare => (LoadOp::DontCare, Vec::new()),
             };
             let index = attachments.len();
-            match access.usage {
-                _ if is_depth => depth = Some(index),
-                Usage::Color {
-                    resolve_target: true,
-                    ..
-                } => {
-                    if let Some(last) = resolve.last_mut() {
-                        *last = Some(index);
-                    }
+            if is_depth {
+                depth = Some(index);
+            } else if access.usage.is_resolve_target() {
+                // It follows the colour attachment it resolves.
+                if let Some(last) = resolve.last_mut() {
+                    *last = Some(index);
                 }
-                _ => {
-                    color.push(index);
-                    resolve.push(None);
-                }
+            } else {
+                color.push(index);
+                resolve.push(None);
             }
             attachments.push(AttachmentDesc {
                 resource: r,

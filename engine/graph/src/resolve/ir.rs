@@ -184,6 +184,29 @@ pub enum Usage {
 }
 
 impl Usage {
+    /// Whether this is the single-sample image a colour attachment resolves
+    /// into (the access just after that attachment's).
+    pub fn is_resolve_target(&self) -> bool {
+        matches!(
+            self,
+            Usage::Color {
+                resolve_target: true,
+                ..
+            }
+        )
+    }
+
+    /// Whether this is a colour attachment shaders write (not a resolve target).
+    pub fn is_color_output(&self) -> bool {
+        matches!(
+            self,
+            Usage::Color {
+                resolve_target: false,
+                ..
+            }
+        )
+    }
+
     /// Whether the access needs what earlier passes left in the resource.
     pub fn reads_previous(&self) -> bool {
         match self {

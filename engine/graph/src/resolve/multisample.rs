@@ -29,15 +29,13 @@ impl Resolver<'_> {
                         "multisampled image \"{name}\" ({samples} samples) cannot be {how}: shaders and transfers see one sample per texel"))
                         .hint = Some(format!("give the attachment that draws \"{name}\" `resolve: \"{name}_resolved\"` (a single-sample image) and read that"));
                 }
-                let Usage::Color {
-                    resolve_target: true,
-                    ..
-                } = access.usage
+                // The attachment a resolve target resolves is the access
+                // just before it.
+                let Some(attachment) = k
+                    .checked_sub(1)
+                    .filter(|_| access.usage.is_resolve_target())
+                    .map(|j| &pass.accesses[j])
                 else {
-                    continue;
-                };
-                // The attachment it resolves is the access just before it.
-                let Some(attachment) = k.checked_sub(1).map(|j| &pass.accesses[j]) else {
                     continue;
                 };
                 let Some((from_format, from_samples)) = image_of(ir, attachment) else {

@@ -291,14 +291,7 @@ impl Resolver<'_> {
                                 .hint = Some("give the attachment image `mips: 1` and `layers: 1`".into());
                             }
                         }
-                        let resolve_target = matches!(
-                            access.usage,
-                            Usage::Color {
-                                resolve_target: true,
-                                ..
-                            }
-                        );
-                        if attachment && !resolve_target {
+                        if attachment && !access.usage.is_resolve_target() {
                             let sizes = PROBE_SIZES
                                 .iter()
                                 .map(|out| {
@@ -360,10 +353,7 @@ pub fn access_path(pass_index: usize, access: &IrAccess) -> Vec<Seg<'static>> {
         path.push(Seg::Index(i));
     }
     match access.usage {
-        Usage::Color {
-            resolve_target: true,
-            ..
-        } => path.push(Seg::Field("resolve")),
+        ref u if u.is_resolve_target() => path.push(Seg::Field("resolve")),
         Usage::Color { .. } | Usage::Depth { .. } => path.push(Seg::Field("image")),
         _ if !access.conditions.is_empty() => path.push(Seg::Field("name")),
         _ => {}

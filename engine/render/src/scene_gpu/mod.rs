@@ -508,10 +508,11 @@ impl<'g> GpuScene<'g> {
         let mut inputs = std::collections::hash_map::DefaultHasher::new();
         // What this frame shows, not how the last one differed or where
         // its jitter fell: a still camera's frames hash alike even right
-        // after it moved, and jittered frames of one view alike.
+        // after it moved, and jittered frames of one view alike (the
+        // inverse follows from `view_proj`, so it is left out).
         let shown = GpuFrame {
             view_proj,
-            inv_view_proj: view_proj.inverse(),
+            inv_view_proj: glam::Mat4::ZERO,
             prev_view_proj: view_proj,
             jitter: glam::Vec4::ZERO,
             ..frame

@@ -30,6 +30,21 @@ fn errors(text: &str) -> Vec<Diagnostic> {
         .collect()
 }
 
+/// Asserts that checking `text` reports the error `message` at a position
+/// where the text starts with `at`; `label` names the case in failures.
+fn assert_error_at(text: &str, message: &str, at: &str, label: &str) {
+    let found = errors(text);
+    let d = found
+        .iter()
+        .find(|d| d.message == message)
+        .unwrap_or_else(|| panic!("{label}: expected \"{message}\", got {found:#?}"));
+    assert!(
+        text_at(text, d).starts_with(at),
+        "{label}: located at {:?}",
+        text_at(text, d)
+    );
+}
+
 fn only_error(text: &str) -> Diagnostic {
     let mut errors = errors(text);
     assert_eq!(

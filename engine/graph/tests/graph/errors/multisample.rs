@@ -2,7 +2,7 @@
 //! compiles into a render pass that resolves, and each misuse is refused at
 //! the text that causes it.
 
-use super::{errors, text_at};
+use super::assert_error_at;
 use crate::support::{check_text, load_files};
 use weft_graph::{CompileOptions, Diagnostic};
 
@@ -116,26 +116,16 @@ fn sample_counts_and_resolve_targets_that_do_not_fit_are_refused_where_written()
     for (from, to, message, at) in cases {
         assert!(MSAA.contains(from), "{from}");
         let text = MSAA.replacen(from, to, 1);
-        let found = errors(&text);
-        let d = found
-            .iter()
-            .find(|d| d.message == message)
-            .unwrap_or_else(|| panic!("{to}: expected \"{message}\", got {found:#?}"));
-        assert!(
-            text_at(&text, d).starts_with(at),
-            "{to}: located at {:?}",
-            text_at(&text, d)
-        );
+        assert_error_at(&text, message, at, to);
     }
     // Without samples to resolve, the resolve is refused too.
     let single = MSAA
         .replacen(r#"R8G8B8A8_UNORM, samples: 4)"#, "R8G8B8A8_UNORM)", 1)
         .replacen(r#"D32_SFLOAT, samples: 4)"#, "D32_SFLOAT)", 1);
-    let found = errors(&single);
-    assert!(
-        found.iter().any(|d| d.message
-            == "colour attachment \"albedo_samples\" has 1 sample, so there is nothing to resolve into \"albedo\""
-            && text_at(&single, d).starts_with("\"albedo\")]")),
-        "{found:#?}"
+    assert_error_at(
+        &single,
+        "colour attachment \"albedo_samples\" has 1 sample, so there is nothing to resolve into \"albedo\"",
+        "\"albedo\")]",
+        "one sample",
     );
 }

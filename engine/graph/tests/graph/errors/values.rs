@@ -81,16 +81,7 @@ fn out_of_range_values_are_located_errors() {
     for (base, (from, to), message, at) in cases {
         assert!(base.contains(from), "{from}");
         let text = base.replacen(from, to, 1);
-        let found = errors(&text);
-        let d = found
-            .iter()
-            .find(|d| d.message == message)
-            .unwrap_or_else(|| panic!("{to}: expected \"{message}\", got {found:#?}"));
-        assert!(
-            text_at(&text, d).starts_with(at),
-            "{to}: located at {:?}",
-            text_at(&text, d)
-        );
+        assert_error_at(&text, message, at, to);
     }
 }
 
@@ -120,16 +111,7 @@ fn caveats_need_a_note_and_features_the_graph_has() {
     ];
     for (edit, message, at) in cases {
         let text = VALID.replacen("Graph(", edit, 1);
-        let found = errors(&text);
-        let d = found
-            .iter()
-            .find(|d| d.message == message)
-            .unwrap_or_else(|| panic!("{edit}: expected \"{message}\", got {found:#?}"));
-        assert!(
-            text_at(&text, d).starts_with(at),
-            "{edit}: located at {:?}",
-            text_at(&text, d)
-        );
+        assert_error_at(&text, message, at, edit);
     }
     // A feature a pass uses is known.
     let known = VALID
