@@ -43,7 +43,7 @@ void main() {
     // A pixel whose filter has faded out (the variance step marks it with a
     // negative variance) is passed through: its own output is the temporal
     // mean, and as a neighbour it is what it is.
-    if ((!surface && step > 2) || centre.a < 0.0) {
+    if (!surface || centre.a < 0.0) {
         imageStore(target, pixel, centre);
         return;
     }

@@ -25,6 +25,17 @@ float variance_of_mean(vec3 moments) {
     return max(moments.y - moments.x * moments.x, 0.0) / max(moments.z, 1.0);
 }
 
+// The albedo a pass's light is divided by, from the includer's `albedo`
+// image (rgb: what the surface reflects; a: what its specular lobe
+// reflects, shaders/pathtrace/guides.comp): the specular lobe's for the
+// specular part of the light (SPECULAR_ALBEDO, graphs/denoise_specular.ron),
+// else the whole. The including shader declares `albedo`.
+#ifdef SPECULAR_ALBEDO
+#define albedo_at(q) (imageLoad(albedo, q).aaa)
+#else
+#define albedo_at(q) (imageLoad(albedo, q).rgb)
+#endif
+
 // Normals: cos^phi of the angle between them (phi 128 in SVGF).
 float normal_weight(vec3 np, vec3 nq, float phi) {
     return pow(max(dot(np, nq), 0.0), phi);

@@ -9,12 +9,20 @@
 // pixel's coverage of it) and elsewhere (a firefly) is left out of it: the
 // image shows a firefly only in the temporal mean's share, so early
 // frames suppress it and the converged image is the unbiased mean.
+//
+// With ADD_TO_DENOISED (graphs/denoise_specular.ron's last pass), the
+// result is the specular part of the light and is added to `denoised`, which
+// holds the diffuse part already.
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2D filtered_5;
 layout(set = 0, binding = 1, rgba16f) uniform readonly image2D albedo;
+#ifdef ADD_TO_DENOISED
+layout(set = 0, binding = 2, rgba32f) uniform image2D denoised;
+#else
 layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D denoised;
+#endif
 layout(set = 0, binding = 3, rgba32f) uniform readonly image2D spatial_excess;
 layout(set = 0, binding = 4, rgba32f) uniform readonly image2D illumination;
 layout(set = 0, binding = 5, rgba32f) uniform readonly image2D moments;
@@ -57,5 +65,9 @@ void main() {
         bias_share = d2 > v ? 1.0 - v / d2 : 0.0;
     }
     vec3 illum = mix(spatial, temporal, max(fade, bias_share));
-    imageStore(denoised, pixel, vec4(remodulate(illum, imageLoad(albedo, pixel).rgb), 1.0));
+    vec3 radiance = remodulate(illum, albedo_at(pixel));
+#ifdef ADD_TO_DENOISED
+    radiance += imageLoad(denoised, pixel).rgb;
+#endif
+    imageStore(denoised, pixel, vec4(radiance, 1.0));
 }

@@ -17,19 +17,21 @@
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+// Bindings in the order the pass declares its resources: a pass that feeds
+// other images (graphs/denoise_specular.ron's) binds them by position.
 layout(set = 0, binding = 0) uniform sampler2D radiance;
 layout(set = 0, binding = 1, rgba16f) uniform readonly image2D albedo;
 layout(set = 0, binding = 2, rgba32f) uniform readonly image2D guide_normal;
 layout(set = 0, binding = 3, rgba32f) uniform readonly image2D guide_position;
-layout(set = 0, binding = 4, rgba32f) uniform readonly image2D normal_prev;
-layout(set = 0, binding = 5, rgba32f) uniform readonly image2D position_prev;
-layout(set = 0, binding = 6, rgba32f) uniform readonly image2D illumination_prev;
-layout(set = 0, binding = 7, rgba32f) uniform readonly image2D moments_prev;
+layout(set = 0, binding = 4, rgba32f) uniform readonly image2D guide_previous_position;
+layout(set = 0, binding = 5, rgba32f) uniform readonly image2D normal_prev;
+layout(set = 0, binding = 6, rgba32f) uniform readonly image2D position_prev;
+layout(set = 0, binding = 7, rgba32f) uniform readonly image2D illumination_prev;
+layout(set = 0, binding = 8, rgba32f) uniform readonly image2D moments_prev;
 // rgb: accumulated illumination, a: the variance of its luminance.
-layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D illumination;
+layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D illumination;
 // x, y: luminance mean and mean square, z: frames averaged.
-layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D moments;
-layout(set = 0, binding = 10, rgba32f) uniform readonly image2D guide_previous_position;
+layout(set = 0, binding = 10, rgba32f) uniform writeonly image2D moments;
 #ifdef HAS_VIEW_DENOISE_HISTORY
 // Debug view `history_length`: the frames each pixel averages, and the
 // frame's largest in word 0 (debug_view.frag's legend scale).
@@ -50,7 +52,7 @@ layout(push_constant) uniform Params {
 float illumination_at(ivec2 q, ivec2 size, float kind, out bool same_kind) {
     q = clamp(q, ivec2(0), size - 1);
     same_kind = pixel_kind(imageLoad(guide_normal, q).w) == kind;
-    return denoise_luminance(demodulate(texelFetch(radiance, q, 0).rgb, imageLoad(albedo, q).rgb));
+    return denoise_luminance(demodulate(texelFetch(radiance, q, 0).rgb, albedo_at(q)));
 }
 
 void main() {
@@ -60,7 +62,7 @@ void main() {
         return;
     }
     vec3 colour = texelFetch(radiance, pixel, 0).rgb;
-    vec3 illum = demodulate(colour, imageLoad(albedo, pixel).rgb);
+    vec3 illum = demodulate(colour, albedo_at(pixel));
     float l = denoise_luminance(illum);
     vec4 n = imageLoad(guide_normal, pixel);
     vec4 p = imageLoad(guide_position, pixel);
@@ -73,9 +75,17 @@ void main() {
     // The background (nothing met) is reprojected by its direction.
     bool background = p.w == 0.0;
     if (params.plan_frames > 0u) {
+        // The motion is the difference of the point's projections at the
+        // frame before and now, not the one projection's distance from the
+        // pixel centre: rounding puts that a few thousandths of a pixel
+        // off, and the bilinear weights would then leak a little of the
+        // neighbours' history into a still pixel every frame (light creeping
+        // into the black background around a silhouette). Where nothing
+        // moved the two projections are the same numbers: no motion at all.
         vec4 clip = frame.prev_view_proj * (background ? vec4(-n.xyz, 0.0) : vec4(was, 1.0));
-        if (clip.w > 0.0) {
-            vec2 at = (clip.xy / clip.w * 0.5 + 0.5) * vec2(size) - 0.5;
+        vec4 now = frame.unjittered_view_proj * (background ? vec4(-n.xyz, 0.0) : vec4(p.xyz, 1.0));
+        if (clip.w > 0.0 && now.w > 0.0) {
+            vec2 at = vec2(pixel) + (clip.xy / clip.w - now.xy / now.w) * 0.5 * vec2(size);
             ivec2 base = ivec2(floor(at));
             found = ivec2(round(at));
             vec2 f = at - vec2(base);

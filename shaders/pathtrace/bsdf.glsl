@@ -210,6 +210,69 @@ bool bsdf_sample(Bsdf b, vec3 n, vec3 wo, vec3 u, out vec3 wi, out vec3 weight, 
     return true;
 }
 
+// What the specular lobe reflects towards `wo` under a uniform white
+// environment (the denoiser's guides keep it: the path tracer's specular
+// light is divided by it): GGX's single scattering (exact, brdf.glsl), a Blinn-Phong lobe's Ks
+// times its albedo at normal incidence (about 8 / (Ns + 2)), a mirror's Ks,
+// a coat's tint times its Fresnel reflectance.
+vec3 specular_albedo(Bsdf b, vec3 n, vec3 wo) {
+    float cos_o = max(dot(n, wo), 1e-4);
+#ifdef SCENE_METALLIC_ROUGHNESS
+    if (b.model == SHADING_METALLIC_ROUGHNESS) {
+        return ggx_single_albedo(b.base, b.metal_rough, cos_o);
+    }
+#endif
+#ifdef SCENE_COATED
+    if (b.model == SHADING_COATED) {
+        return b.specular * coat_fresnel(b, cos_o);
+    }
+#endif
+    return b.model == SHADING_MIRROR ? b.specular : b.specular * min(8.0 / (b.exponent + 2.0), 1.0);
+}
+
+#ifdef SPLIT_LOBES
+// Whether bsdf_sample, given the same u.z, picks the specular lobe (a coat's
+// or a mirror's reflection, the GGX or Blinn-Phong highlight) rather than
+// the diffuse base: the path it starts is specular light.
+bool bsdf_picks_specular(Bsdf b, vec3 n, vec3 wo, float u) {
+#ifdef SCENE_COATED
+    if (b.model == SHADING_COATED) {
+        return u < coat_specular_probability(b, coat_fresnel(b, dot(n, wo)));
+    }
+#endif
+    return u < b.p_specular;
+}
+
+// The specular lobe's part of bsdf_eval's f cos: the GGX single-scattering
+// highlight of cook_torrance (multiple scattering and the diffuse base are
+// the rest), a Blinn-Phong material's Ks lobe; delta lobes (mirrors, coats)
+// have none. Next-event estimation at a path's first vertex splits its light
+// by it.
+vec3 bsdf_eval_specular(Bsdf b, vec3 n, vec3 wo, vec3 wi) {
+    float cos_i = dot(n, wi);
+    if (cos_i <= 0.0) {
+        return vec3(0.0);
+    }
+#if defined(SCENE_METALLIC_ROUGHNESS) || defined(SCENE_GLOSSY)
+    vec3 h = normalize(wo + wi);
+    float cos_h = max(dot(n, h), 0.0);
+#endif
+#ifdef SCENE_METALLIC_ROUGHNESS
+    if (b.model == SHADING_METALLIC_ROUGHNESS) {
+        float cos_o = max(dot(n, wo), 1e-4);
+        vec3 fresnel = b.specular + (1.0 - b.specular) * pow(1.0 - max(dot(wo, h), 0.0), 5.0);
+        return ggx_d(cos_h, b.alpha) * ggx_visibility(cos_i, cos_o, b.alpha) * fresnel * cos_i;
+    }
+#endif
+#ifdef SCENE_GLOSSY
+    if (b.model == SHADING_BLINN_PHONG) {
+        return b.specular * blinn_phong_highlight(cos_h, b.exponent) * cos_i / PI;
+    }
+#endif
+    return vec3(0.0);
+}
+#endif
+
 // Samples the glossy lobe alone: a metallic-roughness surface's GGX
 // single-scattering highlight (visible normals), or a Blinn-Phong
 // material's Ks lobe. `weight` is that lobe's f cos over the density wi was

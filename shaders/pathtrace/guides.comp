@@ -8,6 +8,9 @@
 // glass and where the ray meets a light or nothing (those are not divided).
 // Lights (area-light panels, emissive surfaces) get distance -1 and the
 // background 0: the filters mix those only with pixels of their own kind.
+// The albedo's alpha is the specular lobe's albedo (its luminance; 1 for
+// glass), which graphs/denoise_specular.ron divides the path tracer's
+// specular light by.
 #include "../include/hdr.glsl"
 #include "../include/brdf.glsl"
 #include "../include/area_light.glsl"
@@ -27,6 +30,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, rgba32f) uniform writeonly image2D guide_normal;
 // xyz: world position, w: 1 where a surface was met, 0 elsewhere.
 layout(set = 0, binding = 1, rgba32f) uniform writeonly image2D guide_position;
+// rgb: what the surface reflects, a: what its specular lobe reflects.
 layout(set = 0, binding = 2, rgba16f) uniform writeonly image2D albedo;
 // xyz: where the surface point was at the frame before (world space: its
 // placement's motion undone, Draw.previous), so history follows moving
@@ -76,5 +80,6 @@ void main() {
     bool glass = m.optics.x > 0.0;
     imageStore(guide_normal, pixel, vec4(n, t));
     imageStore(guide_position, pixel, vec4(s.position, 1.0));
-    imageStore(albedo, pixel, vec4(glass ? vec3(1.0) : reflectance, 1.0));
+    float specular = glass ? 1.0 : min(luminance(specular_albedo(b, n, -dir)), 1.0);
+    imageStore(albedo, pixel, vec4(glass ? vec3(1.0) : reflectance, specular));
 }

@@ -26,6 +26,31 @@ float found_weight(bool counted_fully, float bsdf_pdf, float light_pdf) {
     return params.sampling == SAMPLING_NEE ? 0.0 : power_heuristic(bsdf_pdf, light_pdf);
 }
 
+// Adds light the path found to its radiance and, under SPLIT_LOBES, to its
+// specular part when its first bounce took a specular lobe.
+void path_gather(inout Path p, vec3 light) {
+    p.radiance += light;
+#ifdef SPLIT_LOBES
+    if (p.specular_path) {
+        p.specular += light;
+    }
+#endif
+}
+
+// Adds what next-event estimation found at a vertex of BSDF `b`: f cos (`f`)
+// times the light's weighted value. At the first vertex, under SPLIT_LOBES,
+// the specular lobe's share of f goes to the specular part.
+void path_gather_nee(inout Path p, Bsdf b, vec3 n, vec3 wo, vec3 wi, vec3 f, vec3 light) {
+#ifdef SPLIT_LOBES
+    if (p.depth == 1u) {
+        p.radiance += p.throughput * f * light;
+        p.specular += p.throughput * bsdf_eval_specular(b, n, wo, wi) * light;
+        return;
+    }
+#endif
+    path_gather(p, p.throughput * f * light);
+}
+
 // Whether nothing lies between a point and a light sample `distance` away:
 // no triangle, and no other area light (they block BSDF-sampled rays too).
 bool unoccluded(vec3 origin, vec3 dir, float distance) {
@@ -102,11 +127,11 @@ bool path_hit(inout Path p, out TraceSurface s, out Material m) {
     if (area >= 0) {
         float light_pdf;
         vec3 emitted = area_emitted(uint(area), p.origin, p.dir, t, choice, light_pdf);
-        p.radiance += p.throughput * emitted * found_weight(p.counted_fully, p.bsdf_pdf, light_pdf);
+        path_gather(p, p.throughput * emitted * found_weight(p.counted_fully, p.bsdf_pdf, light_pdf));
         return false;
     }
     if (found.x < 0.0) {
-        p.radiance += p.depth > 1u ? p.throughput * frame.ambient.rgb : vec3(0.0);
+        path_gather(p, p.depth > 1u ? p.throughput * frame.ambient.rgb : vec3(0.0));
         return false;
     }
 #ifdef SCENE_DIELECTRICS
@@ -120,7 +145,7 @@ bool path_hit(inout Path p, out TraceSurface s, out Material m) {
         float cos_light = dot(s.geometric_normal, wo);
         float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t
             / (light_choice_odds(frame.counts.w, p.origin, choice) * cos_light);
-        p.radiance += p.throughput * emitted_at(s.material, s.uv) * found_weight(p.counted_fully, p.bsdf_pdf, light_pdf);
+        path_gather(p, p.throughput * emitted_at(s.material, s.uv) * found_weight(p.counted_fully, p.bsdf_pdf, light_pdf));
     }
 #endif
     return true;
@@ -148,6 +173,9 @@ bool path_scatter(inout Path p, inout Rng rng, TraceSurface s, Material m) {
         p.throughput *= weight;
         p.origin = leave(s.position, side);
         p.counted_fully = true;
+#ifdef SPLIT_LOBES
+        p.specular_path = p.specular_path || p.depth == 1u;
+#endif
         return true;
     }
 #endif
@@ -165,13 +193,13 @@ bool path_scatter(inout Path p, inout Rng rng, TraceSurface s, Material m) {
             if (any(greaterThan(f, vec3(0.0))) && unoccluded(from, ls.direction, ls.distance)) {
                 bool mis = ls.pdf > 0.0 && params.sampling == SAMPLING_MIS;
                 float w = mis ? power_heuristic(ls.pdf, pdf) : 1.0;
-                p.radiance += p.throughput * f * ls.value * w;
+                path_gather_nee(p, b, n, wo, ls.direction, f, ls.value * w);
             }
 #ifdef SCENE_DIELECTRICS
             else if (NEE_THROUGH_GLASS != 0 && ls.pdf > 0.0 && any(greaterThan(f, vec3(0.0)))) {
                 vec3 through;
                 if (bent_shadow_ray(from, ls.direction, through)) {
-                    p.radiance += p.throughput * f * ls.value * through;
+                    path_gather_nee(p, b, n, wo, ls.direction, f, ls.value * through);
                 }
             }
 #endif
@@ -186,6 +214,11 @@ bool path_scatter(inout Path p, inout Rng rng, TraceSurface s, Material m) {
     p.throughput *= weight;
     p.counted_fully = delta;
     p.origin = from;
+#ifdef SPLIT_LOBES
+    if (p.depth == 1u) {
+        p.specular_path = bsdf_picks_specular(b, n, wo, u.z);
+    }
+#endif
     // Russian roulette at the rr_depth-th vertex and after, so the first
     // segment it may cut is rr_depth + 1, as in Mitsuba's `path`.
     if (p.depth >= params.rr_depth) {

@@ -19,10 +19,30 @@ struct Path {
     bool counted_fully;
     // This segment's number, the camera ray's being 1.
     uint depth;
+#ifdef SPLIT_LOBES
+    // The part of `radiance` that left the first surface through a specular
+    // lobe (the denoiser filters it apart: graphs/denoise_specular.ron), and
+    // whether the path's first bounce took one.
+    vec3 specular;
+    bool specular_path;
+#endif
 };
 
 Path path_start(vec3 origin, vec3 dir) {
-    return Path(origin, dir, vec3(0.0), vec3(1.0), vec3(0.0), 0.0, true, 1u);
+    Path p;
+    p.origin = origin;
+    p.dir = dir;
+    p.radiance = vec3(0.0);
+    p.throughput = vec3(1.0);
+    p.medium = vec3(0.0);
+    p.bsdf_pdf = 0.0;
+    p.counted_fully = true;
+    p.depth = 1u;
+#ifdef SPLIT_LOBES
+    p.specular = vec3(0.0);
+    p.specular_path = false;
+#endif
+    return p;
 }
 
 #endif

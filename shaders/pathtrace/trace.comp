@@ -27,7 +27,10 @@
 //
 // `accumulate` 1 (the reference) keeps the running mean over frames; 0
 // writes each frame's own `samples_per_frame` samples to `hdr`, the noisy
-// input graphs/pathtrace_denoised.ron filters.
+// input graphs/pathtrace_denoised.ron filters. Where that graph splits the
+// lobes (`split_lobes`: the pass binds `hdr_specular`, SPLIT_LOBES), the
+// light whose path left the first surface through a specular lobe goes to
+// `hdr_specular` and the rest to `hdr` (path.glsl's path_gather).
 //
 // `coherent_lanes` 1 trades uncorrelated noise for speed: the 8 lanes of
 // each SIMD group share each sample's random numbers past the pixel jitter,
@@ -57,6 +60,10 @@
 // light point's value, while BSDF-sampled paths through glass still count:
 // light through glass is counted twice. 0, the default, is unbiased: shadow
 // rays stop at glass and caustics come from BSDF-sampled paths.
+// The graph binds `hdr_specular` where the denoiser filters the lobes apart.
+#ifdef HAS_HDR_SPECULAR
+#define SPLIT_LOBES
+#endif
 #include "../include/hdr.glsl"
 #include "../include/brdf.glsl"
 #include "../include/area_light.glsl"
@@ -73,7 +80,15 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, rgba32f) uniform image2D accumulation;
+#ifdef SPLIT_LOBES
+// Under SPLIT_LOBES (a denoiser's input): the part of this frame's mean that
+// left the first surface through a specular lobe (rgb; a the count), while
+// `hdr` holds the rest.
+layout(set = 0, binding = 1, rgba32f) uniform image2D hdr_specular;
+layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D hdr;
+#else
 layout(set = 0, binding = 1, rgba32f) uniform writeonly image2D hdr;
+#endif
 
 layout(push_constant) uniform Params {
     uint max_depth;
@@ -104,7 +119,7 @@ layout(push_constant) uniform Params {
 // second at depth 1, 1.05-1.16x at 2 to 4; docs/pathtrace.md). With Russian
 // roulette paths end in the scattering, and the turned loop's second copy of
 // the ray walk cost 1-2%.
-vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
+Path path(vec3 origin, vec3 dir, inout Rng rng) {
     Path p = path_start(origin, dir);
 #if MAX_DEPTH <= RR_DEPTH
     TraceSurface s;
@@ -125,7 +140,7 @@ vec3 path(vec3 origin, vec3 dir, inout Rng rng) {
         ++p.depth;
     }
 #endif
-    return p.radiance;
+    return p;
 }
 
 // The invocation's pixel with the image's tile rows interleaved: lavapipe
@@ -181,6 +196,13 @@ void main() {
     vec3 dir = camera_ray(vec2(pixel) + jitter, vec2(size));
     // `accumulate` 0 keeps only this frame's samples (a denoiser's input):
     // the mean restarts every frame.
-    add_sample(pixel, path(eye, dir, rng),
-        (params.history_frames > 0u && params.accumulate != 0u) || params.repeat_index > 0u);
+    bool with_previous = (params.history_frames > 0u && params.accumulate != 0u) || params.repeat_index > 0u;
+    Path p = path(eye, dir, rng);
+#ifdef SPLIT_LOBES
+    // `hdr` gets the diffuse part, `hdr_specular` the specular part.
+    imageStore(hdr_specular, pixel,
+        running_mean(with_previous ? imageLoad(hdr_specular, pixel) : vec4(0.0), p.specular));
+    p.radiance = max(p.radiance - p.specular, vec3(0.0));
+#endif
+    add_sample(pixel, p.radiance, with_previous);
 }

@@ -15,6 +15,7 @@ use weft_render::{render, RenderSettings};
 use weft_tests::TempDir;
 
 mod converges;
+mod split;
 
 const SIZE: u32 = 32;
 
@@ -245,13 +246,16 @@ fn traced(
 
 /// The box on a floor under an ambient sky (tests/e2e/rt_ao.rs's scene),
 /// path traced at one sample per pixel a frame, against a 512-spp
-/// reference: the denoised frame's relative MSE is a fourth of the raw
-/// frame's or less, from the first frame on (measured: 9.2e-2 to 1.58e-2 on
-/// the first, 7.5e-2 to 1.56e-2 on the fourth), and after four still frames
-/// the image's mean is the reference's within 1% (measured 0.9976; the
-/// first frame alone is 1.7% bright: a bias of filtering one sample).
+/// reference: the denoised frame's relative MSE is under half the raw
+/// frame's on the first frame (measured 5.40e-2 to 2.65e-2) and under an
+/// eighth on the fourth (4.49e-2 to 3.94e-3), and after four still frames
+/// the image's mean is the reference's within 1% (measured 1.0011; the
+/// first frame alone is 1.2% bright: a bias of filtering one sample). The
+/// first frame's error is mostly the silhouette pixels' coverage of the
+/// box, which the denoiser leaves to time (shaders/denoise/atrous.comp):
+/// filtered among the background's pixels it was 1.29e-2, and a haze.
 #[test]
-fn on_path_traced_frames_the_error_falls_fourfold_and_the_mean_holds() {
+fn on_path_traced_frames_the_error_falls_and_the_mean_holds() {
     let dir = TempDir::new("denoise-noisy");
     let scene = crate::rt_ao::scene(&dir.0);
     let image = |graph: &str, samples: Option<u64>, frames: u32, toggles_read| {
@@ -275,8 +279,9 @@ fn on_path_traced_frames_the_error_falls_fourfold_and_the_mean_holds() {
         println!(
             "frame {frames}: relative MSE raw {e_raw:.4e}, denoised {e_denoised:.4e}; mean ratio {ratio:.4}"
         );
+        let fall = if frames == 1 { 1.9 } else { 8.0 };
         assert!(
-            e_denoised * 4.0 <= e_raw,
+            e_denoised * fall <= e_raw,
             "frame {frames}: raw {e_raw}, denoised {e_denoised}"
         );
         if frames == 4 {
