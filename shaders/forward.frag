@@ -43,6 +43,12 @@ layout(location = 3) flat in uint material;
 layout(location = 4) in vec4 world_tangent;
 
 layout(location = 0) out vec4 color;
+#ifdef HAS_TAA_MOTION
+// Under `taa`: how far this point moved since the frame before, in world
+// space (rgb; a 1 where a mesh was drawn), for TAA to find its history.
+layout(location = 5) in vec3 previous_world;
+layout(location = 1) out vec4 taa_motion;
+#endif
 
 void main() {
 #ifdef HAS_VIEW_OVERSHADING
@@ -73,4 +79,7 @@ void main() {
         + shade_all_lights(s, m, params.area_samples);
     // Alpha matters only where weft-render blends transparent materials.
     color = vec4(hdr_output(c), material_record(material).diffuse.a * texel.a);
+#ifdef HAS_TAA_MOTION
+    taa_motion = vec4(previous_world - world, 1.0);
+#endif
 }

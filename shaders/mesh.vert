@@ -18,6 +18,11 @@ layout(location = 2) out vec2 texcoord;
 layout(location = 3) flat out uint material;
 // xyz: world tangent; w: handedness in world space (a mirroring instance flips it).
 layout(location = 4) out vec4 world_tangent;
+#ifdef HAS_TAA_MOTION
+// Where this point was at the frame before (its placement's motion undone,
+// Draw.previous): TAA's motion (graphs/taa.ron).
+layout(location = 5) out vec3 previous_world;
+#endif
 
 void main() {
     uint draw = gl_InstanceIndex;
@@ -30,4 +35,7 @@ void main() {
     texcoord = draws[draw].uv_box.xy + draws[draw].uv_box.zw * uv;
     material = draws[draw].material.x;
     gl_Position = clip_position(draw, position);
+#ifdef HAS_TAA_MOTION
+    previous_world = (draws[draw].previous * vec4(world, 1.0)).xyz;
+#endif
 }

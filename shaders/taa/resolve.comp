@@ -10,9 +10,9 @@
 //    pixel's own earlier samples and is kept whole: a running mean over up
 //    to `history_max` frames, which converges to the box-filtered pixel.
 // 2. After a change, the point this pixel's sample saw (its depth through
-//    the jittered inverse) is placed on the unjittered pixel grid now and at
-//    the frame before; their difference is the motion (the camera's only:
-//    meshes a script moves are left to the clipping). Of the four history
+//    the jittered inverse) is placed on the unjittered pixel grid now and,
+//    moved back by its mesh's motion (`taa_motion`, which the forward pass
+//    writes), at the frame before; their difference is the motion. Of the four history
 //    texels around where the pixel was, those showing a surface this
 //    pixel's 3x3 neighbourhood sees now (a linear depth between its
 //    nearest and farthest, moved as the point moved, within
@@ -37,6 +37,9 @@ layout(set = 0, binding = 3, r32f) uniform readonly image2D taa_depth_prev;
 layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D antialiased;
 // Linear depth of the point each pixel saw; 0: the background.
 layout(set = 0, binding = 5, r32f) uniform writeonly image2D taa_depth;
+// Where each pixel's point was at the frame before, less where it is now
+// (world space; a 1 where a mesh was drawn, 0 for the background).
+layout(set = 0, binding = 8) uniform sampler2D taa_motion;
 #ifdef HAS_VIEW_HISTORY_LENGTH
 // Debug view `history_length`: the frames each pixel averages, and the
 // frame's largest in word 0 (debug_view.frag's legend scale).
@@ -137,7 +140,9 @@ void main() {
         weights = 1.0;
     } else if (params.plan_frames > 0u) {
         vec2 fsize = vec2(size);
-        vec2 motion = on_grid(frame.unjittered_view_proj, point, fsize) - on_grid(frame.prev_view_proj, point, fsize);
+        vec4 mesh_motion = texelFetch(taa_motion, pixel, 0);
+        vec4 before = point.w > 0.0 && mesh_motion.a > 0.0 ? vec4(point.xyz + mesh_motion.xyz, 1.0) : point;
+        vec2 motion = on_grid(frame.unjittered_view_proj, point, fsize) - on_grid(frame.prev_view_proj, before, fsize);
         vec2 at = vec2(pixel) - motion;
         ivec2 base = ivec2(floor(at));
         vec2 f = at - vec2(base);
@@ -155,7 +160,7 @@ void main() {
             farthest = max(farthest, zn);
         }
         // Depths then: now's, moved as this pixel's point moved.
-        float was = point.w > 0.0 ? (frame.prev_view_proj * point).w : 0.0;
+        float was = point.w > 0.0 ? (frame.prev_view_proj * before).w : 0.0;
         float moved = point.w > 0.0 ? was - z : 0.0;
         float tolerance = params.position_tolerance * max(farthest + moved, 0.0);
         for (int k = 0; k < 4; ++k) {

@@ -1,8 +1,8 @@
 //! Temporal anti-aliasing (graphs/taa.ron, forward's feature `taa`): a
 //! still camera's frames converge to the supersampled image, a camera
 //! translated by whole pixels finds every texel's history that stays in
-//! view, and what a moving occluder uncovers starts again at once, with no
-//! trace of the occluder.
+//! view, so does a mesh a script moves, and what a moving occluder uncovers
+//! starts again at once, with no trace of the occluder.
 
 use std::path::{Path, PathBuf};
 use weft_graph::plan::Extent;
@@ -178,6 +178,74 @@ fn a_translating_camera_keeps_history_exactly() {
         nearest >= 28 * 32 * 9 / 10,
         "{nearest} of {} texels hold the history 2 to their right",
         28 * 32
+    );
+}
+
+/// A plane of stripes 4 pixels wide (1.25 units, grey and red in turn)
+/// moves 2 pixels to the right between two frames under a still camera:
+/// every texel but the two columns entering on the left finds its history
+/// (two frames averaged), and where the stripes make it tell, that history
+/// is the texel 2 to its left's (where the point was: the forward pass's
+/// `taa_motion`), not the texel's own, which reprojecting by the camera
+/// alone would take.
+#[test]
+fn a_moving_mesh_keeps_its_history() {
+    let dir = TempDir::new("taa-moving-mesh");
+    scene(&dir.0, "", ""); // the MTL file
+    let mut obj = String::from("mtllib m.mtl\nvn 0 0 1\n");
+    for k in 0..16 {
+        let x = -10.0 + 1.25 * k as f32;
+        let v = 4 * k + 1;
+        obj += &format!(
+            "usemtl {}\nv {x} -10 0\nv {} -10 0\nv {} 10 0\nv {x} 10 0\nf {v}//1 {}//1 {}//1\nf {v}//1 {}//1 {}//1\n",
+            if k % 2 == 0 { "grey" } else { "white" },
+            x + 1.25,
+            x + 1.25,
+            v + 1,
+            v + 2,
+            v + 2,
+            v + 3
+        );
+    }
+    std::fs::write(dir.0.join("stripes.obj"), obj).expect("stripes");
+    let script = dir.0.join("stripes.rhai");
+    std::fs::write(
+        &script,
+        "model(\"stripes.obj\", #{});\n\
+         camera(\"front\", #{ position: [0, 0, 5], target: [0, 0, 0], fov_deg: 90 });\n\
+         sun_light(#{ direction: [0, 0, -1], color: [1, 1, 1] });\n\
+         fn update(t, dt) { set_model_transform(0, #{ position: [0.625 * t, 0, 0] }); }\n",
+    )
+    .expect("script");
+    let first = forward(&script, 32, 1, &["taa"], "hdr");
+    let now = forward(&script, 32, 2, &["taa"], "hdr");
+    let image = forward(&script, 32, 2, &["taa"], "antialiased");
+    let (mut telling, mut from_the_left) = (0, 0);
+    for y in 0..32 {
+        for x in 0..32 {
+            let i = y * 32 + x;
+            let frames = image[i * 4 + 3];
+            let expected = if x < 2 { 1.0 } else { 2.0 };
+            assert!(
+                (frames - expected).abs() <= 1e-4,
+                "({x}, {y}) averaged {frames} frames, not {expected}"
+            );
+            if x < 2 || (first[(i - 2) * 4 + 1] - first[i * 4 + 1]).abs() < 0.1 {
+                continue;
+            }
+            telling += 1;
+            let off = |from: usize| {
+                (0.5 * (first[(i - from) * 4 + 1] + now[i * 4 + 1]) - image[i * 4 + 1]).abs()
+            };
+            if off(2) < off(0) {
+                from_the_left += 1;
+            }
+        }
+    }
+    assert!(telling >= 32 * 10, "{telling} texels whose history tells");
+    assert!(
+        from_the_left >= telling * 9 / 10,
+        "{from_the_left} of {telling} texels hold the history 2 to their left"
     );
 }
 

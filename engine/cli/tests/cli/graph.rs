@@ -216,7 +216,7 @@ fn plan_with_a_scene_culls_what_the_scene_lacks() {
     // on).
     assert!(
         text.contains(
-            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS (variant key; 1 of up to 1024 variants: 10 of the 14 features a pass may depend on)\n"
+            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS (variant key; 1 of up to 1024 variants: 10 of the 15 features a pass may depend on)\n"
         ),
         "{text}"
     );

@@ -134,12 +134,13 @@ impl IrPass {
     }
 }
 
-/// Most shader variants a pass may have: 2^14 = 16,384 define sets. The
-/// shipped forward pass is decided by 14 features (11 scene features, shadow
-/// casters, ray-traced shadows and the overshading view). Variants are compiled on demand, only
-/// for the feature sets a scene selects, so the cap bounds the key space of a
-/// pass, not the work done.
-pub const MAX_VARIANT_BITS: u32 = 14;
+/// Most shader variants a pass may have: 2^15 = 32,768 define sets. The
+/// shipped forward pass is decided by 15 features (11 scene features, shadow
+/// casters, ray-traced shadows, the overshading view and TAA's motion
+/// output). Variants are compiled on demand, only for the feature sets a
+/// scene selects, so the cap bounds the key space of a pass, not the work
+/// done.
+pub const MAX_VARIANT_BITS: u32 = 15;
 
 /// 2^`bits`, the variants `bits` features can select, saturating past 2^63.
 pub fn variant_count(bits: u32) -> u64 {
