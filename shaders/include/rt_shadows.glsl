@@ -15,7 +15,8 @@
 // so the product is the ray-traced shadowed integral for a Lambertian surface
 // (the ratio estimator of Heitz et al., "Combining Analytic Direct
 // Illumination and Stochastic Shadows", I3D 2018), and the noise goes where
-// the penumbra is. The strata are offset per pixel but not per frame: a still
+// the penumbra is. The strata are offset per pixel, and per frame only where
+// the camera is jittered (TAA, which averages the frames): otherwise a still
 // image is the same every frame. Replaces the shadow-map lookups
 // (HAS_SHADOW_MAP), which the graphs leave out under `rt_shadows`.
 #ifndef WEFT_RT_SHADOWS_GLSL
@@ -55,6 +56,14 @@ vec3 footprint_point(vec3 p, vec3 n, vec2 offset) {
     return distance(x, p) <= 0.1 * distance(o, p) ? x : p;
 }
 
+// A seed that changes with the camera's sub-pixel jitter (the Frame
+// uniform's, a different Halton point each frame under TAA) and is 0
+// without it.
+uint rt_frame_seed() {
+    uvec2 bits = floatBitsToUint(frame.jitter.xy);
+    return bits.x * 0x9e3779b9u ^ bits.y;
+}
+
 // Visibility of a sun travelling along -`light.xyz` (w = 0) or of a light
 // at `light.xyz` (w = 1) from surface point `x` with unit normal `n`,
 // ignoring whatever lies within `skip` of x along the ray.
@@ -72,13 +81,14 @@ float rt_towards(vec3 x, vec3 n, vec4 light, float skip) {
 // The visible fraction of a sun, point or spot (`light` as rt_towards takes
 // it) over this pixel: one ray from `p` when `rays` is 1, else `rays`
 // (rounded up to a square of strata, at most 32 x 32) from stratified
-// points of the pixel's footprint on p's plane, jittered per pixel.
+// points of the pixel's footprint on p's plane, jittered per pixel (and
+// frame, under TAA).
 float rt_punctual_visibility(vec3 p, vec3 n, vec4 light, uint rays) {
     if (rays <= 1u) {
         return rt_towards(p, n, light, 0.0);
     }
     uint side = clamp(uint(ceil(sqrt(float(rays)))), 1u, 32u);
-    Rng rng = rng_start(uvec2(gl_FragCoord.xy), 0u, 0x27d4eb2fu);
+    Rng rng = rng_start(uvec2(gl_FragCoord.xy), 0u, 0x27d4eb2fu ^ rt_frame_seed());
     float seen = 0.0;
     for (uint j = 0u; j < side; ++j) {
         for (uint i = 0u; i < side; ++i) {
@@ -97,11 +107,12 @@ float rt_punctual_visibility(vec3 p, vec3 n, vec4 light, uint rays) {
 // The unshadowed fraction of area light `index` as seen from `p` (unit normal
 // `n`; `o` its outline moved by -p, area_outline): `rays` rays (rounded up to
 // a square number of strata, at most 32 x 32) at stratified points of the
-// outline, jittered per pixel, each weighted by the diffuse integrand.
+// outline, jittered per pixel (and frame, under TAA), each weighted by the
+// diffuse integrand.
 float rt_area_visibility(uint index, AreaOutline o, vec3 p, vec3 n, uint rays) {
     uint side = clamp(uint(ceil(sqrt(float(max(rays, 1u))))), 1u, 32u);
     float step = 2.0 / float(side);
-    Rng rng = rng_start(uvec2(gl_FragCoord.xy), index, 0x5bd1e995u);
+    Rng rng = rng_start(uvec2(gl_FragCoord.xy), index, 0x5bd1e995u ^ rt_frame_seed());
     vec3 facing = -normalize(o.winding);
     vec3 origin = leave(p, n);
     float start = leave_distance(p);
