@@ -22,6 +22,8 @@ demo: build
 lint: setup
 	$(CARGO) fmt --all -- --check
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
+	python3 tools/line_limit.py 600
+	python3 tools/module_cycles.py
 
 test: lint
 	$(CARGO) test --workspace

@@ -4,9 +4,10 @@
 A module `a` depends on `b` when a file of `a` names `crate::b` (in a `use`
 or a path, not in a comment) or, inside a module folder, `super::b` from its `mod.rs` level.
 Prints, per crate, the strongly connected components with more than one
-module (each is an import cycle) and their count. Usage, from the repository
-root: `python3 tools/module_cycles.py [CRATE_DIR...]` (default: every crate
-under engine/).
+module (each is an import cycle) and their count, and exits 1 if there is
+any (`make lint` runs it). Usage, from the repository root:
+`python3 tools/module_cycles.py [CRATE_DIR...]` (default: every crate under
+engine/).
 """
 import os
 import re
@@ -92,7 +93,8 @@ def main():
         for component in found:
             print("  " + " <-> ".join(component))
     print(f"total: {total}")
+    return 1 if total else 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

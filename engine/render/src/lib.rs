@@ -40,6 +40,7 @@ mod geometry;
 mod gpu_types;
 mod graph_check;
 mod jitter;
+mod light_bounds;
 mod light_choice;
 mod light_tree;
 mod lights;

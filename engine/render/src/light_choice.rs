@@ -12,11 +12,11 @@
 //! light's noise grows more than twofold, while bright lights get most of the
 //! samples.
 
-use crate::emitters::{alias_table, luminance, table_bytes};
+use crate::emitters::{alias_table, table_bytes};
 use crate::gpu_types::GpuLight;
+use crate::light_bounds::power;
 use crate::light_tree::LightTree;
-use crate::lights::{AREA_DISC, AREA_RECT, POINT, SPOT_CONE, SPOT_SPHERE, SUN};
-use std::f32::consts::PI;
+use crate::lights::SUN;
 
 /// Share of the probability spread evenly over the choices.
 const UNIFORM_SHARE: f64 = 0.5;
@@ -145,42 +145,10 @@ fn grouped_mixture(choices: &[(f64, f64)]) -> Vec<f64> {
         .collect()
 }
 
-/// An estimate of the luminous power a light record emits, in the path
-/// tracer's units (docs/pathtrace.md, "Lights and units"): a point light of
-/// colour C gives irradiance π C at unit attenuation, so intensity π C and
-/// power 4π² C; a spot, its cone's share of that; a sun, irradiance π C over
-/// the scene's cross-section π r²; an area light, π L A per emitting face.
-/// Attenuation and cutoff ranges are left out.
-pub fn power(light: &GpuLight, scene_radius: f32) -> f32 {
-    let colour = luminance(light.color_exponent.truncate()).max(0.0);
-    let kind = light.direction_type.w;
-    if kind == SUN {
-        PI * colour * PI * scene_radius * scene_radius
-    } else if kind == POINT {
-        4.0 * PI * PI * colour
-    } else if kind == SPOT_CONE || kind == SPOT_SPHERE {
-        let cos_cutoff = light.attenuation_cos.w.clamp(-1.0, 1.0);
-        2.0 * PI * (1.0 - cos_cutoff) * PI * colour
-    } else if kind == AREA_RECT || kind == AREA_DISC {
-        let (x, y) = (
-            light.direction_type.truncate().length(),
-            light.attenuation_cos.truncate().length(),
-        );
-        let area = if kind == AREA_DISC { PI } else { 4.0 } * x * y;
-        let faces = if light.color_exponent.w != 0.0 {
-            2.0
-        } else {
-            1.0
-        };
-        PI * colour * area * faces
-    } else {
-        0.0
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lights::{POINT, SPOT_CONE};
     use glam::{Vec3, Vec4};
 
     fn light(kind: f32, colour: f32) -> GpuLight {
@@ -240,28 +208,5 @@ mod tests {
             }
         }
         assert!(LightChoices::build(&[], None, 1.0).records.is_empty());
-    }
-
-    #[test]
-    fn powers_follow_the_path_tracers_units() {
-        // A point light of colour 1: intensity π, power 4π².
-        assert!((power(&light(POINT, 1.0), 1.0) - 4.0 * PI * PI).abs() < 1e-4);
-        // A spot of half-angle 60° (cos 0.5) emits a quarter of that.
-        assert!((power(&light(SPOT_CONE, 1.0), 1.0) - PI * PI).abs() < 1e-4);
-        // A one-sided 2 x 1 rectangle of radiance 1 (half axes 1 and 0.5): π A.
-        let rect = GpuLight {
-            position_range: Vec4::ZERO,
-            direction_type: Vec3::X.extend(AREA_RECT),
-            color_exponent: Vec4::new(1.0, 1.0, 1.0, 0.0),
-            attenuation_cos: (Vec3::Y * 0.5).extend(0.0),
-        };
-        assert!((power(&rect, 1.0) - 2.0 * PI).abs() < 1e-5);
-        let two_sided = GpuLight {
-            color_exponent: Vec4::new(1.0, 1.0, 1.0, 1.0),
-            ..rect
-        };
-        assert!((power(&two_sided, 1.0) - 4.0 * PI).abs() < 1e-5);
-        // A sun of colour 1 over a scene of radius 2: π · π 2².
-        assert!((power(&light(SUN, 1.0), 2.0) - 4.0 * PI * PI).abs() < 1e-4);
     }
 }

@@ -4,16 +4,18 @@
 //! steady state is synchronized too; and the epilogue that leaves the output and
 //! history images ready for the next frame.
 
+mod access;
 mod state;
 
-pub use state::{sampled_layout, shader_stages, GpuAccess, ResourceState};
+use access::gpu_access;
+
+use state::{GpuAccess, ResourceState};
 
 use super::lifetimes::Lifetimes;
-use super::order::{PassUse, Uses};
+use super::order::Uses;
 use crate::id::{IdVec, IrPassId, PassId, ResourceId};
 use crate::plan::{Barrier, PlanResource, Residency, ResourceDesc};
-use crate::resolve::{Ir, IrKind, Usage};
-use crate::schema::{LoadDecl, PassKind};
+use crate::resolve::Ir;
 use crate::vk::{Access, Layout, Stage};
 
 /// The barriers of a plan.
@@ -296,99 +298,6 @@ fn pending_of(states: &States, which: impl Iterator<Item = ResourceId>) -> (Stag
         let (js, ja) = states[j].pending();
         (s | js, a | ja)
     })
-}
-
-/// How the GPU sees a pass's merged use of a resource.
-fn gpu_access(ir: &Ir, pass: IrPassId, u: &PassUse) -> GpuAccess {
-    let p = &ir.passes[pass];
-    let aspect = match ir.resources[u.resource].kind {
-        IrKind::Image { format, .. } => Some(format.aspect),
-        IrKind::Buffer { .. } | IrKind::External => None,
-    };
-    let mut stage = Stage::empty();
-    let mut access = Access::empty();
-    let mut layout = Layout::General;
-    for &a in &u.accesses {
-        let (s, acc, l) = match &p.accesses[a].usage {
-            Usage::Sampled => match aspect {
-                Some(aspect) => (
-                    image_read_stages(p.kind),
-                    Access::SHADER_SAMPLED_READ,
-                    sampled_layout(aspect),
-                ),
-                None => (shader_stages(p.kind), Access::UNIFORM_READ, Layout::General),
-            },
-            Usage::StorageRead => (
-                shader_stages(p.kind),
-                Access::SHADER_STORAGE_READ,
-                Layout::General,
-            ),
-            Usage::StorageWrite => (
-                shader_stages(p.kind),
-                Access::SHADER_STORAGE_WRITE,
-                Layout::General,
-            ),
-            Usage::Color { load, .. } => {
-                let read = if *load == LoadDecl::Load {
-                    Access::COLOR_ATTACHMENT_READ
-                } else {
-                    Access::empty()
-                };
-                (
-                    Stage::COLOR_ATTACHMENT_OUTPUT,
-                    Access::COLOR_ATTACHMENT_WRITE | read,
-                    Layout::ColorAttachmentOptimal,
-                )
-            }
-            Usage::Depth {
-                read_only: true, ..
-            } => (
-                Stage::EARLY_FRAGMENT_TESTS | Stage::LATE_FRAGMENT_TESTS,
-                Access::DEPTH_STENCIL_ATTACHMENT_READ,
-                Layout::DepthStencilReadOnlyOptimal,
-            ),
-            Usage::Depth { .. } => (
-                Stage::EARLY_FRAGMENT_TESTS | Stage::LATE_FRAGMENT_TESTS,
-                Access::DEPTH_STENCIL_ATTACHMENT_READ | Access::DEPTH_STENCIL_ATTACHMENT_WRITE,
-                Layout::DepthStencilAttachmentOptimal,
-            ),
-            Usage::TransferSrc => (
-                shader_stages(p.kind),
-                Access::TRANSFER_READ,
-                Layout::TransferSrcOptimal,
-            ),
-            Usage::TransferDst => (
-                shader_stages(p.kind),
-                Access::TRANSFER_WRITE,
-                Layout::TransferDstOptimal,
-            ),
-            Usage::IndirectRead => (
-                Stage::DRAW_INDIRECT,
-                Access::INDIRECT_COMMAND_READ,
-                Layout::General,
-            ),
-        };
-        stage |= s;
-        access |= acc;
-        layout = l;
-    }
-    if aspect.is_none() {
-        layout = Layout::General;
-    }
-    GpuAccess {
-        stage,
-        access,
-        layout,
-        discards: u.discards,
-    }
-}
-
-/// Images are sampled in fragment shaders in raster passes (vertex shaders read buffers).
-fn image_read_stages(kind: PassKind) -> Stage {
-    match kind {
-        PassKind::Raster => Stage::FRAGMENT_SHADER,
-        other => shader_stages(other),
-    }
 }
 
 #[cfg(test)]

@@ -8,5 +8,6 @@ mod errors;
 mod fuzz;
 mod includes;
 mod jitter;
+mod params;
 mod plans;
 mod random;
