@@ -36,6 +36,7 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
                 ior: None,
                 thin: None,
                 material: Default::default(),
+                smooth_normals: false,
             }],
             ..SceneDesc::default()
         }
@@ -96,7 +97,7 @@ fn build(
 ) -> Result<Scene, SceneError> {
     let mut models: Vec<Model> = Vec::new();
     // A file is loaded once per distinct set of material overrides.
-    let mut by_file: HashMap<(PathBuf, [u32; 5]), usize> = HashMap::new();
+    let mut by_file: HashMap<(PathBuf, [u32; 6]), usize> = HashMap::new();
     let mut instances = Vec::new();
     let mut lights = desc.lights;
     let mut cameras = desc.cameras;
@@ -116,6 +117,7 @@ fn build(
                 sigma[2],
                 placement.ior.map_or(u32::MAX, f32::to_bits),
                 placement.thin.map_or(2, u32::from),
+                u32::from(placement.smooth_normals),
             ],
         );
         let index = match by_file.get(&key) {
@@ -126,6 +128,9 @@ fn build(
                     None => load_model(&placement.file, &placement.at, options, diag)?,
                 };
                 override_glass(&mut model, placement);
+                if placement.smooth_normals {
+                    smooth_model_normals(&mut model);
+                }
                 models.push(model);
                 by_file.insert(key, models.len() - 1);
                 models.len() - 1
@@ -215,6 +220,17 @@ fn override_glass(model: &mut Model, placement: &Placement) {
             material.ior = ior;
         }
     }
+}
+
+/// A `model` block's `smooth_normals 1`: every mesh's normals recomputed
+/// smooth across its faces, and its tangents, which follow the normals,
+/// generated again.
+fn smooth_model_normals(model: &mut Model) {
+    for mesh in &mut model.meshes {
+        mesh.normals = crate::mesh::smooth_normals(&mesh.positions, &mesh.indices);
+        mesh.tangents.clear();
+    }
+    crate::tangents::generate_model_tangents(model);
 }
 
 /// Replaces unbounded point-light radii (no falloff) by the scene's diagonal, with a warning.

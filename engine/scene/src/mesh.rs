@@ -73,6 +73,37 @@ pub(crate) fn compute_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> 
         .collect()
 }
 
+/// Smooth vertex normals for a mesh whose vertices may be split per face
+/// (an OBJ with flat `vn`s, `s off`): each vertex gets the area-weighted
+/// normal of every triangle that touches its position, wherever that
+/// position is repeated, so a faceted sphere shades round. A `model`
+/// block's `smooth_normals 1` asks for it.
+pub(crate) fn smooth_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let key = |p: Vec3| p.to_array().map(f32::to_bits);
+    let mut at: std::collections::HashMap<[u32; 3], Vec3> = std::collections::HashMap::new();
+    for tri in indices.chunks_exact(3) {
+        let (Some(&a), Some(&b), Some(&c)) = (
+            positions.get(tri[0] as usize),
+            positions.get(tri[1] as usize),
+            positions.get(tri[2] as usize),
+        ) else {
+            continue;
+        };
+        let n = (b - a).cross(c - a);
+        for p in [a, b, c] {
+            *at.entry(key(p)).or_insert(Vec3::ZERO) += n;
+        }
+    }
+    positions
+        .iter()
+        .map(|&p| {
+            at.get(&key(p))
+                .and_then(|n| n.try_normalize())
+                .unwrap_or(Vec3::Y)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -88,5 +119,30 @@ mod tests {
         ];
         let n = compute_normals(&p, &[0, 1, 2, 0, 2, 3]);
         assert_eq!(n, vec![Vec3::Y, Vec3::Y, Vec3::Y, Vec3::Y, Vec3::Y]);
+    }
+
+    /// Two triangles of a roof meeting at a ridge, each with its own copy
+    /// of the ridge's vertices (flat normals, as an OBJ with `s off` has):
+    /// smoothed, both copies of a ridge vertex point straight up, and the
+    /// eaves keep their own face's normal.
+    #[test]
+    fn split_vertices_share_their_smoothed_normal() {
+        let p = [
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 1.0),
+            Vec3::new(0.0, 1.0, -1.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, -1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ];
+        let n = smooth_normals(&p, &[0, 1, 2, 3, 4, 5]);
+        let left = Vec3::new(-1.0, 1.0, 0.0).normalize();
+        let right = Vec3::new(1.0, 1.0, 0.0).normalize();
+        for (got, want) in n
+            .iter()
+            .zip([left, Vec3::Y, Vec3::Y, right, Vec3::Y, Vec3::Y])
+        {
+            assert!((*got - want).length() < 1e-6, "{got} against {want}");
+        }
     }
 }

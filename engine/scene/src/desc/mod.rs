@@ -44,6 +44,9 @@ pub struct Placement {
     /// `color`, `emission`, `roughness`, `metallic`: factors replaced for
     /// this placement's materials.
     pub material: MaterialOverride,
+    /// `smooth_normals 1`: the model's vertex normals recomputed smooth
+    /// across the faces around each position (for a faceted OBJ).
+    pub smooth_normals: bool,
 }
 
 /// A scene's script: the file, where the scene named it, and the index of
@@ -427,6 +430,8 @@ fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placeme
     let thin = props
         .f32_where("thin", |v| v == 0.0 || v == 1.0, "0 or 1")?
         .map(|v| v == 1.0);
+    let smooth_normals =
+        props.f32_where("smooth_normals", |v| v == 0.0 || v == 1.0, "0 or 1")? == Some(1.0);
     let material = material_override(props)?;
     let Some((name, line)) = file else {
         diag.warn(props.block_at(), "model without a 'file'; skipped");
@@ -440,6 +445,7 @@ fn model(props: &mut Props<'_>, diag: &mut Diagnostics) -> Result<Option<Placeme
         ior,
         thin,
         material,
+        smooth_normals,
     }))
 }
 

@@ -297,6 +297,19 @@ fn model_ior_and_thin_override_the_glass() {
 }
 
 #[test]
+fn model_smooth_normals_is_0_or_1() {
+    let (d, warnings) = desc("model\n{\n file \"sphere.obj\"\n smooth_normals 1\n}\n");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(d.models[0].smooth_normals);
+    let (d, _) = desc("model\n{\n file \"sphere.obj\"\n}\n");
+    assert!(!d.models[0].smooth_normals);
+    assert_eq!(
+        error("model\n{\n file \"sphere.obj\"\n smooth_normals 2\n}\n"),
+        "t.scene:4: 'smooth_normals' must be 0 or 1, found 2"
+    );
+}
+
+#[test]
 fn model_material_overrides_are_read_and_checked_at_their_line() {
     let (d, warnings) = desc(
         "model\n{\n file \"a.obj\"\n color 1 0.5 0\n emission 0 0 2\n roughness 0.25\n metallic 1\n}\n",
