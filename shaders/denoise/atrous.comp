@@ -1,12 +1,12 @@
 #version 450
 // One step of the denoiser's edge-avoiding à-trous wavelet filter
-// (graphs/denoise.ron, SVGF): a 5x5 B3-spline kernel with taps `step`
-// pixels apart, each weighted by how alike its surface is to the centre's
+// (graphs/denoise.ron, SVGF): a 5x5 B3-spline or a 3x3 kernel with taps
+// `step` pixels apart, each weighted by how alike its surface is to the centre's
 // (normals, distances along the ray against the local slope) and how close
 // its illumination's luminance is, in standard deviations of the centre's
 // (the variance 3x3-blurred); the variance is filtered with the squared
-// weights. Steps 1, 2, 4, 8 and 16 in a row reach 61 pixels; lights and the
-// background only the first two steps' 13x13.
+// weights. Steps 1 and 2 with 5x5 taps and 4, 8 and 16 with 3x3 in a row
+// reach 34 pixels. Lights and the background are not filtered.
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -21,7 +21,17 @@ layout(push_constant) uniform Params {
     float phi_depth;
 } params;
 
+// The pass's KERNEL_RADIUS: 2, SVGF's 5x5 B3 spline, for the first two
+// steps; 1, a 3x3 kernel (1/4, 1/2, 1/4), for the wide ones, where the 5x5
+// taps cost twice as much for no better an image (docs/ladder.md).
+#ifndef KERNEL_RADIUS
+#define KERNEL_RADIUS 2
+#endif
+#if KERNEL_RADIUS == 2
 const float KERNEL[3] = float[3](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
+#else
+const float KERNEL[2] = float[2](1.0 / 2.0, 1.0 / 4.0);
+#endif
 
 void main() {
     ivec2 size = imageSize(source);
@@ -33,13 +43,11 @@ void main() {
     vec4 np = imageLoad(guide_normal, pixel);
     bool surface = np.w > 0.0;
     int step = int(max(params.step, 1u));
-    // Lights and the background are filtered by the first two steps alone
-    // (13x13): enough to share a silhouette pixel's stray sample with its
-    // neighbours of its kind, where the reference's box-filtered pixels hold
-    // part of the object too, without carrying it across the background,
-    // which is exactly black in the reference wherever no object is near
-    // (all five steps spread the flight helmet's silhouettes into a haze:
-    // HDR-FLIP 0.70 against 0.18).
+    // Lights and the background pass through: filtered with their own kind
+    // they carried a silhouette pixel's samples of the object into
+    // background that is exactly black in the reference (the flight helmet
+    // at 160x120 after 4 frames: HDR-FLIP 0.22 with two steps over them,
+    // 0.055 without; docs/ladder.md).
     // A pixel whose filter has faded out (the variance step marks it with a
     // negative variance) is passed through: its own output is the temporal
     // mean, and as a neighbour it is what it is.
@@ -65,8 +73,8 @@ void main() {
     vec3 sum = vec3(0.0);
     float variance = 0.0;
     float weights = 0.0;
-    for (int y = -2; y <= 2; ++y) {
-        for (int x = -2; x <= 2; ++x) {
+    for (int y = -KERNEL_RADIUS; y <= KERNEL_RADIUS; ++y) {
+        for (int x = -KERNEL_RADIUS; x <= KERNEL_RADIUS; ++x) {
             ivec2 q = pixel + ivec2(x, y) * step;
             if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) {
                 continue;

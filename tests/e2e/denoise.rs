@@ -247,9 +247,9 @@ fn traced(
 /// The box on a floor under an ambient sky (tests/e2e/rt_ao.rs's scene),
 /// path traced at one sample per pixel a frame, against a 512-spp
 /// reference: the denoised frame's relative MSE is under half the raw
-/// frame's on the first frame (measured 5.40e-2 to 2.65e-2) and under an
-/// eighth on the fourth (4.49e-2 to 3.94e-3), and after four still frames
-/// the image's mean is the reference's within 1% (measured 1.0011; the
+/// frame's on the first frame (measured 5.40e-2 to 2.69e-2) and under an
+/// eighth on the fourth (4.49e-2 to 3.87e-3), and after four still frames
+/// the image's mean is the reference's within 1% (measured 1.0009; the
 /// first frame alone is 1.2% bright: a bias of filtering one sample). The
 /// first frame's error is mostly the silhouette pixels' coverage of the
 /// box, which the denoiser leaves to time (shaders/denoise/atrous.comp):

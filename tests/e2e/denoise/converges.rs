@@ -113,8 +113,8 @@ fn a_light_switched_off_leaves_no_ghost_after_two_frames() {
 
 /// On the box scene (1 sample per pixel a frame, 48 x 48) the denoised
 /// image's relative MSE against 512 spp is below raw accumulation of the
-/// same samples at 4, 8, 16 and 32 frames (measured 3.94e-3 against
-/// 7.26e-3, 1.94e-3 against 3.09e-3, 7.88e-4 against 1.06e-3; at 32 the
+/// same samples at 4, 8, 16 and 32 frames (measured 3.87e-3 against
+/// 7.26e-3, 1.87e-3 against 3.09e-3, 7.78e-4 against 1.06e-3; at 32 the
 /// filter has faded out and both are 4.435e-4 to four digits).
 #[test]
 fn the_denoised_image_is_never_worse_than_raw_accumulation() {

@@ -67,9 +67,9 @@ fn the_split_light_adds_up_to_the_undivided_light() {
 /// On the glossy box (1 sample per pixel a frame, 48 x 48) the split
 /// denoiser's relative MSE against 512 spp is below raw accumulation of the
 /// same samples and below the undivided denoiser's at 4, 8 and 16 frames
-/// (measured 1.18e-2 against 9.76e-2 raw and 1.49e-2 undivided at 4,
-/// 6.45e-3 against 2.55e-2 and 7.18e-3 at 8, 5.78e-3 against 1.08e-2 and
-/// 6.11e-3 at 16).
+/// (measured 1.25e-2 against 9.76e-2 raw and 1.56e-2 undivided at 4,
+/// 6.57e-3 against 2.55e-2 and 7.15e-3 at 8, 5.83e-3 against 1.08e-2 and
+/// 6.14e-3 at 16).
 #[test]
 fn the_split_denoiser_is_never_worse_than_raw_accumulation() {
     let dir = TempDir::new("denoise-split-never-worse");
