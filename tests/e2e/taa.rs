@@ -60,6 +60,18 @@ const QUAD: &str = "model\n{\n\tfile \"quad.obj\"\n}\n";
 /// Forward at `size` x `size` for `frames` frames one second apart, bloom
 /// off, with `features`; the float image `image` read back.
 fn forward(scene: &Path, size: u32, frames: u32, features: &[&str], image: &str) -> Vec<f32> {
+    forward_with(scene, size, frames, features, image, &[])
+}
+
+/// As `forward`, with graph parameters `params`.
+fn forward_with(
+    scene: &Path,
+    size: u32,
+    frames: u32,
+    features: &[&str],
+    image: &str,
+    params: &[(&str, f64)],
+) -> Vec<f32> {
     let settings = RenderSettings {
         graph: weft_tests::shipped("forward.ron"),
         extent: Extent {
@@ -73,37 +85,10 @@ fn forward(scene: &Path, size: u32, frames: u32, features: &[&str], image: &str)
             .chain(features)
             .map(|f| f.to_string())
             .collect(),
-        ..RenderSettings::default()
-    };
-    render_image_validated(scene, settings, image).1
-}
-
-/// As `forward`, with `shadow_rays` for rt_shadows' area-light rays.
-fn forward_with_rays(
-    scene: &Path,
-    frames: u32,
-    features: &[&str],
-    image: &str,
-    rays: u32,
-) -> Vec<f32> {
-    let settings = RenderSettings {
-        graph: weft_tests::shipped("forward.ron"),
-        extent: Extent {
-            width: 64,
-            height: 64,
-        },
-        frames,
-        frame_time: 1.0,
-        features: ["!bloom"]
+        params: params
             .iter()
-            .chain(features)
-            .map(|f| f.to_string())
+            .map(|&(name, value)| (name.to_string(), ParamValue::Number(value)))
             .collect(),
-        params: [(
-            "shadow_rays".to_string(),
-            ParamValue::Number(f64::from(rays)),
-        )]
-        .into(),
         ..RenderSettings::default()
     };
     render_image_validated(scene, settings, image).1
@@ -297,13 +282,30 @@ fn taa_averages_one_shadow_ray_a_frame_over_frames() {
         &format!("{QUAD}arealight\n{{\n\tshape rect\n\tsize 2 2\n\tposition 0 0 3\n\tdirection 0 0 -1\n\temission 5 5 5\n}}\n"),
         "",
     );
-    let still = |rays| forward_with_rays(&scene, 1, &["rt_shadows"], "hdr", rays);
-    let averaged =
-        |rays| forward_with_rays(&scene, 32, &["rt_shadows", "taa"], "antialiased", rays);
+    let still = |rays| {
+        forward_with(
+            &scene,
+            64,
+            1,
+            &["rt_shadows"],
+            "hdr",
+            &[("shadow_rays", rays)],
+        )
+    };
+    let averaged = |rays| {
+        forward_with(
+            &scene,
+            64,
+            32,
+            &["rt_shadows", "taa"],
+            "antialiased",
+            &[("shadow_rays", rays)],
+        )
+    };
     let rgb =
         |image: Vec<f32>| -> Vec<f32> { image.chunks(4).flat_map(|p| p[..3].to_vec()).collect() };
-    let one_frame = relative_rms(&rgb(still(1)), &rgb(still(64)));
-    let over_frames = relative_rms(&rgb(averaged(1)), &rgb(averaged(64)));
+    let one_frame = relative_rms(&rgb(still(1.0)), &rgb(still(64.0)));
+    let over_frames = relative_rms(&rgb(averaged(1.0)), &rgb(averaged(64.0)));
     println!(
         "relative RMS against 64 rays: one frame {one_frame:.4}, 32 frames of TAA {over_frames:.4}"
     );

@@ -243,19 +243,23 @@ fn cone_union(a: (Vec3, f32), b: (Vec3, f32)) -> (Vec3, f32) {
     (axis.normalize(), theta_o.cos())
 }
 
+/// A light record of type `kind` and grey colour `colour`, facing +y, with
+/// a 60-degree spot cutoff: what the light-choice tests build tables of.
+#[cfg(test)]
+pub(crate) fn test_light(kind: f32, colour: f32) -> GpuLight {
+    GpuLight {
+        position_range: glam::Vec4::ZERO,
+        direction_type: Vec3::Y.extend(kind),
+        color_exponent: glam::Vec4::new(colour, colour, colour, 0.0),
+        attenuation_cos: glam::Vec4::new(0.0, 0.0, 1.0, 0.5),
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::test_light as light;
     use super::*;
     use glam::Vec4;
-
-    fn light(kind: f32, colour: f32) -> GpuLight {
-        GpuLight {
-            position_range: Vec4::ZERO,
-            direction_type: Vec3::Y.extend(kind),
-            color_exponent: Vec4::new(colour, colour, colour, 0.0),
-            attenuation_cos: Vec4::new(0.0, 0.0, 1.0, 0.5),
-        }
-    }
 
     #[test]
     fn powers_follow_the_path_tracers_units() {

@@ -148,17 +148,8 @@ fn grouped_mixture(choices: &[(f64, f64)]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::light_bounds::test_light as light;
     use crate::lights::{POINT, SPOT_CONE};
-    use glam::{Vec3, Vec4};
-
-    fn light(kind: f32, colour: f32) -> GpuLight {
-        GpuLight {
-            position_range: Vec4::ZERO,
-            direction_type: Vec3::Y.extend(kind),
-            color_exponent: Vec4::new(colour, colour, colour, 0.0),
-            attenuation_cos: Vec4::new(0.0, 0.0, 1.0, 0.5),
-        }
-    }
 
     /// The probability the table gives each choice: its own threshold share
     /// plus the shares of every choice that aliases to it.
