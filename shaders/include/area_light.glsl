@@ -113,4 +113,39 @@ bool in_light_plane(AreaOutline o, vec3 origin) {
     return len <= 0.0 || within_rounding(dot(o.centre, o.winding) / len, scale);
 }
 
+// Lights are sorted suns, points, spots, areas (engine/render/src/lights.rs).
+uint first_area_light() {
+    return frame.counts.x + frame.counts.y + frame.counts.z;
+}
+
+// The nearest area light a ray meets before `t` (then lowered to its
+// distance): its index, or -1. The panels are opaque to every ray of the
+// path tracer, and to raster graphs' traced shadows (rt_shadows.glsl).
+int hit_area_light(vec3 origin, vec3 dir, inout float t) {
+    int found = -1;
+#ifdef SCENE_AREA_LIGHTS
+    for (uint i = first_area_light(); i < frame.counts.w; ++i) {
+        AreaOutline o = area_outline(i, origin);
+        vec3 facing = -normalize(o.winding);
+        float along = dot(dir, facing);
+        // A ray leaving the light's plane never meets the light.
+        if (along == 0.0 || in_light_plane(o, origin)) {
+            continue;
+        }
+        float s = dot(o.centre, facing) / along;
+        if (s <= 0.0 || s >= t) {
+            continue;
+        }
+        vec3 offset = s * dir - o.centre;
+        vec2 q = vec2(dot(offset, o.x) / dot(o.x, o.x), dot(offset, o.y) / dot(o.y, o.y));
+        bool inside = o.disc ? dot(q, q) <= 1.0 : max(abs(q.x), abs(q.y)) <= 1.0;
+        if (inside) {
+            t = s;
+            found = int(i);
+        }
+    }
+#endif
+    return found;
+}
+
 #endif

@@ -15,7 +15,8 @@
 // so the product is the ray-traced shadowed integral for a Lambertian surface
 // (the ratio estimator of Heitz et al., "Combining Analytic Direct
 // Illumination and Stochastic Shadows", I3D 2018), and the noise goes where
-// the penumbra is. The strata are offset per pixel, and per frame only where
+// the penumbra is. Area lights' panels block shadow rays, as the path
+// tracer's panels block its rays. The strata are offset per pixel, and per frame only where
 // the camera is jittered (TAA, which averages the frames): otherwise a still
 // image is the same every frame. Replaces the shadow-map lookups
 // (HAS_SHADOW_MAP), which the graphs leave out under `rt_shadows`.
@@ -75,7 +76,9 @@ float rt_towards(vec3 x, vec3 n, vec4 light, float skip) {
     if (start >= d) {
         return 1.0;
     }
-    return trace_any(leave(x, n) + l * start, l, (d - start) * (1.0 - RT_SHADOW_SHORTEN)) ? 0.0 : 1.0;
+    vec3 origin = leave(x, n) + l * start;
+    float reach = (d - start) * (1.0 - RT_SHADOW_SHORTEN);
+    return hit_area_light(origin, l, reach) >= 0 || trace_any(origin, l, reach) ? 0.0 : 1.0;
 }
 
 // The visible fraction of a sun, point or spot (`light` as rt_towards takes
@@ -129,7 +132,14 @@ float rt_area_visibility(uint index, AreaOutline o, vec3 p, vec3 n, uint rays) {
             float weight = max(dot(n, l), 0.0) * max(cos_light, 0.0) / max(d * d, 1e-30);
             if (weight > 0.0) {
                 total += weight;
-                if (d <= start || !trace_any(origin + l * start, l, (d - start) * (1.0 - RT_SHADOW_SHORTEN))) {
+                float reach = (d - start) * (1.0 - RT_SHADOW_SHORTEN);
+                // Another light's panel blocks the ray; this light's own,
+                // where the ray ends, does not (the ray starts off the
+                // surface, so it may reach it a little before `reach`).
+                float panel = reach;
+                int blocker = hit_area_light(origin + l * start, l, panel);
+                if (d <= start || ((blocker < 0 || uint(blocker) == index)
+                        && !trace_any(origin + l * start, l, reach))) {
                     seen += weight;
                 }
             }

@@ -29,11 +29,6 @@ const uint LIGHT_CHOICE_UNIFORM = 0u;
 const uint LIGHT_CHOICE_POWER = 1u;
 const uint LIGHT_CHOICE_TREE = 2u;
 
-// Lights are sorted suns, points, spots, areas (engine/render/src/lights.rs).
-uint first_area_light() {
-    return frame.counts.x + frame.counts.y + frame.counts.z;
-}
-
 // One over the probability next-event estimation picks choice `index`
 // (analytic light `index`, or the emissive triangles at index
 // frame.counts.w) for the point `at`: the number of choices when picking
@@ -200,35 +195,6 @@ bool sample_light(vec3 p, vec3 n, vec3 at, vec4 u_pick, vec4 u_point, uint choic
 #else
     return false;
 #endif
-}
-
-// The nearest area light a ray meets before `t` (then lowered to its
-// distance): its index, or -1.
-int hit_area_light(vec3 origin, vec3 dir, inout float t) {
-    int found = -1;
-#ifdef SCENE_AREA_LIGHTS
-    for (uint i = first_area_light(); i < frame.counts.w; ++i) {
-        AreaOutline o = area_outline(i, origin);
-        vec3 facing = -normalize(o.winding);
-        float along = dot(dir, facing);
-        // A ray leaving the light's plane never meets the light.
-        if (along == 0.0 || in_light_plane(o, origin)) {
-            continue;
-        }
-        float s = dot(o.centre, facing) / along;
-        if (s <= 0.0 || s >= t) {
-            continue;
-        }
-        vec3 offset = s * dir - o.centre;
-        vec2 q = vec2(dot(offset, o.x) / dot(o.x, o.x), dot(offset, o.y) / dot(o.y, o.y));
-        bool inside = o.disc ? dot(q, q) <= 1.0 : max(abs(q.x), abs(q.y)) <= 1.0;
-        if (inside) {
-            t = s;
-            found = int(i);
-        }
-    }
-#endif
-    return found;
 }
 
 // Radiance area light `index` sends back along a ray from `origin` along

@@ -296,8 +296,8 @@ fn area_light_shadows_converge_to_the_path_tracers_direct_light() {
     let scene = weft_scene::load_scene(&path).expect("scene");
     let inverse = scene.cameras[0].view_projection(0.0, 1.0).inverse();
     let bvh = Bvh::from_scene(&scene, |_, _| true);
-    // The floor, where the camera does not see the panel (the reference's
-    // panel is opaque; raster panels hide nothing: a raster caveat).
+    // The floor, where the camera does not see the panel in front of it
+    // (the panel, not the floor's shadow, is what those pixels show).
     let keep: Vec<bool> = (0..SIZE * SIZE)
         .map(|i| {
             let (x, y) = (i % SIZE, i / SIZE);

@@ -26,6 +26,12 @@ use weft_graph::schema::{CompareOp, Draw, LightKind, MaterialFilter, ShadingMode
 /// refused with a pointer to tiled shading (see docs/lights.md).
 pub const MAX_LIGHT_VOLUMES: u32 = 65_536;
 
+/// The first instance index `shaders/shadow.vert` reads as an area light's
+/// panel (light record index + this): a `ShadowCasters` pass draws the
+/// panels after the meshes in every shadow view, so they block light as the
+/// path tracer's do.
+pub const PANEL_INSTANCES: u32 = 1 << 30;
+
 /// Whether a pass drawing every mesh must blend its transparent ones itself: it
 /// shades colour (a fragment stage writing attachments) that the graph does not blend.
 fn blends_transparency(state: &PassState) -> bool {
@@ -347,9 +353,32 @@ impl SceneRecorder<'_> {
             ctx.push_constants(p, &[(SHADOW_VIEW, i as f64)])?;
             let draws = self.visible(name, view.clip, filter);
             calls += self.draw_meshes(ctx.cmd, p, draws.iter());
+            if filter == MaterialFilter::ShadowCasters {
+                calls += self.draw_panels(ctx.cmd);
+            }
             self.shadow_tiles[i] = Some(tile);
         }
         Ok(calls)
+    }
+}
+
+impl SceneRecorder<'_> {
+    /// The area lights' panels as casters: the panel mesh once per area
+    /// light, instances from [`PANEL_INSTANCES`] on.
+    fn draw_panels(&self, cmd: vk::CommandBuffer) -> u64 {
+        let lights = &self.scene.light_set;
+        if lights.areas == 0 {
+            return 0;
+        }
+        let panel = self.scene.geometry.panel;
+        Commands::new(self.gpu.device(), cmd).draw_indexed_instanced(
+            panel.index_count,
+            lights.areas,
+            panel.first_index,
+            panel.vertex_offset,
+            PANEL_INSTANCES + lights.first_area(),
+        );
+        1
     }
 }
 
@@ -451,5 +480,25 @@ impl DrawRecorder for SceneRecorder<'_> {
         ctx.commands()
             .bind_sets(pipeline.bind_point, pipeline.layout, SCENE_SET, &[set]);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::PANEL_INSTANCES;
+
+    /// `shaders/shadow.vert` reads instances from [`PANEL_INSTANCES`] on as
+    /// panels: its constant is this one.
+    #[test]
+    fn the_shadow_shader_knows_where_panel_instances_start() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shaders/shadow.vert");
+        let text = std::fs::read_to_string(&path).expect("shadow.vert");
+        assert_eq!(PANEL_INSTANCES, 1 << 30);
+        assert!(
+            text.contains("const uint PANEL_INSTANCES = 1u << 30;"),
+            "{} lost its PANEL_INSTANCES",
+            path.display()
+        );
     }
 }

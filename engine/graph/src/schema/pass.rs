@@ -348,6 +348,8 @@ pub enum MaterialFilter {
     Opaque,
     Transparent,
     Emissive,
+    /// Meshes that cast shadows and, in a shadow-atlas pass, the area
+    /// lights' panels (opaque, as the path tracer's are).
     ShadowCasters,
 }
 

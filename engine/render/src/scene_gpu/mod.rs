@@ -15,7 +15,7 @@ use crate::shadows::{self, ShadowSettings, ShadowView, ViewVolume};
 use crate::texture;
 use ash::vk;
 use glam::{UVec4, Vec4};
-use placement::changed_records;
+use placement::{changed_records, moved_panels};
 use std::collections::HashMap;
 use std::path::PathBuf;
 use trace::TraceBuffers;
@@ -437,14 +437,12 @@ impl<'g> GpuScene<'g> {
         }
     }
 
-    /// Uploads the scene as it is at `time` (`at`, from a
-    /// [`weft_scene::SceneUpdater`]): lights, moved and recoloured placements,
-    /// and `camera` (or the script's camera of its name) for a target of
-    /// `extent`, its projection moved by `jitter` pixels (zero unless the
-    /// plan jitters the camera); call it before each frame (the previous
+    /// Uploads the scene as it is at `time` (`at`, from a [`weft_scene::SceneUpdater`]):
+    /// lights, moved and recoloured placements, and `camera` (or the script's camera of
+    /// its name) for a target of `extent`, its projection moved by `jitter` pixels (zero
+    /// unless the plan jitters the camera); call it before each frame (the previous
     /// frame must have finished). Returns a hash of what it uploaded (camera, lights,
-    /// placements and their colours), so callers can tell whether two frames
-    /// see the same inputs.
+    /// placements and their colours), so callers can tell whether two frames see the same inputs.
     pub fn update(
         &mut self,
         at: &SceneAt<'_>,
@@ -498,6 +496,8 @@ impl<'g> GpuScene<'g> {
         };
         self.frame.write(bytes_of(&[frame]))?;
         if let Some(changed) = changed_records(&self.light_set.records, &lights.records) {
+            let panels = moved_panels(&self.light_set.records, &lights.records, changed.clone());
+            self.moved_boxes.extend(panels);
             let offset = changed.start * std::mem::size_of::<GpuLight>();
             self.lights
                 .write_at(offset, bytes_of(&lights.records[changed]))?;
@@ -506,10 +506,9 @@ impl<'g> GpuScene<'g> {
             }
         }
         let mut inputs = std::collections::hash_map::DefaultHasher::new();
-        // What this frame shows, not how the last one differed or where
-        // its jitter fell: a still camera's frames hash alike even right
-        // after it moved, and jittered frames of one view alike (the
-        // inverse follows from `view_proj`, so it is left out).
+        // What this frame shows, not how the last one differed or where its jitter
+        // fell: a still camera's frames hash alike even right after it moved, and
+        // jittered frames of one view alike (the inverse follows from `view_proj`).
         let shown = GpuFrame {
             view_proj,
             inv_view_proj: glam::Mat4::ZERO,
@@ -529,8 +528,9 @@ impl<'g> GpuScene<'g> {
 }
 
 impl GpuScene<'_> {
-    /// Where the draws the last [`GpuScene::update`] moved were and are now
-    /// (world boxes): a kept shadow tile whose view meets one is stale.
+    /// Where the draws and area-light panels the last [`GpuScene::update`]
+    /// moved were and are now (world boxes): a kept shadow tile whose view
+    /// meets one is stale.
     pub fn moved_boxes(&self) -> &[weft_scene::Aabb] {
         &self.moved_boxes
     }

@@ -85,6 +85,32 @@ impl GpuScene<'_> {
     }
 }
 
+/// The boxes of the area-light panels among records `changed` of `old` and
+/// `new` (where each was and is): a `ShadowCasters` pass draws the panels,
+/// so a moved one stales the shadow tiles it touched or touches.
+pub(super) fn moved_panels(
+    old: &[GpuLight],
+    new: &[GpuLight],
+    changed: std::ops::Range<usize>,
+) -> Vec<weft_scene::Aabb> {
+    let panel = |l: &GpuLight| {
+        let kind = l.direction_type.w;
+        (kind == crate::lights::AREA_RECT || kind == crate::lights::AREA_DISC).then(|| {
+            let reach = l.direction_type.truncate().abs() + l.attenuation_cos.truncate().abs();
+            let centre = l.position_range.truncate();
+            weft_scene::Aabb {
+                min: centre - reach,
+                max: centre + reach,
+            }
+        })
+    };
+    changed
+        .flat_map(|i| [old.get(i), new.get(i)])
+        .flatten()
+        .filter_map(panel)
+        .collect()
+}
+
 /// The records of `new` that differ from `old` (the light buffer's
 /// contents), as one range to write; all of them when the counts differ,
 /// none when nothing changed: what moved or changed colour is all that is
