@@ -164,4 +164,27 @@ mod tests {
         let nan = vec![at(f32::NAN)];
         assert_eq!(changed_records(&nan, &nan), None);
     }
+
+    /// A rect area light moved from x = 1 to x = 5 (half axes 0.5 along x
+    /// and 0.25 along z): its panel's box where it was and where it is; a
+    /// point light beside it that moved too has no panel.
+    #[test]
+    fn moved_panels_are_where_a_panel_was_and_is() {
+        let rect = |x: f32| GpuLight {
+            position_range: Vec4::new(x, 2.0, 0.0, 1.0),
+            direction_type: Vec4::new(0.5, 0.0, 0.0, crate::lights::AREA_RECT),
+            attenuation_cos: Vec4::new(0.0, 0.0, 0.25, 0.0),
+            ..GpuLight::zeroed()
+        };
+        let point = |x: f32| GpuLight {
+            direction_type: Vec4::new(0.0, 0.0, 0.0, crate::lights::POINT),
+            ..at(x)
+        };
+        let boxes = moved_panels(&[point(0.0), rect(1.0)], &[point(9.0), rect(5.0)], 0..2);
+        let expected = |x: f32| weft_scene::Aabb {
+            min: glam::Vec3::new(x - 0.5, 2.0, -0.25),
+            max: glam::Vec3::new(x + 0.5, 2.0, 0.25),
+        };
+        assert_eq!(boxes, vec![expected(1.0), expected(5.0)]);
+    }
 }
