@@ -13,7 +13,29 @@ const SIZE: u32 = 48;
 /// The HDR image of `scene` through shipped graph `graph` (validated, bloom
 /// off), RGB per pixel.
 fn render(scene: &Path, graph: &str, samples: Option<u64>, params: &[(&str, f64)]) -> Vec<Vec3> {
-    let settings = weft_tests::render::square_settings(graph, SIZE, samples, params, &["!bloom"]);
+    render_with(scene, graph, samples, params, &["!bloom"])
+}
+
+/// Forward without shadows (and bloom): every light unoccluded.
+fn unshadowed(scene: &Path) -> Vec<Vec3> {
+    render_with(
+        scene,
+        "forward.ron",
+        None,
+        &[],
+        &["!bloom", "!shadow_casters"],
+    )
+}
+
+/// As `render`, with `features`.
+fn render_with(
+    scene: &Path,
+    graph: &str,
+    samples: Option<u64>,
+    params: &[(&str, f64)],
+    features: &[&str],
+) -> Vec<Vec3> {
+    let settings = weft_tests::render::square_settings(graph, SIZE, samples, params, features);
     let (_, values) = weft_tests::render::render_hdr_validated(scene, settings);
     values
         .chunks(4)
@@ -187,19 +209,7 @@ fn area_lights_cast_soft_shadows_as_the_tracer_sees_them() {
             / reference.iter().sum::<f32>()
     };
     let ratio = |image: &[f32]| image.iter().sum::<f32>() / reference.iter().sum::<f32>();
-    let settings = weft_tests::render::square_settings(
-        "forward.ron",
-        SIZE,
-        None,
-        &[],
-        &["!bloom", "!shadow_casters"],
-    );
-    let (_, values) = weft_tests::render::render_hdr_validated(&scene, settings);
-    let unshadowed: Vec<Vec3> = values
-        .chunks(4)
-        .map(|p| Vec3::new(p[0], p[1], p[2]))
-        .collect();
-    let unshadowed = band(&unshadowed);
+    let unshadowed = band(&unshadowed(&scene));
     println!(
         "unshadowed: error {:.3}, ratio {:.3}",
         error(&unshadowed),
@@ -269,19 +279,7 @@ fn an_area_light_panel_blocks_the_light_behind_it() {
         &[("max_depth", 2.0)],
     ));
     let raster = under(&render(&scene, "forward.ron", None, &[]));
-    let settings = weft_tests::render::square_settings(
-        "forward.ron",
-        SIZE,
-        None,
-        &[],
-        &["!bloom", "!shadow_casters"],
-    );
-    let (_, values) = weft_tests::render::render_hdr_validated(&scene, settings);
-    let unshadowed: Vec<Vec3> = values
-        .chunks(4)
-        .map(|p| Vec3::new(p[0], p[1], p[2]))
-        .collect();
-    let (ratio, unshadowed_ratio) = (raster / traced, under(&unshadowed) / traced);
+    let (ratio, unshadowed_ratio) = (raster / traced, under(&unshadowed(&scene)) / traced);
     println!("forward over the tracer around the panel: {ratio:.3}; without shadows {unshadowed_ratio:.3}");
     assert!(
         (ratio - 1.0).abs() < 0.06,
