@@ -82,8 +82,9 @@ void main() {
         // neighbours' history into a still pixel every frame (light creeping
         // into the black background around a silhouette). Where nothing
         // moved the two projections are the same numbers: no motion at all.
-        vec4 clip = frame.prev_view_proj * (background ? vec4(-n.xyz, 0.0) : vec4(was, 1.0));
-        vec4 now = frame.unjittered_view_proj * (background ? vec4(-n.xyz, 0.0) : vec4(p.xyz, 1.0));
+        vec4 here = background ? vec4(-n.xyz, 0.0) : vec4(p.xyz, 1.0);
+        vec4 clip = frame.prev_view_proj * (background ? here : vec4(was, 1.0));
+        vec4 now = frame.unjittered_view_proj * here;
         if (clip.w > 0.0 && now.w > 0.0) {
             vec2 at = vec2(pixel) + (clip.xy / clip.w - now.xy / now.w) * 0.5 * vec2(size);
             ivec2 base = ivec2(floor(at));

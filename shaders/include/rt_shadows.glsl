@@ -132,14 +132,15 @@ float rt_area_visibility(uint index, AreaOutline o, vec3 p, vec3 n, uint rays) {
             float weight = max(dot(n, l), 0.0) * max(cos_light, 0.0) / max(d * d, 1e-30);
             if (weight > 0.0) {
                 total += weight;
+                vec3 from = origin + l * start;
                 float reach = (d - start) * (1.0 - RT_SHADOW_SHORTEN);
                 // Another light's panel blocks the ray; this light's own,
                 // where the ray ends, does not (the ray starts off the
                 // surface, so it may reach it a little before `reach`).
                 float panel = reach;
-                int blocker = hit_area_light(origin + l * start, l, panel);
-                if (d <= start || ((blocker < 0 || uint(blocker) == index)
-                        && !trace_any(origin + l * start, l, reach))) {
+                int blocker = hit_area_light(from, l, panel);
+                bool other_panel = blocker >= 0 && uint(blocker) != index;
+                if (d <= start || (!other_panel && !trace_any(from, l, reach))) {
                     seen += weight;
                 }
             }
