@@ -114,6 +114,14 @@ vec3 ggx_separable(vec3 base, vec2 mr, vec4 tv, vec4 tl) {
     return mix(dielectric, ggx_multiple_scattering(base, tv.z) * lost, mr.x);
 }
 
+// The GGX single-scattering highlight D Vis F (Schlick's Fresnel from f0),
+// from the cosines of the half vector with the normal (`ndh`) and with v
+// (`vdh`), and of l and v with the normal.
+vec3 ggx_highlight(vec3 f0, float alpha, float ndh, float ndl, float ndv, float vdh) {
+    vec3 fresnel = f0 + (1.0 - f0) * pow(1.0 - vdh, 5.0);
+    return ggx_d(ndh, alpha) * ggx_visibility(ndl, ndv, alpha) * fresnel;
+}
+
 // f(v, l) N.L for base colour `base` and (metallic, roughness) `mr`.
 vec3 cook_torrance(vec3 base, vec2 mr, vec3 n, vec3 v, vec3 l) {
     float ndl = dot(n, l);
@@ -127,8 +135,7 @@ vec3 cook_torrance(vec3 base, vec2 mr, vec3 n, vec3 v, vec3 l) {
     float r = max(mr.y, MIN_ROUGHNESS);
     float alpha = r * r;
     vec3 f0 = mix(vec3(DIELECTRIC_F0), base, mr.x);
-    vec3 fresnel = f0 + (1.0 - f0) * pow(1.0 - vdh, 5.0);
-    vec3 single = ggx_d(ndh, alpha) * ggx_visibility(ndl, ndv, alpha) * fresnel;
+    vec3 single = ggx_highlight(f0, alpha, ndh, ndl, ndv, vdh);
     vec3 separable = ggx_separable(base, mr, ggx_albedo(r, ndv), ggx_albedo(r, ndl));
     return (single + separable / PI) * ndl;
 }

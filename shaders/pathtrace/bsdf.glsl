@@ -260,8 +260,7 @@ vec3 bsdf_eval_specular(Bsdf b, vec3 n, vec3 wo, vec3 wi) {
 #ifdef SCENE_METALLIC_ROUGHNESS
     if (b.model == SHADING_METALLIC_ROUGHNESS) {
         float cos_o = max(dot(n, wo), 1e-4);
-        vec3 fresnel = b.specular + (1.0 - b.specular) * pow(1.0 - max(dot(wo, h), 0.0), 5.0);
-        return ggx_d(cos_h, b.alpha) * ggx_visibility(cos_i, cos_o, b.alpha) * fresnel * cos_i;
+        return ggx_highlight(b.specular, b.alpha, cos_h, cos_i, cos_o, max(dot(wo, h), 0.0)) * cos_i;
     }
 #endif
 #ifdef SCENE_GLOSSY
