@@ -1,6 +1,7 @@
 #version 450
 // Deferred sun pass (fullscreen): ambient, emission, ray-traced specular
-// (under rt_specular) and every sun for each covered pixel; background
+// (under rt_specular) and every sun (or, under restir_di, ReSTIR's direct
+// light from every light) for each covered pixel; background
 // pixels stay black like forward's clear.
 layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
@@ -25,6 +26,11 @@ layout(set = 0, binding = 8) uniform sampler2D gi;
 // Light through mirrors, coats and glass, ray-traced (graphs/rt_specular.ron).
 layout(set = 0, binding = 9) uniform sampler2D rt_specular;
 #endif
+#ifdef HAS_RESTIR_DIRECT
+// Direct light from every light, by ReSTIR (graphs/restir_di.ron): in place
+// of the suns here and the point, spot and area passes.
+layout(set = 0, binding = 10) uniform sampler2D restir_direct;
+#endif
 layout(push_constant) uniform Params {
     float emissive_boost;  // graph parameter: scales material emission
     uint footprint_rays;   // graph parameter: rt_shadows' rays per pixel and sun
@@ -45,5 +51,10 @@ void main() {
     Material m = material_record(s.material);
     vec4 emission_occlusion = read_emission_occlusion();
     vec3 ambient = shade_ambient_emissive(s, m, surroundings(), params.emissive_boost, emission_occlusion.rgb, emission_occlusion.a);
-    color = vec4(hdr_output(ambient + traced_specular() + shade_suns(s, m)), 1.0);
+#ifdef HAS_RESTIR_DIRECT
+    vec3 direct = texelFetch(restir_direct, ivec2(gl_FragCoord.xy), 0).rgb;
+#else
+    vec3 direct = shade_suns(s, m);
+#endif
+    color = vec4(hdr_output(ambient + traced_specular() + direct), 1.0);
 }

@@ -144,30 +144,14 @@ bool sample_emitter(vec3 p, vec4 u, float p_select, out LightSample ls) {
     return true;
 }
 
-// Picks a light and a point on it for a surface at p with normal n, the
-// tree (`choice` 2) walked at `at`, where rays leave the surface. False
-// when there is no light or it sends nothing towards p.
-bool sample_light(vec3 p, vec3 n, vec3 at, vec4 u_pick, vec4 u_point, uint choice, out LightSample ls) {
-    if (light_choice_info().x == 0u) {
-        return false;
-    }
-    uint pick;
-    float p_select;
-    if (choice == LIGHT_CHOICE_TREE) {
-        uvec4 top = tree_top_pick(u_pick.xy);
-        pick = top.w;
-        p_select = uintBitsToFloat(top.z);
-        if (pick == TREE_CHOICE) {
-            float pmf;
-            if (!tree_sample(at, u_pick.z, pick, pmf)) {
-                return false;
-            }
-            p_select *= pmf;
-        }
-    } else {
-        pick = pick_light(u_pick.xy, choice);
-        p_select = 1.0 / light_choice_odds(pick, at, choice);
-    }
+// A point on light choice `pick` (an analytic light, or the emissive
+// triangles at frame.counts.w) for a surface at p with normal n, drawn by
+// u_point and picked with probability p_select: with p_select 1, `value` is
+// the light's contribution over the density of the point alone, which does
+// not depend on p. ReSTIR's reservoirs (shaders/restir) keep (pick, u_point)
+// and evaluate it again here at other surfaces. False when the light sends
+// nothing towards p.
+bool sample_picked_light(uint pick, vec3 p, vec3 n, vec4 u_point, float p_select, out LightSample ls) {
 #ifdef SCENE_EMISSIVE
     if (pick >= frame.counts.w) {
         return sample_emitter(p, u_point, p_select, ls);
@@ -195,6 +179,40 @@ bool sample_light(vec3 p, vec3 n, vec3 at, vec4 u_pick, vec4 u_point, uint choic
 #else
     return false;
 #endif
+}
+
+// Picks a light choice for a surface whose rays leave from `at` (the tree,
+// `choice` 2, walked there): `pick` and the probability `p_select` it had.
+// False when there is no light or the tree finds none.
+bool choose_light(vec3 at, vec4 u_pick, uint choice, out uint pick, out float p_select) {
+    if (light_choice_info().x == 0u) {
+        return false;
+    }
+    if (choice == LIGHT_CHOICE_TREE) {
+        uvec4 top = tree_top_pick(u_pick.xy);
+        pick = top.w;
+        p_select = uintBitsToFloat(top.z);
+        if (pick == TREE_CHOICE) {
+            float pmf;
+            if (!tree_sample(at, u_pick.z, pick, pmf)) {
+                return false;
+            }
+            p_select *= pmf;
+        }
+    } else {
+        pick = pick_light(u_pick.xy, choice);
+        p_select = 1.0 / light_choice_odds(pick, at, choice);
+    }
+    return true;
+}
+
+// Picks a light and a point on it for a surface at p with normal n, the
+// tree (`choice` 2) walked at `at`, where rays leave the surface. False
+// when there is no light or it sends nothing towards p.
+bool sample_light(vec3 p, vec3 n, vec3 at, vec4 u_pick, vec4 u_point, uint choice, out LightSample ls) {
+    uint pick;
+    float p_select;
+    return choose_light(at, u_pick, choice, pick, p_select) && sample_picked_light(pick, p, n, u_point, p_select, ls);
 }
 
 // Radiance area light `index` sends back along a ray from `origin` along

@@ -18,6 +18,7 @@ mod one_physics;
 mod pathtrace;
 mod raycast;
 mod render;
+mod restir;
 mod rt_ao;
 mod rt_shadows;
 mod rt_specular;
