@@ -266,6 +266,8 @@ fn scene_features_cull_passes_and_variants() {
             ("keep_position", "enabled_if [denoise] is false"),
             ("keep_illumination", "enabled_if [denoise] is false"),
             ("keep_moments", "enabled_if [denoise] is false"),
+            ("restir_initial", "enabled_if [restir_di] is false"),
+            ("restir_spatial", "enabled_if [restir_di] is false"),
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
             ("area_lights", "enabled_if [area_lights] is false"),
