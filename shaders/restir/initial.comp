@@ -36,6 +36,8 @@ layout(set = 0, binding = 3, rgba32f) uniform readonly image2D restir_sample_pre
 layout(set = 0, binding = 4, rgba32f) uniform readonly image2D restir_state_prev;
 // xyz: world position, w: shading normal packed; M 0 in the state: none.
 layout(set = 0, binding = 5, rgba32f) uniform readonly image2D restir_surface_prev;
+// The G-buffer's base-colour texture samples (reservoir.glsl, shading_point).
+layout(set = 0, binding = 6) uniform sampler2D gbuffer_albedo;
 
 layout(push_constant) uniform Params {
     uint candidates;
@@ -73,7 +75,7 @@ void main() {
         return;
     }
     uint tri = floatBitsToUint(found.y);
-    ShadingPoint sp = shading_point(tri, dir, t);
+    ShadingPoint sp = shading_point(tri, dir, t, texelFetch(gbuffer_albedo, pixel, 0).rgb);
     imageStore(restir_hit, pixel, vec4(t, found.y, pack_normal(sp.n), 0.0));
 
     // Resampled importance sampling over this frame's candidates: each

@@ -78,8 +78,11 @@ struct ShadingPoint {
     uint draw;   // the placement it belongs to (Draw.previous)
 };
 
-// The surface at distance t along the eye's ray `dir`, triangle `tri`.
-ShadingPoint shading_point(uint tri, vec3 dir, float t) {
+// The surface at distance t along the eye's ray `dir`, triangle `tri`, its
+// base-colour texture's sample `base_texel` taken from the G-buffer: there
+// it is filtered over the pixel (mip-mapped), where the tracer's textures,
+// sampled at the pixel centre, would alias on textures finer than a pixel.
+ShadingPoint shading_point(uint tri, vec3 dir, float t, vec3 base_texel) {
     TraceSurface s = trace_surface(tri, frame.camera_position.xyz, dir, t);
     Material m = material_record(s.material);
     ShadingPoint sp;
@@ -87,7 +90,11 @@ ShadingPoint shading_point(uint tri, vec3 dir, float t) {
     sp.position = s.position;
     sp.wo = -dir;
     sp.from = leave(s.position, sp.ng);
-    sp.bsdf = surface_bsdf(s, m);
+#ifdef SCENE_TEXTURES
+    sp.bsdf = bsdf_of(m, base_texel, trace_texel(material_textures[s.material].y, false, s.uv));
+#else
+    sp.bsdf = bsdf_of(m, base_texel, vec4(1.0));
+#endif
     sp.draw = s.draw;
     return sp;
 }

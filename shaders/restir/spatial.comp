@@ -9,14 +9,13 @@
 // pass), and the reservoir is left for the next frame's temporal reuse
 // (weight 0 where the sample was found occluded).
 //
-// Each merged sample is weighed by the generalized balance heuristic (its
-// source's target over every merged surface's, weighed by their candidate
-// counts; Lin et al. 2022), (k + 1)^2 target evaluations. Biased
+// Samples are weighed by pairwise MIS (Bitterli's 2022 thesis; Lin et al.
+// 2022 for the counts as confidence), 2k target evaluations. Biased
 // (`unbiased` 0): those targets are unshadowed, and the first pass kept
-// occluded samples with weight 0, so where neighbours see a light occluded
-// that this pixel sees it claims too little: shadows' edges darken a little.
-// Unbiased (`unbiased` 1): other surfaces' targets count only where they
-// see the sample (a shadow ray each).
+// occluded samples with weight 0, so where a neighbour sees a light occluded
+// that this pixel sees, this pixel's sample claims too little: shadows'
+// edges darken a little. Unbiased (`unbiased` 1): targets at other surfaces
+// count only where they see the sample (a shadow ray each, 2k a pixel).
 #include "../include/hdr.glsl"
 #include "../include/brdf.glsl"
 #include "../include/gbuffer.glsl"
@@ -42,6 +41,8 @@ layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D restir_state_pre
 layout(set = 0, binding = 5, rgba32f) uniform writeonly image2D restir_surface_prev;
 // rgb: the direct light the surface reflects towards the eye.
 layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D restir_direct;
+// The G-buffer's base-colour texture samples (reservoir.glsl, shading_point).
+layout(set = 0, binding = 7) uniform sampler2D gbuffer_albedo;
 
 layout(push_constant) uniform Params {
     uint spatial_samples;
@@ -52,6 +53,12 @@ layout(push_constant) uniform Params {
 // The most reservoirs merged: this pixel's and up to 8 neighbours' (the
 // parameter's range).
 const uint MAX_MERGED = 9u;
+
+// The balance heuristic's weight for the first of two techniques, given each
+// one's count times its target.
+float pairwise_share(float first, float second) {
+    return first + second > 0.0 ? first / (first + second) : 0.0;
+}
 
 void main() {
     ivec2 size = imageSize(restir_hit);
@@ -68,7 +75,8 @@ void main() {
     // The reservoirs merged: this pixel's first, then its neighbours'.
     ShadingPoint points[MAX_MERGED];
     Reservoir reservoirs[MAX_MERGED];
-    points[0] = shading_point(floatBitsToUint(hit.y), pixel_ray(pixel, size), hit.x);
+    points[0] = shading_point(floatBitsToUint(hit.y), pixel_ray(pixel, size), hit.x,
+        texelFetch(gbuffer_albedo, pixel, 0).rgb);
     reservoirs[0] = reservoir_unpack(imageLoad(restir_sample, pixel), imageLoad(restir_state, pixel));
     uint count = 1u;
     Rng rng = rng_start(uvec2(pixel), params.frame, 0x7f4a7c15u);
@@ -84,39 +92,48 @@ void main() {
         if (other.x < 0.0 || !similar_surface(points[0].n, hit.x, unpack_normal(other.z), other.x, 0.1)) {
             continue;
         }
-        points[count] = shading_point(floatBitsToUint(other.y), pixel_ray(q, size), other.x);
+        points[count] = shading_point(floatBitsToUint(other.y), pixel_ray(q, size), other.x,
+            texelFetch(gbuffer_albedo, q, 0).rgb);
         reservoirs[count] = reservoir_unpack(imageLoad(restir_sample, q), imageLoad(restir_state, q));
         ++count;
     }
 
-    // Each reservoir's sample, weighed by the generalized balance heuristic:
-    // its share of every merged surface's target for it, weighed by their
-    // candidate counts. Where targets differ (a light close to one pixel and
-    // far from its neighbour) a sample stands for little where it was
-    // unlikely, so merging is never much worse than this pixel's own.
+    // Pairwise MIS (Bitterli 2022; the canonical reservoir is this pixel's):
+    // neighbour i's sample y gets a_i(y) / k, where a_i is the balance
+    // heuristic between neighbour i (its count M_i) and this pixel (M / k),
+    // and this pixel's own sample gets the rest, the mean of 1 - a_i. The
+    // weights sum to 1 for every sample, so the merge is unbiased in the
+    // targets they use, with 2k target evaluations, and this pixel's sample
+    // never counts for less than where every neighbour sees it as well.
+    Reservoir own = reservoirs[0];
+    ShadingPoint sp = points[0];
+    float k = float(count - 1u);
+    float own_share = count == 1u ? 1.0 : 0.0;
     Reservoir merged = reservoir_empty();
-    for (uint i = 0u; i < count; ++i) {
+    for (uint i = 1u; i < count; ++i) {
         Reservoir r = reservoirs[i];
         float here = 0.0;
-        float mine = 0.0;
-        float all = 0.0;
+        float share = 0.0;
         if (r.light != NO_SAMPLE && r.weight > 0.0) {
-            for (uint j = 0u; j < count; ++j) {
-                LightSample ls;
-                float target = luminance(sample_contribution(points[j], r.light, r.u, ls));
+            LightSample ls;
+            here = luminance(sample_contribution(sp, r.light, r.u, ls));
 #if UNBIASED == 1
-                target = target > 0.0 && (j == i || sample_visible(points[j], ls)) ? target : 0.0;
+            here = here > 0.0 && sample_visible(sp, ls) ? here : 0.0;
 #endif
-                here = j == 0u ? target : here;
-                mine = j == i ? target : mine;
-                all += reservoirs[j].m * target;
-            }
+            share = pairwise_share(r.m * r.target, own.m / k * here) / k;
         }
-        float w = all > 0.0 ? r.m * mine / all * here * r.weight : 0.0;
-        reservoir_add(merged, r.light, r.u, here, w, r.m, rng_next(rng).x);
+        reservoir_add(merged, r.light, r.u, here, share * here * r.weight, r.m, rng_next(rng).x);
+        if (own.light != NO_SAMPLE && own.weight > 0.0) {
+            LightSample ls;
+            float there = luminance(sample_contribution(points[i], own.light, own.u, ls));
+#if UNBIASED == 1
+            there = there > 0.0 && sample_visible(points[i], ls) ? there : 0.0;
+#endif
+            own_share += (1.0 - pairwise_share(r.m * there, own.m / k * own.target)) / k;
+        }
     }
+    reservoir_add(merged, own.light, own.u, own.target, own_share * own.target * own.weight, own.m, rng_next(rng).x);
     reservoir_finish(merged, 1.0);
-    ShadingPoint sp = points[0];
 
     vec3 direct = vec3(0.0);
     if (merged.weight > 0.0) {
