@@ -8,7 +8,10 @@
 // left where this surface was (reprojected through its placement's motion
 // and the camera's; the same surface by position and normal), its candidate
 // count capped at `history_cap` times this frame's. The merged reservoir and
-// the surface go to the spatial pass (restir/spatial.comp).
+// the surface go to the spatial pass (restir/spatial.comp) under feature
+// `restir_spatial`; without it this pass shades the kept sample itself (one
+// shadow ray in all) and its reservoir and surface are copied for the next
+// frame.
 #include "../include/hdr.glsl"
 #include "../include/brdf.glsl"
 #include "../include/gbuffer.glsl"
@@ -28,7 +31,9 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 // x: distance along the pixel's ray (-1: no surface: the background or a
 // light's panel), y: the triangle's bits, z: the shading normal packed.
+#ifdef HAS_RESTIR_HIT
 layout(set = 0, binding = 0, rgba32f) uniform writeonly image2D restir_hit;
+#endif
 layout(set = 0, binding = 1, rgba32f) uniform writeonly image2D restir_sample;
 layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D restir_state;
 // The last frame's final reservoirs and surfaces (the spatial pass's).
@@ -38,6 +43,13 @@ layout(set = 0, binding = 4, rgba32f) uniform readonly image2D restir_state_prev
 layout(set = 0, binding = 5, rgba32f) uniform readonly image2D restir_surface_prev;
 // The G-buffer's base-colour texture samples (reservoir.glsl, shading_point).
 layout(set = 0, binding = 6) uniform sampler2D gbuffer_albedo;
+#ifdef HAS_RESTIR_DIRECT
+// Without spatial reuse this pass shades: the direct light (as
+// restir/spatial.comp writes it), and this frame's surfaces, which copies
+// keep for the next frame as `restir_surface_prev`.
+layout(set = 0, binding = 7, rgba16f) uniform writeonly image2D restir_direct;
+layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D restir_surface;
+#endif
 
 layout(push_constant) uniform Params {
     uint candidates;
@@ -60,7 +72,7 @@ ivec2 previous_pixel(vec3 was, vec3 now, ivec2 pixel, ivec2 size, out bool on_sc
 }
 
 void main() {
-    ivec2 size = imageSize(restir_hit);
+    ivec2 size = imageSize(restir_sample);
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(pixel, size))) {
         return;
@@ -70,13 +82,19 @@ void main() {
     vec2 found = trace_closest(eye, dir, 1e30);
     float t = found.x < 0.0 ? 1e30 : found.x;
     if (hit_area_light(eye, dir, t) >= 0 || found.x < 0.0) {
+#ifdef HAS_RESTIR_HIT
         imageStore(restir_hit, pixel, vec4(-1.0, 0.0, 0.0, 0.0));
+#else
+        imageStore(restir_direct, pixel, vec4(0.0, 0.0, 0.0, 1.0));
+#endif
         imageStore(restir_state, pixel, reservoir_state(reservoir_empty()));
         return;
     }
     uint tri = floatBitsToUint(found.y);
     ShadingPoint sp = shading_point(tri, dir, t, texelFetch(gbuffer_albedo, pixel, 0).rgb);
+#ifdef HAS_RESTIR_HIT
     imageStore(restir_hit, pixel, vec4(t, found.y, pack_normal(sp.n), 0.0));
+#endif
 
     // Resampled importance sampling over this frame's candidates: each
     // weighed by its target over the probability the light choice had (the
@@ -96,6 +114,9 @@ void main() {
         reservoir_add(fresh, pick, u_point, target, target > 0.0 ? target / p_select : 0.0, 1.0, rng_next(rng).x);
     }
     reservoir_finish(fresh, 1.0 / fresh.m);
+#ifdef HAS_RESTIR_HIT
+    // Before spatial reuse, so neighbours do not take an occluded sample.
+    // Shading here instead tests the one sample it keeps, once.
     if (fresh.weight > 0.0) {
         LightSample ls;
         sample_contribution(sp, fresh.light, fresh.u, ls);
@@ -103,6 +124,7 @@ void main() {
             fresh.weight = 0.0;
         }
     }
+#endif
 
     // Temporal reuse: the last frame's reservoir where this surface was,
     // its sample's target evaluated here, now.
@@ -129,6 +151,22 @@ void main() {
         }
     }
     reservoir_finish(merged, 1.0 / merged.m);
+#ifdef HAS_RESTIR_DIRECT
+    // Shaded by the kept sample; kept for the next frame with weight 0 where
+    // it is occluded, so temporal reuse does not carry it on.
+    vec3 direct = vec3(0.0);
+    if (merged.weight > 0.0) {
+        LightSample ls;
+        vec3 c = sample_contribution(sp, merged.light, merged.u, ls);
+        if (sample_visible(sp, ls)) {
+            direct = c * merged.weight;
+        } else {
+            merged.weight = 0.0;
+        }
+    }
+    imageStore(restir_direct, pixel, vec4(hdr_output(direct), 1.0));
+    imageStore(restir_surface, pixel, vec4(sp.position, pack_normal(sp.n)));
+#endif
     imageStore(restir_sample, pixel, merged.u);
     imageStore(restir_state, pixel, reservoir_state(merged));
 }

@@ -1,7 +1,8 @@
 //! ReSTIR direct light (graphs/restir_di.ron, feature `restir_di` of the
 //! deferred graph): its image's mean is the path tracer's direct light
-//! (`max_depth` 2) on the Cornell box and under 400 point lights; the biased
-//! mode's darkening is measured and bounded; reuse across frames lowers the
+//! (`max_depth` 2) on the Cornell box and under 400 point lights, with
+//! temporal reuse and with unbiased spatial reuse (`restir_spatial`); the
+//! biased spatial mode's darkening is measured and bounded; reuse across frames lowers the
 //! error of the same candidates; and a CPU model of
 //! the estimator (resampled importance sampling over mixed light kinds,
 //! merged by the generalized balance heuristic) is unbiased against a
@@ -14,16 +15,35 @@ use weft_tests::TempDir;
 
 const SIZE: u32 = 48;
 
-/// The HDR image of `scene` through the deferred graph with `restir_di` after
-/// `frames` still frames, or (graph `pathtrace.ron`) the path tracer's
-/// direct light at 1,024 samples; validated, bloom off.
-fn render(scene: &Path, graph: &str, frames: u32, params: &[(&str, f64)]) -> LinearImage {
+/// The HDR image of `scene` through the deferred graph with `restir_di`
+/// (and `features`) after `frames` still frames, or (graph `pathtrace.ron`)
+/// the path tracer's direct light at 1,024 samples; validated, bloom off.
+fn render(
+    scene: &Path,
+    graph: &str,
+    frames: u32,
+    params: &[(&str, f64)],
+    features: &[&str],
+) -> LinearImage {
     let reference = graph == "pathtrace.ron";
-    let features: &[&str] = if reference { &[] } else { &["restir_di"] };
+    let features: Vec<&str> = if reference {
+        Vec::new()
+    } else {
+        ["restir_di"].iter().chain(features).copied().collect()
+    };
     let samples = reference.then_some(1024);
     let mut settings =
-        weft_tests::render::square_settings_without_bloom(graph, SIZE, samples, params, features);
+        weft_tests::render::square_settings_without_bloom(graph, SIZE, samples, params, &features);
     settings.frames = frames;
+    settings.frame_time = 0.0;
+    weft_tests::render::linear_image_validated(scene, settings, "hdr")
+}
+
+/// The deferred graph's own image: every point light summed exactly, with
+/// the same G-buffer (and so the same filtered textures) ReSTIR shades.
+fn raster(scene: &Path) -> LinearImage {
+    let mut settings =
+        weft_tests::render::square_settings_without_bloom("deferred.ron", SIZE, None, &[], &[]);
     settings.frame_time = 0.0;
     weft_tests::render::linear_image_validated(scene, settings, "hdr")
 }
@@ -34,6 +54,7 @@ fn reference(scene: &Path) -> LinearImage {
         "pathtrace.ron",
         1,
         &[("max_depth", 2.0), ("light_choice", 2.0)],
+        &[],
     )
 }
 
@@ -81,40 +102,37 @@ fn many_lights(dir: &Path) -> PathBuf {
 }
 
 #[test]
-fn unbiased_restir_is_the_path_tracers_direct_light_and_biased_is_a_little_darker() {
+fn restir_is_the_path_tracers_direct_light_and_biased_spatial_reuse_a_little_darker() {
     let dir = TempDir::new("restir-mean");
-    // Neighbours 16 pixels apart on the 48-pixel floor see different lights
-    // (each reaches 4 to 8 units): spatial reuse there is unbiased but noisy
-    // (docs/ladder.md), so that scene is measured with temporal reuse alone.
-    let scenes = [
-        (
-            "cornell",
-            weft_tests::render::root().join("scenes/cornell.scene"),
-            4.0,
-        ),
-        ("400 point lights", many_lights(&dir.0), 0.0),
-    ];
-    let mut report = Vec::new();
-    for (name, scene, neighbours) in &scenes {
-        let truth = reference(scene);
-        let spatial = ("restir_di.spatial_samples", *neighbours);
-        let unbiased = mean_ratio(
-            &truth,
-            &render(
-                scene,
-                "deferred.ron",
-                8,
-                &[("restir_di.unbiased", 1.0), spatial],
-            ),
-        );
-        let biased = mean_ratio(&truth, &render(scene, "deferred.ron", 8, &[spatial]));
-        report.push(format!(
-            "{name}: mean over the reference's, unbiased {unbiased:.4}, biased {biased:.4}"
-        ));
-        assert!((unbiased - 1.0).abs() < 0.02, "{report:#?}");
-        assert!(biased < unbiased + 0.005 && biased > 0.95, "{report:#?}");
+    let cornell = weft_tests::render::root().join("scenes/cornell.scene");
+    let lights = many_lights(&dir.0);
+    let cornell_truth = reference(&cornell);
+    // Textures: against the deferred graph's exact sum over its lights,
+    // whose G-buffer texels ReSTIR's surfaces take (the path tracer's
+    // box-filtered texels are another question: raster's mip-filtering).
+    let lights_truth = raster(&lights);
+    let spatial = |unbiased: f64| {
+        let params = [("restir_di.unbiased", unbiased)];
+        mean_ratio(
+            &cornell_truth,
+            &render(&cornell, "deferred.ron", 8, &params, &["restir_spatial"]),
+        )
+    };
+    let temporal = mean_ratio(
+        &cornell_truth,
+        &render(&cornell, "deferred.ron", 8, &[], &[]),
+    );
+    let lights_temporal = mean_ratio(&lights_truth, &render(&lights, "deferred.ron", 8, &[], &[]));
+    let (unbiased, biased) = (spatial(1.0), spatial(0.0));
+    let report = format!(
+        "mean over the reference's: Cornell box, temporal reuse {temporal:.4}, spatial unbiased \
+         {unbiased:.4}, spatial biased {biased:.4}; 400 point lights against the deferred graph's sum, temporal {lights_temporal:.4}"
+    );
+    println!("{report}");
+    for ratio in [temporal, unbiased, lights_temporal] {
+        assert!((ratio - 1.0).abs() < 0.02, "{report}");
     }
-    println!("{report:#?}");
+    assert!(biased < unbiased + 0.005 && biased > 0.95, "{report}");
 }
 
 #[test]
@@ -123,13 +141,10 @@ fn temporal_reuse_lowers_the_error_of_the_same_candidates() {
     let scene = many_lights(&dir.0);
     let truth = reference(&scene);
     let error = |frames: u32, history_cap: f64| {
-        let params = [
-            ("restir_di.history_cap", history_cap),
-            ("restir_di.spatial_samples", 0.0),
-        ];
+        let params = [("restir_di.history_cap", history_cap)];
         rel_mse(
             &truth.pixels,
-            &render(&scene, "deferred.ron", frames, &params).pixels,
+            &render(&scene, "deferred.ron", frames, &params, &[]).pixels,
         )
     };
     let alone = error(1, 0.0);
