@@ -22,6 +22,10 @@ layout(set = 0, binding = 6) uniform sampler2D ao;
 // Ray-traced one-bounce light from the surroundings (graphs/gi.ron).
 layout(set = 0, binding = 8) uniform sampler2D gi;
 #endif
+#ifdef HAS_CACHE_AMBIENT
+// The radiance cache's light of the surroundings (graphs/radiance_cache.ron).
+layout(set = 0, binding = 12) uniform sampler2D cache_ambient;
+#endif
 #ifdef HAS_RT_SPECULAR
 // Light through mirrors, coats and glass, ray-traced (graphs/rt_specular.ron).
 layout(set = 0, binding = 9) uniform sampler2D rt_specular;

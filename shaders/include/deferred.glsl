@@ -42,10 +42,14 @@ vec4 read_emission_occlusion() {
 
 // The radiance this fragment's surroundings send, as the ambient term takes
 // it: the suns' ambient sky, or what ray-traced one-bounce GI found (HAS_GI:
-// graphs/gi.ron, the includer declaring `gi`).
+// graphs/gi.ron, the includer declaring `gi`), or the world-space radiance
+// cache's cell (HAS_CACHE_AMBIENT: graphs/radiance_cache.ron, the includer
+// declaring `cache_ambient`).
 vec3 surroundings() {
 #ifdef HAS_GI
     return texelFetch(gi, ivec2(gl_FragCoord.xy), 0).rgb;
+#elif defined(HAS_CACHE_AMBIENT)
+    return texelFetch(cache_ambient, ivec2(gl_FragCoord.xy), 0).rgb;
 #else
     return frame.ambient.rgb;
 #endif

@@ -1,0 +1,109 @@
+#version 450
+// The radiance cache's update (graphs/radiance_cache.ron), one invocation a
+// slot: a live cell traces `rays` cosine-weighted rays from its point. Each
+// brings back the sky where it escapes; where it meets a surface, the direct
+// light that surface reflects (the path tracer's next-event estimation, one
+// shadow ray) plus its diffuse albedo times the radiance the cache holds
+// there (asking for that cell, so it lives and is updated too): so the light
+// of every bounce accumulates over frames for the price of one. A ray that
+// meets a light's panel brings nothing, and emission is left out: that is
+// the lighting pass's direct light. The mean joins the cell's radiance, a
+// running mean over at most `frames` updates (older ones fade out). A cell
+// whose rays meet a placement that moved since the last frame starts again.
+// A cell nothing asked for in `life` frames is freed. On a new plan's
+// first frame the images hold nothing defined: this pass empties them.
+#include "../include/brdf.glsl"
+#include "../include/gbuffer.glsl"
+#include "../include/running_mean.glsl"
+#include "../include/area_light.glsl"
+#include "../include/surface.glsl"
+#include "../include/punctual.glsl"
+#include "../include/trace.glsl"
+#include "../pathtrace/random.glsl"
+#include "../pathtrace/sampling.glsl"
+#include "../pathtrace/dielectric.glsl"
+#include "../pathtrace/bsdf.glsl"
+#include "../pathtrace/surface_bsdf.glsl"
+#include "../pathtrace/lights.glsl"
+#include "../pathtrace/next_event.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0, r32ui) uniform uimage2D cache_keys;
+layout(set = 0, binding = 1, rgba32f) uniform image2D cache_point;
+layout(set = 0, binding = 2, r32ui) uniform uimage2D cache_life;
+layout(set = 0, binding = 3, rgba32f) uniform image2D cache_radiance;
+
+layout(push_constant) uniform Params {
+    uint rays;
+    uint frames;
+    float cell_scale;
+    uint life;
+    uint frame;
+    uint plan_frames;
+} params;
+
+#include "cells.glsl"
+
+// Whether placement `draw` moved since the last frame.
+bool moved(uint draw) {
+    mat4 m = draws[draw].previous;
+    return m != mat4(1.0);
+}
+
+void main() {
+    ivec2 at = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(at, imageSize(cache_keys)))) {
+        return;
+    }
+    // New images (a new plan or scene) hold nothing defined: empty them.
+    if (params.plan_frames == 0u) {
+        imageStore(cache_keys, at, uvec4(0u));
+        imageStore(cache_life, at, uvec4(0u));
+        imageStore(cache_radiance, at, vec4(0.0));
+        return;
+    }
+    if (imageLoad(cache_keys, at).x == 0u) {
+        return;
+    }
+    uint life = imageLoad(cache_life, at).x;
+    if (life == 0u) {
+        imageStore(cache_keys, at, uvec4(0u));
+        return;
+    }
+    imageStore(cache_life, at, uvec4(life - 1u));
+    vec4 point = imageLoad(cache_point, at);
+    vec3 p = point.xyz;
+    vec3 n = octahedral_decode(unpackSnorm2x16(floatBitsToUint(point.w)));
+    mat3 to_world = basis(n);
+    vec3 origin = leave(p, n);
+    float step = leave_distance(p);
+    Rng rng = rng_start(uvec2(at), params.frame, 0x5bd1e995u);
+    vec3 sum = vec3(0.0);
+    bool restart = false;
+    for (uint i = 0u; i < params.rays; ++i) {
+        vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
+        vec3 from = origin + dir * step;
+        vec2 found = trace_closest(from, dir, 1e30);
+        float t = found.x < 0.0 ? 1e30 : found.x;
+        if (hit_area_light(from, dir, t) >= 0) {
+            continue;
+        }
+        if (found.x < 0.0) {
+            sum += frame.ambient.rgb;
+            continue;
+        }
+        TraceSurface s = trace_surface(floatBitsToUint(found.y), from, dir, t);
+        Material m = material_record(s.material);
+        vec3 ng;
+        vec3 sn;
+        facing_normals(s, m, dir, ng, sn);
+        Bsdf b = surface_bsdf(s, m);
+        vec3 leave_from = leave(s.position, ng);
+        sum += next_event(s.position, sn, ng, -dir, b, leave_from, LIGHT_CHOICE, rng);
+        sum += b.diffuse * cache_radiance_at(cache_cell(s.position, sn, params.cell_scale, params.life));
+        restart = restart || moved(s.draw);
+    }
+    vec3 radiance = sum / float(max(params.rays, 1u));
+    vec4 kept = imageLoad(cache_radiance, at);
+    imageStore(cache_radiance, at, running_mean(kept, radiance, params.frames, !restart && kept.a > 0.0));
+}
