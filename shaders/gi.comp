@@ -14,6 +14,9 @@
 // with its albedo; the lighting pass multiplies it with the environment
 // albedo in place of the ambient term. So in expectation this is the path
 // tracer's light over paths of at most three segments (`max_depth=3`) for
+// diffuse surfaces. Under `radiance_cache` (graphs/radiance_cache.ron) a
+// ray's hit adds its albedo times the cache's radiance there in place of
+// the sky along a second ray: every bounce, the reference at any depth for
 // diffuse surfaces. `gi.rgb` is averaged with the last frames' (at most
 // `frames`, counted in `gi.a`) while `history_frames` says nothing changed.
 #include "include/brdf.glsl"
@@ -35,13 +38,48 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform sampler2D depth;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2, rgba32f) uniform image2D gi;
+#ifdef HAS_CACHE_RADIANCE
+// The world-space radiance cache (graphs/radiance_cache.ron), read only.
+layout(set = 0, binding = 3, r32ui) uniform readonly uimage2D cache_keys;
+layout(set = 0, binding = 4, rgba32f) uniform readonly image2D cache_radiance;
+#include "cache/cells.glsl"
+#endif
 
 layout(push_constant) uniform Params {
     uint rays;
     uint frames;
     uint history_frames;
     uint frame;
+#ifdef HAS_CACHE_RADIANCE
+    float cell_scale;
+#endif
 } params;
+
+#ifdef HAS_CACHE_RADIANCE
+// A ray's light where it ends in the radiance cache after its first hit:
+// the sky where it escapes; at a surface, the direct light it reflects
+// (next_event) plus its diffuse albedo times the radiance the cache holds
+// there, so every bounce the cache has gathered counts. As one_bounce,
+// nothing from a light's panel or a surface's own emission.
+vec3 cached_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng) {
+    vec2 found = trace_closest(origin, dir, 1e30);
+    float t = found.x < 0.0 ? 1e30 : found.x;
+    if (hit_area_light(origin, dir, t) >= 0) {
+        return vec3(0.0);
+    }
+    if (found.x < 0.0) {
+        return frame.ambient.rgb;
+    }
+    TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
+    Material m = material_record(s.material);
+    vec3 ng;
+    vec3 n;
+    facing_normals(s, m, dir, ng, n);
+    Bsdf b = surface_bsdf(s, m);
+    vec3 direct = next_event(s.position, n, ng, -dir, b, leave(s.position, ng), choice, rng);
+    return direct + b.diffuse * cache_smooth(s.position, n, params.cell_scale);
+}
+#endif
 
 void main() {
     ivec2 size = imageSize(gi);
@@ -67,7 +105,11 @@ void main() {
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
+#ifdef HAS_CACHE_RADIANCE
+        sum += cached_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng);
+#else
         sum += one_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng);
+#endif
     }
     vec3 radiance = sum / float(max(params.rays, 1u));
     // A running mean over the last frames, its count capped at `frames`;

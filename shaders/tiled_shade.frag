@@ -19,6 +19,10 @@ layout(set = 0, binding = 5) uniform sampler2D gbuffer_emission;
 // Ray-traced environment visibility (graphs/rt_ao.ron).
 layout(set = 0, binding = 6) uniform sampler2D ao;
 #endif
+#ifdef HAS_CACHE_AMBIENT
+// The radiance cache's light of the surroundings (graphs/radiance_cache.ron).
+layout(set = 0, binding = 10) uniform sampler2D cache_ambient;
+#endif
 #ifdef HAS_GI
 // Ray-traced one-bounce light from the surroundings (graphs/gi.ron).
 layout(set = 0, binding = 8) uniform sampler2D gi;

@@ -9,9 +9,10 @@
 // (the first surface that asked for it), its radiance, and the frames it
 // has left unless something asks for it again.
 //
-// The includer declares cache_keys (r32ui), cache_point and cache_radiance
-// (rgba32f) and cache_life (r32ui) images, and includes random.glsl and
-// gbuffer.glsl (octahedral normals).
+// The includer declares cache_keys (r32ui) and cache_radiance (rgba32f)
+// images, and includes random.glsl and gbuffer.glsl (octahedral normals);
+// passes that make cells (CACHE_MAKES_CELLS) declare cache_point (rgba32f)
+// and cache_life (r32ui) too.
 #ifndef WEFT_CACHE_CELLS_GLSL
 #define WEFT_CACHE_CELLS_GLSL
 
@@ -57,6 +58,7 @@ ivec2 cache_texel(uint slot) {
     return ivec2(slot % side, slot / side);
 }
 
+#ifdef CACHE_MAKES_CELLS
 // The slot of the cell holding p (normal n), made if there is none and a
 // free slot within CACHE_PROBES: a new cell starts at p and n with no
 // radiance. Whoever asks keeps it alive for `life` more frames.
@@ -80,6 +82,7 @@ uint cache_cell(vec3 p, vec3 n, float cell_scale, uint life) {
     }
     return CACHE_NONE;
 }
+#endif
 
 // The radiance cell `slot` holds (black for none, or before its first
 // update).

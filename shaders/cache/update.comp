@@ -42,6 +42,7 @@ layout(push_constant) uniform Params {
     uint plan_frames;
 } params;
 
+#define CACHE_MAKES_CELLS
 #include "cells.glsl"
 
 // Whether placement `draw` moved since the last frame.

@@ -16,6 +16,7 @@ mod mutants;
 mod normal_maps;
 mod one_physics;
 mod pathtrace;
+mod radiance_cache;
 mod raycast;
 mod render;
 mod restir;
