@@ -244,6 +244,8 @@ fn scene_features_cull_passes_and_variants() {
             ("show_normals", "enabled_if [normals] is false"),
             ("show_light_count", "enabled_if [light_count] is false"),
             ("rt_ao", "enabled_if [rt_ao] is false"),
+            ("cache_update", "enabled_if [radiance_cache] is false"),
+            ("cache_lookup", "enabled_if [radiance_cache] is false"),
             ("gi", "enabled_if [gi] is false"),
             (
                 "rt_specular",
@@ -267,7 +269,13 @@ fn scene_features_cull_passes_and_variants() {
             ("keep_illumination", "enabled_if [denoise] is false"),
             ("keep_moments", "enabled_if [denoise] is false"),
             ("restir_initial", "enabled_if [restir_di] is false"),
-            ("restir_spatial", "enabled_if [restir_di] is false"),
+            (
+                "restir_spatial",
+                "enabled_if [restir_di, restir_spatial] is false"
+            ),
+            ("restir_keep_sample", "enabled_if [restir_di] is false"),
+            ("restir_keep_state", "enabled_if [restir_di] is false"),
+            ("restir_keep_surface", "enabled_if [restir_di] is false"),
             ("point_lights", "enabled_if [point_lights] is false"),
             ("spot_lights", "enabled_if [spot_lights] is false"),
             ("area_lights", "enabled_if [area_lights] is false"),

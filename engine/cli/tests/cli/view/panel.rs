@@ -132,11 +132,11 @@ fn a_feature_and_a_parameter_set_in_the_panel_render_as_weft_render_does() {
     let lists: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
     assert_eq!(lists.len(), 2, "{stdout}");
     assert!(
-        lists[0].contains("Shift+8 tile_depth_mask [on]"),
+        lists[0].contains("Shift+9 tile_depth_mask [on]"),
         "{stdout}"
     );
     assert!(
-        lists[1].contains("Shift+8 tile_depth_mask [off]"),
+        lists[1].contains("Shift+9 tile_depth_mask [off]"),
         "{stdout}"
     );
     assert!(stdout.contains("parameter exposure = 2\n"), "{stdout}");
