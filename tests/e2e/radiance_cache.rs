@@ -67,7 +67,7 @@ fn furnace(dir: &Path) -> PathBuf {
 fn render(scene: &Path, frames: u32, features: &[&str]) -> LinearImage {
     let params = [
         ("radiance_cache.cells", 64.0),
-        ("radiance_cache.cell_scale", 0.2),
+        ("cache_cell_scale", 0.2),
         ("radiance_cache.frames", 16.0),
     ];
     let mut settings = weft_tests::render::square_settings_without_bloom(

@@ -3,7 +3,8 @@
 //! (`max_depth` 2) on the Cornell box and under 400 point lights, with
 //! temporal reuse and with unbiased spatial reuse (`restir_spatial`); the
 //! biased spatial mode's darkening is measured and bounded; reuse across frames lowers the
-//! error of the same candidates; and a CPU model of
+//! error of the same candidates; a light switched off is gone from the very
+//! frame it goes dark (no ghost in the reservoirs); and a CPU model of
 //! the estimator (resampled importance sampling over mixed light kinds,
 //! merged by the generalized balance heuristic) is unbiased against a
 //! closed form.
@@ -156,6 +157,78 @@ fn temporal_reuse_lowers_the_error_of_the_same_candidates() {
     println!("{report}");
     assert!((eighth_alone / alone - 1.0).abs() < 0.25, "{report}");
     assert!(eight < 0.6 * alone, "{report}");
+}
+
+/// A white floor under two point lights, the second switched off by the
+/// scene's script after t = 0.125 s when `switch` (frames 1/60 s apart: the
+/// ninth frame is the first without it), or left out of the scene.
+fn two_lights(dir: &Path, name: &str, second: bool, switch: bool) -> PathBuf {
+    std::fs::write(
+        dir.join("floor.mtl"),
+        "newmtl white\nKd 0.8 0.8 0.8\nKs 0 0 0\n",
+    )
+    .expect("mtl");
+    std::fs::write(
+        dir.join("floor.obj"),
+        "mtllib floor.mtl\nusemtl white\nv -4 0 4\nv 4 0 4\nv 4 0 -4\nv -4 0 -4\nf 1 2 3\nf 1 3 4\n",
+    )
+    .expect("obj");
+    std::fs::write(
+        dir.join("switch.rhai"),
+        "fn update(t, dt) {\n    if t > 0.125 {\n        set_light_on(1, false);\n    }\n}\n",
+    )
+    .expect("script");
+    let mut text = String::from(
+        "model\n{\n\tfile \"floor.obj\"\n}\n\
+         pointlight\n{\n\tposition -1.5 1 0\n\tcolor 2 2 2\n\tattenuation 0 0 1\n}\n\
+         camera\n{\n\tposition 0 6 5\n\ttarget 0 0 0\n\tfov_deg 60\n}\n",
+    );
+    if second {
+        text += "pointlight\n{\n\tposition 1.5 1 0\n\tcolor 2 2 2\n\tattenuation 0 0 1\n}\n";
+    }
+    if switch {
+        text += "script \"switch.rhai\"\n";
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, text).expect("scene");
+    path
+}
+
+#[test]
+fn a_light_switched_off_is_gone_from_the_frame_it_goes_dark() {
+    let dir = TempDir::new("restir-switch");
+    let image = |scene: &Path, frames: u32| {
+        let mut settings = weft_tests::render::square_settings_without_bloom(
+            "deferred.ron",
+            SIZE,
+            None,
+            &[],
+            &["restir_di"],
+        );
+        settings.frames = frames;
+        settings.frame_time = 1.0 / 60.0;
+        weft_tests::render::linear_image_validated(scene, settings, "hdr")
+    };
+    let switched = two_lights(&dir.0, "switched.scene", true, true);
+    let one = two_lights(&dir.0, "one.scene", false, false);
+    let both = two_lights(&dir.0, "both.scene", true, false);
+    let lit = |image: &LinearImage| -> f64 {
+        image
+            .pixels
+            .iter()
+            .map(|p| f64::from(p[0] + p[1] + p[2]))
+            .sum()
+    };
+    // Eight frames with both lights; the ninth is the first without.
+    let before = lit(&image(&switched, 8));
+    let after = lit(&image(&switched, 9));
+    let (one, both) = (lit(&image(&one, 9)), lit(&image(&both, 9)));
+    let report = format!(
+        "light summed over the image: both lights {both:.1}, frame 8 {before:.1}; one light {one:.1}, frame 9 {after:.1}"
+    );
+    println!("{report}");
+    assert!((before / both - 1.0).abs() < 0.03, "{report}");
+    assert!((after / one - 1.0).abs() < 0.03, "{report}");
 }
 
 /// The CPU model: lights of two kinds for a surface at `x` in [0, 1] — a

@@ -242,31 +242,25 @@ fn number_spans(text: &str) -> Vec<(usize, usize)> {
     spans
 }
 
-/// The shipped files a mutant may edit, relative to the repository root.
+/// The shipped files a mutant may edit, relative to the repository root:
+/// every graph and shader under `graphs/` and `shaders/`, however deep.
 fn mutable_files() -> Vec<PathBuf> {
     let mut files = Vec::new();
-    for dir in [
-        "graphs",
-        "graphs/bench",
-        "shaders",
-        "shaders/include",
-        "shaders/bench",
-        "shaders/pathtrace",
-        "shaders/denoise",
-    ] {
-        let mut found: Vec<PathBuf> = std::fs::read_dir(root().join(dir))
-            .expect("read dir")
-            .map(|e| e.expect("entry").path())
-            .filter(|p| {
-                p.extension().is_some_and(|e| {
-                    ["ron", "frag", "vert", "comp", "glsl"].contains(&e.to_str().unwrap_or(""))
-                })
-            })
-            .map(|p| Path::new(dir).join(p.file_name().expect("name")))
-            .collect();
-        found.sort();
-        files.extend(found);
+    let mut dirs = vec![PathBuf::from("graphs"), PathBuf::from("shaders")];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(root().join(&dir)).expect("read dir") {
+            let path = entry.expect("entry").path();
+            let name = dir.join(path.file_name().expect("name"));
+            if path.is_dir() {
+                dirs.push(name);
+            } else if path.extension().is_some_and(|e| {
+                ["ron", "frag", "vert", "comp", "glsl"].contains(&e.to_str().unwrap_or(""))
+            }) {
+                files.push(name);
+            }
+        }
     }
+    files.sort();
     files
 }
 

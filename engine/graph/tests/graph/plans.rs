@@ -244,9 +244,9 @@ fn scene_features_cull_passes_and_variants() {
             ("show_normals", "enabled_if [normals] is false"),
             ("show_light_count", "enabled_if [light_count] is false"),
             ("rt_ao", "enabled_if [rt_ao] is false"),
+            ("gi", "enabled_if [gi] is false"),
             ("cache_update", "enabled_if [radiance_cache] is false"),
             ("cache_lookup", "enabled_if [radiance_cache] is false"),
-            ("gi", "enabled_if [gi] is false"),
             (
                 "rt_specular",
                 "enabled_if [rt_specular, specular_lobes] is false",
