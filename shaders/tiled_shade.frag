@@ -2,8 +2,9 @@
 // Tiled deferred shading (fullscreen): ambient, emission and every sun as in
 // deferred_sun.frag, then the point and spot lights listed for this pixel's
 // tile by light_cull.comp (points and spots kept apart), each type in its own
-// loop through the same shade_point / shade_spot as forward and deferred;
-// background pixels stay black like forward's clear.
+// loop through the same shade_point / shade_spot as forward and deferred
+// (under restir_di, ReSTIR's direct light from every light in place of
+// both); background pixels stay black like forward's clear.
 layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
@@ -31,7 +32,14 @@ layout(set = 0, binding = 8) uniform sampler2D gi;
 // Light through mirrors, coats and glass, ray-traced (graphs/rt_specular.ron).
 layout(set = 0, binding = 9) uniform sampler2D rt_specular;
 #endif
+#ifdef HAS_RESTIR_DIRECT
+// Direct light from every light, by ReSTIR (graphs/restir_di.ron): in place
+// of the suns and the tile's lights here and of the area pass.
+layout(set = 0, binding = 11) uniform sampler2D restir_direct;
+#endif
+#ifdef HAS_TILE_LIGHTS
 layout(std430, set = 0, binding = 7) readonly buffer TileLights { uint words[]; } tile_lights;
+#endif
 layout(push_constant) uniform Push {
     uint max_per_tile;
     float emissive_boost;
@@ -60,8 +68,11 @@ void main() {
     Material m = material_record(s.material);
     vec4 emission_occlusion = read_emission_occlusion();
     vec3 c = shade_ambient_emissive(s, m, surroundings(), pc.emissive_boost, emission_occlusion.rgb, emission_occlusion.a)
-        + traced_specular()
-        + shade_suns(s, m);
+        + traced_specular();
+#ifdef HAS_RESTIR_DIRECT
+    c += texelFetch(restir_direct, ivec2(gl_FragCoord.xy), 0).rgb;
+#else
+    c += shade_suns(s, m);
     uint record = tile_record(tile_of(ivec2(gl_FragCoord.xy)), pc.max_per_tile);
     uint slots = record + TILE_HEADER;
 #ifdef SCENE_POINT_LIGHTS
@@ -76,6 +87,7 @@ void main() {
     for (uint k = 0u; k < spots; ++k) {
         c += shade_spot(tile_lights.words[last - k], s, m);
     }
+#endif
 #endif
     color = vec4(hdr_output(c), 1.0);
 }

@@ -159,6 +159,39 @@ fn temporal_reuse_lowers_the_error_of_the_same_candidates() {
     assert!(eight < 0.6 * alone, "{report}");
 }
 
+/// The tiled graph takes ReSTIR's light as the deferred graph does: the same
+/// passes over the same G-buffer, so the same image.
+#[test]
+fn tiled_and_deferred_shade_the_same_restir_light() {
+    let dir = TempDir::new("restir-tiled");
+    let scene = many_lights(&dir.0);
+    let image = |graph: &str| {
+        let mut settings = weft_tests::render::square_settings_without_bloom(
+            graph,
+            SIZE,
+            None,
+            &[],
+            &["restir_di"],
+        );
+        settings.frames = 3;
+        settings.frame_time = 0.0;
+        weft_tests::render::linear_image_validated(&scene, settings, "hdr")
+    };
+    let (tiled, deferred) = (image("tiled.ron"), image("deferred.ron"));
+    let worst = tiled
+        .pixels
+        .iter()
+        .zip(&deferred.pixels)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs() / b[c].abs().max(1e-3)))
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-3, "worst relative difference {worst}");
+    assert!(lit_pixels(&deferred) > (SIZE * SIZE / 4) as usize);
+}
+
+fn lit_pixels(image: &LinearImage) -> usize {
+    image.pixels.iter().filter(|p| p[1] > 0.0).count()
+}
+
 /// A white floor under two point lights, the second switched off by the
 /// scene's script after t = 0.125 s when `switch` (frames 1/60 s apart: the
 /// ninth frame is the first without it), or left out of the scene.
