@@ -104,8 +104,8 @@ fn the_panel_docks_beside_the_view_and_stays_out_of_screenshots_unless_asked() {
     );
 }
 
-/// A feature past the ninth key (`tile_depth_mask`, the tiled graph's
-/// sixteenth) is switched off and `exposure` typed as 2 through the panel's
+/// A feature past the ninth key (`rt_shadows`, the tiled graph's
+/// sixteenth) is switched on and `exposure` typed as 2 through the panel's
 /// own widgets; the next frames equal `weft render` with the same toggle
 /// and `--param`.
 #[test]
@@ -123,7 +123,7 @@ fn a_feature_and_a_parameter_set_in_the_panel_render_as_weft_render_does() {
             "graphs/tiled.ron",
             "--panel",
             "--ui",
-            "1:click:feature:tile_depth_mask,5:click:param:exposure,6:text:2,6:enter",
+            "1:click:feature:rt_shadows,5:click:param:exposure,6:text:2,6:enter",
         ],
     );
     // The view renders beside the docked panel: compared at its size.
@@ -131,14 +131,8 @@ fn a_feature_and_a_parameter_set_in_the_panel_render_as_weft_render_does() {
     assert!(width < 640 && height == 360, "{width}x{height}");
     let lists: Vec<&str> = stdout.lines().filter(|l| l.starts_with("graph ")).collect();
     assert_eq!(lists.len(), 2, "{stdout}");
-    assert!(
-        lists[0].contains("Shift+9 tile_depth_mask [on]"),
-        "{stdout}"
-    );
-    assert!(
-        lists[1].contains("Shift+9 tile_depth_mask [off]"),
-        "{stdout}"
-    );
+    assert!(lists[0].contains("Shift+7 rt_shadows [off]"), "{stdout}");
+    assert!(lists[1].contains("Shift+7 rt_shadows [on]"), "{stdout}");
     assert!(stdout.contains("parameter exposure = 2\n"), "{stdout}");
     let out = x.weft(&[
         "render",
@@ -148,7 +142,7 @@ fn a_feature_and_a_parameter_set_in_the_panel_render_as_weft_render_does() {
         "--size",
         &format!("{width}x{height}"),
         "--features",
-        "!tile_depth_mask",
+        "rt_shadows",
         "--param",
         "exposure=2",
         "--out",
