@@ -2,16 +2,17 @@
 // ReSTIR DI, first pass (graphs/restir_di.ron): each pixel's surface, found
 // by a ray through its centre, streams `candidates` light samples through a
 // reservoir (resampled importance sampling: drawn by the light choice, by
-// the light tree by default, kept by the unshadowed light they bring), tests
-// the one it keeps with a shadow ray (an occluded sample is kept with weight
-// 0, so reuse does not spread it), then merges the reservoir the last frame
-// left where this surface was (reprojected through its placement's motion
-// and the camera's; the same surface by position and normal), its candidate
-// count capped at `history_cap` times this frame's. The merged reservoir and
-// the surface go to the spatial pass (restir/spatial.comp) under feature
-// `restir_spatial`; without it this pass shades the kept sample itself (one
-// shadow ray in all) and its reservoir and surface are copied for the next
-// frame.
+// the light tree by default, kept by the unshadowed light they bring),
+// then merges the reservoir the last frame left where this surface was
+// (reprojected through its placement's motion and the camera's; the same
+// surface by position and normal), its candidate count capped at
+// `history_cap` times this frame's. Without feature `restir_spatial` this
+// pass shades the kept sample (one shadow ray in all; an occluded sample is
+// kept with weight 0, so the next frame does not carry it on) and its
+// reservoir and surface are copied for the next frame. With it, the fresh
+// sample is tested before the merge (so neighbours do not take an occluded
+// one) and the merged reservoir and the surface go to the spatial pass
+// (restir/spatial.comp), which shades.
 #include "../include/hdr.glsl"
 #include "../include/brdf.glsl"
 #include "../include/gbuffer.glsl"

@@ -2,8 +2,8 @@
 // ReSTIR DI, second pass (graphs/restir_di.ron): each pixel's reservoir
 // from the first pass (restir/initial.comp) merges those of
 // `spatial_samples` neighbours within `spatial_radius` pixels whose surface
-// is like its own (normals within about 25 degrees, distances within 10%),
-// each neighbour's sample weighed by its target here. The kept sample is
+// is like its own (normals within about 25 degrees, distances within 10%).
+// The kept sample is
 // shaded with one shadow ray into `restir_direct`: the direct light the
 // surface reflects towards the eye (its own emission left to the lighting
 // pass), and the reservoir is left for the next frame's temporal reuse
