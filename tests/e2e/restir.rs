@@ -192,6 +192,134 @@ fn lit_pixels(image: &LinearImage) -> usize {
     image.pixels.iter().filter(|p| p[1] > 0.0).count()
 }
 
+/// A wall facing the camera with a box before it, lit by a sun; the scene's
+/// script moves the camera sideways after t = 0.125 s (the ninth frame of
+/// frames 1/60 s apart) by exactly two pixels' width at the wall.
+fn wall_and_box(dir: &Path) -> PathBuf {
+    std::fs::write(
+        dir.join("wall.mtl"),
+        "newmtl white\nKd 0.8 0.8 0.8\nKs 0 0 0\n",
+    )
+    .expect("mtl");
+    let quads: [[[f32; 3]; 4]; 2] = [
+        // The wall, z = 0, facing +z.
+        [
+            [-4.0, -3.0, 0.0],
+            [4.0, -3.0, 0.0],
+            [4.0, 5.0, 0.0],
+            [-4.0, 5.0, 0.0],
+        ],
+        // The box's front, z = 2.5.
+        [
+            [-0.5, 0.5, 2.5],
+            [0.5, 0.5, 2.5],
+            [0.5, 1.5, 2.5],
+            [-0.5, 1.5, 2.5],
+        ],
+    ];
+    let mut obj = String::from("mtllib wall.mtl\nusemtl white\n");
+    for (k, q) in quads.iter().enumerate() {
+        for c in q {
+            obj += &format!("v {} {} {}\n", c[0], c[1], c[2]);
+        }
+        let v = 1 + 4 * k;
+        obj += &format!("f {} {} {}\nf {} {} {}\n", v, v + 1, v + 2, v, v + 2, v + 3);
+    }
+    std::fs::write(dir.join("wall.obj"), obj).expect("obj");
+    // Two pixels at the wall, 5 away, through a 60-degree view SIZE across.
+    let step = 2.0 * 5.0 * (30.0f64.to_radians()).tan() / (f64::from(SIZE) / 2.0);
+    std::fs::write(
+        dir.join("pan.rhai"),
+        format!(
+            "fn update(t, dt) {{\n    if t > 0.125 {{\n        set_camera(\"main\", #{{ position: [{step}, 1.0, 5.0], target: [{step}, 1.0, 0.0] }});\n    }}\n}}\n"
+        ),
+    )
+    .expect("script");
+    let path = dir.join("wall.scene");
+    std::fs::write(
+        &path,
+        "model\n{\n\tfile \"wall.obj\"\n}\n\
+         sunlight\n{\n\tdirection 0.2 -0.3 -1\n\tcolor 1 1 1\n\tambient 0 0 0\n}\n\
+         camera \"main\"\n{\n\tposition 0 1 5\n\ttarget 0 1 0\n\tfov_deg 60\n}\n\
+         script \"pan.rhai\"\n",
+    )
+    .expect("scene");
+    path
+}
+
+/// Temporal reuse under a camera moved two pixels: every pixel whose surface
+/// the last frame saw keeps its reservoir (its count grows by this frame's
+/// 2 candidates), the two columns the move uncovered start again (2), and so
+/// do the wall pixels the box uncovered, which lie beside its edge.
+#[test]
+fn a_camera_moved_two_pixels_keeps_reservoirs_where_the_surface_stays() {
+    let dir = TempDir::new("restir-pan");
+    let scene = wall_and_box(&dir.0);
+    // Component `c` of image `image` (RGBA floats) after `frames` frames.
+    let read = |frames: u32, image: &str, c: usize| -> Vec<f32> {
+        let mut settings = weft_tests::render::square_settings_without_bloom(
+            "deferred.ron",
+            SIZE,
+            None,
+            &[],
+            &["restir_di"],
+        );
+        settings.frames = frames;
+        settings.frame_time = 1.0 / 60.0;
+        let (_, texels) = weft_tests::render::render_image_validated(&scene, settings, image);
+        texels.chunks(4).map(|texel| texel[c]).collect()
+    };
+    // The reservoirs' counts before and after the move, and which pixels
+    // see the box after it (its front is at z = 2.5, the wall at 0).
+    let (still, moved) = (read(8, "restir_state", 2), read(9, "restir_state", 2));
+    let on_box: Vec<bool> = read(9, "restir_surface", 2)
+        .iter()
+        .map(|&z| z > 1.0)
+        .collect();
+    // 2 candidates a frame, the history's count below its cap (20 frames'):
+    // 16 after eight frames, 18 after nine where history was kept.
+    let (steady, kept_count) = (16.0, 18.0);
+    let at = |x: u32, y: u32| (y * SIZE + x) as usize;
+    let pixels = || (0..SIZE).flat_map(|y| (0..SIZE).map(move |x| (x, y)));
+    let near_box = |x: u32, y: u32| {
+        pixels().any(|(bx, by)| on_box[at(bx, by)] && bx.abs_diff(x) <= 3 && by.abs_diff(y) <= 3)
+    };
+    let restarted: Vec<(u32, u32)> = pixels().filter(|&(x, y)| moved[at(x, y)] == 2.0).collect();
+    let whole: Vec<u32> = (0..SIZE)
+        .filter(|&x| (0..SIZE).all(|y| moved[at(x, y)] == 2.0))
+        .collect();
+    let report = format!(
+        "still: {} of {} pixels at the count {steady}; after the move {} restarted, whole columns {whole:?}",
+        still.iter().filter(|&&m| m == steady).count(),
+        SIZE * SIZE,
+        restarted.len()
+    );
+    println!("{report}");
+    assert!(still.iter().all(|&m| m == steady), "{report}");
+    // The two columns the move uncovered, at one edge.
+    assert!(whole == [0, 1] || whole == [SIZE - 2, SIZE - 1], "{report}");
+    let mut uncovered = 0;
+    for (x, y) in pixels().filter(|(x, _)| !whole.contains(x)) {
+        let kept = moved[at(x, y)] == kept_count;
+        if on_box[at(x, y)] || !near_box(x, y) {
+            assert!(kept, "({x}, {y}) lost its history: {report}");
+        } else if !kept {
+            assert_eq!(moved[at(x, y)], 2.0, "({x}, {y}): {report}");
+            uncovered += 1;
+        }
+    }
+    // The wall the box uncovered: a strip two pixels wide (the box, half as
+    // far, moved four) down every row it covers.
+    let rows = (0..SIZE)
+        .filter(|&y| (0..SIZE).any(|x| on_box[at(x, y)]))
+        .count();
+    assert_eq!(
+        uncovered,
+        2 * rows,
+        "wall pixels restarted beside the box's {rows} rows: {report}"
+    );
+}
+
 /// A white floor under two point lights, the second switched off by the
 /// scene's script after t = 0.125 s when `switch` (frames 1/60 s apart: the
 /// ninth frame is the first without it), or left out of the scene.
