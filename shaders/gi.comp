@@ -56,29 +56,11 @@ layout(push_constant) uniform Params {
 } params;
 
 #ifdef HAS_CACHE_RADIANCE
-// A ray's light where it ends in the radiance cache after its first hit:
-// the sky where it escapes; at a surface, the direct light it reflects
-// (next_event) plus its diffuse albedo times the radiance the cache holds
-// there, so every bounce the cache has gathered counts. As one_bounce,
-// nothing from a light's panel or a surface's own emission.
-vec3 cached_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng) {
-    vec2 found = trace_closest(origin, dir, 1e30);
-    float t = found.x < 0.0 ? 1e30 : found.x;
-    if (hit_area_light(origin, dir, t) >= 0) {
-        return vec3(0.0);
-    }
-    if (found.x < 0.0) {
-        return frame.ambient.rgb;
-    }
-    TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
-    Material m = material_record(s.material);
-    vec3 ng;
-    vec3 n;
-    facing_normals(s, m, dir, ng, n);
-    Bsdf b = surface_bsdf(s, m);
-    vec3 direct = next_event(s.position, n, ng, -dir, b, leave(s.position, ng), choice, rng);
-    return direct + b.diffuse * cache_smooth(s.position, n, params.cell_scale);
+// gi's rays read the cache between the cells around a hit.
+vec3 cache_at_hit(vec3 p, vec3 n) {
+    return cache_smooth(p, n, params.cell_scale);
 }
+#include "cache/bounce.glsl"
 #endif
 
 void main() {
@@ -106,7 +88,8 @@ void main() {
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
 #ifdef HAS_CACHE_RADIANCE
-        sum += cached_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng);
+        uint draw;
+        sum += cached_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng, draw);
 #else
         sum += one_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng);
 #endif

@@ -72,7 +72,7 @@ uint cache_cell(vec3 p, vec3 n, float cell_scale, uint life) {
         ivec2 at = cache_texel(slot);
         uint held = imageAtomicCompSwap(cache_keys, at, 0u, key);
         if (held == 0u) {
-            imageStore(cache_point, at, vec4(p, uintBitsToFloat(packSnorm2x16(octahedral_encode(n)))));
+            imageStore(cache_point, at, vec4(p, pack_normal(n)));
             imageStore(cache_radiance, at, vec4(0.0));
         }
         if (held == 0u || held == key) {

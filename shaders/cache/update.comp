@@ -45,6 +45,13 @@ layout(push_constant) uniform Params {
 #define CACHE_MAKES_CELLS
 #include "cells.glsl"
 
+// The update's rays make the cells they meet, so those live and are
+// updated too.
+vec3 cache_at_hit(vec3 p, vec3 n) {
+    return cache_radiance_at(cache_cell(p, n, params.cell_scale, params.life));
+}
+#include "bounce.glsl"
+
 // Whether placement `draw` moved since the last frame.
 bool moved(uint draw) {
     mat4 m = draws[draw].previous;
@@ -74,7 +81,7 @@ void main() {
     imageStore(cache_life, at, uvec4(life - 1u));
     vec4 point = imageLoad(cache_point, at);
     vec3 p = point.xyz;
-    vec3 n = octahedral_decode(unpackSnorm2x16(floatBitsToUint(point.w)));
+    vec3 n = unpack_normal(point.w);
     mat3 to_world = basis(n);
     vec3 origin = leave(p, n);
     float step = leave_distance(p);
@@ -83,26 +90,9 @@ void main() {
     bool restart = false;
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
-        vec3 from = origin + dir * step;
-        vec2 found = trace_closest(from, dir, 1e30);
-        float t = found.x < 0.0 ? 1e30 : found.x;
-        if (hit_area_light(from, dir, t) >= 0) {
-            continue;
-        }
-        if (found.x < 0.0) {
-            sum += frame.ambient.rgb;
-            continue;
-        }
-        TraceSurface s = trace_surface(floatBitsToUint(found.y), from, dir, t);
-        Material m = material_record(s.material);
-        vec3 ng;
-        vec3 sn;
-        facing_normals(s, m, dir, ng, sn);
-        Bsdf b = surface_bsdf(s, m);
-        vec3 leave_from = leave(s.position, ng);
-        sum += next_event(s.position, sn, ng, -dir, b, leave_from, LIGHT_CHOICE, rng);
-        sum += b.diffuse * cache_radiance_at(cache_cell(s.position, sn, params.cell_scale, params.life));
-        restart = restart || moved(s.draw);
+        uint draw;
+        sum += cached_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng, draw);
+        restart = restart || (draw != CACHE_NO_DRAW && moved(draw));
     }
     vec3 radiance = sum / float(max(params.rays, 1u));
     vec4 kept = imageLoad(cache_radiance, at);

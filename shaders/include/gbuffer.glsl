@@ -25,6 +25,16 @@ vec3 octahedral_decode(vec2 e) {
     return normalize(n);
 }
 
+// A normal kept in one float of a float image: octahedral, two 16-bit
+// snorms (ReSTIR's surfaces, the radiance cache's cells).
+float pack_normal(vec3 n) {
+    return uintBitsToFloat(packSnorm2x16(octahedral_encode(n)));
+}
+
+vec3 unpack_normal(float bits) {
+    return octahedral_decode(unpackSnorm2x16(floatBitsToUint(bits)));
+}
+
 // The half-float pair closest in angle to `n`: the rounded encoding and its
 // neighbours one half-float step either way on each axis are decoded and the
 // best kept, which roughly halves the worst quantization error.

@@ -118,13 +118,7 @@ void main() {
 #ifdef HAS_RESTIR_HIT
     // Before spatial reuse, so neighbours do not take an occluded sample.
     // Shading here instead tests the one sample it keeps, once.
-    if (fresh.weight > 0.0) {
-        LightSample ls;
-        sample_contribution(sp, fresh.light, fresh.u, ls);
-        if (!sample_visible(sp, ls)) {
-            fresh.weight = 0.0;
-        }
-    }
+    shade_kept(sp, fresh);
 #endif
 
     // Temporal reuse: the last frame's reservoir where this surface was,
@@ -155,17 +149,7 @@ void main() {
 #ifdef HAS_RESTIR_DIRECT
     // Shaded by the kept sample; kept for the next frame with weight 0 where
     // it is occluded, so temporal reuse does not carry it on.
-    vec3 direct = vec3(0.0);
-    if (merged.weight > 0.0) {
-        LightSample ls;
-        vec3 c = sample_contribution(sp, merged.light, merged.u, ls);
-        if (sample_visible(sp, ls)) {
-            direct = c * merged.weight;
-        } else {
-            merged.weight = 0.0;
-        }
-    }
-    imageStore(restir_direct, pixel, vec4(hdr_output(direct), 1.0));
+    imageStore(restir_direct, pixel, vec4(hdr_output(shade_kept(sp, merged)), 1.0));
     imageStore(restir_surface, pixel, vec4(sp.position, pack_normal(sp.n)));
 #endif
     imageStore(restir_sample, pixel, merged.u);

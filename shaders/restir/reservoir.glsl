@@ -124,13 +124,20 @@ bool sample_visible(ShadingPoint sp, LightSample ls) {
     return hit_area_light(sp.from, ls.direction, reach) < 0 && !trace_any(sp.from, ls.direction, reach);
 }
 
-// Normals kept in one float: octahedral (gbuffer.glsl), two 16-bit snorms.
-float pack_normal(vec3 n) {
-    return uintBitsToFloat(packSnorm2x16(octahedral_encode(n)));
-}
-
-vec3 unpack_normal(float bits) {
-    return octahedral_decode(unpackSnorm2x16(floatBitsToUint(bits)));
+// The light the reservoir's kept sample brings to `sp` through one shadow
+// ray, times its contribution weight; where the sample is occluded, black,
+// and the weight becomes 0 so reuse does not carry the sample on.
+vec3 shade_kept(ShadingPoint sp, inout Reservoir r) {
+    if (r.weight <= 0.0) {
+        return vec3(0.0);
+    }
+    LightSample ls;
+    vec3 c = sample_contribution(sp, r.light, r.u, ls);
+    if (!sample_visible(sp, ls)) {
+        r.weight = 0.0;
+        return vec3(0.0);
+    }
+    return c * r.weight;
 }
 
 // Reuse across pixels and frames takes only the same kind of surface: normals
