@@ -40,6 +40,16 @@ fn render(
     weft_tests::render::linear_image_validated(scene, settings, "hdr")
 }
 
+/// Settings for `graph` with `restir_di` on and nothing else changed,
+/// `frames` frames `frame_time` seconds apart, bloom off.
+fn restir_settings(graph: &str, frames: u32, frame_time: f64) -> weft_render::RenderSettings {
+    let mut settings =
+        weft_tests::render::square_settings_without_bloom(graph, SIZE, None, &[], &["restir_di"]);
+    settings.frames = frames;
+    settings.frame_time = frame_time;
+    settings
+}
+
 /// The deferred graph's own image: every point light summed exactly, with
 /// the same G-buffer (and so the same filtered textures) ReSTIR shades.
 fn raster(scene: &Path) -> LinearImage {
@@ -166,15 +176,7 @@ fn tiled_and_deferred_shade_the_same_restir_light() {
     let dir = TempDir::new("restir-tiled");
     let scene = many_lights(&dir.0);
     let image = |graph: &str| {
-        let mut settings = weft_tests::render::square_settings_without_bloom(
-            graph,
-            SIZE,
-            None,
-            &[],
-            &["restir_di"],
-        );
-        settings.frames = 3;
-        settings.frame_time = 0.0;
+        let settings = restir_settings(graph, 3, 0.0);
         weft_tests::render::linear_image_validated(&scene, settings, "hdr")
     };
     let (tiled, deferred) = (image("tiled.ron"), image("deferred.ron"));
@@ -257,15 +259,7 @@ fn a_camera_moved_two_pixels_keeps_reservoirs_where_the_surface_stays() {
     let scene = wall_and_box(&dir.0);
     // Component `c` of image `image` (RGBA floats) after `frames` frames.
     let read = |frames: u32, image: &str, c: usize| -> Vec<f32> {
-        let mut settings = weft_tests::render::square_settings_without_bloom(
-            "deferred.ron",
-            SIZE,
-            None,
-            &[],
-            &["restir_di"],
-        );
-        settings.frames = frames;
-        settings.frame_time = 1.0 / 60.0;
+        let settings = restir_settings("deferred.ron", frames, 1.0 / 60.0);
         let (_, texels) = weft_tests::render::render_image_validated(&scene, settings, image);
         texels.chunks(4).map(|texel| texel[c]).collect()
     };
@@ -359,15 +353,7 @@ fn two_lights(dir: &Path, name: &str, second: bool, switch: bool) -> PathBuf {
 fn a_light_switched_off_is_gone_from_the_frame_it_goes_dark() {
     let dir = TempDir::new("restir-switch");
     let image = |scene: &Path, frames: u32| {
-        let mut settings = weft_tests::render::square_settings_without_bloom(
-            "deferred.ron",
-            SIZE,
-            None,
-            &[],
-            &["restir_di"],
-        );
-        settings.frames = frames;
-        settings.frame_time = 1.0 / 60.0;
+        let settings = restir_settings("deferred.ron", frames, 1.0 / 60.0);
         weft_tests::render::linear_image_validated(scene, settings, "hdr")
     };
     let switched = two_lights(&dir.0, "switched.scene", true, true);
