@@ -6,7 +6,7 @@ use super::{load, Xvfb};
 use crate::harness::repo;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::sync::mpsc::{channel, Receiver};
 use std::time::{Duration, Instant};
 
@@ -71,6 +71,35 @@ fn lines(pipe: impl Read + Send + 'static) -> Receiver<String> {
     receive
 }
 
+/// `weft view` with `args` in `dir`, its output read line by line, once it
+/// has listed the graph's features (its first frame is up).
+fn view(x: &Xvfb, dir: &Path, args: &[&str]) -> (Child, Receiver<String>, Receiver<String>) {
+    let mut child = x
+        .command(args, dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("weft starts");
+    let stdout = lines(child.stdout.take().expect("stdout"));
+    let stderr = lines(child.stderr.take().expect("stderr"));
+    wait_for(&stdout, |l| l.starts_with("graph "), "features line");
+    (child, stdout, stderr)
+}
+
+/// Stops the viewer as a user's SIGTERM would: it exits cleanly (writing its
+/// screenshot) with no validation message left on stderr.
+fn stop(mut child: Child, stderr: &Receiver<String>) {
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(killed.success());
+    let status = child.wait().expect("weft exits");
+    let rest: Vec<String> = stderr.try_iter().collect();
+    assert!(status.success(), "{status:?}; stderr: {rest:?}");
+    assert!(rest.iter().all(|l| !l.contains("validation")), "{rest:?}");
+}
+
 #[test]
 fn shader_edits_reload_while_viewing_and_a_broken_one_keeps_the_last_good() {
     const TONEMAP: &str = "shaders/tonemap.frag";
@@ -79,26 +108,19 @@ fn shader_edits_reload_while_viewing_and_a_broken_one_keeps_the_last_good() {
     let copy = Copy::new("reload");
     let shot = copy.0.join("last.png");
     let scene = repo().join("scenes/demo.scene");
-    let mut child = x
-        .command(
-            &[
-                "view",
-                scene.to_str().expect("utf-8 path"),
-                "--size",
-                "64x36",
-                "--validate",
-                "--screenshot-on-exit",
-                shot.to_str().expect("utf-8 path"),
-            ],
-            &copy.0,
-        )
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("weft starts");
-    let stdout = lines(child.stdout.take().expect("stdout"));
-    let stderr = lines(child.stderr.take().expect("stderr"));
-    wait_for(&stdout, |l| l.starts_with("graph "), "features line");
+    let (child, stdout, stderr) = view(
+        &x,
+        &copy.0,
+        &[
+            "view",
+            scene.to_str().expect("utf-8 path"),
+            "--size",
+            "64x36",
+            "--validate",
+            "--screenshot-on-exit",
+            shot.to_str().expect("utf-8 path"),
+        ],
+    );
     let tonemap = copy.0.join(TONEMAP);
     let original = std::fs::read_to_string(&tonemap).expect("read shader");
     assert!(original.contains(OUT));
@@ -125,15 +147,7 @@ fn shader_edits_reload_while_viewing_and_a_broken_one_keeps_the_last_good() {
         "{error}"
     );
 
-    let killed = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .expect("kill runs");
-    assert!(killed.success());
-    let status = child.wait().expect("weft exits");
-    let rest: Vec<String> = stderr.try_iter().collect();
-    assert!(status.success(), "{status:?}; stderr: {rest:?}");
-    assert!(rest.iter().all(|l| !l.contains("validation")), "{rest:?}");
+    stop(child, &stderr);
     let image = load(&shot);
     assert_eq!(image.dimensions(), (64, 36));
     assert!(
@@ -165,28 +179,21 @@ fn a_slow_reload_is_prepared_while_frames_keep_being_presented() {
     )
     .expect("write scene");
     let shot = copy.0.join("last.png");
-    let mut child = x
-        .command(
-            &[
-                "view",
-                "scenes/tiny.scene",
-                "--size",
-                "64x36",
-                "--validate",
-                "--prepare-delay-ms",
-                "1500",
-                "--screenshot-on-exit",
-                shot.to_str().expect("utf-8 path"),
-            ],
-            &copy.0,
-        )
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("weft starts");
-    let stdout = lines(child.stdout.take().expect("stdout"));
-    let stderr = lines(child.stderr.take().expect("stderr"));
-    wait_for(&stdout, |l| l.starts_with("graph "), "features line");
+    let (child, stdout, stderr) = view(
+        &x,
+        &copy.0,
+        &[
+            "view",
+            "scenes/tiny.scene",
+            "--size",
+            "64x36",
+            "--validate",
+            "--prepare-delay-ms",
+            "1500",
+            "--screenshot-on-exit",
+            shot.to_str().expect("utf-8 path"),
+        ],
+    );
     let tonemap = copy.0.join(TONEMAP);
     let original = std::fs::read_to_string(&tonemap).expect("read shader");
     std::fs::write(
@@ -215,15 +222,7 @@ fn a_slow_reload_is_prepared_while_frames_keep_being_presented() {
     assert!(frames > 0.0, "{line}");
     assert!(longest < DELAY_MS, "{line}");
 
-    let killed = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .expect("kill runs");
-    assert!(killed.success());
-    let status = child.wait().expect("weft exits");
-    let rest: Vec<String> = stderr.try_iter().collect();
-    assert!(status.success(), "{status:?}; stderr: {rest:?}");
-    assert!(rest.iter().all(|l| !l.contains("validation")), "{rest:?}");
+    stop(child, &stderr);
     assert!(
         load(&shot).pixels().all(|p| p.0 == [255, 0, 0, 255]),
         "the edit is live"
