@@ -244,6 +244,18 @@ fn traced(
     weft_tests::render::linear_image_validated(scene, settings, read)
 }
 
+/// The path tracer's plain running mean of `samples` per pixel: the raw
+/// accumulation the denoiser is measured against, or (at 512) a reference.
+fn accumulated(scene: &Path, samples: u64) -> LinearImage {
+    traced(
+        scene,
+        ("pathtrace.ron", Some(samples)),
+        (1, 0.0),
+        (&[], "hdr"),
+        &[],
+    )
+}
+
 /// The box on a floor under an ambient sky (tests/e2e/rt_ao.rs's scene),
 /// path traced at one sample per pixel a frame, against a 512-spp
 /// reference: the denoised frame's relative MSE is under half the raw

@@ -4,7 +4,7 @@
 //! never worse than raw accumulation of the same samples, ending as that
 //! accumulation once the spatial filter has faded out.
 
-use super::{at, fixture, fixture_with, plane_scene, traced, SIZE};
+use super::{accumulated, at, fixture, fixture_with, plane_scene, traced, SIZE};
 use weft_compare::rel_mse;
 use weft_tests::TempDir;
 
@@ -120,21 +120,9 @@ fn a_light_switched_off_leaves_no_ghost_after_two_frames() {
 fn the_denoised_image_is_never_worse_than_raw_accumulation() {
     let dir = TempDir::new("denoise-never-worse");
     let scene = crate::rt_ao::scene(&dir.0);
-    let reference = traced(
-        &scene,
-        ("pathtrace.ron", Some(512)),
-        (1, 0.0),
-        (&[], "hdr"),
-        &[],
-    );
+    let reference = accumulated(&scene, 512);
     for frames in [4u32, 8, 16, 32] {
-        let raw = traced(
-            &scene,
-            ("pathtrace.ron", Some(u64::from(frames))),
-            (1, 0.0),
-            (&[], "hdr"),
-            &[],
-        );
+        let raw = accumulated(&scene, u64::from(frames));
         let denoised = traced(
             &scene,
             ("pathtrace_denoised.ron", None),

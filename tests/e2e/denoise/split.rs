@@ -4,7 +4,7 @@
 //! the specular part is the specular lobes' light, and the split denoiser
 //! is never worse than raw accumulation of the same samples.
 
-use super::traced;
+use super::{accumulated, traced};
 use std::path::{Path, PathBuf};
 use weft_compare::rel_mse;
 use weft_tests::TempDir;
@@ -74,21 +74,9 @@ fn the_split_light_adds_up_to_the_undivided_light() {
 fn the_split_denoiser_is_never_worse_than_raw_accumulation() {
     let dir = TempDir::new("denoise-split-never-worse");
     let scene = glossy_scene(&dir.0);
-    let reference = traced(
-        &scene,
-        ("pathtrace.ron", Some(512)),
-        (1, 0.0),
-        (&[], "hdr"),
-        &[],
-    );
+    let reference = accumulated(&scene, 512);
     for frames in [4u32, 8, 16] {
-        let raw = traced(
-            &scene,
-            ("pathtrace.ron", Some(u64::from(frames))),
-            (1, 0.0),
-            (&[], "hdr"),
-            &[],
-        );
+        let raw = accumulated(&scene, u64::from(frames));
         let split = traced(
             &scene,
             ("pathtrace_denoised.ron", None),
