@@ -29,6 +29,7 @@
 #define BINDING_MATERIAL_TEXTURES      18 // the materials' texture slots
 #define BINDING_TRIANGLE_TANGENTS      19 // the corners' tangents
 #define BINDING_LIGHT_CHOICES          23 // the light choice table
+#define BINDING_RAY_COUNTS             24 // the per-pass ray counters
 
 #define MATERIAL_BASE_COLOR             0 // the base-colour texture
 #define MATERIAL_METALLIC_ROUGHNESS     1 // the metallic-roughness texture

@@ -79,6 +79,44 @@ layout(set = SET_SCENE, binding = BINDING_TRIANGLE_TANGENTS) uniform usamplerBuf
 
 #define NO_TEXTURE 0xffffffffu
 
+// Rays per pass (engine/render/src/providers/ray_counts.rs): a pass that traces is
+// compiled with RAY_COUNT_SLOT, its slot in this buffer, so `weft compare`
+// shows rays per pixel per pass. Each invocation counts its walks in a
+// private variable and adds them once, when the shader's own main (renamed
+// by the macro below) returns: an atomic per walk cost the path tracer 6% on
+// lavapipe. A compute shader adds its subgroup's sum in one atomic; a
+// fragment shader adds per lane, as its helper invocations take part in
+// subgroup sums but their atomics do nothing.
+#if defined(RAY_COUNT_SLOT) && !defined(WEFT_VERTEX_SHADER)
+layout(std430, set = SET_SCENE, binding = BINDING_RAY_COUNTS) buffer RayCounts { uint ray_counts[]; };
+uint traced_rays = 0u;
+#ifdef WEFT_COMPUTE_SHADER
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+void add_traced_rays() {
+    uint rays = subgroupAdd(traced_rays);
+    if (subgroupElect() && rays > 0u) {
+        atomicAdd(ray_counts[RAY_COUNT_SLOT], rays);
+    }
+}
+#else
+void add_traced_rays() {
+    if (traced_rays > 0u) {
+        atomicAdd(ray_counts[RAY_COUNT_SLOT], traced_rays);
+    }
+}
+#endif
+void counted_main();
+void main() {
+    counted_main();
+    add_traced_rays();
+}
+#define main counted_main
+#define COUNT_RAY() ++traced_rays
+#else
+#define COUNT_RAY()
+#endif
+
 // The texel of a colour (`colour`) or data texture slot at uv, level 0 (the
 // path tracer's jittered samples filter); white for no texture.
 vec4 trace_texel(uint slot, bool colour, vec2 uv) {
@@ -261,6 +299,7 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
     float best_t = t_max;
     uint best_tri = 0u;
     bool hit = false;
+    COUNT_RAY();
     // An empty scene still has a (minimum-size) buffer: fewer than 3 corners.
     if (textureSize(trace_corners) < 3) {
         return vec2(-1.0, 0.0);

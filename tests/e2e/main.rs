@@ -17,6 +17,7 @@ mod normal_maps;
 mod one_physics;
 mod pathtrace;
 mod radiance_cache;
+mod ray_counts;
 mod raycast;
 mod render;
 mod restir;

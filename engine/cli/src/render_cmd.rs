@@ -362,6 +362,8 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         .collect();
     let record_ms = Rendered::steady_mean(&rendered.record_ms);
     let frame_ms = Rendered::steady_mean(&rendered.frame_ms);
+    let pixels = f64::from(args.size.width) * f64::from(args.size.height);
+    let rays = rendered.rays.last().map(Vec::as_slice).unwrap_or_default();
     if args.json {
         let timings: Vec<_> = rendered
             .report
@@ -392,6 +394,11 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             "frame_ms": frame_ms,
             "prepare_ms": rendered.prepare_ms,
             "timings": timings,
+            "rays": rays.iter().map(|r| serde_json::json!({
+                "pass": r.pass,
+                "rays": r.rays,
+                "per_pixel": r.rays as f64 / pixels,
+            })).collect::<Vec<_>>(),
             "statistics": rendered.report.statistics,
             "views": rendered.views
                 .iter()
@@ -453,6 +460,13 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         }
         if !rendered.report.timings.is_empty() {
             print!("{}", format_timings(&rendered.report.timings));
+        }
+        if !rays.is_empty() {
+            let per_pass: Vec<String> = rays
+                .iter()
+                .map(|r| format!("{} {:.3}", r.pass, r.rays as f64 / pixels))
+                .collect();
+            println!("rays per pixel, last frame: {}", per_pass.join(", "));
         }
         if args.validate {
             println!("validation: {counts}");

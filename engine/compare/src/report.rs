@@ -58,6 +58,10 @@ pub struct PassTime {
     /// submitted alone (where timestamps are meaningless, e.g. compute on
     /// lavapipe).
     pub timer: String,
+    /// For a pass that traces rays, the median over the measured frames of
+    /// the rays it traced per output pixel (BVH walks, closest-hit and
+    /// shadow rays alike): where the time went.
+    pub rays_per_pixel: Option<f64>,
 }
 
 /// One configuration's measurements.
@@ -366,11 +370,14 @@ impl Report {
             "LDR-FLIP and PSNR measure each configuration's HDR image through the reference's tonemap, so post effects the reference does not model (bloom) are not counted as error (`--post` counts them).\n\n"
         };
         out += &self.table();
-        out += "\n## Passes\n\n| configuration | pass | ms: median (IQR) | timer |\n|---|---|---|---|\n";
+        out += "\n## Passes\n\nRays per pixel: the rays a pass traced per output pixel each frame (median), where it traces.\n\n| configuration | pass | ms: median (IQR) | rays per pixel | timer |\n|---|---|---|---|---|\n";
         for c in &self.configurations {
             for p in &c.passes {
+                let rays = p
+                    .rays_per_pixel
+                    .map_or_else(|| "–".to_string(), |r| format!("{r:.3}"));
                 out += &format!(
-                    "| {} | {} | {:.3} ({:.3}–{:.3}) | {} |\n",
+                    "| {} | {} | {:.3} ({:.3}–{:.3}) | {rays} | {} |\n",
                     c.name, p.name, p.ms, p.spread.p25, p.spread.p75, p.timer
                 );
             }

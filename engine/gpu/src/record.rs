@@ -9,6 +9,40 @@ use ash::vk;
 use weft_graph::plan::{Barrier, Plan, PlanPass};
 use weft_graph::vk::Aspect;
 
+/// The shader stages that may add to a scene counter (set 1 storage the
+/// shaders write, such as the per-pass ray counters).
+const COUNTING_STAGES: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::from_raw(
+    vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw()
+        | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw(),
+);
+
+/// Orders a pass that adds to the scene's counters (a pass that traces)
+/// after every earlier shader's additions; the plan's barriers cover only
+/// graph resources, and the counters are the scene's.
+pub fn scene_counter_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(COUNTING_STAGES)
+        .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+        .dst_stage_mask(COUNTING_STAGES)
+        .dst_access_mask(
+            vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        )];
+    let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
+    unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };
+}
+
+/// Makes the frame's counter additions visible to the host, which reads
+/// them once the frame's fence has signalled.
+pub fn scene_counters_to_host(device: &ash::Device, cmd: vk::CommandBuffer) {
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(COUNTING_STAGES)
+        .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+    let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
+    unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };
+}
+
 /// Records one `vkCmdPipelineBarrier2` with the given barriers (nothing when empty).
 pub fn barriers(
     device: &ash::Device,

@@ -29,6 +29,18 @@ impl ShaderStage {
             Self::Compute => shaderc::ShaderKind::Compute,
         }
     }
+
+    /// The macro every shader of this stage is compiled with, so an include
+    /// shared by stages can choose per stage (a fragment shader's helper
+    /// invocations take part in subgroup operations; a compute shader has
+    /// none).
+    pub fn macro_name(self) -> &'static str {
+        match self {
+            Self::Vertex => "WEFT_VERTEX_SHADER",
+            Self::Fragment => "WEFT_FRAGMENT_SHADER",
+            Self::Compute => "WEFT_COMPUTE_SHADER",
+        }
+    }
 }
 
 /// One problem reported by the compiler, located in the file that has it
@@ -188,6 +200,7 @@ impl ShaderCompiler {
             shaderc::EnvVersion::Vulkan1_3 as u32,
         );
         options.set_generate_debug_info();
+        options.add_macro_definition(stage.macro_name(), None);
         for define in defines {
             let (name, value) = parse_define(define)?;
             options.add_macro_definition(name, value);

@@ -95,6 +95,10 @@ pub const INDICES_BINDING: u32 = 22;
 /// Binding of the table next-event estimation picks a light from
 /// (`light_choice_table`, a texel buffer; [`crate::light_choice::LightChoices`]).
 pub const LIGHT_CHOICES_BINDING: u32 = 23;
+/// Binding of the per-pass ray counters (`ray_counts` in `trace.glsl`): every
+/// traced ray adds one to its pass's slot ([`crate::providers::ray_counts`]), so
+/// `weft compare` can show rays per pixel per pass.
+pub const RAY_COUNTS_BINDING: u32 = 24;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -160,7 +164,7 @@ pub const SCENE_SET_BINDINGS: [SceneBinding; 8] = [
 /// Set 1 bindings for ray tracing: built only when a compute pass that
 /// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
-pub const TRACE_SET_BINDINGS: [SceneBinding; 16] = [
+pub const TRACE_SET_BINDINGS: [SceneBinding; 17] = [
     tracing(
         "TRIANGLES",
         TRIANGLES_BINDING,
@@ -256,6 +260,12 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 16] = [
         LIGHT_CHOICES_BINDING,
         DescriptorKind::UniformTexelBuffer,
         "the light choice table",
+    ),
+    tracing(
+        "RAY_COUNTS",
+        RAY_COUNTS_BINDING,
+        DescriptorKind::StorageBuffer,
+        "the per-pass ray counters",
     ),
 ];
 

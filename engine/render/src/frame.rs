@@ -114,6 +114,9 @@ pub struct Rendered {
     /// Per-pass times of every frame (empty lists when timing is off), so
     /// callers can take medians over frames.
     pub timings: Vec<Vec<weft_gpu::PassTiming>>,
+    /// Rays each tracing pass traced, every frame (empty lists when nothing
+    /// traces): the cost model beside the times.
+    pub rays: Vec<Vec<crate::PassRays>>,
     /// The plan's summarised views of the last frame (mean, median, p95,
     /// histogram of each per-pixel count or measure), by view name.
     pub views: Vec<(String, crate::ViewSummary)>,
@@ -317,6 +320,7 @@ pub fn render_with_progress(
     let mut record_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut frame_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut timings = Vec::with_capacity(count.min(4096) as usize);
+    let mut rays = Vec::with_capacity(count.min(4096) as usize);
     let mut last = None;
     let start = std::time::Instant::now();
     for frame in 0..count {
@@ -338,6 +342,7 @@ pub fn render_with_progress(
         frame_ms.push(started.elapsed().as_secs_f64() * 1e3);
         record_ms.push(report.record_ms);
         timings.push(report.timings.clone());
+        rays.push(frames.rays().to_vec());
         last = Some(report);
         progress(Progress {
             frames: frame + 1,
@@ -370,6 +375,7 @@ pub fn render_with_progress(
         warnings,
         samples,
         timings,
+        rays,
         prepare_ms,
     })
 }

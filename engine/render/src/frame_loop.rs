@@ -6,6 +6,7 @@
 //! the benchmarks all draw through [`FrameLoop::draw`].
 
 use crate::error::RenderError;
+use crate::providers::ray_counts::PassRays;
 use crate::recorder::SceneRecorder;
 use crate::scene_gpu::GpuScene;
 use std::sync::Arc;
@@ -29,6 +30,8 @@ pub struct FrameLoop<'g> {
     accumulation: Accumulation,
     /// Frames drawn on the current resources and scene (`plan_frames`).
     plan_frames: u32,
+    /// The rays each tracing pass traced in the last frame.
+    rays: Vec<PassRays>,
 }
 
 /// Counts the frames in a row that drew the same inputs, so history images
@@ -96,6 +99,7 @@ impl<'g> FrameLoop<'g> {
             plan,
             accumulation: Accumulation::default(),
             plan_frames: 0,
+            rays: Vec::new(),
         })
     }
 
@@ -127,6 +131,7 @@ impl<'g> FrameLoop<'g> {
                 .scene
                 .update(&at, request.camera, request.time, (extent, jitter))?;
         let history_frames = self.accumulation.next(inputs);
+        self.recorder.scene.reset_ray_counts()?;
         let options = FrameOptions {
             timing: request.timing,
             readback: request.readback,
@@ -144,8 +149,14 @@ impl<'g> FrameLoop<'g> {
                 &options,
             )
             .map_err(|e| RenderError::at_pass(e, &self.plan))?;
+        self.rays = self.recorder.scene.pass_rays(&self.plan)?;
         self.plan_frames = self.plan_frames.saturating_add(1);
         Ok(report)
+    }
+
+    /// The rays each tracing pass traced in the last frame drawn.
+    pub fn rays(&self) -> &[PassRays] {
+        &self.rays
     }
 
     /// The scene script's error from `update`, if one failed since the last

@@ -249,12 +249,14 @@ pub(crate) fn param_text(value: &ParamValue) -> String {
     }
 }
 
-/// One pass's measured times: its name, its timer's label and the
-/// milliseconds of every measured frame.
+/// One pass's measured times: its name, its timer's label, the
+/// milliseconds of every measured frame and, for a pass that traces, the rays
+/// per pixel it traced in each.
 struct PassSamples {
     name: String,
     timer: String,
     ms: Vec<f64>,
+    rays_per_pixel: Vec<f64>,
 }
 
 /// A configuration's measured frames, from one round or several: every
@@ -278,26 +280,46 @@ impl Timings {
                 timings.add_pass(&t.pass, t.source.label(), &[t.ms]);
             }
         }
+        let pixels = f64::from(rendered.plan.extent.width) * f64::from(rendered.plan.extent.height);
+        for frame in &rendered.rays[1.min(rendered.rays.len())..] {
+            for r in frame {
+                if let Some(p) = timings.passes.iter_mut().find(|p| p.name == r.pass) {
+                    p.rays_per_pixel.push(r.rays as f64 / pixels);
+                }
+            }
+        }
         timings
     }
 
     /// `ms` more of pass `name`, measured by `timer`.
     fn add_pass(&mut self, name: &str, timer: &str, ms: &[f64]) {
-        match self.passes.iter_mut().find(|p| p.name == name) {
-            Some(p) => p.ms.extend(ms),
-            None => self.passes.push(PassSamples {
-                name: name.to_string(),
-                timer: timer.to_string(),
-                ms: ms.to_vec(),
-            }),
-        }
+        self.pass(name, timer).ms.extend(ms);
+    }
+
+    /// Pass `name`'s samples, a new entry when it has none yet.
+    fn pass(&mut self, name: &str, timer: &str) -> &mut PassSamples {
+        let at = match self.passes.iter().position(|p| p.name == name) {
+            Some(at) => at,
+            None => {
+                self.passes.push(PassSamples {
+                    name: name.to_string(),
+                    timer: timer.to_string(),
+                    ms: Vec::new(),
+                    rays_per_pixel: Vec::new(),
+                });
+                self.passes.len() - 1
+            }
+        };
+        &mut self.passes[at]
     }
 
     /// These timings and `other`'s together.
     fn extend(&mut self, other: &Timings) {
         self.frames.extend(&other.frames);
         for p in &other.passes {
-            self.add_pass(&p.name, &p.timer, &p.ms);
+            let mine = self.pass(&p.name, &p.timer);
+            mine.ms.extend(&p.ms);
+            mine.rays_per_pixel.extend(&p.rays_per_pixel);
         }
     }
 
@@ -313,6 +335,8 @@ impl Timings {
                     ms: spread.median,
                     spread,
                     timer: p.timer.clone(),
+                    rays_per_pixel: (!p.rays_per_pixel.is_empty())
+                        .then(|| Spread::of(&p.rays_per_pixel).median),
                 }
             })
             .collect();

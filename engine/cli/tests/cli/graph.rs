@@ -216,7 +216,7 @@ fn plan_with_a_scene_culls_what_the_scene_lacks() {
     // twelve features it may depend on).
     assert!(
         text.contains(
-            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS (variant key; 1 of up to 4096 variants: 12 of the 15 features a pass may depend on)\n"
+            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS RAY_COUNT_SLOT=0 (variant key; 1 of up to 4096 variants: 12 of the 15 features a pass may depend on)\n"
         ),
         "{text}"
     );

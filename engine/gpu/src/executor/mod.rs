@@ -479,6 +479,9 @@ impl<'g> Renderer<'g> {
         }
         let t = Instant::now();
         record::barriers(self.gpu.device(), cmd, &plan.epilogue, resources)?;
+        if self.scene.is_some() {
+            record::scene_counters_to_host(self.gpu.device(), cmd);
+        }
         for rb in readbacks.iter() {
             rb.record(self.gpu, cmd, resources)?;
         }

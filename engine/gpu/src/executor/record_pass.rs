@@ -37,6 +37,9 @@ impl<'g> Renderer<'g> {
         };
         let label = Label::begin(self.gpu, cmd, &pass.name);
         record::barriers(device, cmd, &pass.barriers, resources)?;
+        if self.traces(pass) {
+            record::scene_counter_barrier(device, cmd);
+        }
         let result = match pass.kind {
             PassKind::Copy => record::transfer(self.gpu, cmd, plan, pass, resources, false),
             PassKind::Blit => record::transfer(self.gpu, cmd, plan, pass, resources, true),
@@ -156,6 +159,9 @@ impl<'g> Renderer<'g> {
         for repeat_index in 0..pass.repeat.max(1) {
             if repeat_index > 0 {
                 record::barriers(device, cmd, &pass.repeat_barriers, resources)?;
+                if self.traces(pass) {
+                    record::scene_counter_barrier(device, cmd);
+                }
                 if let Some((p, (_, stages))) = prep
                     .pipeline
                     .as_ref()
@@ -174,6 +180,13 @@ impl<'g> Renderer<'g> {
             }
         }
         Ok(())
+    }
+
+    /// Whether `pass` traces rays, and so adds to the scene's ray counters.
+    fn traces(&self, pass: &PlanPass) -> bool {
+        self.scene
+            .as_ref()
+            .is_some_and(|scene| (scene.interface.traces)(pass))
     }
 
     pub(super) fn bind(&self, cmd: vk::CommandBuffer, prep: &Prepared) {

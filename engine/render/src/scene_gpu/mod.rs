@@ -398,29 +398,6 @@ impl<'g> GpuScene<'g> {
         }
     }
 
-    /// Builds the ray tracer's buffers, once; placements a script has moved
-    /// give new geometry each frame, so their BVH is not cached.
-    fn ensure_trace_buffers(&mut self) -> Result<(), GpuError> {
-        if self.trace.is_none() {
-            let cache = self.bvh_cache.as_deref().filter(|_| !self.moved);
-            let built = TraceBuffers::build(
-                self.gpu,
-                &self.geometry,
-                cache,
-                (&self.light_set, scene_radius(&self.bounds)),
-                &mut self.warnings,
-            )?;
-            self.trace = Some(built);
-        }
-        Ok(())
-    }
-
-    /// Caches the ray tracer's BVH in `dir` (the user's cache folder), so
-    /// the next run over the same geometry reads it instead of building it.
-    pub fn cache_bvh_in(&mut self, dir: Option<PathBuf>) {
-        self.bvh_cache = dir;
-    }
-
     /// Set 1 of the layout `kind`: the raster bindings, or with the ray
     /// tracer's too (its BVH built and its buffers uploaded on first use).
     pub fn scene_set(&mut self, kind: SceneSet) -> Result<vk::DescriptorSet, GpuError> {

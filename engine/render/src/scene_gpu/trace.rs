@@ -1,16 +1,18 @@
 //! The ray tracer's scene data on the device, built when a pass first traces:
 //! world-space triangles, the BVH over them (in its 4-wide form), per-corner normals, tangents and
 //! UVs, per-triangle materials and draws, the emitters' alias table, the lights' choice
-//! table and the texture arrays (set 1's tracing-only bindings,
-//! [`crate::bindings::TRACE_SET_BINDINGS`]).
+//! table, the texture arrays and the per-pass ray counters (set 1's
+//! tracing-only bindings, [`crate::bindings::TRACE_SET_BINDINGS`]); and the
+//! scene's methods that build them and read the counters.
 
+use super::{scene_radius, GpuScene};
 use crate::bindings::*;
 use crate::geometry::SceneGeometry;
 use crate::gpu_types::bytes_of;
 use crate::light_choice::LightChoices;
 use crate::lights::LightSet;
 use ash::vk;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use weft_gpu::buffer::TexelFormat::{Words2, Words4};
 use weft_gpu::buffer::{Buffer, TexelBuffer};
 use weft_gpu::texture::{Rgba8Image, Texture};
@@ -33,6 +35,9 @@ pub(super) struct TraceBuffers<'g> {
     /// Colour arrays by class, then data arrays by class.
     pub(super) textures: Vec<Texture<'g>>,
     pub(super) material_textures: Buffer<'g>,
+    /// Rays per tracing pass this frame ([`crate::providers::ray_counts`]), host-visible:
+    /// zeroed before a frame, read after it.
+    ray_counts: Buffer<'g>,
 }
 
 impl<'g> TraceBuffers<'g> {
@@ -177,7 +182,24 @@ impl<'g> TraceBuffers<'g> {
                 bytes_of(&trace_textures.slots),
                 storage,
             )?,
+            ray_counts: zeroed_counters(gpu)?,
         })
+    }
+
+    /// Zeroes the ray counters; the previous frame must have finished.
+    pub(super) fn reset_ray_counts(&mut self) -> Result<(), GpuError> {
+        self.ray_counts
+            .write(&[0u8; crate::providers::ray_counts::BYTES as usize])
+    }
+
+    /// The ray counters' words, slot order; the frame must have finished.
+    pub(super) fn ray_counts(&self) -> Result<Vec<u32>, GpuError> {
+        Ok(self
+            .ray_counts
+            .mapped()?
+            .chunks_exact(4)
+            .map(|w| u32::from_ne_bytes([w[0], w[1], w[2], w[3]]))
+            .collect())
     }
 
     /// Rewrites the light choice table for `lights` as they are now (the
@@ -211,9 +233,72 @@ impl<'g> TraceBuffers<'g> {
     pub(super) fn buffer(&self, binding: u32) -> Option<&Buffer<'g>> {
         match binding {
             MATERIAL_TEXTURES_BINDING => Some(&self.material_textures),
+            RAY_COUNTS_BINDING => Some(&self.ray_counts),
             _ => None,
         }
     }
+}
+
+impl GpuScene<'_> {
+    /// Builds the ray tracer's buffers, once; placements a script has moved
+    /// give new geometry each frame, so their BVH is not cached.
+    pub(super) fn ensure_trace_buffers(&mut self) -> Result<(), GpuError> {
+        if self.trace.is_none() {
+            let cache = self.bvh_cache.as_deref().filter(|_| !self.moved);
+            let built = TraceBuffers::build(
+                self.gpu,
+                &self.geometry,
+                cache,
+                (&self.light_set, scene_radius(&self.bounds)),
+                &mut self.warnings,
+            )?;
+            self.trace = Some(built);
+        }
+        Ok(())
+    }
+
+    /// Caches the ray tracer's BVH in `dir` (the user's cache folder), so
+    /// the next run over the same geometry reads it instead of building it.
+    pub fn cache_bvh_in(&mut self, dir: Option<PathBuf>) {
+        self.bvh_cache = dir;
+    }
+
+    /// Zeroes the per-pass ray counters before a frame (the previous one
+    /// must have finished); nothing to do before the ray tracer's data exists.
+    pub fn reset_ray_counts(&mut self) -> Result<(), GpuError> {
+        match &mut self.trace {
+            Some(trace) => trace.reset_ray_counts(),
+            None => Ok(()),
+        }
+    }
+
+    /// The rays each pass of `plan` traced in the frame that just finished
+    /// ([`crate::providers::ray_counts`]); empty when nothing traces.
+    pub fn pass_rays(
+        &self,
+        plan: &weft_graph::plan::Plan,
+    ) -> Result<Vec<crate::providers::ray_counts::PassRays>, GpuError> {
+        match &self.trace {
+            Some(trace) => Ok(crate::providers::ray_counts::per_pass(
+                plan.passes.iter(),
+                &trace.ray_counts()?,
+            )),
+            None => Ok(Vec::new()),
+        }
+    }
+}
+
+/// The ray counters, zeroed: built during a frame's recording, they count
+/// that frame's rays from the first.
+fn zeroed_counters(gpu: &Gpu) -> Result<Buffer<'_>, GpuError> {
+    let mut counters = Buffer::host(
+        gpu,
+        "the per-pass ray counters",
+        crate::providers::ray_counts::BYTES,
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+    )?;
+    counters.write(&[0u8; crate::providers::ray_counts::BYTES as usize])?;
+    Ok(counters)
 }
 
 /// The choice table over `lights`' analytic records (the emissive polygons

@@ -13,7 +13,10 @@
 //! - `RayTracing()`: the scene's world-space triangles, their corners'
 //!   normals and UVs, their materials, and a BVH over them (`bvh.rs`), built
 //!   on first use and bound in set 1 of the pass (compute, fullscreen or
-//!   scene-drawing: raster lighting traces its shadow rays in place).
+//!   scene-drawing: raster lighting traces its shadow rays in place); each
+//!   such pass also gets its slot in the ray counters (`ray_counts.rs`).
+
+pub mod ray_counts;
 
 use crate::gaussian::{self, GaussianTaps};
 use crate::shadows::{ShadowSettings, MAX_AREA_SHADOWS, MAX_CASCADES, MAX_PCF_RADIUS};
@@ -176,8 +179,10 @@ fn number(args: &std::collections::BTreeMap<String, ParamValue>, name: &str) -> 
     }
 }
 
-/// Adds the values computed once per plan to its passes' parameters (the
-/// Gaussian taps). The plan must come from a graph that passed [`check`].
+/// Adds the values computed once per plan to its passes: the Gaussian taps
+/// as parameters, each tracing pass's ray-counter slot as a define
+/// ([`crate::providers::ray_counts`]). The plan must come from a graph that passed
+/// [`check`].
 pub fn derive_values(plan: &mut Plan) -> Result<(), Vec<Diagnostic>> {
     let mut errors = Vec::new();
     for pass in plan.passes.iter_mut() {
@@ -207,7 +212,7 @@ pub fn derive_values(plan: &mut Plan) -> Result<(), Vec<Diagnostic>> {
         }
     }
     if errors.is_empty() {
-        Ok(())
+        ray_counts::assign_slots(plan.passes.iter_mut())
     } else {
         Err(errors)
     }
@@ -234,12 +239,12 @@ pub fn supplied(pass: &PlanPass, name: &str) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::collections::BTreeMap;
     use weft_graph::plan::Location;
 
-    fn pass_with(derive: Vec<ProviderDecl>) -> PlanPass {
+    pub(crate) fn pass_with(derive: Vec<ProviderDecl>) -> PlanPass {
         PlanPass {
             name: "blur".into(),
             declared_at: Location::default(),
