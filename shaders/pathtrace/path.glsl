@@ -26,6 +26,19 @@ float found_weight(bool counted_fully, float bsdf_pdf, float light_pdf) {
     return params.sampling == SAMPLING_NEE ? 0.0 : power_heuristic(bsdf_pdf, light_pdf);
 }
 
+// Under HAS_RESTIR_DIRECT (graphs/pathtrace_denoised.ron with `restir_di`)
+// the light that reaches the first surface straight from a light is ReSTIR's
+// (trace.comp adds `restir_direct`): the path makes no next-event estimate
+// there, and light its BSDF-sampled ray from there finds counts only through
+// a delta lobe or glass, which ReSTIR's light samples cannot take.
+bool direct_from_restir(Path p) {
+#ifdef HAS_RESTIR_DIRECT
+    return p.depth == 2u && !p.counted_fully;
+#else
+    return false;
+#endif
+}
+
 // Adds light the path found to its radiance and, under SPLIT_LOBES, to its
 // specular part when its first bounce took a specular lobe.
 void path_gather(inout Path p, vec3 light) {
@@ -127,7 +140,9 @@ bool path_hit(inout Path p, out TraceSurface s, out Material m) {
     if (area >= 0) {
         float light_pdf;
         vec3 emitted = area_emitted(uint(area), p.origin, p.dir, t, choice, light_pdf);
-        path_gather(p, p.throughput * emitted * found_weight(p.counted_fully, p.bsdf_pdf, light_pdf));
+        if (!direct_from_restir(p)) {
+            path_gather(p, p.throughput * emitted * found_weight(p.counted_fully, p.bsdf_pdf, light_pdf));
+        }
         return false;
     }
     if (found.x < 0.0) {
@@ -141,7 +156,7 @@ bool path_hit(inout Path p, out TraceSurface s, out Material m) {
     m = material_record(s.material);
 #ifdef SCENE_EMISSIVE
     vec3 wo = -p.dir;
-    if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0) {
+    if (any(greaterThan(m.emissive.rgb, vec3(0.0))) && dot(s.geometric_normal, wo) > 0.0 && !direct_from_restir(p)) {
         float cos_light = dot(s.geometric_normal, wo);
         float light_pdf = emitter_area_pdf(m.emissive.rgb) * t * t
             / (light_choice_odds(frame.counts.w, p.origin, choice) * cos_light);
@@ -184,7 +199,12 @@ bool path_scatter(inout Path p, inout Rng rng, TraceSurface s, Material m) {
     vec4 u_pick = rng_next(rng);
     vec4 u_point = rng_next(rng);
     LightSample ls;
-    if (b.p_specular < 1.0 || b.model != SHADING_MIRROR) {
+#ifdef HAS_RESTIR_DIRECT
+    bool nee = p.depth > 1u && (b.p_specular < 1.0 || b.model != SHADING_MIRROR);
+#else
+    bool nee = b.p_specular < 1.0 || b.model != SHADING_MIRROR;
+#endif
+    if (nee) {
         bool found = sample_light(s.position, n, from, u_pick, u_point, choice, ls)
             && dot(ls.direction, ng) > 0.0;
         if (found && (ls.pdf == 0.0 || params.sampling != SAMPLING_BSDF)) {

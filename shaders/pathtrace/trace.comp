@@ -89,6 +89,12 @@ layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D hdr;
 #else
 layout(set = 0, binding = 1, rgba32f) uniform writeonly image2D hdr;
 #endif
+#ifdef HAS_RESTIR_DIRECT
+// Under `restir_di` (graphs/pathtrace_denoised.ron): the direct light at each
+// pixel's first surface, by ReSTIR (graphs/restir_di.ron); the paths leave
+// it out (path.glsl, direct_from_restir) and each sample adds it.
+layout(set = 0, binding = 3, rgba16f) uniform readonly image2D restir_direct;
+#endif
 
 layout(push_constant) uniform Params {
     uint max_depth;
@@ -198,6 +204,9 @@ void main() {
     // the mean restarts every frame.
     bool with_previous = (params.history_frames > 0u && params.accumulate != 0u) || params.repeat_index > 0u;
     Path p = path(eye, dir, rng);
+#ifdef HAS_RESTIR_DIRECT
+    p.radiance += imageLoad(restir_direct, pixel).rgb;
+#endif
 #ifdef SPLIT_LOBES
     // `hdr` gets the diffuse part, `hdr_specular` the specular part.
     imageStore(hdr_specular, pixel,

@@ -21,6 +21,7 @@ mod ray_counts;
 mod raycast;
 mod render;
 mod restir;
+mod restir_model;
 mod rt_ao;
 mod rt_shadows;
 mod rt_specular;

@@ -4,10 +4,9 @@
 //! temporal reuse and with unbiased spatial reuse (`restir_spatial`); the
 //! biased spatial mode's darkening is measured and bounded; reuse across frames lowers the
 //! error of the same candidates; a light switched off is gone from the very
-//! frame it goes dark (no ghost in the reservoirs); and a CPU model of
-//! the estimator (resampled importance sampling over mixed light kinds,
-//! merged by the generalized balance heuristic) is unbiased against a
-//! closed form.
+//! frame it goes dark (no ghost in the reservoirs); and the path tracer
+//! with ReSTIR at its first surface keeps the reference's mean. The
+//! estimator's CPU model is tests/e2e/restir_model.rs.
 
 use std::path::{Path, PathBuf};
 use weft_compare::{rel_mse, LinearImage};
@@ -144,6 +143,42 @@ fn restir_is_the_path_tracers_direct_light_and_biased_spatial_reuse_a_little_dar
         assert!((ratio - 1.0).abs() < 0.02, "{report}");
     }
     assert!(biased < unbiased + 0.005 && biased > 0.95, "{report}");
+}
+
+/// The path tracer with `restir_di` (graphs/path_tracer.ron): the direct
+/// light at each pixel's first surface is ReSTIR's and the paths bring the
+/// rest, so the raw frames' mean is the reference's, at direct light only
+/// (`max_depth` 2: the paths add only what the camera sees of the light) and
+/// with every bounce; with the feature off the same frames agree as well.
+#[test]
+fn the_path_tracer_with_restir_at_its_first_surface_keeps_the_references_mean() {
+    let cornell = weft_tests::render::root().join("scenes/cornell.scene");
+    let mut report = String::new();
+    for depth in [2.0, 8.0] {
+        let truth = render(&cornell, "pathtrace.ron", 1, &[("max_depth", depth)], &[]);
+        let frames = |features: &[&str]| {
+            let params = [("max_depth", depth), ("samples_per_frame", 16.0)];
+            let mut settings = weft_tests::render::square_settings(
+                "pathtrace_denoised.ron",
+                SIZE,
+                None,
+                &params,
+                features,
+            );
+            settings.frames = 8;
+            settings.frame_time = 0.0;
+            mean_ratio(
+                &truth,
+                &weft_tests::render::linear_image_validated(&cornell, settings, "hdr"),
+            )
+        };
+        let (restir, nee) = (frames(&["!denoise", "restir_di"]), frames(&["!denoise"]));
+        report += &format!("max_depth {depth}: with restir_di {restir:.4}, without {nee:.4}; ");
+        for ratio in [restir, nee] {
+            assert!((ratio - 1.0).abs() < 0.02, "{report}");
+        }
+    }
+    println!("{report}");
 }
 
 #[test]
@@ -376,101 +411,4 @@ fn a_light_switched_off_is_gone_from_the_frame_it_goes_dark() {
     println!("{report}");
     assert!((before / both - 1.0).abs() < 0.03, "{report}");
     assert!((after / one - 1.0).abs() < 0.03, "{report}");
-}
-
-/// The CPU model: lights of two kinds for a surface at `x` in [0, 1] — a
-/// point light (one choice, contribution `point(x)`) and a unit segment
-/// light (contribution `segment(x, u)` for u uniform) — chosen with
-/// probability 0.3 and 0.7. Each pixel draws `m` candidates and keeps one by
-/// resampled importance sampling with the contribution as target; a pixel
-/// then merges its reservoir with its neighbours' by the generalized balance
-/// heuristic. The estimate's mean over seeds is the closed form
-/// point(x) + integral of segment(x, u) du within 4 standard errors.
-#[test]
-fn the_estimator_model_is_unbiased_for_mixed_lights_after_merging() {
-    #[derive(Clone, Copy)]
-    struct Sample {
-        light: usize,
-        u: f64,
-    }
-    #[derive(Clone, Copy)]
-    struct Reservoir {
-        sample: Option<Sample>,
-        weight: f64,
-        m: f64,
-    }
-    let point = |x: f64| 0.5 + x;
-    let segment = |x: f64, u: f64| 3.0 * (u - x) * (u - x) + 0.1;
-    let target = |x: f64, s: Sample| {
-        if s.light == 0 {
-            point(x)
-        } else {
-            segment(x, s.u)
-        }
-    };
-    let p_select = [0.3, 0.7];
-    let exact = |x: f64| point(x) + (1.0 - x).powi(3) + x.powi(3) + 0.1;
-    let ris = |x: f64, m: usize, rng: &mut Rng| {
-        let (mut kept, mut w_sum) = (None, 0.0);
-        for _ in 0..m {
-            let light = usize::from(rng.next_f32() >= 0.3);
-            let s = Sample {
-                light,
-                u: f64::from(rng.next_f32()),
-            };
-            let w = target(x, s) / p_select[light];
-            w_sum += w;
-            if f64::from(rng.next_f32()) * w_sum < w {
-                kept = Some(s);
-            }
-        }
-        let weight = kept.map_or(0.0, |s| w_sum / (m as f64 * target(x, s)));
-        Reservoir {
-            sample: kept,
-            weight,
-            m: m as f64,
-        }
-    };
-    let surfaces = [0.2, 0.35, 0.6];
-    let counts = [4, 1, 8];
-    let runs = 20_000;
-    let (mut sum, mut sum_sq) = (0.0, 0.0);
-    let mut rng = Rng::new(7);
-    for _ in 0..runs {
-        let reservoirs: Vec<Reservoir> = surfaces
-            .iter()
-            .zip(counts)
-            .map(|(&x, m)| ris(x, m, &mut rng))
-            .collect();
-        let here = surfaces[0];
-        let (mut kept, mut w_sum) = (None, 0.0);
-        for (i, r) in reservoirs.iter().enumerate() {
-            let Some(s) = r.sample else { continue };
-            let all: f64 = surfaces
-                .iter()
-                .zip(&reservoirs)
-                .map(|(&x, q)| q.m * target(x, s))
-                .sum();
-            let w = r.m * target(surfaces[i], s) / all * target(here, s) * r.weight;
-            w_sum += w;
-            if f64::from(rng.next_f32()) * w_sum < w {
-                kept = Some(s);
-            }
-        }
-        // f(kept) W = target(here, kept) w_sum / target(here, kept).
-        let estimate = if kept.is_some() { w_sum } else { 0.0 };
-        sum += estimate;
-        sum_sq += estimate * estimate;
-    }
-    let mean = sum / f64::from(runs);
-    let error = ((sum_sq / f64::from(runs) - mean * mean) / f64::from(runs)).sqrt();
-    let want = exact(surfaces[0]);
-    assert!(
-        (mean - want).abs() < 4.0 * error,
-        "mean {mean:.5} ± {error:.5}, closed form {want:.5}"
-    );
-    assert!(
-        error < 0.01 * want,
-        "standard error {error:.5} too large to test"
-    );
 }
