@@ -10,7 +10,6 @@
 
 use std::path::{Path, PathBuf};
 use weft_compare::{rel_mse, LinearImage};
-use weft_scene::rng::Rng;
 use weft_tests::TempDir;
 
 const SIZE: u32 = 48;
