@@ -1,6 +1,8 @@
 #version 450
 // The radiance cache's update (graphs/radiance_cache.ron), one invocation a
-// slot: a live cell traces `rays` cosine-weighted rays from its point. Each
+// cell of the live list the sweep made (cache/sweep.comp; with a `budget`
+// below the live cells, a share of the list, a different one each frame):
+// the cell traces `rays` cosine-weighted rays from its point. Each
 // brings back the sky where it escapes; where it meets a surface, the direct
 // light that surface reflects (the path tracer's next-event estimation, one
 // shadow ray) plus its diffuse albedo times the radiance the cache holds
@@ -10,8 +12,6 @@
 // the lighting pass's direct light. The mean joins the cell's radiance, a
 // running mean over at most `frames` updates (older ones fade out). A cell
 // whose rays meet a placement that moved since the last frame starts again.
-// A cell nothing asked for in `life` frames is freed. On a new plan's
-// first frame the images hold nothing defined: this pass empties them.
 #include "../include/brdf.glsl"
 #include "../include/gbuffer.glsl"
 #include "../include/running_mean.glsl"
@@ -27,19 +27,22 @@
 #include "../pathtrace/lights.glsl"
 #include "../pathtrace/next_event.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+#include "live.glsl"
+
+layout(local_size_x = 64) in;  // CACHE_UPDATE_GROUP
 layout(set = 0, binding = 0, r32ui) uniform uimage2D cache_keys;
 layout(set = 0, binding = 1, rgba32f) uniform image2D cache_point;
 layout(set = 0, binding = 2, r32ui) uniform uimage2D cache_life;
 layout(set = 0, binding = 3, rgba32f) uniform image2D cache_radiance;
+layout(std430, set = 0, binding = 4) readonly buffer CacheLive { CACHE_LIVE_MEMBERS } cache_live;
 
 layout(push_constant) uniform Params {
     uint rays;
     uint frames;
     float cell_scale;
     uint life;
+    uint budget;
     uint frame;
-    uint plan_frames;
 } params;
 
 #define CACHE_MAKES_CELLS
@@ -59,26 +62,13 @@ bool moved(uint draw) {
 }
 
 void main() {
-    ivec2 at = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(at, imageSize(cache_keys)))) {
+    uint count = cache_live.count;
+    uint listed = params.budget > 0u ? min(count, params.budget) : count;
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= listed) {
         return;
     }
-    // New images (a new plan or scene) hold nothing defined: empty them.
-    if (params.plan_frames == 0u) {
-        imageStore(cache_keys, at, uvec4(0u));
-        imageStore(cache_life, at, uvec4(0u));
-        imageStore(cache_radiance, at, vec4(0.0));
-        return;
-    }
-    if (imageLoad(cache_keys, at).x == 0u) {
-        return;
-    }
-    uint life = imageLoad(cache_life, at).x;
-    if (life == 0u) {
-        imageStore(cache_keys, at, uvec4(0u));
-        return;
-    }
-    imageStore(cache_life, at, uvec4(life - 1u));
+    ivec2 at = cache_texel(cache_live.slots[listed < count ? (params.frame * listed + i) % count : i]);
     vec4 point = imageLoad(cache_point, at);
     vec3 p = point.xyz;
     vec3 n = unpack_normal(point.w);

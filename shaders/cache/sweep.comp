@@ -1,0 +1,51 @@
+#version 450
+// The radiance cache's sweep (graphs/radiance_cache.ron), one invocation a
+// slot, before the update: a cell nothing asked for in `life` frames is
+// freed, every other live cell loses a frame of life and joins `cache_live`,
+// the list the update traces from (an indirect dispatch: one invocation per
+// listed cell, not per slot, so no SIMD lane idles beside one that traces).
+// On a new plan's first frame the images hold nothing defined: this pass
+// empties them.
+#include "live.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0, r32ui) uniform uimage2D cache_keys;
+layout(set = 0, binding = 1, r32ui) uniform uimage2D cache_life;
+layout(set = 0, binding = 2, rgba32f) uniform image2D cache_radiance;
+layout(std430, set = 0, binding = 3) buffer CacheLive { CACHE_LIVE_MEMBERS } cache_live;
+
+layout(push_constant) uniform Params {
+    uint budget;
+    uint plan_frames;
+} params;
+
+void main() {
+    ivec2 at = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = imageSize(cache_keys);
+    if (any(greaterThanEqual(at, size))) {
+        return;
+    }
+    if (params.plan_frames == 0u) {
+        imageStore(cache_keys, at, uvec4(0u));
+        imageStore(cache_life, at, uvec4(0u));
+        imageStore(cache_radiance, at, vec4(0.0));
+        return;
+    }
+    if (imageLoad(cache_keys, at).x == 0u) {
+        return;
+    }
+    uint life = imageLoad(cache_life, at).x;
+    if (life == 0u) {
+        imageStore(cache_keys, at, uvec4(0u));
+        return;
+    }
+    imageStore(cache_life, at, uvec4(life - 1u));
+    uint index = atomicAdd(cache_live.count, 1u);
+    cache_live.slots[index] = uint(at.y * size.x + at.x);
+    // The update's groups: enough for the listed cells, at most the budget's.
+    uint groups = index / CACHE_UPDATE_GROUP + 1u;
+    if (params.budget > 0u) {
+        groups = min(groups, (params.budget + CACHE_UPDATE_GROUP - 1u) / CACHE_UPDATE_GROUP);
+    }
+    atomicMax(cache_live.groups_x, groups);
+}
