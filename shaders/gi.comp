@@ -88,8 +88,7 @@ void main() {
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
 #ifdef HAS_CACHE_RADIANCE
-        uint draw;
-        sum += cached_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng, draw);
+        sum += cached_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng);
 #else
         sum += one_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng);
 #endif

@@ -12,11 +12,7 @@
 // diffuse albedo times the cache's radiance there, so every bounce the
 // cache has gathered counts. As one_bounce, nothing from a light's panel or
 // a surface's own emission: that is the lighting pass's direct light.
-// `draw` is the placement it met (CACHE_NO_DRAW for none).
-const uint CACHE_NO_DRAW = 0xffffffffu;
-
-vec3 cached_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng, out uint draw) {
-    draw = CACHE_NO_DRAW;
+vec3 cached_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng) {
     vec2 found = trace_closest(origin, dir, 1e30);
     float t = found.x < 0.0 ? 1e30 : found.x;
     if (hit_area_light(origin, dir, t) >= 0) {
@@ -31,7 +27,6 @@ vec3 cached_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng, out uint d
     vec3 n;
     facing_normals(s, m, dir, ng, n);
     Bsdf b = surface_bsdf(s, m);
-    draw = s.draw;
     vec3 direct = next_event(s.position, n, ng, -dir, b, leave(s.position, ng), choice, rng);
     return direct + b.diffuse * cache_at_hit(s.position, n);
 }

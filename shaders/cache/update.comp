@@ -10,8 +10,8 @@
 // of every bounce accumulates over frames for the price of one. A ray that
 // meets a light's panel brings nothing, and emission is left out: that is
 // the lighting pass's direct light. The mean joins the cell's radiance, a
-// running mean over at most `frames` updates (older ones fade out). A cell
-// whose rays meet a placement that moved since the last frame starts again.
+// running mean over at most `frames` updates (older ones fade out), or
+// starts again where the sweep emptied it (something it sees moved).
 #include "../include/brdf.glsl"
 #include "../include/gbuffer.glsl"
 #include "../include/running_mean.glsl"
@@ -55,12 +55,6 @@ vec3 cache_at_hit(vec3 p, vec3 n) {
 }
 #include "bounce.glsl"
 
-// Whether placement `draw` moved since the last frame.
-bool moved(uint draw) {
-    mat4 m = draws[draw].previous;
-    return m != mat4(1.0);
-}
-
 void main() {
     uint count = cache_live.count;
     uint listed = params.budget > 0u ? min(count, params.budget) : count;
@@ -77,14 +71,11 @@ void main() {
     float step = leave_distance(p);
     Rng rng = rng_start(uvec2(at), params.frame, 0x5bd1e995u);
     vec3 sum = vec3(0.0);
-    bool restart = false;
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
-        uint draw;
-        sum += cached_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng, draw);
-        restart = restart || (draw != CACHE_NO_DRAW && moved(draw));
+        sum += cached_bounce(origin + dir * step, dir, LIGHT_CHOICE, rng);
     }
     vec3 radiance = sum / float(max(params.rays, 1u));
     vec4 kept = imageLoad(cache_radiance, at);
-    imageStore(cache_radiance, at, running_mean(kept, radiance, params.frames, !restart && kept.a > 0.0));
+    imageStore(cache_radiance, at, running_mean(kept, radiance, params.frames, kept.a > 0.0));
 }

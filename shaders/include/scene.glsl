@@ -76,6 +76,9 @@ layout(set = SET_SCENE, binding = BINDING_FRAME) uniform Frame {
     mat4 prev_view_proj;   // unjittered view_proj of the frame before (the same on a scene's first)
     mat4 unjittered_view_proj;  // view_proj without this frame's jitter: the history's pixel grid
     vec4 jitter;           // xy: this frame's sub-pixel jitter in pixels (0: none)
+    uvec4 moved;           // x: boxes in moved_lo/hi (gpu_types.rs, moved_boxes)
+    vec4 moved_lo[8];      // where what moved since the last frame was and is now: smallest corners
+    vec4 moved_hi[8];      // and largest
 } frame;
 
 layout(std430, set = SET_SCENE, binding = BINDING_LIGHTS) readonly buffer Lights { Light lights[]; };

@@ -108,6 +108,48 @@ pub struct GpuFrame {
     /// xy: this frame's sub-pixel jitter of `view_proj` in pixels (0 when
     /// the plan does not jitter), zw: 0.
     pub jitter: Vec4,
+    /// x: how many of `moved_lo`/`moved_hi` hold boxes ([`moved_boxes`]).
+    pub moved: UVec4,
+    /// The smallest corners of the world boxes where what moved since the
+    /// last frame was and is now, w 0.
+    pub moved_lo: [Vec4; MAX_MOVED_BOXES],
+    /// Their largest corners, w 0.
+    pub moved_hi: [Vec4; MAX_MOVED_BOXES],
+}
+
+/// The most boxes of moved placements and panels the `Frame` block holds;
+/// more are merged into the last.
+pub const MAX_MOVED_BOXES: usize = 8;
+
+/// The `Frame` block's moved boxes (`moved`, `moved_lo`, `moved_hi`) for the
+/// world boxes where placements and area-light panels that moved since the
+/// last frame were and are now: the radiance cache restarts cells whose
+/// rays cross one (shaders/cache/update.comp). Boxes past the
+/// [`MAX_MOVED_BOXES`]th are merged into the last, which can only restart
+/// more cells, never fewer.
+pub fn moved_boxes(
+    boxes: &[weft_scene::Aabb],
+) -> (UVec4, [Vec4; MAX_MOVED_BOXES], [Vec4; MAX_MOVED_BOXES]) {
+    let mut lo = [Vec4::ZERO; MAX_MOVED_BOXES];
+    let mut hi = [Vec4::ZERO; MAX_MOVED_BOXES];
+    let mut count = 0;
+    for b in boxes.iter().filter(|b| !b.is_empty()) {
+        if count < MAX_MOVED_BOXES {
+            count += 1;
+        } else {
+            let last = weft_scene::Aabb {
+                min: lo[count - 1].truncate(),
+                max: hi[count - 1].truncate(),
+            };
+            let merged = last.union(b);
+            lo[count - 1] = merged.min.extend(0.0);
+            hi[count - 1] = merged.max.extend(0.0);
+            continue;
+        }
+        lo[count - 1] = b.min.extend(0.0);
+        hi[count - 1] = b.max.extend(0.0);
+    }
+    (UVec4::new(count as u32, 0, 0, 0), lo, hi)
 }
 
 /// The head of the `Shadows` buffer, before the views.
@@ -148,7 +190,7 @@ const _: () = {
     assert!(size_of::<GpuDraw>() == 224);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMaterial>() == 128);
-    assert!(size_of::<GpuFrame>() == 4 * 64 + 6 * 16);
+    assert!(size_of::<GpuFrame>() == 4 * 64 + (7 + 2 * MAX_MOVED_BOXES) * 16);
     assert!(size_of::<GpuShadowsHeader>() == 64);
     assert!(size_of::<GpuShadowView>() == 176);
 };

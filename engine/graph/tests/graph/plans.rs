@@ -245,6 +245,8 @@ fn scene_features_cull_passes_and_variants() {
             ("show_light_count", "enabled_if [light_count] is false"),
             ("rt_ao", "enabled_if [rt_ao] is false"),
             ("gi", "enabled_if [gi] is false"),
+            ("cache_reset", "enabled_if [radiance_cache] is false"),
+            ("cache_sweep", "enabled_if [radiance_cache] is false"),
             ("cache_update", "enabled_if [radiance_cache] is false"),
             ("cache_lookup", "enabled_if [radiance_cache] is false"),
             (

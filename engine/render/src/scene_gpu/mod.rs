@@ -454,6 +454,12 @@ impl<'g> GpuScene<'g> {
         let mut lights = pack_lights(at.lights, &bounds);
         lights.add_emitter_polygons(&self.emitter_lights.records());
         let shown_view_proj = crate::jitter::jittered(view_proj, jitter, glam::Vec2::new(w, h));
+        let changed = changed_records(&self.light_set.records, &lights.records);
+        if let Some(changed) = changed.clone() {
+            let panels = moved_panels(&self.light_set.records, &lights.records, changed);
+            self.moved_boxes.extend(panels);
+        }
+        let (moved, moved_lo, moved_hi) = crate::gpu_types::moved_boxes(&self.moved_boxes);
         let frame = GpuFrame {
             view_proj: shown_view_proj,
             inv_view_proj: shown_view_proj.inverse(),
@@ -470,11 +476,12 @@ impl<'g> GpuScene<'g> {
             prev_view_proj,
             unjittered_view_proj: view_proj,
             jitter: jitter.extend(0.0).extend(0.0),
+            moved,
+            moved_lo,
+            moved_hi,
         };
         self.frame.write(bytes_of(&[frame]))?;
-        if let Some(changed) = changed_records(&self.light_set.records, &lights.records) {
-            let panels = moved_panels(&self.light_set.records, &lights.records, changed.clone());
-            self.moved_boxes.extend(panels);
+        if let Some(changed) = changed {
             let offset = changed.start * std::mem::size_of::<GpuLight>();
             self.lights
                 .write_at(offset, bytes_of(&lights.records[changed]))?;
@@ -491,6 +498,9 @@ impl<'g> GpuScene<'g> {
             inv_view_proj: glam::Mat4::ZERO,
             prev_view_proj: view_proj,
             jitter: glam::Vec4::ZERO,
+            moved: glam::UVec4::ZERO,
+            moved_lo: Default::default(),
+            moved_hi: Default::default(),
             ..frame
         };
         std::hash::Hash::hash(bytes_of(&[shown]), &mut inputs);
