@@ -88,7 +88,7 @@ fn plan_json_has_stats() {
     assert!(aliased < unaliased, "{aliased} < {unaliased}");
     assert!(stats["compile_us"].as_f64().expect("time") > 0.0);
     assert_eq!(json["extent"]["width"], 1920);
-    assert_eq!(json["culled"][38]["name"], "spot_lights");
+    assert_eq!(json["culled"][40]["name"], "spot_lights");
 }
 
 #[test]
