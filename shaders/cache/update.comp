@@ -62,7 +62,12 @@ void main() {
     if (i >= listed) {
         return;
     }
-    ivec2 at = cache_texel(cache_live.slots[listed < count ? (params.frame * listed + i) % count : i]);
+    // Under a budget, frame k takes the k-th run of `listed` cells of the
+    // list, in turn (the list's order is the sweep's, so each frame's run
+    // is a different share; no product here passes the list's length).
+    uint rounds = (count + listed - 1u) / listed;
+    uint start = (params.frame % rounds) * listed;
+    ivec2 at = cache_texel(cache_live.slots[(start + i) % count]);
     vec4 point = imageLoad(cache_point, at);
     vec3 p = point.xyz;
     vec3 n = unpack_normal(point.w);

@@ -5,7 +5,10 @@
 //! to radiance rho E / (pi (1 - rho)): the image with the cache is the
 //! direct-only image times 1 / (1 - rho), which the cache reaches within 1%
 //! once its bounces have accumulated (160 frames; 1.6% short at 64, as each
-//! frame adds a bounce and a cell averages its last 16 updates).
+//! frame adds a bounce and a cell averages its last 16 updates). A block
+//! moved away takes its bounce light with it at once (the sweep empties the
+//! cells that see where it was), and `budget` bounds the cells updated a
+//! frame exactly.
 
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
@@ -211,4 +214,39 @@ fn a_block_moved_away_empties_the_cells_that_saw_it() {
         (after - never).abs() < 0.1 * (with_block - never),
         "{report}"
     );
+}
+
+/// `budget` bounds the cells updated a frame: inside the closed furnace
+/// sphere every update ray meets the sphere and makes one shadow ray towards
+/// the light at its centre, so the update traces exactly 2 rays a cell
+/// (`rays` 1), 2 x 16 with a budget of 16, more without one.
+#[test]
+fn a_budget_bounds_the_cells_updated_a_frame() {
+    let dir = TempDir::new("cache-budget");
+    let scene = furnace(&dir.0);
+    let update_rays = |budget: f64| {
+        let params = [
+            ("radiance_cache.cells", 64.0),
+            ("cache_cell_scale", 0.2),
+            ("radiance_cache.budget", budget),
+        ];
+        let mut settings = weft_tests::render::square_settings_without_bloom(
+            "deferred.ron",
+            SIZE,
+            None,
+            &params,
+            &["radiance_cache"],
+        );
+        settings.frames = 8;
+        settings.frame_time = 0.0;
+        let (rendered, _) = weft_tests::render::render_hdr_validated(&scene, settings);
+        let last = rendered.rays.last().expect("frames");
+        last.iter()
+            .find(|r| r.pass == "cache_update")
+            .expect("the update traces")
+            .rays
+    };
+    let (all, budgeted) = (update_rays(0.0), update_rays(16.0));
+    assert_eq!(budgeted, 2 * 16, "every cell: {all}");
+    assert!(all > 2 * 16 && all % 2 == 0, "{all}");
 }
