@@ -5,8 +5,10 @@
 #ifndef WEFT_CACHE_LIVE_GLSL
 #define WEFT_CACHE_LIVE_GLSL
 
-// Invocations in one of the update's work groups (its local_size_x).
-#define CACHE_UPDATE_GROUP 64u
+// Invocations in one of the update's work groups (its local_size_x): 128,
+// so the most cells (2048 x 2048) need 32,768 groups, within every
+// device's 65,535.
+#define CACHE_UPDATE_GROUP 128u
 
 // The members of the buffer block each pass declares `cache_live` with.
 #define CACHE_LIVE_MEMBERS \

@@ -5,8 +5,9 @@
 // the list the update traces from (an indirect dispatch: one invocation per
 // listed cell, not per slot, so no SIMD lane idles beside one that traces).
 // A live cell that sees where something moved since the last frame is
-// emptied (its count 0: lookups pass it over, the update starts it again),
-// whichever frame the update's budget reaches it.
+// emptied (black, its count 0: lookups pass it over, rays that meet it
+// bring nothing back from it, the update starts it again), whichever frame
+// the update's budget reaches it.
 // On a new plan's first frame the images hold nothing defined: this pass
 // empties them.
 #include "../include/scene.glsl"
@@ -70,7 +71,7 @@ void main() {
     imageStore(cache_life, at, uvec4(life - 1u));
     vec4 point = imageLoad(cache_point, at);
     if (sees_moved(point.xyz, unpack_normal(point.w))) {
-        imageStore(cache_radiance, at, vec4(imageLoad(cache_radiance, at).rgb, 0.0));
+        imageStore(cache_radiance, at, vec4(0.0));
     }
     uint index = atomicAdd(cache_live.count, 1u);
     cache_live.slots[index] = uint(at.y * size.x + at.x);

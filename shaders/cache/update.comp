@@ -29,7 +29,7 @@
 
 #include "live.glsl"
 
-layout(local_size_x = 64) in;  // CACHE_UPDATE_GROUP
+layout(local_size_x = 128) in;  // CACHE_UPDATE_GROUP
 layout(set = 0, binding = 0, r32ui) uniform uimage2D cache_keys;
 layout(set = 0, binding = 1, rgba32f) uniform image2D cache_point;
 layout(set = 0, binding = 2, r32ui) uniform uimage2D cache_life;
@@ -62,9 +62,11 @@ void main() {
     if (i >= listed) {
         return;
     }
-    // Under a budget, frame k takes the k-th run of `listed` cells of the
-    // list, in turn (the list's order is the sweep's, so each frame's run
-    // is a different share; no product here passes the list's length).
+    // Under a budget, frame k takes the (k mod rounds)-th run of `listed`
+    // cells of the list. The sweep lists the cells in a different order
+    // each frame, so a run is a different share, and a cell is updated once
+    // in `rounds` frames on average, not on a fixed turn (no product here
+    // passes the list's length).
     uint rounds = (count + listed - 1u) / listed;
     uint start = (params.frame % rounds) * listed;
     ivec2 at = cache_texel(cache_live.slots[(start + i) % count]);

@@ -26,7 +26,7 @@ float found_weight(bool counted_fully, float bsdf_pdf, float light_pdf) {
     return params.sampling == SAMPLING_NEE ? 0.0 : power_heuristic(bsdf_pdf, light_pdf);
 }
 
-// Under HAS_RESTIR_DIRECT (graphs/pathtrace_denoised.ron with `restir_di`)
+// Under HAS_RESTIR_DIRECT (graphs/path_tracer.ron's feature `restir_di`)
 // the light that reaches the first surface straight from a light is ReSTIR's
 // (trace.comp adds `restir_direct`): the path makes no next-event estimate
 // there, and light its BSDF-sampled ray from there finds counts only through

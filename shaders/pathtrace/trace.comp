@@ -90,9 +90,10 @@ layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D hdr;
 layout(set = 0, binding = 1, rgba32f) uniform writeonly image2D hdr;
 #endif
 #ifdef HAS_RESTIR_DIRECT
-// Under `restir_di` (graphs/pathtrace_denoised.ron): the direct light at each
-// pixel's first surface, by ReSTIR (graphs/restir_di.ron); the paths leave
-// it out (path.glsl, direct_from_restir) and each sample adds it.
+// Under `restir_di` (graphs/path_tracer.ron's feature): the direct light at
+// each pixel's first surface, by ReSTIR (graphs/restir_di.ron) at the
+// pixel's centre; the paths leave it out (path.glsl, direct_from_restir)
+// and each sample adds it.
 layout(set = 0, binding = 3, rgba16f) uniform readonly image2D restir_direct;
 #endif
 
@@ -205,7 +206,11 @@ void main() {
     bool with_previous = (params.history_frames > 0u && params.accumulate != 0u) || params.repeat_index > 0u;
     Path p = path(eye, dir, rng);
 #ifdef HAS_RESTIR_DIRECT
-    p.radiance += imageLoad(restir_direct, pixel).rgb;
+    // The share of the surface that is not glass (alpha) is lit so: the
+    // path refracts through the rest and makes no estimate there. At
+    // max_depth 1 the path only looks, so nothing is lit.
+    vec4 restir = imageLoad(restir_direct, pixel);
+    p.radiance += params.max_depth > 1u ? restir.rgb * restir.a : vec3(0.0);
 #endif
 #ifdef SPLIT_LOBES
     // `hdr` gets the diffuse part, `hdr_specular` the specular part.

@@ -149,7 +149,7 @@ void main() {
 #ifdef HAS_RESTIR_DIRECT
     // Shaded by the kept sample; kept for the next frame with weight 0 where
     // it is occluded, so temporal reuse does not carry it on.
-    imageStore(restir_direct, pixel, vec4(hdr_output(sp.opaque * shade_kept(sp, merged)), 1.0));
+    imageStore(restir_direct, pixel, vec4(hdr_output(shade_kept(sp, merged)), sp.opaque));
     imageStore(restir_surface, pixel, vec4(sp.position, pack_normal(sp.n)));
 #endif
     imageStore(restir_sample, pixel, merged.u);

@@ -23,7 +23,7 @@ struct ShadingPoint {
     vec3 from;   // where its rays leave
     Bsdf bsdf;
     uint draw;   // the placement it belongs to (Draw.previous)
-    float opaque; // the share of the surface that is not glass, whose light the estimate is
+    float opaque; // the share of the surface that is not glass (restir_direct's alpha)
 };
 
 // The surface at distance t along the eye's ray `dir`, triangle `tri`, its

@@ -135,7 +135,7 @@ void main() {
     reservoir_add(merged, own.light, own.u, own.target, own_share * own.target * own.weight, own.m, rng_next(rng).x);
     reservoir_finish(merged, 1.0);
 
-    imageStore(restir_direct, pixel, vec4(hdr_output(sp.opaque * shade_kept(sp, merged)), 1.0));
+    imageStore(restir_direct, pixel, vec4(hdr_output(shade_kept(sp, merged)), sp.opaque));
     imageStore(restir_sample_prev, pixel, merged.u);
     // The next frame trusts it as much as this pixel's own candidates: the
     // neighbours' stand for surfaces that are not this one, and counting

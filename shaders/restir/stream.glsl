@@ -2,7 +2,7 @@
 // importance sampling streamed one candidate at a time): what
 // restir/reservoir.glsl evaluates at surfaces, and what the test fixture
 // tests/shaders/reservoir_model.comp runs against a CPU model of the
-// estimator on the same random numbers (tests/e2e/restir.rs).
+// estimator on the same random numbers (tests/e2e/restir_model.rs).
 #ifndef WEFT_RESTIR_STREAM_GLSL
 #define WEFT_RESTIR_STREAM_GLSL
 

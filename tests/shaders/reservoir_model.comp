@@ -1,5 +1,5 @@
 #version 450
-// Test fixture: the estimator tests/e2e/restir.rs models on the CPU, run
+// Test fixture: the estimator tests/e2e/restir_model.rs models on the CPU, run
 // through the engine's reservoirs (shaders/restir/stream.glsl). A point light
 // (target 0.5 + x) and a segment light (a point u in [0, 1), target
 // 3 (u - x)^2 + 0.1), picked with probability 0.3 and 0.7. Surfaces

@@ -123,8 +123,8 @@ pub const MAX_MOVED_BOXES: usize = 8;
 
 /// The `Frame` block's moved boxes (`moved`, `moved_lo`, `moved_hi`) for the
 /// world boxes where placements and area-light panels that moved since the
-/// last frame were and are now: the radiance cache restarts cells whose
-/// rays cross one (shaders/cache/update.comp). Boxes past the
+/// last frame were and are now: the radiance cache's sweep empties the cells
+/// that see one (shaders/cache/sweep.comp). Boxes past the
 /// [`MAX_MOVED_BOXES`]th are merged into the last, which can only restart
 /// more cells, never fewer.
 pub fn moved_boxes(
