@@ -86,8 +86,10 @@ layout(set = SET_SCENE, binding = BINDING_TRIANGLE_TANGENTS) uniform usamplerBuf
 // by the macro below) returns: an atomic per walk cost the path tracer 6% on
 // lavapipe. A compute shader adds its subgroup's sum in one atomic; a
 // fragment shader adds per lane, as its helper invocations take part in
-// subgroup sums but their atomics do nothing (an invocation that discards
-// after tracing adds nothing).
+// subgroup sums but their atomics do nothing (a ballot of the other lanes
+// would need gl_HelperInvocation, which lavapipe 22.3 cannot compile; the
+// per-lane atomics cost a forward pass with rt_shadows 6%). An invocation
+// that discards after tracing adds nothing.
 #if defined(RAY_COUNT_SLOT) && !defined(WEFT_VERTEX_SHADER)
 layout(std430, set = SET_SCENE, binding = BINDING_RAY_COUNTS) buffer RayCounts { uint ray_counts[]; };
 uint traced_rays = 0u;
