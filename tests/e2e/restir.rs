@@ -133,20 +133,29 @@ fn restir_is_the_path_tracers_direct_light_and_biased_spatial_reuse_a_little_dar
         &render(&cornell, "deferred.ron", 8, &[], &[]),
     );
     let lights_temporal = mean_ratio(&lights_truth, &render(&lights, "deferred.ron", 8, &[], &[]));
-    let lights_unbiased = mean_ratio(
-        &lights_truth,
-        &render(
-            &lights,
-            "deferred.ron",
-            8,
-            &[("restir_di.unbiased", 1.0)],
-            &["restir_spatial"],
-        ),
-    );
+    // Spatial reuse under 400 lights is noisy from frame to frame (the mean
+    // ratio spans 0.971-1.025 over frames 4 to 16): the mean of four frames.
+    let lights_unbiased = [6, 8, 10, 12]
+        .iter()
+        .map(|&frames| {
+            let params = [("restir_di.unbiased", 1.0)];
+            mean_ratio(
+                &lights_truth,
+                &render(
+                    &lights,
+                    "deferred.ron",
+                    frames,
+                    &params,
+                    &["restir_spatial"],
+                ),
+            )
+        })
+        .sum::<f64>()
+        / 4.0;
     let (unbiased, biased) = (spatial(1.0), spatial(0.0));
     let report = format!(
         "mean over the reference's: Cornell box, temporal reuse {temporal:.4}, spatial unbiased \
-         {unbiased:.4}, spatial biased {biased:.4}; 400 point lights against the deferred graph's sum, temporal {lights_temporal:.4}, spatial unbiased {lights_unbiased:.4}"
+         {unbiased:.4}, spatial biased {biased:.4}; 400 point lights against the deferred graph's sum, temporal {lights_temporal:.4}, spatial unbiased {lights_unbiased:.4} (frames 6, 8, 10, 12)"
     );
     println!("{report}");
     for ratio in [temporal, unbiased, lights_temporal, lights_unbiased] {
