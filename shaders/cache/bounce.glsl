@@ -13,22 +13,13 @@
 // cache has gathered counts. As one_bounce, nothing from a light's panel or
 // a surface's own emission: that is the lighting pass's direct light.
 vec3 cached_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng) {
-    vec2 found = trace_closest(origin, dir, 1e30);
-    float t = found.x < 0.0 ? 1e30 : found.x;
-    if (hit_area_light(origin, dir, t) >= 0) {
-        return vec3(0.0);
+    vec3 escaped;
+    BounceHit hit;
+    if (!bounce_hit(origin, dir, escaped, hit)) {
+        return escaped;
     }
-    if (found.x < 0.0) {
-        return frame.ambient.rgb;
-    }
-    TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
-    Material m = material_record(s.material);
-    vec3 ng;
-    vec3 n;
-    facing_normals(s, m, dir, ng, n);
-    Bsdf b = surface_bsdf(s, m);
-    vec3 direct = next_event(s.position, n, ng, -dir, b, leave(s.position, ng), choice, rng);
-    return direct + b.diffuse * cache_at_hit(s.position, n);
+    vec3 direct = next_event(hit.position, hit.n, hit.ng, -dir, hit.b, leave(hit.position, hit.ng), choice, rng);
+    return direct + hit.b.diffuse * cache_at_hit(hit.position, hit.n);
 }
 
 #endif

@@ -29,6 +29,35 @@ vec3 next_event(vec3 position, vec3 n, vec3 ng, vec3 wo, Bsdf b, vec3 from, uint
     return lit ? f * ls.value : vec3(0.0);
 }
 
+// The surface a bounce ray met: the point, its normals facing the ray
+// (facing_normals) and its BSDF.
+struct BounceHit {
+    vec3 position;
+    vec3 n;
+    vec3 ng;
+    Bsdf b;
+};
+
+// Where a bounce ray from `origin` along `dir` goes, for one_bounce and
+// cache/bounce.glsl's cached_bounce: false, with the light it brings in
+// `escaped`, where it meets a light with area (nothing: the raster passes
+// draw that light) or leaves the scene (the suns' ambient sky); true where
+// it meets a surface, described in `hit`.
+bool bounce_hit(vec3 origin, vec3 dir, out vec3 escaped, out BounceHit hit) {
+    vec2 found = trace_closest(origin, dir, 1e30);
+    float t = found.x < 0.0 ? 1e30 : found.x;
+    escaped = found.x < 0.0 ? frame.ambient.rgb : vec3(0.0);
+    if (hit_area_light(origin, dir, t) >= 0 || found.x < 0.0) {
+        return false;
+    }
+    TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
+    Material m = material_record(s.material);
+    facing_normals(s, m, dir, hit.ng, hit.n);
+    hit.position = s.position;
+    hit.b = surface_bsdf(s, m);
+    return true;
+}
+
 // The radiance a ray from `origin` along `dir` brings back after at most one
 // bounce, for the raster graphs' traced rungs (gi.comp, rt_specular.comp's
 // glossy lobes), whose lighting passes draw the lights themselves: the
@@ -39,30 +68,21 @@ vec3 next_event(vec3 position, vec3 n, vec3 ng, vec3 wo, Bsdf b, vec3 from, uint
 // brings nothing, and a surface's own emission is left out: that light is
 // the raster passes' direct light.
 vec3 one_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng) {
-    vec2 found = trace_closest(origin, dir, 1e30);
-    float t = found.x < 0.0 ? 1e30 : found.x;
-    if (hit_area_light(origin, dir, t) >= 0) {
-        return vec3(0.0);
+    vec3 escaped;
+    BounceHit hit;
+    if (!bounce_hit(origin, dir, escaped, hit)) {
+        return escaped;
     }
-    if (found.x < 0.0) {
-        return frame.ambient.rgb;
-    }
-    TraceSurface s = trace_surface(floatBitsToUint(found.y), origin, dir, t);
-    Material m = material_record(s.material);
     vec3 wo = -dir;
-    vec3 ng;
-    vec3 n;
-    facing_normals(s, m, dir, ng, n);
-    Bsdf b = surface_bsdf(s, m);
-    vec3 from = leave(s.position, ng);
-    vec3 radiance = next_event(s.position, n, ng, wo, b, from, choice, rng);
+    vec3 from = leave(hit.position, hit.ng);
+    vec3 radiance = next_event(hit.position, hit.n, hit.ng, wo, hit.b, from, choice, rng);
     if (any(greaterThan(frame.ambient.rgb, vec3(0.0)))) {
         vec3 wi;
         vec3 weight;
         float pdf;
         bool delta;
         float far = 1e30;
-        if (bsdf_sample(b, n, wo, rng_next(rng).xyz, wi, weight, pdf, delta) && dot(wi, ng) > 0.0
+        if (bsdf_sample(hit.b, hit.n, wo, rng_next(rng).xyz, wi, weight, pdf, delta) && dot(wi, hit.ng) > 0.0
             && hit_area_light(from, wi, far) < 0 && !trace_any(from, wi, far)) {
             radiance += weight * frame.ambient.rgb;
         }

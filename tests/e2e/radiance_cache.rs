@@ -67,21 +67,32 @@ fn furnace(dir: &Path) -> PathBuf {
     path
 }
 
+/// The deferred graph, bloom off, with `params` and `features`, for
+/// `frames` frames `frame_time` seconds apart.
+fn deferred(
+    params: &[(&str, f64)],
+    features: &[&str],
+    (frames, frame_time): (u32, f64),
+) -> weft_render::RenderSettings {
+    let mut settings = weft_tests::render::square_settings_without_bloom(
+        "deferred.ron",
+        SIZE,
+        None,
+        params,
+        features,
+    );
+    settings.frames = frames;
+    settings.frame_time = frame_time;
+    settings
+}
+
 fn render(scene: &Path, frames: u32, features: &[&str]) -> LinearImage {
     let params = [
         ("radiance_cache.cells", 64.0),
         ("cache_cell_scale", 0.2),
         ("radiance_cache.frames", 16.0),
     ];
-    let mut settings = weft_tests::render::square_settings_without_bloom(
-        "deferred.ron",
-        SIZE,
-        None,
-        &params,
-        features,
-    );
-    settings.frames = frames;
-    settings.frame_time = 0.0;
+    let settings = deferred(&params, features, (frames, 0.0));
     weft_tests::render::linear_image_validated(scene, settings, "hdr")
 }
 
@@ -187,15 +198,7 @@ fn a_block_moved_away_empties_the_cells_that_saw_it() {
             ("radiance_cache.frames", 64.0),
             ("cache_cell_scale", 0.2),
         ];
-        let mut settings = weft_tests::render::square_settings_without_bloom(
-            "deferred.ron",
-            SIZE,
-            None,
-            &params,
-            &["radiance_cache"],
-        );
-        settings.frames = count;
-        settings.frame_time = 1.0 / 60.0;
+        let settings = deferred(&params, &["radiance_cache"], (count, 1.0 / 60.0));
         red_over_green(&weft_tests::render::linear_image_validated(
             scene, settings, "hdr",
         ))
@@ -230,15 +233,7 @@ fn a_budget_bounds_the_cells_updated_a_frame() {
             ("cache_cell_scale", 0.2),
             ("radiance_cache.budget", budget),
         ];
-        let mut settings = weft_tests::render::square_settings_without_bloom(
-            "deferred.ron",
-            SIZE,
-            None,
-            &params,
-            &["radiance_cache"],
-        );
-        settings.frames = 8;
-        settings.frame_time = 0.0;
+        let settings = deferred(&params, &["radiance_cache"], (8, 0.0));
         let (rendered, _) = weft_tests::render::render_hdr_validated(&scene, settings);
         let last = rendered.rays.last().expect("frames");
         last.iter()

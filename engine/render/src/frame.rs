@@ -342,7 +342,7 @@ pub fn render_with_progress(
         frame_ms.push(started.elapsed().as_secs_f64() * 1e3);
         record_ms.push(report.record_ms);
         timings.push(report.timings.clone());
-        rays.push(frames.rays().to_vec());
+        rays.push(frames.rays()?);
         last = Some(report);
         progress(Progress {
             frames: frame + 1,

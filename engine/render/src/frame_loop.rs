@@ -30,8 +30,6 @@ pub struct FrameLoop<'g> {
     accumulation: Accumulation,
     /// Frames drawn on the current resources and scene (`plan_frames`).
     plan_frames: u32,
-    /// The rays each tracing pass traced in the last frame.
-    rays: Vec<PassRays>,
 }
 
 /// Counts the frames in a row that drew the same inputs, so history images
@@ -99,7 +97,6 @@ impl<'g> FrameLoop<'g> {
             plan,
             accumulation: Accumulation::default(),
             plan_frames: 0,
-            rays: Vec::new(),
         })
     }
 
@@ -149,14 +146,14 @@ impl<'g> FrameLoop<'g> {
                 &options,
             )
             .map_err(|e| RenderError::at_pass(e, &self.plan))?;
-        self.rays = self.recorder.scene.pass_rays(&self.plan)?;
         self.plan_frames = self.plan_frames.saturating_add(1);
         Ok(report)
     }
 
-    /// The rays each tracing pass traced in the last frame drawn.
-    pub fn rays(&self) -> &[PassRays] {
-        &self.rays
+    /// The rays each tracing pass traced in the last frame drawn (read from
+    /// the counters, which keep them until the next frame starts).
+    pub fn rays(&self) -> Result<Vec<PassRays>, RenderError> {
+        Ok(self.recorder.scene.pass_rays(&self.plan)?)
     }
 
     /// The scene script's error from `update`, if one failed since the last

@@ -134,20 +134,18 @@ pub fn moved_boxes(
     let mut hi = [Vec4::ZERO; MAX_MOVED_BOXES];
     let mut count = 0;
     for b in boxes.iter().filter(|b| !b.is_empty()) {
-        if count < MAX_MOVED_BOXES {
+        let (at, b) = if count < MAX_MOVED_BOXES {
             count += 1;
+            (count - 1, *b)
         } else {
             let last = weft_scene::Aabb {
                 min: lo[count - 1].truncate(),
                 max: hi[count - 1].truncate(),
             };
-            let merged = last.union(b);
-            lo[count - 1] = merged.min.extend(0.0);
-            hi[count - 1] = merged.max.extend(0.0);
-            continue;
-        }
-        lo[count - 1] = b.min.extend(0.0);
-        hi[count - 1] = b.max.extend(0.0);
+            (count - 1, last.union(b))
+        };
+        lo[at] = b.min.extend(0.0);
+        hi[at] = b.max.extend(0.0);
     }
     (UVec4::new(count as u32, 0, 0, 0), lo, hi)
 }
