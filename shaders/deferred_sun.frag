@@ -2,7 +2,7 @@
 // Deferred sun pass (fullscreen): ambient, emission, ray-traced specular
 // (under rt_specular) and every sun (or, under restir_di, ReSTIR's direct
 // light from every light) for each covered pixel; background
-// pixels stay black like forward's clear.
+// pixels show the environment map (black without one: camera_ray.glsl).
 layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
@@ -49,12 +49,12 @@ layout(location = 0) out vec4 color;
 void main() {
     Surface s;
     if (!read_surface(s)) {
-        color = vec4(0.0, 0.0, 0.0, 1.0);
+        color = vec4(hdr_output(background(gl_FragCoord.xy, frame.viewport.xy)), 1.0);
         return;
     }
     Material m = material_record(s.material);
     vec4 emission_occlusion = read_emission_occlusion();
-    vec3 ambient = shade_ambient_emissive(s, m, surroundings(), params.emissive_boost, emission_occlusion.rgb, emission_occlusion.a);
+    vec3 ambient = shade_ambient_emissive(s, m, surroundings(s.normal), params.emissive_boost, emission_occlusion.rgb, emission_occlusion.a);
 #ifdef HAS_RESTIR_DIRECT
     vec3 direct = texelFetch(restir_direct, ivec2(gl_FragCoord.xy), 0).rgb;
 #else

@@ -75,7 +75,7 @@ void main() {
 #endif
     // Emitters emit from their front only, as the path tracer's do.
     emission_texel *= gl_FrontFacing ? 1.0 : 0.0;
-    vec3 c = shade_ambient_emissive(s, m, frame.ambient.rgb, params.emissive_boost, emission_texel, occlusion)
+    vec3 c = shade_ambient_emissive(s, m, sky_irradiance(s.normal), params.emissive_boost, emission_texel, occlusion)
         + shade_all_lights(s, m, params.area_samples);
     // Alpha matters only where weft-render blends transparent materials.
     color = vec4(hdr_output(c), material_record(material).diffuse.a * texel.a);

@@ -89,7 +89,7 @@ vec3 chain(vec3 origin, vec3 dir, uint depth, vec3 medium, inout Rng rng) {
             break;
         }
         if (found.x < 0.0) {
-            radiance += throughput * frame.ambient.rgb;
+            radiance += throughput * sky_radiance(dir);
             break;
         }
         throughput *= exp(-medium * t);
@@ -136,7 +136,7 @@ vec3 chain(vec3 origin, vec3 dir, uint depth, vec3 medium, inout Rng rng) {
         if (!delta) {
             float far = 1e30;
             if (depth + 1u <= params.max_depth && hit_area_light(from, wi, far) < 0 && !trace_any(from, wi, far)) {
-                radiance += throughput * frame.ambient.rgb;
+                radiance += throughput * sky_radiance(wi);
             }
             break;
         }

@@ -4,7 +4,8 @@
 // tile by light_cull.comp (points and spots kept apart), each type in its own
 // loop through the same shade_point / shade_spot as forward and deferred
 // (under restir_di, ReSTIR's direct light from every light in place of
-// both); background pixels stay black like forward's clear.
+// both); background pixels show the environment map (black without one:
+// camera_ray.glsl).
 layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
@@ -62,12 +63,12 @@ layout(location = 0) out vec4 color;
 void main() {
     Surface s;
     if (!read_surface(s)) {
-        color = vec4(0.0, 0.0, 0.0, 1.0);
+        color = vec4(hdr_output(background(gl_FragCoord.xy, frame.viewport.xy)), 1.0);
         return;
     }
     Material m = material_record(s.material);
     vec4 emission_occlusion = read_emission_occlusion();
-    vec3 c = shade_ambient_emissive(s, m, surroundings(), pc.emissive_boost, emission_occlusion.rgb, emission_occlusion.a)
+    vec3 c = shade_ambient_emissive(s, m, surroundings(s.normal), pc.emissive_boost, emission_occlusion.rgb, emission_occlusion.a)
         + traced_specular();
 #ifdef HAS_RESTIR_DIRECT
     c += texelFetch(restir_direct, ivec2(gl_FragCoord.xy), 0).rgb;

@@ -13,6 +13,7 @@
 #define BINDING_LTC_TABLES             20 // the area-light LTC tables
 #define BINDING_VERTICES               21 // the vertices
 #define BINDING_INDICES                22 // the indices
+#define BINDING_ENVIRONMENT            25 // the environment map
 #define BINDING_TRIANGLES               5 // the ray tracer's triangles
 #define BINDING_BVH_NODES               6 // the BVH nodes
 #define BINDING_BVH_LEAF_TRIANGLES      7 // the BVH's leaf triangles
@@ -30,6 +31,7 @@
 #define BINDING_TRIANGLE_TANGENTS      19 // the corners' tangents
 #define BINDING_LIGHT_CHOICES          23 // the light choice table
 #define BINDING_RAY_COUNTS             24 // the per-pass ray counters
+#define BINDING_ENVIRONMENT_TABLE      26 // the environment's sampling table
 
 #define MATERIAL_BASE_COLOR             0 // the base-colour texture
 #define MATERIAL_METALLIC_ROUGHNESS     1 // the metallic-roughness texture

@@ -11,4 +11,11 @@ vec3 camera_ray(vec2 at, vec2 size) {
     return normalize(on_near.xyz / on_near.w - frame.camera_position.xyz);
 }
 
+// What the camera ray through `at` sees where it meets nothing: the
+// environment map (black without one; the suns' ambient is not seen from
+// the camera, as the path tracer's camera rays do not see it).
+vec3 background(vec2 at, vec2 size) {
+    return frame.environment_size.z != 0u ? environment_radiance(camera_ray(at, size)) : vec3(0.0);
+}
+
 #endif

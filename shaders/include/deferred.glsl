@@ -4,6 +4,7 @@
 #ifndef WEFT_DEFERRED_GLSL
 #define WEFT_DEFERRED_GLSL
 #include "gbuffer.glsl"
+#include "camera_ray.glsl"
 
 // The surface under this fragment; false for background pixels (depth 0).
 bool read_surface(out Surface s) {
@@ -41,17 +42,19 @@ vec4 read_emission_occlusion() {
 }
 
 // The radiance this fragment's surroundings send, as the ambient term takes
-// it: the suns' ambient sky, or what ray-traced one-bounce GI found (HAS_GI:
+// it at a surface facing `n`: the sky's irradiance over pi (the suns'
+// ambient and the environment map's, environment.glsl), or what ray-traced
+// one-bounce GI found (HAS_GI:
 // graphs/gi.ron, the includer declaring `gi`), or the world-space radiance
 // cache's cell (HAS_CACHE_AMBIENT: graphs/radiance_cache.ron, the includer
 // declaring `cache_ambient`).
-vec3 surroundings() {
+vec3 surroundings(vec3 n) {
 #ifdef HAS_GI
     return texelFetch(gi, ivec2(gl_FragCoord.xy), 0).rgb;
 #elif defined(HAS_CACHE_AMBIENT)
     return texelFetch(cache_ambient, ivec2(gl_FragCoord.xy), 0).rgb;
 #else
-    return frame.ambient.rgb;
+    return sky_irradiance(n);
 #endif
 }
 

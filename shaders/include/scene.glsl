@@ -79,6 +79,9 @@ layout(set = SET_SCENE, binding = BINDING_FRAME) uniform Frame {
     uvec4 moved;           // x: boxes in moved_lo/hi (gpu_types.rs, moved_boxes)
     vec4 moved_lo[8];      // where what moved since the last frame was and is now: smallest corners
     vec4 moved_hi[8];      // and largest
+    vec4 environment;      // the environment map: intensity, cos and sin of its turn about +y, 1 when sampled
+    uvec4 environment_size;  // its width, height, 1 when the scene has one
+    vec4 environment_sh[9];  // its irradiance over pi, nine SH coefficients (environment.glsl)
 } frame;
 
 layout(std430, set = SET_SCENE, binding = BINDING_LIGHTS) readonly buffer Lights { Light lights[]; };
@@ -97,5 +100,7 @@ Material material_record(uint i) {
         uintBitsToFloat(texelFetch(material_table, at + 5)), uintBitsToFloat(texelFetch(material_table, at + 6)),
         uintBitsToFloat(texelFetch(material_table, at + 7)));
 }
+
+#include "environment.glsl"
 
 #endif

@@ -41,12 +41,13 @@ struct BounceHit {
 // Where a bounce ray from `origin` along `dir` goes, for one_bounce and
 // cache/bounce.glsl's cached_bounce: false, with the light it brings in
 // `escaped`, where it meets a light with area (nothing: the raster passes
-// draw that light) or leaves the scene (the suns' ambient sky); true where
+// draw that light) or leaves the scene (the sky: the environment map and
+// the suns' ambient, environment.glsl); true where
 // it meets a surface, described in `hit`.
 bool bounce_hit(vec3 origin, vec3 dir, out vec3 escaped, out BounceHit hit) {
     vec2 found = trace_closest(origin, dir, 1e30);
     float t = found.x < 0.0 ? 1e30 : found.x;
-    escaped = found.x < 0.0 ? frame.ambient.rgb : vec3(0.0);
+    escaped = found.x < 0.0 ? sky_radiance(dir) : vec3(0.0);
     if (hit_area_light(origin, dir, t) >= 0 || found.x < 0.0) {
         return false;
     }
@@ -76,7 +77,10 @@ vec3 one_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng) {
     vec3 wo = -dir;
     vec3 from = leave(hit.position, hit.ng);
     vec3 radiance = next_event(hit.position, hit.n, hit.ng, wo, hit.b, from, choice, rng);
-    if (any(greaterThan(frame.ambient.rgb, vec3(0.0)))) {
+#ifndef SCENE_ENVIRONMENT
+    if (any(greaterThan(frame.ambient.rgb, vec3(0.0))))
+#endif
+    {
         vec3 wi;
         vec3 weight;
         float pdf;
@@ -84,7 +88,7 @@ vec3 one_bounce(vec3 origin, vec3 dir, uint choice, inout Rng rng) {
         float far = 1e30;
         if (bsdf_sample(hit.b, hit.n, wo, rng_next(rng).xyz, wi, weight, pdf, delta) && dot(wi, hit.ng) > 0.0
             && hit_area_light(from, wi, far) < 0 && !trace_any(from, wi, far)) {
-            radiance += weight * frame.ambient.rgb;
+            radiance += weight * sky_radiance(wi);
         }
     }
     return radiance;

@@ -122,6 +122,26 @@ bool bent_shadow_ray(vec3 origin, vec3 dir, out vec3 through) {
 }
 #endif
 
+#ifdef SCENE_ENVIRONMENT
+// Next-event estimation of the environment map, a strategy of its own beside
+// the lights': one direction drawn from the map (environment_sampling.glsl),
+// one shadow ray, weighed by MIS against the BSDF's density.
+void environment_next_event(inout Path p, inout Rng rng, Bsdf b, vec3 n, vec3 ng, vec3 wo, vec3 from) {
+    vec4 u = rng_next(rng);
+    vec3 wi;
+    float env_pdf;
+    if (params.sampling == SAMPLING_BSDF || !environment_sample(u, wi, env_pdf) || dot(wi, ng) <= 0.0) {
+        return;
+    }
+    float pdf;
+    vec3 f = bsdf_eval(b, n, wo, wi, pdf);
+    if (any(greaterThan(f, vec3(0.0))) && unoccluded(from, wi, 1e30)) {
+        float w = params.sampling == SAMPLING_MIS ? power_heuristic(env_pdf, pdf) : 1.0;
+        path_gather_nee(p, b, n, wo, wi, f, environment_radiance(wi) * (w / env_pdf));
+    }
+}
+#endif
+
 // Traces the ray of the path's segment number `p.depth` and adds the light it
 // finds: a light with area, the sky, or an emissive surface. True when the
 // ray met a surface the path can scatter at (`s` and `m` then describe it),
@@ -146,7 +166,14 @@ bool path_hit(inout Path p, out TraceSurface s, out Material m) {
         return false;
     }
     if (found.x < 0.0) {
-        path_gather(p, p.depth > 1u ? p.throughput * frame.ambient.rgb : vec3(0.0));
+        vec3 sky = p.depth > 1u ? frame.ambient.rgb : vec3(0.0);
+#ifdef SCENE_ENVIRONMENT
+        // The map is sampled by next-event estimation too (path_scatter),
+        // except where ReSTIR's light stands in for it.
+        float w = direct_from_restir(p) ? 1.0 : found_weight(p.counted_fully, p.bsdf_pdf, environment_pdf(p.dir));
+        sky += environment_radiance(p.dir) * w;
+#endif
+        path_gather(p, p.throughput * sky);
         return false;
     }
 #ifdef SCENE_DIELECTRICS
@@ -224,6 +251,9 @@ bool path_scatter(inout Path p, inout Rng rng, TraceSurface s, Material m) {
             }
 #endif
         }
+#ifdef SCENE_ENVIRONMENT
+        environment_next_event(p, rng, b, n, ng, wo, from);
+#endif
     }
     vec4 u = rng_next(rng);
     vec3 weight;

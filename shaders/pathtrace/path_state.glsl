@@ -2,6 +2,9 @@
 // the segments; the wavefront passes keep it in their queue).
 #ifndef WEFT_PT_PATH_STATE_GLSL
 #define WEFT_PT_PATH_STATE_GLSL
+#ifdef SCENE_ENVIRONMENT
+#include "environment_sampling.glsl"
+#endif
 
 // A path between segments: where its next ray starts and goes, what it has
 // gathered, and how much of what it finds next reaches the camera.

@@ -297,8 +297,12 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         });
     }
     let graph = loaded?;
-    let scene = weft_render::load_scene(&args.scene, settings.cache_dir.as_deref())
-        .with_context(|| format!("loading {}", args.scene.display()))?;
+    let scene = weft_render::load_scene(
+        &args.scene,
+        settings.cache_dir.as_deref(),
+        settings.environment.as_deref(),
+    )
+    .with_context(|| format!("loading {}", args.scene.display()))?;
     for w in &scene.warnings {
         eprintln!("warning: {}: {}", w.at, w.message);
     }

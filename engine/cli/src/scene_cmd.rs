@@ -35,6 +35,7 @@ pub fn run(cmd: SceneCommand) -> Result<ExitCode> {
                 cache_dir: weft_scene::cache::user_cache_dir()
                     .filter(|_| !no_cache)
                     .map(|d| d.join("models")),
+                environment: None,
             };
             match weft_scene::check_report_with(&file, &options) {
                 Ok(report) => {

@@ -99,6 +99,12 @@ pub const LIGHT_CHOICES_BINDING: u32 = 23;
 /// traced ray adds one to its pass's slot ([`crate::providers::ray_counts`]), so
 /// `weft compare` can show rays per pixel per pass.
 pub const RAY_COUNTS_BINDING: u32 = 24;
+/// Binding of the environment map's texels (`environment_texels` in
+/// `shaders/include/environment.glsl`: RGB f32 bits, a texel each).
+pub const ENVIRONMENT_BINDING: u32 = 25;
+/// Binding of the table the path tracer samples the environment from
+/// (`environment_table`, [`crate::environment::EnvironmentTable`]).
+pub const ENVIRONMENT_TABLE_BINDING: u32 = 26;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -110,7 +116,7 @@ pub const EMISSIVE_BINDING: u32 = 3;
 /// Set 2 binding of the occlusion texture (its red channel; white when none).
 pub const OCCLUSION_BINDING: u32 = 4;
 /// Set 1 as the engine creates and writes it for every scene pass.
-pub const SCENE_SET_BINDINGS: [SceneBinding; 8] = [
+pub const SCENE_SET_BINDINGS: [SceneBinding; 9] = [
     raster(
         "FRAME",
         FRAME_BINDING,
@@ -159,12 +165,18 @@ pub const SCENE_SET_BINDINGS: [SceneBinding; 8] = [
         DescriptorKind::StorageBuffer,
         "the indices",
     ),
+    raster(
+        "ENVIRONMENT",
+        ENVIRONMENT_BINDING,
+        DescriptorKind::UniformTexelBuffer,
+        "the environment map",
+    ),
 ];
 
 /// Set 1 bindings for ray tracing: built only when a compute pass that
 /// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
-pub const TRACE_SET_BINDINGS: [SceneBinding; 17] = [
+pub const TRACE_SET_BINDINGS: [SceneBinding; 18] = [
     tracing(
         "TRIANGLES",
         TRIANGLES_BINDING,
@@ -267,10 +279,16 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 17] = [
         DescriptorKind::StorageBuffer,
         "the per-pass ray counters",
     ),
+    tracing(
+        "ENVIRONMENT_TABLE",
+        ENVIRONMENT_TABLE_BINDING,
+        DescriptorKind::UniformTexelBuffer,
+        "the environment's sampling table",
+    ),
 ];
 
 /// How many of set 1's raster bindings are texel buffers (the material
-/// records).
+/// records, the environment map).
 pub const SCENE_TEXEL_BUFFERS: u32 = texel_buffers(&SCENE_SET_BINDINGS);
 /// How many of set 1's tracing-only bindings are texel buffers (the tables
 /// every ray or light sample reads: triangles, BVH, per-corner attributes,

@@ -26,7 +26,8 @@ use weft_scene::{AreaShape, Light, Scene};
 /// last five (the lobes ray-traced specular traces); `textures` when a placed mesh has a
 /// base colour, metallic-roughness, normal or emissive texture, `normal_maps` when one
 /// has a normal texture with a non-zero scale, `emission_occlusion_maps` when
-/// one has an emissive or occlusion texture.
+/// one has an emissive or occlusion texture; `environment` when the scene has
+/// an environment map.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
     // Only the names graphs can rely on (weft_graph::SCENE_FEATURES).
     fn set(features: &mut Vec<String>, name: &'static str) {
@@ -142,6 +143,9 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     if placed().any(|m| m.textures.normal.is_some() && m.normal_scale != 0.0) {
         set(&mut features, "normal_maps");
     }
+    if scene.environment.is_some() {
+        set(&mut features, "environment");
+    }
     if placed().any(|m| {
         m.textures.base_color.is_some()
             || m.textures.metallic_roughness.is_some()
@@ -180,6 +184,7 @@ pub fn scene_feature_reason(name: &str) -> Option<&'static str> {
         "emission_occlusion_maps" => "a material has an emissive or occlusion texture",
         "normal_maps" => "a material has a normal texture",
         "textures" => "a material has a texture",
+        "environment" => "the scene has an environment map",
         _ => return None,
     })
 }

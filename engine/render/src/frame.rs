@@ -58,6 +58,8 @@ pub struct RenderSettings {
     /// Where derived scene data is cached between runs (the ray tracer's
     /// BVH); `None` caches nothing.
     pub cache_dir: Option<PathBuf>,
+    /// An environment map that replaces the scene's (`--environment`).
+    pub environment: Option<PathBuf>,
 }
 
 impl Default for RenderSettings {
@@ -81,6 +83,7 @@ impl Default for RenderSettings {
             samples: None,
             time_limit: None,
             cache_dir: None,
+            environment: None,
         }
     }
 }

@@ -115,6 +115,14 @@ pub struct GpuFrame {
     pub moved_lo: [Vec4; MAX_MOVED_BOXES],
     /// Their largest corners, w 0.
     pub moved_hi: [Vec4; MAX_MOVED_BOXES],
+    /// The environment map: intensity, cos and sin of its turn about +y, 1
+    /// when it can be sampled (`crate::scene_gpu::FrameEnvironment`).
+    pub environment: Vec4,
+    /// The map's width, height, 1 when the scene has one, 0.
+    pub environment_size: UVec4,
+    /// Its irradiance over π in nine spherical-harmonic coefficients (rgb,
+    /// [`crate::environment::irradiance_sh`]).
+    pub environment_sh: [Vec4; 9],
 }
 
 /// The most boxes of moved placements and panels the `Frame` block holds;
@@ -188,7 +196,7 @@ const _: () = {
     assert!(size_of::<GpuDraw>() == 224);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMaterial>() == 128);
-    assert!(size_of::<GpuFrame>() == 4 * 64 + (7 + 2 * MAX_MOVED_BOXES) * 16);
+    assert!(size_of::<GpuFrame>() == 4 * 64 + (7 + 2 * MAX_MOVED_BOXES + 11) * 16);
     assert!(size_of::<GpuShadowsHeader>() == 64);
     assert!(size_of::<GpuShadowView>() == 176);
 };

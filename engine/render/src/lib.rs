@@ -30,6 +30,7 @@ mod bvh_cache;
 mod bvh_wide;
 mod emitter_lights;
 mod emitters;
+pub mod environment;
 mod error;
 mod features;
 mod frame;

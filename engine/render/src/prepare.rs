@@ -235,9 +235,12 @@ fn prepare_files(
         checker.cache.invalidate(gpu.device(), raw);
     }
     let new_scene = if scene_changed {
-        let loaded =
-            crate::scene_load::load_scene(&base.scene_path, base.settings.cache_dir.as_deref())
-                .map_err(|e| ReloadError::scene(&e))?;
+        let loaded = crate::scene_load::load_scene(
+            &base.scene_path,
+            base.settings.cache_dir.as_deref(),
+            base.settings.environment.as_deref(),
+        )
+        .map_err(|e| ReloadError::scene(&e))?;
         Some(Arc::new(loaded))
     } else {
         None

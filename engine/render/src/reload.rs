@@ -80,8 +80,12 @@ impl<'g> LiveRender<'g> {
         graph: Prepared,
         settings: RenderSettings,
     ) -> Result<Self, ReloadError> {
-        let scene = crate::scene_load::load_scene(scene_path, settings.cache_dir.as_deref())
-            .map_err(|e| ReloadError::scene(&e))?;
+        let scene = crate::scene_load::load_scene(
+            scene_path,
+            settings.cache_dir.as_deref(),
+            settings.environment.as_deref(),
+        )
+        .map_err(|e| ReloadError::scene(&e))?;
         pick_camera(&scene, &settings).map_err(|e| ReloadError::render(e, scene_path))?;
         let plan = compile_for_scene(gpu, &scene, &graph, &settings)
             .map_err(|e| ReloadError::render(e, &settings.graph))?;
@@ -335,7 +339,11 @@ pub fn startup_files(
     files.insert(normalize(&settings.graph));
     files.insert(normalize(&error.file));
     files.extend(scene_path_files(scene_path));
-    let Ok(scene) = crate::scene_load::load_scene(scene_path, settings.cache_dir.as_deref()) else {
+    let Ok(scene) = crate::scene_load::load_scene(
+        scene_path,
+        settings.cache_dir.as_deref(),
+        settings.environment.as_deref(),
+    ) else {
         return files;
     };
     files.extend(scene_files(&scene));

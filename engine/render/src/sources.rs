@@ -147,6 +147,9 @@ pub fn scene_files(scene: &Scene) -> BTreeSet<PathBuf> {
         files.insert(normalize(&model.path));
         files.extend(model.sources.iter().map(|p| normalize(p)));
     }
+    if let Some(environment) = &scene.environment {
+        files.insert(normalize(&environment.file));
+    }
     files
 }
 

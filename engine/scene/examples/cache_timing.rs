@@ -17,6 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let options = LoadOptions {
         cache_dir: Some(cache),
+        ..LoadOptions::default()
     };
     let start = Instant::now();
     let first = load_scene_with(file.as_ref(), &options)?;

@@ -28,6 +28,7 @@ pub mod bounds;
 pub mod cache;
 pub mod camera;
 pub mod desc;
+pub mod environment;
 pub mod error;
 pub mod gltf_import;
 mod guard;

@@ -6,6 +6,7 @@ use crate::bounds::Aabb;
 use crate::camera::default_camera;
 use crate::desc::ScriptRef;
 use crate::desc::{read_scene_desc, Placement, SceneDesc};
+use crate::environment::{load_environment, EnvironmentDesc};
 use crate::error::{Diagnostics, Location, SceneError};
 use crate::light::Light;
 use crate::material::Optics;
@@ -160,6 +161,18 @@ fn build(
     let bounds = instances
         .iter()
         .fold(Aabb::EMPTY, |b, i| b.union(&i.bounds));
+    let environment_desc = match &options.environment {
+        Some(file) => Some(EnvironmentDesc {
+            file: file.clone(),
+            at: Location::file(file),
+            intensity: 1.0,
+            rotation_deg: 0.0,
+        }),
+        None => desc.environment,
+    };
+    let environment = environment_desc
+        .map(|e| load_environment(&e, diag))
+        .transpose()?;
     let framing = desc.bounding_box.unwrap_or(bounds);
     bound_radii(&mut lights, &framing, path, diag);
     if cameras.is_empty() {
@@ -175,6 +188,7 @@ fn build(
         declared_bounds: desc.bounding_box,
         origin: desc.origin,
         script: desc.script,
+        environment,
         warnings: std::mem::take(&mut diag.warnings),
     })
 }

@@ -13,6 +13,9 @@ use std::path::{Path, PathBuf};
 pub struct LoadOptions {
     /// Folder for the processed-model cache; `None` disables caching.
     pub cache_dir: Option<PathBuf>,
+    /// An environment map that replaces the scene's (`--environment`, for a
+    /// bare model file), at intensity 1 and no rotation.
+    pub environment: Option<PathBuf>,
 }
 
 /// Whether the path names a model file rather than a scene file.

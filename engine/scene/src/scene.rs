@@ -49,6 +49,8 @@ pub struct Scene {
     /// The Rhai script that added to the scene and animates it per frame
     /// ([`crate::script`]), if any.
     pub script: Option<crate::desc::ScriptRef>,
+    /// The environment map rays that leave the scene see, if any.
+    pub environment: Option<crate::environment::Environment>,
     /// What the loader accepted but reported.
     pub warnings: Vec<Warning>,
 }

@@ -46,7 +46,7 @@ impl Session {
             weft_gpu::spirv_cache::set_dir(None);
         }
         let cache = weft_scene::cache::user_cache_dir().filter(|_| !common.no_cache);
-        let scene = weft_render::load_scene(common.scene(), cache.as_deref())
+        let scene = weft_render::load_scene(common.scene(), cache.as_deref(), None)
             .with_context(|| format!("loading {}", common.scene().display()))?;
         let camera = match &common.camera {
             Some(name) => name.clone(),

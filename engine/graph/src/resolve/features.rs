@@ -35,7 +35,7 @@ pub fn pass_feature_names(pass: &IrPass, defines: bool) -> BTreeSet<String> {
 /// The features the engine sets from what a scene holds (weft-render's
 /// `scene_features`, which sets no other): a graph may test them without any
 /// pass of its own doing so (a fragment's caveat, say).
-pub const SCENE_FEATURES: [&str; 20] = [
+pub const SCENE_FEATURES: [&str; 21] = [
     "shadow_casters",
     "emissive",
     "transparent",
@@ -56,4 +56,5 @@ pub const SCENE_FEATURES: [&str; 20] = [
     "emission_occlusion_maps",
     "normal_maps",
     "textures",
+    "environment",
 ];

@@ -2,6 +2,7 @@
 //! textures, and the per-frame camera and light buffers; descriptor set 1 (scene
 //! data) and set 2 (a material's textures) that every scene shader binds.
 
+mod environment;
 mod placement;
 mod trace;
 
@@ -18,6 +19,7 @@ use glam::{UVec4, Vec4};
 use placement::{changed_records, moved_panels};
 use std::collections::HashMap;
 use std::path::PathBuf;
+use environment::EnvironmentBuffers;
 use trace::TraceBuffers;
 use weft_gpu::buffer::{Buffer, TexelBuffer, TexelFormat};
 use weft_gpu::descriptors::{DescriptorPool, DescriptorWriter};
@@ -94,6 +96,7 @@ pub struct GpuScene<'g> {
     lights: Buffer<'g>,
     shadows: Buffer<'g>,
     ltc_tables: Buffer<'g>,
+    environment: EnvironmentBuffers<'g>,
     textures: Vec<Texture<'g>>,
     sampler: Sampler<'g>,
     pool: DescriptorPool<'g>,
@@ -273,6 +276,7 @@ impl<'g> GpuScene<'g> {
         let words = ltc_table_words(tables, albedo);
         let mut ltc_tables = Buffer::host(gpu, "ltc_tables", (words.len() * 4) as u64, storage)?;
         ltc_tables.write(bytes_of(&words))?;
+        let environment = EnvironmentBuffers::new(gpu, scene.environment.as_ref())?;
         let sampler = Sampler::linear_repeat(gpu)?;
         let layouts = SceneLayouts::new(gpu, &bindings::scene_interface())?;
         let pool = descriptor_pool(gpu, material_texture.len() as u32)?;
@@ -287,6 +291,7 @@ impl<'g> GpuScene<'g> {
             lights,
             shadows,
             ltc_tables,
+            environment,
             textures,
             sampler,
             pool,
@@ -380,6 +385,8 @@ impl<'g> GpuScene<'g> {
     fn scene_texel_view(&self, binding: u32) -> Option<vk::BufferView> {
         match binding {
             MATERIALS_BINDING => Some(self.materials.view),
+            ENVIRONMENT_BINDING => Some(self.environment.texels.view),
+            ENVIRONMENT_TABLE_BINDING => Some(self.environment.table.view),
             _ => self.trace.as_ref().and_then(|t| t.texel_view(binding)),
         }
     }
@@ -479,6 +486,9 @@ impl<'g> GpuScene<'g> {
             moved,
             moved_lo,
             moved_hi,
+            environment: self.environment.frame.params,
+            environment_size: self.environment.frame.size,
+            environment_sh: self.environment.frame.sh,
         };
         self.frame.write(bytes_of(&[frame]))?;
         if let Some(changed) = changed {

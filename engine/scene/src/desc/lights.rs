@@ -1,8 +1,10 @@
 //! Light blocks of a `.scene`: `sunlight`, `spotlight`, `pointlight`,
-//! `arealight` and seeded `generate` blocks of point lights.
+//! `arealight`, seeded `generate` blocks of point lights, and the
+//! `environment` map.
 
 use super::{rotation, DEFAULT_SWIVEL_PERIOD, MAX_GENERATED_LIGHTS};
 use crate::camera::look_at_rotation;
+use crate::environment::EnvironmentDesc;
 use crate::error::{Diagnostics, Location, SceneError};
 use crate::light::{
     derive_radius, AreaLight, AreaShape, Attenuation, PointLight, RadiusSource, SpotLight,
@@ -31,6 +33,34 @@ fn warn_if_beyond_half(props: &mut Props<'_>, name: &str, value: Vec3, diag: &mu
             );
         }
     }
+}
+
+/// An `environment` block: `file` (required), `intensity` (at least 0,
+/// default 1), `rotation_deg` (about +y, default 0).
+pub(super) fn environment(props: &mut Props<'_>) -> Result<EnvironmentDesc, SceneError> {
+    let Some((name, line)) = props.text("file")? else {
+        return Err(SceneError::Syntax {
+            at: props.block_at(),
+            message: "'environment' needs a 'file': an equirectangular OpenEXR or Radiance HDR map"
+                .into(),
+        });
+    };
+    let intensity = props
+        .f32_where(
+            "intensity",
+            |v| v.is_finite() && v >= 0.0,
+            "a finite number of at least 0",
+        )?
+        .unwrap_or(1.0);
+    let rotation_deg = props
+        .f32_where("rotation_deg", f32::is_finite, "a finite angle in degrees")?
+        .unwrap_or(0.0);
+    Ok(EnvironmentDesc {
+        file: super::resolve(props.file(), &name),
+        at: Location::line(props.file(), line),
+        intensity,
+        rotation_deg,
+    })
 }
 
 /// A `sunlight` block.

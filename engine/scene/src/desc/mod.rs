@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 mod lights;
 
-use lights::{arealight, generate, pointlight, spotlight, sunlight};
+use lights::{arealight, environment, generate, pointlight, spotlight, sunlight};
 
 /// How deep `include` may nest.
 pub const MAX_INCLUDE_DEPTH: usize = 16;
@@ -80,6 +80,8 @@ pub struct SceneDesc {
     pub origin: DVec3,
     /// The scene's script (`script "file.rhai"`, or the `.rhai` scene itself).
     pub script: Option<ScriptRef>,
+    /// The `environment` block (the last one, when several are given).
+    pub environment: Option<crate::environment::EnvironmentDesc>,
 }
 
 /// Reads a `.scene` file and its includes.
@@ -321,6 +323,7 @@ fn block_into(
             desc.cameras
                 .push(camera(&mut props, block.label.clone(), index)?);
         }
+        "environment" => desc.environment = Some(environment(&mut props)?),
         "boundingbox" => {
             let min = props.point_or("min", DVec3::ZERO)?;
             let max = props.point_or("max", DVec3::ZERO)?;

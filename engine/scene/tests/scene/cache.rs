@@ -11,6 +11,7 @@ fn cached_loads_equal_fresh_loads() {
     let cache = temp_dir("cache-equal");
     let options = LoadOptions {
         cache_dir: Some(cache.to_path_buf()),
+        ..LoadOptions::default()
     };
     for file in [
         repo_scene("demo.scene"),

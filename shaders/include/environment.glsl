@@ -1,0 +1,91 @@
+// The environment map (engine/render/src/environment.rs is its CPU model,
+// and says why each step is as it is): the radiance arriving from a
+// direction, looked up exactly as Mitsuba 3's `envmap` does, and the
+// irradiance raster passes light with, from nine SH coefficients. The sky
+// functions add the suns' constant ambient, so shaders call one function
+// whether or not the scene has a map. Tracing passes compile the map's
+// lookups only under SCENE_ENVIRONMENT (the scene has one: the
+// `path_tracer_scene` define set); raster shading tests the `Frame` block
+// instead (a uniform branch, and the define would double the variants of
+// passes already keyed on 15 features). Included by scene.glsl.
+#ifndef WEFT_ENVIRONMENT_GLSL
+#define WEFT_ENVIRONMENT_GLSL
+
+// RGB radiance as f32 bits, a texel per map texel, rows from the top.
+layout(set = SET_SCENE, binding = BINDING_ENVIRONMENT) uniform usamplerBuffer environment_texels;
+
+const float ENVIRONMENT_PI = 3.14159265358979;
+
+// A world direction in the map's frame (turned about +y).
+vec3 environment_local(vec3 d) {
+    float c = frame.environment.y;
+    float s = frame.environment.z;
+    return vec3(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
+}
+
+// A direction in the map's frame, in the world.
+vec3 environment_world(vec3 l) {
+    float c = frame.environment.y;
+    float s = frame.environment.z;
+    return vec3(c * l.x + s * l.z, l.y, -s * l.x + c * l.z);
+}
+
+// Map coordinates of a unit direction in the map's frame, u in [0, 1).
+vec2 environment_uv(vec3 l) {
+    float u = atan(l.x, -l.z) * (0.5 / ENVIRONMENT_PI);
+    return vec2(u - floor(u), acos(clamp(l.y, -1.0, 1.0)) / ENVIRONMENT_PI);
+}
+
+// Texel (x, y): x wrapped, y clamped.
+vec3 environment_texel(int x, int y) {
+    int w = int(frame.environment_size.x);
+    int h = int(frame.environment_size.y);
+    x = x - w * int(floor(float(x) / float(w)));
+    y = clamp(y, 0, h - 1);
+    return uintBitsToFloat(texelFetch(environment_texels, y * w + x).xyz);
+}
+
+// The radiance arriving from world direction `dir` (unit): the bilinear
+// lookup at (u W - 1/2, v (H - 1)), times the intensity.
+vec3 environment_radiance(vec3 dir) {
+    vec2 uv = environment_uv(environment_local(dir));
+    float x = uv.x * float(frame.environment_size.x) - 0.5;
+    float y = uv.y * float(frame.environment_size.y - 1u);
+    vec2 f = vec2(x - floor(x), y - floor(y));
+    int x0 = int(floor(x));
+    int y0 = int(floor(y));
+    vec3 top = mix(environment_texel(x0, y0), environment_texel(x0 + 1, y0), f.x);
+    vec3 bottom = mix(environment_texel(x0, y0 + 1), environment_texel(x0 + 1, y0 + 1), f.x);
+    return frame.environment.x * mix(top, bottom, f.y);
+}
+
+// The map's irradiance at a surface facing `n`, over pi (what a uniform sky
+// of that irradiance would send from every direction).
+vec3 environment_irradiance(vec3 n) {
+    vec3 d = environment_local(n);
+    float b[9] = float[9](0.282095, 0.488603 * d.y, 0.488603 * d.z, 0.488603 * d.x, 1.092548 * d.x * d.y,
+        1.092548 * d.y * d.z, 0.315392 * (3.0 * d.z * d.z - 1.0), 1.092548 * d.x * d.z,
+        0.546274 * (d.x * d.x - d.y * d.y));
+    vec3 e = vec3(0.0);
+    for (int i = 0; i < 9; ++i) {
+        e += frame.environment_sh[i].rgb * b[i];
+    }
+    return max(e, vec3(0.0));
+}
+
+// The sky a ray that leaves the scene along `dir` sees: the map (under
+// SCENE_ENVIRONMENT) plus the suns' ambient.
+vec3 sky_radiance(vec3 dir) {
+#ifdef SCENE_ENVIRONMENT
+    return frame.ambient.rgb + environment_radiance(dir);
+#else
+    return frame.ambient.rgb;
+#endif
+}
+
+// The sky's irradiance over pi at a surface facing `n`, unoccluded.
+vec3 sky_irradiance(vec3 n) {
+    return frame.ambient.rgb + (frame.environment_size.z != 0u ? environment_irradiance(n) : vec3(0.0));
+}
+
+#endif
