@@ -6,6 +6,7 @@ mod bsdf_sampling;
 mod debug_views;
 mod denoise;
 mod emissive;
+mod environment;
 mod extremes;
 mod gi;
 mod light_matrix;

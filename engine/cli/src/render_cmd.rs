@@ -40,6 +40,11 @@ pub struct RenderArgs {
     /// Camera name; the scene's first camera by default.
     #[arg(long)]
     camera: Option<String>,
+    /// An equirectangular HDR map (OpenEXR or Radiance .hdr) that lights the
+    /// scene in place of its own `environment` (for a bare glTF or OBJ),
+    /// at intensity 1 and no rotation.
+    #[arg(long)]
+    environment: Option<PathBuf>,
     /// Output image: .png (the graph's tonemapped sRGB output) or .exr (the first
     /// image read back, where there is one — the graph's `readback` list or
     /// --readback — else the output as floats); default out/<scene stem>.png.
@@ -233,6 +238,7 @@ fn settings(args: &RenderArgs, extra_readback: Vec<String>) -> RenderSettings {
         } else {
             weft_scene::cache::user_cache_dir()
         },
+        environment: args.environment.clone(),
         ..RenderSettings::default()
     }
 }

@@ -38,7 +38,7 @@ pub enum ReloadChange {
     /// Files edited since the last good version (normalized, all watched).
     Files(BTreeSet<PathBuf>),
     /// Other settings (graph, features, size) for the same scene.
-    Settings(RenderSettings),
+    Settings(Box<RenderSettings>),
 }
 
 /// One reload to prepare: where it starts and what changes.

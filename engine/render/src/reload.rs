@@ -228,7 +228,7 @@ impl<'g> LiveRender<'g> {
     pub fn settings_job(&self, settings: RenderSettings) -> ReloadJob {
         ReloadJob {
             base: self.base(),
-            change: ReloadChange::Settings(settings),
+            change: ReloadChange::Settings(Box::new(settings)),
         }
     }
 

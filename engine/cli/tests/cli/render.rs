@@ -356,3 +356,61 @@ fn spp_on_a_graph_that_does_not_accumulate_is_refused() {
         "{stderr}"
     );
 }
+
+#[test]
+fn environment_lights_a_bare_model_and_a_map_with_nan_is_refused_with_its_texel() {
+    let dir = crate::harness::scratch(&format!("weft-render-env-{}", std::process::id()));
+    let map = dir.join("sky.exr");
+    let mut texels = vec![[0.25f32, 0.5, 1.0]; 8 * 4];
+    texels[3] = [-2.0, 0.5, 1.0];
+    std::fs::write(
+        &map,
+        weft_io::exr::encode_rgb(8, 4, &texels).expect("encodes"),
+    )
+    .expect("map");
+    let out_path = temp_png("environment.png");
+    let args = |map: &Path| {
+        vec![
+            "render".to_string(),
+            "../shared/assets/gltf/rise/Box.glb".into(),
+            "--environment".into(),
+            map.to_string_lossy().into_owned(),
+            "--size".into(),
+            "32x18".into(),
+            "--validate".into(),
+            "--out".into(),
+            out_path.to_string_lossy().into_owned(),
+        ]
+    };
+    let run = |map: &Path| {
+        let args = args(map);
+        weft(&args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let out = run(&map);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success(),
+        "{stderr}{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(
+        stderr.contains(&format!(
+            "warning: {}: 1 texel(s) have negative channels; clamped to 0",
+            map.display()
+        )),
+        "{stderr}"
+    );
+    texels[13] = [0.0, f32::INFINITY, 0.0];
+    std::fs::write(
+        &map,
+        weft_io::exr::encode_rgb(8, 4, &texels).expect("encodes"),
+    )
+    .expect("map");
+    let out = run(&map);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("texel (5, 1) is [0.0, inf, 0.0]: environment radiance must be finite"),
+        "{stderr}"
+    );
+}

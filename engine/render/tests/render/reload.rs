@@ -451,3 +451,61 @@ fn shader_edits_the_gpu_would_reject_are_refused_before_commit() {
     assert_eq!(gpu.validation().messages(), Vec::new());
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+/// Writes a `value`-everywhere 8×4 environment map to `path`.
+fn write_map(path: &Path, value: f32) {
+    let bytes = weft_io::exr::encode_rgb(8, 4, &[[value; 3]; 32]).expect("encodes");
+    std::fs::write(path, bytes).expect("write the map");
+}
+
+#[test]
+fn an_edited_environment_map_reloads_and_a_broken_one_keeps_the_last_good() {
+    let dir = fixture("environment");
+    let map = dir.join("scenes/sky.exr");
+    write_map(&map, 0.5);
+    let scene = dir.join("scenes/tiny.scene");
+    let text = std::fs::read_to_string(&scene).expect("scene");
+    std::fs::write(
+        &scene,
+        format!("environment\n{{\n\tfile \"sky.exr\"\n}}\n{text}"),
+    )
+    .expect("scene");
+    let gpu = Gpu::new(&GpuOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("gpu");
+    let mut live = LiveRender::new(&gpu, &scene, settings(&dir)).expect("live");
+    assert!(live.sources().scene.contains(&normalize(&map)));
+    let first = pixels(&mut live);
+
+    let mut texels = [[0.5f32; 3]; 32];
+    texels[13] = [f32::NAN, 0.0, 0.0];
+    std::fs::write(
+        &map,
+        weft_io::exr::encode_rgb(8, 4, &texels).expect("encodes"),
+    )
+    .expect("write");
+    let err = live
+        .apply(&BTreeSet::from([normalize(&map)]))
+        .expect_err("a NaN texel");
+    assert!(
+        err.message.contains("texel (5, 1)") && err.message.contains("must be finite"),
+        "{err}"
+    );
+    assert_eq!(
+        pixels(&mut live),
+        first,
+        "the last good map keeps rendering"
+    );
+
+    write_map(&map, 2.0);
+    live.apply(&BTreeSet::from([normalize(&map)]))
+        .expect("a good map");
+    let brighter = pixels(&mut live);
+    let sum = |p: &[u8]| p.iter().map(|&v| u64::from(v)).sum::<u64>();
+    assert!(sum(&brighter) > sum(&first), "the brighter map is live");
+    drop(live);
+    assert!(gpu.validation().messages().is_empty());
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
