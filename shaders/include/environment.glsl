@@ -73,6 +73,47 @@ vec3 environment_irradiance(vec3 n) {
     return max(e, vec3(0.0));
 }
 
+// The prefiltered levels after the map in `environment_texels`
+// (engine/render/src/environment_prefilter.rs): level k from 1 holds the map
+// prefiltered for GGX roughness k / LEVELS, each WIDTH x HEIGHT texels.
+const uint ENVIRONMENT_PREFILTER_LEVELS = 5u;
+const int ENVIRONMENT_PREFILTER_WIDTH = 64;
+const int ENVIRONMENT_PREFILTER_HEIGHT = 32;
+
+// Level `level`'s bilinear value at map coordinates `uv`, before the intensity.
+vec3 environment_level(uint level, vec2 uv) {
+    int first = int(frame.environment_size.x * frame.environment_size.y)
+        + int(level - 1u) * ENVIRONMENT_PREFILTER_WIDTH * ENVIRONMENT_PREFILTER_HEIGHT;
+    float x = uv.x * float(ENVIRONMENT_PREFILTER_WIDTH) - 0.5;
+    float y = uv.y * float(ENVIRONMENT_PREFILTER_HEIGHT - 1);
+    vec2 f = vec2(x - floor(x), y - floor(y));
+    int x0 = int(floor(x));
+    int y0 = int(floor(y));
+    vec3 t[4];
+    for (int i = 0; i < 4; ++i) {
+        int xi = (x0 + (i & 1) + ENVIRONMENT_PREFILTER_WIDTH) % ENVIRONMENT_PREFILTER_WIDTH;
+        int yi = clamp(y0 + (i >> 1), 0, ENVIRONMENT_PREFILTER_HEIGHT - 1);
+        t[i] = uintBitsToFloat(texelFetch(environment_texels, first + yi * ENVIRONMENT_PREFILTER_WIDTH + xi).xyz);
+    }
+    return mix(mix(t[0], t[1], f.x), mix(t[2], t[3], f.x), f.y);
+}
+
+// The map prefiltered for a GGX lobe of perceptual `roughness` around
+// direction `r` (split sum), interpolated between the two nearest levels;
+// roughness 0 is the map itself.
+vec3 environment_specular(vec3 r, float roughness) {
+    vec2 uv = environment_uv(environment_local(r));
+    float t = clamp(roughness, 0.0, 1.0) * float(ENVIRONMENT_PREFILTER_LEVELS);
+    uint lo = min(uint(t), ENVIRONMENT_PREFILTER_LEVELS - 1u);
+    vec3 below = lo == 0u ? environment_radiance(r) / max(frame.environment.x, 1e-30) : environment_level(lo, uv);
+    return frame.environment.x * mix(below, environment_level(lo + 1u, uv), t - float(lo));
+}
+
+// The sky's radiance prefiltered for a GGX lobe of `roughness` around `r`.
+vec3 sky_specular(vec3 r, float roughness) {
+    return frame.ambient.rgb + (frame.environment_size.z != 0u ? environment_specular(r, roughness) : vec3(0.0));
+}
+
 // The sky a ray that leaves the scene along `dir` sees: the map (under
 // SCENE_ENVIRONMENT) plus the suns' ambient.
 vec3 sky_radiance(vec3 dir) {

@@ -397,11 +397,57 @@ vec3 environment_albedo(Surface s, Material m) {
     return albedo * opaque_share(m);
 }
 
+// The glossy lobe's share of environment_albedo that an environment map
+// reflects by direction (split sum: the single-scattering albedo, to multiply
+// by the map prefiltered at the lobe's roughness), in `albedo`, and that
+// roughness; 0 where ray-traced specular traces the lobe (RT_SPECULAR).
+void environment_glossy_lobe(Surface s, Material m, float ndv, out vec3 albedo, out float roughness) {
+    albedo = vec3(0.0);
+    roughness = 1.0;
+#ifndef RT_SPECULAR
+#ifdef SCENE_METALLIC_ROUGHNESS
+    if (m.emissive.w == SHADING_METALLIC_ROUGHNESS) {
+        albedo = ggx_single_albedo(m.diffuse.rgb * s.texel, s.metal_rough, ndv) * opaque_share(m);
+        roughness = max(s.metal_rough.y, MIN_ROUGHNESS);
+        return;
+    }
+#endif
+    float shininess = m.specular.w;
+    if (shininess > 0.0) {
+        // Blinn-Phong's exponent as GGX roughness: alpha^2 = 2 / (Ns + 2).
+        roughness = pow(2.0 / (shininess + 2.0), 0.25);
+        vec2 scale;
+        ltc_lookup(LTC_BLINN_PHONG, roughness, ndv, scale);
+        albedo = highlight_colour(m) * (scale.x / PI) * opaque_share(m);
+    }
+#endif
+}
+
+// The light the surroundings send that the surface reflects: `surroundings`
+// (the sky's irradiance over pi, or what GI or the radiance cache found)
+// through the directional albedo; with an environment map and nothing
+// traced in its place, the glossy lobe reflects the map prefiltered at its
+// roughness along the mirror direction instead (environment.glsl).
+vec3 environment_reflected(Surface s, Material m, vec3 surroundings) {
+    vec3 albedo = environment_albedo(s, m);
+#if !defined(HAS_GI) && !defined(HAS_CACHE_AMBIENT)
+    if (frame.environment_size.z != 0u) {
+        vec3 v = normalize(frame.camera_position.xyz - s.position);
+        float ndv = clamp(dot(s.normal, v), 1e-3, 1.0);
+        vec3 glossy;
+        float roughness;
+        environment_glossy_lobe(s, m, ndv, glossy, roughness);
+        return surroundings * (albedo - glossy) + sky_specular(reflect(-v, s.normal), roughness) * glossy;
+    }
+#endif
+    return surroundings * albedo;
+}
+
 vec3 shade_ambient_emissive(Surface s, Material m, vec3 surroundings, float emissive_boost, vec3 emission_texel,
                             float occlusion) {
     vec3 environment = vec3(0.0);
-    if (any(greaterThan(surroundings, vec3(0.0)))) {
-        environment = surroundings * environment_albedo(s, m) * occlusion;
+    if (any(greaterThan(surroundings, vec3(0.0))) || frame.environment_size.z != 0u) {
+        environment = environment_reflected(s, m, surroundings) * occlusion;
     }
     return environment + m.emissive.rgb * emission_texel * emissive_boost;
 }

@@ -31,6 +31,7 @@ mod bvh_wide;
 mod emitter_lights;
 mod emitters;
 pub mod environment;
+pub mod environment_prefilter;
 mod error;
 mod features;
 mod frame;

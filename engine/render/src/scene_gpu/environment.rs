@@ -6,6 +6,7 @@
 //! empty table, so every shader binds the same layout.
 
 use crate::environment::{irradiance_sh, EnvironmentTable};
+use crate::environment_prefilter::prefiltered;
 use crate::gpu_types::bytes_of;
 use glam::{UVec4, Vec4};
 use weft_gpu::buffer::{TexelBuffer, TexelFormat};
@@ -27,7 +28,8 @@ pub struct FrameEnvironment {
 
 /// The map's texel buffers and the fields the `Frame` block carries.
 pub struct EnvironmentBuffers<'g> {
-    /// RGB radiance as f32 bits, one `uvec4` per texel, rows from the top.
+    /// RGB radiance as f32 bits, one `uvec4` per texel, rows from the top:
+    /// the map, then its prefiltered levels ([`prefiltered`]).
     pub texels: TexelBuffer<'g>,
     /// [`EnvironmentTable::records`].
     pub table: TexelBuffer<'g>,
@@ -58,7 +60,9 @@ impl<'g> EnvironmentBuffers<'g> {
                     size: UVec4::new(env.width, env.height, 1, 0),
                     sh: irradiance_sh(env).map(|c| c.extend(0.0)),
                 };
-                (words(&env.texels), table.records, frame)
+                let mut texels = words(&env.texels);
+                texels.extend(words(&prefiltered(env)));
+                (texels, table.records, frame)
             }
             None => (
                 vec![[0; 4]],
