@@ -287,3 +287,60 @@ fn an_area_light_panel_blocks_the_light_behind_it() {
     );
     assert!(unshadowed_ratio > 1.2, "without shadows {unshadowed_ratio}");
 }
+
+#[test]
+fn an_emissive_texture_lights_the_floor_with_its_mean_in_every_raster_graph_and_the_tracer() {
+    // The panel of the first test, its emission `Ke 3 2 1` times a uniform
+    // sRGB texture of (128, 192, 160), against the same panel emitting the
+    // texture's linear value times Ke untextured.
+    let textured = TempDir::new("emissive-texture");
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([128, 192, 160, 255]))
+        .save(textured.0.join("glow.png"))
+        .expect("texture");
+    let panel = "v -0.5 1 -0.3\nv 0.5 1 -0.3\nv 0.5 1 0.3\nv -0.5 1 0.3\nvn 0 -1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl glow\n\
+                 f 5/1/2 6/2/2 7/3/2\nf 5/1/2 7/3/2 8/4/2\n";
+    let textured_scene = floor_scene(&textured.0, panel, "");
+    let mtl = textured.0.join("floor.mtl");
+    let text = std::fs::read_to_string(&mtl).expect("mtl");
+    std::fs::write(
+        &mtl,
+        text.replace("Ke 3 2 1\n", "Ke 3 2 1\nmap_Ke glow.png\n"),
+    )
+    .expect("mtl");
+    let linear = [128.0f32, 192.0, 160.0].map(|v| weft_gpu::readback::srgb_to_linear(v / 255.0));
+    let plain = TempDir::new("emissive-plain");
+    let plain_scene = floor_scene(&plain.0, panel, "");
+    let mtl = plain.0.join("floor.mtl");
+    let text = std::fs::read_to_string(&mtl).expect("mtl");
+    let ke = format!("Ke {} {} {}\n", 3.0 * linear[0], 2.0 * linear[1], linear[2]);
+    std::fs::write(&mtl, text.replace("Ke 3 2 1\n", &ke)).expect("mtl");
+    let floor = |image: &[Vec3]| {
+        let around: Vec<Vec3> = (0..SIZE * SIZE)
+            .filter(|i| (i % SIZE).abs_diff(SIZE / 2) > 9 || (i / SIZE).abs_diff(SIZE / 2) > 9)
+            .map(|i| image[i as usize])
+            .collect();
+        mean(&around)
+    };
+    for graph in ["forward.ron", "deferred.ron", "tiled.ron"] {
+        let lit = floor(&render(&textured_scene, graph, None, &[]));
+        let expected = floor(&render(&plain_scene, graph, None, &[]));
+        assert!(expected.min_element() > 0.002, "{graph}: {expected}");
+        let ratio = lit / expected;
+        assert!(
+            (ratio - Vec3::ONE).abs().max_element() < 0.005,
+            "{graph}: textured {lit} against untextured {expected}"
+        );
+    }
+    let traced = floor(&render(
+        &textured_scene,
+        "pathtrace.ron",
+        Some(64),
+        &[("max_depth", 2.0)],
+    ));
+    let raster = floor(&render(&textured_scene, "forward.ron", None, &[]));
+    let ratio = raster / traced;
+    assert!(
+        (ratio - Vec3::ONE).abs().max_element() < 0.05,
+        "forward {raster} against the tracer's {traced}"
+    );
+}

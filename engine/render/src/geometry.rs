@@ -374,6 +374,23 @@ impl SceneGeometry {
         })
     }
 
+    /// The UVs of `draw`'s triangles, in the order [`Self::world_triangles`]
+    /// gives them (unmirrored).
+    pub fn triangle_uvs<'a>(&'a self, draw: &'a DrawItem) -> impl Iterator<Item = [Vec2; 3]> + 'a {
+        let first = (draw.range.first_index as usize).min(self.indices.len());
+        let end = (first + draw.range.index_count as usize).min(self.indices.len());
+        let offset = draw.range.vertex_offset;
+        let uv = move |i: u32| {
+            self.uvs
+                .get((offset + i as i32) as usize)
+                .copied()
+                .unwrap_or(Vec2::ZERO)
+        };
+        self.indices[first..end]
+            .chunks_exact(3)
+            .map(move |t| [uv(t[0]), uv(t[1]), uv(t[2])])
+    }
+
     /// The box around every draw as placed now.
     pub fn placed_bounds(&self) -> Aabb {
         self.draws

@@ -54,11 +54,17 @@ fn check_reports_emissive_geometry_as_raster_lights() {
         text.contains("emissive geometry: 2 triangles -> 1 polygon lights (1 quads merged)"),
         "{text}"
     );
-    // The damaged helmet's emission is textured: it glows but lights nothing in raster graphs.
+    // The damaged helmet's emission is textured: it lights raster graphs
+    // through the texture's mean over each triangle, its thousands of
+    // glowing triangles clustered into the budget of lights.
     let out = weft(&["scene", "check", "scenes/gltf.scene", "--json"]);
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
-    assert_eq!(json["emitter_lights"]["polygons"], 0);
+    assert_eq!(json["emitter_lights"]["polygons"], 64);
     assert_eq!(json["emitter_lights"]["textured"], 1);
+    assert!(
+        json["emitter_lights"]["clusters"].as_u64() > Some(0),
+        "{json}"
+    );
 }
 
 #[test]

@@ -11,11 +11,14 @@
 //!
 //! Emission is what the tracer uses: the material's factor (MTL `Ke`, glTF
 //! `emissiveFactor` times `KHR_materials_emissive_strength`, `.scene`
-//! `emission`). Materials whose emission is modulated by an emissive texture
-//! are not turned into lights (their glow is drawn; what they cast is not
-//! modelled) and are counted in [`EmitterLights::textured`].
+//! `emission`), times, where an emissive texture modulates it, the
+//! texture's mean over each triangle (`textured`; such meshes are counted in
+//! [`EmitterLights::textured`]).
 
 mod clusters;
+mod textured;
+
+pub use textured::TextureMeans;
 
 use crate::emitters::luminance;
 use crate::geometry::SceneGeometry;
@@ -23,7 +26,8 @@ use crate::gpu_types::GpuLight;
 use crate::lights::AREA_POLYGON;
 use crate::sanitize;
 use glam::Vec3;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
 
 /// The most emissive polygons raster passes shade: each costs every shaded
 /// pixel one LTC integral per lobe (about as much as a rectangle light).
@@ -79,7 +83,7 @@ impl EmitterPolygon {
 pub struct EmitterLights {
     /// The polygons raster passes shade, most powerful first.
     pub polygons: Vec<EmitterPolygon>,
-    /// Emissive triangles with area (of materials without an emissive texture).
+    /// Emissive triangles with area and light.
     pub triangles: usize,
     /// Pairs of triangles merged into quads.
     pub quads: usize,
@@ -95,8 +99,11 @@ pub struct EmitterLights {
     pub dropped: usize,
     /// The share of the emitted power the dropped polygons had (0 to 1).
     pub dropped_power: f64,
-    /// Placed meshes whose emission an emissive texture modulates (not lights).
+    /// Placed meshes whose emission an emissive texture modulates (lit by
+    /// the texture's mean per triangle).
     pub textured: usize,
+    /// Those meshes' texture means, kept so moved emitters need no decoding.
+    pub means: Arc<TextureMeans>,
 }
 
 impl EmitterLights {
@@ -134,7 +141,7 @@ impl EmitterLights {
         }
         if self.textured > 0 {
             line += &format!(
-                "; {} meshes with an emissive texture glow but light nothing in raster graphs",
+                "; {} meshes light through their emissive texture's mean over each triangle",
                 self.textured
             );
         }
@@ -142,44 +149,57 @@ impl EmitterLights {
     }
 }
 
-/// Whether a material's emission becomes polygon lights: it emits, and no
-/// emissive texture modulates it.
+/// Whether a material's emission becomes polygon lights: it emits (an
+/// emissive texture scales each triangle's light by its mean there).
 pub fn lights_raster(m: &weft_scene::Material) -> bool {
-    m.emissive.max_element() > 0.0 && m.textures.emissive.is_none()
+    m.emissive.max_element() > 0.0
 }
 
-/// The emissive polygons of the placed meshes of `geometry`.
+/// The emissive polygons of the placed meshes of `geometry`, their emissive
+/// textures decoded to take their means.
 pub fn emitter_lights(geometry: &SceneGeometry) -> EmitterLights {
+    emitter_lights_with(geometry, Arc::new(TextureMeans::gather(geometry)))
+}
+
+/// [`emitter_lights`] with the texture means already taken (a moved emitter
+/// keeps its texture's).
+pub fn emitter_lights_with(geometry: &SceneGeometry, means: Arc<TextureMeans>) -> EmitterLights {
     let mut out = EmitterLights::default();
     let mut polygons = Vec::new();
     for draw in &geometry.draws {
         let Some(material) = geometry.materials.get(draw.material as usize) else {
             continue;
         };
-        if material.emissive.max_element() <= 0.0 {
-            continue;
-        }
         if !lights_raster(material) {
-            out.textured += 1;
             continue;
         }
-        let radiance = sanitize::radiance(material.emissive);
-        if luminance(radiance) <= 0.0 {
-            continue;
+        let factor = sanitize::radiance(material.emissive);
+        let texture = means.of(draw);
+        out.textured += usize::from(texture.is_some());
+        // Triangles of one radiance merge into quads among themselves.
+        let mut by_radiance: BTreeMap<[u32; 3], Vec<[Vec3; 3]>> = BTreeMap::new();
+        for (i, t) in geometry.world_triangles(draw).enumerate() {
+            let radiance = factor * texture.and_then(|m| m.get(i)).copied().unwrap_or(Vec3::ONE);
+            if t.iter().all(|p| p.is_finite()) && area(&t) > 0.0 && luminance(radiance) > 0.0 {
+                by_radiance
+                    .entry(radiance.to_array().map(f32::to_bits))
+                    .or_default()
+                    .push(t);
+            }
         }
-        let triangles: Vec<[Vec3; 3]> = geometry
-            .world_triangles(draw)
-            .filter(|t| t.iter().all(|p| p.is_finite()) && area(t) > 0.0)
-            .collect();
-        out.triangles += triangles.len();
-        let merged = merge_quads(&triangles);
-        out.quads += merged.iter().filter(|p| p[2] != p[3]).count();
-        polygons.extend(
-            merged
-                .into_iter()
-                .map(|corners| EmitterPolygon { corners, radiance }),
-        );
+        for (radiance, triangles) in by_radiance {
+            let radiance = Vec3::from_array(radiance.map(f32::from_bits));
+            out.triangles += triangles.len();
+            let merged = merge_quads(&triangles);
+            out.quads += merged.iter().filter(|p| p[2] != p[3]).count();
+            polygons.extend(
+                merged
+                    .into_iter()
+                    .map(|corners| EmitterPolygon { corners, radiance }),
+            );
+        }
     }
+    out.means = means;
     let clustered = clusters::cluster(polygons, MAX_EMITTER_LIGHTS);
     out.clusters = clustered.clusters;
     out.clustered = clustered.members;

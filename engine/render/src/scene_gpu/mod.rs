@@ -248,8 +248,7 @@ impl<'g> GpuScene<'g> {
         )?;
         let bounds = scene.effective_bounds();
         let emitter_lights = crate::emitter_lights::emitter_lights(&geometry);
-        if emitter_lights.clusters > 0 || emitter_lights.dropped > 0 || emitter_lights.textured > 0
-        {
+        if emitter_lights.clusters > 0 || emitter_lights.dropped > 0 {
             warnings.extend(emitter_lights.summary());
         }
         let mut light_set = pack_lights(

@@ -31,7 +31,8 @@ impl GpuScene<'_> {
         if !self.emitter_lights.polygons.is_empty() {
             // The light buffer was sized for the polygons at load: a moved
             // emitter keeps its count (only non-finite corners could change it).
-            let moved = crate::emitter_lights::emitter_lights(&self.geometry);
+            let means = self.emitter_lights.means.clone();
+            let moved = crate::emitter_lights::emitter_lights_with(&self.geometry, means);
             if moved.polygons.len() == self.emitter_lights.polygons.len() {
                 self.emitter_lights = moved;
             }
