@@ -1,10 +1,14 @@
 #version 450
 // Deferred point lights: one light volume per light, blended additively into
-// the HDR buffer; each covered pixel is shaded with that light only.
+// the HDR buffer; each covered pixel is shaded with that light only, through
+// its cube shadow views where it has them.
 layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;
 layout(set = 0, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_material;
 layout(set = 0, binding = 3) uniform sampler2D depth;
+#ifdef HAS_SHADOW_MAP
+layout(set = 0, binding = 4) uniform sampler2DShadow shadow_map;
+#endif
 layout(push_constant) uniform Params {
     uint footprint_rays;  // graph parameter: rt_shadows' rays per pixel and point light
 } params;

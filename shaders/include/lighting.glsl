@@ -59,10 +59,12 @@
 #if !defined(SCENE_METALLIC_ROUGHNESS) && !defined(SCENE_BLINN_PHONG)
 #define SCENE_BLINN_PHONG
 #endif
-// A bound shadow map means a sun, a spot or an area light casts shadows: a
-// pass that loops over none of them (feature sets `weft graph check --shaders` tries, not scenes)
-// keeps the sun loop, so the map it is given is used.
-#if defined(HAS_SHADOW_MAP) && !defined(SCENE_SUNS) && !defined(SCENE_SPOT_LIGHTS) && !defined(SCENE_AREA_LIGHTS)
+// A bound shadow map means a sun, a point, a spot or an area light casts
+// shadows: a pass that loops over none of them (feature sets `weft graph
+// check --shaders` tries, not scenes) keeps the sun loop, so the map it is
+// given is used.
+#if defined(HAS_SHADOW_MAP) && !defined(SCENE_SUNS) && !defined(SCENE_SPOT_LIGHTS) && !defined(SCENE_AREA_LIGHTS) \
+    && !defined(SCENE_POINT_LIGHTS)
 #define SCENE_SUNS
 #endif
 

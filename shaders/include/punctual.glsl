@@ -69,6 +69,11 @@ vec3 incoming_point(uint index, Surface s, out vec3 l) {
         return vec3(0.0);
     }
     float visible = 1.0;
+#ifdef HAS_SHADOW_MAP
+    if (dot(s.normal, l) > 0.0) {
+        visible = point_visibility(index, s.position, s.normal);
+    }
+#endif
 #ifdef RT_SHADOWS
     if (dot(s.normal, l) > 0.0) {
         visible = rt_punctual_visibility(s.position, s.normal,

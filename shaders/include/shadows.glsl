@@ -1,7 +1,8 @@
 // Shadow lookups shared by forward and deferred (engine/render/src/shadows/
 // writes the record, laid out by gpu_types.rs). The shadow map is an atlas of square tiles: the sun's
 // cascades, then one perspective view per shadow-casting spot cone, then one per
-// area light (soft shadows, `area_visibility` below). A sun or spot lookup is
+// area light (soft shadows, `area_visibility` below), then six (a cube) per
+// shadowed point light. A sun or spot lookup is
 // one matrix multiply (world to atlas coordinates, precomputed per view) and
 // textureProj on a compare sampler, whose 2x2 hardware filter is widened by a
 // manual (2r+1)^2 kernel, r = the shadow pass's `pcf_radius`. The lookups are
@@ -25,7 +26,8 @@ layout(std430, set = SET_SCENE, binding = BINDING_SHADOWS) readonly buffer Shado
     uvec4 shadow_counts;    // cascades, spot views, light index of the first spot cone, PCF radius
     vec4 shadow_splits;     // far view depth of each cascade
     vec4 shadow_forward;    // camera view direction, w: normal offset in texels
-    uvec4 shadow_areas;     // first area view, light index of the first area light, area views
+    uvec4 shadow_areas;     // first area view, light index of the first area light, area views, cube-shadowed points
+    uvec4 shadow_point_lights;  // light index of each cube-shadowed point light (its six views follow the area views)
     ShadowView shadow_views[];
 };
 
@@ -79,6 +81,31 @@ float spot_visibility(uint index, vec3 p, vec3 n, float d) {
     }
     uint v = shadow_counts.x + k;
     float seen = shadow_view_visibility(v, p, n, shadow_forward.w * shadow_views[v].texel.x * d);
+    return seen >= 0.0 ? seen : 1.0;
+}
+
+// Fraction of point light `index`'s light reaching `p` (`n` its normal),
+// through the cube face its direction from the light falls in (+x, -x, +y,
+// -y, +z, -z: shadows/points.rs); lit for points without cube views. The
+// face is picked for the normal-offset point, which its widened view holds.
+float point_visibility(uint index, vec3 p, vec3 n) {
+    uint k = 0u;
+    while (k < shadow_areas.w && shadow_point_lights[k] != index) {
+        ++k;
+    }
+    if (k == shadow_areas.w) {
+        return 1.0;
+    }
+    vec3 d = p - lights[index].position_range.xyz;
+    vec3 a = abs(d);
+    float depth = max(a.x, max(a.y, a.z));
+    uint first = shadow_areas.x + shadow_areas.z + 6u * k;
+    float offset = shadow_forward.w * shadow_views[first].texel.x * depth;
+    vec3 q = d + n * offset;
+    vec3 b = abs(q);
+    uint face = b.x >= b.y && b.x >= b.z ? (q.x >= 0.0 ? 0u : 1u)
+        : (b.y >= b.z ? (q.y >= 0.0 ? 2u : 3u) : (q.z >= 0.0 ? 4u : 5u));
+    float seen = shadow_view_visibility(first + face, p, n, offset);
     return seen >= 0.0 ? seen : 1.0;
 }
 

@@ -373,3 +373,74 @@ fn area_light_shadows_converge_to_the_path_tracers_direct_light() {
     }
     eprintln!("{}", report.join("\n"));
 }
+
+/// Point lights' cube shadow maps (`point_shadows`, graphs/shadows.ron): the
+/// floor's visibility equals CPU ray casts in every raster graph, away from
+/// the shadow's edge (where moving the point by 0.1 units, about two shadow
+/// texels plus the PCF kernel, changes the cast). The light sits over the
+/// box's corner, so the shadow spans the cube's −y face and its neighbours.
+#[test]
+fn point_light_shadow_maps_equal_cpu_ray_casts_away_from_edges_in_every_raster_graph() {
+    let dir = TempDir::new("point-shadow-maps");
+    let block = "pointlight\n{\n\tposition 0.9 3.2 0.7\n\tcolor 4 4 4\n\tattenuation 1 0 0\n}\n";
+    let light = Punctual::At(Vec3::new(0.9, 3.2, 0.7));
+    let boxed = write_scene(&dir.0, "point", block, true);
+    let open = write_scene(&dir.0, "point_open", block, false);
+    let scene = weft_scene::load_scene(&boxed).expect("scene");
+    let inverse = scene.cameras[0].view_projection(0.0, 1.0).inverse();
+    let bvh = Bvh::from_scene(&scene, |_, _| true);
+    let unshadowed = render(&open, "forward.ron", None, &[], &[]);
+    for graph in ["forward.ron", "deferred.ron", "tiled.ron"] {
+        let image = render(&boxed, graph, None, &[], &[]);
+        let (mut lit, mut shadowed, mut wrong) = (0, 0, Vec::new());
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                let Some(p) = floor_point(&bvh, &inverse, x, y) else {
+                    continue;
+                };
+                let i = (y * SIZE + x) as usize;
+                let expected = cpu_visible(&bvh, &light, p);
+                let near_edge = (0..8).any(|k| {
+                    let a = k as f32 * std::f32::consts::FRAC_PI_4;
+                    cpu_visible(&bvh, &light, p + Vec3::new(a.cos(), 0.0, a.sin()) * 0.1)
+                        != expected
+                });
+                if near_edge {
+                    continue;
+                }
+                let seen = image[i][0] / unshadowed[i][0];
+                if expected {
+                    lit += 1;
+                } else {
+                    shadowed += 1;
+                }
+                if (seen - if expected { 1.0 } else { 0.0 }).abs() > 0.02 {
+                    wrong.push(format!("({x}, {y}): {seen} for {expected}"));
+                }
+            }
+        }
+        assert!(
+            wrong.is_empty(),
+            "{graph}: {} pixel(s) differ from the CPU's ray casts: {}",
+            wrong.len(),
+            wrong.iter().take(8).cloned().collect::<Vec<_>>().join(", ")
+        );
+        assert!(
+            shadowed > 300 && lit > 3000,
+            "{graph}: {lit} lit, {shadowed} shadowed"
+        );
+    }
+    // Without a budget the point light casts nothing on the floor.
+    let image = render(
+        &boxed,
+        "forward.ron",
+        None,
+        &[("shadows.point_shadows", 0.0)],
+        &[],
+    );
+    let darker = (0..SIZE * SIZE)
+        .filter(|&i| floor_point(&bvh, &inverse, i % SIZE, i / SIZE).is_some())
+        .filter(|&i| image[i as usize][0] < unshadowed[i as usize][0] * 0.99)
+        .count();
+    assert_eq!(darker, 0, "floor pixels darkened with point_shadows 0");
+}

@@ -8,8 +8,8 @@ use weft_scene::material::ShadingModel;
 use weft_scene::{AreaShape, Light, Scene};
 
 /// The features `scene` switches on: `shadow_casters` when a placed mesh casts
-/// and a light casts shadows (a sun, a spot narrow enough for a cone, an area
-/// light or emissive geometry that lights raster passes),
+/// and a light casts shadows (a sun, a point light, a spot narrow enough for a
+/// cone, an area light or emissive geometry that lights raster passes),
 /// `suns` / `point_lights` / `spot_lights` when there are such lights, `emissive` when a
 /// placed mesh glows, `transparent` when a placed mesh blends, `area_lights` when
 /// there are area lights or emissive geometry that lights raster passes
@@ -57,9 +57,8 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
     let emitter_lights = placed().any(|m| crate::emitter_lights::lights_raster(&m));
     let shadowing_light = emitter_lights
         || scene.lights.iter().any(|l| match l {
-            Light::Sun(_) | Light::Area(_) => true,
+            Light::Sun(_) | Light::Area(_) | Light::Point(_) => true,
             Light::Spot(s) => is_cone(s.angle),
-            _ => false,
         });
     if shadowing_light && placed().any(|m| matches(MaterialFilter::ShadowCasters, &m)) {
         set(&mut features, "shadow_casters");
@@ -163,7 +162,7 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
 pub fn scene_feature_reason(name: &str) -> Option<&'static str> {
     Some(match name {
         "shadow_casters" => {
-            "a placed mesh casts shadows and a sun, cone spot, area light or emissive mesh casts them"
+            "a placed mesh casts shadows and a sun, point light, cone spot, area light or emissive mesh casts them"
         }
         "emissive" => "a placed mesh glows",
         "transparent" => "a placed mesh blends",

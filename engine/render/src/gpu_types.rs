@@ -169,8 +169,12 @@ pub struct GpuShadowsHeader {
     /// Camera view direction, w: normal offset in texels.
     pub forward: Vec4,
     /// First area-light view, light index of the first area light, area
-    /// views, 0.
+    /// views, point lights with cube views (their six views follow the
+    /// area views).
     pub areas: UVec4,
+    /// The light index of each point light with cube views, in view order
+    /// (unused slots `u32::MAX`).
+    pub point_lights: UVec4,
 }
 
 /// `struct ShadowView`.
@@ -197,7 +201,7 @@ const _: () = {
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMaterial>() == 128);
     assert!(size_of::<GpuFrame>() == 4 * 64 + (7 + 2 * MAX_MOVED_BOXES + 11) * 16);
-    assert!(size_of::<GpuShadowsHeader>() == 64);
+    assert!(size_of::<GpuShadowsHeader>() == 80);
     assert!(size_of::<GpuShadowView>() == 176);
 };
 

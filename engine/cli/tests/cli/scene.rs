@@ -55,16 +55,15 @@ fn check_reports_emissive_geometry_as_raster_lights() {
         "{text}"
     );
     // The damaged helmet's emission is textured: it lights raster graphs
-    // through the texture's mean over each triangle, its thousands of
-    // glowing triangles clustered into the budget of lights.
+    // through the texture's mean over each triangle, its glowing triangles
+    // clustered into at most the budget of lights.
     let out = weft(&["scene", "check", "scenes/gltf.scene", "--json"]);
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
-    assert_eq!(json["emitter_lights"]["polygons"], 64);
-    assert_eq!(json["emitter_lights"]["textured"], 1);
-    assert!(
-        json["emitter_lights"]["clusters"].as_u64() > Some(0),
-        "{json}"
-    );
+    let lights = &json["emitter_lights"];
+    let polygons = lights["polygons"].as_u64().unwrap_or(0);
+    assert!(polygons > 0 && polygons <= 64, "{lights}");
+    assert_eq!(lights["textured"], 1);
+    assert!(lights["clusters"].as_u64() > Some(0), "{lights}");
 }
 
 #[test]

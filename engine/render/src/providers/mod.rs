@@ -19,7 +19,9 @@
 pub mod ray_counts;
 
 use crate::gaussian::{self, GaussianTaps};
-use crate::shadows::{ShadowSettings, MAX_AREA_SHADOWS, MAX_CASCADES, MAX_PCF_RADIUS};
+use crate::shadows::{
+    ShadowSettings, MAX_AREA_SHADOWS, MAX_CASCADES, MAX_PCF_RADIUS, MAX_POINT_SHADOWS,
+};
 use weft_graph::plan::{Plan, PlanPass};
 use weft_graph::provider::{find, ArgDefault, ArgKind, ArgSpec, ProviderSpec};
 use weft_graph::schema::{ParamValue, PassKind, ProviderDecl};
@@ -60,7 +62,7 @@ pub const GAUSSIAN: ProviderSpec = ProviderSpec {
 pub const SHADOW_ATLAS: ProviderSpec = ProviderSpec {
     name: "ShadowAtlas",
     summary:
-        "sun cascades, spot views and area-light views in one depth atlas, drawn once per view",
+        "sun cascades, spot views, area-light views and point-light cubes in one depth atlas, drawn once per view",
     kinds: &[PassKind::Raster],
     args: &[
         ArgSpec {
@@ -99,6 +101,14 @@ pub const SHADOW_ATLAS: ProviderSpec = ProviderSpec {
                 max: MAX_AREA_SHADOWS as i64,
             },
             default: Some(ArgDefault::Number(MAX_AREA_SHADOWS as f64)),
+        },
+        ArgSpec {
+            name: "point_lights",
+            kind: ArgKind::Integer {
+                min: 0,
+                max: MAX_POINT_SHADOWS as i64,
+            },
+            default: Some(ArgDefault::Number(MAX_POINT_SHADOWS as f64)),
         },
     ],
     supplies: &[SHADOW_VIEW],
@@ -227,6 +237,7 @@ pub fn shadow_atlas(pass: &PlanPass) -> Option<ShadowSettings> {
         normal_bias: number(&args, "normal_bias") as f32,
         split_lambda: number(&args, "split_lambda") as f32,
         area_lights: number(&args, "area_lights") as u32,
+        point_lights: number(&args, "point_lights") as u32,
     })
 }
 

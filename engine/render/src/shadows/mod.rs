@@ -6,14 +6,17 @@
 //!
 //! Atlas: the graph's `shadow_map` (`resolution` squared) is cut into a
 //! `grid` x `grid` array of square tiles, `grid = ceil(sqrt(views))`; views are
-//! the cascades, then the spots, then the area lights. One cascade and nothing
-//! else uses the whole map.
+//! the cascades, then the spots, then the area lights, then six cube faces per
+//! shadowed point light (`points`). One cascade and nothing else uses the
+//! whole map.
 
 mod atlas;
 mod perspective;
+mod points;
 
 pub use atlas::Atlas;
 pub use perspective::{area_clip, area_emitter, spot_clip};
+pub use points::{shadowed_points, CUBE_FACES, MAX_POINT_SHADOWS};
 
 use crate::gpu_types::{bytes_of, GpuShadowView, GpuShadowsHeader};
 use crate::lights::LightSet;
@@ -38,8 +41,9 @@ pub const HEADER_BYTES: usize = std::mem::size_of::<GpuShadowsHeader>();
 /// Bytes of one view record: clip matrix, lookup matrix, tile bounds, texel size.
 pub const VIEW_BYTES: usize = std::mem::size_of::<GpuShadowView>();
 /// Bytes of the whole record with room for every view.
-pub const SHADOWS_BYTES: usize =
-    HEADER_BYTES + VIEW_BYTES * (MAX_CASCADES + MAX_SPOT_SHADOWS + MAX_AREA_SHADOWS) as usize;
+pub const SHADOWS_BYTES: usize = HEADER_BYTES
+    + VIEW_BYTES
+        * (MAX_CASCADES + MAX_SPOT_SHADOWS + MAX_AREA_SHADOWS + 6 * MAX_POINT_SHADOWS) as usize;
 
 /// A shadow pass's settings: the `ShadowAtlas` provider's arguments
 /// (`providers.rs` declares their ranges and defaults).
@@ -57,6 +61,9 @@ pub struct ShadowSettings {
     /// Area lights given soft shadows, 0..=[`MAX_AREA_SHADOWS`]: the first
     /// ones in record order; 0 turns area shadows off.
     pub area_lights: u32,
+    /// Point lights given cube shadows, 0..=[`MAX_POINT_SHADOWS`]
+    /// ([`shadowed_points`] picks them).
+    pub point_lights: u32,
 }
 
 impl Default for ShadowSettings {
@@ -67,6 +74,7 @@ impl Default for ShadowSettings {
             normal_bias: 1.0,
             split_lambda: 0.75,
             area_lights: MAX_AREA_SHADOWS,
+            point_lights: MAX_POINT_SHADOWS,
         }
     }
 }
@@ -275,6 +283,8 @@ pub struct ShadowFrame {
     /// Light index of the first area light (area view k belongs to light
     /// `first_area + k`: rectangles and discs, then emissive polygons).
     pub first_area: u32,
+    /// The point lights with cube views (six each, after the area views).
+    pub points: Vec<u32>,
     /// Far view depth of each cascade.
     pub splits: [f32; 4],
     /// The camera's view direction, for picking a cascade by view depth.
@@ -316,7 +326,11 @@ pub fn shadow_frame(
         .take(settings.area_lights.min(MAX_AREA_SHADOWS) as usize)
         .collect();
     let areas = emitters.len() as u32;
-    let atlas = Atlas::new(atlas_size, cascades + spots + areas);
+    let points = shadowed_points(lights, volume.eye, settings.point_lights);
+    let atlas = Atlas::new(
+        atlas_size,
+        cascades + spots + areas + 6 * points.len() as u32,
+    );
     let margin = settings.margin();
     let far = volume.shadow_far(bounds);
     let near = volume.near.min(far * 0.5);
@@ -362,6 +376,22 @@ pub fn shadow_frame(
         v.area = Some([size, near, reach.max(1e-3) * 1.01]);
         views.push(v);
     }
+    for &light in &points {
+        let record = &lights.records[light as usize];
+        for face in CUBE_FACES {
+            let at = views.len() as u32;
+            let (position, range) = (record.position_range.truncate(), record.position_range.w);
+            let (clip, texel) = spot_clip(
+                position,
+                face,
+                std::f32::consts::FRAC_1_SQRT_2,
+                range,
+                atlas.tile,
+                margin,
+            );
+            views.push(view(&atlas, at, clip, texel, true, margin));
+        }
+    }
     ShadowFrame {
         views,
         cascades,
@@ -369,6 +399,7 @@ pub fn shadow_frame(
         first_spot,
         areas,
         first_area,
+        points,
         splits,
         forward: volume.forward,
     }
@@ -409,7 +440,14 @@ impl ShadowFrame {
             forward: self
                 .forward
                 .extend(settings.normal_bias * (settings.pcf_radius as f32 + 1.0)),
-            areas: glam::UVec4::new(self.cascades + self.spots, self.first_area, self.areas, 0),
+            areas: glam::UVec4::new(
+                self.cascades + self.spots,
+                self.first_area,
+                self.areas,
+                self.points.len() as u32,
+            ),
+            point_lights: std::array::from_fn(|k| self.points.get(k).copied().unwrap_or(u32::MAX))
+                .into(),
         };
         let views: Vec<GpuShadowView> = self
             .views

@@ -34,6 +34,7 @@ fn every_example_scene_loads_without_warnings() {
             "cornell_pan.scene",
             "day_cycle.scene",
             "demo.scene",
+            "environment.scene",
             "flight_helmet.scene",
             "flocking.rhai",
             "gltf.scene",
@@ -47,7 +48,15 @@ fn every_example_scene_loads_without_warnings() {
     );
     for name in names {
         let scene = load_scene(&dir.join(&name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert!(scene.warnings.is_empty(), "{name}: {:?}", scene.warnings);
+        // Every HDRI in ../shared/assets/hdri has negative texels: the one
+        // warning that counts them is expected (venice.exr: 233).
+        let expected: &[&str] = if name == "environment.scene" {
+            &["233 texel(s) have negative channels; clamped to 0"]
+        } else {
+            &[]
+        };
+        let messages: Vec<&str> = scene.warnings.iter().map(|w| w.message.as_str()).collect();
+        assert_eq!(messages, expected, "{name}");
     }
 }
 
