@@ -37,8 +37,12 @@ fn a_thousand_lights_agree_across_forward_deferred_and_tiled() {
     for out in [&forward, &deferred, &tiled] {
         assert_eq!(out.messages, Vec::new());
     }
-    // Point lights cast no shadows here: no shadow pass.
-    assert_eq!(tiled.passes, ["gbuffer", "cull_lights", "shade", "tonemap"]);
+    // The four point lights whose reach lies nearest the camera cast cube
+    // shadows.
+    assert_eq!(
+        tiled.passes,
+        ["shadow_sun", "gbuffer", "cull_lights", "shade", "tonemap"]
+    );
     let fd = agreement(&forward.image, &deferred.image);
     let td = agreement(&tiled.image, &deferred.image);
     eprintln!("forward vs deferred {fd:?}; tiled vs deferred {td:?}");

@@ -46,23 +46,45 @@ fn forward_renders_the_demo_scene_cleanly_and_matches_its_golden() {
     );
     // Nine meshes placed (box parts, dragon, bunny, sphere), each drawn by the
     // shading pass and by the shadow pass once per view (the sun, the spot,
-    // the `arealight` and the box's emissive ceiling quad) unless it lies
-    // outside that view's frustum: the spot's view leaves out three meshes,
-    // each area light's view the two behind its panel, and the camera one.
-    assert_eq!(
-        out.culling,
-        [
-            ("shadow_sun[0]".to_string(), 9, 0),
-            ("shadow_sun[1]".to_string(), 6, 3),
-            ("shadow_sun[2]".to_string(), 7, 2),
-            ("shadow_sun[3]".to_string(), 7, 2),
-            ("forward".to_string(), 8, 1),
-        ]
-    );
+    // the `arealight`, the box's emissive ceiling quad, and six cube faces
+    // for each of the three point lights) unless it lies outside that view's
+    // frustum: the spot's view leaves out three meshes, each area light's
+    // view the two behind its panel, each cube face what lies on the other
+    // sides of its light, and the camera one.
+    let cube_faces = [
+        (7, 2),
+        (1, 8),
+        (3, 6),
+        (3, 6),
+        (1, 8),
+        (5, 4),
+        (1, 8),
+        (6, 3),
+        (4, 5),
+        (6, 3),
+        (4, 5),
+        (2, 7),
+        (6, 3),
+        (3, 6),
+        (7, 2),
+        (2, 7),
+        (2, 7),
+        (5, 4),
+    ];
+    let expected: Vec<(String, u64, u64)> = [(9, 0), (6, 3), (7, 2), (7, 2)]
+        .into_iter()
+        .chain(cube_faces)
+        .enumerate()
+        .map(|(i, (drawn, culled))| (format!("shadow_sun[{i}]"), drawn, culled))
+        .chain([("forward".to_string(), 8, 1)])
+        .collect();
+    assert_eq!(out.culling, expected);
     // The area-light panel (issue 32) and the two area lights' shadow views
     // (7 meshes each) since the last count of 23; and the panel as a caster
-    // in each of the four shadow views (issue 58).
-    assert_eq!(out.draw_calls, 42);
+    // in each of the four shadow views (issue 58); then the 18 cube faces
+    // of the three point lights (issue 58): the 68 meshes they draw and the
+    // panel in each.
+    assert_eq!(out.draw_calls, 42 + 68 + 18);
     assert_golden(&out.image, "demo_forward_320x180.png");
 }
 

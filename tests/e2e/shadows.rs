@@ -472,19 +472,19 @@ fn an_unchanged_shadow_view_keeps_its_tile_and_the_image_does_not_change() {
             .filter(|c| c.view.starts_with("shadow_sun"))
             .map(|c| (c.view.as_str(), c.kept))
             .collect();
-        // The sun's view and the two area lights' are unchanged since the
-        // last frame and keep their tiles; the swivelling spot's view is
-        // drawn again.
-        assert_eq!(
-            shadow_views,
-            [
-                ("shadow_sun[0]", true),
-                ("shadow_sun[1]", false),
-                ("shadow_sun[2]", true),
-                ("shadow_sun[3]", true)
-            ],
-            "{graph}"
-        );
+        // The sun's view, the two area lights' and the cubes of the two
+        // still point lights are unchanged since the last frame and keep
+        // their tiles; the swivelling spot's view and the circling point
+        // light's six faces are drawn again.
+        let expected: Vec<(String, bool)> = [true, false, true, true]
+            .into_iter()
+            .chain([true; 12])
+            .chain([false; 6])
+            .enumerate()
+            .map(|(i, kept)| (format!("shadow_sun[{i}]"), kept))
+            .collect();
+        let expected: Vec<(&str, bool)> = expected.iter().map(|(v, k)| (v.as_str(), *k)).collect();
+        assert_eq!(shadow_views, expected, "{graph}");
         let (redrawn, culling) = three_frames(&graph_including(&dir, graph, &cleared));
         assert!(culling.iter().all(|c| !c.kept), "{culling:?}");
         assert_eq!(agreement(&kept, &redrawn).max, 0, "{graph}");
