@@ -3,7 +3,8 @@
 // `rays` cosine-weighted directions about the surface normal, each traced
 // for any hit within `radius` (0: unbounded); `ao.r` gets the fraction that
 // meet nothing, averaged with the last frames' (at most `frames` in all,
-// counted in `ao.g`) while `history_frames` says nothing changed. Cosine weighting makes that fraction, times the ambient
+// counted in `ao.g`) while `history_frames` says nothing changed; under an
+// environment map, the fraction of the map's light they carry. Cosine weighting makes that fraction, times the ambient
 // radiance and the diffuse albedo, the estimate of light from a uniform sky
 // that the path tracer makes at its first bounce: the two agree in
 // expectation. Rays start just off the surface (`leave`, shared with the
@@ -48,12 +49,19 @@ void main() {
     // New rays every frame, numbered by the frame (`history_frames` restarts
     // at every change, and a moving scene would repeat the same rays).
     Rng rng = rng_start(uvec2(pixel), params.frame, 0x6a09e667u);
-    uint open = 0u;
+    // Under an environment map each ray counts by the luminance of the sky
+    // it points at, so the fraction is of the map's light, not of the
+    // directions: what the lighting pass's SH irradiance is scaled by.
+    bool mapped = frame.environment_size.z != 0u;
+    float open = 0.0;
+    float all_rays = 0.0;
     for (uint i = 0u; i < params.rays; ++i) {
         vec3 dir = to_world * sample_cosine(rng_next(rng).xy);
-        open += trace_any(origin + dir * step, dir, t_max) ? 0u : 1u;
+        float weight = mapped ? dot(environment_radiance(dir), vec3(0.2126, 0.7152, 0.0722)) : 1.0;
+        open += trace_any(origin + dir * step, dir, t_max) ? 0.0 : weight;
+        all_rays += weight;
     }
-    float visible = float(open) / float(max(params.rays, 1u));
+    float visible = all_rays > 0.0 ? open / all_rays : 1.0;
     // A running mean over the last frames, its count capped at `frames`, so
     // older frames fade out rather than weigh forever.
     float kept = 0.0;
