@@ -76,6 +76,17 @@ fn mean(image: &[Vec3]) -> Vec3 {
     image.iter().copied().sum::<Vec3>() / image.len() as f32
 }
 
+/// The mean of the floor around the panel of the emissive-quad tests (more
+/// than 9 pixels from the centre either way): the panel itself shows
+/// differently as a mesh and as a light.
+fn floor_around_panel(image: &[Vec3]) -> Vec3 {
+    let around: Vec<Vec3> = (0..SIZE * SIZE)
+        .filter(|i| (i % SIZE).abs_diff(SIZE / 2) > 9 || (i / SIZE).abs_diff(SIZE / 2) > 9)
+        .map(|i| image[i as usize])
+        .collect();
+    mean(&around)
+}
+
 #[test]
 fn an_emissive_quad_lights_the_floor_as_the_same_rect_area_light() {
     // A 1 x 0.6 panel at height 1, emitting (3, 2, 1) downwards: once as two
@@ -96,16 +107,9 @@ fn an_emissive_quad_lights_the_floor_as_the_same_rect_area_light() {
     // The panel (about 7 x 4 pixels each way of the centre) shows differently:
     // an emissive mesh's back is culled, an area light's back is drawn black.
     // The floor around it is compared.
-    let floor = |image: &[Vec3]| {
-        let around: Vec<Vec3> = (0..SIZE * SIZE)
-            .filter(|i| (i % SIZE).abs_diff(SIZE / 2) > 9 || (i / SIZE).abs_diff(SIZE / 2) > 9)
-            .map(|i| image[i as usize])
-            .collect();
-        mean(&around)
-    };
     for graph in ["forward.ron", "deferred.ron", "tiled.ron"] {
-        let from_quad = floor(&render(&quad_scene, graph, None, &[]));
-        let from_rect = floor(&render(&rect_scene, graph, None, &[]));
+        let from_quad = floor_around_panel(&render(&quad_scene, graph, None, &[]));
+        let from_rect = floor_around_panel(&render(&rect_scene, graph, None, &[]));
         assert!(
             from_rect.min_element() > 0.01,
             "{graph}: the floor is lit: {from_rect}"
@@ -314,16 +318,9 @@ fn an_emissive_texture_lights_the_floor_with_its_mean_in_every_raster_graph_and_
     let text = std::fs::read_to_string(&mtl).expect("mtl");
     let ke = format!("Ke {} {} {}\n", 3.0 * linear[0], 2.0 * linear[1], linear[2]);
     std::fs::write(&mtl, text.replace("Ke 3 2 1\n", &ke)).expect("mtl");
-    let floor = |image: &[Vec3]| {
-        let around: Vec<Vec3> = (0..SIZE * SIZE)
-            .filter(|i| (i % SIZE).abs_diff(SIZE / 2) > 9 || (i / SIZE).abs_diff(SIZE / 2) > 9)
-            .map(|i| image[i as usize])
-            .collect();
-        mean(&around)
-    };
     for graph in ["forward.ron", "deferred.ron", "tiled.ron"] {
-        let lit = floor(&render(&textured_scene, graph, None, &[]));
-        let expected = floor(&render(&plain_scene, graph, None, &[]));
+        let lit = floor_around_panel(&render(&textured_scene, graph, None, &[]));
+        let expected = floor_around_panel(&render(&plain_scene, graph, None, &[]));
         assert!(expected.min_element() > 0.002, "{graph}: {expected}");
         let ratio = lit / expected;
         assert!(
@@ -331,13 +328,13 @@ fn an_emissive_texture_lights_the_floor_with_its_mean_in_every_raster_graph_and_
             "{graph}: textured {lit} against untextured {expected}"
         );
     }
-    let traced = floor(&render(
+    let traced = floor_around_panel(&render(
         &textured_scene,
         "pathtrace.ron",
         Some(64),
         &[("max_depth", 2.0)],
     ));
-    let raster = floor(&render(&textured_scene, "forward.ron", None, &[]));
+    let raster = floor_around_panel(&render(&textured_scene, "forward.ron", None, &[]));
     let ratio = raster / traced;
     assert!(
         (ratio - Vec3::ONE).abs().max_element() < 0.05,
