@@ -169,6 +169,13 @@ impl<'g> FrameLoop<'g> {
         &self.recorder.scene.warnings
     }
 
+    /// Turns the scene's environment map to `rotation_deg` about +y from
+    /// the next frame on, in place of its `rotation_deg` (until the scene
+    /// reloads).
+    pub fn turn_environment(&mut self, rotation_deg: f32) {
+        self.recorder.scene.environment.turn(rotation_deg);
+    }
+
     /// The plan that runs.
     pub fn plan(&self) -> &Arc<Plan> {
         &self.plan

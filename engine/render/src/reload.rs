@@ -167,6 +167,12 @@ impl<'g> LiveRender<'g> {
         self.frames.output()
     }
 
+    /// Turns the scene's environment map to `rotation_deg` about +y from the
+    /// next frame on (the viewer's panel), until the scene reloads.
+    pub fn turn_environment(&mut self, rotation_deg: f32) {
+        self.frames.turn_environment(rotation_deg);
+    }
+
     /// Renders one frame of the live version at the settings' time, reading the
     /// output (and the settings' extra images) back.
     pub fn frame(&mut self) -> Result<FrameReport, RenderError> {

@@ -38,6 +38,13 @@ pub struct EnvironmentBuffers<'g> {
 }
 
 impl<'g> EnvironmentBuffers<'g> {
+    /// Turns the map to `rotation_deg` about +y (the viewer's panel): the
+    /// `Frame` block's next upload carries it; nothing else depends on it.
+    pub fn turn(&mut self, rotation_deg: f32) {
+        let r = rotation_deg.to_radians();
+        (self.frame.params.y, self.frame.params.z) = (r.cos(), r.sin());
+    }
+
     /// Uploads `environment`'s map and table (one black texel without one).
     pub fn new(gpu: &'g Gpu, environment: Option<&Environment>) -> Result<Self, GpuError> {
         let words = |texels: &[[f32; 3]]| -> Vec<[u32; 4]> {

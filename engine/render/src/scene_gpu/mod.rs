@@ -96,7 +96,7 @@ pub struct GpuScene<'g> {
     lights: Buffer<'g>,
     shadows: Buffer<'g>,
     ltc_tables: Buffer<'g>,
-    environment: EnvironmentBuffers<'g>,
+    pub(crate) environment: EnvironmentBuffers<'g>,
     textures: Vec<Texture<'g>>,
     sampler: Sampler<'g>,
     pool: DescriptorPool<'g>,

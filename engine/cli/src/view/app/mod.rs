@@ -391,6 +391,9 @@ impl<'g> Viewer<'g> {
             path: Vec::new(),
             ..self.lens.clone()
         };
+        if let Some(degrees) = self.ui.environment_turn {
+            self.live.turn_environment(degrees);
+        }
         let measure = self.ui.live_error_due(&self.live);
         let read_views = self.ui.panel.visible && !self.live.plan().views.is_empty();
         let report = self

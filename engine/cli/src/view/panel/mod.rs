@@ -5,6 +5,7 @@
 //! click wants done comes back as [`PanelAction`]s, which the viewer applies
 //! at the next frame boundary like a hot reload.
 
+mod environment;
 mod history;
 mod params;
 
@@ -41,6 +42,8 @@ pub enum PanelAction {
     GoToBookmark(usize),
     /// Start or stop the live error against the reference.
     LiveError(bool),
+    /// Turn the environment map to this many degrees about +y.
+    TurnEnvironment(f32),
 }
 
 /// What the live error shows now.
@@ -96,6 +99,8 @@ pub struct PanelView<'a> {
     pub live_error: Option<&'a LiveErrorStatus>,
     /// For a debug view: the value under the cursor.
     pub under_cursor: Option<&'a str>,
+    /// The scene's environment map and its turn now, in degrees.
+    pub environment: Option<(&'a Path, f32)>,
 }
 
 /// The panel's own state between frames.
@@ -173,6 +178,7 @@ impl Panel {
                     self.status(ui, view, &mut actions);
                     self.graph_section(ui, view, &mut actions);
                     self.params_section(ui, view, &mut actions);
+                    self.environment_section(ui, view, &mut actions);
                     self.timing_section(ui, view);
                     plan_section(ui, view.plan);
                     self.camera_section(ui, view, &mut actions);

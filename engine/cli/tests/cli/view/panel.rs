@@ -18,9 +18,20 @@ fn view_demo(
     frames: &str,
     extra: &[&str],
 ) -> String {
+    view_scene(x, "scenes/demo.scene", (shot, size), frames, extra)
+}
+
+/// [`view_demo`] of `scene`.
+fn view_scene(
+    x: &Xvfb,
+    scene: &str,
+    (shot, size): (&std::path::Path, &str),
+    frames: &str,
+    extra: &[&str],
+) -> String {
     let mut args = vec![
         "view",
-        "scenes/demo.scene",
+        scene,
         "--size",
         size,
         "--paused",
@@ -363,5 +374,57 @@ fn the_overlay_and_live_error_stay_silent_across_a_resize() {
         text(&out.stdout).contains("live error on"),
         "{}",
         text(&out.stdout)
+    );
+}
+
+#[test]
+fn the_panel_turns_the_environment_map_as_a_scenes_rotation_deg_does() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("panel-environment");
+    let shown = tmp.file("shown.png");
+    let headless = tmp.file("headless.png");
+    let stdout = view_scene(
+        &x,
+        "scenes/environment.scene",
+        (&shown, "480x270"),
+        "10",
+        &[
+            "--panel",
+            "--ui",
+            "3:click:environment:rotation_deg,4:text:90,4:enter",
+        ],
+    );
+    assert!(
+        stdout.contains("environment rotation_deg = 90\n"),
+        "{stdout}"
+    );
+    // The same scene with the map turned in the file, rendered headless at
+    // the view's size beside the panel.
+    let text_of = std::fs::read_to_string(repo().join("scenes/environment.scene")).expect("scene");
+    let turned = tmp.file("turned.scene");
+    let scenes = repo().join("scenes");
+    let absolute = text_of
+        .replace(
+            "\"../../shared",
+            &format!("\"{}/../shared", repo().display()),
+        )
+        .replace("\"models/", &format!("\"{}/models/", scenes.display()))
+        .replace("rotation_deg 0", "rotation_deg 90");
+    assert_ne!(absolute, text_of);
+    std::fs::write(&turned, absolute).expect("scene");
+    let (width, height) = load(&shown).dimensions();
+    let out = x.weft(&[
+        "render",
+        turned.to_str().expect("utf-8 path"),
+        "--size",
+        &format!("{width}x{height}"),
+        "--out",
+        headless.to_str().expect("utf-8 path"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (mean, p99, max) = differences(&load(&shown), &load(&headless));
+    assert!(
+        mean <= 0.05 && p99 <= 1 && max <= 1,
+        "viewer vs render: mean {mean}, p99 {p99}, max {max}"
     );
 }
