@@ -298,7 +298,20 @@ fn prepare_settings(
     settings: &RenderSettings,
 ) -> Result<PreparedReload, ReloadError> {
     let graph = &settings.graph;
-    pick_camera(&base.scene, settings).map_err(|e| ReloadError::render(e, &base.scene_path))?;
+    // Another environment map (the viewer's picker) is a scene loaded again.
+    let new_scene = if settings.environment != base.settings.environment {
+        let loaded = crate::scene_load::load_scene(
+            &base.scene_path,
+            settings.cache_dir.as_deref(),
+            settings.environment.as_deref(),
+        )
+        .map_err(|e| ReloadError::scene(&e))?;
+        Some(Arc::new(loaded))
+    } else {
+        None
+    };
+    let scene = new_scene.as_deref().unwrap_or(&base.scene);
+    pick_camera(scene, settings).map_err(|e| ReloadError::render(e, &base.scene_path))?;
     // The same graph file with the same parameters is the live graph value
     // (its edits arrive as file changes); another is loaded.
     let same_graph =
@@ -310,7 +323,7 @@ fn prepare_settings(
         Some(Arc::new(loaded))
     };
     let value = new_graph.as_deref().unwrap_or(&base.graph);
-    let plan = compile_for_scene(gpu, &base.scene, value, settings)
+    let plan = compile_for_scene(gpu, scene, value, settings)
         .map_err(|e| ReloadError::render(e, graph))?;
     let fail = |e: GpuError| ReloadError::gpu(e, graph);
     let mut cache = PipelineCache::new().map_err(fail)?;
@@ -318,14 +331,16 @@ fn prepare_settings(
     let sources = Sources {
         graph: graph_files(value.graph()),
         shaders: shader_files(&mut cache, &plan).map_err(fail)?,
-        scene: base.sources.scene.clone(),
+        scene: new_scene
+            .as_deref()
+            .map_or_else(|| base.sources.scene.clone(), scene_files),
     };
     let modules = plan_modules(&mut cache, &plan, graph)?;
     Ok(PreparedReload {
         version: base.version,
         settings: settings.clone(),
         graph: new_graph,
-        scene: None,
+        scene: new_scene,
         plan: Some(Arc::new(plan)),
         sources,
         shaders: BTreeSet::new(),

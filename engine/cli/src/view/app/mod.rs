@@ -4,6 +4,7 @@
 //! (all-or-nothing, at the frame boundary), renders the live graph from the fly
 //! camera and presents it.
 
+mod environment;
 mod output;
 mod reload;
 mod ui;
@@ -99,6 +100,8 @@ pub struct Viewer<'g> {
     last_reload: Option<String>,
     /// The panel (F1) and what it needs between frames.
     ui: ui::UiState<'g>,
+    /// The environment map's turn the panel set (the scene's until then).
+    environment_turn: Option<f32>,
 }
 
 /// What the frame loop did while a reload was on its way.
@@ -178,6 +181,7 @@ impl<'g> Viewer<'g> {
             reloaded: None,
             last_reload: None,
             ui,
+            environment_turn: None,
             live,
         };
         viewer.print_features();
@@ -391,7 +395,7 @@ impl<'g> Viewer<'g> {
             path: Vec::new(),
             ..self.lens.clone()
         };
-        if let Some(degrees) = self.ui.environment_turn {
+        if let Some(degrees) = self.environment_turn {
             self.live.turn_environment(degrees);
         }
         let measure = self.ui.live_error_due(&self.live);

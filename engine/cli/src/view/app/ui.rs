@@ -55,8 +55,6 @@ pub(super) struct UiState<'g> {
     /// What the panel costs per frame.
     pub cost: PanelCost,
     scene: PathBuf,
-    /// The environment map's turn the panel set (the scene's until then).
-    pub environment_turn: Option<f32>,
 }
 
 impl<'g> UiState<'g> {
@@ -95,7 +93,6 @@ impl<'g> UiState<'g> {
             drawn: false,
             cost: PanelCost::default(),
             scene: args.scene.clone(),
-            environment_turn: None,
         })
     }
 
@@ -429,12 +426,7 @@ impl Viewer<'_> {
             bookmarks: (&self.ui.bookmarks, &self.ui.bookmarks_path),
             live_error: live_status.as_ref(),
             under_cursor: self.ui.under_cursor.as_deref(),
-            environment: self.live.scene().environment.as_ref().map(|e| {
-                (
-                    e.file.as_path(),
-                    self.ui.environment_turn.unwrap_or(e.rotation_deg),
-                )
-            }),
+            environment: super::environment::environment_view(&self.live, self.environment_turn),
         };
         let panel = &mut self.ui.panel;
         let map = &self.ui.map;
@@ -474,9 +466,8 @@ impl Viewer<'_> {
                     );
                 }
             }
-            PanelAction::TurnEnvironment(degrees) => {
-                self.ui.environment_turn = Some(degrees);
-                println!("environment rotation_deg = {degrees}");
+            action @ (PanelAction::PickEnvironment(_) | PanelAction::TurnEnvironment(_)) => {
+                self.apply_environment(action, settings)
             }
             PanelAction::Pause => self.paused = !self.paused,
             PanelAction::PrintCamera => print!("{}", self.camera_block()),

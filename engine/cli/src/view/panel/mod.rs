@@ -44,6 +44,8 @@ pub enum PanelAction {
     LiveError(bool),
     /// Turn the environment map to this many degrees about +y.
     TurnEnvironment(f32),
+    /// Light the scene with this environment map instead.
+    PickEnvironment(PathBuf),
 }
 
 /// What the live error shows now.

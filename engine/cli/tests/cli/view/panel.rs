@@ -428,3 +428,40 @@ fn the_panel_turns_the_environment_map_as_a_scenes_rotation_deg_does() {
         "viewer vs render: mean {mean}, p99 {p99}, max {max}"
     );
 }
+
+#[test]
+fn the_panel_picks_another_map_as_environment_does() {
+    let x = Xvfb::start();
+    let tmp = Temp::new("panel-pick-map");
+    let shown = tmp.file("shown.png");
+    let headless = tmp.file("headless.png");
+    view_scene(
+        &x,
+        "scenes/environment.scene",
+        (&shown, "480x270"),
+        "12",
+        &[
+            "--panel",
+            "--ui",
+            "3:click:environment,4:click:environment:sky.exr",
+        ],
+    );
+    let (width, height) = load(&shown).dimensions();
+    let sky = repo().join("../shared/assets/hdri/sky.exr");
+    let out = x.weft(&[
+        "render",
+        "scenes/environment.scene",
+        "--environment",
+        sky.to_str().expect("utf-8 path"),
+        "--size",
+        &format!("{width}x{height}"),
+        "--out",
+        headless.to_str().expect("utf-8 path"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (mean, p99, max) = differences(&load(&shown), &load(&headless));
+    assert!(
+        mean <= 0.05 && p99 <= 1 && max <= 1,
+        "viewer vs render: mean {mean}, p99 {p99}, max {max}"
+    );
+}
