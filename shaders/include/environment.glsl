@@ -36,27 +36,35 @@ vec2 environment_uv(vec3 l) {
     return vec2(u - floor(u), acos(clamp(l.y, -1.0, 1.0)) / ENVIRONMENT_PI);
 }
 
-// Texel (x, y): x wrapped, y clamped.
-vec3 environment_texel(int x, int y) {
-    int w = int(frame.environment_size.x);
-    int h = int(frame.environment_size.y);
-    x = x - w * int(floor(float(x) / float(w)));
-    y = clamp(y, 0, h - 1);
-    return uintBitsToFloat(texelFetch(environment_texels, y * w + x).xyz);
-}
-
-// The radiance arriving from world direction `dir` (unit): the bilinear
-// lookup at (u W - 1/2, v (H - 1)), times the intensity.
-vec3 environment_radiance(vec3 dir) {
-    vec2 uv = environment_uv(environment_local(dir));
-    float x = uv.x * float(frame.environment_size.x) - 0.5;
-    float y = uv.y * float(frame.environment_size.y - 1u);
+// The bilinear value at map coordinates `uv` of the `w` x `h` image whose
+// texels start at `first` in environment_texels, at texel coordinates
+// (u w - 1/2, v (h - 1)), wrapping in x and clamped in y: the map's lookup,
+// and its prefiltered levels' (before the intensity).
+vec3 environment_bilinear(int first, int w, int h, vec2 uv) {
+    float x = uv.x * float(w) - 0.5;
+    float y = uv.y * float(h - 1);
     vec2 f = vec2(x - floor(x), y - floor(y));
     int x0 = int(floor(x));
     int y0 = int(floor(y));
-    vec3 top = mix(environment_texel(x0, y0), environment_texel(x0 + 1, y0), f.x);
-    vec3 bottom = mix(environment_texel(x0, y0 + 1), environment_texel(x0 + 1, y0 + 1), f.x);
-    return frame.environment.x * mix(top, bottom, f.y);
+    vec3 t[4];
+    for (int i = 0; i < 4; ++i) {
+        int xi = x0 + (i & 1);
+        xi -= w * int(floor(float(xi) / float(w)));
+        int yi = clamp(y0 + (i >> 1), 0, h - 1);
+        t[i] = uintBitsToFloat(texelFetch(environment_texels, first + yi * w + xi).xyz);
+    }
+    return mix(mix(t[0], t[1], f.x), mix(t[2], t[3], f.x), f.y);
+}
+
+// The map's own bilinear value at `uv`, before the intensity.
+vec3 environment_map(vec2 uv) {
+    return environment_bilinear(0, int(frame.environment_size.x), int(frame.environment_size.y), uv);
+}
+
+// The radiance arriving from world direction `dir` (unit): the map's
+// lookup times the intensity.
+vec3 environment_radiance(vec3 dir) {
+    return frame.environment.x * environment_map(environment_uv(environment_local(dir)));
 }
 
 // The map's irradiance at a surface facing `n`, over pi (what a uniform sky
@@ -84,18 +92,7 @@ const int ENVIRONMENT_PREFILTER_HEIGHT = 32;
 vec3 environment_level(uint level, vec2 uv) {
     int first = int(frame.environment_size.x * frame.environment_size.y)
         + int(level - 1u) * ENVIRONMENT_PREFILTER_WIDTH * ENVIRONMENT_PREFILTER_HEIGHT;
-    float x = uv.x * float(ENVIRONMENT_PREFILTER_WIDTH) - 0.5;
-    float y = uv.y * float(ENVIRONMENT_PREFILTER_HEIGHT - 1);
-    vec2 f = vec2(x - floor(x), y - floor(y));
-    int x0 = int(floor(x));
-    int y0 = int(floor(y));
-    vec3 t[4];
-    for (int i = 0; i < 4; ++i) {
-        int xi = (x0 + (i & 1) + ENVIRONMENT_PREFILTER_WIDTH) % ENVIRONMENT_PREFILTER_WIDTH;
-        int yi = clamp(y0 + (i >> 1), 0, ENVIRONMENT_PREFILTER_HEIGHT - 1);
-        t[i] = uintBitsToFloat(texelFetch(environment_texels, first + yi * ENVIRONMENT_PREFILTER_WIDTH + xi).xyz);
-    }
-    return mix(mix(t[0], t[1], f.x), mix(t[2], t[3], f.x), f.y);
+    return environment_bilinear(first, ENVIRONMENT_PREFILTER_WIDTH, ENVIRONMENT_PREFILTER_HEIGHT, uv);
 }
 
 // The map prefiltered for a GGX lobe of perceptual `roughness` around
@@ -105,7 +102,7 @@ vec3 environment_specular(vec3 r, float roughness) {
     vec2 uv = environment_uv(environment_local(r));
     float t = clamp(roughness, 0.0, 1.0) * float(ENVIRONMENT_PREFILTER_LEVELS);
     uint lo = min(uint(t), ENVIRONMENT_PREFILTER_LEVELS - 1u);
-    vec3 below = lo == 0u ? environment_radiance(r) / max(frame.environment.x, 1e-30) : environment_level(lo, uv);
+    vec3 below = lo == 0u ? environment_map(uv) : environment_level(lo, uv);
     return frame.environment.x * mix(below, environment_level(lo + 1u, uv), t - float(lo));
 }
 

@@ -54,22 +54,31 @@ pub fn uv_direction(uv: Vec2) -> Vec3 {
     Vec3::new(sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi)
 }
 
-/// Texel (x, y), x wrapped and y clamped.
-fn texel(env: &Environment, x: i64, y: i64) -> Vec3 {
-    let (w, h) = (i64::from(env.width), i64::from(env.height));
-    let (x, y) = (x.rem_euclid(w), y.clamp(0, h - 1));
-    Vec3::from(env.texels[(y * w + x) as usize])
+/// The bilinear value at texel coordinates (`x`, `y`) of a `width`×`height`
+/// image whose texel number `i` (row by row) is `texel(i)`, wrapping in x
+/// and clamping in y as the map's lookup does (the prefiltered levels are
+/// read the same way).
+pub(crate) fn bilinear(
+    width: u32,
+    height: u32,
+    texel: impl Fn(usize) -> Vec3,
+    x: f32,
+    y: f32,
+) -> Vec3 {
+    let (w, h) = (i64::from(width), i64::from(height));
+    let at = |x: i64, y: i64| texel((y.clamp(0, h - 1) * w + x.rem_euclid(w)) as usize);
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let row = |y| at(x0, y).lerp(at(x0 + 1, y), fx);
+    row(y0).lerp(row(y0 + 1), fy)
 }
 
 /// The map's bilinear value at `uv`, before `intensity`.
 fn lookup_uv(env: &Environment, uv: Vec2) -> Vec3 {
     let x = uv.x * env.width as f32 - 0.5;
     let y = uv.y * (env.height - 1) as f32;
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = (x - x0, y - y0);
-    let (x0, y0) = (x0 as i64, y0 as i64);
-    let row = |y| texel(env, x0, y).lerp(texel(env, x0 + 1, y), fx);
-    row(y0).lerp(row(y0 + 1), fy)
+    bilinear(env.width, env.height, |i| Vec3::from(env.texels[i]), x, y)
 }
 
 /// The radiance arriving from world direction `dir` (unit).

@@ -9,7 +9,7 @@
 //! covers its solid angle (filtered importance sampling, Křivánek and
 //! Colbert 2008), on the CPU when the map is loaded.
 
-use crate::environment::{direction_uv, uv_direction};
+use crate::environment::{bilinear, direction_uv, uv_direction};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::f32::consts::PI;
@@ -44,7 +44,6 @@ struct Level {
 impl Level {
     /// Bilinear at `uv` with the map's convention (wrapping in x).
     fn lookup(&self, uv: Vec2) -> Vec3 {
-        let (w, h) = (i64::from(self.width), i64::from(self.height));
         let x = uv.x * self.width as f32 - 0.5;
         // The map's rows sit at v = y / (H - 1); a coarser level's texel
         // averages a cell, so its row sits at the cell's centre.
@@ -53,12 +52,7 @@ impl Level {
         } else {
             uv.y * (self.height - 1) as f32
         };
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let at = |x: i64, y: i64| self.texels[(y.clamp(0, h - 1) * w + x.rem_euclid(w)) as usize];
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let row = |y| at(x0, y).lerp(at(x0 + 1, y), fx);
-        row(y0).lerp(row(y0 + 1), fy)
+        bilinear(self.width, self.height, |i| self.texels[i], x, y)
     }
 
     /// The next coarser level: 2×2 box averages (odd sizes keep their last

@@ -18,6 +18,15 @@ pub struct Decoded {
     pub warning: Option<String>,
 }
 
+/// What names a texture's source for sharing one decoded copy: a file's
+/// path, an embedded image's id.
+pub fn source_key(source: &TextureSource) -> String {
+    match source {
+        TextureSource::File(p) => p.display().to_string(),
+        TextureSource::Embedded { id, .. } => id.clone(),
+    }
+}
+
 /// Decodes a texture's image file or embedded bytes, downscaled (keeping its
 /// aspect, each side at least 1) so neither side exceeds `max_side`.
 pub fn decode(source: &TextureSource, max_side: u32) -> Result<Decoded, RenderError> {

@@ -17,7 +17,7 @@
 use crate::texture::decode;
 use std::collections::HashMap;
 use weft_gpu::texture::Rgba8Image;
-use weft_scene::material::{TextureRef, TextureSource};
+use weft_scene::material::TextureRef;
 use weft_scene::Material;
 
 /// Sides of the size classes, in texels.
@@ -82,13 +82,6 @@ fn resample(image: Rgba8Image, side: u32) -> Rgba8Image {
     }
 }
 
-fn source_key(source: &TextureSource) -> String {
-    match source {
-        TextureSource::File(p) => p.display().to_string(),
-        TextureSource::Embedded { id, .. } => id.clone(),
-    }
-}
-
 /// Decodes and places the base colour, metallic-roughness, normal and emissive textures of
 /// `materials`, each distinct source once per colour space.
 pub fn gather(materials: &[Material]) -> TraceTextures {
@@ -96,7 +89,7 @@ pub fn gather(materials: &[Material]) -> TraceTextures {
     let mut placed: HashMap<(String, bool), u32> = HashMap::new();
     let mut slot = |t: Option<&TextureRef>, colour: bool, out: &mut TraceTextures| -> u32 {
         let Some(t) = t else { return NO_TEXTURE };
-        let key = (source_key(&t.source), colour);
+        let key = (crate::texture::source_key(&t.source), colour);
         if let Some(&s) = placed.get(&key) {
             return s;
         }

@@ -96,7 +96,7 @@ impl TextureMeans {
             }
             let source = &texture.source;
             let linear = decoded
-                .entry(format!("{source:?}"))
+                .entry(crate::texture::source_key(source))
                 .or_insert_with(|| LinearTexture::decode(source));
             let means: Arc<[Vec3]> = geometry
                 .triangle_uvs(draw)

@@ -27,7 +27,7 @@ use weft_gpu::samplers::Sampler;
 use weft_gpu::scene::{SceneBinding, SceneLayouts, SceneSet};
 use weft_gpu::texture::{Rgba8Image, Texture};
 use weft_gpu::{Gpu, GpuError};
-use weft_scene::material::{TextureRef, TextureSource};
+use weft_scene::material::TextureRef;
 use weft_scene::{Camera, Scene, SceneAt};
 
 /// The LTC tables as `ltc_tables.glsl` reads them, in vec4s: the GGX
@@ -202,7 +202,7 @@ impl<'g> GpuScene<'g> {
         let mut material_records: Vec<GpuMaterial> = Vec::with_capacity(geometry.materials.len());
         let mut slot = |t: Option<&TextureRef>, srgb: bool| -> Result<usize, GpuError> {
             let Some(t) = t else { return Ok(0) };
-            let key = (source_key(&t.source), srgb);
+            let key = (texture::source_key(&t.source), srgb);
             if let Some(&i) = by_source.get(&key) {
                 return Ok(i);
             }
@@ -567,13 +567,6 @@ fn rewritable<'g>(
         Ok(buffer)
     } else {
         Buffer::device_local(gpu, name, bytes, storage)
-    }
-}
-
-fn source_key(source: &TextureSource) -> String {
-    match source {
-        TextureSource::File(p) => PathBuf::from(p).display().to_string(),
-        TextureSource::Embedded { id, .. } => id.clone(),
     }
 }
 

@@ -47,6 +47,33 @@ fn view_scene(
     text(&out.stdout)
 }
 
+/// Asserts the viewer's screenshot `shown` equals `weft render ARGS` at its
+/// size (the view renders beside the docked panel), written to `headless`.
+fn assert_render_matches(
+    x: &Xvfb,
+    shown: &std::path::Path,
+    headless: &std::path::Path,
+    args: &[&str],
+) {
+    let (width, height) = load(shown).dimensions();
+    let size = format!("{width}x{height}");
+    let mut render = vec!["render"];
+    render.extend_from_slice(args);
+    render.extend([
+        "--size",
+        &size,
+        "--out",
+        headless.to_str().expect("utf-8 path"),
+    ]);
+    let out = x.weft(&render);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (mean, p99, max) = differences(&load(shown), &load(headless));
+    assert!(
+        mean <= 0.05 && p99 <= 1 && max <= 1,
+        "viewer vs render: mean {mean}, p99 {p99}, max {max}"
+    );
+}
+
 #[test]
 fn the_panel_docks_beside_the_view_and_stays_out_of_screenshots_unless_asked() {
     let x = Xvfb::start();
@@ -145,25 +172,19 @@ fn a_feature_and_a_parameter_set_in_the_panel_render_as_weft_render_does() {
     assert!(lists[0].contains("Shift+7 rt_shadows [off]"), "{stdout}");
     assert!(lists[1].contains("Shift+7 rt_shadows [on]"), "{stdout}");
     assert!(stdout.contains("parameter exposure = 2\n"), "{stdout}");
-    let out = x.weft(&[
-        "render",
-        "scenes/demo.scene",
-        "--graph",
-        "graphs/tiled.ron",
-        "--size",
-        &format!("{width}x{height}"),
-        "--features",
-        "rt_shadows",
-        "--param",
-        "exposure=2",
-        "--out",
-        headless.to_str().expect("utf-8 path"),
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let (mean, p99, max) = differences(&load(&shown), &load(&headless));
-    assert!(
-        mean <= 0.05 && p99 <= 1 && max <= 1,
-        "viewer vs render: mean {mean}, p99 {p99}, max {max}"
+    assert_render_matches(
+        &x,
+        &shown,
+        &headless,
+        &[
+            "scenes/demo.scene",
+            "--graph",
+            "graphs/tiled.ron",
+            "--features",
+            "rt_shadows",
+            "--param",
+            "exposure=2",
+        ],
     );
 }
 
@@ -412,20 +433,11 @@ fn the_panel_turns_the_environment_map_as_a_scenes_rotation_deg_does() {
         .replace("rotation_deg 0", "rotation_deg 90");
     assert_ne!(absolute, text_of);
     std::fs::write(&turned, absolute).expect("scene");
-    let (width, height) = load(&shown).dimensions();
-    let out = x.weft(&[
-        "render",
-        turned.to_str().expect("utf-8 path"),
-        "--size",
-        &format!("{width}x{height}"),
-        "--out",
-        headless.to_str().expect("utf-8 path"),
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let (mean, p99, max) = differences(&load(&shown), &load(&headless));
-    assert!(
-        mean <= 0.05 && p99 <= 1 && max <= 1,
-        "viewer vs render: mean {mean}, p99 {p99}, max {max}"
+    assert_render_matches(
+        &x,
+        &shown,
+        &headless,
+        &[turned.to_str().expect("utf-8 path")],
     );
 }
 
@@ -446,22 +458,12 @@ fn the_panel_picks_another_map_as_environment_does() {
             "3:click:environment,4:click:environment:sky.exr",
         ],
     );
-    let (width, height) = load(&shown).dimensions();
     let sky = repo().join("../shared/assets/hdri/sky.exr");
-    let out = x.weft(&[
-        "render",
-        "scenes/environment.scene",
-        "--environment",
-        sky.to_str().expect("utf-8 path"),
-        "--size",
-        &format!("{width}x{height}"),
-        "--out",
-        headless.to_str().expect("utf-8 path"),
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let (mean, p99, max) = differences(&load(&shown), &load(&headless));
-    assert!(
-        mean <= 0.05 && p99 <= 1 && max <= 1,
-        "viewer vs render: mean {mean}, p99 {p99}, max {max}"
+    let sky = sky.to_str().expect("utf-8 path");
+    assert_render_matches(
+        &x,
+        &shown,
+        &headless,
+        &["scenes/environment.scene", "--environment", sky],
     );
 }
