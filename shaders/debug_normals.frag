@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Debug view `normals` (graphs/debug_views.ron) on the visible surface,
 // chosen by the graph parameter `normals_mode`:
 // 0: the geometric normal, interpolated from the vertices, no normal map;

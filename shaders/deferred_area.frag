@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Deferred area lights (fullscreen, blended additively after the sun pass):
 // every area light for each covered pixel. They are the last light records,
 // after suns, point lights and spots (engine/render/src/lights.rs).

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Deferred point lights: one light volume per light, blended additively into
 // the HDR buffer; each covered pixel is shaded with that light only, through
 // its cube shadow views where it has them.

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Deferred spot lights: one light volume per light, blended additively into
 // the HDR buffer; each covered pixel is shaded with that light only.
 layout(set = 0, binding = 0) uniform sampler2D gbuffer_albedo;

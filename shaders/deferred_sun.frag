@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Deferred sun pass (fullscreen): ambient, emission, ray-traced specular
 // (under rt_specular) and every sun (or, under restir_di, ReSTIR's direct
 // light from every light) for each covered pixel; background

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Forward shading: every light evaluated per pixel with the shared lighting
 // code (include/lighting.glsl: one loop per light type, only the types and
 // shading models the graph's SCENE_* defines name), plus ambient and emission,

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Deferred geometry pass: what lighting needs, in the compact encoding of
 // include/gbuffer.glsl (12 bytes per pixel plus depth; 16 when the scene has
 // emissive or occlusion textures, whose samples go to gbuffer_emission).

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // One-bounce diffuse global illumination (graphs/gi.ron). For each G-buffer
 // pixel, `rays` cosine-weighted rays leave the surface; each returns the
 // radiance it brings back (one_bounce, pathtrace/next_event.glsl): the

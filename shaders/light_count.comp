@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Debug view `light_count` (graphs/debug_views.ron): for each pixel with a
 // surface, the point and spot lights that reach it, by the tests the lighting
 // code applies (`point_reaches` and `spot_reaches` in include/punctual.glsl:

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Ray-traced ambient occlusion (graphs/rt_ao.ron): for each G-buffer pixel,
 // `rays` cosine-weighted directions about the surface normal, each traced
 // for any hit within `radius` (0: unbounded); `ao.r` gets the fraction that

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Ray-traced specular (graphs/rt_specular.ron): for each G-buffer pixel whose
 // material has a delta lobe (a mirror's Ks, a coat's reflection, glass), the
 // light that reaches the camera through it, which raster passes cannot draw;

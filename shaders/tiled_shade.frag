@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Tiled deferred shading (fullscreen): ambient, emission and every sun as in
 // deferred_sun.frag, then the point and spot lights listed for this pixel's
 // tile by light_cull.comp (points and spots kept apart), each type in its own

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // The radiance cache's lookup (graphs/radiance_cache.ron): each pixel the
 // G-buffer covers asks for the cell holding its surface (made where there is
 // none, kept alive where there is) and takes the radiance the cells around

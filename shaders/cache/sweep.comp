@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // The radiance cache's sweep (graphs/radiance_cache.ron), one invocation a
 // slot, before the update: a cell nothing asked for in `life` frames is
 // freed, every other live cell loses a frame of life and joins `cache_live`,

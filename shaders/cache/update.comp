@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // The radiance cache's update (graphs/radiance_cache.ron), one invocation a
 // cell of the live list the sweep made (cache/sweep.comp; with a `budget`
 // below the live cells, a share of the list, a different one each frame):

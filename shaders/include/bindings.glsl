@@ -32,6 +32,7 @@
 #define BINDING_LIGHT_CHOICES          23 // the light choice table
 #define BINDING_RAY_COUNTS             24 // the per-pass ray counters
 #define BINDING_ENVIRONMENT_TABLE      26 // the environment's sampling table
+#define BINDING_TOP_LEVEL              27 // the top-level acceleration structure (hardware ray queries)
 
 #define MATERIAL_BASE_COLOR             0 // the base-colour texture
 #define MATERIAL_METALLIC_ROUGHNESS     1 // the metallic-roughness texture

@@ -274,6 +274,38 @@ void trace_group(uint child, uint child_count, float d, float best_t, uint base,
     count += add ? 1u : 0u;
 }
 
+#ifdef TRACE_HARDWARE
+// The ray-query backend (engine/render/src/providers/trace_backend.rs): the
+// scene's top-level acceleration structure (scene_gpu/acceleration.rs), a
+// bottom level per mesh, each placement's first triangle in the ray
+// tracer's order as its instance's custom index, so a hit names the
+// triangle the BVH walk would. Every triangle is opaque and seen from both
+// sides, as the walk sees it.
+#extension GL_EXT_ray_query : require
+layout(set = SET_SCENE, binding = BINDING_TOP_LEVEL) uniform accelerationStructureEXT trace_top_level;
+
+// The most a ray query's t_max may be: it must be finite.
+#define TRACE_FINITE_FAR 3.0e38
+
+// trace_walk's contract on ray queries: the nearest hit with t in (0, t_max)
+// (any hit with `first_hit`), its distance in .x and triangle in .y (as uint
+// bits), or x = -1 when nothing is hit.
+vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
+    COUNT_RAY();
+    rayQueryEXT query;
+    uint flags = gl_RayFlagsOpaqueEXT | (first_hit ? gl_RayFlagsTerminateOnFirstHitEXT : 0u);
+    rayQueryInitializeEXT(query, trace_top_level, flags, 0xffu, origin, 0.0, dir, min(t_max, TRACE_FINITE_FAR));
+    while (rayQueryProceedEXT(query)) {
+    }
+    if (rayQueryGetIntersectionTypeEXT(query, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
+        return vec2(-1.0, 0.0);
+    }
+    float t = rayQueryGetIntersectionTEXT(query, true);
+    uint tri = uint(rayQueryGetIntersectionInstanceCustomIndexEXT(query, true))
+        + uint(rayQueryGetIntersectionPrimitiveIndexEXT(query, true));
+    return t > 0.0 ? vec2(t, uintBitsToFloat(tri)) : vec2(-1.0, 0.0);
+}
+#else
 // Walks the wide BVH: each step takes the next node of the current group,
 // measures where the ray enters its four child boxes, orders them nearest
 // first and tests the triangles of the leaves among them; its inner children
@@ -427,6 +459,7 @@ vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
     }
     return hit ? vec2(best_t, uintBitsToFloat(best_tri)) : vec2(-1.0, 0.0);
 }
+#endif  // TRACE_HARDWARE
 
 // How far a ray leaving surface point p starts from it (`leave`), scaled
 // with p's magnitude as float rounding is.

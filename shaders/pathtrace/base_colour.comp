@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // The base-colour texture's sample at each pixel's surface, for ReSTIR in a
 // graph without a G-buffer (graphs/pathtrace_denoised.ron under `restir_di`):
 // graphs/restir_di.ron's passes read it as `gbuffer_albedo`, which a raster

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // What the denoiser's filters are guided by (graphs/pathtrace_denoised.ron):
 // one ray per pixel through its centre, and at the surface it meets first the
 // shading normal facing the camera, the distance along the ray, the world

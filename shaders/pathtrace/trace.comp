@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Progressive unidirectional path tracer (docs/pathtrace.md). Each dispatch
 // adds one sample per pixel to the running mean in `accumulation` (a history
 // image: rgb the mean, a the sample count) and writes the mean to `hdr`; the

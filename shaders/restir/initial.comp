@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // ReSTIR DI, first pass (graphs/restir_di.ron): each pixel's surface, found
 // by a ray through its centre, streams `candidates` light samples through a
 // reservoir (resampled importance sampling: drawn by the light choice, by

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // ReSTIR DI, second pass (graphs/restir_di.ron): each pixel's reservoir
 // from the first pass (restir/initial.comp) merges those of
 // `spatial_samples` neighbours within `spatial_radius` pixels whose surface

@@ -31,4 +31,5 @@ mod shading;
 mod shadows;
 mod shipped;
 mod taa;
+mod trace_backends;
 mod transparency;

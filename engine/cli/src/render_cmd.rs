@@ -45,6 +45,12 @@ pub struct RenderArgs {
     /// at intensity 1 and no rotation.
     #[arg(long)]
     environment: Option<PathBuf>,
+    /// How passes that trace rays traverse the scene: `software` (the BVH
+    /// walk, any device), `hardware` (ray queries: VK_KHR_ray_query and
+    /// VK_KHR_acceleration_structure) or `auto` (hardware on a GPU that
+    /// offers them, software elsewhere).
+    #[arg(long, default_value = "auto")]
+    backend: weft_render::TraceBackend,
     /// Output image: .png (the graph's tonemapped sRGB output) or .exr (the first
     /// image read back, where there is one — the graph's `readback` list or
     /// --readback — else the output as floats); default out/<scene stem>.png.
@@ -239,6 +245,7 @@ fn settings(args: &RenderArgs, extra_readback: Vec<String>) -> RenderSettings {
             weft_scene::cache::user_cache_dir()
         },
         environment: args.environment.clone(),
+        trace_backend: args.backend,
         ..RenderSettings::default()
     }
 }

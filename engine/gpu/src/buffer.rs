@@ -150,6 +150,14 @@ impl<'g> Buffer<'g> {
 }
 
 impl Buffer<'_> {
+    /// The buffer's device address: it must have been made with
+    /// `SHADER_DEVICE_ADDRESS` usage, on a device with `bufferDeviceAddress`
+    /// (enabled with ray queries, [`crate::ShaderSupport::ray_query`]).
+    pub fn address(&self) -> u64 {
+        let info = vk::BufferDeviceAddressInfo::default().buffer(self.buffer);
+        unsafe { self.gpu.device().get_buffer_device_address(&info) }
+    }
+
     /// The bytes of a host-visible buffer (a read-back buffer after the
     /// GPU's writes were made visible to the host).
     pub fn mapped(&self) -> Result<&[u8], GpuError> {

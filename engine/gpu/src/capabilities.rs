@@ -41,6 +41,12 @@ pub struct ShaderSupport {
     pub compute_invocations: u32,
     /// `maxComputeWorkGroupSize`, per axis.
     pub compute_size: [u32; 3],
+    /// Ray queries against hardware acceleration structures: the device
+    /// offers `VK_KHR_acceleration_structure` and `VK_KHR_ray_query` with
+    /// their `accelerationStructure`, `rayQuery` and `bufferDeviceAddress`
+    /// features (all enabled when offered): what the ray tracer's hardware
+    /// backend needs.
+    pub ray_query: bool,
 }
 
 impl ShaderSupport {
@@ -60,6 +66,7 @@ impl ShaderSupport {
             compute_shared_bytes: 16384,
             compute_invocations: 128,
             compute_size: [128, 128, 64],
+            ray_query: false,
         }
     }
 
@@ -85,6 +92,7 @@ impl ShaderSupport {
             compute_shared_bytes: limits.max_compute_shared_memory_size,
             compute_invocations: limits.max_compute_work_group_invocations,
             compute_size: limits.max_compute_work_group_size,
+            ray_query: crate::acceleration::offered(instance, physical),
         }
     }
 
@@ -101,7 +109,8 @@ impl ShaderSupport {
             }
         }
         for extension in header.extensions {
-            if !ENABLED_EXTENSIONS.contains(&extension.as_str()) {
+            let ray_query = self.ray_query && extension == RAY_QUERY_EXTENSION;
+            if !ray_query && !ENABLED_EXTENSIONS.contains(&extension.as_str()) {
                 unmet.push(format!(
                     "the SPIR-V extension {extension} (weft enables no device extension for it)"
                 ));
@@ -205,6 +214,11 @@ impl ShaderSupport {
                 feature(self.float16, "16-bit float arithmetic", "shaderFloat16")
             }
             Capability::Int8 => feature(self.int8, "8-bit integer arithmetic", "shaderInt8"),
+            Capability::RayQueryKHR => (!self.ray_query).then(|| {
+                "ray queries (the `rayQuery` feature of VK_KHR_ray_query, with \
+                 VK_KHR_acceleration_structure)"
+                    .to_string()
+            }),
             other if CORE_CAPABILITIES.contains(&other) => None,
             other => {
                 let Some((operation, name)) = subgroup_operation(other) else {
@@ -248,6 +262,10 @@ const CORE_CAPABILITIES: [Capability; 10] = [
 /// SPIR-V extensions that need no device extension on Vulkan 1.3: storage
 /// buffers and non-semantic debug information are core, and the Google ones
 /// only annotate.
+/// The SPIR-V extension of ray queries, enabled with the device's
+/// `VK_KHR_ray_query` where it is offered.
+const RAY_QUERY_EXTENSION: &str = "SPV_KHR_ray_query";
+
 const ENABLED_EXTENSIONS: [&str; 6] = [
     "SPV_KHR_storage_buffer_storage_class",
     "SPV_KHR_non_semantic_info",

@@ -88,6 +88,7 @@ pub struct DescriptorWriter {
     images: Vec<(u32, vk::DescriptorType, [vk::DescriptorImageInfo; 1])>,
     buffers: Vec<(u32, vk::DescriptorType, [vk::DescriptorBufferInfo; 1])>,
     texel_buffers: Vec<(u32, [vk::BufferView; 1])>,
+    structures: Vec<(u32, [vk::AccelerationStructureKHR; 1])>,
 }
 
 impl DescriptorWriter {
@@ -131,6 +132,16 @@ impl DescriptorWriter {
         self
     }
 
+    /// A top-level acceleration structure at `binding`, for ray queries.
+    pub fn acceleration_structure(
+        &mut self,
+        binding: u32,
+        structure: vk::AccelerationStructureKHR,
+    ) -> &mut Self {
+        self.structures.push((binding, [structure]));
+        self
+    }
+
     /// Writes everything collected into `set`, which no pending work may be using.
     pub fn write(&self, gpu: &Gpu, set: vk::DescriptorSet) {
         let images = self.images.iter().map(|(binding, ty, info)| {
@@ -154,7 +165,31 @@ impl DescriptorWriter {
                 .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
                 .texel_buffer_view(view)
         });
-        let writes: Vec<_> = images.chain(buffers).chain(texel_buffers).collect();
+        let mut structures: Vec<_> = self
+            .structures
+            .iter()
+            .map(|(_, handle)| {
+                vk::WriteDescriptorSetAccelerationStructureKHR::default()
+                    .acceleration_structures(handle)
+            })
+            .collect();
+        let structure_writes =
+            self.structures
+                .iter()
+                .zip(structures.iter_mut())
+                .map(|((binding, _), info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(*binding)
+                        .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
+                        .descriptor_count(1)
+                        .push_next(info)
+                });
+        let writes: Vec<_> = images
+            .chain(buffers)
+            .chain(texel_buffers)
+            .chain(structure_writes)
+            .collect();
         if !writes.is_empty() {
             unsafe { gpu.device().update_descriptor_sets(&writes, &[]) };
         }

@@ -71,6 +71,16 @@ pub enum GpuError {
     /// The plan itself is inconsistent.
     #[error("plan: {0}")]
     Plan(String),
+    /// Something the device does not offer.
+    #[error("{what} need {needs}, which the device `{device}` does not offer")]
+    Unsupported {
+        /// What was asked for.
+        what: String,
+        /// The device, by name.
+        device: String,
+        /// The extensions or features it would need.
+        needs: String,
+    },
 }
 
 /// Extension that turns `VkResult` errors into `GpuError::Vulkan` naming the

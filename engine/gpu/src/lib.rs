@@ -3,6 +3,7 @@
 
 #![warn(missing_docs)]
 
+pub mod acceleration;
 pub mod bind;
 pub mod buffer;
 pub mod capabilities;

@@ -21,6 +21,8 @@ pub enum DescriptorKind {
     StorageBuffer,
     /// `samplerBuffer` and friends: a buffer read through `texelFetch`.
     UniformTexelBuffer,
+    /// `accelerationStructureEXT`: a top level that ray queries trace.
+    AccelerationStructure,
 }
 
 impl DescriptorKind {
@@ -32,6 +34,7 @@ impl DescriptorKind {
             Self::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
             Self::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
             Self::UniformTexelBuffer => vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
+            Self::AccelerationStructure => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
         }
     }
 }
@@ -181,6 +184,7 @@ impl ShaderInterface {
                         DescriptorType::UniformBuffer() => DescriptorKind::UniformBuffer,
                         DescriptorType::StorageBuffer(_) => DescriptorKind::StorageBuffer,
                         DescriptorType::UniformTexelBuffer() => DescriptorKind::UniformTexelBuffer,
+                        DescriptorType::AccelStruct() => DescriptorKind::AccelerationStructure,
                         other => {
                             return Err(fail(format!(
                                 "binding {} uses unsupported descriptor type {other:?}",

@@ -131,10 +131,15 @@ const SCENE_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
         | vk::ShaderStageFlags::COMPUTE.as_raw(),
 );
 
+/// The layout bindings of `bindings`, leaving out acceleration structures
+/// on a device without ray queries (`ray_query`): shaders for its other
+/// backend declare none.
 fn layout_bindings<'a>(
     bindings: impl Iterator<Item = &'a SceneBinding>,
+    ray_query: bool,
 ) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
     bindings
+        .filter(|b| ray_query || b.kind != DescriptorKind::AccelerationStructure)
         .map(|b| {
             vk::DescriptorSetLayoutBinding::default()
                 .binding(b.binding)
@@ -149,10 +154,14 @@ impl<'g> SceneLayouts<'g> {
     /// Creates the layouts of `interface`'s sets.
     pub fn new(gpu: &'g Gpu, interface: &SceneInterface) -> Result<Self, GpuError> {
         let raster = interface.scene_set.iter().filter(|b| !b.tracing);
+        let ray_query = gpu.info().shaders.ray_query;
         Ok(Self {
-            raster: SetLayout::new(gpu, &layout_bindings(raster))?,
-            traced: SetLayout::new(gpu, &layout_bindings(interface.scene_set.iter()))?,
-            material: SetLayout::new(gpu, &layout_bindings(interface.material_set.iter()))?,
+            raster: SetLayout::new(gpu, &layout_bindings(raster, ray_query))?,
+            traced: SetLayout::new(gpu, &layout_bindings(interface.scene_set.iter(), ray_query))?,
+            material: SetLayout::new(
+                gpu,
+                &layout_bindings(interface.material_set.iter(), ray_query),
+            )?,
         })
     }
 

@@ -105,6 +105,11 @@ pub const ENVIRONMENT_BINDING: u32 = 25;
 /// Binding of the table the path tracer samples the environment from
 /// (`environment_table`, [`crate::environment::EnvironmentTable`]).
 pub const ENVIRONMENT_TABLE_BINDING: u32 = 26;
+/// Binding of the top-level acceleration structure that ray queries trace
+/// (`trace_top_level` in `trace.glsl`, compiled with
+/// [`crate::providers::trace_backend::HARDWARE_DEFINE`]): only on a device
+/// with hardware ray queries, whose traced layout alone has it.
+pub const TOP_LEVEL_BINDING: u32 = 27;
 /// Set 2 binding of a material's base-colour texture (sRGB).
 pub const BASE_COLOR_BINDING: u32 = 0;
 /// Set 2 binding of a material's metallicRoughness texture (UNORM; B metal, G rough).
@@ -176,7 +181,7 @@ pub const SCENE_SET_BINDINGS: [SceneBinding; 9] = [
 /// Set 1 bindings for ray tracing: built only when a compute pass that
 /// declares `derive: [RayTracing()]` first asks for them, since the BVH costs
 /// a build (docs/pathtrace.md) that raster graphs should not pay.
-pub const TRACE_SET_BINDINGS: [SceneBinding; 18] = [
+pub const TRACE_SET_BINDINGS: [SceneBinding; 19] = [
     tracing(
         "TRIANGLES",
         TRIANGLES_BINDING,
@@ -284,6 +289,12 @@ pub const TRACE_SET_BINDINGS: [SceneBinding; 18] = [
         ENVIRONMENT_TABLE_BINDING,
         DescriptorKind::UniformTexelBuffer,
         "the environment's sampling table",
+    ),
+    tracing(
+        "TOP_LEVEL",
+        TOP_LEVEL_BINDING,
+        DescriptorKind::AccelerationStructure,
+        "the top-level acceleration structure (hardware ray queries)",
     ),
 ];
 

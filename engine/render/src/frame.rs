@@ -60,6 +60,8 @@ pub struct RenderSettings {
     pub cache_dir: Option<PathBuf>,
     /// An environment map that replaces the scene's (`--environment`).
     pub environment: Option<PathBuf>,
+    /// How passes that trace rays traverse the scene (`--backend`).
+    pub trace_backend: crate::providers::trace_backend::TraceBackend,
 }
 
 impl Default for RenderSettings {
@@ -84,6 +86,7 @@ impl Default for RenderSettings {
             time_limit: None,
             cache_dir: None,
             environment: None,
+            trace_backend: Default::default(),
         }
     }
 }
@@ -190,7 +193,14 @@ pub fn compile_for_scene(
         readback: settings.extra_readback.clone(),
         readback_asked: settings.readback_asked,
     };
-    let plan = crate::providers::compile(graph, &options).map_err(RenderError::Graph)?;
+    let mut plan = crate::providers::compile(graph, &options).map_err(RenderError::Graph)?;
+    let device = crate::providers::trace_backend::DeviceTracing {
+        name: gpu.info().name.clone(),
+        ray_query: gpu.info().shaders.ray_query,
+        cpu: gpu.info().kind == weft_gpu::DeviceKind::Cpu,
+    };
+    crate::providers::trace_backend::choose(&mut plan, settings.trace_backend, &device)
+        .map_err(RenderError::Graph)?;
     if let Some((image, size)) = weft_gpu::oversized_images(gpu, &plan).into_iter().next() {
         return Err(RenderError::ImageTooLarge {
             image,

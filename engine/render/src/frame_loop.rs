@@ -107,15 +107,25 @@ impl<'g> FrameLoop<'g> {
         self.renderer
             .prepare(&self.plan, &mut self.resources)
             .map_err(|e| RenderError::at_pass(e, &self.plan))?;
+        self.choose_tracing()?;
         if self.plan.passes.iter().any(crate::providers::traces) {
             self.recorder.scene.scene_set(SceneSet::Traced)?;
         }
         Ok(())
     }
 
+    /// Tells the scene which traversal the plan's tracing passes were
+    /// compiled for ([`crate::providers::trace_backend`]), so it builds and
+    /// binds what they read.
+    fn choose_tracing(&mut self) -> Result<(), GpuError> {
+        let hardware = crate::providers::trace_backend::in_hardware(&self.plan);
+        self.recorder.scene.trace_in_hardware(hardware)
+    }
+
     /// Draws one frame: the scene moved to the request's time, the plan
     /// recorded and submitted, waited for, read back when asked.
     pub fn draw(&mut self, request: &FrameRequest<'_>) -> Result<FrameReport, RenderError> {
+        self.choose_tracing()?;
         let extent = [self.plan.extent.width, self.plan.extent.height];
         let at = self.updater.at(request.time);
         let jitter = if self.plan.camera_jitter {

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // The wavefront path tracer's segment pass (graphs/path_tracer_wavefront.ron),
 // dispatched `max_depth` times a frame, indirectly: dispatch k traces segment
 // k + 1 of every path still going, one invocation per queued path, with the

@@ -97,6 +97,8 @@ pub struct Gpu {
     instance: ash::Instance,
     debug: DebugParts,
     debug_device: Option<ash::ext::debug_utils::Device>,
+    /// The acceleration-structure entry points, with hardware ray queries.
+    acceleration: Option<ash::khr::acceleration_structure::Device>,
     physical: vk::PhysicalDevice,
     device: ash::Device,
     queue: vk::Queue,
@@ -172,7 +174,7 @@ impl Gpu {
             device: device.clone(),
             physical_device: physical,
             debug_settings: AllocatorDebugSettings::default(),
-            buffer_device_address: false,
+            buffer_device_address: info.shaders.ray_query,
             allocation_sizes: AllocationSizes::default(),
         });
         let allocator = match allocator {
@@ -189,11 +191,16 @@ impl Gpu {
         let debug_device = debug
             .as_ref()
             .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
+        let acceleration = info
+            .shaders
+            .ray_query
+            .then(|| ash::khr::acceleration_structure::Device::new(&instance, &device));
         Ok(Self {
             entry,
             instance,
             debug,
             debug_device,
+            acceleration,
             physical,
             device,
             queue,
@@ -249,6 +256,12 @@ impl Gpu {
     /// Name, type and timestamp support of the chosen device.
     pub fn info(&self) -> &DeviceInfo {
         &self.info
+    }
+
+    /// The acceleration-structure entry points, on a device with hardware
+    /// ray queries ([`ShaderSupport::ray_query`]).
+    pub fn acceleration(&self) -> Option<&ash::khr::acceleration_structure::Device> {
+        self.acceleration.as_ref()
     }
 
     /// The memory allocator.

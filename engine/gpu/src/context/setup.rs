@@ -206,15 +206,26 @@ pub(super) fn create_device(
         .shader_float64(shaders.float64)
         .shader_int64(shaders.int64)
         .shader_int16(shaders.int16);
+    let ray_query = shaders.ray_query;
+    f12 = f12.buffer_device_address(ray_query);
+    let mut structures =
+        vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
+    let mut queries = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
     let mut features = vk::PhysicalDeviceFeatures2::default()
         .features(core)
         .push_next(&mut f12)
         .push_next(&mut f13);
-    let extensions = if presenting {
+    if ray_query {
+        features = features.push_next(&mut structures).push_next(&mut queries);
+    }
+    let mut extensions = if presenting {
         vec![ash::khr::swapchain::NAME.as_ptr()]
     } else {
         Vec::new()
     };
+    if ray_query {
+        extensions.extend(crate::acceleration::DEVICE_EXTENSIONS.map(|name| name.as_ptr()));
+    }
     let info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)
         .enabled_extension_names(&extensions)

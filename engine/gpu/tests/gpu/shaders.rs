@@ -302,7 +302,41 @@ void main() { colour = vec4(float(gl_PrimitiveID)); }
             compute_shared_bytes: 1 << 16,
             compute_invocations: 1024,
             compute_size: [1024, 1024, 64],
+            ray_query: true,
         }
+    }
+
+    /// A compute shader tracing a ray query, as `trace.glsl` does under
+    /// `TRACE_HARDWARE`.
+    const RAY_QUERY: &str = "#version 460
+#extension GL_EXT_ray_query : require
+layout(local_size_x = 1) in;
+layout(set = 0, binding = 0) uniform accelerationStructureEXT top;
+layout(set = 0, binding = 1) buffer Out { float t; };
+void main() {
+    rayQueryEXT query;
+    rayQueryInitializeEXT(query, top, gl_RayFlagsOpaqueEXT, 0xff, vec3(0.0), 0.0, vec3(0.0, 0.0, 1.0), 10.0);
+    while (rayQueryProceedEXT(query)) {
+    }
+    t = rayQueryGetIntersectionTEXT(query, true);
+}
+";
+
+    #[test]
+    fn ray_queries_are_refused_on_a_device_without_them_naming_the_extensions() {
+        let query = compiled(RAY_QUERY, "shaders/query.comp", ShaderStage::Compute);
+        assert_eq!(everything().unmet(&query), Vec::<String>::new());
+        let without = ShaderSupport {
+            ray_query: false,
+            ..everything()
+        };
+        assert_eq!(
+            without.unmet(&query),
+            [
+                "ray queries (the `rayQuery` feature of VK_KHR_ray_query, with VK_KHR_acceleration_structure)",
+                "the SPIR-V extension SPV_KHR_ray_query (weft enables no device extension for it)",
+            ]
+        );
     }
 
     #[test]

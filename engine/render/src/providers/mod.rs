@@ -14,9 +14,12 @@
 //!   normals and UVs, their materials, and a BVH over them (`bvh.rs`), built
 //!   on first use and bound in set 1 of the pass (compute, fullscreen or
 //!   scene-drawing: raster lighting traces its shadow rays in place); each
-//!   such pass also gets its slot in the ray counters (`ray_counts.rs`).
+//!   such pass also gets its slot in the ray counters (`ray_counts.rs`), and
+//!   traces through the software BVH or hardware ray queries
+//!   (`trace_backend.rs`; `hardware: true` insists on ray queries).
 
 pub mod ray_counts;
+pub mod trace_backend;
 
 use crate::gaussian::{self, GaussianTaps};
 use crate::shadows::{
@@ -126,7 +129,11 @@ pub const RAY_TRACING: ProviderSpec = ProviderSpec {
     name: "RayTracing",
     summary: "the scene's triangles and their BVH for shaders that trace rays",
     kinds: &[PassKind::Compute, PassKind::Fullscreen, PassKind::Raster],
-    args: &[],
+    args: &[ArgSpec {
+        name: "hardware",
+        kind: ArgKind::Bool,
+        default: Some(ArgDefault::Bool(false)),
+    }],
     supplies: &[
         "Triangles",
         "BvhNodes",
@@ -358,6 +365,13 @@ pub(crate) mod tests {
         let without_area = decl("ShadowAtlas", &[("area_lights", ParamValue::Number(0.0))]);
         let settings = shadow_atlas(&pass_with(vec![without_area])).expect("a shadow pass");
         assert_eq!(settings.area_lights, 0);
+    }
+
+    /// A plan of `pass` alone.
+    pub(crate) fn plan_of_one(pass: PlanPass) -> Plan {
+        let mut passes = weft_graph::id::IdVec::new();
+        passes.push(pass);
+        plan_of(passes)
     }
 
     fn plan_of(passes: weft_graph::id::IdVec<weft_graph::id::PassId, PlanPass>) -> Plan {

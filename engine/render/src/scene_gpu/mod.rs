@@ -2,7 +2,9 @@
 //! textures, and the per-frame camera and light buffers; descriptor set 1 (scene
 //! data) and set 2 (a material's textures) that every scene shader binds.
 
+mod acceleration;
 mod environment;
+mod ltc;
 mod placement;
 mod trace;
 
@@ -17,6 +19,7 @@ use crate::texture;
 use ash::vk;
 use environment::EnvironmentBuffers;
 use glam::{UVec4, Vec4};
+use ltc::ltc_table_words;
 use placement::{changed_records, moved_panels};
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -30,36 +33,14 @@ use weft_gpu::{Gpu, GpuError};
 use weft_scene::material::TextureRef;
 use weft_scene::{Camera, Scene, SceneAt};
 
-/// The LTC tables as `ltc_tables.glsl` reads them, in vec4s: the GGX
-/// inverses, the GGX (integral, Fresnel moment, 0, 0), the same for
-/// Blinn-Phong, then GGX's albedo for energy compensation (integral,
-/// Fresnel moment, and the averages of both over the entry's row,
-/// [`weft_ltc::energy::AlbedoTable::row_averages`]).
-pub fn ltc_table_words(
-    tables: &weft_ltc::tables::Tables,
-    (albedo, averages): &weft_ltc::energy::WithAverages,
-) -> Vec<f32> {
-    let mut words = Vec::with_capacity(4 * (4 * tables.ggx.len() + albedo.entries.len()));
-    for table in [&tables.ggx, &tables.blinn_phong] {
-        words.extend(table.iter().flat_map(|e| e.inverse));
-        words.extend(
-            table
-                .iter()
-                .flat_map(|e| [e.magnitude, e.fresnel, 0.0, 0.0]),
-        );
-    }
-    words.extend(albedo.entries.iter().enumerate().flat_map(|(i, e)| {
-        let [average, average_fresnel] = averages[i / weft_ltc::energy::COLUMNS];
-        [e.integral, e.fresnel, average, average_fresnel]
-    }));
-    words
-}
-
 /// Bytes of the `Frame` uniform block.
 pub const FRAME_BYTES: usize = std::mem::size_of::<GpuFrame>();
-/// A pool for the two scene sets (raster, traced) and one set per material.
+/// A pool for the two scene sets (raster, traced) and one set per material;
+/// the traced set's top level only on a device with ray queries.
 fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuError> {
     let scene_sets = 2;
+    let top_level = (vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, 1);
+    let ray_query = gpu.info().shaders.ray_query;
     DescriptorPool::new(
         gpu,
         scene_sets + materials,
@@ -77,7 +58,10 @@ fn descriptor_pool(gpu: &Gpu, materials: u32) -> Result<DescriptorPool<'_>, GpuE
                 vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
                 MATERIAL_SET_BINDINGS.len() as u32 * materials.max(1) + TRACE_TEXTURE_ARRAYS,
             ),
-        ],
+        ]
+        .into_iter()
+        .chain(ray_query.then_some(top_level))
+        .collect::<Vec<_>>(),
     )
 }
 
@@ -111,6 +95,10 @@ pub struct GpuScene<'g> {
     pub material_sets: Vec<vk::DescriptorSet>,
     /// Built on first use by a ray-tracing pass.
     trace: Option<TraceBuffers<'g>>,
+    /// Whether tracing passes use ray queries, and then the acceleration
+    /// structures, built with the ray tracer's buffers.
+    hardware: bool,
+    structures: Option<acceleration::SceneStructures<'g>>,
     /// Where the BVH is cached (`crate::bvh_cache`); `None` builds it every time.
     bvh_cache: Option<PathBuf>,
     /// Each scene instance's transform as the draw records hold it.
@@ -305,6 +293,8 @@ impl<'g> GpuScene<'g> {
             moved: false,
             moved_boxes: Vec::new(),
             trace: None,
+            hardware: false,
+            structures: None,
             bvh_cache: None,
             bounds,
             view_volume: ViewVolume::new(
@@ -361,6 +351,9 @@ impl<'g> GpuScene<'g> {
             }
             if let Some(view) = self.scene_texel_view(b) {
                 writer.texel_buffer(b, view);
+            }
+            if let Some(structures) = self.structures.as_ref().filter(|_| b == TOP_LEVEL_BINDING) {
+                writer.acceleration_structure(b, structures.top.structure.handle);
             }
             let texture = self
                 .trace

@@ -9,7 +9,8 @@ use weft_gpu::GpuError;
 impl GpuScene<'_> {
     /// Moves the placements the script moved: their draw records rewritten
     /// in place as one range, the scene's box refitted (unless declared),
-    /// and the ray tracer's triangles and BVH rebuilt if a pass traces. A
+    /// and the ray tracer's triangles and BVH rebuilt if a pass traces (the
+    /// top-level acceleration structure refitted, for ray queries). A
     /// placement still again after moving only has its records rewritten
     /// (their `previous`): no geometry moved.
     pub(super) fn place_instances(&mut self, transforms: &[glam::Mat4]) -> Result<(), GpuError> {
@@ -43,6 +44,7 @@ impl GpuScene<'_> {
         if self.trace.is_some() {
             self.trace = None;
             self.ensure_trace_buffers()?;
+            self.refit_structures()?;
             if let Some(set) = self.traced_set {
                 self.write_scene_set(set, true);
             }

@@ -38,24 +38,31 @@ pub(super) struct TraceBuffers<'g> {
     /// Rays per tracing pass this frame ([`crate::providers::ray_counts`]), host-visible:
     /// zeroed before a frame, read after it.
     ray_counts: Buffer<'g>,
+    /// Whether the BVH was built (tracing through ray queries needs none).
+    bvh: bool,
 }
 
 impl<'g> TraceBuffers<'g> {
     /// Builds the BVH over `geometry`'s triangles (read from and stored in
-    /// `cache` when given) and uploads it with them and the choice table over
-    /// `lights` (a scene of radius `scene_radius`); what went wrong on the way
-    /// is added to `warnings`.
+    /// `cache` when given; with `bvh` false, for ray queries, an empty one)
+    /// and uploads it with them and the choice table over `lights` (a scene
+    /// of radius `scene_radius`); what went wrong on the way is added to
+    /// `warnings`.
     pub(super) fn build(
         gpu: &'g Gpu,
-        geometry: &SceneGeometry,
+        (geometry, bvh): (&SceneGeometry, bool),
         cache: Option<&Path>,
         (lights, scene_radius): (&LightSet, f32),
         warnings: &mut Vec<String>,
     ) -> Result<Self, GpuError> {
         let mesh = geometry.trace_mesh();
-        let (bvh, cache_warning) = crate::bvh_cache::load_or_build(&mesh.corners, cache);
-        warnings.extend(cache_warning);
-        let wide = crate::bvh_wide::WideBvh::collapse(&bvh, &mesh.corners);
+        let wide = if bvh {
+            let (tree, cache_warning) = crate::bvh_cache::load_or_build(&mesh.corners, cache);
+            warnings.extend(cache_warning);
+            crate::bvh_wide::WideBvh::collapse(&tree, &mesh.corners)
+        } else {
+            crate::bvh_wide::WideBvh::collapse(&crate::bvh::Bvh::build(&[]), &[])
+        };
         // The walk names nodes and leaf slots in 24 bits.
         let tables = [
             (
@@ -183,7 +190,13 @@ impl<'g> TraceBuffers<'g> {
                 storage,
             )?,
             ray_counts: zeroed_counters(gpu)?,
+            bvh,
         })
+    }
+
+    /// Whether the BVH was built, so the software walk can trace.
+    pub(super) fn has_bvh(&self) -> bool {
+        self.bvh
     }
 
     /// Zeroes the ray counters; the previous frame must have finished.
@@ -240,21 +253,23 @@ impl<'g> TraceBuffers<'g> {
 }
 
 impl GpuScene<'_> {
-    /// Builds the ray tracer's buffers, once; placements a script has moved
-    /// give new geometry each frame, so their BVH is not cached.
+    /// Builds the ray tracer's buffers, once, with the BVH unless rays
+    /// trace through ray queries, and then the acceleration structures;
+    /// placements a script has moved give new geometry each frame, so their
+    /// BVH is not cached.
     pub(super) fn ensure_trace_buffers(&mut self) -> Result<(), GpuError> {
         if self.trace.is_none() {
             let cache = self.bvh_cache.as_deref().filter(|_| !self.moved);
             let built = TraceBuffers::build(
                 self.gpu,
-                &self.geometry,
+                (&self.geometry, !self.hardware),
                 cache,
                 (&self.light_set, scene_radius(&self.bounds)),
                 &mut self.warnings,
             )?;
             self.trace = Some(built);
         }
-        Ok(())
+        self.ensure_structures()
     }
 
     /// Caches the ray tracer's BVH in `dir` (the user's cache folder), so

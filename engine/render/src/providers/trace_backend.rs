@@ -1,0 +1,243 @@
+//! Which traversal the passes that trace rays compile against: the software
+//! BVH walk every Vulkan device runs, or ray queries against hardware
+//! acceleration structures (`VK_KHR_ray_query`). The choice is one define,
+//! [`HARDWARE_DEFINE`], that `shaders/include/trace.glsl` tests, added to
+//! every pass that declares `RayTracing`: every fragment that traces runs on
+//! either backend unchanged. A pass may insist on hardware
+//! (`RayTracing(hardware: true)`); on a device without ray queries its graph
+//! is then refused at that pass, naming the missing extension.
+
+use super::{call, traces, RAY_TRACING};
+use weft_graph::plan::Plan;
+use weft_graph::schema::ParamValue;
+use weft_graph::Diagnostic;
+
+/// The define that selects the ray-query implementation of `trace.glsl`.
+pub const HARDWARE_DEFINE: &str = "TRACE_HARDWARE";
+
+/// The backend asked for (`--backend`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TraceBackend {
+    /// Hardware on a GPU that offers ray queries, software elsewhere (on a
+    /// CPU device such as lavapipe the software walk is the faster:
+    /// docs/hardware_rt.md).
+    #[default]
+    Auto,
+    /// The software BVH walk, on every device.
+    Software,
+    /// Ray queries; refused on a device without them.
+    Hardware,
+}
+
+impl TraceBackend {
+    /// The backend's name, as `--backend` takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Software => "software",
+            Self::Hardware => "hardware",
+        }
+    }
+}
+
+impl std::str::FromStr for TraceBackend {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        [Self::Auto, Self::Software, Self::Hardware]
+            .into_iter()
+            .find(|b| b.name() == text)
+            .ok_or_else(|| format!("expected auto, software or hardware, found `{text}`"))
+    }
+}
+
+/// What the device offers, as the choice needs it.
+#[derive(Debug, Clone)]
+pub struct DeviceTracing {
+    /// The device's name, for errors.
+    pub name: String,
+    /// Whether it offers hardware ray queries.
+    pub ray_query: bool,
+    /// Whether it is a CPU device (lavapipe), where `auto` stays in software.
+    pub cpu: bool,
+}
+
+/// What the missing extensions are called in errors.
+const NEEDS: &str = "VK_KHR_acceleration_structure and VK_KHR_ray_query";
+
+/// Chooses the backend for `plan`'s tracing passes as `asked` on `device`,
+/// and adds [`HARDWARE_DEFINE`] to each when it is hardware. Returns whether
+/// it is; a pass that insists on hardware, or `--backend hardware`, on a
+/// device without ray queries is an error at that pass.
+pub fn choose(
+    plan: &mut Plan,
+    asked: TraceBackend,
+    device: &DeviceTracing,
+) -> Result<bool, Vec<Diagnostic>> {
+    let insisting: Vec<_> = plan
+        .passes
+        .iter()
+        .filter(|p| insists(p))
+        .map(|p| (p.name.clone(), p.declared_at.clone()))
+        .collect();
+    let mut errors = Vec::new();
+    if !device.ray_query {
+        for (name, at) in &insisting {
+            errors.push(
+                Diagnostic::error(
+                    at.file.clone(),
+                    at.pos,
+                    format!(
+                        "pass \"{name}\" traces with `RayTracing(hardware: true)`, which needs {NEEDS}: \
+                         the device `{}` offers neither",
+                        device.name
+                    ),
+                )
+                .with_hint("drop `hardware: true` to let the software BVH trace on this device"),
+            );
+        }
+    }
+    if asked == TraceBackend::Hardware && !device.ray_query {
+        if let Some(pass) = plan.passes.iter().find(|p| traces(p)) {
+            errors.push(
+                Diagnostic::error(
+                    pass.declared_at.file.clone(),
+                    pass.declared_at.pos,
+                    format!(
+                        "--backend hardware: pass \"{}\" would trace with ray queries, which need \
+                         {NEEDS}: the device `{}` offers neither",
+                        pass.name, device.name
+                    ),
+                )
+                .with_hint("use --backend software (or auto)"),
+            );
+        }
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let hardware = match asked {
+        TraceBackend::Hardware => true,
+        TraceBackend::Software => !insisting.is_empty(),
+        TraceBackend::Auto => device.ray_query && (!device.cpu || !insisting.is_empty()),
+    };
+    if hardware {
+        for pass in plan.passes.iter_mut().filter(|p| traces(p)) {
+            pass.defines.push(HARDWARE_DEFINE.to_string());
+        }
+    }
+    Ok(hardware && plan.passes.iter().any(traces))
+}
+
+/// Whether a plan's tracing passes were compiled for ray queries.
+pub fn in_hardware(plan: &Plan) -> bool {
+    plan.passes
+        .iter()
+        .any(|p| p.defines.iter().any(|d| d == HARDWARE_DEFINE))
+}
+
+/// Whether a pass declares `RayTracing(hardware: true)`.
+fn insists(pass: &weft_graph::plan::PlanPass) -> bool {
+    call(pass, &RAY_TRACING)
+        .is_some_and(|args| args.get("hardware") == Some(&ParamValue::Bool(true)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::providers::tests::pass_with;
+    use weft_graph::schema::ProviderDecl;
+
+    fn plan_tracing(hardware: Option<bool>) -> Plan {
+        let args = hardware
+            .map(|h| ("hardware".to_string(), ParamValue::Bool(h)))
+            .into_iter()
+            .collect();
+        let mut pass = pass_with(vec![ProviderDecl {
+            name: "RayTracing".into(),
+            args,
+        }]);
+        pass.declared_at.file = "graphs/t.ron".into();
+        pass.declared_at.pos = weft_graph::spans::Pos { line: 7, col: 9 };
+        let mut plan = crate::providers::tests::plan_of_one(pass);
+        plan.passes.push(pass_with(Vec::new()));
+        plan
+    }
+
+    fn device(ray_query: bool, cpu: bool) -> DeviceTracing {
+        DeviceTracing {
+            name: "llvmpipe".into(),
+            ray_query,
+            cpu,
+        }
+    }
+
+    fn defined(plan: &Plan) -> Vec<bool> {
+        plan.passes
+            .iter()
+            .map(|p| p.defines.iter().any(|d| d == HARDWARE_DEFINE))
+            .collect()
+    }
+
+    #[test]
+    fn auto_takes_hardware_on_a_gpu_with_ray_queries_and_software_elsewhere() {
+        let cases = [
+            (device(true, false), true),
+            (device(true, true), false),
+            (device(false, false), false),
+        ];
+        for (device, expected) in cases {
+            let mut plan = plan_tracing(None);
+            let chosen = choose(&mut plan, TraceBackend::Auto, &device).expect("chosen");
+            assert_eq!(chosen, expected, "{device:?}");
+            // Only the tracing pass gets the define.
+            assert_eq!(defined(&plan), vec![expected, false]);
+            assert_eq!(in_hardware(&plan), expected);
+        }
+    }
+
+    #[test]
+    fn asking_for_a_backend_takes_it_where_the_device_allows() {
+        let mut plan = plan_tracing(None);
+        assert!(choose(&mut plan, TraceBackend::Hardware, &device(true, true)).expect("hw"));
+        let mut plan = plan_tracing(None);
+        assert!(!choose(&mut plan, TraceBackend::Software, &device(true, false)).expect("sw"));
+        assert_eq!(defined(&plan), vec![false, false]);
+    }
+
+    #[test]
+    fn hardware_on_a_device_without_ray_queries_is_refused_at_the_pass() {
+        let mut plan = plan_tracing(Some(true));
+        let errors =
+            choose(&mut plan, TraceBackend::Auto, &device(false, false)).expect_err("refused");
+        assert_eq!(errors.len(), 1);
+        let text = errors[0].to_string();
+        assert!(text.contains("graphs/t.ron:7:9"), "{text}");
+        assert!(
+            text.contains(
+                "pass \"blur\" traces with `RayTracing(hardware: true)`, which needs \
+                 VK_KHR_acceleration_structure and VK_KHR_ray_query: the device `llvmpipe` offers neither"
+            ),
+            "{text}"
+        );
+        let mut plan = plan_tracing(None);
+        let errors =
+            choose(&mut plan, TraceBackend::Hardware, &device(false, false)).expect_err("refused");
+        assert!(errors[0].to_string().contains("--backend hardware"));
+        // A pass that insists takes hardware even where auto would not.
+        let mut plan = plan_tracing(Some(true));
+        assert!(choose(&mut plan, TraceBackend::Software, &device(true, true)).expect("hw"));
+    }
+
+    #[test]
+    fn backend_names_round_trip() {
+        for backend in [
+            TraceBackend::Auto,
+            TraceBackend::Software,
+            TraceBackend::Hardware,
+        ] {
+            assert_eq!(backend.name().parse::<TraceBackend>(), Ok(backend));
+        }
+        assert!("rtx".parse::<TraceBackend>().is_err());
+    }
+}
