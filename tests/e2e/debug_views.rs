@@ -228,7 +228,10 @@ fn overshading_totals_against_the_pipeline_statistics() {
             eprintln!(
                 "{graph_name} front_to_back {front_to_back}: image total {total}, statistics {invocations}"
             );
-            assert_eq!(total, invocations, "{graph_name} {pass} front_to_back {front_to_back}");
+            assert_eq!(
+                total, invocations,
+                "{graph_name} {pass} front_to_back {front_to_back}"
+            );
         }
     }
     std::fs::remove_dir_all(&dir).unwrap();
