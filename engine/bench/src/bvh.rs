@@ -2,7 +2,11 @@
 //! scene's world-space triangles (the ones the `RayTracing` provider uploads),
 //! its shape (nodes, leaves, depth) and quality (surface area heuristic cost)
 //! as built and in the 4-wide form shaders walk, and the memory of the path
-//! tracer's texture arrays for the scene's materials.
+//! tracer's texture arrays for the scene's materials; on a device with ray
+//! queries, the hardware backend's acceleration structures beside it: the
+//! bottom levels' and top level's build, a top-level refit (what a frame
+//! that moves a placement pays) and the memory of each, against the BVH's
+//! (docs/hardware_rt.md).
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -40,6 +44,19 @@ struct Row {
     /// Reading the BVH back from the cache (`weft_render::load_or_build_bvh`), median.
     cached_ms: f64,
     texture_bytes: u64,
+    /// Bytes of the 4-wide BVH the walk reads (nodes and leaf triangles).
+    bvh_bytes: u64,
+}
+
+/// One scene's acceleration structures (hardware backend), medians of the
+/// runs.
+struct StructureRow {
+    scene: String,
+    bottom_ms: f64,
+    top_ms: f64,
+    refit_ms: f64,
+    bottom_bytes: u64,
+    top_bytes: u64,
 }
 
 /// Runs `weft bench bvh`.
@@ -90,6 +107,8 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
         collapses.sort_by(f64::total_cmp);
         let wide = wide.context("at least one collapse")?;
         cached.sort_by(f64::total_cmp);
+        let bvh_bytes = (std::mem::size_of_val(wide.nodes.as_slice())
+            + std::mem::size_of_val(wide.triangles.as_slice())) as u64;
         rows.push(Row {
             scene: path.display().to_string(),
             triangles: triangles.len(),
@@ -104,10 +123,84 @@ pub fn run(args: BvhArgs) -> Result<ExitCode> {
             wide_sah: wide.sah_cost(),
             cached_ms: cached[cached.len() / 2],
             texture_bytes,
+            bvh_bytes,
         });
     }
     print!("{}", table(&rows));
+    let gpu = weft_gpu::Gpu::new(&weft_gpu::GpuOptions::default())?;
+    if !gpu.info().shaders.ray_query {
+        println!(
+            "\n{} offers no ray queries: no acceleration structures to build",
+            gpu.info().name
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut structures = Vec::new();
+    for path in &args.scenes {
+        let scene = weft_scene::load_scene(path)
+            .with_context(|| format!("loading scene {}", path.display()))?;
+        structures.push(structure_row(&gpu, &scene, path, args.runs)?);
+    }
+    println!("\nAcceleration structures on {}:\n", gpu.info().name);
+    print!("{}", structure_table(&structures, &rows));
     Ok(ExitCode::SUCCESS)
+}
+
+/// Builds `scene`'s acceleration structures `runs` times (each on a scene
+/// uploaded afresh) and refits the top level `runs` times.
+fn structure_row(
+    gpu: &weft_gpu::Gpu,
+    scene: &weft_scene::Scene,
+    path: &std::path::Path,
+    runs: u32,
+) -> Result<StructureRow> {
+    let (mut bottom, mut top, mut refit) = (Vec::new(), Vec::new(), Vec::new());
+    let mut bytes = (0, 0);
+    for _ in 0..runs {
+        let mut uploaded = weft_render::GpuScene::new(gpu, scene, false)?;
+        uploaded.trace_in_hardware(true)?;
+        uploaded.scene_set(weft_gpu::scene::SceneSet::Traced)?;
+        let built = uploaded
+            .structure_report()
+            .context("ray queries build acceleration structures")?;
+        bottom.push(built.bottom_build.as_secs_f64() * 1e3);
+        top.push(built.top_build.as_secs_f64() * 1e3);
+        bytes = (built.bottom_bytes, built.top_bytes);
+        uploaded.refit_structures()?;
+        let refitted = uploaded.structure_report().context("still built")?;
+        refit.push(refitted.top_build.as_secs_f64() * 1e3);
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    Ok(StructureRow {
+        scene: path.display().to_string(),
+        bottom_ms: median(bottom),
+        top_ms: median(top),
+        refit_ms: median(refit),
+        bottom_bytes: bytes.0,
+        top_bytes: bytes.1,
+    })
+}
+
+fn structure_table(structures: &[StructureRow], rows: &[Row]) -> String {
+    let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
+    let mut out = String::from("| scene | bottom levels: build (ms, median) | top level: build (ms) | top level: refit (ms) | bottom levels (MiB) | top level (MiB) | BVH: build + collapse (ms) | BVH (MiB) |\n|---|---|---|---|---|---|---|---|\n");
+    for (s, r) in structures.iter().zip(rows) {
+        out.push_str(&format!(
+            "| {} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} | {:.2} |\n",
+            s.scene,
+            s.bottom_ms,
+            s.top_ms,
+            s.refit_ms,
+            mib(s.bottom_bytes),
+            mib(s.top_bytes),
+            r.build_ms + r.wide_ms,
+            mib(r.bvh_bytes)
+        ));
+    }
+    out
 }
 
 fn table(rows: &[Row]) -> String {
@@ -153,10 +246,23 @@ mod tests {
             wide_sah: 7.25,
             cached_ms: 0.125,
             texture_bytes: 3 * 1024 * 1024,
+            bvh_bytes: 1024 * 1024,
         }];
         assert_eq!(
             table(&rows),
             "| scene | triangles | build (ms, median) | from the cache (ms, median) | nodes | leaves | depth | SAH cost | 4-wide: collapse (ms, median) | nodes | depth | SAH cost | texture arrays (MiB) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n| a.scene | 12 | 0.2 | 0.1 | 7 | 4 | 3 | 9.5 | 0.1 | 2 | 2 | 7.2 | 3.0 |\n"
+        );
+        let structures = [StructureRow {
+            scene: "a.scene".into(),
+            bottom_ms: 1.25,
+            top_ms: 0.5,
+            refit_ms: 0.25,
+            bottom_bytes: 2 * 1024 * 1024,
+            top_bytes: 512 * 1024,
+        }];
+        assert_eq!(
+            structure_table(&structures, &rows),
+            "| scene | bottom levels: build (ms, median) | top level: build (ms) | top level: refit (ms) | bottom levels (MiB) | top level (MiB) | BVH: build + collapse (ms) | BVH (MiB) |\n|---|---|---|---|---|---|---|---|\n| a.scene | 1.2 | 0.50 | 0.25 | 2.00 | 0.50 | 0.3 | 1.00 |\n"
         );
     }
 }

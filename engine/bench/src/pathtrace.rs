@@ -54,6 +54,10 @@ pub struct PathtraceArgs {
     /// Also write the last render here (linear EXR).
     #[arg(long)]
     image: Option<PathBuf>,
+    /// How rays traverse the scene: `software` (the BVH walk), `hardware`
+    /// (ray queries) or `auto` (docs/hardware_rt.md).
+    #[arg(long, default_value = "auto")]
+    backend: weft_render::TraceBackend,
     /// Print the figures as JSON.
     #[arg(long)]
     json: bool,
@@ -146,6 +150,7 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
             samples: Some(spp),
             extra_readback: vec!["hdr".into()],
             params,
+            trace_backend: args.backend,
             ..RenderSettings::default()
         };
         let rendered = render(&gpu, &scene, &settings)?;
@@ -227,11 +232,18 @@ pub fn run(args: PathtraceArgs) -> Result<ExitCode> {
                 "size": [args.size.width, args.size.height],
                 "max_depth": args.max_depth,
                 "device": gpu.info().name,
+                "backend": args.backend.name(),
                 "renders": rows,
                 "image": args.image,
             })
         );
     } else {
+        println!(
+            "{} on {}, --backend {}",
+            args.scene.display(),
+            gpu.info().name,
+            args.backend.name()
+        );
         println!("| spp | seconds | samples/s | rel. MSE |\n|---|---|---|---|");
         for s in &samples {
             let rel = s.rel_mse.map(|r| format!("{r:.3e}")).unwrap_or("-".into());

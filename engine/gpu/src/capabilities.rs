@@ -92,7 +92,7 @@ impl ShaderSupport {
             compute_shared_bytes: limits.max_compute_shared_memory_size,
             compute_invocations: limits.max_compute_work_group_invocations,
             compute_size: limits.max_compute_work_group_size,
-            ray_query: crate::acceleration::offered(instance, physical),
+            ray_query: crate::ray_query::offered(instance, physical),
         }
     }
 

@@ -21,6 +21,7 @@ pub mod graphics;
 pub mod layouts;
 pub mod pipeline;
 pub mod present;
+pub mod ray_query;
 pub mod readback;
 pub mod record;
 pub mod reflect;

@@ -224,7 +224,7 @@ pub(super) fn create_device(
         Vec::new()
     };
     if ray_query {
-        extensions.extend(crate::acceleration::DEVICE_EXTENSIONS.map(|name| name.as_ptr()));
+        extensions.extend(crate::ray_query::DEVICE_EXTENSIONS.map(|name| name.as_ptr()));
     }
     let info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)

@@ -177,8 +177,10 @@ impl super::GpuScene<'_> {
         Ok(())
     }
 
-    /// Refits the top level to moved placements, when there is one.
-    pub(super) fn refit_structures(&mut self) -> Result<(), GpuError> {
+    /// Refits the top level to the placements as they are now, when there is
+    /// one: what each frame that moves a placement pays (`weft bench bvh`
+    /// times it with [`Self::structure_report`]).
+    pub fn refit_structures(&mut self) -> Result<(), GpuError> {
         match &mut self.structures {
             Some(structures) => structures.refit(&self.geometry),
             None => Ok(()),

@@ -1,0 +1,41 @@
+//! Whether a device offers hardware ray queries, and the device extensions
+//! they need: what the context enables and the capability check reports
+//! (the acceleration structures themselves are `acceleration.rs`).
+
+use ash::vk;
+
+/// The device extensions ray queries need, all enabled when offered.
+pub const DEVICE_EXTENSIONS: [&std::ffi::CStr; 3] = [
+    ash::khr::acceleration_structure::NAME,
+    ash::khr::ray_query::NAME,
+    ash::khr::deferred_host_operations::NAME,
+];
+
+/// Whether `physical` offers hardware ray queries: the extensions of
+/// [`DEVICE_EXTENSIONS`] and the `accelerationStructure`, `rayQuery` and
+/// `bufferDeviceAddress` features.
+pub(crate) fn offered(instance: &ash::Instance, physical: vk::PhysicalDevice) -> bool {
+    let Ok(extensions) = (unsafe { instance.enumerate_device_extension_properties(physical) })
+    else {
+        return false;
+    };
+    let has = |name: &std::ffi::CStr| {
+        extensions
+            .iter()
+            .any(|e| e.extension_name_as_c_str() == Ok(name))
+    };
+    if !DEVICE_EXTENSIONS.iter().all(|name| has(name)) {
+        return false;
+    }
+    let mut structures = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
+    let mut queries = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
+    let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
+    let mut features = vk::PhysicalDeviceFeatures2::default()
+        .push_next(&mut structures)
+        .push_next(&mut queries)
+        .push_next(&mut f12);
+    unsafe { instance.get_physical_device_features2(physical, &mut features) };
+    structures.acceleration_structure == vk::TRUE
+        && queries.ray_query == vk::TRUE
+        && f12.buffer_device_address == vk::TRUE
+}
