@@ -31,5 +31,4 @@ mod shading;
 mod shadows;
 mod shipped;
 mod taa;
-mod trace_backends;
 mod transparency;

@@ -39,3 +39,19 @@ pub(crate) fn offered(instance: &ash::Instance, physical: vk::PhysicalDevice) ->
         && queries.ray_query == vk::TRUE
         && f12.buffer_device_address == vk::TRUE
 }
+
+/// The ICD file of the lavapipe with ray queries that `tools/setup` unpacks
+/// beside an older system driver (`$XDG_CACHE_HOME/weft/mesa/lvp_icd.json`,
+/// `~/.cache` by default), or `WEFT_RAY_QUERY_ICD` where set: what the
+/// hardware ray tracing tests, and a user on such a system, point
+/// `VK_ICD_FILENAMES` at. `None` when neither names an existing file.
+pub fn unpacked_icd() -> Option<std::path::PathBuf> {
+    let path = match std::env::var_os("WEFT_RAY_QUERY_ICD") {
+        Some(path) => std::path::PathBuf::from(path),
+        None => std::env::var_os("XDG_CACHE_HOME")
+            .map(std::path::PathBuf::from)
+            .or_else(|| std::env::var_os("HOME").map(|h| std::path::Path::new(&h).join(".cache")))?
+            .join("weft/mesa/lvp_icd.json"),
+    };
+    path.is_file().then_some(path)
+}

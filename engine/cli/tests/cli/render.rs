@@ -414,3 +414,57 @@ fn environment_lights_a_bare_model_and_a_map_with_nan_is_refused_with_its_texel(
         "{stderr}"
     );
 }
+
+#[test]
+fn both_ray_tracing_backends_render_and_an_unknown_one_is_refused() {
+    let out_path = temp_png("backend.png");
+    // On the lavapipe with ray queries tools/setup unpacks, where the
+    // system's has none (docs/hardware_rt.md).
+    let icd = weft_gpu::ray_query::unpacked_icd();
+    let rays = |backend: &str| {
+        let mut command = crate::harness::command_in(
+            &crate::harness::repo(),
+            &[
+                "render",
+                "scenes/cornell.scene",
+                "--graph",
+                "graphs/pathtrace.ron",
+                "--spp",
+                "2",
+                "--size",
+                "24x24",
+                "--backend",
+                backend,
+                "--validate",
+                "--out",
+                &out_path.to_string_lossy(),
+            ],
+        );
+        if let Some(icd) = &icd {
+            command.env("VK_ICD_FILENAMES", icd);
+        }
+        let out = command.output().expect("weft runs");
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{backend}: {stderr}{stdout}");
+        assert!(
+            stdout.contains("validation: 0 errors, 0 warnings"),
+            "{backend}: {stdout}"
+        );
+        stdout
+            .lines()
+            .find(|l| l.starts_with("rays per pixel"))
+            .unwrap_or_else(|| panic!("{backend}: no ray counts in {stdout}"))
+            .to_string()
+    };
+    // The same paths on both: the same rays per pixel.
+    let software = rays("software");
+    assert_eq!(rays("hardware"), software);
+    let out = weft(&["render", "scenes/cornell.scene", "--backend", "rtx"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("expected auto, software or hardware, found `rtx`"),
+        "{stderr}"
+    );
+}

@@ -1,8 +1,7 @@
 //! The ray tracer's two backends against each other on one device: the
 //! software BVH walk and ray queries against hardware acceleration
-//! structures (`TRACE_HARDWARE` in `shaders/include/trace.glsl`). tools/setup
-//! installs a lavapipe with `VK_KHR_ray_query` (Mesa ≥ 24.1), so both run
-//! here; a device without it fails these tests rather than skipping them.
+//! structures (`TRACE_HARDWARE` in `shaders/include/trace.glsl`), on the
+//! device [`crate::gpu`] selects.
 //!
 //! - Hit equality: a hostile ray set (random, aimed at corners, at points on
 //!   edges, grazing; `tests/shaders/ray_set.comp`) gives the same hit on
@@ -40,12 +39,7 @@ struct Cast {
 /// `frames` frames from `time`, half a second apart.
 fn ray_hits(scene: &Path, backend: TraceBackend, (time, frames): (f64, u32)) -> Vec<Cast> {
     let scene = weft_scene::load_scene(scene).expect("scene loads");
-    let gpu = weft_tests::gpu();
-    assert!(
-        gpu.info().shaders.ray_query,
-        "the device `{}` offers no ray queries: run tools/setup (Mesa ≥ 24.1 lavapipe)",
-        gpu.info().name
-    );
+    let gpu = crate::gpu();
     let log = gpu.validation();
     let settings = RenderSettings {
         graph: weft_tests::graph("ray_set.ron"),
@@ -270,8 +264,17 @@ fn hdr_mean(graph: &str, features: &[&str], samples: Option<u64>, backend: Trace
     let mut settings = square_settings(graph, 48, samples, &[], features);
     settings.trace_backend = backend;
     settings.frames = 2;
-    let (_, values) =
-        weft_tests::render::render_hdr_validated(&root().join("scenes/cornell.scene"), settings);
+    settings.extra_readback = vec!["hdr".into()];
+    settings.readback_asked = true;
+    let scene = weft_scene::load_scene(&root().join("scenes/cornell.scene")).expect("loads");
+    let gpu = crate::gpu();
+    let log = gpu.validation();
+    let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new(), "{graph} {backend:?}");
+    let weft_gpu::Pixels::RgbaF32(values) = &rendered.report.readbacks[0].1.pixels else {
+        panic!("hdr is a float image");
+    };
     let sum: f64 = values
         .chunks(4)
         .map(|p| f64::from(p[0] + p[1] + p[2]))
