@@ -29,7 +29,9 @@ rungs=(
   "graphs/pathtrace_denoised.ron|"
 )
 
-device=$(vulkaninfo --summary 2>/dev/null | grep -m1 -E '^\s*deviceName' | sed 's/.*= //')
+# (awk reads all of vulkaninfo's output: grep -m1 would break its pipe.)
+device=$(vulkaninfo --summary 2>/dev/null | awk -F'= ' '/deviceName/ && !found {print $2; found = 1}' || true)
+device=${device:-an unnamed device}
 echo "## $device: per-pass GPU times at $size on $scene"
 echo
 for rung in "${rungs[@]}"; do
@@ -55,7 +57,7 @@ done
 echo "## $device: path tracer samples per second at $size"
 echo
 for backend in software hardware; do
-  "$weft" bench pathtrace --scene "$scene" --size "$size" --spp 16,64 --backend "$backend" --out-dir "$out"
+  "$weft" bench pathtrace --scene "$scene" --size "$size" --spp 16,64 --backend "$backend" --out-dir "$out/$backend"
   echo
 done
 

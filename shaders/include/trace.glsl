@@ -281,20 +281,30 @@ void trace_group(uint child, uint child_count, float d, float best_t, uint base,
 // tracer's order as its instance's custom index, so a hit names the
 // triangle the BVH walk would. Every triangle is opaque and seen from both
 // sides, as the walk sees it.
+#if __VERSION__ < 460
+#error "ray queries (TRACE_HARDWARE) need GLSL 4.60: make the shader that includes trace.glsl #version 460"
+#endif
 #extension GL_EXT_ray_query : require
 layout(set = SET_SCENE, binding = BINDING_TOP_LEVEL) uniform accelerationStructureEXT trace_top_level;
 
-// The most a ray query's t_max may be: it must be finite.
+// The most a ray query's t_max may be (it must be finite), and its t_min:
+// the walk keeps hits with t > 0, and a query from 0 would commit one at 0.
 #define TRACE_FINITE_FAR 3.0e38
+#define TRACE_NEAREST 1e-30
 
 // trace_walk's contract on ray queries: the nearest hit with t in (0, t_max)
 // (any hit with `first_hit`), its distance in .x and triangle in .y (as uint
 // bits), or x = -1 when nothing is hit.
 vec2 trace_walk(vec3 origin, vec3 dir, float t_max, bool first_hit) {
     COUNT_RAY();
+    // A query's origin and direction must be finite and its interval
+    // ordered; the walk finds nothing for such a ray, and so does this.
+    if (any(isnan(origin)) || any(isinf(origin)) || any(isnan(dir)) || any(isinf(dir)) || !(t_max > TRACE_NEAREST)) {
+        return vec2(-1.0, 0.0);
+    }
     rayQueryEXT query;
     uint flags = gl_RayFlagsOpaqueEXT | (first_hit ? gl_RayFlagsTerminateOnFirstHitEXT : 0u);
-    rayQueryInitializeEXT(query, trace_top_level, flags, 0xffu, origin, 0.0, dir, min(t_max, TRACE_FINITE_FAR));
+    rayQueryInitializeEXT(query, trace_top_level, flags, 0xffu, origin, TRACE_NEAREST, dir, min(t_max, TRACE_FINITE_FAR));
     while (rayQueryProceedEXT(query)) {
     }
     if (rayQueryGetIntersectionTypeEXT(query, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {

@@ -44,6 +44,8 @@ fn traced_pixels_match_the_cpu(scene: &std::path::Path, textured: bool) {
             height: HEIGHT,
         },
         extra_readback: vec!["surface".into(), "ray".into()],
+        // The CPU mirror is the software walk's, step for step.
+        trace_backend: weft_render::TraceBackend::Software,
         ..RenderSettings::default()
     };
     let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));

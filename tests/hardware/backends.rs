@@ -41,8 +41,8 @@ struct Cast {
 /// Each ray of the fixture on `scene` through `backend`, the last of
 /// `frames` frames from `time`, half a second apart.
 fn ray_hits(scene: &Path, backend: TraceBackend, (time, frames): (f64, u32)) -> Vec<Cast> {
-    let scene = weft_scene::load_scene(scene).expect("scene loads");
     let gpu = crate::gpu();
+    let scene = weft_scene::load_scene(scene).expect("scene loads");
     let log = gpu.validation();
     let settings = RenderSettings {
         graph: weft_tests::graph("ray_set.ron"),
@@ -269,8 +269,8 @@ fn hdr_mean(graph: &str, features: &[&str], samples: Option<u64>, backend: Trace
     settings.frames = 2;
     settings.extra_readback = vec!["hdr".into()];
     settings.readback_asked = true;
-    let scene = weft_scene::load_scene(&root().join("scenes/cornell.scene")).expect("loads");
     let gpu = crate::gpu();
+    let scene = weft_scene::load_scene(&root().join("scenes/cornell.scene")).expect("loads");
     let log = gpu.validation();
     let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
     drop(gpu);

@@ -1,4 +1,4 @@
-#version 450
+#version 460
 // Test fixture: one camera ray per pixel through the ray tracer's BVH
 // (include/trace.glsl). `hit` gets the hit distance (x), the triangle index
 // (y, exact in a float below 2^24) and the interpolated UV (zw), or -1 in x

@@ -288,15 +288,11 @@ impl<'g> TopLevel<'g> {
         placements: &[Placement],
     ) -> Result<(), GpuError> {
         if placements.len() as u32 != self.count {
-            return Err(GpuError::Unsupported {
-                what: format!(
-                    "refitting a top level of {} placements with {}",
-                    self.count,
-                    placements.len()
-                ),
-                device: self.gpu.info().name.clone(),
-                needs: "a rebuild".into(),
-            });
+            return Err(GpuError::Plan(format!(
+                "a top level of {} placements cannot be refitted with {}: it needs a rebuild",
+                self.count,
+                placements.len()
+            )));
         }
         self.record(
             levels,

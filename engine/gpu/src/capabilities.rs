@@ -259,13 +259,13 @@ const CORE_CAPABILITIES: [Capability; 10] = [
     Capability::StorageImageExtendedFormats,
 ];
 
-/// SPIR-V extensions that need no device extension on Vulkan 1.3: storage
-/// buffers and non-semantic debug information are core, and the Google ones
-/// only annotate.
 /// The SPIR-V extension of ray queries, enabled with the device's
 /// `VK_KHR_ray_query` where it is offered.
 const RAY_QUERY_EXTENSION: &str = "SPV_KHR_ray_query";
 
+/// SPIR-V extensions that need no device extension on Vulkan 1.3: storage
+/// buffers and non-semantic debug information are core, and the Google ones
+/// only annotate.
 const ENABLED_EXTENSIONS: [&str; 6] = [
     "SPV_KHR_storage_buffer_storage_class",
     "SPV_KHR_non_semantic_info",

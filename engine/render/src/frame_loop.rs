@@ -118,6 +118,10 @@ impl<'g> FrameLoop<'g> {
     /// compiled for ([`crate::providers::trace_backend`]), so it builds and
     /// binds what they read.
     fn choose_tracing(&mut self) -> Result<(), GpuError> {
+        // A plan that traces nothing leaves the scene's tracing as it is.
+        if !self.plan.passes.iter().any(crate::providers::traces) {
+            return Ok(());
+        }
         let hardware = crate::providers::trace_backend::in_hardware(&self.plan);
         self.recorder.scene.trace_in_hardware(hardware)
     }

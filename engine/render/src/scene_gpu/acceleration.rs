@@ -153,15 +153,21 @@ impl super::GpuScene<'_> {
         if hardware == self.hardware {
             return Ok(());
         }
-        self.hardware = hardware;
         let Some(trace) = &self.trace else {
+            self.hardware = hardware;
             return Ok(());
         };
-        if !hardware && !trace.has_bvh() {
+        let rebuild_tables = !hardware && !trace.has_bvh();
+        self.hardware = hardware;
+        if rebuild_tables {
             // Built for ray queries alone: the walk needs its BVH.
             self.trace = None;
         }
-        self.ensure_trace_buffers()?;
+        if let Err(error) = self.ensure_trace_buffers() {
+            // The bound set still holds what the other backend reads.
+            self.hardware = !hardware;
+            return Err(error);
+        }
         if let Some(set) = self.traced_set {
             self.write_scene_set(set, true);
         }
