@@ -171,3 +171,81 @@ fn ray_tracing_data_needs_the_provider_declared() {
     let clean = weft_render::check_graph_and_shaders(&declared, &target).expect("shaderc");
     assert!(clean.iter().all(|d| !d.is_error()), "{clean:#?}");
 }
+
+/// Hardware tracing, asked for (`--backend hardware`) or insisted on
+/// (`RayTracing(hardware: true)`), on this binary's device: where it has no
+/// ray queries (lavapipe before Mesa 24.1, the system driver tools/setup
+/// leaves in place), each is refused at the tracing pass of the graph, naming
+/// the missing extensions; where it has them, both render clean.
+#[test]
+fn hardware_tracing_is_refused_at_the_pass_on_a_device_without_ray_queries() {
+    let gpu = weft_tests::gpu();
+    let offered = gpu.info().shaders.ray_query;
+    let scene =
+        weft_scene::load_scene(&common::root().join("scenes/cornell.scene")).expect("loads");
+    let path = weft_tests::graph("ray_set.ron");
+    let text = std::fs::read_to_string(&path).expect("fixture");
+    let insisting = text.replace(
+        "derive: [RayTracing()]",
+        "derive: [RayTracing(hardware: true)]",
+    );
+    assert_ne!(insisting, text);
+    let graph = weft_graph::load_with(&path, &|p: &std::path::Path| {
+        if p == path {
+            Ok(insisting.clone())
+        } else {
+            std::fs::read_to_string(p)
+        }
+    });
+    let prepared = weft_graph::Prepared::new(graph).expect("the graph loads");
+    let settings = RenderSettings {
+        graph: path.clone(),
+        extent: Extent {
+            width: 8,
+            height: 8,
+        },
+        ..RenderSettings::default()
+    };
+    let insisted =
+        weft_render::render_with_progress(&gpu, &scene, &prepared, &settings, &mut |_| {});
+    let asked = render(
+        &gpu,
+        &scene,
+        &RenderSettings {
+            trace_backend: weft_render::TraceBackend::Hardware,
+            ..settings.clone()
+        },
+    );
+    let log = gpu.validation();
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+    if offered {
+        assert!(
+            insisted.is_ok() && asked.is_ok(),
+            "a device with ray queries renders both"
+        );
+        return;
+    }
+    // A pass is located at its name.
+    let pass_line = text
+        .lines()
+        .position(|l| l.trim() == "name: \"cast\",")
+        .expect("the fixture's pass")
+        + 1;
+    let at = format!("{}:{pass_line}:", path.display());
+    let insisted = insisted.err().expect("refused").to_string();
+    assert!(
+        insisted.starts_with(&at)
+            && insisted.contains(
+                "pass \"cast\" traces with `RayTracing(hardware: true)`, which needs \
+                 VK_KHR_acceleration_structure and VK_KHR_ray_query: the device `llvmpipe"
+            ),
+        "{insisted}"
+    );
+    let asked = asked.err().expect("refused").to_string();
+    assert!(
+        asked.starts_with(&at)
+            && asked.contains("--backend hardware: pass \"cast\" would trace with ray queries"),
+        "{asked}"
+    );
+}
