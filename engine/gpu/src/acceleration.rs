@@ -86,19 +86,35 @@ fn loader(gpu: &Gpu) -> Result<&ash::khr::acceleration_structure::Device, GpuErr
     })
 }
 
-/// One mesh in its own space: positions and triangle indices into them.
-pub struct Mesh<'a> {
-    /// Vertex positions.
-    pub positions: &'a [[f32; 3]],
-    /// Three indices per triangle.
-    pub indices: &'a [u32],
+/// The usage the buffers a build reads meshes from need: the renderer's
+/// vertex and index buffers carry it on a device with ray queries, so the
+/// bottom levels read the geometry already there.
+pub const INPUT_USAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::from_raw(
+    vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR.as_raw()
+        | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS.as_raw(),
+);
+
+/// One mesh in its own space, in buffers made with [`INPUT_USAGE`]: vertex
+/// positions (three floats at the start of each vertex) and 32-bit indices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Mesh {
+    /// Device address of its first vertex.
+    pub vertices: u64,
+    /// Bytes from one vertex to the next.
+    pub stride: u64,
+    /// The highest index its triangles use.
+    pub max_vertex: u32,
+    /// Device address of its first index.
+    pub indices: u64,
+    /// How many triangles: three indices each.
+    pub triangles: u32,
 }
 
 /// The bottom levels over a scene's meshes, built together.
 pub struct BottomLevels<'g> {
     /// One per mesh, in the order given.
     pub levels: Vec<AccelerationStructure<'g>>,
-    /// How long the build took on the device, the upload of its inputs included.
+    /// How long the build took: recording, submission and the wait.
     pub build_time: Duration,
 }
 
@@ -106,7 +122,7 @@ pub struct BottomLevels<'g> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Placement {
     /// Object-to-world, the top three rows of the matrix, row-major.
-    pub transform: [[f32; 4]; 3],
+    pub transform: [f32; 12],
     /// Which bottom level it places (an index into [`BottomLevels::levels`]).
     pub level: usize,
     /// What ray queries report for its hits as the instance's custom index
@@ -121,44 +137,31 @@ pub const MAX_CUSTOM_INDEX: u32 = (1 << 24) - 1;
 /// faces seen, built for fast tracing), in one command buffer.
 pub fn build_bottom_levels<'g>(
     gpu: &'g Gpu,
-    meshes: &[Mesh<'_>],
+    meshes: &[Mesh],
 ) -> Result<BottomLevels<'g>, GpuError> {
     let loader = loader(gpu)?;
     let start = Instant::now();
-    let input = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
-        | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
-    let positions: Vec<[f32; 3]> = meshes.iter().flat_map(|m| m.positions).copied().collect();
-    let indices: Vec<u32> = meshes.iter().flat_map(|m| m.indices).copied().collect();
-    let positions = Buffer::device_local(gpu, "BLAS positions", bytes(&positions), input)?;
-    let indices = Buffer::device_local(gpu, "BLAS indices", bytes(&indices), input)?;
-    let (vertex_base, index_base) = (positions.address(), indices.address());
-    let mut geometries = Vec::with_capacity(meshes.len());
-    let (mut first_vertex, mut first_index) = (0u64, 0u64);
-    for mesh in meshes {
-        let triangles = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
-            .vertex_format(vk::Format::R32G32B32_SFLOAT)
-            .vertex_data(vk::DeviceOrHostAddressConstKHR {
-                device_address: vertex_base + first_vertex * 12,
-            })
-            .vertex_stride(12)
-            .max_vertex(mesh.positions.len().saturating_sub(1) as u32)
-            .index_type(vk::IndexType::UINT32)
-            .index_data(vk::DeviceOrHostAddressConstKHR {
-                device_address: index_base + first_index * 4,
-            });
-        geometries.push(
+    let geometries: Vec<_> = meshes
+        .iter()
+        .map(|mesh| {
+            let triangles = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
+                .vertex_format(vk::Format::R32G32B32_SFLOAT)
+                .vertex_data(vk::DeviceOrHostAddressConstKHR {
+                    device_address: mesh.vertices,
+                })
+                .vertex_stride(mesh.stride)
+                .max_vertex(mesh.max_vertex)
+                .index_type(vk::IndexType::UINT32)
+                .index_data(vk::DeviceOrHostAddressConstKHR {
+                    device_address: mesh.indices,
+                });
             vk::AccelerationStructureGeometryKHR::default()
                 .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
                 .geometry(vk::AccelerationStructureGeometryDataKHR { triangles })
-                .flags(vk::GeometryFlagsKHR::OPAQUE),
-        );
-        first_vertex += mesh.positions.len() as u64;
-        first_index += mesh.indices.len() as u64;
-    }
-    let counts: Vec<u32> = meshes
-        .iter()
-        .map(|m| (m.indices.len() / 3) as u32)
+                .flags(vk::GeometryFlagsKHR::OPAQUE)
+        })
         .collect();
+    let counts: Vec<u32> = meshes.iter().map(|m| m.triangles).collect();
     let mut levels = Vec::with_capacity(meshes.len());
     let mut scratch_offsets = Vec::with_capacity(meshes.len());
     let mut scratch_size = 0u64;
@@ -367,14 +370,7 @@ fn instance(
     let flags = vk::GeometryInstanceFlagsKHR::TRIANGLE_FACING_CULL_DISABLE.as_raw() as u8;
     Ok(vk::AccelerationStructureInstanceKHR {
         transform: vk::TransformMatrixKHR {
-            matrix: [
-                placement.transform[0],
-                placement.transform[1],
-                placement.transform[2],
-            ]
-            .concat()
-            .try_into()
-            .unwrap_or([0.0; 12]),
+            matrix: placement.transform,
         },
         instance_custom_index_and_mask: vk::Packed24_8::new(
             placement.custom_index & MAX_CUSTOM_INDEX,
@@ -487,9 +483,4 @@ fn built(gpu: &Gpu, cmd: vk::CommandBuffer) {
     let barriers = [barrier];
     let dependency = vk::DependencyInfo::default().memory_barriers(&barriers);
     unsafe { gpu.device().cmd_pipeline_barrier2(cmd, &dependency) };
-}
-
-fn bytes<T: Copy>(values: &[T]) -> &[u8] {
-    // Plain floats and integers: every byte is initialised.
-    unsafe { std::slice::from_raw_parts(values.as_ptr().cast(), std::mem::size_of_val(values)) }
 }

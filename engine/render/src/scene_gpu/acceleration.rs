@@ -7,47 +7,60 @@
 //! the same triangle the software walk does. Moved placements refit the top
 //! level in place; the bottom levels never change.
 
-use crate::geometry::{MeshRange, SceneGeometry};
+use crate::geometry::{MeshRange, SceneGeometry, VERTEX_BYTES};
 use std::collections::HashMap;
 use std::time::Duration;
 use weft_gpu::acceleration::{self, BottomLevels, Mesh, Placement, TopLevel};
+use weft_gpu::buffer::Buffer;
 use weft_gpu::{Gpu, GpuError};
 
 /// The scene's acceleration structures on the device.
 pub(super) struct SceneStructures<'g> {
     bottom: BottomLevels<'g>,
     pub(super) top: TopLevel<'g>,
-}
-
-/// A mesh's place in the shared index and vertex buffers: placements of
-/// one mesh share its bottom level.
-type MeshKey = (u32, u32, i32);
-
-fn key(range: &MeshRange) -> MeshKey {
-    (range.first_index, range.index_count, range.vertex_offset)
+    /// Per traced draw, in the ray tracer's order, the bottom level it places.
+    levels: Vec<usize>,
 }
 
 impl<'g> SceneStructures<'g> {
-    /// Builds the bottom levels over `geometry`'s meshes and the top level
-    /// placing them as its draw records do now.
-    pub(super) fn build(gpu: &'g Gpu, geometry: &SceneGeometry) -> Result<Self, GpuError> {
+    /// Builds the bottom levels over `geometry`'s meshes, read in place from
+    /// the scene's vertex and index buffers (made with
+    /// [`acceleration::INPUT_USAGE`]), and the top level placing them as its
+    /// draw records do now.
+    pub(super) fn build(
+        gpu: &'g Gpu,
+        geometry: &SceneGeometry,
+        (vertices, indices): (&Buffer<'g>, &Buffer<'g>),
+    ) -> Result<Self, GpuError> {
         let (meshes, levels) = distinct_meshes(geometry);
-        let inputs: Vec<(Vec<[f32; 3]>, Vec<u32>)> =
-            meshes.iter().map(|m| mesh_input(geometry, m)).collect();
-        let views: Vec<Mesh<'_>> = inputs
+        let (vertex_base, index_base) = (vertices.address(), indices.address());
+        let inputs: Vec<Mesh> = meshes
             .iter()
-            .map(|(positions, indices)| Mesh { positions, indices })
+            .map(|mesh| {
+                let first = mesh.first_index as usize;
+                let used = &geometry.indices[first..first + mesh.index_count as usize];
+                Mesh {
+                    vertices: vertex_base + mesh.vertex_offset as u64 * VERTEX_BYTES as u64,
+                    stride: VERTEX_BYTES as u64,
+                    max_vertex: used.iter().copied().max().unwrap_or(0),
+                    indices: index_base + u64::from(mesh.first_index) * 4,
+                    triangles: mesh.index_count / 3,
+                }
+            })
             .collect();
-        let bottom = acceleration::build_bottom_levels(gpu, &views)?;
+        let bottom = acceleration::build_bottom_levels(gpu, &inputs)?;
         let top = TopLevel::build(gpu, &bottom, &placements(geometry, &levels)?)?;
-        Ok(Self { bottom, top })
+        Ok(Self {
+            bottom,
+            top,
+            levels,
+        })
     }
 
     /// Refits the top level to the draw records' transforms as they are now.
     pub(super) fn refit(&mut self, geometry: &SceneGeometry) -> Result<(), GpuError> {
-        let (_, levels) = distinct_meshes(geometry);
         self.top
-            .refit(&self.bottom, &placements(geometry, &levels)?)
+            .refit(&self.bottom, &placements(geometry, &self.levels)?)
     }
 
     /// How long the bottom levels took to build, and the top level's last
@@ -64,17 +77,22 @@ impl<'g> SceneStructures<'g> {
     }
 }
 
-/// The distinct meshes the ray tracer's draws place, in first-placed order,
-/// and the index of each key among them.
-fn distinct_meshes(geometry: &SceneGeometry) -> (Vec<MeshRange>, HashMap<MeshKey, usize>) {
+/// The distinct meshes the ray tracer's draws place, in first-placed order
+/// (placements of one mesh, the same range of the shared buffers, share its
+/// bottom level), and per traced draw the index of its mesh among them.
+fn distinct_meshes(geometry: &SceneGeometry) -> (Vec<MeshRange>, Vec<usize>) {
     let mut meshes = Vec::new();
-    let mut levels = HashMap::new();
-    for draw in traced_draws(geometry) {
-        levels.entry(key(&draw.range)).or_insert_with(|| {
-            meshes.push(draw.range);
-            meshes.len() - 1
-        });
-    }
+    let mut seen = HashMap::new();
+    let levels = traced_draws(geometry)
+        .map(|draw| {
+            let range = draw.range;
+            let key = (range.first_index, range.index_count, range.vertex_offset);
+            *seen.entry(key).or_insert_with(|| {
+                meshes.push(range);
+                meshes.len() - 1
+            })
+        })
+        .collect();
     (meshes, levels)
 }
 
@@ -86,28 +104,12 @@ fn traced_draws(geometry: &SceneGeometry) -> impl Iterator<Item = &crate::geomet
         .filter(|d| geometry.draw_records.get(d.draw_id as usize).is_some())
 }
 
-/// A mesh's positions (those its indices reach) and its triangles' indices.
-fn mesh_input(geometry: &SceneGeometry, mesh: &MeshRange) -> (Vec<[f32; 3]>, Vec<u32>) {
-    let first = mesh.first_index as usize;
-    let indices = geometry.indices[first..first + mesh.index_count as usize].to_vec();
-    let reach = indices.iter().max().map_or(0, |&i| i as usize + 1);
-    let base = mesh.vertex_offset as usize;
-    let positions = geometry.vertices[base..base + reach]
-        .iter()
-        .map(|v| v.position)
-        .collect();
-    (positions, indices)
-}
-
 /// Each traced draw as a placement: its record's transform, its mesh's
-/// level and its first triangle.
-fn placements(
-    geometry: &SceneGeometry,
-    levels: &HashMap<MeshKey, usize>,
-) -> Result<Vec<Placement>, GpuError> {
+/// level (`levels`, per traced draw) and its first triangle.
+fn placements(geometry: &SceneGeometry, levels: &[usize]) -> Result<Vec<Placement>, GpuError> {
     let mut first_triangle = 0u32;
     let mut placements = Vec::new();
-    for draw in traced_draws(geometry) {
+    for (draw, &level) in traced_draws(geometry).zip(levels) {
         if first_triangle > acceleration::MAX_CUSTOM_INDEX {
             return Err(GpuError::Allocation {
                 what: "the top-level acceleration structure".into(),
@@ -118,11 +120,14 @@ fn placements(
                 ),
             });
         }
-        let model = geometry.draw_records[draw.draw_id as usize].model;
-        let rows = model.transpose().to_cols_array_2d();
+        // The transpose's columns are the model matrix's rows.
+        let rows = geometry.draw_records[draw.draw_id as usize]
+            .model
+            .transpose()
+            .to_cols_array();
         placements.push(Placement {
-            transform: [rows[0], rows[1], rows[2]],
-            level: levels[&key(&draw.range)],
+            transform: std::array::from_fn(|i| rows[i]),
+            level,
             custom_index: first_triangle,
         });
         first_triangle += draw.range.index_count / 3;
@@ -178,7 +183,8 @@ impl super::GpuScene<'_> {
     /// queries and they are not built yet.
     pub(super) fn ensure_structures(&mut self) -> Result<(), GpuError> {
         if self.hardware && self.structures.is_none() {
-            self.structures = Some(SceneStructures::build(self.gpu, &self.geometry)?);
+            let buffers = (&self.vertices, &self.indices);
+            self.structures = Some(SceneStructures::build(self.gpu, &self.geometry, buffers)?);
         }
         Ok(())
     }

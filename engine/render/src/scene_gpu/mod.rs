@@ -161,11 +161,16 @@ impl<'g> GpuScene<'g> {
             )));
         }
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        // Bottom-level acceleration structures read the geometry in place.
+        let geometry_usage = match gpu.info().shaders.ray_query {
+            true => storage | weft_gpu::acceleration::INPUT_USAGE,
+            false => storage,
+        };
         let vertices = Buffer::device_local(
             gpu,
             "scene vertices",
             bytes_of(&geometry.vertices),
-            vk::BufferUsageFlags::VERTEX_BUFFER | storage,
+            vk::BufferUsageFlags::VERTEX_BUFFER | geometry_usage,
         )?;
         let index_bytes: Vec<u8> = geometry
             .indices
@@ -176,7 +181,7 @@ impl<'g> GpuScene<'g> {
             gpu,
             "scene indices",
             &index_bytes,
-            vk::BufferUsageFlags::INDEX_BUFFER | storage,
+            vk::BufferUsageFlags::INDEX_BUFFER | geometry_usage,
         )?;
         let draws = rewritable(
             gpu,
