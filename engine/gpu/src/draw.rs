@@ -1,20 +1,20 @@
 //! The narrow seam through which a renderer records scene draws (meshes,
 //! light volumes) inside the render passes the executor begins. The executor
-//! prepares every pass, scene passes included: their pipelines come from its
-//! one cache, built against the registered scene interface, with set 0 and
-//! push constants bound by [`RasterContext::bind_variant`]. A draw recorder
-//! only binds the scene's sets and issues draws.
+//! prepares every pass before its first frame, scene passes included: the
+//! draw recorder names the pipeline variants each scene pass binds
+//! ([`DrawRecorder::variants`]), and the executor builds them from its one
+//! cache against the registered scene interface and writes their set 0. At
+//! record time [`RasterContext::bind_variant`] only binds; a recorder only
+//! binds the scene's sets and issues draws.
 
-use crate::bind::{pack_push, resolve_bindings, FrameValues};
+use crate::bind::{pack_push, FrameValues, ResolvedBinding};
 use crate::check::scene_pass_keys_with;
 use crate::context::Gpu;
-use crate::descriptors::{write_graph_set, DescriptorPool};
 use crate::error::GpuError;
-use crate::pipeline::{Pipeline, PipelineCache, PipelineKey, ShaderKey};
+use crate::pipeline::{Pipeline, PipelineKey, ShaderKey};
 use crate::resources::FrameResources;
-use crate::samplers::Samplers;
 use crate::scene::RegisteredScene;
-use crate::scene_check::{scene_pass_problems, with_per_draw};
+use crate::scene_check::with_per_draw;
 use crate::sets::SCENE_SET;
 use crate::state::{pass_state, PassState};
 use ash::vk;
@@ -23,25 +23,43 @@ use weft_graph::id::{PassId, ResourceId};
 use weft_graph::plan::{Plan, PlanPass};
 use weft_graph::schema::ParamValue;
 
-/// Pipeline variants one scene pass may use in a prepared plan: two shading
-/// models, each opaque and blended.
-pub const SCENE_VARIANTS: u32 = 4;
-
-/// A scene pass's pipeline variant made ready for one prepared plan: its
-/// pipeline and its set 0, written once.
-pub(crate) struct Variant {
-    key: PipelineKey,
-    pipeline: Arc<Pipeline>,
-    graph_set: vk::DescriptorSet,
+/// One pipeline variant a scene pass binds: its shaders compiled with
+/// `defines`, drawn with `state` (the pass's own, or one derived from it
+/// such as blended transparency).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneVariant {
+    /// The shader defines (the pass's, or those for one shading model).
+    pub defines: Vec<String>,
+    /// The fixed-function state.
+    pub state: PassState,
 }
 
-/// What the executor lends a scene pass for building and binding its variants.
-pub(crate) struct ScenePass<'a> {
-    pub(crate) pipelines: &'a mut PipelineCache,
-    pub(crate) scene: &'a RegisteredScene<'a>,
-    pub(crate) samplers: &'a Samplers,
-    pub(crate) variants: &'a mut Vec<Variant>,
-    pub(crate) pool: Option<&'a DescriptorPool<'a>>,
+impl SceneVariant {
+    /// The pipeline key and the shaders of this variant of `pass` in
+    /// `render_pass`; `None` when the pass has no vertex shader.
+    pub(crate) fn key(
+        &self,
+        pass: &PlanPass,
+        render_pass: vk::RenderPass,
+    ) -> Option<(PipelineKey, Vec<ShaderKey>)> {
+        let keys = scene_pass_keys_with(pass, &self.defines)?;
+        let key = PipelineKey::Scene {
+            vertex: keys[0].clone(),
+            fragment: keys.get(1).cloned(),
+            render_pass,
+            state: self.state.clone(),
+        };
+        Some((key, keys))
+    }
+}
+
+/// A scene pass's pipeline variant made ready for one prepared plan: its
+/// pipeline, the graph resources its set 0 reads, and that set once written.
+pub(crate) struct Variant {
+    pub(crate) key: PipelineKey,
+    pub(crate) pipeline: Arc<Pipeline>,
+    pub(crate) bindings: Vec<ResolvedBinding>,
+    pub(crate) graph_set: vk::DescriptorSet,
 }
 
 /// What a draw recorder gets for a pass that draws scene content: it
@@ -65,7 +83,10 @@ pub struct RasterContext<'a> {
     pub resources: &'a FrameResources<'a>,
     /// The frame's `time`, `frame`, `extent` and `history_frames` for push constants.
     pub frame: FrameValues,
-    pub(crate) scene: Option<ScenePass<'a>>,
+    /// The registered scene interface, for the per-draw parameters.
+    pub(crate) scene: Option<&'a RegisteredScene<'a>>,
+    /// The pass's variants, prepared with the plan.
+    pub(crate) variants: &'a [Variant],
 }
 
 impl RasterContext<'_> {
@@ -103,34 +124,27 @@ impl RasterContext<'_> {
     /// Binds a variant of the pass's pipeline: its shaders compiled with
     /// `defines`, drawn with `state` (the pass's own, or one derived from it
     /// such as blended transparency), with set 0 (the graph resources it
-    /// reads, written once per prepared plan) and the push constants. Built,
-    /// after the scene interface check, on first use.
+    /// reads, written once per prepared plan) and the push constants. The
+    /// variant must be one the recorder's [`DrawRecorder::variants`] named,
+    /// so it was built and checked before the first frame.
     pub fn bind_variant(
         &mut self,
         defines: &[String],
         state: &PassState,
     ) -> Result<Arc<Pipeline>, GpuError> {
-        let keys = scene_pass_keys_with(self.pass(), defines)
-            .ok_or_else(|| self.fail("needs a vertex shader"))?;
-        let key = PipelineKey::Scene {
-            vertex: keys[0].clone(),
-            fragment: keys.get(1).cloned(),
-            render_pass: self.render_pass,
+        let wanted = SceneVariant {
+            defines: defines.to_vec(),
             state: state.clone(),
         };
-        let (gpu, plan, pass, resources) = (self.gpu, self.plan, self.pass_index, self.resources);
-        let Some(scene) = self.scene.as_mut() else {
-            return Err(self.fail("draws scene content but no scene interface is registered"));
+        let (key, _) = wanted
+            .key(self.pass(), self.render_pass)
+            .ok_or_else(|| self.fail("needs a vertex shader"))?;
+        let Some(variant) = self.variants.iter().find(|v| v.key == key) else {
+            return Err(self.fail(format!(
+                "binds a pipeline variant (defines [{}]) its draw recorder did not name in `DrawRecorder::variants`, so none was prepared",
+                defines.join(", ")
+            )));
         };
-        let index = match scene.variants.iter().position(|v| v.key == key) {
-            Some(index) => index,
-            None => {
-                let variant = scene.prepare_variant((gpu, plan, pass, resources), key, &keys)?;
-                scene.variants.push(variant);
-                scene.variants.len() - 1
-            }
-        };
-        let variant = &scene.variants[index];
         let (pipeline, graph_set) = (Arc::clone(&variant.pipeline), variant.graph_set);
         let commands = self.commands();
         commands.bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
@@ -159,9 +173,8 @@ impl RasterContext<'_> {
         };
         let scene = self
             .scene
-            .as_ref()
             .ok_or_else(|| self.fail("no scene interface is registered"))?;
-        let mut params = with_per_draw(&scene.scene.interface, self.pass());
+        let mut params = with_per_draw(&scene.interface, self.pass());
         for (name, value) in overrides {
             params.insert(name.to_string(), ParamValue::Number(*value));
         }
@@ -173,84 +186,6 @@ impl RasterContext<'_> {
     }
 }
 
-impl ScenePass<'_> {
-    /// Checks the variant's shaders against the graph and the scene
-    /// interface, builds its pipeline and writes its set 0.
-    fn prepare_variant(
-        &mut self,
-        (gpu, plan, pass_index, resources): (&Gpu, &Plan, PassId, &FrameResources<'_>),
-        key: PipelineKey,
-        keys: &[ShaderKey],
-    ) -> Result<Variant, GpuError> {
-        let pass = &plan.passes[pass_index];
-        let fail = |message: String| GpuError::Pass {
-            pass: pass.name.clone(),
-            message,
-        };
-        let depth_clamp = matches!(&key, PipelineKey::Scene { state, .. } if state.depth_clamp);
-        if depth_clamp && !gpu.info().depth_clamp {
-            return Err(fail(
-                "`raster.depth_clamp` needs the device feature depthClamp, which this device lacks"
-                    .into(),
-            ));
-        }
-        let modules = keys
-            .iter()
-            .map(|k| self.pipelines.shader(k))
-            .collect::<Result<Vec<_>, _>>()?;
-        let compiled: Vec<_> = modules.iter().map(|m| &m.compiled).collect();
-        let info = gpu.info();
-        info.shaders.check(&info.name, &pass.name, &compiled)?;
-        let problems = scene_pass_problems(
-            &self.scene.interface,
-            plan,
-            pass,
-            &modules[0].interface,
-            modules.get(1).map(|m| &m.interface),
-        );
-        if !problems.is_empty() {
-            return Err(fail(problems.join("; ")));
-        }
-        let pipeline = self
-            .pipelines
-            .pipeline(gpu.device(), &key, Some(self.scene))?;
-        let mut graph_only = pipeline.interface.clone();
-        graph_only.bindings.retain(|(set, _), _| *set == 0);
-        let mut graph_set = vk::DescriptorSet::null();
-        if !graph_only.bindings.is_empty() {
-            let resolved = resolve_bindings(plan, pass, &graph_only).map_err(|problems| {
-                GpuError::Mismatch {
-                    pass: pass.name.clone(),
-                    problems,
-                }
-            })?;
-            let pool = self
-                .pool
-                .ok_or_else(|| fail("no descriptor pool for scene passes".into()))?;
-            graph_set = pool.allocate(pipeline.set_layouts[0]).map_err(|e| {
-                fail(format!(
-                    "its graph set for one more pipeline variant could not be allocated ({e}); a prepared plan holds {} per scene pass",
-                    SCENE_VARIANTS
-                ))
-            })?;
-            let samplers = self.samplers;
-            write_graph_set(
-                gpu,
-                graph_set,
-                &resolved,
-                resources,
-                |compare, format| samplers.for_binding(gpu, compare, format),
-                |r| crate::convert::layout(crate::layouts::layout_at(plan, pass_index, r)),
-            )?;
-        }
-        Ok(Variant {
-            key,
-            pipeline,
-            graph_set,
-        })
-    }
-}
-
 /// Records the draws of raster passes whose content comes from outside the
 /// graph (scene meshes, light volumes); the render crate implements it.
 pub trait DrawRecorder {
@@ -259,6 +194,17 @@ pub trait DrawRecorder {
     /// per-frame state (counters) may be recycled.
     fn begin_frame(&mut self) -> Result<(), GpuError> {
         Ok(())
+    }
+
+    /// The pipeline variants `pass` (a scene pass) binds through
+    /// [`RasterContext::bind_variant`] with the recorder's current scene;
+    /// the executor builds each, and writes its set 0, before the first
+    /// frame, and prepares the plan again when the list changes. None by
+    /// default: a recorder that draws without the executor's pipelines
+    /// (clears) needs none.
+    fn variants(&self, pass: &PlanPass) -> Vec<SceneVariant> {
+        let _ = pass;
+        Vec::new()
     }
 
     /// Records the pass's draws into `ctx.cmd`, binding pipelines with

@@ -113,6 +113,12 @@ pub struct Rendered {
     /// pipelines and, for a graph that traces, the BVH and the ray tracer's
     /// tables ([`FrameLoop::prepare`]); not counted against `time_limit`.
     pub prepare_ms: f64,
+    /// Pipelines built before the first frame, every scene-pass variant the
+    /// scene needs among them.
+    pub pipelines_prepared: usize,
+    /// Pipelines after the last frame: the same number, since no frame
+    /// builds one.
+    pub pipelines_built: usize,
     /// Textures that could not be loaded, meshes skipped.
     pub warnings: Vec<String>,
     /// Samples per pixel the output holds, for a progressive graph.
@@ -330,6 +336,7 @@ pub fn render_with_progress(
     let preparing = std::time::Instant::now();
     frames.prepare()?;
     let prepare_ms = preparing.elapsed().as_secs_f64() * 1e3;
+    let pipelines_prepared = frames.pipeline_count();
     let mut record_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut frame_ms = Vec::with_capacity(count.min(4096) as usize);
     let mut timings = Vec::with_capacity(count.min(4096) as usize);
@@ -371,6 +378,7 @@ pub fn render_with_progress(
     let report =
         last.ok_or_else(|| RenderError::Gpu(weft_gpu::GpuError::Plan("no frame".into())))?;
     let draw_calls = frames.draw_calls();
+    let pipelines_built = frames.pipeline_count();
     let culling = frames.culling().to_vec();
     let warnings = frames.warnings().to_vec();
     drop(frames);
@@ -390,6 +398,8 @@ pub fn render_with_progress(
         timings,
         rays,
         prepare_ms,
+        pipelines_prepared,
+        pipelines_built,
     })
 }
 

@@ -100,12 +100,17 @@ impl<'g> FrameLoop<'g> {
         })
     }
 
+    /// Pipelines built so far (the executor's cache).
+    pub fn pipeline_count(&self) -> usize {
+        self.renderer.pipelines().pipeline_count()
+    }
+
     /// Builds the plan's pipelines, and the ray tracer's BVH and tables when
     /// a pass traces, now instead of in the first frame, so a caller timing
     /// frames can leave the builds out.
     pub fn prepare(&mut self) -> Result<(), RenderError> {
         self.renderer
-            .prepare(&self.plan, &mut self.resources)
+            .prepare(&self.plan, &mut self.resources, &self.recorder)
             .map_err(|e| RenderError::at_pass(e, &self.plan))?;
         self.choose_tracing()?;
         if self.plan.passes.iter().any(crate::providers::traces) {

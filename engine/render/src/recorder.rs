@@ -15,9 +15,10 @@ use glam::{Mat4, Vec3};
 use weft_gpu::commands::Commands;
 use weft_gpu::pipeline::Pipeline;
 
-use weft_gpu::state::{front_face, BlendCode, DepthTest, PassState};
+use weft_gpu::draw::SceneVariant;
+use weft_gpu::state::{front_face, pass_state, BlendCode, DepthTest, PassState};
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, MATERIAL_SET, SCENE_SET};
-use weft_graph::plan::LoadOp;
+use weft_graph::plan::{LoadOp, PlanPass};
 use weft_graph::schema::{CompareOp, Draw, LightKind, MaterialFilter, ShadingModel};
 
 /// The most light volumes (point spheres, spot cones and spheres) one pass
@@ -240,6 +241,39 @@ impl<'g> SceneRecorder<'g> {
         Ok(calls)
     }
 
+    /// The variants `draw_variants` binds for the draws of `filter` with
+    /// `state`: the pass's own, or with `by_model` one per shading model
+    /// among those draws.
+    fn model_variants(
+        &self,
+        pass: &PlanPass,
+        state: &PassState,
+        filter: MaterialFilter,
+        by_model: bool,
+    ) -> Vec<SceneVariant> {
+        if !by_model {
+            return vec![SceneVariant {
+                defines: pass.defines.clone(),
+                state: state.clone(),
+            }];
+        }
+        let mut models: Vec<ShadingModel> = self
+            .scene
+            .geometry
+            .filtered(filter)
+            .map(|d| self.model_of(d))
+            .collect();
+        models.sort();
+        models.dedup();
+        models
+            .into_iter()
+            .map(|model| SceneVariant {
+                defines: pass.defines_for(model),
+                state: state.clone(),
+            })
+            .collect()
+    }
+
     /// The shading model of a draw's material, as passes group draws by it.
     fn model_of(&self, d: &DrawItem) -> ShadingModel {
         let material = self.scene.geometry.materials.get(d.material as usize);
@@ -388,6 +422,38 @@ impl DrawRecorder for SceneRecorder<'_> {
         self.draw_calls = 0;
         self.culling.clear();
         Ok(())
+    }
+
+    /// What `record` binds, with this scene: one variant per shading model
+    /// among the pass's draws when it groups by model (opaque, and blended
+    /// where it blends the scene's transparent meshes itself), else the
+    /// pass's own.
+    fn variants(&self, pass: &PlanPass) -> Vec<SceneVariant> {
+        let state = pass_state(pass);
+        let by_model = pass.groups_by_model() && providers::shadow_atlas(pass).is_none();
+        match pass.draw {
+            Some(Draw::Meshes(MaterialFilter::All)) if blends_transparency(&state) => {
+                let mut variants =
+                    self.model_variants(pass, &state, MaterialFilter::Opaque, by_model);
+                let transparent = self.scene.geometry.filtered(MaterialFilter::Transparent);
+                if transparent.count() > 0 {
+                    let blended = transparent_state(&state);
+                    variants.extend(self.model_variants(
+                        pass,
+                        &blended,
+                        MaterialFilter::Transparent,
+                        by_model,
+                    ));
+                }
+                variants
+            }
+            Some(Draw::Meshes(filter)) => self.model_variants(pass, &state, filter, by_model),
+            Some(Draw::LightVolumes(_)) => vec![SceneVariant {
+                defines: pass.defines.clone(),
+                state,
+            }],
+            _ => Vec::new(),
+        }
     }
 
     fn record(&mut self, ctx: &mut RasterContext<'_>) -> Result<(), GpuError> {

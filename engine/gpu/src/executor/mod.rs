@@ -6,7 +6,7 @@
 use crate::bind::ResolvedBinding;
 use crate::check::{self, PassShaders, ShaderProblem};
 use crate::context::{Gpu, MemoryReport};
-use crate::draw::{DrawRecorder, Variant};
+use crate::draw::{DrawRecorder, SceneVariant, Variant};
 use crate::error::GpuError;
 use crate::frame::FramePools;
 use crate::pipeline::{Pipeline, PipelineCache, PipelineKey};
@@ -20,10 +20,12 @@ use crate::scene_check::scene_set_problems;
 use crate::sets::SCENE_SET;
 use crate::statistics::PassStatistics;
 use crate::timing::{PassTiming, TimingMode, TimingSource};
+mod kinds;
 mod prepare;
 mod record_pass;
 
 use crate::descriptors::DescriptorPool;
+use kinds::PassAt;
 
 use ash::vk;
 use std::sync::Arc;
@@ -108,8 +110,29 @@ pub(crate) struct Prepared {
     bindings: Vec<ResolvedBinding>,
     push: Vec<u8>,
     set: vk::DescriptorSet,
-    /// A scene pass's pipeline variants, built as its draws first need them.
+    /// A scene pass's pipeline variants, the draw recorder's list built
+    /// before the first frame.
     variants: Vec<Variant>,
+}
+
+impl Prepared {
+    /// Nothing prepared yet: no pipeline, the plan's extent.
+    fn new(plan: &Plan) -> Self {
+        Self {
+            pipeline: None,
+            render_pass: vk::RenderPass::null(),
+            framebuffer: vk::Framebuffer::null(),
+            extent: vk::Extent2D {
+                width: plan.extent.width,
+                height: plan.extent.height,
+            },
+            clears: Vec::new(),
+            bindings: Vec::new(),
+            push: Vec::new(),
+            set: vk::DescriptorSet::null(),
+            variants: Vec::new(),
+        }
+    }
 }
 
 /// A plan's passes made ready on its resources, once: pipelines, render
@@ -121,11 +144,12 @@ pub(crate) struct PreparedPlan<'g> {
     generation: u64,
     /// The [`FrameResources::id`] it was prepared on.
     resources: u64,
+    /// Per pass, the scene variants the draw recorder named when it was
+    /// prepared; a different list (a new scene) prepares the plan again.
+    wanted: Vec<Vec<SceneVariant>>,
     passes: Vec<Prepared>,
-    /// Holds the passes' descriptor sets.
+    /// Holds the passes' and the scene variants' descriptor sets.
     _pool: DescriptorPool<'g>,
-    /// Holds the scene passes' variants' graph sets.
-    scene_pool: Option<DescriptorPool<'g>>,
 }
 
 /// Executes plans; owns the render-pass and pipeline caches and the samplers.
@@ -299,33 +323,50 @@ impl<'g> Renderer<'g> {
         Ok(Some((key, bindings)))
     }
 
-    /// Builds the plan's pipelines and writes its descriptor sets now rather
-    /// than in the first [`execute`](Self::execute), so a caller that times
-    /// frames (`--time-limit`) can leave the pipeline builds out.
+    /// Builds the plan's pipelines, the scene passes' variants `draws` names
+    /// among them, and writes its descriptor sets now rather than in the
+    /// first [`execute`](Self::execute), so a caller that times frames
+    /// (`--time-limit`) can leave the pipeline builds out.
     pub fn prepare(
         &mut self,
         plan: &Plan,
         resources: &mut FrameResources<'g>,
+        draws: &dyn DrawRecorder,
     ) -> Result<(), GpuError> {
-        let ready = self.ready_plan(plan, resources)?;
+        let ready = self.ready_plan(plan, resources, draws)?;
         self.prepared = Some(ready);
         Ok(())
     }
 
     /// The prepared plan kept from the last frame or [`prepare`](Self::prepare),
-    /// or a new one when the plan's pipelines or its resources changed since.
+    /// or a new one when the plan's pipelines, its resources or the scene
+    /// variants `draws` names changed since.
     fn ready_plan(
         &mut self,
         plan: &Plan,
         resources: &mut FrameResources<'g>,
+        draws: &dyn DrawRecorder,
     ) -> Result<PreparedPlan<'g>, GpuError> {
+        let wanted: Vec<Vec<SceneVariant>> = plan
+            .passes
+            .iter()
+            .map(|pass| {
+                if kinds::draws_scene(pass) {
+                    draws.variants(pass)
+                } else {
+                    Vec::new()
+                }
+            })
+            .collect();
         match self.prepared.take() {
             Some(ready)
-                if ready.generation == self.generation && ready.resources == resources.id =>
+                if ready.generation == self.generation
+                    && ready.resources == resources.id
+                    && ready.wanted == wanted =>
             {
                 Ok(ready)
             }
-            _ => self.prepare_plan(plan, resources),
+            _ => self.prepare_plan(plan, resources, wanted),
         }
     }
 
@@ -340,7 +381,7 @@ impl<'g> Renderer<'g> {
     ) -> Result<FrameReport, GpuError> {
         let started = Instant::now();
         draws.begin_frame()?;
-        let mut ready = self.ready_plan(plan, resources)?;
+        let mut ready = self.ready_plan(plan, resources, &*draws)?;
         for (pass, prep) in plan.passes.iter().zip(&mut ready.passes) {
             prep.push = self.pack_push(pass, prep, options, 0)?;
         }
@@ -369,7 +410,7 @@ impl<'g> Renderer<'g> {
             plan,
             (resources, draws),
             &mut pools,
-            (&mut ready.passes, ready.scene_pool.as_ref()),
+            &mut ready.passes,
             options,
             started,
         );
@@ -408,7 +449,7 @@ impl<'g> Renderer<'g> {
         plan: &Plan,
         (resources, draws): (&mut FrameResources<'g>, &mut dyn DrawRecorder),
         pools: &mut FramePools<'g>,
-        (prepared, scene_pool): (&mut [Prepared], Option<&DescriptorPool<'g>>),
+        prepared: &mut [Prepared],
         options: &FrameOptions,
         started: Instant,
     ) -> Result<Recorded, GpuError> {
@@ -446,13 +487,12 @@ impl<'g> Renderer<'g> {
             if let Some(s) = &stats {
                 s.begin(cmd, i as u32);
             }
-            self.record_pass(
-                (plan, PassId::new(i), pass),
-                (&mut prepared[i], scene_pool),
-                resources,
-                (draws, options),
-                cmd,
-            )?;
+            let at = PassAt {
+                plan,
+                index: PassId::new(i),
+                pass,
+            };
+            self.record_pass(at, &mut prepared[i], resources, (draws, options), cmd)?;
             if let Some(s) = &stats {
                 s.end(cmd, i as u32);
             }

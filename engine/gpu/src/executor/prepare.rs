@@ -1,40 +1,67 @@
-//! Per-pass preparation before recording: pipelines, render passes and
-//! framebuffers, push-constant bytes, descriptor sets written with image
-//! layouts as the plan's barriers leave them.
+//! A plan's preparation before recording: every pass through its kind
+//! ([`super::kinds`]), then one descriptor pool sized from the prepared
+//! sets' bindings and every set written with image layouts as the plan's
+//! barriers leave them; push-constant bytes per frame.
 
+use super::kinds::{self, PassAt};
 use super::{FrameOptions, Prepared, PreparedPlan, Renderer};
-use crate::bind::{self, FrameValues};
+use crate::bind::{self, FrameValues, ResolvedBinding};
 use crate::context::Gpu;
 use crate::descriptors::DescriptorPool;
-use crate::draw::SCENE_VARIANTS;
+use crate::draw::SceneVariant;
 use crate::error::GpuError;
 use crate::layouts;
 use crate::resources::FrameResources;
 use ash::vk;
 use weft_graph::id::PassId;
 use weft_graph::plan::{Plan, PlanPass, PlanResource, ResourceDesc};
-use weft_graph::schema::Draw;
 
 impl<'g> Renderer<'g> {
-    /// Prepares every pass of `plan` on `resources` and writes their descriptor sets.
+    /// Prepares every pass of `plan` on `resources` (scene passes with the
+    /// variants `wanted` names for them) and writes every descriptor set
+    /// from one pool sized from their layouts.
     pub(super) fn prepare_plan(
         &mut self,
         plan: &Plan,
         resources: &mut FrameResources<'g>,
+        wanted: Vec<Vec<SceneVariant>>,
     ) -> Result<PreparedPlan<'g>, GpuError> {
         let mut passes = Vec::with_capacity(plan.passes.len());
-        for pass in &plan.passes {
-            passes.push(self.prepare_pass(plan, pass, resources)?);
+        for (index, (pass, variants)) in plan.passes.iter().zip(&wanted).enumerate() {
+            let mut prepared = Prepared::new(plan);
+            let at = PassAt {
+                plan,
+                index: PassId::new(index),
+                pass,
+            };
+            kinds::of(pass).prepare(self, at, resources, variants, &mut prepared)?;
+            passes.push(prepared);
         }
         let pool = descriptor_pool(self.gpu, &passes)?;
         self.write_descriptors(plan, resources, &pool, &mut passes)?;
         Ok(PreparedPlan {
             generation: self.generation,
             resources: resources.id,
+            wanted,
             passes,
             _pool: pool,
-            scene_pool: scene_pool(self.gpu, plan)?,
         })
+    }
+
+    /// Checks the pass's shaders against the graph and builds its own
+    /// pipeline (compute and fullscreen passes).
+    pub(super) fn prepare_pipeline(
+        &mut self,
+        plan: &Plan,
+        pass: &PlanPass,
+        prepared: &mut Prepared,
+    ) -> Result<(), GpuError> {
+        if let Some((key, bindings)) = self.checked_interface(plan, pass)? {
+            let scene = self.scene.as_ref();
+            prepared.pipeline = Some(self.pipelines.pipeline(self.gpu.device(), &key, scene)?);
+            prepared.bindings = bindings;
+        }
+        Ok(())
     }
 
     /// This frame's push-constant bytes of a prepared pass for its
@@ -68,53 +95,8 @@ impl<'g> Renderer<'g> {
         })
     }
 
-    fn prepare_pass(
-        &mut self,
-        plan: &Plan,
-        pass: &PlanPass,
-        resources: &mut FrameResources<'g>,
-    ) -> Result<Prepared, GpuError> {
-        let checked = self.checked_interface(plan, pass)?;
-        let mut prepared = Prepared {
-            pipeline: None,
-            render_pass: vk::RenderPass::null(),
-            framebuffer: vk::Framebuffer::null(),
-            extent: vk::Extent2D {
-                width: plan.extent.width,
-                height: plan.extent.height,
-            },
-            clears: Vec::new(),
-            bindings: Vec::new(),
-            push: Vec::new(),
-            set: vk::DescriptorSet::null(),
-            variants: Vec::new(),
-        };
-        if let Some((key, bindings)) = checked {
-            let scene = self.scene.as_ref();
-            prepared.pipeline = Some(self.pipelines.pipeline(self.gpu.device(), &key, scene)?);
-            prepared.bindings = bindings;
-        }
-        if let Some(rp) = &pass.render_pass {
-            prepared.render_pass = self.render_passes.get(self.gpu.device(), rp)?;
-            prepared.extent = vk::Extent2D {
-                width: rp.extent.width,
-                height: rp.extent.height,
-            };
-            let mut views = Vec::with_capacity(rp.attachments.len());
-            for a in &rp.attachments {
-                views.push(resources.image(a.resource)?.attachment_view);
-                prepared
-                    .clears
-                    .push(clear_value(&plan.resources[a.resource], &a.clear));
-            }
-            prepared.framebuffer =
-                resources.framebuffer(prepared.render_pass, views, prepared.extent)?;
-        }
-        Ok(prepared)
-    }
-
-    /// Writes every pass's descriptor set, with image layouts as the plan's
-    /// barriers leave them at that pass.
+    /// Writes every pass's descriptor set and its scene variants' sets 0,
+    /// with image layouts as the plan's barriers leave them at that pass.
     fn write_descriptors(
         &self,
         plan: &Plan,
@@ -125,36 +107,53 @@ impl<'g> Renderer<'g> {
         let mut layouts = layouts::frame_start(plan);
         for (index, prep) in prepared.iter_mut().enumerate() {
             layouts::apply_pass(plan, PassId::new(index), &mut layouts);
-            let Some(pipeline) = &prep.pipeline else {
-                continue;
+            let write = |set_layout: vk::DescriptorSetLayout, bindings: &[ResolvedBinding]| {
+                let set = pool.allocate(set_layout)?;
+                crate::descriptors::write_graph_set(
+                    self.gpu,
+                    set,
+                    bindings,
+                    resources,
+                    |compare, format| self.samplers.for_binding(self.gpu, compare, format),
+                    |r| crate::convert::layout(layouts[r]),
+                )?;
+                Ok::<_, GpuError>(set)
             };
-            let Some(&set_layout) = pipeline.set_layouts.first() else {
-                continue;
-            };
-            prep.set = pool.allocate(set_layout)?;
-            crate::descriptors::write_graph_set(
-                self.gpu,
-                prep.set,
-                &prep.bindings,
-                resources,
-                |compare, format| self.samplers.for_binding(self.gpu, compare, format),
-                |r| crate::convert::layout(layouts[r]),
-            )?;
+            if let Some(&set_layout) = prep.pipeline.as_ref().and_then(|p| p.set_layouts.first()) {
+                prep.set = write(set_layout, &prep.bindings)?;
+            }
+            for variant in prep.variants.iter_mut().filter(|v| !v.bindings.is_empty()) {
+                variant.graph_set = write(variant.pipeline.set_layouts[0], &variant.bindings)?;
+            }
         }
         Ok(())
     }
 }
 
-/// A pool with room for every prepared pass's descriptor set.
+/// A pool with room for every prepared pass's descriptor set and its scene
+/// variants' sets 0, counted from their resolved bindings.
 fn descriptor_pool<'g>(
     gpu: &'g Gpu,
     prepared: &[Prepared],
 ) -> Result<DescriptorPool<'g>, GpuError> {
     let mut counts: Vec<(vk::DescriptorType, u32)> = Vec::new();
     let mut sets = 0;
-    for p in prepared.iter().filter(|p| p.pipeline.is_some()) {
+    let pass_sets = prepared
+        .iter()
+        .filter(|p| {
+            p.pipeline
+                .as_ref()
+                .is_some_and(|p| !p.set_layouts.is_empty())
+        })
+        .map(|p| p.bindings.as_slice());
+    let variant_sets = prepared
+        .iter()
+        .flat_map(|p| &p.variants)
+        .filter(|v| !v.bindings.is_empty())
+        .map(|v| v.bindings.as_slice());
+    for bindings in pass_sets.chain(variant_sets) {
         sets += 1;
-        for b in &p.bindings {
+        for b in bindings {
             let ty = b.shader.kind.vk();
             match counts.iter_mut().find(|(t, _)| *t == ty) {
                 Some((_, n)) => *n += b.shader.count,
@@ -165,37 +164,8 @@ fn descriptor_pool<'g>(
     DescriptorPool::new(gpu, sets, &counts)
 }
 
-/// Whether a pass draws scene content through the draw recorder.
-fn draws_scene(pass: &PlanPass) -> bool {
-    matches!(pass.draw, Some(Draw::Meshes(_) | Draw::LightVolumes(_)))
-}
-
-/// A pool with room for the graph sets of [`SCENE_VARIANTS`] pipeline
-/// variants of every scene pass (each binding counted for every descriptor
-/// type, as arrays of up to 8: the variants' layouts are not known before
-/// their shaders are); `None` for a plan without scene passes.
-fn scene_pool<'g>(gpu: &'g Gpu, plan: &Plan) -> Result<Option<DescriptorPool<'g>>, GpuError> {
-    let scene_passes: Vec<&PlanPass> = plan.passes.iter().filter(|p| draws_scene(p)).collect();
-    if scene_passes.is_empty() {
-        return Ok(None);
-    }
-    let sets = SCENE_VARIANTS * scene_passes.len() as u32;
-    let bindings: u32 = scene_passes
-        .iter()
-        .map(|p| p.bindings.len().max(1) as u32)
-        .sum();
-    let per_type = SCENE_VARIANTS * bindings * 8;
-    let counts = [
-        vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-        vk::DescriptorType::STORAGE_IMAGE,
-        vk::DescriptorType::STORAGE_BUFFER,
-        vk::DescriptorType::UNIFORM_BUFFER,
-    ]
-    .map(|ty| (ty, per_type));
-    DescriptorPool::new(gpu, sets, &counts).map(Some)
-}
-
-fn clear_value(resource: &PlanResource, clear: &[f64]) -> vk::ClearValue {
+/// The clear value of an attachment: depth for a depth image, else colour.
+pub(super) fn clear_value(resource: &PlanResource, clear: &[f64]) -> vk::ClearValue {
     let depth = matches!(&resource.desc, ResourceDesc::Image(d) if d.aspect != weft_graph::vk::Aspect::Color);
     if depth {
         vk::ClearValue {

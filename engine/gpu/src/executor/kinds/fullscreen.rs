@@ -1,0 +1,64 @@
+//! Fullscreen passes: a checked pipeline drawing one triangle inside the
+//! pass's render pass, with scene data bound when its shaders read it.
+
+use super::{PassAt, PassKindOps, Recording};
+use crate::draw::SceneVariant;
+use crate::error::GpuError;
+use crate::executor::{Prepared, Renderer};
+use crate::resources::FrameResources;
+use crate::sets::SCENE_SET;
+
+/// The fullscreen kind (a `Fullscreen` pass, or a `Raster` pass drawing
+/// `FullscreenTriangle`).
+pub(super) struct Fullscreen;
+
+impl PassKindOps for Fullscreen {
+    fn prepare<'g>(
+        &self,
+        renderer: &mut Renderer<'g>,
+        at: PassAt<'_>,
+        resources: &mut FrameResources<'g>,
+        _variants: &[SceneVariant],
+        prepared: &mut Prepared,
+    ) -> Result<(), GpuError> {
+        super::prepare_render_pass(renderer, at, resources, prepared)?;
+        renderer.prepare_pipeline(at.plan, at.pass, prepared)
+    }
+
+    fn record<'g>(
+        &self,
+        renderer: &mut Renderer<'g>,
+        rec: &mut Recording<'_, 'g>,
+    ) -> Result<(), GpuError> {
+        let device = renderer.gpu.device();
+        let Some(pipeline) = rec.prep.pipeline.clone() else {
+            return Err(GpuError::Pass {
+                pass: rec.at.pass.name.clone(),
+                message: "has no pipeline prepared".into(),
+            });
+        };
+        super::begin_render_pass(device, rec.cmd, rec.prep);
+        renderer.bind(rec.cmd, rec.prep);
+        let reads_scene = pipeline
+            .interface
+            .bindings
+            .keys()
+            .any(|(s, _)| *s == SCENE_SET);
+        let bound = if reads_scene {
+            let ctx = super::raster_context(
+                renderer,
+                (rec.at, &*rec.prep, rec.resources),
+                (rec.cmd, rec.frame),
+                rec.prep.render_pass,
+            );
+            rec.draws.bind_scene(&ctx, &pipeline)
+        } else {
+            Ok(())
+        };
+        if bound.is_ok() {
+            unsafe { device.cmd_draw(rec.cmd, 3, 1, 0, 0) };
+        }
+        super::end_render_pass(device, rec.cmd);
+        bound
+    }
+}
