@@ -65,10 +65,11 @@ fn a_scene_pass_names_only_the_variants_its_scene_draws() {
     let graph = weft_graph::Prepared::new(weft_graph::load(&weft_tests::shipped("forward.ron")))
         .expect("forward loads");
     let (phong, metal) = (ShadingModel::BlinnPhong, ShadingModel::MetallicRoughness);
-    let cases: [(bool, bool, &[(ShadingModel, bool)]); 3] = [
-        (true, false, &[(phong, true)]),
-        (false, true, &[(metal, false)]),
-        (true, true, &[(metal, false), (phong, true)]),
+    // (quad, helmet, the variants as (model, blended)).
+    let cases = [
+        (true, false, vec![(phong, true)]),
+        (false, true, vec![(metal, false)]),
+        (true, true, vec![(metal, false), (phong, true)]),
     ];
     for (quad, helmet, expected) in cases {
         let scene = weft_scene::load_scene(&variant_scene(&dir.0, quad, helmet)).expect("scene");
