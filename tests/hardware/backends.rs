@@ -64,13 +64,11 @@ fn ray_hits(scene: &Path, backend: TraceBackend, (time, frames): (f64, u32)) -> 
         weft_gpu::Pixels::RgbaF32(texels) => texels.clone(),
         _ => panic!("the fixture's images are float images"),
     };
-    let hits = floats(&rendered.report.output.expect("read back").pixels);
+    let hits = floats(&rendered.report.output.as_ref().expect("read back").pixels);
     let read = |name: &str| {
-        let (_, image) = rendered
+        let image = rendered
             .report
-            .readbacks
-            .iter()
-            .find(|(n, _)| n == name)
+            .first_read_back(&[name.to_string()])
             .unwrap_or_else(|| panic!("{name} read back"));
         floats(&image.pixels)
     };

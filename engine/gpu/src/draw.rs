@@ -197,11 +197,12 @@ pub trait DrawRecorder {
     }
 
     /// The pipeline variants `pass` (a scene pass) binds through
-    /// [`RasterContext::bind_variant`] with the recorder's current scene;
-    /// the executor builds each, and writes its set 0, before the first
-    /// frame, and prepares the plan again when the list changes. None by
-    /// default: a recorder that draws without the executor's pipelines
-    /// (clears) needs none.
+    /// [`RasterContext::bind_variant`] with the recorder's scene; the
+    /// executor builds each, and writes its set 0, when it prepares the
+    /// plan, before the first frame. The list must stay the same while the
+    /// plan is kept: a recorder with another scene is handed over with
+    /// [`crate::Renderer::forget_prepared`]. None by default: a recorder
+    /// that draws without the executor's pipelines (clears) needs none.
     fn variants(&self, pass: &PlanPass) -> Vec<SceneVariant> {
         let _ = pass;
         Vec::new()

@@ -236,6 +236,8 @@ impl<'g> FrameLoop<'g> {
         self.recorder = recorder;
         self.updater = updater;
         self.plan_frames = 0;
+        // The scene passes' variants are the new scene's.
+        self.renderer.forget_prepared();
     }
 
     /// Drops every shader and pipeline built from the edited source `changed`

@@ -39,6 +39,13 @@ fn blends_transparency(state: &PassState) -> bool {
     !state.blends.is_empty() && state.blends.iter().all(|b| *b == BlendCode::Off)
 }
 
+/// Whether a pass draws its meshes in runs of one shading model, each with
+/// that model's variant: it groups by model and is not a shadow-atlas pass
+/// (whose views draw every mesh with the pass's own).
+fn draws_by_model(pass: &PlanPass) -> bool {
+    pass.groups_by_model() && providers::shadow_atlas(pass).is_none()
+}
+
 /// The state for transparent meshes in such a pass: alpha blending, depth tested
 /// but not written, so they do not hide each other or what lies behind them.
 fn transparent_state(state: &PassState) -> PassState {
@@ -430,13 +437,13 @@ impl DrawRecorder for SceneRecorder<'_> {
     /// pass's own.
     fn variants(&self, pass: &PlanPass) -> Vec<SceneVariant> {
         let state = pass_state(pass);
-        let by_model = pass.groups_by_model() && providers::shadow_atlas(pass).is_none();
+        let by_model = draws_by_model(pass);
         match pass.draw {
             Some(Draw::Meshes(MaterialFilter::All)) if blends_transparency(&state) => {
                 let mut variants =
                     self.model_variants(pass, &state, MaterialFilter::Opaque, by_model);
-                let transparent = self.scene.geometry.filtered(MaterialFilter::Transparent);
-                if transparent.count() > 0 {
+                let mut transparent = self.scene.geometry.filtered(MaterialFilter::Transparent);
+                if transparent.next().is_some() {
                     let blended = transparent_state(&state);
                     variants.extend(self.model_variants(
                         pass,
@@ -469,7 +476,7 @@ impl DrawRecorder for SceneRecorder<'_> {
             .ok_or_else(|| fail("raster pass without a `draw`".into()))?;
         let defines = pass.defines.clone();
         let shadow_atlas = providers::shadow_atlas(pass);
-        let by_model = pass.groups_by_model() && shadow_atlas.is_none();
+        let by_model = draws_by_model(pass);
         let state = ctx.pass_state();
         let mut calls = 0u64;
         match draw {

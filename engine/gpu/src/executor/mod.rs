@@ -3,10 +3,11 @@
 //! command buffer (or one per pass when profiling), submits, and reads the
 //! output back.
 
+use crate::bind::FrameValues;
 use crate::bind::ResolvedBinding;
 use crate::check::{self, PassShaders, ShaderProblem};
 use crate::context::{Gpu, MemoryReport};
-use crate::draw::{DrawRecorder, SceneVariant, Variant};
+use crate::draw::{DrawRecorder, Variant};
 use crate::error::GpuError;
 use crate::frame::FramePools;
 use crate::pipeline::{Pipeline, PipelineCache, PipelineKey};
@@ -50,6 +51,21 @@ pub struct FrameOptions {
     /// For `plan_frames` push constants: frames drawn before this one on the
     /// same resources (see [`crate::bind::FrameValues`]).
     pub plan_frames: u32,
+}
+
+impl FrameOptions {
+    /// The values shaders read as push constants for a pass drawn at
+    /// `extent`, in its `repeat_index`-th dispatch.
+    fn frame_values(&self, extent: vk::Extent2D, repeat_index: u32) -> FrameValues {
+        FrameValues {
+            time: self.time,
+            frame: self.frame,
+            extent: [extent.width, extent.height],
+            history_frames: self.history_frames,
+            plan_frames: self.plan_frames,
+            repeat_index,
+        }
+    }
 }
 
 /// What a frame produced; serialises (without the image) for `--json`.
@@ -110,8 +126,8 @@ pub(crate) struct Prepared {
     bindings: Vec<ResolvedBinding>,
     push: Vec<u8>,
     set: vk::DescriptorSet,
-    /// A scene pass's pipeline variants, the draw recorder's list built
-    /// before the first frame.
+    /// A scene pass's pipeline variants, those its draw recorder names,
+    /// built before the first frame.
     variants: Vec<Variant>,
 }
 
@@ -144,9 +160,6 @@ pub(crate) struct PreparedPlan<'g> {
     generation: u64,
     /// The [`FrameResources::id`] it was prepared on.
     resources: u64,
-    /// Per pass, the scene variants the draw recorder named when it was
-    /// prepared; a different list (a new scene) prepares the plan again.
-    wanted: Vec<Vec<SceneVariant>>,
     passes: Vec<Prepared>,
     /// Holds the passes' and the scene variants' descriptor sets.
     _pool: DescriptorPool<'g>,
@@ -338,35 +351,29 @@ impl<'g> Renderer<'g> {
         Ok(())
     }
 
+    /// Drops the prepared plan, so the next frame prepares it again: a
+    /// caller that hands frames a draw recorder holding another scene calls
+    /// it, since the scene passes' variants are the recorder's.
+    pub fn forget_prepared(&mut self) {
+        self.prepared = None;
+    }
+
     /// The prepared plan kept from the last frame or [`prepare`](Self::prepare),
-    /// or a new one when the plan's pipelines, its resources or the scene
-    /// variants `draws` names changed since.
+    /// or a new one when the plan's pipelines or its resources changed since
+    /// (or [`forget_prepared`](Self::forget_prepared) was called).
     fn ready_plan(
         &mut self,
         plan: &Plan,
         resources: &mut FrameResources<'g>,
         draws: &dyn DrawRecorder,
     ) -> Result<PreparedPlan<'g>, GpuError> {
-        let wanted: Vec<Vec<SceneVariant>> = plan
-            .passes
-            .iter()
-            .map(|pass| {
-                if kinds::draws_scene(pass) {
-                    draws.variants(pass)
-                } else {
-                    Vec::new()
-                }
-            })
-            .collect();
         match self.prepared.take() {
             Some(ready)
-                if ready.generation == self.generation
-                    && ready.resources == resources.id
-                    && ready.wanted == wanted =>
+                if ready.generation == self.generation && ready.resources == resources.id =>
             {
                 Ok(ready)
             }
-            _ => self.prepare_plan(plan, resources, wanted),
+            _ => self.prepare_plan(plan, resources, draws),
         }
     }
 

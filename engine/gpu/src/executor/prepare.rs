@@ -3,12 +3,12 @@
 //! sets' bindings and every set written with image layouts as the plan's
 //! barriers leave them; push-constant bytes per frame.
 
-use super::kinds::{self, PassAt};
+use super::kinds::{self, PassAt, Preparing};
 use super::{FrameOptions, Prepared, PreparedPlan, Renderer};
-use crate::bind::{self, FrameValues, ResolvedBinding};
+use crate::bind::{self, ResolvedBinding};
 use crate::context::Gpu;
 use crate::descriptors::DescriptorPool;
-use crate::draw::SceneVariant;
+use crate::draw::DrawRecorder;
 use crate::error::GpuError;
 use crate::layouts;
 use crate::resources::FrameResources;
@@ -18,23 +18,28 @@ use weft_graph::plan::{Plan, PlanPass, PlanResource, ResourceDesc};
 
 impl<'g> Renderer<'g> {
     /// Prepares every pass of `plan` on `resources` (scene passes with the
-    /// variants `wanted` names for them) and writes every descriptor set
+    /// variants `draws` names for them) and writes every descriptor set
     /// from one pool sized from their layouts.
     pub(super) fn prepare_plan(
         &mut self,
         plan: &Plan,
         resources: &mut FrameResources<'g>,
-        wanted: Vec<Vec<SceneVariant>>,
+        draws: &dyn DrawRecorder,
     ) -> Result<PreparedPlan<'g>, GpuError> {
         let mut passes = Vec::with_capacity(plan.passes.len());
-        for (index, (pass, variants)) in plan.passes.iter().zip(&wanted).enumerate() {
+        for (index, pass) in plan.passes.iter().enumerate() {
             let mut prepared = Prepared::new(plan);
-            let at = PassAt {
-                plan,
-                index: PassId::new(index),
-                pass,
+            let mut prep = Preparing {
+                at: PassAt {
+                    plan,
+                    index: PassId::new(index),
+                    pass,
+                },
+                resources,
+                draws,
+                prepared: &mut prepared,
             };
-            kinds::of(pass).prepare(self, at, resources, variants, &mut prepared)?;
+            kinds::of(pass).prepare(self, &mut prep)?;
             passes.push(prepared);
         }
         let pool = descriptor_pool(self.gpu, &passes)?;
@@ -42,7 +47,6 @@ impl<'g> Renderer<'g> {
         Ok(PreparedPlan {
             generation: self.generation,
             resources: resources.id,
-            wanted,
             passes,
             _pool: pool,
         })
@@ -81,14 +85,7 @@ impl<'g> Renderer<'g> {
         else {
             return Ok(Vec::new());
         };
-        let frame = FrameValues {
-            time: options.time,
-            frame: options.frame,
-            extent: [prep.extent.width, prep.extent.height],
-            history_frames: options.history_frames,
-            plan_frames: options.plan_frames,
-            repeat_index,
-        };
+        let frame = options.frame_values(prep.extent, repeat_index);
         bind::pack_push(block, &pass.params, &frame).map_err(|problems| GpuError::Pass {
             pass: pass.name.clone(),
             message: problems.join("; "),

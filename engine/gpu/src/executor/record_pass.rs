@@ -3,7 +3,6 @@
 
 use super::kinds::{self, PassAt, Recording};
 use super::{FrameOptions, Prepared, Renderer};
-use crate::bind::FrameValues;
 use crate::draw::DrawRecorder;
 use crate::error::GpuError;
 use crate::frame::Label;
@@ -22,14 +21,7 @@ impl<'g> Renderer<'g> {
         cmd: vk::CommandBuffer,
     ) -> Result<(), GpuError> {
         let device = self.gpu.device();
-        let frame = FrameValues {
-            time: options.time,
-            frame: options.frame,
-            extent: [prep.extent.width, prep.extent.height],
-            history_frames: options.history_frames,
-            plan_frames: options.plan_frames,
-            repeat_index: 0,
-        };
+        let frame = options.frame_values(prep.extent, 0);
         let label = Label::begin(self.gpu, cmd, &at.pass.name);
         record::barriers(device, cmd, &at.pass.barriers, resources)?;
         if self.traces(at.pass) {

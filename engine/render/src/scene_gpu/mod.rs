@@ -162,9 +162,10 @@ impl<'g> GpuScene<'g> {
         }
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         // Bottom-level acceleration structures read the geometry in place.
-        let geometry_usage = match gpu.info().shaders.ray_query {
-            true => storage | weft_gpu::acceleration::INPUT_USAGE,
-            false => storage,
+        let geometry_usage = if gpu.info().shaders.ray_query {
+            storage | weft_gpu::acceleration::INPUT_USAGE
+        } else {
+            storage
         };
         let vertices = Buffer::device_local(
             gpu,

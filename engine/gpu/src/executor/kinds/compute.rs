@@ -2,11 +2,10 @@
 //! reads it (tiled light culling reads the camera and the lights), and one
 //! dispatch or `repeat` of them with the pass's repeat barriers between.
 
-use super::{PassAt, PassKindOps, Recording};
+use super::{PassKindOps, Preparing, Recording};
 use crate::bind::REPEAT_INDEX;
-use crate::draw::SceneVariant;
 use crate::error::GpuError;
-use crate::executor::{Prepared, Renderer};
+use crate::executor::Renderer;
 use crate::record;
 use crate::resources::FrameResources;
 use crate::sets::SCENE_SET;
@@ -21,12 +20,9 @@ impl PassKindOps for Compute {
     fn prepare<'g>(
         &self,
         renderer: &mut Renderer<'g>,
-        at: PassAt<'_>,
-        _resources: &mut FrameResources<'g>,
-        _variants: &[SceneVariant],
-        prepared: &mut Prepared,
+        prep: &mut Preparing<'_, 'g>,
     ) -> Result<(), GpuError> {
-        renderer.prepare_pipeline(at.plan, at.pass, prepared)
+        renderer.prepare_pipeline(prep.at.plan, prep.at.pass, prep.prepared)
     }
 
     fn record<'g>(

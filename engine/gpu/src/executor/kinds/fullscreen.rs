@@ -1,11 +1,9 @@
 //! Fullscreen passes: a checked pipeline drawing one triangle inside the
 //! pass's render pass, with scene data bound when its shaders read it.
 
-use super::{PassAt, PassKindOps, Recording};
-use crate::draw::SceneVariant;
+use super::{PassKindOps, Preparing, Recording};
 use crate::error::GpuError;
-use crate::executor::{Prepared, Renderer};
-use crate::resources::FrameResources;
+use crate::executor::Renderer;
 use crate::sets::SCENE_SET;
 
 /// The fullscreen kind (a `Fullscreen` pass, or a `Raster` pass drawing
@@ -16,13 +14,10 @@ impl PassKindOps for Fullscreen {
     fn prepare<'g>(
         &self,
         renderer: &mut Renderer<'g>,
-        at: PassAt<'_>,
-        resources: &mut FrameResources<'g>,
-        _variants: &[SceneVariant],
-        prepared: &mut Prepared,
+        prep: &mut Preparing<'_, 'g>,
     ) -> Result<(), GpuError> {
-        super::prepare_render_pass(renderer, at, resources, prepared)?;
-        renderer.prepare_pipeline(at.plan, at.pass, prepared)
+        super::prepare_render_pass(renderer, prep)?;
+        renderer.prepare_pipeline(prep.at.plan, prep.at.pass, prep.prepared)
     }
 
     fn record<'g>(

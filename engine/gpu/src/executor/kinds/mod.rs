@@ -11,27 +11,28 @@ mod transfer;
 use super::{FrameOptions, Prepared, Renderer};
 use crate::bind::FrameValues;
 use crate::check::is_fullscreen;
-use crate::draw::{DrawRecorder, RasterContext, SceneVariant};
+use crate::draw::{DrawRecorder, RasterContext};
 use crate::error::GpuError;
 use crate::resources::FrameResources;
 use ash::vk;
 use weft_graph::id::PassId;
 use weft_graph::plan::{Plan, PlanPass};
-use weft_graph::schema::{Draw, PassKind};
+use weft_graph::schema::PassKind;
 
 /// How one kind of pass is made ready and recorded.
 pub(super) trait PassKindOps: Sync {
-    /// Makes the pass ready on `resources`: its checked pipeline, render
-    /// pass and framebuffer, the scene variants `variants` names; descriptor
-    /// sets are written afterwards, once the plan's pool is sized.
+    /// Makes the pass ready: its checked pipeline, render pass and
+    /// framebuffer, the scene variants its draw recorder names; descriptor
+    /// sets are written afterwards, once the plan's pool is sized. Nothing
+    /// by default (copies and blits).
     fn prepare<'g>(
         &self,
         renderer: &mut Renderer<'g>,
-        at: PassAt<'_>,
-        resources: &mut FrameResources<'g>,
-        variants: &[SceneVariant],
-        prepared: &mut Prepared,
-    ) -> Result<(), GpuError>;
+        prep: &mut Preparing<'_, 'g>,
+    ) -> Result<(), GpuError> {
+        let _ = (renderer, prep);
+        Ok(())
+    }
 
     /// Records the pass's work into `rec.cmd`; its barriers are recorded.
     fn record<'g>(
@@ -47,6 +48,14 @@ pub(super) struct PassAt<'a> {
     pub(super) plan: &'a Plan,
     pub(super) index: PassId,
     pub(super) pass: &'a PlanPass,
+}
+
+/// Everything a pass is prepared with.
+pub(super) struct Preparing<'a, 'g> {
+    pub(super) at: PassAt<'a>,
+    pub(super) resources: &'a mut FrameResources<'g>,
+    pub(super) draws: &'a dyn DrawRecorder,
+    pub(super) prepared: &'a mut Prepared,
 }
 
 /// Everything a pass records with.
@@ -72,19 +81,18 @@ pub(super) fn of(pass: &PlanPass) -> &'static dyn PassKindOps {
     }
 }
 
-/// Whether a pass draws scene content through the draw recorder.
-pub(super) fn draws_scene(pass: &PlanPass) -> bool {
-    matches!(pass.draw, Some(Draw::Meshes(_) | Draw::LightVolumes(_)))
-}
-
 /// Gets the pass's render pass from the cache and its framebuffer on
 /// `resources`, with the attachments' clear values.
 fn prepare_render_pass<'g>(
     renderer: &mut Renderer<'g>,
-    at: PassAt<'_>,
-    resources: &mut FrameResources<'g>,
-    prepared: &mut Prepared,
+    prep: &mut Preparing<'_, 'g>,
 ) -> Result<(), GpuError> {
+    let Preparing {
+        at,
+        resources,
+        prepared,
+        ..
+    } = prep;
     let Some(rp) = &at.pass.render_pass else {
         return Err(GpuError::Pass {
             pass: at.pass.name.clone(),

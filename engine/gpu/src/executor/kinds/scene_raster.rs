@@ -4,12 +4,11 @@
 //! the scene interface and built here, before the first frame; its set 0 is
 //! written with the plan's other sets.
 
-use super::{PassAt, PassKindOps, Recording};
+use super::{PassAt, PassKindOps, Preparing, Recording};
 use crate::bind::resolve_bindings;
 use crate::draw::{SceneVariant, Variant};
 use crate::error::GpuError;
 use crate::executor::{Prepared, Renderer};
-use crate::resources::FrameResources;
 use crate::scene_check::scene_pass_problems;
 
 /// The scene-drawing kind (a `Raster` pass drawing meshes or light volumes).
@@ -19,16 +18,13 @@ impl PassKindOps for SceneRaster {
     fn prepare<'g>(
         &self,
         renderer: &mut Renderer<'g>,
-        at: PassAt<'_>,
-        resources: &mut FrameResources<'g>,
-        variants: &[SceneVariant],
-        prepared: &mut Prepared,
+        prep: &mut Preparing<'_, 'g>,
     ) -> Result<(), GpuError> {
-        super::prepare_render_pass(renderer, at, resources, prepared)?;
-        for wanted in variants {
-            let variant = prepare_variant(renderer, at, prepared, wanted)?;
-            if !prepared.variants.iter().any(|v| v.key == variant.key) {
-                prepared.variants.push(variant);
+        super::prepare_render_pass(renderer, prep)?;
+        for wanted in prep.draws.variants(prep.at.pass) {
+            let variant = prepare_variant(renderer, prep.at, prep.prepared, &wanted)?;
+            if !prep.prepared.variants.iter().any(|v| v.key == variant.key) {
+                prep.prepared.variants.push(variant);
             }
         }
         Ok(())

@@ -1,12 +1,10 @@
 //! Copies and blits between graph images and buffers: no pipeline, no
 //! descriptor set, only the transfer command.
 
-use super::{PassAt, PassKindOps, Recording};
-use crate::draw::SceneVariant;
+use super::{PassKindOps, Recording};
 use crate::error::GpuError;
-use crate::executor::{Prepared, Renderer};
+use crate::executor::Renderer;
 use crate::record;
-use crate::resources::FrameResources;
 
 /// A copy (`filtered: false`) or a blit (a scaled, filtered copy).
 pub(super) struct Transfer {
@@ -19,17 +17,6 @@ pub(super) const COPY: Transfer = Transfer { filtered: false };
 pub(super) const BLIT: Transfer = Transfer { filtered: true };
 
 impl PassKindOps for Transfer {
-    fn prepare<'g>(
-        &self,
-        _renderer: &mut Renderer<'g>,
-        _at: PassAt<'_>,
-        _resources: &mut FrameResources<'g>,
-        _variants: &[SceneVariant],
-        _prepared: &mut Prepared,
-    ) -> Result<(), GpuError> {
-        Ok(())
-    }
-
     fn record<'g>(
         &self,
         renderer: &mut Renderer<'g>,
