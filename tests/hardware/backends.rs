@@ -25,6 +25,8 @@
 use glam::Vec3;
 use std::path::Path;
 use weft_graph::plan::Extent;
+use weft_graph::schema::PassKind;
+use weft_graph::vk::{Access, Stage};
 use weft_render::{render, RenderSettings, TraceBackend};
 use weft_tests::render::{root, square_settings};
 
@@ -60,6 +62,7 @@ fn ray_hits(scene: &Path, backend: TraceBackend, (time, frames): (f64, u32)) -> 
     let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
     drop(gpu);
     assert_eq!(log.messages(), Vec::new(), "{backend:?}");
+    assert_builds_structures(&rendered.plan, backend == TraceBackend::Hardware);
     let floats = |pixels: &weft_gpu::Pixels| match pixels {
         weft_gpu::Pixels::RgbaF32(texels) => texels.clone(),
         _ => panic!("the fixture's images are float images"),
@@ -85,6 +88,52 @@ fn ray_hits(scene: &Path, backend: TraceBackend, (time, frames): (f64, u32)) -> 
             }
         })
         .collect()
+}
+
+/// On the hardware backend the plan's first pass builds the scene's
+/// acceleration structures and every pass that traces reads them, after it
+/// (the compiler's barrier from the build stage); on the software backend
+/// the build is culled and nothing reads them.
+fn assert_builds_structures(plan: &weft_graph::plan::Plan, hardware: bool) {
+    let builds: Vec<_> = plan
+        .passes
+        .iter()
+        .filter(|p| p.kind == PassKind::BuildAccelerationStructures)
+        .collect();
+    let tracing: Vec<_> = plan
+        .passes
+        .iter()
+        .filter(|p| p.derive.iter().any(|d| d.name == "RayTracing"))
+        .collect();
+    if !hardware {
+        assert!(builds.is_empty(), "{}: software builds nothing", plan.name);
+        assert!(tracing.iter().all(|p| p.structure.is_none()));
+        return;
+    }
+    assert_eq!(builds.len(), 1, "{}: one build pass", plan.name);
+    let structure = builds[0].structure.expect("the build names its structure");
+    let readers: Vec<_> = tracing.iter().filter(|p| p.structure.is_some()).collect();
+    assert!(
+        !readers.is_empty(),
+        "{}: a tracing pass reads it",
+        plan.name
+    );
+    for pass in readers {
+        assert_eq!(pass.structure, Some(structure), "{} reads it", pass.name);
+    }
+    let first_reader = plan
+        .passes
+        .iter()
+        .find(|p| p.kind != PassKind::BuildAccelerationStructures && p.structure.is_some())
+        .expect("a reader");
+    let barrier = first_reader
+        .barriers
+        .iter()
+        .find(|b| b.resource == structure)
+        .expect("the first reader waits for the build");
+    assert_eq!(barrier.src_stage, Stage::ACCELERATION_STRUCTURE_BUILD);
+    assert_eq!(barrier.src_access, Access::ACCELERATION_STRUCTURE_WRITE);
+    assert_eq!(barrier.dst_access, Access::ACCELERATION_STRUCTURE_READ);
 }
 
 /// How the backends' answers for one ray set compare.
@@ -273,6 +322,7 @@ fn hdr_mean(graph: &str, features: &[&str], samples: Option<u64>, backend: Trace
     let rendered = render(&gpu, &scene, &settings).unwrap_or_else(|e| panic!("render: {e}"));
     drop(gpu);
     assert_eq!(log.messages(), Vec::new(), "{graph} {backend:?}");
+    assert_builds_structures(&rendered.plan, backend == TraceBackend::Hardware);
     let weft_gpu::Pixels::RgbaF32(values) = &rendered.report.readbacks[0].1.pixels else {
         panic!("hdr is a float image");
     };

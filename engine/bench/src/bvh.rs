@@ -159,15 +159,12 @@ fn structure_row(
     for _ in 0..runs {
         let mut uploaded = weft_render::GpuScene::new(gpu, scene, false)?;
         uploaded.trace_in_hardware(true)?;
-        uploaded.scene_set(weft_gpu::scene::SceneSet::Traced)?;
-        let built = uploaded
-            .structure_report()
-            .context("ray queries build acceleration structures")?;
+        let built = uploaded.build_structures_now()?;
         bottom.push(built.bottom_build.as_secs_f64() * 1e3);
         top.push(built.top_build.as_secs_f64() * 1e3);
         bytes = (built.bottom_bytes, built.top_bytes);
         uploaded.refit_structures()?;
-        let refitted = uploaded.structure_report().context("still built")?;
+        let refitted = uploaded.build_structures_now()?;
         refit.push(refitted.top_build.as_secs_f64() * 1e3);
     }
     let median = |mut v: Vec<f64>| {

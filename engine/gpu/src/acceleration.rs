@@ -4,16 +4,16 @@
 //! (`VK_KHR_ray_query`) trace against the top level; the ray tracer's
 //! software BVH is the other backend, on devices without these extensions.
 //!
-//! Each build is recorded into one command buffer and followed by a barrier
-//! from the build's writes (`ACCELERATION_STRUCTURE_BUILD`) to every later
-//! read, builds of the top level and shaders' ray queries alike.
+//! The structures are created here, sized for the device, and their builds
+//! recorded into a command buffer the caller orders: in a frame, the render
+//! graph's `BuildAccelerationStructures` pass, whose barriers the compiler
+//! derives like any other pass's.
 
 use crate::buffer::Buffer;
 use crate::context::Gpu;
 use crate::error::{GpuError, VkCall};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use std::time::{Duration, Instant};
 
 /// An acceleration structure and the buffer holding it, destroyed on drop.
 pub struct AccelerationStructure<'g> {
@@ -110,12 +110,16 @@ pub struct Mesh {
     pub triangles: u32,
 }
 
-/// The bottom levels over a scene's meshes, built together.
+/// The bottom levels over a scene's meshes, created together and built by
+/// one recorded command ([`Self::record_build`]).
 pub struct BottomLevels<'g> {
     /// One per mesh, in the order given.
     pub levels: Vec<AccelerationStructure<'g>>,
-    /// How long the build took: recording, submission and the wait.
-    pub build_time: Duration,
+    meshes: Vec<Mesh>,
+    /// Each level's scratch, at offsets aligned to the device's minimum.
+    scratch_offsets: Vec<u64>,
+    /// Bytes of scratch the build needs, all levels together.
+    pub scratch_bytes: u64,
 }
 
 /// A placement of a bottom level in the top level.
@@ -133,82 +137,100 @@ pub struct Placement {
 /// The most a custom index may be: 24 bits.
 pub const MAX_CUSTOM_INDEX: u32 = (1 << 24) - 1;
 
-/// Builds one bottom level per mesh of `meshes` (triangles opaque, both
-/// faces seen, built for fast tracing), in one command buffer.
-pub fn build_bottom_levels<'g>(
-    gpu: &'g Gpu,
-    meshes: &[Mesh],
-) -> Result<BottomLevels<'g>, GpuError> {
-    let loader = loader(gpu)?;
-    let start = Instant::now();
-    let geometries: Vec<_> = meshes
-        .iter()
-        .map(|mesh| {
-            let triangles = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
-                .vertex_format(vk::Format::R32G32B32_SFLOAT)
-                .vertex_data(vk::DeviceOrHostAddressConstKHR {
-                    device_address: mesh.vertices,
-                })
-                .vertex_stride(mesh.stride)
-                .max_vertex(mesh.max_vertex)
-                .index_type(vk::IndexType::UINT32)
-                .index_data(vk::DeviceOrHostAddressConstKHR {
-                    device_address: mesh.indices,
-                });
-            vk::AccelerationStructureGeometryKHR::default()
-                .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
-                .geometry(vk::AccelerationStructureGeometryDataKHR { triangles })
-                .flags(vk::GeometryFlagsKHR::OPAQUE)
+impl<'g> BottomLevels<'g> {
+    /// Creates one bottom level per mesh of `meshes` (triangles opaque,
+    /// both faces seen, built for fast tracing), sized for the device; the
+    /// build is recorded later, by [`Self::record_build`].
+    pub fn new(gpu: &'g Gpu, meshes: &[Mesh]) -> Result<Self, GpuError> {
+        let loader = loader(gpu)?;
+        let align = scratch_alignment(gpu);
+        let mut levels = Vec::with_capacity(meshes.len());
+        let mut scratch_offsets = Vec::with_capacity(meshes.len());
+        let mut scratch_bytes = 0u64;
+        for (i, mesh) in meshes.iter().enumerate() {
+            let geometry = [bottom_geometry(mesh)];
+            let sizes = build_sizes(loader, &bottom_info(&geometry), mesh.triangles);
+            levels.push(AccelerationStructure::new(
+                gpu,
+                &format!("BLAS {i}"),
+                vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL,
+                sizes.acceleration_structure_size,
+            )?);
+            scratch_offsets.push(scratch_bytes);
+            scratch_bytes += sizes.build_scratch_size.next_multiple_of(align);
+        }
+        Ok(Self {
+            levels,
+            meshes: meshes.to_vec(),
+            scratch_offsets,
+            scratch_bytes,
         })
-        .collect();
-    let counts: Vec<u32> = meshes.iter().map(|m| m.triangles).collect();
-    let mut levels = Vec::with_capacity(meshes.len());
-    let mut scratch_offsets = Vec::with_capacity(meshes.len());
-    let mut scratch_size = 0u64;
-    let align = scratch_alignment(gpu);
-    for (i, geometry) in geometries.iter().enumerate() {
-        let info = bottom_info(std::slice::from_ref(geometry));
-        let sizes = build_sizes(loader, &info, counts[i]);
-        levels.push(AccelerationStructure::new(
-            gpu,
-            &format!("BLAS {i}"),
-            vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL,
-            sizes.acceleration_structure_size,
-        )?);
-        scratch_offsets.push(scratch_size);
-        scratch_size += sizes.build_scratch_size.next_multiple_of(align);
     }
-    let scratch = scratch_buffer(gpu, "BLAS scratch", scratch_size + align)?;
-    let scratch_base = scratch.address().next_multiple_of(align);
-    let infos: Vec<_> = geometries
-        .iter()
-        .zip(&levels)
-        .zip(&scratch_offsets)
-        .map(|((geometry, level), offset)| {
-            bottom_info(std::slice::from_ref(geometry))
-                .dst_acceleration_structure(level.handle)
-                .scratch_data(vk::DeviceOrHostAddressKHR {
-                    device_address: scratch_base + offset,
+
+    /// Records every level's build, one `vkCmdBuildAccelerationStructuresKHR`,
+    /// with its scratch from `scratch` (at least [`Self::scratch_bytes`]).
+    /// The caller orders it: the geometry read before, the levels' readers
+    /// after.
+    pub fn record_build(
+        &self,
+        gpu: &Gpu,
+        cmd: vk::CommandBuffer,
+        scratch: &Scratch<'_>,
+    ) -> Result<(), GpuError> {
+        let loader = loader(gpu)?;
+        if self.levels.is_empty() {
+            return Ok(());
+        }
+        let geometries: Vec<[vk::AccelerationStructureGeometryKHR; 1]> =
+            self.meshes.iter().map(|m| [bottom_geometry(m)]).collect();
+        let infos: Vec<_> = geometries
+            .iter()
+            .zip(&self.levels)
+            .zip(&self.scratch_offsets)
+            .map(|((geometry, level), offset)| {
+                bottom_info(geometry)
+                    .dst_acceleration_structure(level.handle)
+                    .scratch_data(vk::DeviceOrHostAddressKHR {
+                        device_address: scratch.address + offset,
+                    })
+            })
+            .collect();
+        let ranges: Vec<[vk::AccelerationStructureBuildRangeInfoKHR; 1]> =
+            self.meshes
+                .iter()
+                .map(|m| {
+                    [vk::AccelerationStructureBuildRangeInfoKHR::default()
+                        .primitive_count(m.triangles)]
                 })
-        })
-        .collect();
-    let ranges: Vec<[vk::AccelerationStructureBuildRangeInfoKHR; 1]> = counts
-        .iter()
-        .map(|&n| [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(n)])
-        .collect();
-    let range_refs: Vec<&[vk::AccelerationStructureBuildRangeInfoKHR]> =
-        ranges.iter().map(|r| &r[..]).collect();
-    if !infos.is_empty() {
-        gpu.one_shot(|cmd| {
-            unsafe { loader.cmd_build_acceleration_structures(cmd, &infos, &range_refs) };
-            built(gpu, cmd);
-            Ok(())
-        })?;
+                .collect();
+        let range_refs: Vec<&[vk::AccelerationStructureBuildRangeInfoKHR]> =
+            ranges.iter().map(|r| &r[..]).collect();
+        unsafe { loader.cmd_build_acceleration_structures(cmd, &infos, &range_refs) };
+        Ok(())
     }
-    Ok(BottomLevels {
-        levels,
-        build_time: start.elapsed(),
-    })
+
+    /// Bytes of device memory the levels hold.
+    pub fn bytes(&self) -> u64 {
+        self.levels.iter().map(AccelerationStructure::bytes).sum()
+    }
+}
+
+fn bottom_geometry(mesh: &Mesh) -> vk::AccelerationStructureGeometryKHR<'static> {
+    let triangles = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
+        .vertex_format(vk::Format::R32G32B32_SFLOAT)
+        .vertex_data(vk::DeviceOrHostAddressConstKHR {
+            device_address: mesh.vertices,
+        })
+        .vertex_stride(mesh.stride)
+        .max_vertex(mesh.max_vertex)
+        .index_type(vk::IndexType::UINT32)
+        .index_data(vk::DeviceOrHostAddressConstKHR {
+            device_address: mesh.indices,
+        });
+    vk::AccelerationStructureGeometryKHR::default()
+        .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
+        .geometry(vk::AccelerationStructureGeometryDataKHR { triangles })
+        .flags(vk::GeometryFlagsKHR::OPAQUE)
 }
 
 fn bottom_info<'a>(
@@ -221,23 +243,64 @@ fn bottom_info<'a>(
         .geometries(geometry)
 }
 
-/// The top level: placements of bottom levels, rebuilt or refitted in
-/// place as placements move.
+/// Scratch memory for builds: a device buffer and its first address aligned
+/// to `minAccelerationStructureScratchOffsetAlignment`.
+pub struct Scratch<'g> {
+    buffer: Buffer<'g>,
+    /// The aligned address builds start at.
+    pub address: u64,
+}
+
+impl<'g> Scratch<'g> {
+    /// A scratch buffer with `bytes` usable from its aligned start.
+    pub fn new(gpu: &'g Gpu, bytes: u64) -> Result<Self, GpuError> {
+        let align = scratch_alignment(gpu);
+        let buffer = Buffer::new(
+            gpu,
+            "acceleration-structure scratch",
+            bytes.max(1) + align,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
+            MemoryLocation::GpuOnly,
+        )?;
+        let address = buffer.address().next_multiple_of(align);
+        Ok(Self { buffer, address })
+    }
+
+    /// Bytes of device memory it holds.
+    pub fn bytes(&self) -> u64 {
+        self.buffer.size
+    }
+}
+
+/// Whether the next recorded top-level build starts afresh or refits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TopState {
+    /// Created, never built: the next record builds it.
+    Unbuilt,
+    /// Built for the placements as they are.
+    Current,
+    /// Placements moved since the last build: the next record refits.
+    Moved,
+}
+
+/// The top level: placements of bottom levels, built, then refitted in
+/// place as placements move, each by a recorded command ([`Self::record`]).
 pub struct TopLevel<'g> {
-    gpu: &'g Gpu,
     /// The structure ray queries trace against.
     pub structure: AccelerationStructure<'g>,
     /// The instance records, host-visible: rewritten before a refit.
     instances: Buffer<'g>,
-    scratch: Buffer<'g>,
     count: u32,
-    /// How long the last build or refit took on the device.
-    pub last_time: Duration,
+    /// Bytes of scratch a build or a refit needs.
+    pub scratch_bytes: u64,
+    state: TopState,
 }
 
 impl<'g> TopLevel<'g> {
-    /// Builds the top level placing `levels` as `placements` say.
-    pub fn build(
+    /// Creates the top level placing `levels` as `placements` say, sized
+    /// for the device, its instance records written; the build is recorded
+    /// later, by [`Self::record`].
+    pub fn new(
         gpu: &'g Gpu,
         levels: &BottomLevels<'g>,
         placements: &[Placement],
@@ -261,31 +324,21 @@ impl<'g> TopLevel<'g> {
             vk::AccelerationStructureTypeKHR::TOP_LEVEL,
             sizes.acceleration_structure_size,
         )?;
-        let align = scratch_alignment(gpu);
-        let scratch = scratch_buffer(
-            gpu,
-            "TLAS scratch",
-            sizes.build_scratch_size.max(sizes.update_scratch_size) + align,
-        )?;
         let mut top = Self {
-            gpu,
             structure,
             instances,
-            scratch,
             count,
-            last_time: Duration::ZERO,
+            scratch_bytes: sizes.build_scratch_size.max(sizes.update_scratch_size),
+            state: TopState::Unbuilt,
         };
-        top.record(
-            levels,
-            placements,
-            vk::BuildAccelerationStructureModeKHR::BUILD,
-        )?;
+        top.write_instances(levels, placements)?;
         Ok(top)
     }
 
     /// Moves the placements to `placements` (the same count, each placing
-    /// the same level as before) and refits the top level in place.
-    pub fn refit(
+    /// the same level as before): the next [`Self::record`] refits. Call it
+    /// between frames, when no build still reads the instance records.
+    pub fn place(
         &mut self,
         levels: &BottomLevels<'g>,
         placements: &[Placement],
@@ -297,20 +350,55 @@ impl<'g> TopLevel<'g> {
                 placements.len()
             )));
         }
-        self.record(
-            levels,
-            placements,
-            vk::BuildAccelerationStructureModeKHR::UPDATE,
-        )
+        self.write_instances(levels, placements)?;
+        if self.state == TopState::Current {
+            self.state = TopState::Moved;
+        }
+        Ok(())
     }
 
-    fn record(
+    /// Whether the next [`Self::record`] has work: a first build or a refit.
+    pub fn pending(&self) -> bool {
+        self.state != TopState::Current
+    }
+
+    /// Records the top level's build (the first time) or refit (placements
+    /// moved), with its scratch from `scratch`; nothing when it is current.
+    /// The caller orders it after the bottom levels' build and the last
+    /// reads of the structure, and before the ray queries that read it.
+    pub fn record(
+        &mut self,
+        gpu: &Gpu,
+        cmd: vk::CommandBuffer,
+        scratch: &Scratch<'_>,
+    ) -> Result<(), GpuError> {
+        let mode = match self.state {
+            TopState::Current => return Ok(()),
+            TopState::Unbuilt => vk::BuildAccelerationStructureModeKHR::BUILD,
+            TopState::Moved => vk::BuildAccelerationStructureModeKHR::UPDATE,
+        };
+        let loader = loader(gpu)?;
+        let geometry = [top_geometry(self.instances.address())];
+        let mut info = top_info(&geometry, mode)
+            .dst_acceleration_structure(self.structure.handle)
+            .scratch_data(vk::DeviceOrHostAddressKHR {
+                device_address: scratch.address,
+            });
+        if mode == vk::BuildAccelerationStructureModeKHR::UPDATE {
+            info = info.src_acceleration_structure(self.structure.handle);
+        }
+        let ranges =
+            [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(self.count)];
+        unsafe { loader.cmd_build_acceleration_structures(cmd, &[info], &[&ranges]) };
+        self.state = TopState::Current;
+        Ok(())
+    }
+
+    fn write_instances(
         &mut self,
         levels: &BottomLevels<'g>,
         placements: &[Placement],
-        mode: vk::BuildAccelerationStructureModeKHR,
     ) -> Result<(), GpuError> {
-        let start = Instant::now();
         let records: Vec<vk::AccelerationStructureInstanceKHR> = placements
             .iter()
             .map(|p| instance(p, levels))
@@ -321,34 +409,12 @@ impl<'g> TopLevel<'g> {
                 std::mem::size_of_val(records.as_slice()),
             )
         };
-        self.instances.write(raw)?;
-        let loader = loader(self.gpu)?;
-        let geometry = [top_geometry(self.instances.address())];
-        let align = scratch_alignment(self.gpu);
-        let mut info = top_info(&geometry, mode)
-            .dst_acceleration_structure(self.structure.handle)
-            .scratch_data(vk::DeviceOrHostAddressKHR {
-                device_address: self.scratch.address().next_multiple_of(align),
-            });
-        if mode == vk::BuildAccelerationStructureModeKHR::UPDATE {
-            info = info.src_acceleration_structure(self.structure.handle);
-        }
-        let ranges =
-            [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(self.count)];
-        self.gpu.one_shot(|cmd| {
-            // Earlier traces and builds read the structure a refit rewrites.
-            before_build(self.gpu, cmd);
-            unsafe { loader.cmd_build_acceleration_structures(cmd, &[info], &[&ranges]) };
-            built(self.gpu, cmd);
-            Ok(())
-        })?;
-        self.last_time = start.elapsed();
-        Ok(())
+        self.instances.write(raw)
     }
 
-    /// Bytes of device memory the level, its instances and scratch hold.
+    /// Bytes of device memory the level and its instances hold.
     pub fn bytes(&self) -> u64 {
-        self.structure.bytes() + self.instances.size + self.scratch.size
+        self.structure.bytes() + self.instances.size
     }
 }
 
@@ -441,44 +507,18 @@ fn scratch_alignment(gpu: &Gpu) -> u64 {
     )
 }
 
-fn scratch_buffer<'g>(gpu: &'g Gpu, name: &str, size: u64) -> Result<Buffer<'g>, GpuError> {
-    Buffer::new(
-        gpu,
-        name,
-        size,
-        vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
-        MemoryLocation::GpuOnly,
-    )
-}
-
-/// The barrier before a build that rewrites a structure earlier commands
-/// read or wrote: every earlier access, then the build.
-fn before_build(gpu: &Gpu, cmd: vk::CommandBuffer) {
+/// The barrier between builds in one pass: the bottom levels' writes (and
+/// their scratch's) made visible to the top level's build, which reads the
+/// levels and reuses the scratch. What comes before and after the pass is
+/// the render graph's to order.
+pub fn between_builds(gpu: &Gpu, cmd: vk::CommandBuffer) {
     let barrier = vk::MemoryBarrier2::default()
-        .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-        .src_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)
+        .src_stage_mask(vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR)
+        .src_access_mask(vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR)
         .dst_stage_mask(vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR)
         .dst_access_mask(
             vk::AccessFlags2::ACCELERATION_STRUCTURE_READ_KHR
                 | vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR,
-        );
-    let barriers = [barrier];
-    let dependency = vk::DependencyInfo::default().memory_barriers(&barriers);
-    unsafe { gpu.device().cmd_pipeline_barrier2(cmd, &dependency) };
-}
-
-/// The barrier after a build: its writes made visible to later builds (a
-/// top level reading its bottom levels) and to every shader's ray queries.
-fn built(gpu: &Gpu, cmd: vk::CommandBuffer) {
-    let barrier = vk::MemoryBarrier2::default()
-        .src_stage_mask(vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR)
-        .src_access_mask(vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR)
-        .dst_stage_mask(
-            vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR
-                | vk::PipelineStageFlags2::ALL_COMMANDS,
-        )
-        .dst_access_mask(
-            vk::AccessFlags2::ACCELERATION_STRUCTURE_READ_KHR | vk::AccessFlags2::MEMORY_READ,
         );
     let barriers = [barrier];
     let dependency = vk::DependencyInfo::default().memory_barriers(&barriers);

@@ -268,12 +268,7 @@ fn own_pass_problems(
         .err()
         .unwrap_or_default();
     if let Some(scene) = scene {
-        found.extend(scene_set_problems(
-            scene,
-            &interface,
-            false,
-            (scene.traces)(pass),
-        ));
+        found.extend(scene_set_problems(scene, &interface, false, pass));
     }
     Ok(found
         .into_iter()

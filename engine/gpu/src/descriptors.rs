@@ -221,7 +221,7 @@ pub fn write_graph_set(
                 layout(rb.graph.resource),
             ),
             Some(GpuResource::Buffer(buf)) => writer.buffer(binding, ty, buf.buffer),
-            None => {
+            Some(GpuResource::AccelerationStructure) | None => {
                 return Err(GpuError::Plan(format!(
                     "resource {} missing",
                     rb.graph.resource

@@ -212,6 +212,25 @@ pub trait DrawRecorder {
     /// [`RasterContext::bind_variant`].
     fn record(&mut self, ctx: &mut RasterContext<'_>) -> Result<(), GpuError>;
 
+    /// Records into `cmd` what the scene's acceleration structures need
+    /// before this frame's ray queries: their first build, or a refit of
+    /// the top level to placements that moved since, or nothing. The
+    /// executor runs it for a `BuildAccelerationStructures` pass, after
+    /// the barriers the plan orders it by (the last frame's traces) and
+    /// before those that order the traces after it.
+    fn build_structures(
+        &mut self,
+        pass: &PlanPass,
+        cmd: vk::CommandBuffer,
+    ) -> Result<(), GpuError> {
+        let _ = cmd;
+        Err(GpuError::Pass {
+            pass: pass.name.clone(),
+            message: "builds acceleration structures, but no draw recorder holds a scene with them"
+                .into(),
+        })
+    }
+
     /// Binds scene data at set [`SCENE_SET`] for a fullscreen or compute
     /// pass whose shaders declare it; `pipeline.scene_set` says which layout
     /// of the set it was built with.

@@ -55,6 +55,7 @@ pub fn barriers(
     }
     let mut images = Vec::new();
     let mut buffers = Vec::new();
+    let mut memory = Vec::new();
     for b in list {
         match resources.get(b.resource) {
             Some(GpuResource::Image(img)) => {
@@ -90,6 +91,14 @@ pub fn barriers(
                     .offset(0)
                     .size(vk::WHOLE_SIZE),
             ),
+            // The scene's structures live in its buffers: a memory barrier.
+            Some(GpuResource::AccelerationStructure) => memory.push(
+                vk::MemoryBarrier2::default()
+                    .src_stage_mask(convert::stage(b.src_stage))
+                    .src_access_mask(convert::access(b.src_access))
+                    .dst_stage_mask(convert::stage(b.dst_stage))
+                    .dst_access_mask(convert::access(b.dst_access)),
+            ),
             None => {
                 return Err(GpuError::Plan(format!(
                     "barrier on resource {} which does not exist",
@@ -99,6 +108,7 @@ pub fn barriers(
         }
     }
     let dep = vk::DependencyInfo::default()
+        .memory_barriers(&memory)
         .image_memory_barriers(&images)
         .buffer_memory_barriers(&buffers);
     unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };

@@ -45,6 +45,9 @@ pub enum GpuResource {
     Image(GpuImage),
     /// A buffer resource.
     Buffer(GpuBuffer),
+    /// The scene's acceleration structures: nothing of the plan's own, only
+    /// a resource its barriers name (as memory barriers).
+    AccelerationStructure,
 }
 
 /// The device objects for one plan, destroyed on drop.
@@ -169,6 +172,7 @@ impl<'g> FrameResources<'g> {
             let created = match &r.desc {
                 ResourceDesc::Image(desc) => this.create_image(r, desc)?,
                 ResourceDesc::Buffer(desc) => this.create_buffer(r, desc)?,
+                ResourceDesc::AccelerationStructure => GpuResource::AccelerationStructure,
             };
             this.resources.push(created);
         }
@@ -254,6 +258,7 @@ impl<'g> FrameResources<'g> {
             match &self.resources[index] {
                 GpuResource::Image(i) => device.get_image_memory_requirements(i.image),
                 GpuResource::Buffer(b) => device.get_buffer_memory_requirements(b.buffer),
+                GpuResource::AccelerationStructure => vk::MemoryRequirements::default(),
             }
         }
     }
@@ -298,6 +303,7 @@ impl<'g> FrameResources<'g> {
                 GpuResource::Buffer(b) => device
                     .bind_buffer_memory(b.buffer, memory, base + offset)
                     .call("vkBindBufferMemory"),
+                GpuResource::AccelerationStructure => Ok(()),
             }
         }
     }
@@ -355,6 +361,7 @@ impl<'g> FrameResources<'g> {
             let scheme = match &self.resources[i] {
                 GpuResource::Image(img) => AllocationScheme::DedicatedImage(img.image),
                 GpuResource::Buffer(buf) => AllocationScheme::DedicatedBuffer(buf.buffer),
+                GpuResource::AccelerationStructure => continue,
             };
             let allocation = self.allocate(&r.name, self.requirements(i), scheme)?;
             self.bind(i, allocation, 0)?;
@@ -460,6 +467,7 @@ impl Drop for FrameResources<'_> {
                         device.destroy_image(i.image, None);
                     }
                     GpuResource::Buffer(b) => device.destroy_buffer(b.buffer, None),
+                    GpuResource::AccelerationStructure => {}
                 }
             }
         }

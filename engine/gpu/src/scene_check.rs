@@ -6,7 +6,7 @@
 
 use crate::bind::FrameValues;
 use crate::bind::{check_outputs, link_problems, pack_push, resolve_bindings, shape_name};
-use crate::reflect::{PipelineInterface, ScalarKind, ShaderInterface};
+use crate::reflect::{DescriptorKind, PipelineInterface, ScalarKind, ShaderInterface};
 use crate::scene::{SceneBinding, SceneInterface, VertexFormat};
 use crate::sets::{MATERIAL_SET, SCENE_SET};
 use weft_graph::plan::{Plan, PlanPass};
@@ -16,13 +16,16 @@ use weft_graph::schema::ParamValue;
 /// a pass's merged interface declares: every binding must be one the engine
 /// writes, with the descriptor type it writes (material textures as float 2D
 /// `sampler2D`s). The tracing-only bindings are fed only to passes that
-/// trace rays (`tracing`).
+/// trace rays (the scene's `traces`), and the acceleration structure only to
+/// those that read one the plan builds (`structure`), so the build is
+/// ordered before their ray queries.
 pub fn scene_set_problems(
     scene: &SceneInterface,
     interface: &PipelineInterface,
     materials: bool,
-    tracing: bool,
+    pass: &PlanPass,
 ) -> Vec<String> {
+    let tracing = (scene.traces)(pass);
     let mut problems = Vec::new();
     for (shader, _) in interface.bindings.values() {
         let table: Vec<&SceneBinding> = match shader.set {
@@ -40,6 +43,19 @@ pub fn scene_set_problems(
         if shader.set == SCENE_SET && !tracing && tracing_only {
             problems.push(format!(
                 "shader binding `{}` (set {} binding {}) is ray-tracing scene data, which the engine feeds only to passes that declare `derive: [RayTracing()]`",
+                shader.name, shader.set, shader.binding
+            ));
+            continue;
+        }
+        if shader.set == SCENE_SET
+            && shader.kind == DescriptorKind::AccelerationStructure
+            && pass.structure.is_none()
+        {
+            problems.push(format!(
+                "shader binding `{}` (set {} binding {}) is the scene's acceleration structure, \
+                 which a pass traces against only when it reads one the plan builds: add \
+                 `(name: \"scene_structures\", enabled_if: [\"ray_queries\"])` to its \
+                 `storage_read` and include graphs/acceleration.ron",
                 shader.name, shader.set, shader.binding
             ));
             continue;
@@ -170,12 +186,7 @@ pub fn scene_pass_problems(
                 )
             }),
     );
-    problems.extend(scene_set_problems(
-        scene,
-        &merged,
-        true,
-        (scene.traces)(pass),
-    ));
+    problems.extend(scene_set_problems(scene, &merged, true, pass));
     problems.extend(vertex_input_problems(scene, pass, vs));
     if fs.is_some() {
         problems.extend(link_problems(&merged));

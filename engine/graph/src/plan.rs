@@ -114,6 +114,10 @@ pub struct PlanResource {
 pub enum ResourceDesc {
     Image(ImageDesc),
     Buffer(BufferDesc),
+    /// The scene's acceleration structures: the scene creates and owns them,
+    /// so the executor creates nothing and synchronizes them with memory
+    /// barriers.
+    AccelerationStructure,
 }
 
 /// Image creation parameters.
@@ -232,6 +236,13 @@ pub struct PlanPass {
     /// resolved (checked against the registry by `check_providers`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub derive: Vec<ProviderDecl>,
+    /// The acceleration structure the pass builds (a
+    /// `BuildAccelerationStructures` pass) or its ray queries read (a
+    /// `storage_read` of an `AccelerationStructure`), if any: it has no
+    /// binding of its own, and the renderer lets a pass trace in hardware
+    /// only against a structure the plan builds and orders it after.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub structure: Option<ResourceId>,
 }
 
 /// An indirect dispatch's source: the `k`-th dispatch of the pass reads the

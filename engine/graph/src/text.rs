@@ -72,6 +72,9 @@ pub fn render(plan: &Plan) -> String {
             ResourceDesc::Buffer(b) => {
                 format!("buffer {} bytes usage {}", b.size, flag_names(b.usage))
             }
+            ResourceDesc::AccelerationStructure => {
+                "acceleration structures (the scene's memory)".to_string()
+            }
         };
         let residency = match r.residency {
             Residency::Transient => match r.placement {

@@ -20,6 +20,7 @@ bitflags! {
         const COMPUTE_SHADER = 0x800;
         const ALL_TRANSFER = 0x1000;
         const BOTTOM_OF_PIPE = 0x2000;
+        const ACCELERATION_STRUCTURE_BUILD = 0x0200_0000;
         const COPY = 0x1_0000_0000;
         const BLIT = 0x4_0000_0000;
         const CLEAR = 0x8_0000_0000;
@@ -40,6 +41,8 @@ bitflags! {
         const DEPTH_STENCIL_ATTACHMENT_WRITE = 0x400;
         const TRANSFER_READ = 0x800;
         const TRANSFER_WRITE = 0x1000;
+        const ACCELERATION_STRUCTURE_READ = 0x0020_0000;
+        const ACCELERATION_STRUCTURE_WRITE = 0x0040_0000;
         const SHADER_SAMPLED_READ = 0x1_0000_0000;
         const SHADER_STORAGE_READ = 0x2_0000_0000;
         const SHADER_STORAGE_WRITE = 0x4_0000_0000;
@@ -52,7 +55,8 @@ impl Access {
         .union(Access::COLOR_ATTACHMENT_WRITE)
         .union(Access::DEPTH_STENCIL_ATTACHMENT_WRITE)
         .union(Access::TRANSFER_WRITE)
-        .union(Access::SHADER_STORAGE_WRITE);
+        .union(Access::SHADER_STORAGE_WRITE)
+        .union(Access::ACCELERATION_STRUCTURE_WRITE);
 
     /// Whether any bit of this mask writes memory.
     pub fn is_write(self) -> bool {

@@ -5,6 +5,7 @@
 use crate::error::RenderError;
 use crate::features::scene_features;
 use crate::frame_loop::{FrameLoop, FrameRequest};
+use crate::providers::trace_backend::{self, RAY_QUERY_FEATURE};
 use crate::scene_gpu::GpuScene;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -191,22 +192,46 @@ pub fn compile_for_scene(
     let loaded = graph.graph();
     let mut requested = scene_features(scene);
     requested.extend(settings.features.iter().cloned());
+    // The renderer's to set: on exactly when the plan traces in hardware.
+    requested.retain(|f| f.trim().trim_start_matches('!') != RAY_QUERY_FEATURE);
     let memory = memory_requirements(gpu);
-    let options = CompileOptions {
-        extent: settings.extent,
-        features: loaded.features(&requested),
-        memory: &memory,
-        readback: settings.extra_readback.clone(),
-        readback_asked: settings.readback_asked,
-    };
-    let mut plan = crate::providers::compile(graph, &options).map_err(RenderError::Graph)?;
-    let device = crate::providers::trace_backend::DeviceTracing {
+    let device = trace_backend::DeviceTracing {
         name: gpu.info().name.clone(),
         ray_query: gpu.info().shaders.ray_query,
         cpu: gpu.info().kind == weft_gpu::DeviceKind::Cpu,
     };
-    crate::providers::trace_backend::choose(&mut plan, settings.trace_backend, &device)
-        .map_err(RenderError::Graph)?;
+    let mut hardware = trace_backend::compile_for_hardware(settings.trace_backend, &device);
+    let mut compiles = 0;
+    let plan = loop {
+        compiles += 1;
+        let mut features = loaded.features(&requested);
+        if hardware {
+            features.insert(RAY_QUERY_FEATURE.to_string());
+        }
+        let options = CompileOptions {
+            extent: settings.extent,
+            features,
+            memory: &memory,
+            readback: settings.extra_readback.clone(),
+            readback_asked: settings.readback_asked,
+        };
+        let mut plan = crate::providers::compile(graph, &options).map_err(RenderError::Graph)?;
+        match trace_backend::choose(&mut plan, settings.trace_backend, &device)
+            .map_err(RenderError::Graph)?
+        {
+            trace_backend::Choice::Chosen { .. } => break plan,
+            // The second compile has the feature as chosen; a third would
+            // flip it back, which only a plan that changes under it could ask.
+            trace_backend::Choice::Recompile { .. } if compiles == 3 => {
+                return Err(RenderError::Graph(vec![weft_graph::Diagnostic::error(
+                    plan.file.clone(),
+                    Default::default(),
+                    "the trace backend changed with every compile of the graph".to_string(),
+                )]))
+            }
+            trace_backend::Choice::Recompile { hardware: again } => hardware = again,
+        }
+    };
     if let Some((image, size)) = weft_gpu::oversized_images(gpu, &plan).into_iter().next() {
         return Err(RenderError::ImageTooLarge {
             image,
@@ -236,7 +261,8 @@ fn unsupported_samples(
 ) -> weft_graph::Diagnostic {
     let declared = graph.resources.iter().find(|r| match &r.item {
         weft_graph::schema::ResourceDecl::Image(i) => i.name == image,
-        weft_graph::schema::ResourceDecl::Buffer(_) => false,
+        weft_graph::schema::ResourceDecl::Buffer(_)
+        | weft_graph::schema::ResourceDecl::AccelerationStructure(_) => false,
     });
     let (file, pos) = declared.map_or_else(Default::default, |r| {
         graph.locate(

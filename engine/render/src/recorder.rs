@@ -463,6 +463,16 @@ impl DrawRecorder for SceneRecorder<'_> {
         }
     }
 
+    /// The scene's structures: built the first time, refitted after a
+    /// placement moved.
+    fn build_structures(
+        &mut self,
+        pass: &PlanPass,
+        cmd: vk::CommandBuffer,
+    ) -> Result<(), GpuError> {
+        self.scene.record_structures(&pass.name, cmd)
+    }
+
     fn record(&mut self, ctx: &mut RasterContext<'_>) -> Result<(), GpuError> {
         let pass = ctx.pass();
         let name = pass.name.clone();

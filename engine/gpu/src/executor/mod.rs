@@ -296,8 +296,7 @@ impl<'g> Renderer<'g> {
             Some(RegisteredScene {
                 interface: scene, ..
             }) => {
-                let traces = (scene.traces)(pass);
-                let problems = scene_set_problems(scene, &interface, false, traces);
+                let problems = scene_set_problems(scene, &interface, false, pass);
                 if !problems.is_empty() {
                     return Err(mismatch(problems));
                 }

@@ -9,6 +9,7 @@ use crate::id::{IdVec, IrPassId, IrResourceId};
 use crate::load::LoadedGraph;
 use crate::plan::CulledPass;
 use crate::resolve::{Ir, IrKind};
+use crate::schema::PassKind;
 use crate::spans::{Pos, Seg};
 use std::collections::BTreeSet;
 
@@ -80,6 +81,9 @@ pub(crate) struct Culled {
 /// Why a live pass is culled when nothing it writes reaches a root.
 pub(crate) const UNNEEDED: &str = "contributes nothing to the output";
 
+/// Why a live build pass is culled when no live pass reads what it builds.
+pub(crate) const NOTHING_TRACES: &str = "no pass that runs traces against what it builds";
+
 /// The warning for live pass `name` culled for [`UNNEEDED`].
 pub(crate) fn unneeded_warning(name: &str) -> String {
     format!("pass \"{name}\" is culled: it {UNNEEDED}")
@@ -105,6 +109,9 @@ pub(crate) fn cull(
                 .map(String::as_str)
                 .collect();
             format!("enabled_if [{}] is false", failing.join(", "))
+        } else if !needed[p] && pass.kind == PassKind::BuildAccelerationStructures {
+            // It serves whichever passes trace; with none live, it has no work.
+            NOTHING_TRACES.to_string()
         } else if !needed[p] {
             let mut d = locate(graph, ir, p, &[Seg::Field("name")]);
             d.severity = Severity::Warning;

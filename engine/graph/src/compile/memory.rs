@@ -24,7 +24,7 @@ pub(crate) fn alias(
                     lifetime: (r.lifetime.0.index(), r.lifetime.1.index()),
                 },
             )),
-            ResourceDesc::Buffer(_) => None,
+            ResourceDesc::Buffer(_) | ResourceDesc::AccelerationStructure => None,
         })
         .collect();
     let requests: Vec<Transient> = transient.iter().map(|(_, t)| *t).collect();

@@ -78,6 +78,7 @@ fn plan_pass(
             .map(|(a, _)| a)
     };
     let mut bindings = Vec::new();
+    let mut structure = None;
     let mut defines: BTreeSet<String> = BTreeSet::new();
     for access in active_accesses() {
         let kind = match access.usage {
@@ -87,6 +88,11 @@ fn plan_pass(
             _ => continue,
         };
         let r = lifetimes.plan_index(access.resource);
+        if matches!(resources[r].desc, ResourceDesc::AccelerationStructure) {
+            // Built, or traced through the scene's set: not bound in the pass's own.
+            structure = Some(r);
+            continue;
+        }
         if let Some(existing) = bindings.iter_mut().find(|b: &&mut Binding| b.resource == r) {
             if matches!(
                 (existing.kind, kind),
@@ -268,6 +274,7 @@ fn plan_pass(
         transfer,
         raster: pass.raster,
         derive: pass.derive.clone(),
+        structure,
     }
 }
 

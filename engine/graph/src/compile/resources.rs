@@ -90,6 +90,7 @@ pub(crate) fn describe(
                     texel_bytes: format.bytes,
                 })
             }
+            IrKind::AccelerationStructure => ResourceDesc::AccelerationStructure,
             IrKind::External => unreachable!(
                 "only fragments have external resources, and fragments are not compiled"
             ),
@@ -170,7 +171,7 @@ mod tests {
             let r = plan.resource(name).expect("kept");
             match &plan.resources[r].desc {
                 ResourceDesc::Image(d) => (d.usage, plan.resources[r].residency),
-                ResourceDesc::Buffer(_) => panic!("{name} is an image"),
+                _ => panic!("{name} is an image"),
             }
         };
         assert_eq!(

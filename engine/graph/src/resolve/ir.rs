@@ -61,6 +61,8 @@ pub enum IrKind {
     Buffer {
         size: BufferSize,
     },
+    /// The scene's acceleration structures: no memory of the graph's own.
+    AccelerationStructure,
     /// A fragment's input when the fragment is checked on its own, or an image
     /// whose format is unknown: names resolve, but nothing more is checked.
     External,
@@ -134,13 +136,14 @@ impl IrPass {
     }
 }
 
-/// Most shader variants a pass may have: 2^15 = 32,768 define sets. The
-/// shipped forward pass is decided by 15 features (11 scene features, shadow
-/// casters, ray-traced shadows, the overshading view and TAA's motion
-/// output). Variants are compiled on demand, only for the feature sets a
-/// scene selects, so the cap bounds the key space of a pass, not the work
-/// done.
-pub const MAX_VARIANT_BITS: u32 = 15;
+/// Most shader variants a pass may have: 2^16 = 65,536 define sets. The
+/// shipped forward pass and the path tracer's trace pass are decided by 16
+/// features (forward: 11 scene features, shadow casters, ray-traced shadows,
+/// the overshading view, TAA's motion output and ray queries, whose read of
+/// the acceleration structure selects the hardware walk). Variants are
+/// compiled on demand, only for the feature sets a scene selects, so the cap
+/// bounds the key space of a pass, not the work done.
+pub const MAX_VARIANT_BITS: u32 = 16;
 
 /// 2^`bits`, the variants `bits` features can select, saturating past 2^63.
 pub fn variant_count(bits: u32) -> u64 {

@@ -9,6 +9,7 @@ mod multisample;
 mod passes;
 mod resources;
 mod rules;
+mod structures;
 mod values;
 
 pub use features::{feature_names, pass_feature_names, SCENE_FEATURES};
@@ -173,6 +174,7 @@ impl<'a> Resolver<'a> {
             views,
         };
         self.check_usages(&ir);
+        self.check_structure_uses(&ir);
         self.check_multisampling(&ir);
         self.check_extents(&ir);
         self.check_caveats(&ir);
@@ -511,5 +513,6 @@ fn resource_name(r: &ResourceDecl) -> &str {
     match r {
         ResourceDecl::Image(i) => &i.name,
         ResourceDecl::Buffer(b) => &b.name,
+        ResourceDecl::AccelerationStructure(a) => &a.name,
     }
 }

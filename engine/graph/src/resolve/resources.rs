@@ -167,6 +167,15 @@ impl Resolver<'_> {
                     persistent: false,
                 }
             }
+            // Built each frame before it is traced; the scene keeps it.
+            ResourceDecl::AccelerationStructure(decl) => IrResource {
+                name: decl.name.clone(),
+                source,
+                index,
+                kind: IrKind::AccelerationStructure,
+                history: false,
+                persistent: true,
+            },
         }
     }
 }

@@ -75,6 +75,10 @@ impl Resolver<'_> {
                     );
                 }
             }
+            PassKind::BuildAccelerationStructures => {
+                self.check_build_pass(pass, decl, resources);
+                return;
+            }
         }
         if decl.repeat.is_some() && pass.kind != PassKind::Compute {
             self.error(
@@ -96,7 +100,7 @@ impl Resolver<'_> {
                 PassKind::Raster => stage != "compute",
                 PassKind::Fullscreen => stage == "fragment",
                 PassKind::Compute => stage == "compute",
-                PassKind::Copy | PassKind::Blit => false,
+                PassKind::Copy | PassKind::Blit | PassKind::BuildAccelerationStructures => false,
             };
             if present && !allowed {
                 self.error(
@@ -204,7 +208,7 @@ impl Resolver<'_> {
                 }
                 seen.insert(access.resource, access);
                 match &resource.kind {
-                    IrKind::External => {}
+                    IrKind::External | IrKind::AccelerationStructure => {}
                     IrKind::Buffer { .. } => {
                         if matches!(access.usage, Usage::Color { .. } | Usage::Depth { .. }) {
                             self.error(

@@ -209,6 +209,20 @@ pub enum ResourceDecl {
     Image(ImageDecl),
     /// A buffer.
     Buffer(BufferDecl),
+    /// The scene's acceleration structures for ray queries (a bottom level
+    /// per mesh, a top level placing them): the scene owns their memory, a
+    /// `BuildAccelerationStructures` pass writes them each frame, and passes
+    /// that trace list them in `storage_read`, so the compiler orders the
+    /// build before the traces and synchronizes both ways.
+    AccelerationStructure(AccelerationStructureDecl),
+}
+
+/// An acceleration-structure declaration (see
+/// [`ResourceDecl::AccelerationStructure`]): a name, nothing to size.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AccelerationStructureDecl {
+    pub name: String,
 }
 
 /// An image declaration.

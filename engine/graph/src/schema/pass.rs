@@ -17,6 +17,9 @@ pub enum PassKind {
     Copy,
     /// Blits (scaled, filtered copy) one image to another.
     Blit,
+    /// Builds or refits the scene's acceleration structures (the one it
+    /// names in `storage_write`) for passes that trace with ray queries.
+    BuildAccelerationStructures,
 }
 
 /// A pass declaration.

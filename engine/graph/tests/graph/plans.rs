@@ -22,6 +22,9 @@ const FEATURE_SETS: &[(&str, &[&str])] = &[
             "area_lights",
             "depth_prepass",
             "transparent",
+            // Tracing in hardware: the acceleration structure's build and reads.
+            "ray_queries",
+            "rt_shadows",
         ],
     ),
 ];
@@ -228,6 +231,10 @@ fn scene_features_cull_passes_and_variants() {
     assert_eq!(
         culled,
         [
+            (
+                "build_structures",
+                "no pass that runs traces against what it builds"
+            ),
             ("shadow_sun", "enabled_if [shadow_casters] is false"),
             ("bloom_naive_h", "enabled_if [bloom_naive] is false"),
             ("bloom_naive_v", "enabled_if [bloom_naive] is false"),

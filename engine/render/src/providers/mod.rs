@@ -283,6 +283,7 @@ pub(crate) mod tests {
             transfer: None,
             raster: Default::default(),
             derive,
+            structure: None,
         }
     }
 

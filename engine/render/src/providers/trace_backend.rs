@@ -65,15 +65,52 @@ pub struct DeviceTracing {
 /// What the missing extensions are called in errors.
 const NEEDS: &str = "VK_KHR_acceleration_structure and VK_KHR_ray_query";
 
+/// The feature the renderer turns on when a plan is compiled for ray
+/// queries (and off otherwise, whatever a user asks): graphs read the
+/// scene's acceleration structure under it (`storage_read: [(name:
+/// "scene_structures", enabled_if: ["ray_queries"])]`), so its build pass
+/// runs only for the hardware backend.
+pub const RAY_QUERY_FEATURE: &str = "ray_queries";
+
+/// Whether to compile for ray queries before the plan says whether a pass
+/// insists on them: what `asked` means on `device` ([`choose`] may still ask
+/// for another compile).
+pub fn compile_for_hardware(asked: TraceBackend, device: &DeviceTracing) -> bool {
+    device.ray_query
+        && match asked {
+            TraceBackend::Hardware => true,
+            TraceBackend::Software => false,
+            TraceBackend::Auto => !device.cpu,
+        }
+}
+
+/// What [`choose`] decided for a plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Choice {
+    /// The backend, hardware or not; the plan's tracing passes are compiled
+    /// for it.
+    Chosen { hardware: bool },
+    /// The plan must be compiled again with [`RAY_QUERY_FEATURE`] on
+    /// (`hardware`) or off, and chosen for again.
+    Recompile { hardware: bool },
+}
+
 /// Chooses the backend for `plan`'s tracing passes as `asked` on `device`,
-/// and adds [`HARDWARE_DEFINE`] to each when it is hardware. Returns whether
-/// it is; a pass that insists on hardware, or `--backend hardware`, on a
-/// device without ray queries is an error at that pass.
+/// and adds [`HARDWARE_DEFINE`] to each when it is hardware. Hardware means
+/// a plan compiled with [`RAY_QUERY_FEATURE`] on, so its tracing passes read
+/// the acceleration structure its build pass writes: where the plan was
+/// compiled the other way, the answer is to compile it again. Where no pass
+/// reads a structure (a graph without one, or whose tracing is off) `auto`
+/// takes the software walk; a pass whose shaders then trace in hardware
+/// without reading one is refused when its pipeline is checked
+/// (`weft_gpu::scene_set_problems`). A pass that insists on hardware, or
+/// `--backend hardware`, on a device without ray queries is an error at
+/// that pass.
 pub fn choose(
     plan: &mut Plan,
     asked: TraceBackend,
     device: &DeviceTracing,
-) -> Result<bool, Vec<Diagnostic>> {
+) -> Result<Choice, Vec<Diagnostic>> {
     let insisting: Vec<_> = plan
         .passes
         .iter()
@@ -116,17 +153,29 @@ pub fn choose(
     if !errors.is_empty() {
         return Err(errors);
     }
-    let hardware = match asked {
-        TraceBackend::Hardware => true,
-        TraceBackend::Software => !insisting.is_empty(),
-        TraceBackend::Auto => device.ray_query && (!device.cpu || !insisting.is_empty()),
-    };
+    let required = asked == TraceBackend::Hardware || !insisting.is_empty();
+    let compiled_for = plan.features.iter().any(|f| f == RAY_QUERY_FEATURE);
+    if required && !compiled_for {
+        return Ok(Choice::Recompile { hardware: true });
+    }
+    if !required && !compile_for_hardware(asked, device) && compiled_for {
+        return Ok(Choice::Recompile { hardware: false });
+    }
+    // Where no pass reads a structure the plan builds (a graph without one,
+    // or whose tracing is off), what is not required takes the software walk.
+    let reads_structures = plan.passes.iter().any(|p| p.structure.is_some());
+    let hardware = compiled_for && (required || reads_structures);
+    if compiled_for && !hardware {
+        return Ok(Choice::Recompile { hardware: false });
+    }
     if hardware {
         for pass in plan.passes.iter_mut().filter(|p| traces(p)) {
             pass.defines.push(HARDWARE_DEFINE.to_string());
         }
     }
-    Ok(hardware && plan.passes.iter().any(traces))
+    Ok(Choice::Chosen {
+        hardware: hardware && plan.passes.iter().any(traces),
+    })
 }
 
 /// Whether a plan's tracing passes were compiled for ray queries.
@@ -148,7 +197,11 @@ mod tests {
     use crate::providers::tests::pass_with;
     use weft_graph::schema::ProviderDecl;
 
-    fn plan_tracing(hardware: Option<bool>) -> Plan {
+    /// A plan with a tracing pass (insisting on hardware as `hardware`
+    /// says) and one that does not trace, compiled with the ray-query
+    /// feature as `feature` says; the tracing pass reads a structure under
+    /// it where the graph `reads` one.
+    fn plan_tracing(hardware: Option<bool>, reads: bool, feature: bool) -> Plan {
         let args = hardware
             .map(|h| ("hardware".to_string(), ParamValue::Bool(h)))
             .into_iter()
@@ -159,9 +212,34 @@ mod tests {
         }]);
         pass.declared_at.file = "graphs/t.ron".into();
         pass.declared_at.pos = weft_graph::spans::Pos { line: 7, col: 9 };
+        if reads && feature {
+            pass.structure = Some(weft_graph::id::ResourceId::new(0));
+        }
         let mut plan = crate::providers::tests::plan_of_one(pass);
         plan.passes.push(pass_with(Vec::new()));
+        if feature {
+            plan.features.push(RAY_QUERY_FEATURE.into());
+        }
         plan
+    }
+
+    /// What the renderer's compile loop settles on: the plan compiled as
+    /// [`compile_for_hardware`] says, then again while [`choose`] asks.
+    fn settle(
+        hardware: Option<bool>,
+        reads: bool,
+        asked: TraceBackend,
+        device: &DeviceTracing,
+    ) -> Result<(bool, Plan), Vec<Diagnostic>> {
+        let mut feature = compile_for_hardware(asked, device);
+        for _ in 0..3 {
+            let mut plan = plan_tracing(hardware, reads, feature);
+            match choose(&mut plan, asked, device)? {
+                Choice::Chosen { hardware } => return Ok((hardware, plan)),
+                Choice::Recompile { hardware } => feature = hardware,
+            }
+        }
+        panic!("choose kept asking for another compile");
     }
 
     fn device(ray_query: bool, cpu: bool) -> DeviceTracing {
@@ -187,29 +265,67 @@ mod tests {
             (device(false, false), false),
         ];
         for (device, expected) in cases {
-            let mut plan = plan_tracing(None);
-            let chosen = choose(&mut plan, TraceBackend::Auto, &device).expect("chosen");
+            let (chosen, plan) = settle(None, true, TraceBackend::Auto, &device).expect("chosen");
             assert_eq!(chosen, expected, "{device:?}");
             // Only the tracing pass gets the define.
             assert_eq!(defined(&plan), vec![expected, false]);
             assert_eq!(in_hardware(&plan), expected);
+            let feature = plan.features.iter().any(|f| f == RAY_QUERY_FEATURE);
+            assert_eq!(
+                feature, expected,
+                "compiled with the feature only for hardware"
+            );
         }
     }
 
     #[test]
     fn asking_for_a_backend_takes_it_where_the_device_allows() {
-        let mut plan = plan_tracing(None);
-        assert!(choose(&mut plan, TraceBackend::Hardware, &device(true, true)).expect("hw"));
-        let mut plan = plan_tracing(None);
-        assert!(!choose(&mut plan, TraceBackend::Software, &device(true, false)).expect("sw"));
+        let (hw, _) = settle(None, true, TraceBackend::Hardware, &device(true, true)).expect("hw");
+        assert!(hw);
+        let (hw, plan) =
+            settle(None, true, TraceBackend::Software, &device(true, false)).expect("sw");
+        assert!(!hw);
         assert_eq!(defined(&plan), vec![false, false]);
     }
 
     #[test]
+    fn a_plan_compiled_the_other_way_is_compiled_again() {
+        let mut plan = plan_tracing(None, true, false);
+        let choice = choose(&mut plan, TraceBackend::Hardware, &device(true, false));
+        assert_eq!(
+            choice.expect("no error"),
+            Choice::Recompile { hardware: true }
+        );
+        assert_eq!(defined(&plan), vec![false, false], "nothing defined yet");
+        let mut plan = plan_tracing(None, true, true);
+        let choice = choose(&mut plan, TraceBackend::Software, &device(true, false));
+        assert_eq!(
+            choice.expect("no error"),
+            Choice::Recompile { hardware: false }
+        );
+    }
+
+    #[test]
+    fn a_graph_without_a_structure_traces_in_software_unless_hardware_is_required() {
+        let (hw, plan) = settle(None, false, TraceBackend::Auto, &device(true, false)).expect("sw");
+        assert!(!hw, "auto falls back to the software walk");
+        assert_eq!(defined(&plan), vec![false, false]);
+        // Required: hardware, and the pipeline check refuses a pass whose
+        // shaders then trace against nothing built.
+        for (insisting, asked) in [
+            (Some(true), TraceBackend::Auto),
+            (None, TraceBackend::Hardware),
+        ] {
+            let (hw, plan) = settle(insisting, false, asked, &device(true, false)).expect("hw");
+            assert!(hw, "{asked:?}");
+            assert_eq!(defined(&plan), vec![true, false]);
+        }
+    }
+
+    #[test]
     fn hardware_on_a_device_without_ray_queries_is_refused_at_the_pass() {
-        let mut plan = plan_tracing(Some(true));
-        let errors =
-            choose(&mut plan, TraceBackend::Auto, &device(false, false)).expect_err("refused");
+        let errors = settle(Some(true), true, TraceBackend::Auto, &device(false, false))
+            .expect_err("refused");
         assert_eq!(errors.len(), 1);
         let text = errors[0].to_string();
         assert!(text.contains("graphs/t.ron:7:9"), "{text}");
@@ -220,13 +336,18 @@ mod tests {
             ),
             "{text}"
         );
-        let mut plan = plan_tracing(None);
         let errors =
-            choose(&mut plan, TraceBackend::Hardware, &device(false, false)).expect_err("refused");
+            settle(None, true, TraceBackend::Hardware, &device(false, false)).expect_err("refused");
         assert!(errors[0].to_string().contains("--backend hardware"));
         // A pass that insists takes hardware even where auto would not.
-        let mut plan = plan_tracing(Some(true));
-        assert!(choose(&mut plan, TraceBackend::Software, &device(true, true)).expect("hw"));
+        let (hw, _) = settle(
+            Some(true),
+            true,
+            TraceBackend::Software,
+            &device(true, true),
+        )
+        .expect("hw");
+        assert!(hw);
     }
 
     #[test]

@@ -5,12 +5,15 @@
 //! its first triangle in the ray tracer's triangle order
 //! ([`SceneGeometry::trace_mesh`]) as its custom index, so a ray query names
 //! the same triangle the software walk does. Moved placements refit the top
-//! level in place; the bottom levels never change.
+//! level in place; the bottom levels never change. Builds and refits are
+//! recorded by the graph's `BuildAccelerationStructures` pass
+//! ([`super::GpuScene::record_structures`]), which the compiler orders and
+//! synchronizes with the passes that trace.
 
 use crate::geometry::{MeshRange, SceneGeometry, VERTEX_BYTES};
 use std::collections::HashMap;
-use std::time::Duration;
-use weft_gpu::acceleration::{self, BottomLevels, Mesh, Placement, TopLevel};
+use std::time::{Duration, Instant};
+use weft_gpu::acceleration::{self, BottomLevels, Mesh, Placement, Scratch, TopLevel};
 use weft_gpu::buffer::Buffer;
 use weft_gpu::{Gpu, GpuError};
 
@@ -20,14 +23,20 @@ pub(super) struct SceneStructures<'g> {
     pub(super) top: TopLevel<'g>,
     /// Per traced draw, in the ray tracer's order, the bottom level it places.
     levels: Vec<usize>,
+    /// One scratch buffer, for the bottom levels' build and then the top
+    /// level's builds and refits.
+    scratch: Scratch<'g>,
+    /// Whether the bottom levels' build has been recorded.
+    bottom_built: bool,
 }
 
 impl<'g> SceneStructures<'g> {
-    /// Builds the bottom levels over `geometry`'s meshes, read in place from
-    /// the scene's vertex and index buffers (made with
-    /// [`acceleration::INPUT_USAGE`]), and the top level placing them as its
-    /// draw records do now.
-    pub(super) fn build(
+    /// Creates the bottom levels over `geometry`'s meshes, read in place
+    /// from the scene's vertex and index buffers (made with
+    /// [`acceleration::INPUT_USAGE`]), the top level placing them as its
+    /// draw records do now, and their scratch; nothing is built until
+    /// [`Self::record`].
+    pub(super) fn new(
         gpu: &'g Gpu,
         geometry: &SceneGeometry,
         (vertices, indices): (&Buffer<'g>, &Buffer<'g>),
@@ -48,32 +57,46 @@ impl<'g> SceneStructures<'g> {
                 }
             })
             .collect();
-        let bottom = acceleration::build_bottom_levels(gpu, &inputs)?;
-        let top = TopLevel::build(gpu, &bottom, &placements(geometry, &levels)?)?;
+        let bottom = BottomLevels::new(gpu, &inputs)?;
+        let top = TopLevel::new(gpu, &bottom, &placements(geometry, &levels)?)?;
+        let scratch = Scratch::new(gpu, bottom.scratch_bytes.max(top.scratch_bytes))?;
         Ok(Self {
             bottom,
             top,
             levels,
+            scratch,
+            bottom_built: false,
         })
     }
 
-    /// Refits the top level to the draw records' transforms as they are now.
-    pub(super) fn refit(&mut self, geometry: &SceneGeometry) -> Result<(), GpuError> {
+    /// Moves the top level's placements to the draw records' transforms as
+    /// they are now: the next [`Self::record`] refits it.
+    pub(super) fn place(&mut self, geometry: &SceneGeometry) -> Result<(), GpuError> {
         self.top
-            .refit(&self.bottom, &placements(geometry, &self.levels)?)
+            .place(&self.bottom, &placements(geometry, &self.levels)?)
     }
 
-    /// How long the bottom levels took to build, and the top level's last
-    /// build or refit.
-    pub(super) fn build_times(&self) -> (Duration, Duration) {
-        (self.bottom.build_time, self.top.last_time)
+    /// Records what the structures need before this frame's ray queries:
+    /// the bottom levels' build the first time (then a barrier, as the top
+    /// level reads them and reuses the scratch), the top level's build or
+    /// refit when it is not current, or nothing.
+    pub(super) fn record(
+        &mut self,
+        gpu: &Gpu,
+        cmd: ash::vk::CommandBuffer,
+    ) -> Result<(), GpuError> {
+        if !self.bottom_built {
+            self.bottom.record_build(gpu, cmd, &self.scratch)?;
+            acceleration::between_builds(gpu, cmd);
+            self.bottom_built = true;
+        }
+        self.top.record(gpu, cmd, &self.scratch)
     }
 
     /// Bytes of device memory the structures hold (bottom levels, then the
-    /// top level with its instances and scratch).
+    /// top level with its instances and the scratch).
     pub(super) fn bytes(&self) -> (u64, u64) {
-        let bottom = self.bottom.levels.iter().map(|l| l.bytes()).sum();
-        (bottom, self.top.bytes())
+        (self.bottom.bytes(), self.top.bytes() + self.scratch.bytes())
     }
 }
 
@@ -138,9 +161,12 @@ fn placements(geometry: &SceneGeometry, levels: &[usize]) -> Result<Vec<Placemen
 /// What the acceleration structures cost, for `weft bench bvh`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StructureReport {
-    /// The bottom levels' build, inputs' upload included.
+    /// The bottom levels' build, when it was recorded by
+    /// [`super::GpuScene::build_structures_now`] (zero when it is not built
+    /// yet, or was built by a frame).
     pub bottom_build: Duration,
-    /// The top level's last build or refit.
+    /// The top level's build or refit by the last
+    /// [`super::GpuScene::build_structures_now`].
     pub top_build: Duration,
     /// Bytes the bottom levels hold.
     pub bottom_bytes: u64,
@@ -179,32 +205,82 @@ impl super::GpuScene<'_> {
         Ok(())
     }
 
-    /// Builds the acceleration structures when tracing passes use ray
-    /// queries and they are not built yet.
+    /// Creates the acceleration structures when tracing passes use ray
+    /// queries and they do not exist yet; the graph's build pass builds
+    /// them.
     pub(super) fn ensure_structures(&mut self) -> Result<(), GpuError> {
         if self.hardware && self.structures.is_none() {
             let buffers = (&self.vertices, &self.indices);
-            self.structures = Some(SceneStructures::build(self.gpu, &self.geometry, buffers)?);
+            self.structures = Some(SceneStructures::new(self.gpu, &self.geometry, buffers)?);
         }
         Ok(())
     }
 
-    /// Refits the top level to the placements as they are now, when there is
-    /// one: what each frame that moves a placement pays (`weft bench bvh`
-    /// times it with [`Self::structure_report`]).
+    /// Moves the top level's placements to the draw records as they are
+    /// now, when there is one: the next build pass refits it, what each
+    /// frame that moves a placement pays.
     pub fn refit_structures(&mut self) -> Result<(), GpuError> {
         match &mut self.structures {
-            Some(structures) => structures.refit(&self.geometry),
+            Some(structures) => structures.place(&self.geometry),
             None => Ok(()),
         }
     }
 
-    /// The acceleration structures' build times and memory, once built.
-    pub fn structure_report(&self) -> Option<StructureReport> {
-        let structures = self.structures.as_ref()?;
-        let (bottom_build, top_build) = structures.build_times();
+    /// Records into `cmd` what the acceleration structures need before the
+    /// frame's ray queries (their first build, a refit, or nothing), after
+    /// creating them and the ray tracer's tables if this is the first frame:
+    /// the work of a `BuildAccelerationStructures` pass, whose barriers
+    /// order it. `pass` names the pass in errors.
+    pub fn record_structures(
+        &mut self,
+        pass: &str,
+        cmd: ash::vk::CommandBuffer,
+    ) -> Result<(), GpuError> {
+        if !self.hardware {
+            return Err(GpuError::Pass {
+                pass: pass.to_string(),
+                message: "builds acceleration structures, but the scene traces with the software \
+                          BVH: the plan was not compiled for ray queries"
+                    .into(),
+            });
+        }
+        self.ensure_trace_buffers()?;
+        let structures = self.structures.as_mut().ok_or_else(|| GpuError::Pass {
+            pass: pass.to_string(),
+            message: "the scene has no acceleration structures".into(),
+        })?;
+        structures.record(self.gpu, cmd)
+    }
+
+    /// Builds (or refits) the acceleration structures now, each level in a
+    /// command buffer of its own waited for, and times both: what `weft
+    /// bench bvh` measures. A frame's build pass records the same commands.
+    pub fn build_structures_now(&mut self) -> Result<StructureReport, GpuError> {
+        self.ensure_trace_buffers()?;
+        let gpu = self.gpu;
+        let Some(structures) = self.structures.as_mut() else {
+            return Err(GpuError::Plan(
+                "the scene traces with the software BVH: no acceleration structures".into(),
+            ));
+        };
+        let mut bottom_build = Duration::ZERO;
+        if !structures.bottom_built {
+            let start = Instant::now();
+            gpu.one_shot(|cmd| {
+                structures
+                    .bottom
+                    .record_build(gpu, cmd, &structures.scratch)?;
+                acceleration::between_builds(gpu, cmd);
+                Ok(())
+            })?;
+            structures.bottom_built = true;
+            bottom_build = start.elapsed();
+        }
+        let start = Instant::now();
+        gpu.one_shot(|cmd| structures.top.record(gpu, cmd, &structures.scratch))?;
+        let top_build = start.elapsed();
         let (bottom_bytes, top_bytes) = structures.bytes();
-        Some(StructureReport {
+        Ok(StructureReport {
             bottom_build,
             top_build,
             bottom_bytes,

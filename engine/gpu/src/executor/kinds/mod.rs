@@ -3,6 +3,7 @@
 //! records after the pass's barriers. [`of`] is the one table the executor
 //! dispatches through; a new kind is a module here and a row there.
 
+mod acceleration;
 mod compute;
 mod fullscreen;
 mod scene_raster;
@@ -78,6 +79,7 @@ pub(super) fn of(pass: &PlanPass) -> &'static dyn PassKindOps {
         PassKind::Fullscreen => &fullscreen::Fullscreen,
         PassKind::Raster if is_fullscreen(pass) => &fullscreen::Fullscreen,
         PassKind::Raster => &scene_raster::SceneRaster,
+        PassKind::BuildAccelerationStructures => &acceleration::BuildStructures,
     }
 }
 

@@ -14,6 +14,7 @@ pub(super) fn gpu_access(ir: &Ir, pass: IrPassId, u: &PassUse) -> GpuAccess {
     let p = &ir.passes[pass];
     let aspect = match ir.resources[u.resource].kind {
         IrKind::Image { format, .. } => Some(format.aspect),
+        IrKind::AccelerationStructure => return structure_access(p.kind, u),
         IrKind::Buffer { .. } | IrKind::External => None,
     };
     let mut stage = Stage::empty();
@@ -90,6 +91,27 @@ pub(super) fn gpu_access(ir: &Ir, pass: IrPassId, u: &PassUse) -> GpuAccess {
         stage,
         access,
         layout,
+        discards: u.discards,
+    }
+}
+
+/// How the GPU sees a use of the scene's acceleration structures: a build
+/// (or refit, which reads what it rewrites) at the build stage, or ray
+/// queries in the shaders of a pass that traces. The structures live in the
+/// scene's buffers, so the barriers are memory barriers with no layout.
+fn structure_access(kind: PassKind, u: &PassUse) -> GpuAccess {
+    let (stage, access) = if kind == PassKind::BuildAccelerationStructures {
+        (
+            Stage::ACCELERATION_STRUCTURE_BUILD,
+            Access::ACCELERATION_STRUCTURE_READ | Access::ACCELERATION_STRUCTURE_WRITE,
+        )
+    } else {
+        (shader_stages(kind), Access::ACCELERATION_STRUCTURE_READ)
+    };
+    GpuAccess {
+        stage,
+        access,
+        layout: Layout::General,
         discards: u.discards,
     }
 }

@@ -32,6 +32,7 @@ pub fn shader_stages(kind: PassKind) -> Stage {
         PassKind::Compute => Stage::COMPUTE_SHADER,
         PassKind::Copy => Stage::COPY,
         PassKind::Blit => Stage::BLIT,
+        PassKind::BuildAccelerationStructures => Stage::ACCELERATION_STRUCTURE_BUILD,
     }
 }
 

@@ -74,6 +74,7 @@ fn shader_stage(kind: PassKind, image: bool) -> Stage {
         PassKind::Compute => Stage::COMPUTE_SHADER,
         PassKind::Copy => Stage::COPY,
         PassKind::Blit => Stage::BLIT,
+        PassKind::BuildAccelerationStructures => Stage::ACCELERATION_STRUCTURE_BUILD,
     }
 }
 
@@ -121,7 +122,7 @@ fn uses_of(plan: &Plan, pass: usize) -> Vec<(usize, Use)> {
     for b in &p.bindings {
         let (image, aspect) = match &plan.resources[b.resource].desc {
             ResourceDesc::Image(i) => (true, Some(i.aspect)),
-            ResourceDesc::Buffer(_) => (false, None),
+            ResourceDesc::Buffer(_) | ResourceDesc::AccelerationStructure => (false, None),
         };
         let stage = shader_stage(p.kind, image);
         let (access, layout, needs_contents) = match b.kind {
@@ -157,6 +158,23 @@ fn uses_of(plan: &Plan, pass: usize) -> Vec<(usize, Use)> {
                 access,
                 layout,
                 needs_contents,
+            },
+        ));
+    }
+    if let Some(structure) = p.structure {
+        // Built (a refit reads what it rewrites), or read by ray queries.
+        let access = if p.kind == PassKind::BuildAccelerationStructures {
+            Access::ACCELERATION_STRUCTURE_READ | Access::ACCELERATION_STRUCTURE_WRITE
+        } else {
+            Access::ACCELERATION_STRUCTURE_READ
+        };
+        out.push((
+            structure.index(),
+            Use {
+                stage: shader_stage(p.kind, false),
+                access,
+                layout: Layout::General,
+                needs_contents: true,
             },
         ));
     }

@@ -1,0 +1,107 @@
+//! Rules for the scene's acceleration structures: a
+//! `BuildAccelerationStructures` pass writes one and does nothing else, and
+//! other passes only read one, through ray queries (`storage_read`).
+
+use super::{pass_path, rules::access_path, Ir, IrKind, IrPass, IrResource, Resolver, Usage};
+use crate::id::{IdVec, IrResourceId};
+use crate::schema::{PassDecl, PassKind};
+use crate::spans::Seg;
+
+impl Resolver<'_> {
+    /// A build pass declares one acceleration structure in `storage_write`
+    /// and nothing the executor would ignore: no shaders, attachments, other
+    /// reads or writes, copy endpoints, draws or dispatches.
+    pub(super) fn check_build_pass(
+        &mut self,
+        pass: &IrPass,
+        decl: &PassDecl,
+        resources: &IdVec<IrResourceId, IrResource>,
+    ) {
+        let (source, index) = (pass.source, pass.index);
+        let name = &pass.name;
+        let declared: [(&'static str, bool); 9] = [
+            ("shaders", decl.shaders != Default::default()),
+            ("color", !decl.color.is_empty()),
+            ("depth", decl.depth.is_some()),
+            ("sampled", !decl.sampled.is_empty()),
+            ("storage_read", !decl.storage_read.is_empty()),
+            ("src", decl.src.is_some() || decl.dst.is_some()),
+            ("draw", decl.draw.is_some()),
+            ("dispatch", decl.dispatch.is_some()),
+            ("repeat", decl.repeat.is_some()),
+        ];
+        for (field, present) in declared {
+            if present {
+                self.error(
+                    source,
+                    &pass_path(index, &[Seg::Field(field)]),
+                    format!(
+                        "BuildAccelerationStructures pass \"{name}\" takes no `{field}`: it builds \
+                         the acceleration structure it names in `storage_write`, and nothing else"
+                    ),
+                );
+            }
+        }
+        let written: Vec<bool> = pass
+            .accesses
+            .iter()
+            .filter(|a| a.usage == Usage::StorageWrite)
+            .map(|a| {
+                resources
+                    .get(a.resource)
+                    .is_some_and(|r| matches!(r.kind, IrKind::AccelerationStructure))
+            })
+            .collect();
+        if written.len() != 1 || !written[0] {
+            self.error(
+                source,
+                &pass_path(index, &[Seg::Field("storage_write")]),
+                format!(
+                    "BuildAccelerationStructures pass \"{name}\" needs exactly one \
+                     `AccelerationStructure` resource in `storage_write`"
+                ),
+            )
+            .hint = Some(
+                "declare `AccelerationStructure(name: \"scene_structures\")` in `resources` and \
+                 write it here"
+                    .into(),
+            );
+        }
+    }
+
+    /// Every use of an acceleration structure is a build pass's write or a
+    /// ray-query read (`storage_read`) in a pass that runs shaders.
+    pub(super) fn check_structure_uses(&mut self, ir: &Ir) {
+        for pass in &ir.passes {
+            for access in &pass.accesses {
+                let resource = &ir.resources[access.resource];
+                if !matches!(resource.kind, IrKind::AccelerationStructure) {
+                    continue;
+                }
+                let build = pass.kind == PassKind::BuildAccelerationStructures;
+                let fine = match access.usage {
+                    Usage::StorageWrite => build,
+                    Usage::StorageRead => matches!(
+                        pass.kind,
+                        PassKind::Compute | PassKind::Raster | PassKind::Fullscreen
+                    ),
+                    _ => false,
+                };
+                if !fine {
+                    self.error(
+                        pass.source,
+                        &access_path(pass.index, access),
+                        format!(
+                            "pass \"{}\" uses acceleration structure \"{}\" as {}: shaders read \
+                             one through ray queries (`storage_read`), and only a \
+                             BuildAccelerationStructures pass writes one",
+                            pass.name,
+                            resource.name,
+                            super::rules::usage_name(&access.usage)
+                        ),
+                    );
+                }
+            }
+        }
+    }
+}
