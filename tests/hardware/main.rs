@@ -7,6 +7,7 @@
 //! skipping them.
 
 mod backends;
+mod structures;
 
 /// A validating context on a device with ray queries.
 pub fn gpu() -> weft_gpu::Gpu {

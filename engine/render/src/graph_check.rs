@@ -3,6 +3,7 @@
 //! and the engine's scene bindings, under every feature set the graph check
 //! enumerates (features change the shader variants through defines).
 
+use crate::providers::trace_backend;
 use std::collections::HashSet;
 use weft_gpu::check::check_pass;
 use weft_gpu::pipeline::PipelineCache;
@@ -79,6 +80,20 @@ pub fn check_graph_and_shaders(
             }
             continue;
         }
+        // Under the ray-query feature the renderer traces in hardware, on a
+        // device that offers it: the variants the hardware backend compiles.
+        match traced_as_rendered(&mut plan, target) {
+            Ok(true) => {}
+            Ok(false) => continue,
+            Err(errors) => {
+                for d in errors {
+                    if !diags.contains(&d) {
+                        diags.push(d);
+                    }
+                }
+                continue;
+            }
+        }
         // A pass whose shaders, defines and bound resources are as under a
         // set checked before gives the same problems: checked once.
         let resources = resource_signature(&plan);
@@ -103,6 +118,38 @@ pub fn check_graph_and_shaders(
         }
     }
     Ok(diags)
+}
+
+/// Gives `plan`'s tracing passes the backend the renderer would: the
+/// hardware walk under [`trace_backend::RAY_QUERY_FEATURE`] (asked for, so
+/// a pass that traces without reading a structure the plan builds is
+/// refused by its check), the software walk otherwise, where building a
+/// structure is an error ([`trace_backend::built_in_software`]). `false`
+/// when the plan could not be rendered on `target` as compiled: the feature
+/// on a device without ray queries, which the renderer never sets.
+fn traced_as_rendered(
+    plan: &mut weft_graph::plan::Plan,
+    target: &ShaderTarget,
+) -> Result<bool, Vec<Diagnostic>> {
+    if !plan
+        .features
+        .iter()
+        .any(|f| f == trace_backend::RAY_QUERY_FEATURE)
+    {
+        return match trace_backend::built_in_software(plan) {
+            Some(error) => Err(vec![error]),
+            None => Ok(true),
+        };
+    }
+    let device = trace_backend::DeviceTracing {
+        name: target.device.clone(),
+        ray_query: target.support.ray_query,
+        cpu: false,
+    };
+    Ok(matches!(
+        trace_backend::choose(plan, trace_backend::TraceBackend::Hardware, &device),
+        Ok(trace_backend::Choice::Chosen { .. })
+    ))
 }
 
 /// Every resource of `plan` by name and description: bindings and

@@ -8,7 +8,7 @@ use super::{conditions_hold, locate};
 use crate::diagnostic::Diagnostic;
 use crate::id::{IdVec, IrPassId, IrResourceId};
 use crate::load::LoadedGraph;
-use crate::resolve::{access_path, Ir, Usage};
+use crate::resolve::{access_path, Ir, IrKind, Usage};
 use crate::spans::Seg;
 use std::cmp::Reverse;
 use std::collections::{BTreeSet, BinaryHeap};
@@ -193,7 +193,10 @@ pub fn order(ir: &Ir, live: &IdVec<IrPassId, bool>, uses: &Uses) -> Result<Order
                 });
             }
         }
-        if resource.kept_across_frames() {
+        // An acceleration structure outlives the frame in the scene, but a
+        // ray query needs this frame's build (or refit) before it.
+        let built_each_frame = matches!(resource.kind, IrKind::AccelerationStructure);
+        if resource.kept_across_frames() && !built_each_frame {
             continue;
         }
         match w.first() {

@@ -9,7 +9,7 @@
 
 use super::{call, traces, RAY_TRACING};
 use weft_graph::plan::Plan;
-use weft_graph::schema::ParamValue;
+use weft_graph::schema::{ParamValue, PassKind};
 use weft_graph::Diagnostic;
 
 /// The define that selects the ray-query implementation of `trace.glsl`.
@@ -168,6 +168,9 @@ pub fn choose(
     if compiled_for && !hardware {
         return Ok(Choice::Recompile { hardware: false });
     }
+    if let Some(error) = built_in_software(plan).filter(|_| !hardware) {
+        return Err(vec![error]);
+    }
     if hardware {
         for pass in plan.passes.iter_mut().filter(|p| traces(p)) {
             pass.defines.push(HARDWARE_DEFINE.to_string());
@@ -176,6 +179,35 @@ pub fn choose(
     Ok(Choice::Chosen {
         hardware: hardware && plan.passes.iter().any(traces),
     })
+}
+
+/// The error at a plan's acceleration-structure build when the plan was
+/// compiled without [`RAY_QUERY_FEATURE`]: a pass reads the structure where
+/// nothing traces in hardware, so the build would run for the software walk,
+/// which has no structures to build.
+pub fn built_in_software(plan: &Plan) -> Option<Diagnostic> {
+    if plan.features.iter().any(|f| f == RAY_QUERY_FEATURE) {
+        return None;
+    }
+    let build = plan
+        .passes
+        .iter()
+        .find(|p| p.kind == PassKind::BuildAccelerationStructures)?;
+    Some(
+        Diagnostic::error(
+            build.declared_at.file.clone(),
+            build.declared_at.pos,
+            format!(
+                "pass \"{}\" builds acceleration structures without `{RAY_QUERY_FEATURE}`: a pass \
+                 reads them where the software BVH traces, which has none to build",
+                build.name
+            ),
+        )
+        .with_hint(format!(
+            "read the structure only under ray queries: `(name: \"...\", enabled_if: \
+             [\"{RAY_QUERY_FEATURE}\"])`"
+        )),
+    )
 }
 
 /// Whether a plan's tracing passes were compiled for ray queries.

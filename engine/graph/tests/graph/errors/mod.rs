@@ -7,6 +7,7 @@ use support::{check_text, load_files};
 use weft_graph::{Diagnostic, Severity};
 
 mod multisample;
+mod structures;
 mod values;
 
 /// The text at a diagnostic's position, up to the end of its line.
