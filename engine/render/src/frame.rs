@@ -193,7 +193,23 @@ pub fn compile_for_scene(
     let mut requested = scene_features(scene);
     requested.extend(settings.features.iter().cloned());
     // The renderer's to set: on exactly when the plan traces in hardware.
-    requested.retain(|f| f.trim().trim_start_matches('!') != RAY_QUERY_FEATURE);
+    if settings
+        .features
+        .iter()
+        .any(|f| f.trim().trim_start_matches('!') == RAY_QUERY_FEATURE)
+    {
+        return Err(RenderError::Graph(vec![weft_graph::Diagnostic::error(
+            settings.graph.clone(),
+            weft_graph::spans::Pos { line: 1, col: 1 },
+            format!(
+                "feature `{RAY_QUERY_FEATURE}` is the renderer's: it is on exactly when passes \
+                 trace with ray queries"
+            ),
+        )
+        .with_hint(
+            "choose the backend with --backend hardware or --backend software",
+        )]));
+    }
     let memory = memory_requirements(gpu);
     let device = trace_backend::DeviceTracing {
         name: gpu.info().name.clone(),

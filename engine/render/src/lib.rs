@@ -74,7 +74,7 @@ pub use frame_loop::{FrameLoop, FrameRequest};
 pub use graph_check::{check_graph_and_shaders, ShaderTarget};
 pub use prepare::{PreparedReload, ReloadJob, ShaderChecker};
 pub use providers::ray_counts::PassRays;
-pub use providers::trace_backend::TraceBackend;
+pub use providers::trace_backend::{TraceBackend, RAY_QUERY_FEATURE};
 pub use recorder::{SceneRecorder, ViewCulling};
 pub use reload::{startup_files, Committed, LiveRender};
 pub use reload_error::ReloadError;

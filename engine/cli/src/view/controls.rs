@@ -131,6 +131,8 @@ pub fn split_frame<'t>(text: &'t str, what: &str) -> Result<(u32, &'t str), Stri
 pub fn graph_features(graph: &weft_graph::Prepared) -> Vec<String> {
     let mut names = weft_graph::feature_names(graph.ir());
     names.extend(graph.graph().default_features.iter().cloned());
+    // The renderer's own, on exactly when passes trace in hardware.
+    names.remove(weft_render::RAY_QUERY_FEATURE);
     let (scene, own): (Vec<String>, Vec<String>) = names
         .into_iter()
         .partition(|n| weft_graph::SCENE_FEATURES.contains(&n.as_str()));

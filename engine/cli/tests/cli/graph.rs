@@ -78,17 +78,19 @@ fn plan_json_has_stats() {
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     let stats = &json["stats"];
     assert_eq!(stats["passes"], 8);
+    // The acceleration-structure build (nothing traces in hardware),
     // bloom_naive_h/v, area_lights, area_light_panels, transparent, rt_ao,
     // gi, rt_specular, the 12 passes of the debug views and the denoiser's
     // 14, ReSTIR's 5 and the radiance cache's 4 (all off).
-    assert_eq!(stats["culled"], 44);
+    assert_eq!(stats["culled"], 45);
     assert!(stats["barriers"].as_u64().expect("barriers") > 10);
     let aliased = stats["transient_bytes"].as_u64().expect("bytes");
     let unaliased = stats["transient_bytes_unaliased"].as_u64().expect("bytes");
     assert!(aliased < unaliased, "{aliased} < {unaliased}");
     assert!(stats["compile_us"].as_f64().expect("time") > 0.0);
     assert_eq!(json["extent"]["width"], 1920);
-    assert_eq!(json["culled"][40]["name"], "spot_lights");
+    assert_eq!(json["culled"][0]["name"], "build_structures");
+    assert_eq!(json["culled"][41]["name"], "spot_lights");
 }
 
 #[test]
@@ -107,7 +109,7 @@ fn plan_text_lists_culled_passes_and_barriers() {
         "{text}"
     );
     assert!(
-        text.contains("culled:\n  shadow_sun: enabled_if [shadow_casters] is false\n"),
+        text.contains("culled:\n  build_structures: no pass that runs traces against what it builds\n  shadow_sun: enabled_if [shadow_casters] is false\n"),
         "{text}"
     );
     assert!(text.contains("     barrier hdr: COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE -> FRAGMENT_SHADER/SHADER_SAMPLED_READ COLOR_ATTACHMENT_OPTIMAL -> SHADER_READ_ONLY_OPTIMAL\n"), "{text}");
@@ -206,17 +208,18 @@ fn plan_with_a_scene_culls_what_the_scene_lacks() {
     );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
-        text.contains("culled:\n  bloom_naive_h: enabled_if [bloom_naive] is false\n  bloom_naive_v: enabled_if [bloom_naive] is false\n  clear_overdraw: enabled_if [overdraw] is false\n  overdraw: enabled_if [overdraw] is false\n  clear_overshading: enabled_if [overshading] is false\n  clear_light_count: enabled_if [light_count] is false\n  light_count: enabled_if [light_count] is false\n  mesh_density: enabled_if [mesh_density] is false\n  normals: enabled_if [normals] is false\n  show_overdraw: enabled_if [overdraw] is false\n  show_overshading: enabled_if [overshading] is false\n  show_mesh_density: enabled_if [mesh_density] is false\n  show_normals: enabled_if [normals] is false\n  show_light_count: enabled_if [light_count] is false\n  rt_ao: enabled_if [rt_ao] is false\n  gi: enabled_if [gi] is false\n  cache_reset: enabled_if [radiance_cache] is false\n  cache_sweep: enabled_if [radiance_cache] is false\n  cache_update: enabled_if [radiance_cache] is false\n  cache_lookup: enabled_if [radiance_cache] is false\n  rt_specular: enabled_if [rt_specular, specular_lobes] is false\n  guides: enabled_if [denoise] is false\n  denoise_temporal: enabled_if [denoise] is false\n  denoise_variance: enabled_if [denoise] is false\n  denoise_atrous_1: enabled_if [denoise] is false\n  denoise_atrous_2: enabled_if [denoise] is false\n  denoise_atrous_4: enabled_if [denoise] is false\n  denoise_atrous_8: enabled_if [denoise] is false\n  denoise_atrous_16: enabled_if [denoise] is false\n  denoise_modulate: enabled_if [denoise] is false\n  clear_denoise_history: enabled_if [denoise, history_length] is false\n  keep_normal: enabled_if [denoise] is false\n  keep_position: enabled_if [denoise] is false\n  keep_illumination: enabled_if [denoise] is false\n  keep_moments: enabled_if [denoise] is false\n  restir_initial: enabled_if [restir_di] is false\n  restir_spatial: enabled_if [restir_di, restir_spatial] is false\n  restir_keep_sample: enabled_if [restir_di] is false\n  restir_keep_state: enabled_if [restir_di] is false\n  restir_keep_surface: enabled_if [restir_di] is false\n  point_lights: enabled_if [point_lights] is false\n  spot_lights: enabled_if [spot_lights] is false\n"),
+        text.contains("culled:\n  build_structures: no pass that runs traces against what it builds\n  bloom_naive_h: enabled_if [bloom_naive] is false\n  bloom_naive_v: enabled_if [bloom_naive] is false\n  clear_overdraw: enabled_if [overdraw] is false\n  overdraw: enabled_if [overdraw] is false\n  clear_overshading: enabled_if [overshading] is false\n  clear_light_count: enabled_if [light_count] is false\n  light_count: enabled_if [light_count] is false\n  mesh_density: enabled_if [mesh_density] is false\n  normals: enabled_if [normals] is false\n  show_overdraw: enabled_if [overdraw] is false\n  show_overshading: enabled_if [overshading] is false\n  show_mesh_density: enabled_if [mesh_density] is false\n  show_normals: enabled_if [normals] is false\n  show_light_count: enabled_if [light_count] is false\n  rt_ao: enabled_if [rt_ao] is false\n  gi: enabled_if [gi] is false\n  cache_reset: enabled_if [radiance_cache] is false\n  cache_sweep: enabled_if [radiance_cache] is false\n  cache_update: enabled_if [radiance_cache] is false\n  cache_lookup: enabled_if [radiance_cache] is false\n  rt_specular: enabled_if [rt_specular, specular_lobes] is false\n  guides: enabled_if [denoise] is false\n  denoise_temporal: enabled_if [denoise] is false\n  denoise_variance: enabled_if [denoise] is false\n  denoise_atrous_1: enabled_if [denoise] is false\n  denoise_atrous_2: enabled_if [denoise] is false\n  denoise_atrous_4: enabled_if [denoise] is false\n  denoise_atrous_8: enabled_if [denoise] is false\n  denoise_atrous_16: enabled_if [denoise] is false\n  denoise_modulate: enabled_if [denoise] is false\n  clear_denoise_history: enabled_if [denoise, history_length] is false\n  keep_normal: enabled_if [denoise] is false\n  keep_position: enabled_if [denoise] is false\n  keep_illumination: enabled_if [denoise] is false\n  keep_moments: enabled_if [denoise] is false\n  restir_initial: enabled_if [restir_di] is false\n  restir_spatial: enabled_if [restir_di, restir_spatial] is false\n  restir_keep_sample: enabled_if [restir_di] is false\n  restir_keep_state: enabled_if [restir_di] is false\n  restir_keep_surface: enabled_if [restir_di] is false\n  point_lights: enabled_if [point_lights] is false\n  spot_lights: enabled_if [spot_lights] is false\n"),
         "{text}"
     );
     assert!(text.contains("  0. shadow_sun (Raster)"), "{text}");
     // The variant key: the sun pass compiles the sun loop and Blinn-Phong only
-    // (rt_ao, rt_shadows, gi, radiance_cache, rt_specular, restir_di and
-    // `specular_lobes`, the scene's lobes rt_specular traces, are among the
-    // twelve features it may depend on).
+    // (rt_ao, rt_shadows, gi, radiance_cache, rt_specular, restir_di,
+    // `specular_lobes`, the scene's lobes rt_specular traces, and
+    // ray_queries, the hardware backend's, are among the thirteen features
+    // it may depend on).
     assert!(
         text.contains(
-            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS RAY_COUNT_SLOT=0 (variant key; 1 of up to 4096 variants: 12 of the 15 features a pass may depend on)\n"
+            "     defines HAS_SHADOW_MAP SCENE_BLINN_PHONG SCENE_SPECIALISED SCENE_SUNS RAY_COUNT_SLOT=0 (variant key; 1 of up to 8192 variants: 13 of the 16 features a pass may depend on)\n"
         ),
         "{text}"
     );

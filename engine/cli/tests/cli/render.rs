@@ -110,7 +110,7 @@ fn image_size(path: &Path) -> (u32, u32) {
 
 #[test]
 fn bad_times_frame_counts_and_feature_names_are_refused() {
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 7] = [
         (&["--time", "NaN"], "time must be a finite number of seconds, found \"NaN\""),
         (&["--time", "inf"], "time must be a finite number of seconds, found \"inf\""),
         (&["--frames", "0"], "invalid value '0' for '--frames <FRAMES>'"),
@@ -121,6 +121,15 @@ fn bad_times_frame_counts_and_feature_names_are_refused() {
         (
             &["--features", "!shadow_caster"],
             "unknown feature \"shadow_caster\" (did you mean \"shadow_casters\"?)",
+        ),
+        // The backend's feature is the renderer's, whichever way it is asked.
+        (
+            &["--features", "ray_queries"],
+            "graphs/forward.ron:1:1: error: feature `ray_queries` is the renderer's: it is on exactly when passes trace with ray queries",
+        ),
+        (
+            &["--features", "rt_shadows,!ray_queries"],
+            "hint: choose the backend with --backend hardware or --backend software",
         ),
     ];
     for (extra, expected) in cases {

@@ -139,7 +139,7 @@ fn parameters_beyond_a_float_or_a_glsl_int_and_nan_bounds_are_refused_where_decl
         (
             "graphs/forward.ron",
             "emissive_boost=1e39",
-            "graphs/forward.ron:25:27: error: parameter \"emissive_boost\" must be a finite 32-bit float (at most 3.4e38 in size), found 1e39",
+            "graphs/forward.ron:26:27: error: parameter \"emissive_boost\" must be a finite 32-bit float (at most 3.4e38 in size), found 1e39",
         ),
         (
             "graphs/forward.ron",

@@ -132,7 +132,7 @@ fn params_are_held_to_the_type_and_range_their_graph_declares() {
     for (param, expected) in [
         (
             "max_depth=-1",
-            "pathtrace.ron:25:22: error: parameter \"max_depth\" set to -1: it must be at least 1",
+            "pathtrace.ron:26:22: error: parameter \"max_depth\" set to -1: it must be at least 1",
         ),
         (
             "sampling=99",
