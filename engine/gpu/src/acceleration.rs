@@ -357,11 +357,6 @@ impl<'g> TopLevel<'g> {
         Ok(())
     }
 
-    /// Whether the next [`Self::record`] has work: a first build or a refit.
-    pub fn pending(&self) -> bool {
-        self.state != TopState::Current
-    }
-
     /// Records the top level's build (the first time) or refit (placements
     /// moved), with its scratch from `scratch`; nothing when it is current.
     /// The caller orders it after the bottom levels' build and the last

@@ -216,11 +216,17 @@ pub fn compile_for_scene(
         ray_query: gpu.info().shaders.ray_query,
         cpu: gpu.info().kind == weft_gpu::DeviceKind::Cpu,
     };
-    let mut hardware = trace_backend::compile_for_hardware(settings.trace_backend, &device);
+    // A graph that never names the feature compiles the same either way:
+    // once, for the software walk, unless the plan then requires hardware.
+    let names_feature = weft_graph::feature_names(graph.ir()).contains(RAY_QUERY_FEATURE);
+    let mut hardware =
+        names_feature && trace_backend::compile_for_hardware(settings.trace_backend, &device);
     let mut compiles = 0;
     let plan = loop {
         compiles += 1;
         let mut features = loaded.features(&requested);
+        // Whatever the graph's defaults say.
+        features.remove(RAY_QUERY_FEATURE);
         if hardware {
             features.insert(RAY_QUERY_FEATURE.to_string());
         }
@@ -236,9 +242,9 @@ pub fn compile_for_scene(
             .map_err(RenderError::Graph)?
         {
             trace_backend::Choice::Chosen { .. } => break plan,
-            // The second compile has the feature as chosen; a third would
-            // flip it back, which only a plan that changes under it could ask.
-            trace_backend::Choice::Recompile { .. } if compiles == 3 => {
+            // The second compile has the feature as chosen: asking again
+            // would flip it back.
+            trace_backend::Choice::Recompile { .. } if compiles == 2 => {
                 return Err(RenderError::Graph(vec![weft_graph::Diagnostic::error(
                     plan.file.clone(),
                     Default::default(),

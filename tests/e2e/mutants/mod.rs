@@ -395,9 +395,9 @@ fn run_mutant(gpu: &Gpu, scene: &weft_scene::Scene, graph: &Path) -> Result<Outc
     let prepared =
         weft_graph::Prepared::new(loaded).map_err(|d| Failure::RenderRefused(format!("{d:?}")))?;
     let mut names: BTreeSet<String> = feature_names(prepared.ir());
+    names.extend(prepared.graph().default_features.iter().cloned());
     // The renderer's own: on exactly when passes trace in hardware.
     names.remove(weft_render::RAY_QUERY_FEATURE);
-    names.extend(prepared.graph().default_features.iter().cloned());
     let none: Vec<String> = names.iter().map(|n| format!("!{n}")).collect();
     let all: Vec<String> = names.iter().cloned().collect();
     for features in [Vec::new(), none, all] {

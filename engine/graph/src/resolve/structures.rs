@@ -2,7 +2,9 @@
 //! `BuildAccelerationStructures` pass writes one and does nothing else, and
 //! other passes only read one, through ray queries (`storage_read`).
 
-use super::{pass_path, rules::access_path, Ir, IrKind, IrPass, IrResource, Resolver, Usage};
+use super::{
+    pass_path, resource_path, rules::access_path, Ir, IrKind, IrPass, IrResource, Resolver, Usage,
+};
 use crate::id::{IdVec, IrResourceId};
 use crate::schema::{PassDecl, PassKind};
 use crate::spans::Seg;
@@ -69,9 +71,48 @@ impl Resolver<'_> {
         }
     }
 
+    /// The scene has one set of structures, built once a frame: a graph
+    /// declares at most one `AccelerationStructure` and one build pass.
+    fn check_one_structure(&mut self, ir: &Ir) {
+        let declared: Vec<&IrResource> = ir
+            .resources
+            .iter()
+            .filter(|r| matches!(r.kind, IrKind::AccelerationStructure))
+            .collect();
+        if let [first, second, ..] = declared[..] {
+            self.error(
+                second.source,
+                &resource_path(second.index, &[Seg::Field("name")]),
+                format!(
+                    "acceleration structures \"{}\" and \"{}\": the scene has one, which one \
+                     BuildAccelerationStructures pass builds",
+                    first.name, second.name
+                ),
+            );
+        }
+        let builds: Vec<&IrPass> = ir
+            .passes
+            .iter()
+            .filter(|p| p.kind == PassKind::BuildAccelerationStructures)
+            .collect();
+        if let [first, second, ..] = builds[..] {
+            self.error(
+                second.source,
+                &pass_path(second.index, &[Seg::Field("kind")]),
+                format!(
+                    "passes \"{}\" and \"{}\" both build acceleration structures: the scene's are \
+                     built once a frame, by one pass",
+                    first.name, second.name
+                ),
+            );
+        }
+    }
+
     /// Every use of an acceleration structure is a build pass's write or a
-    /// ray-query read (`storage_read`) in a pass that runs shaders.
+    /// ray-query read (`storage_read`) in a pass that runs shaders, and
+    /// there is one structure, built by one pass.
     pub(super) fn check_structure_uses(&mut self, ir: &Ir) {
+        self.check_one_structure(ir);
         for pass in &ir.passes {
             for access in &pass.accesses {
                 let resource = &ir.resources[access.resource];

@@ -163,7 +163,10 @@ pub fn choose(
     }
     // Where no pass reads a structure the plan builds (a graph without one,
     // or whose tracing is off), what is not required takes the software walk.
-    let reads_structures = plan.passes.iter().any(|p| p.structure.is_some());
+    let reads_structures = plan
+        .passes
+        .iter()
+        .any(|p| traces(p) && p.structure.is_some());
     let hardware = compiled_for && (required || reads_structures);
     if compiled_for && !hardware {
         return Ok(Choice::Recompile { hardware: false });

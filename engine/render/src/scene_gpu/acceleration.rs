@@ -23,11 +23,13 @@ pub(super) struct SceneStructures<'g> {
     pub(super) top: TopLevel<'g>,
     /// Per traced draw, in the ray tracer's order, the bottom level it places.
     levels: Vec<usize>,
-    /// One scratch buffer, for the bottom levels' build and then the top
-    /// level's builds and refits.
+    /// One scratch buffer: for the bottom levels' build and the top level's
+    /// first, then only as large as the top level's refits need.
     scratch: Scratch<'g>,
     /// Whether the bottom levels' build has been recorded.
     bottom_built: bool,
+    /// Whether `scratch` is still sized for the bottom levels' build.
+    scratch_for_bottom: bool,
 }
 
 impl<'g> SceneStructures<'g> {
@@ -61,6 +63,7 @@ impl<'g> SceneStructures<'g> {
         let top = TopLevel::new(gpu, &bottom, &placements(geometry, &levels)?)?;
         let scratch = Scratch::new(gpu, bottom.scratch_bytes.max(top.scratch_bytes))?;
         Ok(Self {
+            scratch_for_bottom: bottom.scratch_bytes > top.scratch_bytes,
             bottom,
             top,
             levels,
@@ -79,24 +82,34 @@ impl<'g> SceneStructures<'g> {
     /// Records what the structures need before this frame's ray queries:
     /// the bottom levels' build the first time (then a barrier, as the top
     /// level reads them and reuses the scratch), the top level's build or
-    /// refit when it is not current, or nothing.
+    /// refit when it is not current, or nothing. Frames run one at a time,
+    /// so on the frame after the first the bottom levels' scratch is no
+    /// longer in use: it is replaced by one the top level's size.
     pub(super) fn record(
         &mut self,
-        gpu: &Gpu,
+        gpu: &'g Gpu,
         cmd: ash::vk::CommandBuffer,
     ) -> Result<(), GpuError> {
         if !self.bottom_built {
             self.bottom.record_build(gpu, cmd, &self.scratch)?;
             acceleration::between_builds(gpu, cmd);
             self.bottom_built = true;
+        } else if self.scratch_for_bottom {
+            self.scratch = Scratch::new(gpu, self.top.scratch_bytes)?;
+            self.scratch_for_bottom = false;
         }
         self.top.record(gpu, cmd, &self.scratch)
     }
 
-    /// Bytes of device memory the structures hold (bottom levels, then the
-    /// top level with its instances and the scratch).
+    /// Bytes of device memory the structures hold after their first frame
+    /// (bottom levels, then the top level with its instances and the
+    /// scratch its refits need); the first frame also holds the bottom
+    /// levels' build scratch.
     pub(super) fn bytes(&self) -> (u64, u64) {
-        (self.bottom.bytes(), self.top.bytes() + self.scratch.bytes())
+        (
+            self.bottom.bytes(),
+            self.top.bytes() + self.top.scratch_bytes,
+        )
     }
 }
 
@@ -277,7 +290,11 @@ impl super::GpuScene<'_> {
             bottom_build = start.elapsed();
         }
         let start = Instant::now();
-        gpu.one_shot(|cmd| structures.top.record(gpu, cmd, &structures.scratch))?;
+        gpu.one_shot(|cmd| {
+            // After the last submission's build, whose scratch this reuses.
+            acceleration::between_builds(gpu, cmd);
+            structures.top.record(gpu, cmd, &structures.scratch)
+        })?;
         let top_build = start.elapsed();
         let (bottom_bytes, top_bytes) = structures.bytes();
         Ok(StructureReport {

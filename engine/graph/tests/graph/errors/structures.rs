@@ -57,6 +57,16 @@ fn structures_are_built_by_their_pass_alone_and_read_by_ray_queries() {
             "pass \"trace\" reads \"tlas\" before anything writes it (with features [!never, ray_queries])",
             r#""tlas", enabled_if"#,
         ),
+        (
+            (r#"AccelerationStructure(name: "tlas"),"#, r#"AccelerationStructure(name: "tlas"), AccelerationStructure(name: "blas"),"#),
+            "acceleration structures \"tlas\" and \"blas\": the scene has one, which one BuildAccelerationStructures pass builds",
+            r#""blas")"#,
+        ),
+        (
+            ("        Pass(name: \"trace\"", "        Pass(name: \"again\", kind: BuildAccelerationStructures, storage_write: [\"tlas\"], after: [\"build\"]),\n        Pass(name: \"trace\""),
+            "passes \"build\" and \"again\" both build acceleration structures: the scene's are built once a frame, by one pass",
+            "BuildAccelerationStructures, storage_write: [\"tlas\"], after",
+        ),
     ];
     for ((from, to), message, at) in cases {
         assert!(STRUCTURES.contains(from), "{from}");
