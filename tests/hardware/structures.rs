@@ -187,3 +187,32 @@ fn every_edit_of_the_structure_passes_is_refused_by_check_or_renders_clean() {
         }
     }
 }
+
+/// A frame that fails after its build pass recorded never runs that build:
+/// the scene records it again at the next frame, rather than trace a top
+/// level that was never built; a build that was submitted counts.
+#[test]
+fn a_build_recorded_into_a_frame_never_submitted_is_recorded_again() {
+    let gpu = crate::gpu();
+    let log = gpu.validation();
+    let scene = weft_scene::load_scene(&root().join("scenes/cornell.scene")).expect("loads");
+    let mut uploaded = weft_render::GpuScene::new(&gpu, &scene, false).expect("uploads");
+    uploaded.trace_in_hardware(true).expect("hardware");
+    // The frame's build pass records; a later pass fails, so nothing is submitted.
+    let failed = gpu.one_shot(|cmd| {
+        uploaded.record_structures("build_structures", cmd)?;
+        Err(weft_gpu::GpuError::Plan("a later pass failed".into()))
+    });
+    assert!(failed.is_err());
+    uploaded.forget_unsubmitted_structures();
+    let rebuilt = uploaded.build_structures_now().expect("builds");
+    assert!(
+        rebuilt.bottom_build > std::time::Duration::ZERO,
+        "the bottom levels are built again"
+    );
+    let after = uploaded.build_structures_now().expect("nothing to build");
+    assert_eq!(after.bottom_build, std::time::Duration::ZERO, "built once");
+    drop(uploaded);
+    drop(gpu);
+    assert_eq!(log.messages(), Vec::new());
+}

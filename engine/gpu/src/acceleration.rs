@@ -294,6 +294,9 @@ pub struct TopLevel<'g> {
     /// Bytes of scratch a build or a refit needs.
     pub scratch_bytes: u64,
     state: TopState,
+    /// The state before the last recorded build, until it is known to have
+    /// been submitted ([`Self::submitted`]).
+    unsubmitted: Option<TopState>,
 }
 
 impl<'g> TopLevel<'g> {
@@ -330,6 +333,7 @@ impl<'g> TopLevel<'g> {
             count,
             scratch_bytes: sizes.build_scratch_size.max(sizes.update_scratch_size),
             state: TopState::Unbuilt,
+            unsubmitted: None,
         };
         top.write_instances(levels, placements)?;
         Ok(top)
@@ -385,8 +389,26 @@ impl<'g> TopLevel<'g> {
         let ranges =
             [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(self.count)];
         unsafe { loader.cmd_build_acceleration_structures(cmd, &[info], &[&ranges]) };
+        self.unsubmitted = Some(self.state);
         self.state = TopState::Current;
         Ok(())
+    }
+
+    /// The last recorded build was submitted: it counts.
+    pub fn submitted(&mut self) {
+        self.unsubmitted = None;
+    }
+
+    /// The last recorded build was never submitted (its frame failed before
+    /// it): the next [`Self::record`] does its work again.
+    pub fn forget_unsubmitted(&mut self) {
+        if let Some(before) = self.unsubmitted.take() {
+            // Moves since then leave it `Moved`, a refit, as does `before`.
+            self.state = match (before, self.state) {
+                (TopState::Unbuilt, _) => TopState::Unbuilt,
+                _ => TopState::Moved,
+            };
+        }
     }
 
     fn write_instances(

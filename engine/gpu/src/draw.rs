@@ -196,6 +196,12 @@ pub trait DrawRecorder {
         Ok(())
     }
 
+    /// Called by the executor after each submission of the frame's commands
+    /// (one at the end, or one per pass when timing passes on the CPU):
+    /// what was recorded so far will run, so state that records work once
+    /// (an acceleration structure's build) may count it done.
+    fn submitted(&mut self) {}
+
     /// The pipeline variants `pass` (a scene pass) binds through
     /// [`RasterContext::bind_variant`] with the recorder's scene; the
     /// executor builds each, and writes its set 0, when it prepares the

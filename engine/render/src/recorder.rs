@@ -424,11 +424,17 @@ impl SceneRecorder<'_> {
 }
 
 impl DrawRecorder for SceneRecorder<'_> {
-    /// The draw count and the culling figures start again.
+    /// The draw count and the culling figures start again; structure builds
+    /// the last frame recorded but never submitted are to be recorded again.
     fn begin_frame(&mut self) -> Result<(), GpuError> {
         self.draw_calls = 0;
         self.culling.clear();
+        self.scene.forget_unsubmitted_structures();
         Ok(())
+    }
+
+    fn submitted(&mut self) {
+        self.scene.structures_submitted();
     }
 
     /// What `record` binds, with this scene: one variant per shading model

@@ -514,6 +514,7 @@ impl<'g> Renderer<'g> {
             if per_pass {
                 let wall = Instant::now();
                 commands.submit_and_wait(cmd)?;
+                draws.submitted();
                 timings.push(PassTiming {
                     pass: pass.name.clone(),
                     kind: pass.kind,
@@ -533,6 +534,7 @@ impl<'g> Renderer<'g> {
         }
         record_ms += t.elapsed().as_secs_f64() * 1e3;
         commands.submit_and_wait(cmd)?;
+        draws.submitted();
         if let Some(q) = &queries {
             timings = q.timings(self.gpu, plan)?;
         }

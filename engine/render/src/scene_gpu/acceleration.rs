@@ -28,6 +28,8 @@ pub(super) struct SceneStructures<'g> {
     scratch: Scratch<'g>,
     /// Whether the bottom levels' build has been recorded.
     bottom_built: bool,
+    /// Whether that record is not yet known to have been submitted.
+    bottom_unsubmitted: bool,
     /// Whether `scratch` is still sized for the bottom levels' build.
     scratch_for_bottom: bool,
 }
@@ -69,6 +71,7 @@ impl<'g> SceneStructures<'g> {
             levels,
             scratch,
             bottom_built: false,
+            bottom_unsubmitted: false,
         })
     }
 
@@ -94,11 +97,27 @@ impl<'g> SceneStructures<'g> {
             self.bottom.record_build(gpu, cmd, &self.scratch)?;
             acceleration::between_builds(gpu, cmd);
             self.bottom_built = true;
-        } else if self.scratch_for_bottom {
+            self.bottom_unsubmitted = true;
+        } else if self.scratch_for_bottom && !self.bottom_unsubmitted {
             self.scratch = Scratch::new(gpu, self.top.scratch_bytes)?;
             self.scratch_for_bottom = false;
         }
         self.top.record(gpu, cmd, &self.scratch)
+    }
+
+    /// What was recorded has been submitted: it counts.
+    pub(super) fn submitted(&mut self) {
+        self.bottom_unsubmitted = false;
+        self.top.submitted();
+    }
+
+    /// What was recorded was never submitted (its frame failed first): the
+    /// next [`Self::record`] records it again.
+    pub(super) fn forget_unsubmitted(&mut self) {
+        if std::mem::take(&mut self.bottom_unsubmitted) {
+            self.bottom_built = false;
+        }
+        self.top.forget_unsubmitted();
     }
 
     /// Bytes of device memory the structures hold after their first frame
@@ -265,6 +284,24 @@ impl super::GpuScene<'_> {
         structures.record(self.gpu, cmd)
     }
 
+    /// The frame whose command buffer [`Self::record_structures`] recorded
+    /// into was submitted: its builds count. The executor says so through
+    /// the draw recorder after each submission.
+    pub fn structures_submitted(&mut self) {
+        if let Some(structures) = &mut self.structures {
+            structures.submitted();
+        }
+    }
+
+    /// Builds recorded but never submitted (a frame that failed after its
+    /// build pass) are recorded again by the next build pass: what a draw
+    /// recorder calls as each frame begins.
+    pub fn forget_unsubmitted_structures(&mut self) {
+        if let Some(structures) = &mut self.structures {
+            structures.forget_unsubmitted();
+        }
+    }
+
     /// Builds (or refits) the acceleration structures now, each level in a
     /// command buffer of its own waited for, and times both: what `weft
     /// bench bvh` measures. A frame's build pass records the same commands.
@@ -287,6 +324,7 @@ impl super::GpuScene<'_> {
                 Ok(())
             })?;
             structures.bottom_built = true;
+            structures.bottom_unsubmitted = false;
             bottom_build = start.elapsed();
         }
         let start = Instant::now();
@@ -295,6 +333,7 @@ impl super::GpuScene<'_> {
             acceleration::between_builds(gpu, cmd);
             structures.top.record(gpu, cmd, &structures.scratch)
         })?;
+        structures.top.submitted();
         let top_build = start.elapsed();
         let (bottom_bytes, top_bytes) = structures.bytes();
         Ok(StructureReport {
