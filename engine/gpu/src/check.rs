@@ -1,14 +1,13 @@
-//! Which shaders a pass runs and whether they agree with the graph and the
-//! scene interface, without a device: `weft graph check --shaders` and a hot
-//! reload use this, and the executor runs the same checks before it builds a
-//! pipeline.
+//! The parts of the shader check that do not depend on a pass's kind: the
+//! shaders a pass runs as keys ([`PassShaders`], a scene pass's variants),
+//! their interface against the graph ([`pass_problems`]), and problems
+//! located in the shaders. The check itself, which asks each pass's kind for
+//! its shaders, is [`crate::executor::shader_check`].
 
 use crate::bind::{self, FrameValues, ResolvedBinding};
 use crate::error::GpuError;
 use crate::pipeline::{PipelineCache, ShaderKey};
 use crate::reflect::PipelineInterface;
-use crate::scene::SceneInterface;
-use crate::scene_check::{scene_pass_problems, scene_set_problems};
 use crate::shader::ShaderStage;
 use std::path::Path;
 use weft_graph::plan::{Plan, PlanPass};
@@ -41,45 +40,6 @@ impl PassShaders {
 /// Whether a raster/fullscreen pass draws one fullscreen triangle.
 pub fn is_fullscreen(pass: &PlanPass) -> bool {
     pass.kind == PassKind::Fullscreen || pass.draw == Some(Draw::FullscreenTriangle)
-}
-
-/// The pass's shaders; `None` for copies, blits and scene draws (which a
-/// draw recorder supplies).
-pub fn pass_shaders(pass: &PlanPass) -> Result<Option<PassShaders>, GpuError> {
-    let missing = |what: &str| GpuError::Pass {
-        pass: pass.name.clone(),
-        message: format!("needs a {what} shader"),
-    };
-    let key = |path: &std::path::Path, stage| ShaderKey {
-        path: path.to_path_buf(),
-        stage,
-        defines: pass.defines.clone(),
-    };
-    Ok(Some(match pass.kind {
-        PassKind::Compute => {
-            let cs = pass
-                .shaders
-                .compute
-                .as_deref()
-                .ok_or_else(|| missing("compute"))?;
-            PassShaders::Compute(key(cs, ShaderStage::Compute))
-        }
-        PassKind::Fullscreen | PassKind::Raster if is_fullscreen(pass) => {
-            let fs = pass
-                .shaders
-                .fragment
-                .as_deref()
-                .ok_or_else(|| missing("fragment"))?;
-            PassShaders::Fullscreen {
-                vertex: match pass.shaders.vertex.as_deref() {
-                    Some(vs) => key(vs, ShaderStage::Vertex),
-                    None => ShaderKey::fullscreen_vertex(),
-                },
-                fragment: key(fs, ShaderStage::Fragment),
-            }
-        }
-        _ => return Ok(None),
-    }))
 }
 
 /// Cross-checks a pass's merged shader interface with the graph: bindings,
@@ -186,17 +146,6 @@ pub struct ShaderProblem {
     pub message: String,
 }
 
-/// Compiles and reflects every pass's shaders and checks them against the
-/// graph (and, with `scene`, against the scene data a renderer supplies), with
-/// no Vulkan device; every problem is returned.
-pub fn check_shaders(
-    plan: &Plan,
-    scene: Option<&SceneInterface>,
-) -> Result<Vec<ShaderProblem>, GpuError> {
-    let mut cache = PipelineCache::new()?;
-    Ok(check_with(&mut cache, plan, scene))
-}
-
 /// One line per problem a pass's check found: the problems themselves, or a
 /// compile failure's diagnostics (each with its file:line), or the error.
 pub fn problem_messages(found: Result<Vec<String>, GpuError>) -> Vec<String> {
@@ -208,107 +157,6 @@ pub fn problem_messages(found: Result<Vec<String>, GpuError>) -> Vec<String> {
         Err(GpuError::Pass { message, .. }) => vec![message],
         Err(e) => vec![e.to_string()],
     }
-}
-
-/// `check_shaders` with a given cache (the executor's): the one shader check.
-/// Fullscreen and compute passes are checked against the graph and, where
-/// they read scene data, the scene sets; scene-drawing passes (with `scene`)
-/// in every variant they run. Each problem names its pass, once.
-pub fn check_with(
-    cache: &mut PipelineCache,
-    plan: &Plan,
-    scene: Option<&SceneInterface>,
-) -> Vec<ShaderProblem> {
-    let mut problems = Vec::new();
-    for pass in &plan.passes {
-        for problem in check_pass(cache, plan, pass, scene) {
-            if !problems.contains(&problem) {
-                problems.push(problem);
-            }
-        }
-    }
-    problems
-}
-
-/// [`check_with`] for one pass of `plan`.
-pub fn check_pass(
-    cache: &mut PipelineCache,
-    plan: &Plan,
-    pass: &PlanPass,
-    scene: Option<&SceneInterface>,
-) -> Vec<ShaderProblem> {
-    let found = match pass_shaders(pass) {
-        Ok(Some(shaders)) => own_pass_problems(cache, plan, pass, &shaders, scene),
-        Ok(None) => match scene {
-            Some(scene) => scene_pass_shader_problems(cache, scene, plan, pass),
-            None => Ok(Vec::new()),
-        },
-        Err(e) => Err(e),
-    };
-    problem_messages(found)
-        .into_iter()
-        .map(|message| ShaderProblem {
-            pass: pass.name.clone(),
-            message,
-        })
-        .collect()
-}
-
-/// A fullscreen or compute pass's problems, located in its shaders.
-fn own_pass_problems(
-    cache: &mut PipelineCache,
-    plan: &Plan,
-    pass: &PlanPass,
-    shaders: &PassShaders,
-    scene: Option<&SceneInterface>,
-) -> Result<Vec<String>, GpuError> {
-    let interface = cache.interface(&shaders.keys())?;
-    let keys: Vec<ShaderKey> = shaders.keys().into_iter().cloned().collect();
-    let mut found = pass_problems(plan, pass, shaders, &interface)
-        .err()
-        .unwrap_or_default();
-    if let Some(scene) = scene {
-        found.extend(scene_set_problems(scene, &interface, false, pass));
-    }
-    Ok(found
-        .into_iter()
-        .map(|m| with_declaration(cache, &keys, m))
-        .collect())
-}
-
-/// A scene-drawing pass's shaders, in every variant it runs, compiled through
-/// `cache` and checked against the scene interface.
-fn scene_pass_shader_problems(
-    cache: &mut PipelineCache,
-    scene: &SceneInterface,
-    plan: &Plan,
-    pass: &PlanPass,
-) -> Result<Vec<String>, GpuError> {
-    if pass.draw.is_none() {
-        return Ok(Vec::new());
-    }
-    if pass.shaders.vertex.is_none() {
-        return Ok(vec!["needs a vertex shader".into()]);
-    }
-    let mut found = Vec::new();
-    for keys in scene_pass_variants(pass) {
-        let vs = cache.shader(&keys[0])?;
-        let fs = keys.get(1).map(|k| cache.shader(k)).transpose()?;
-        let problems = scene_pass_problems(
-            scene,
-            plan,
-            pass,
-            &vs.interface,
-            fs.as_ref().map(|f| &f.interface),
-        );
-        for m in problems {
-            let located = with_declaration(cache, &keys, m);
-            if !found.contains(&located) {
-                found.push(located);
-            }
-        }
-    }
-    Ok(found)
 }
 
 /// The shader variant of a scene pass's stage with `defines`.

@@ -42,10 +42,11 @@ pub mod validation;
 pub mod workgroup;
 
 pub use capabilities::ShaderSupport;
-pub use check::{check_shaders, ShaderProblem};
+pub use check::ShaderProblem;
 pub use context::{DeviceInfo, DeviceKind, Gpu, GpuOptions, MemoryReport};
 pub use draw::{DrawRecorder, NoDraws, RasterContext};
 pub use error::{GpuError, VkCall};
+pub use executor::shader_check::check_shaders;
 pub use executor::{FrameOptions, FrameReport, Renderer};
 pub use present::{Capture, Overlay, OverlayTarget, PresentSource, Presented, Presenter};
 pub use readback::{Pixels, Readback};

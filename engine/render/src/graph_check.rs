@@ -5,7 +5,7 @@
 
 use crate::providers::trace_backend;
 use std::collections::HashSet;
-use weft_gpu::check::check_pass;
+use weft_gpu::executor::shader_check::check_pass;
 use weft_gpu::pipeline::PipelineCache;
 use weft_gpu::{Gpu, GpuError, ShaderProblem, ShaderSupport};
 use weft_graph::check::variant_sets;
@@ -180,7 +180,7 @@ fn unoffered(
     pass: &PlanPass,
     target: &ShaderTarget,
 ) -> Vec<ShaderProblem> {
-    let keys = match weft_gpu::check::pass_shaders(pass) {
+    let keys = match weft_gpu::executor::shader_check::pass_shaders(pass) {
         Ok(Some(shaders)) => shaders.keys().into_iter().cloned().collect(),
         Ok(None) => crate::sources::scene_pass_keys(pass),
         Err(_) => return Vec::new(), // reported by `check_pass`

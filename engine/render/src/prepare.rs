@@ -155,7 +155,7 @@ pub(crate) fn check_shaders(
         }
     }
     let scene = crate::bindings::scene_interface();
-    let problems = weft_gpu::check::check_with(checker, plan, Some(&scene));
+    let problems = weft_gpu::executor::shader_check::check_with(checker, plan, Some(&scene));
     match problems.first() {
         None => Ok(()),
         Some(problem) => {

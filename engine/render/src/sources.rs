@@ -54,7 +54,7 @@ pub fn normalize(path: &Path) -> PathBuf {
 pub fn plan_shader_keys(plan: &Plan) -> Result<Vec<ShaderKey>, GpuError> {
     let mut keys = Vec::new();
     for pass in &plan.passes {
-        if let Some(shaders) = weft_gpu::check::pass_shaders(pass)? {
+        if let Some(shaders) = weft_gpu::executor::shader_check::pass_shaders(pass)? {
             keys.extend(shaders.keys().into_iter().cloned());
             continue;
         }

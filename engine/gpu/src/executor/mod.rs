@@ -24,6 +24,7 @@ use crate::timing::{PassTiming, TimingMode, TimingSource};
 mod kinds;
 mod prepare;
 mod record_pass;
+pub mod shader_check;
 
 use crate::descriptors::DescriptorPool;
 use kinds::PassAt;
@@ -261,10 +262,10 @@ impl<'g> Renderer<'g> {
     }
 
     /// Compiles and reflects every pass's shaders and cross-checks them with
-    /// the graph (see `check::check_shaders`); no pipeline is built.
+    /// the graph (see `shader_check::check_shaders`); no pipeline is built.
     pub fn check_shaders(&mut self, plan: &Plan) -> Vec<ShaderProblem> {
         let scene = self.scene.as_ref().map(|r| &r.interface);
-        check::check_with(&mut self.pipelines, plan, scene)
+        shader_check::check_with(&mut self.pipelines, plan, scene)
     }
 
     /// The pass's pipeline key and resolved bindings, after checking that
@@ -274,7 +275,7 @@ impl<'g> Renderer<'g> {
         plan: &Plan,
         pass: &PlanPass,
     ) -> Result<Option<(PipelineKey, Vec<ResolvedBinding>)>, GpuError> {
-        let Some(shaders) = check::pass_shaders(pass)? else {
+        let Some(shaders) = shader_check::pass_shaders(pass)? else {
             return Ok(None);
         };
         let interface = self.pipelines.interface(&shaders.keys())?;

@@ -4,11 +4,13 @@
 
 use super::{PassKindOps, Preparing, Recording};
 use crate::bind::REPEAT_INDEX;
+use crate::check::PassShaders;
 use crate::error::GpuError;
 use crate::executor::Renderer;
 use crate::record;
 use crate::resources::FrameResources;
 use crate::sets::SCENE_SET;
+use crate::shader::ShaderStage;
 use ash::vk;
 use weft_graph::plan::PlanPass;
 use weft_graph::resolve::INDIRECT_RECORD_BYTES;
@@ -17,6 +19,16 @@ use weft_graph::resolve::INDIRECT_RECORD_BYTES;
 pub(super) struct Compute;
 
 impl PassKindOps for Compute {
+    fn shaders(&self, pass: &PlanPass) -> Result<Option<PassShaders>, GpuError> {
+        let compute = pass.shaders.compute.as_deref();
+        let compute = compute.ok_or_else(|| super::missing_shader(pass, "compute"))?;
+        Ok(Some(PassShaders::Compute(super::shader_key(
+            pass,
+            compute,
+            ShaderStage::Compute,
+        ))))
+    }
+
     fn prepare<'g>(
         &self,
         renderer: &mut Renderer<'g>,

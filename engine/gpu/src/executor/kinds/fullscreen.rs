@@ -2,15 +2,33 @@
 //! pass's render pass, with scene data bound when its shaders read it.
 
 use super::{PassKindOps, Preparing, Recording};
+use crate::check::PassShaders;
 use crate::error::GpuError;
 use crate::executor::Renderer;
+use crate::pipeline::ShaderKey;
 use crate::sets::SCENE_SET;
+use crate::shader::ShaderStage;
+use weft_graph::plan::PlanPass;
 
 /// The fullscreen kind (a `Fullscreen` pass, or a `Raster` pass drawing
 /// `FullscreenTriangle`).
 pub(super) struct Fullscreen;
 
 impl PassKindOps for Fullscreen {
+    /// The pass's vertex shader, or the built-in triangle, and its fragment
+    /// shader.
+    fn shaders(&self, pass: &PlanPass) -> Result<Option<PassShaders>, GpuError> {
+        let fragment = pass.shaders.fragment.as_deref();
+        let fragment = fragment.ok_or_else(|| super::missing_shader(pass, "fragment"))?;
+        Ok(Some(PassShaders::Fullscreen {
+            vertex: match pass.shaders.vertex.as_deref() {
+                Some(vertex) => super::shader_key(pass, vertex, ShaderStage::Vertex),
+                None => ShaderKey::fullscreen_vertex(),
+            },
+            fragment: super::shader_key(pass, fragment, ShaderStage::Fragment),
+        }))
+    }
+
     fn prepare<'g>(
         &self,
         renderer: &mut Renderer<'g>,

@@ -11,10 +11,12 @@ mod transfer;
 
 use super::{FrameOptions, Prepared, Renderer};
 use crate::bind::FrameValues;
-use crate::check::is_fullscreen;
+use crate::check::{is_fullscreen, PassShaders};
 use crate::draw::{DrawRecorder, RasterContext};
 use crate::error::GpuError;
+use crate::pipeline::ShaderKey;
 use crate::resources::FrameResources;
+use crate::shader::ShaderStage;
 use ash::vk;
 use weft_graph::id::PassId;
 use weft_graph::plan::{Plan, PlanPass};
@@ -33,6 +35,15 @@ pub(super) trait PassKindOps: Sync {
     ) -> Result<(), GpuError> {
         let _ = (renderer, prep);
         Ok(())
+    }
+
+    /// The shaders the executor builds the pass's pipeline from, which
+    /// `weft graph check --shaders` checks; `None` where there are none
+    /// (copies, blits, builds) or the draw recorder supplies them (scene
+    /// draws).
+    fn shaders(&self, pass: &PlanPass) -> Result<Option<PassShaders>, GpuError> {
+        let _ = pass;
+        Ok(None)
     }
 
     /// Records the pass's work into `rec.cmd`; its barriers are recorded.
@@ -80,6 +91,23 @@ pub(super) fn of(pass: &PlanPass) -> &'static dyn PassKindOps {
         PassKind::Raster if is_fullscreen(pass) => &fullscreen::Fullscreen,
         PassKind::Raster => &scene_raster::SceneRaster,
         PassKind::BuildAccelerationStructures => &acceleration::BuildStructures,
+    }
+}
+
+/// A shader of `pass` at `path` for `stage`, with the pass's defines.
+fn shader_key(pass: &PlanPass, path: &std::path::Path, stage: ShaderStage) -> ShaderKey {
+    ShaderKey {
+        path: path.to_path_buf(),
+        stage,
+        defines: pass.defines.clone(),
+    }
+}
+
+/// The error of a pass that lacks the `what` shader its kind runs.
+fn missing_shader(pass: &PlanPass, what: &str) -> GpuError {
+    GpuError::Pass {
+        pass: pass.name.clone(),
+        message: format!("needs a {what} shader"),
     }
 }
 
