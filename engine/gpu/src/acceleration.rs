@@ -110,8 +110,8 @@ pub struct Mesh {
     pub triangles: u32,
 }
 
-/// The bottom levels over a scene's meshes, created together and built by
-/// one recorded command ([`Self::record_build`]).
+/// The bottom levels over a scene's meshes, created together and built
+/// once by one recorded command ([`Self::record`]).
 pub struct BottomLevels<'g> {
     /// One per mesh, in the order given.
     pub levels: Vec<AccelerationStructure<'g>>,
@@ -120,6 +120,10 @@ pub struct BottomLevels<'g> {
     scratch_offsets: Vec<u64>,
     /// Bytes of scratch the build needs, all levels together.
     pub scratch_bytes: u64,
+    /// Whether the build has been recorded.
+    built: bool,
+    /// Whether that record is not yet known to have been submitted.
+    unsubmitted: bool,
 }
 
 /// A placement of a bottom level in the top level.
@@ -164,14 +168,52 @@ impl<'g> BottomLevels<'g> {
             meshes: meshes.to_vec(),
             scratch_offsets,
             scratch_bytes,
+            built: false,
+            unsubmitted: false,
         })
     }
 
-    /// Records every level's build, one `vkCmdBuildAccelerationStructuresKHR`,
-    /// with its scratch from `scratch` (at least [`Self::scratch_bytes`]).
-    /// The caller orders it: the geometry read before, the levels' readers
-    /// after.
-    pub fn record_build(
+    /// Records every level's build the first time, one
+    /// `vkCmdBuildAccelerationStructuresKHR` with its scratch from `scratch`
+    /// (at least [`Self::scratch_bytes`]), then a barrier to the top level's
+    /// build, which reads the levels and reuses the scratch; nothing once
+    /// built. The caller orders the geometry's writes before it.
+    pub fn record(
+        &mut self,
+        gpu: &Gpu,
+        cmd: vk::CommandBuffer,
+        scratch: &Scratch<'_>,
+    ) -> Result<(), GpuError> {
+        if self.built {
+            return Ok(());
+        }
+        self.record_build(gpu, cmd, scratch)?;
+        between_builds(gpu, cmd);
+        self.built = true;
+        self.unsubmitted = true;
+        Ok(())
+    }
+
+    /// Whether the build is recorded and known to have been submitted: its
+    /// scratch is no longer in use once that frame has finished.
+    pub fn settled(&self) -> bool {
+        self.built && !self.unsubmitted
+    }
+
+    /// The recorded build was submitted: it counts.
+    pub fn submitted(&mut self) {
+        self.unsubmitted = false;
+    }
+
+    /// The recorded build was never submitted (its frame failed before it):
+    /// the next [`Self::record`] records it again.
+    pub fn forget_unsubmitted(&mut self) {
+        if std::mem::take(&mut self.unsubmitted) {
+            self.built = false;
+        }
+    }
+
+    fn record_build(
         &self,
         gpu: &Gpu,
         cmd: vk::CommandBuffer,
@@ -403,10 +445,11 @@ impl<'g> TopLevel<'g> {
     /// it): the next [`Self::record`] does its work again.
     pub fn forget_unsubmitted(&mut self) {
         if let Some(before) = self.unsubmitted.take() {
-            // Moves since then leave it `Moved`, a refit, as does `before`.
-            self.state = match (before, self.state) {
-                (TopState::Unbuilt, _) => TopState::Unbuilt,
-                _ => TopState::Moved,
+            // Never built stays so; a refit (and any move since) refits.
+            self.state = if before == TopState::Unbuilt {
+                TopState::Unbuilt
+            } else {
+                TopState::Moved
             };
         }
     }
@@ -524,9 +567,9 @@ fn scratch_alignment(gpu: &Gpu) -> u64 {
     )
 }
 
-/// The barrier between builds in one pass: the bottom levels' writes (and
-/// their scratch's) made visible to the top level's build, which reads the
-/// levels and reuses the scratch. What comes before and after the pass is
+/// The barrier between builds: the earlier builds' writes (and their
+/// scratch's) made visible to a later build, which reads the levels and
+/// reuses the scratch. What comes before and after a frame's build pass is
 /// the render graph's to order.
 pub fn between_builds(gpu: &Gpu, cmd: vk::CommandBuffer) {
     let barrier = vk::MemoryBarrier2::default()

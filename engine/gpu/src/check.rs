@@ -159,8 +159,8 @@ pub fn problem_messages(found: Result<Vec<String>, GpuError>) -> Vec<String> {
     }
 }
 
-/// The shader variant of a scene pass's stage with `defines`.
-fn stage_key(path: &Path, stage: ShaderStage, defines: &[String]) -> ShaderKey {
+/// The shader variant of a pass's stage with `defines`.
+pub(crate) fn stage_key(path: &Path, stage: ShaderStage, defines: &[String]) -> ShaderKey {
     ShaderKey {
         path: path.to_path_buf(),
         stage,

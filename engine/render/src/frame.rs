@@ -216,44 +216,25 @@ pub fn compile_for_scene(
         ray_query: gpu.info().shaders.ray_query,
         cpu: gpu.info().kind == weft_gpu::DeviceKind::Cpu,
     };
-    // A graph that never names the feature compiles the same either way:
-    // once, for the software walk, unless the plan then requires hardware.
     let names_feature = weft_graph::feature_names(graph.ir()).contains(RAY_QUERY_FEATURE);
-    let mut hardware =
-        names_feature && trace_backend::compile_for_hardware(settings.trace_backend, &device);
-    let mut compiles = 0;
-    let plan = loop {
-        compiles += 1;
-        let mut features = loaded.features(&requested);
-        // Whatever the graph's defaults say.
-        features.remove(RAY_QUERY_FEATURE);
-        if hardware {
-            features.insert(RAY_QUERY_FEATURE.to_string());
-        }
-        let options = CompileOptions {
-            extent: settings.extent,
-            features,
-            memory: &memory,
-            readback: settings.extra_readback.clone(),
-            readback_asked: settings.readback_asked,
-        };
-        let mut plan = crate::providers::compile(graph, &options).map_err(RenderError::Graph)?;
-        match trace_backend::choose(&mut plan, settings.trace_backend, &device)
-            .map_err(RenderError::Graph)?
-        {
-            trace_backend::Choice::Chosen { .. } => break plan,
-            // The second compile has the feature as chosen: asking again
-            // would flip it back.
-            trace_backend::Choice::Recompile { .. } if compiles == 2 => {
-                return Err(RenderError::Graph(vec![weft_graph::Diagnostic::error(
-                    plan.file.clone(),
-                    Default::default(),
-                    "the trace backend changed with every compile of the graph".to_string(),
-                )]))
+    let plan =
+        trace_backend::compile_traced(settings.trace_backend, &device, names_feature, |hardware| {
+            let mut features = loaded.features(&requested);
+            // Whatever the graph's defaults say.
+            features.remove(RAY_QUERY_FEATURE);
+            if hardware {
+                features.insert(RAY_QUERY_FEATURE.to_string());
             }
-            trace_backend::Choice::Recompile { hardware: again } => hardware = again,
-        }
-    };
+            let options = CompileOptions {
+                extent: settings.extent,
+                features,
+                memory: &memory,
+                readback: settings.extra_readback.clone(),
+                readback_asked: settings.readback_asked,
+            };
+            crate::providers::compile(graph, &options)
+        })
+        .map_err(RenderError::Graph)?;
     if let Some((image, size)) = weft_gpu::oversized_images(gpu, &plan).into_iter().next() {
         return Err(RenderError::ImageTooLarge {
             image,

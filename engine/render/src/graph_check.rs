@@ -131,11 +131,7 @@ fn traced_as_rendered(
     plan: &mut weft_graph::plan::Plan,
     target: &ShaderTarget,
 ) -> Result<bool, Vec<Diagnostic>> {
-    if !plan
-        .features
-        .iter()
-        .any(|f| f == trace_backend::RAY_QUERY_FEATURE)
-    {
+    if !trace_backend::compiled_for_ray_queries(plan) {
         return match trace_backend::built_in_software(plan) {
             Some(error) => Err(vec![error]),
             None => Ok(true),
@@ -148,7 +144,7 @@ fn traced_as_rendered(
     };
     Ok(matches!(
         trace_backend::choose(plan, trace_backend::TraceBackend::Hardware, &device),
-        Ok(trace_backend::Choice::Chosen { .. })
+        Ok(trace_backend::Choice::Chosen)
     ))
 }
 

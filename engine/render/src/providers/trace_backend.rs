@@ -84,15 +84,50 @@ pub fn compile_for_hardware(asked: TraceBackend, device: &DeviceTracing) -> bool
         }
 }
 
+/// Whether `plan` was compiled with [`RAY_QUERY_FEATURE`] on.
+pub fn compiled_for_ray_queries(plan: &Plan) -> bool {
+    plan.features.iter().any(|f| f == RAY_QUERY_FEATURE)
+}
+
 /// What [`choose`] decided for a plan.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Choice {
-    /// The backend, hardware or not; the plan's tracing passes are compiled
-    /// for it.
-    Chosen { hardware: bool },
+    /// The backend is chosen and the plan's tracing passes are compiled for
+    /// it ([`in_hardware`] says which).
+    Chosen,
     /// The plan must be compiled again with [`RAY_QUERY_FEATURE`] on
     /// (`hardware`) or off, and chosen for again.
     Recompile { hardware: bool },
+}
+
+/// The plan `compile` makes with [`RAY_QUERY_FEATURE`] on (`true`) or off,
+/// its tracing passes compiled for the backend `asked` means on `device`
+/// ([`choose`]): compiled first as [`compile_for_hardware`] says (in
+/// software where the graph never names the feature, `names_feature`, as
+/// it then compiles the same either way), and once more where the plan
+/// asks for the feature the other way.
+pub fn compile_traced(
+    asked: TraceBackend,
+    device: &DeviceTracing,
+    names_feature: bool,
+    mut compile: impl FnMut(bool) -> Result<Plan, Vec<Diagnostic>>,
+) -> Result<Plan, Vec<Diagnostic>> {
+    let mut hardware = names_feature && compile_for_hardware(asked, device);
+    let mut plan = compile(hardware)?;
+    if let Choice::Recompile { hardware: again } = choose(&mut plan, asked, device)? {
+        hardware = again;
+        plan = compile(hardware)?;
+        // The second compile has the feature as chosen: asking again would
+        // flip it back.
+        if choose(&mut plan, asked, device)? != Choice::Chosen {
+            return Err(vec![Diagnostic::error(
+                plan.file.clone(),
+                Default::default(),
+                "the trace backend changed with every compile of the graph",
+            )]);
+        }
+    }
+    Ok(plan)
 }
 
 /// Chooses the backend for `plan`'s tracing passes as `asked` on `device`,
@@ -154,7 +189,7 @@ pub fn choose(
         return Err(errors);
     }
     let required = asked == TraceBackend::Hardware || !insisting.is_empty();
-    let compiled_for = plan.features.iter().any(|f| f == RAY_QUERY_FEATURE);
+    let compiled_for = compiled_for_ray_queries(plan);
     if required && !compiled_for {
         return Ok(Choice::Recompile { hardware: true });
     }
@@ -179,9 +214,7 @@ pub fn choose(
             pass.defines.push(HARDWARE_DEFINE.to_string());
         }
     }
-    Ok(Choice::Chosen {
-        hardware: hardware && plan.passes.iter().any(traces),
-    })
+    Ok(Choice::Chosen)
 }
 
 /// The error at a plan's acceleration-structure build when the plan was
@@ -189,7 +222,7 @@ pub fn choose(
 /// nothing traces in hardware, so the build would run for the software walk,
 /// which has no structures to build.
 pub fn built_in_software(plan: &Plan) -> Option<Diagnostic> {
-    if plan.features.iter().any(|f| f == RAY_QUERY_FEATURE) {
+    if compiled_for_ray_queries(plan) {
         return None;
     }
     let build = plan
@@ -258,23 +291,18 @@ mod tests {
         plan
     }
 
-    /// What the renderer's compile loop settles on: the plan compiled as
-    /// [`compile_for_hardware`] says, then again while [`choose`] asks.
+    /// What the renderer's compile settles on ([`compile_traced`]): whether
+    /// the plan traces in hardware, and the plan.
     fn settle(
         hardware: Option<bool>,
         reads: bool,
         asked: TraceBackend,
         device: &DeviceTracing,
     ) -> Result<(bool, Plan), Vec<Diagnostic>> {
-        let mut feature = compile_for_hardware(asked, device);
-        for _ in 0..3 {
-            let mut plan = plan_tracing(hardware, reads, feature);
-            match choose(&mut plan, asked, device)? {
-                Choice::Chosen { hardware } => return Ok((hardware, plan)),
-                Choice::Recompile { hardware } => feature = hardware,
-            }
-        }
-        panic!("choose kept asking for another compile");
+        let plan = compile_traced(asked, device, true, |feature| {
+            Ok(plan_tracing(hardware, reads, feature))
+        })?;
+        Ok((in_hardware(&plan), plan))
     }
 
     fn device(ray_query: bool, cpu: bool) -> DeviceTracing {
@@ -305,7 +333,7 @@ mod tests {
             // Only the tracing pass gets the define.
             assert_eq!(defined(&plan), vec![expected, false]);
             assert_eq!(in_hardware(&plan), expected);
-            let feature = plan.features.iter().any(|f| f == RAY_QUERY_FEATURE);
+            let feature = compiled_for_ray_queries(&plan);
             assert_eq!(
                 feature, expected,
                 "compiled with the feature only for hardware"

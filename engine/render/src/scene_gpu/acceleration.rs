@@ -26,10 +26,6 @@ pub(super) struct SceneStructures<'g> {
     /// One scratch buffer: for the bottom levels' build and the top level's
     /// first, then only as large as the top level's refits need.
     scratch: Scratch<'g>,
-    /// Whether the bottom levels' build has been recorded.
-    bottom_built: bool,
-    /// Whether that record is not yet known to have been submitted.
-    bottom_unsubmitted: bool,
     /// Whether `scratch` is still sized for the bottom levels' build.
     scratch_for_bottom: bool,
 }
@@ -70,8 +66,6 @@ impl<'g> SceneStructures<'g> {
             top,
             levels,
             scratch,
-            bottom_built: false,
-            bottom_unsubmitted: false,
         })
     }
 
@@ -93,30 +87,24 @@ impl<'g> SceneStructures<'g> {
         gpu: &'g Gpu,
         cmd: ash::vk::CommandBuffer,
     ) -> Result<(), GpuError> {
-        if !self.bottom_built {
-            self.bottom.record_build(gpu, cmd, &self.scratch)?;
-            acceleration::between_builds(gpu, cmd);
-            self.bottom_built = true;
-            self.bottom_unsubmitted = true;
-        } else if self.scratch_for_bottom && !self.bottom_unsubmitted {
+        if self.scratch_for_bottom && self.bottom.settled() {
             self.scratch = Scratch::new(gpu, self.top.scratch_bytes)?;
             self.scratch_for_bottom = false;
         }
+        self.bottom.record(gpu, cmd, &self.scratch)?;
         self.top.record(gpu, cmd, &self.scratch)
     }
 
     /// What was recorded has been submitted: it counts.
     pub(super) fn submitted(&mut self) {
-        self.bottom_unsubmitted = false;
+        self.bottom.submitted();
         self.top.submitted();
     }
 
     /// What was recorded was never submitted (its frame failed first): the
     /// next [`Self::record`] records it again.
     pub(super) fn forget_unsubmitted(&mut self) {
-        if std::mem::take(&mut self.bottom_unsubmitted) {
-            self.bottom_built = false;
-        }
+        self.bottom.forget_unsubmitted();
         self.top.forget_unsubmitted();
     }
 
@@ -314,17 +302,10 @@ impl super::GpuScene<'_> {
             ));
         };
         let mut bottom_build = Duration::ZERO;
-        if !structures.bottom_built {
+        if !structures.bottom.settled() {
             let start = Instant::now();
-            gpu.one_shot(|cmd| {
-                structures
-                    .bottom
-                    .record_build(gpu, cmd, &structures.scratch)?;
-                acceleration::between_builds(gpu, cmd);
-                Ok(())
-            })?;
-            structures.bottom_built = true;
-            structures.bottom_unsubmitted = false;
+            gpu.one_shot(|cmd| structures.bottom.record(gpu, cmd, &structures.scratch))?;
+            structures.bottom.submitted();
             bottom_build = start.elapsed();
         }
         let start = Instant::now();

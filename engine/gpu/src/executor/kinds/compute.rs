@@ -4,7 +4,7 @@
 
 use super::{PassKindOps, Preparing, Recording};
 use crate::bind::REPEAT_INDEX;
-use crate::check::PassShaders;
+use crate::check::{stage_key, PassShaders};
 use crate::error::GpuError;
 use crate::executor::Renderer;
 use crate::record;
@@ -22,10 +22,10 @@ impl PassKindOps for Compute {
     fn shaders(&self, pass: &PlanPass) -> Result<Option<PassShaders>, GpuError> {
         let compute = pass.shaders.compute.as_deref();
         let compute = compute.ok_or_else(|| super::missing_shader(pass, "compute"))?;
-        Ok(Some(PassShaders::Compute(super::shader_key(
-            pass,
+        Ok(Some(PassShaders::Compute(stage_key(
             compute,
             ShaderStage::Compute,
+            &pass.defines,
         ))))
     }
 

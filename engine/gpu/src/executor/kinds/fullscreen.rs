@@ -2,7 +2,7 @@
 //! pass's render pass, with scene data bound when its shaders read it.
 
 use super::{PassKindOps, Preparing, Recording};
-use crate::check::PassShaders;
+use crate::check::{stage_key, PassShaders};
 use crate::error::GpuError;
 use crate::executor::Renderer;
 use crate::pipeline::ShaderKey;
@@ -22,10 +22,10 @@ impl PassKindOps for Fullscreen {
         let fragment = fragment.ok_or_else(|| super::missing_shader(pass, "fragment"))?;
         Ok(Some(PassShaders::Fullscreen {
             vertex: match pass.shaders.vertex.as_deref() {
-                Some(vertex) => super::shader_key(pass, vertex, ShaderStage::Vertex),
+                Some(vertex) => stage_key(vertex, ShaderStage::Vertex, &pass.defines),
                 None => ShaderKey::fullscreen_vertex(),
             },
-            fragment: super::shader_key(pass, fragment, ShaderStage::Fragment),
+            fragment: stage_key(fragment, ShaderStage::Fragment, &pass.defines),
         }))
     }
 

@@ -14,9 +14,7 @@ use crate::bind::FrameValues;
 use crate::check::{is_fullscreen, PassShaders};
 use crate::draw::{DrawRecorder, RasterContext};
 use crate::error::GpuError;
-use crate::pipeline::ShaderKey;
 use crate::resources::FrameResources;
-use crate::shader::ShaderStage;
 use ash::vk;
 use weft_graph::id::PassId;
 use weft_graph::plan::{Plan, PlanPass};
@@ -91,15 +89,6 @@ pub(super) fn of(pass: &PlanPass) -> &'static dyn PassKindOps {
         PassKind::Raster if is_fullscreen(pass) => &fullscreen::Fullscreen,
         PassKind::Raster => &scene_raster::SceneRaster,
         PassKind::BuildAccelerationStructures => &acceleration::BuildStructures,
-    }
-}
-
-/// A shader of `pass` at `path` for `stage`, with the pass's defines.
-fn shader_key(pass: &PlanPass, path: &std::path::Path, stage: ShaderStage) -> ShaderKey {
-    ShaderKey {
-        path: path.to_path_buf(),
-        stage,
-        defines: pass.defines.clone(),
     }
 }
 
