@@ -59,12 +59,12 @@ fn variant_scene(dir: &std::path::Path, quad: bool, helmet: bool) -> std::path::
 fn a_scene_pass_names_only_the_variants_its_scene_draws() {
     use weft_gpu::state::{pass_state, BlendCode};
     use weft_gpu::DrawRecorder;
-    use weft_graph::schema::{Draw, MaterialFilter, ShadingModel};
+    use weft_graph::schema::{Draw, SceneTerm};
     let dir = weft_tests::TempDir::new("scene-variants");
     let gpu = weft_tests::gpu();
     let graph = weft_graph::Prepared::new(weft_graph::load(&weft_tests::shipped("forward.ron")))
         .expect("forward loads");
-    let (phong, metal) = (ShadingModel::BlinnPhong, ShadingModel::MetallicRoughness);
+    let (phong, metal) = ("BlinnPhong", "MetallicRoughness");
     // (quad, helmet, the variants as (model, blended)).
     let cases = [
         (true, false, vec![(phong, true)]),
@@ -80,7 +80,7 @@ fn a_scene_pass_names_only_the_variants_its_scene_draws() {
         let pass = plan
             .passes
             .iter()
-            .find(|p| p.draw == Some(Draw::Meshes(MaterialFilter::All)))
+            .find(|p| p.draw == Some(Draw::Meshes(SceneTerm("All".into()))))
             .expect("forward draws every mesh");
         let variants = recorder.variants(pass);
         let got: Vec<(Vec<String>, bool)> = variants

@@ -2,8 +2,8 @@
 //! is from it: the share of pixels where the two disagree on lit or shadowed.
 
 use glam::{Mat4, Vec2, Vec3};
-use weft_graph::schema::MaterialFilter;
 use weft_render::material_matches as matches;
+use weft_render::vocabulary::MeshFilter;
 use weft_scene::{Camera, Light, Scene};
 use weft_testkit::raytrace::Bvh;
 
@@ -28,7 +28,7 @@ pub fn scene_sun_visibility(
             .and_then(|i| m.materials.get(i))
             .cloned()
             .unwrap_or_default();
-        matches(MaterialFilter::ShadowCasters, &material)
+        matches(MeshFilter::ShadowCasters, &material)
     });
     let aspect = size[0].max(1) as f32 / size[1].max(1) as f32;
     let view_proj = camera.view_projection(0.0, aspect);

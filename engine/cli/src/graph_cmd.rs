@@ -158,7 +158,7 @@ pub fn run(cmd: GraphCommand) -> Result<ExitCode> {
                     weft_render::check_graph_and_shaders(&graph, target)?
                 } else {
                     let mut diags = weft_graph::check(&graph);
-                    diags.extend(weft_render::check_providers(&graph));
+                    diags.extend(weft_render::check_against_renderer(&graph));
                     diags
                 };
                 if !json {

@@ -188,7 +188,7 @@ pub fn scene_pass_keys_with(pass: &PlanPass, defines: &[String]) -> Option<Vec<S
 pub fn scene_pass_variants(pass: &PlanPass) -> Vec<Vec<ShaderKey>> {
     let mut defines = vec![pass.defines.clone()];
     if pass.groups_by_model() {
-        let mut models: Vec<_> = pass.model_defines.iter().map(|(m, _)| *m).collect();
+        let mut models: Vec<&str> = pass.model_defines.iter().map(|(m, _)| m.as_str()).collect();
         models.dedup();
         defines = models.into_iter().map(|m| pass.defines_for(m)).collect();
     }

@@ -18,6 +18,7 @@ pub mod schema;
 pub mod spans;
 pub mod text;
 pub mod vk;
+pub mod vocabulary;
 
 pub use check::check;
 pub use compile::conditions_hold;
@@ -26,4 +27,5 @@ pub use compile::{compile, CompileOptions, Prepared};
 pub use diagnostic::{Diagnostic, Severity};
 pub use load::{load, load_with, load_with_params, LoadedGraph};
 pub use plan::{Extent, Plan};
-pub use resolve::{feature_names, SCENE_FEATURES};
+pub use resolve::feature_names;
+pub use vocabulary::{check_vocabulary, SceneVocabulary};

@@ -4,7 +4,7 @@
 
 use crate::diagnostic::Diagnostic;
 use crate::id::{IdVec, PassId, ResourceId};
-use crate::schema::{Blend, Draw, ParamValue, PassKind, ProviderDecl, RasterState, ShadingModel};
+use crate::schema::{Blend, Draw, ParamValue, PassKind, ProviderDecl, RasterState};
 use crate::vk::{Access, Aspect, BufferUsage, ImageUsage, Layout, Stage};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -214,10 +214,11 @@ pub struct PlanPass {
     /// Preprocessor defines selecting the shader variant (`HAS_SHADOW_MAP`, ...).
     pub defines: Vec<String>,
     /// Defines set only for the mesh draws of one shading model (declared with
-    /// `draws:`); when there are any, the pass draws its meshes grouped by
-    /// model, each group with `defines` plus its own.
+    /// `draws:`, the model named as the scene vocabulary names it); when
+    /// there are any, the pass draws its meshes grouped by model, each group
+    /// with `defines` plus its own.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub model_defines: Vec<(ShadingModel, String)>,
+    pub model_defines: Vec<(String, String)>,
     /// How many define sets the pass's features can give its shaders (the
     /// variant this plan compiles is one of them), at most
     /// 2^[`crate::resolve::MAX_VARIANT_BITS`].
@@ -266,12 +267,12 @@ impl PlanPass {
 
     /// The defines of the variant that draws meshes of `model` (sorted): the
     /// pass's defines plus those declared for that model.
-    pub fn defines_for(&self, model: ShadingModel) -> Vec<String> {
+    pub fn defines_for(&self, model: &str) -> Vec<String> {
         let mut defines = self.defines.clone();
         defines.extend(
             self.model_defines
                 .iter()
-                .filter(|(m, _)| *m == model)
+                .filter(|(m, _)| m == model)
                 .map(|(_, d)| d.clone()),
         );
         defines.sort();

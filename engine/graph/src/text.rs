@@ -153,7 +153,7 @@ pub fn render(plan: &Plan) -> String {
         if p.groups_by_model() {
             let mut groups: Vec<String> = Vec::new();
             for (model, define) in &p.model_defines {
-                let label = format!("{model:?}");
+                let label = model.clone();
                 match groups.iter_mut().find(|g| g.starts_with(&label)) {
                     Some(g) => g.push_str(&format!(" {define}")),
                     None => groups.push(format!("{label} +{define}")),

@@ -3,7 +3,7 @@
 
 use crate::lights::is_cone;
 use crate::materials::{coat, dielectric, is_mirror, matches};
-use weft_graph::schema::MaterialFilter;
+use crate::vocabulary::MeshFilter;
 use weft_scene::material::ShadingModel;
 use weft_scene::{AreaShape, Light, Scene};
 
@@ -29,9 +29,12 @@ use weft_scene::{AreaShape, Light, Scene};
 /// one has an emissive or occlusion texture; `environment` when the scene has
 /// an environment map.
 pub fn scene_features(scene: &Scene) -> Vec<String> {
-    // Only the names graphs can rely on (weft_graph::SCENE_FEATURES).
+    // Only the names graphs can rely on (crate::vocabulary::SCENE_FEATURES).
     fn set(features: &mut Vec<String>, name: &'static str) {
-        debug_assert!(weft_graph::SCENE_FEATURES.contains(&name), "{name}");
+        debug_assert!(
+            crate::vocabulary::scene_feature_reason(name).is_some(),
+            "{name}"
+        );
         features.push(name.to_string());
     }
     let placed = || {
@@ -60,13 +63,13 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
             Light::Sun(_) | Light::Area(_) | Light::Point(_) => true,
             Light::Spot(s) => is_cone(s.angle),
         });
-    if shadowing_light && placed().any(|m| matches(MaterialFilter::ShadowCasters, &m)) {
+    if shadowing_light && placed().any(|m| matches(MeshFilter::ShadowCasters, &m)) {
         set(&mut features, "shadow_casters");
     }
-    if placed().any(|m| matches(MaterialFilter::Emissive, &m)) {
+    if placed().any(|m| matches(MeshFilter::Emissive, &m)) {
         set(&mut features, "emissive");
     }
-    if placed().any(|m| matches(MaterialFilter::Transparent, &m)) {
+    if placed().any(|m| matches(MeshFilter::Transparent, &m)) {
         set(&mut features, "transparent");
     }
     if scene.lights.iter().any(|l| matches!(l, Light::Sun(_))) {
@@ -154,47 +157,4 @@ pub fn scene_features(scene: &Scene) -> Vec<String> {
         set(&mut features, "textures");
     }
     features
-}
-
-/// Why [`scene_features`] sets `name`, in a phrase a user reads beside it
-/// (the viewer's panel shows scene features read-only with this); `None`
-/// for a name it never sets.
-pub fn scene_feature_reason(name: &str) -> Option<&'static str> {
-    Some(match name {
-        "shadow_casters" => {
-            "a placed mesh casts shadows and a sun, point light, cone spot, area light or emissive mesh casts them"
-        }
-        "emissive" => "a placed mesh glows",
-        "transparent" => "a placed mesh blends",
-        "suns" => "the scene has a sun",
-        "point_lights" => "the scene has a point light",
-        "spot_lights" => "the scene has a spot light",
-        "area_lights" => "the scene has an area light or emissive geometry that lights raster passes",
-        "rect_lights" => "the scene has a rectangle or emissive-polygon light",
-        "disc_lights" => "the scene has a disc light",
-        "punctual_lights" => "the scene has a sun, point or spot light",
-        "glossy" => "a Blinn-Phong material has a specular lobe",
-        "dielectrics" => "a material is glass",
-        "mirrors" => "a material is a mirror (MTL illum 3)",
-        "coated" => "a material has a Fresnel coat (MTL illum 5)",
-        "metallic_roughness" => "a glTF material is placed",
-        "specular_lobes" => "a material is glossy, a mirror, coated, glass or glTF (lobes rt_specular traces)",
-        "blinn_phong" => "a material shades with Blinn-Phong",
-        "emission_occlusion_maps" => "a material has an emissive or occlusion texture",
-        "normal_maps" => "a material has a normal texture",
-        "textures" => "a material has a texture",
-        "environment" => "the scene has an environment map",
-        _ => return None,
-    })
-}
-
-#[cfg(test)]
-mod reason_tests {
-    #[test]
-    fn every_scene_feature_has_a_reason() {
-        for name in weft_graph::SCENE_FEATURES {
-            assert!(super::scene_feature_reason(name).is_some(), "{name}");
-        }
-        assert_eq!(super::scene_feature_reason("bloom"), None);
-    }
 }

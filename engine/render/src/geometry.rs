@@ -5,11 +5,11 @@
 
 use crate::gpu_types::{GpuDraw, GpuVertex};
 use crate::materials;
+use crate::vocabulary::MeshFilter;
 use crate::volumes::{self, VolumeMesh};
 use glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 use weft_gpu::scene::{VertexAttribute, VertexFormat};
-use weft_graph::schema::MaterialFilter;
 use weft_scene::tangent_frame::{self, TangentFrame};
 use weft_scene::{Aabb, Material, Mesh, Scene};
 
@@ -478,7 +478,7 @@ impl SceneGeometry {
     }
 
     /// The draws a pass with `filter` makes, in material order.
-    pub fn filtered(&self, filter: MaterialFilter) -> impl Iterator<Item = &DrawItem> + '_ {
+    pub fn filtered(&self, filter: MeshFilter) -> impl Iterator<Item = &DrawItem> + '_ {
         self.draws.iter().filter(move |d| {
             self.materials
                 .get(d.material as usize)

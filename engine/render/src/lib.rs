@@ -62,11 +62,12 @@ mod sources;
 mod texture;
 mod trace_textures;
 mod view_summary;
+pub mod vocabulary;
 mod volumes;
 mod watch;
 
 pub use error::RenderError;
-pub use features::{scene_feature_reason, scene_features};
+pub use features::scene_features;
 pub use frame::{
     compile_for_scene, load_graph, render, render_with_progress, Progress, RenderSettings, Rendered,
 };
@@ -82,6 +83,7 @@ pub use reload_worker::{ReloadWorker, WorkerReply};
 pub use scene_gpu::GpuScene;
 pub use scene_load::load_scene;
 pub use view_summary::{Bin, ViewSummary};
+pub use vocabulary::{scene_feature_reason, VOCABULARY};
 pub use watch::{FileWatcher, QUIET};
 
 pub use bindings::scene_interface;
@@ -94,7 +96,7 @@ pub use geometry::{quantize_uv, uv_box, SceneGeometry, TraceMesh, VERTEX_BYTES};
 pub use gpu_types::GpuDraw;
 pub use lights::{area_shape, pack_lights, AreaGeometry, LightSet};
 pub use materials::matches as material_matches;
-pub use providers::{check as check_providers, compile as compile_plan};
+pub use providers::{check as check_against_renderer, compile as compile_plan};
 pub use sanitize::RADIANCE_MAX;
 pub use sources::{
     graph_source_files, normalize as normalize_path, scene_files, scene_path_files, shader_files,

@@ -5,8 +5,8 @@
 use crate::gpu_types::GpuMaterial;
 use crate::optics::Coat;
 use crate::sanitize;
+use crate::vocabulary::MeshFilter;
 use glam::{Vec3, Vec4};
-use weft_graph::schema::MaterialFilter;
 use weft_scene::material::{AlphaMode, Optics, ShadingModel};
 use weft_scene::Material;
 
@@ -24,13 +24,13 @@ pub const MIRROR: f32 = 2.0;
 pub const COATED: f32 = 3.0;
 
 /// Whether a mesh with this material is drawn by a pass with `filter`.
-pub fn matches(filter: MaterialFilter, m: &Material) -> bool {
+pub fn matches(filter: MeshFilter, m: &Material) -> bool {
     let blended = m.alpha_mode == AlphaMode::Blend;
     match filter {
-        MaterialFilter::All => true,
-        MaterialFilter::Opaque | MaterialFilter::ShadowCasters => !blended,
-        MaterialFilter::Transparent => blended,
-        MaterialFilter::Emissive => m.emissive.max_element() > 0.0,
+        MeshFilter::All => true,
+        MeshFilter::Opaque | MeshFilter::ShadowCasters => !blended,
+        MeshFilter::Transparent => blended,
+        MeshFilter::Emissive => m.emissive.max_element() > 0.0,
     }
 }
 
@@ -196,13 +196,13 @@ mod tests {
             emissive: Vec3::new(17.0, 12.0, 4.0),
             ..Material::default()
         };
-        assert!(matches(MaterialFilter::Opaque, &opaque));
-        assert!(!matches(MaterialFilter::Opaque, &glass));
-        assert!(matches(MaterialFilter::Transparent, &glass));
-        assert!(!matches(MaterialFilter::ShadowCasters, &glass));
-        assert!(matches(MaterialFilter::Emissive, &lamp));
-        assert!(!matches(MaterialFilter::Emissive, &opaque));
-        assert!(matches(MaterialFilter::All, &glass));
+        assert!(matches(MeshFilter::Opaque, &opaque));
+        assert!(!matches(MeshFilter::Opaque, &glass));
+        assert!(matches(MeshFilter::Transparent, &glass));
+        assert!(!matches(MeshFilter::ShadowCasters, &glass));
+        assert!(matches(MeshFilter::Emissive, &lamp));
+        assert!(!matches(MeshFilter::Emissive, &opaque));
+        assert!(matches(MeshFilter::All, &glass));
     }
 
     #[test]

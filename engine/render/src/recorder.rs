@@ -15,11 +15,12 @@ use glam::{Mat4, Vec3};
 use weft_gpu::commands::Commands;
 use weft_gpu::pipeline::Pipeline;
 
+use crate::vocabulary::{LightVolume, MeshFilter, SceneDraw, ShadingModelName};
 use weft_gpu::draw::SceneVariant;
 use weft_gpu::state::{front_face, pass_state, BlendCode, DepthTest, PassState};
 use weft_gpu::{DrawRecorder, Gpu, GpuError, RasterContext, MATERIAL_SET, SCENE_SET};
 use weft_graph::plan::{LoadOp, PlanPass};
-use weft_graph::schema::{CompareOp, Draw, LightKind, MaterialFilter, ShadingModel};
+use weft_graph::schema::CompareOp;
 
 /// The most light volumes (point spheres, spot cones and spheres) one pass
 /// draws: 65,536 volumes of 320 triangles already take seconds a frame on a
@@ -189,7 +190,7 @@ impl<'g> SceneRecorder<'g> {
     }
 
     /// The draws of `filter` inside the frustum of `clip`, counted under `view`.
-    fn visible(&mut self, view: String, clip: Mat4, filter: MaterialFilter) -> Vec<DrawItem> {
+    fn visible(&mut self, view: String, clip: Mat4, filter: MeshFilter) -> Vec<DrawItem> {
         let frustum = Frustum::from_clip(clip);
         let (inside, outside): (Vec<DrawItem>, Vec<DrawItem>) = self
             .scene
@@ -233,13 +234,13 @@ impl<'g> SceneRecorder<'g> {
             // Depth-tested opaque draws may go in any order: one run per model.
             draws.sort_by_key(|d| self.model_of(d));
         }
-        let models: Vec<ShadingModel> = draws.iter().map(|d| self.model_of(d)).collect();
+        let models: Vec<ShadingModelName> = draws.iter().map(|d| self.model_of(d)).collect();
         let mut calls = 0;
         let mut start = 0;
         while start < draws.len() {
             let model = models[start];
             let end = start + models[start..].iter().take_while(|m| **m == model).count();
-            let defines = ctx.pass().defines_for(model);
+            let defines = ctx.pass().defines_for(model.name());
             let p = ctx.bind_variant(&defines, state)?;
             self.bind(ctx, &p)?;
             calls += self.draw_meshes(ctx.cmd, &p, draws[start..end].iter());
@@ -255,7 +256,7 @@ impl<'g> SceneRecorder<'g> {
         &self,
         pass: &PlanPass,
         state: &PassState,
-        filter: MaterialFilter,
+        filter: MeshFilter,
         by_model: bool,
     ) -> Vec<SceneVariant> {
         if !by_model {
@@ -264,7 +265,7 @@ impl<'g> SceneRecorder<'g> {
                 state: state.clone(),
             }];
         }
-        let mut models: Vec<ShadingModel> = self
+        let mut models: Vec<ShadingModelName> = self
             .scene
             .geometry
             .filtered(filter)
@@ -275,21 +276,18 @@ impl<'g> SceneRecorder<'g> {
         models
             .into_iter()
             .map(|model| SceneVariant {
-                defines: pass.defines_for(model),
+                defines: pass.defines_for(model.name()),
                 state: state.clone(),
             })
             .collect()
     }
 
     /// The shading model of a draw's material, as passes group draws by it.
-    fn model_of(&self, d: &DrawItem) -> ShadingModel {
+    fn model_of(&self, d: &DrawItem) -> ShadingModelName {
         let material = self.scene.geometry.materials.get(d.material as usize);
-        match material.map(|m| m.shading) {
-            Some(weft_scene::material::ShadingModel::MetallicRoughness) => {
-                ShadingModel::MetallicRoughness
-            }
-            _ => ShadingModel::BlinnPhong,
-        }
+        material.map_or(ShadingModelName::BlinnPhong, |m| {
+            ShadingModelName::of(m.shading)
+        })
     }
 
     /// `draws` sorted farthest from the camera first (by the placed model's
@@ -319,7 +317,7 @@ impl SceneRecorder<'_> {
         &mut self,
         ctx: &RasterContext<'_>,
         p: &Pipeline,
-        filter: MaterialFilter,
+        filter: MeshFilter,
         settings: &ShadowSettings,
     ) -> Result<u64, GpuError> {
         let pass = ctx.pass();
@@ -394,7 +392,7 @@ impl SceneRecorder<'_> {
             ctx.push_constants(p, &[(SHADOW_VIEW, i as f64)])?;
             let draws = self.visible(name, view.clip, filter);
             calls += self.draw_meshes(ctx.cmd, p, draws.iter());
-            if filter == MaterialFilter::ShadowCasters {
+            if filter == MeshFilter::ShadowCasters {
                 calls += self.draw_panels(ctx.cmd);
             }
             self.shadow_tiles[i] = Some(tile);
@@ -444,24 +442,25 @@ impl DrawRecorder for SceneRecorder<'_> {
     fn variants(&self, pass: &PlanPass) -> Vec<SceneVariant> {
         let state = pass_state(pass);
         let by_model = draws_by_model(pass);
-        match pass.draw {
-            Some(Draw::Meshes(MaterialFilter::All)) if blends_transparency(&state) => {
-                let mut variants =
-                    self.model_variants(pass, &state, MaterialFilter::Opaque, by_model);
-                let mut transparent = self.scene.geometry.filtered(MaterialFilter::Transparent);
+        match pass.draw.as_ref().map(SceneDraw::of) {
+            Some(Ok(SceneDraw::Meshes(MeshFilter::All))) if blends_transparency(&state) => {
+                let mut variants = self.model_variants(pass, &state, MeshFilter::Opaque, by_model);
+                let mut transparent = self.scene.geometry.filtered(MeshFilter::Transparent);
                 if transparent.next().is_some() {
                     let blended = transparent_state(&state);
                     variants.extend(self.model_variants(
                         pass,
                         &blended,
-                        MaterialFilter::Transparent,
+                        MeshFilter::Transparent,
                         by_model,
                     ));
                 }
                 variants
             }
-            Some(Draw::Meshes(filter)) => self.model_variants(pass, &state, filter, by_model),
-            Some(Draw::LightVolumes(_)) => vec![SceneVariant {
+            Some(Ok(SceneDraw::Meshes(filter))) => {
+                self.model_variants(pass, &state, filter, by_model)
+            }
+            Some(Ok(SceneDraw::LightVolumes(_))) => vec![SceneVariant {
                 defines: pass.defines.clone(),
                 state,
             }],
@@ -488,27 +487,28 @@ impl DrawRecorder for SceneRecorder<'_> {
         };
         let draw = pass
             .draw
-            .clone()
-            .ok_or_else(|| fail("raster pass without a `draw`".into()))?;
+            .as_ref()
+            .ok_or_else(|| fail("raster pass without a `draw`".into()))
+            .and_then(|d| SceneDraw::of(d).map_err(fail))?;
         let defines = pass.defines.clone();
         let shadow_atlas = providers::shadow_atlas(pass);
         let by_model = draws_by_model(pass);
         let state = ctx.pass_state();
         let mut calls = 0u64;
         match draw {
-            Draw::Meshes(MaterialFilter::All) if blends_transparency(&state) => {
+            SceneDraw::Meshes(MeshFilter::All) if blends_transparency(&state) => {
                 // Opaque first, then transparent meshes blended over them, farthest first.
                 let camera = self.scene.view_proj;
-                let opaque = self.visible(name.clone(), camera, MaterialFilter::Opaque);
+                let opaque = self.visible(name.clone(), camera, MeshFilter::Opaque);
                 calls += self.draw_variants(ctx, &state, opaque, by_model)?;
-                let transparent = self.visible(name.clone(), camera, MaterialFilter::Transparent);
+                let transparent = self.visible(name.clone(), camera, MeshFilter::Transparent);
                 let transparent = self.back_to_front(transparent);
                 if !transparent.is_empty() {
                     let blended = transparent_state(&state);
                     calls += self.draw_variants(ctx, &blended, transparent, by_model)?;
                 }
             }
-            Draw::Meshes(filter) => match &shadow_atlas {
+            SceneDraw::Meshes(filter) => match &shadow_atlas {
                 Some(settings) => {
                     let p = ctx.bind_variant(&defines, &state)?;
                     self.bind(ctx, &p)?;
@@ -519,18 +519,18 @@ impl DrawRecorder for SceneRecorder<'_> {
                     calls += self.draw_variants(ctx, &state, draws, by_model)?;
                 }
             },
-            Draw::LightVolumes(kind) => {
+            SceneDraw::LightVolumes(kind) => {
                 let p = ctx.bind_variant(&defines, &state)?;
                 self.bind(ctx, &p)?;
                 let g = &self.scene.geometry;
                 let lights = &self.scene.light_set;
                 let groups = match kind {
-                    LightKind::Point => vec![(g.sphere, lights.points, lights.first_point())],
-                    LightKind::Spot => vec![
+                    LightVolume::Point => vec![(g.sphere, lights.points, lights.first_point())],
+                    LightVolume::Spot => vec![
                         (g.cone, lights.spot_cones, lights.first_spot_cone()),
                         (g.sphere, lights.spot_spheres, lights.first_spot_sphere()),
                     ],
-                    LightKind::Area => vec![(g.panel, lights.areas, lights.first_area())],
+                    LightVolume::Area => vec![(g.panel, lights.areas, lights.first_area())],
                 };
                 let volumes: u64 = groups.iter().map(|g| u64::from(g.1)).sum();
                 if volumes > u64::from(MAX_LIGHT_VOLUMES) {
@@ -550,7 +550,7 @@ impl DrawRecorder for SceneRecorder<'_> {
                     calls += 1;
                 }
             }
-            Draw::FullscreenTriangle => {
+            SceneDraw::FullscreenTriangle => {
                 return Err(fail(
                     "a fullscreen triangle is drawn by the executor".into(),
                 ))

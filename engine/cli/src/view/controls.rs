@@ -135,7 +135,7 @@ pub fn graph_features(graph: &weft_graph::Prepared) -> Vec<String> {
     names.remove(weft_render::RAY_QUERY_FEATURE);
     let (scene, own): (Vec<String>, Vec<String>) = names
         .into_iter()
-        .partition(|n| weft_graph::SCENE_FEATURES.contains(&n.as_str()));
+        .partition(|n| weft_render::scene_feature_reason(n).is_some());
     own.into_iter().chain(scene).collect()
 }
 
@@ -363,12 +363,12 @@ mod tests {
         // The graph's own features first, then the scene's, each sorted.
         let own = names
             .iter()
-            .take_while(|n| !weft_graph::SCENE_FEATURES.contains(&n.as_str()))
+            .take_while(|n| weft_render::scene_feature_reason(n).is_none())
             .count();
         assert!(own >= 2, "bloom and depth_prepass come first: {names:?}");
         assert!(names[own..]
             .iter()
-            .all(|n| weft_graph::SCENE_FEATURES.contains(&n.as_str())));
+            .all(|n| weft_render::scene_feature_reason(n).is_some()));
         assert!(
             names[..own].is_sorted() && names[own..].is_sorted(),
             "{names:?}"

@@ -282,3 +282,39 @@ fn provider_arguments_out_of_range_are_errors_at_the_argument() {
         "{stderr}"
     );
 }
+
+#[test]
+fn scene_names_outside_the_renderers_vocabulary_are_located_errors() {
+    let text = r#"Graph(
+    resources: [
+        Image(name: "ldr", format: R8G8B8A8_SRGB),
+        Image(name: "depth", format: D32_SFLOAT),
+    ],
+    passes: [
+        Pass(
+            name: "draw",
+            kind: Raster,
+            shaders: (vertex: "a.vert", fragment: "a.frag"),
+            color: [(image: "ldr", load: Clear([0.0, 0.0, 0.0, 1.0]))],
+            depth: (image: "depth", load: Clear([0.0])),
+            draw: Meshes(Opaqe),
+            defines: [(name: "PBR", draws: MetalicRoughness)],
+        ),
+    ],
+    caveats: [(note: "no sky light", enabled_if: ["environmnt"])],
+    output: "ldr",
+)"#;
+    let path = temp_graph("vocabulary", text);
+    let out = weft(&["graph", "check", path.to_str().expect("utf-8 path")]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let file = path.display();
+    for expected in [
+        format!("{file}:13:19: error: unknown mesh filter `Opaqe`\n  hint: did you mean `Opaque`?"),
+        format!("{file}:14:44: error: unknown shading model `MetalicRoughness`\n  hint: did you mean `MetallicRoughness`?"),
+        format!("{file}:17:50: error: caveat condition \"environmnt\" names a feature neither this graph nor scenes set\n  hint: did you mean \"environment\"?"),
+    ] {
+        assert!(stderr.contains(&expected), "{expected}\nin\n{stderr}");
+    }
+    assert!(stderr.contains("3 error(s)"), "{stderr}");
+}

@@ -126,8 +126,8 @@ fn plan_pass(
                 Some(crate::schema::ParamValue::Number(n)) => format!("{}={n}", define.name),
                 _ => define.name.clone(),
             };
-            match define.draws {
-                Some(model) => model_defines.push((model, text)),
+            match &define.draws {
+                Some(model) => model_defines.push((model.0.clone(), text)),
                 None => {
                     defines.insert(text);
                 }
@@ -283,7 +283,6 @@ mod tests {
     use super::super::fixture::CHAIN;
     use super::super::tests::plan_of;
     use super::*;
-    use crate::schema::ShadingModel;
 
     #[test]
     fn stores_are_kept_only_for_contents_read_later() {
@@ -425,17 +424,14 @@ mod tests {
         let b = plan.passes.iter().find(|p| p.name == "b").expect("b runs");
         assert_eq!(b.defines, ["ALWAYS"]);
         assert!(b.groups_by_model());
-        assert_eq!(b.defines_for(ShadingModel::BlinnPhong), ["ALWAYS", "PHONG"]);
-        assert_eq!(
-            b.defines_for(ShadingModel::MetallicRoughness),
-            ["ALWAYS", "PBR"]
-        );
+        assert_eq!(b.defines_for("BlinnPhong"), ["ALWAYS", "PHONG"]);
+        assert_eq!(b.defines_for("MetallicRoughness"), ["ALWAYS", "PBR"]);
         let plan = plan_of(&text, &[]);
         let b = plan.passes.iter().find(|p| p.name == "b").expect("b runs");
         assert_eq!(
             b.model_defines,
-            [(ShadingModel::MetallicRoughness, "PBR".to_string())]
+            [("MetallicRoughness".to_string(), "PBR".to_string())]
         );
-        assert_eq!(b.defines_for(ShadingModel::BlinnPhong), ["ALWAYS"]);
+        assert_eq!(b.defines_for("BlinnPhong"), ["ALWAYS"]);
     }
 }

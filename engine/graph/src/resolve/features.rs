@@ -1,5 +1,5 @@
-//! The feature names a graph may test: those its conditions mention, and
-//! those the engine sets from what a scene holds.
+//! The feature names a graph's conditions mention (those the engine sets
+//! from what a scene holds are the scene vocabulary's, `crate::vocabulary`).
 
 use super::{Ir, IrPass};
 use std::collections::BTreeSet;
@@ -31,30 +31,3 @@ pub fn pass_feature_names(pass: &IrPass, defines: bool) -> BTreeSet<String> {
         .map(str::to_string)
         .collect()
 }
-
-/// The features the engine sets from what a scene holds (weft-render's
-/// `scene_features`, which sets no other): a graph may test them without any
-/// pass of its own doing so (a fragment's caveat, say).
-pub const SCENE_FEATURES: [&str; 21] = [
-    "shadow_casters",
-    "emissive",
-    "transparent",
-    "suns",
-    "point_lights",
-    "spot_lights",
-    "area_lights",
-    "rect_lights",
-    "disc_lights",
-    "punctual_lights",
-    "glossy",
-    "dielectrics",
-    "mirrors",
-    "coated",
-    "metallic_roughness",
-    "specular_lobes",
-    "blinn_phong",
-    "emission_occlusion_maps",
-    "normal_maps",
-    "textures",
-    "environment",
-];

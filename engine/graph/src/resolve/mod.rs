@@ -12,7 +12,7 @@ mod rules;
 mod structures;
 mod values;
 
-pub use features::{feature_names, pass_feature_names, SCENE_FEATURES};
+pub use features::{feature_names, pass_feature_names};
 pub use ir::*;
 pub use rules::{access_path, usage_name};
 pub(crate) use values::oversized_image;
@@ -27,7 +27,7 @@ use crate::load::LoadedGraph;
 use crate::plan::Extent;
 use crate::schema::ResourceDecl;
 use crate::spans::Seg;
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 
 /// An attachment's extent and sample count at one probe size (`None` when unknown).
 type SizeAtProbe = Option<(Extent, u32)>;
@@ -177,8 +177,8 @@ impl<'a> Resolver<'a> {
         self.check_structure_uses(&ir);
         self.check_multisampling(&ir);
         self.check_extents(&ir);
-        self.check_caveats(&ir);
-        self.check_jitter(&ir);
+        self.check_caveats();
+        self.check_jitter();
         self.check_define_sets();
         ir
     }
@@ -219,11 +219,10 @@ impl<'a> Resolver<'a> {
         }
     }
 
-    /// Every caveat says something, and holds under features the graph has
-    /// or the engine sets from scenes: a misspelt feature would silently
-    /// never show the caveat.
-    fn check_caveats(&mut self, ir: &Ir) {
-        let known = self.known_features(ir);
+    /// Every caveat says something, and its conditions are well formed
+    /// (whether they name features scenes set is the scene vocabulary's
+    /// check, `crate::vocabulary::check_vocabulary`).
+    fn check_caveats(&mut self) {
         let caveats = &self.graph.caveats;
         for (k, (source, caveat)) in caveats.iter().enumerate() {
             let index = caveats[..k].iter().filter(|(s, _)| s == source).count();
@@ -232,20 +231,12 @@ impl<'a> Resolver<'a> {
                 self.error(*source, &path("note"), "a caveat's note is empty".into())
                     .hint = Some("say what differs from the reference and why".into());
             }
-            self.check_declared_conditions(
-                *source,
-                &path("enabled_if"),
-                &caveat.enabled_if,
-                &known,
-                "caveat",
-            );
+            self.check_malformed_conditions(*source, &path("enabled_if"), &caveat.enabled_if);
         }
     }
 
-    /// The camera jitter's conditions are well formed and name features the
-    /// graph has or scenes set: a misspelt one would never jitter.
-    fn check_jitter(&mut self, ir: &Ir) {
-        let known = self.known_features(ir);
+    /// The camera jitter's conditions are well formed.
+    fn check_jitter(&mut self) {
         let jitter = &self.graph.jitter;
         for (k, (source, decl)) in jitter.iter().enumerate() {
             let index = jitter[..k].iter().filter(|(s, _)| s == source).count();
@@ -254,49 +245,15 @@ impl<'a> Resolver<'a> {
                 Seg::Index(index),
                 Seg::Field("enabled_if"),
             ];
-            self.check_declared_conditions(*source, &path, &decl.enabled_if, &known, "jitter");
+            self.check_malformed_conditions(*source, &path, &decl.enabled_if);
         }
     }
 
-    /// Features a condition may name: the graph's own, its defaults, and
-    /// those the engine sets from scenes.
-    fn known_features(&self, ir: &Ir) -> BTreeSet<String> {
-        let mut known = feature_names(ir);
-        known.extend(self.graph.default_features.iter().cloned());
-        known.extend(SCENE_FEATURES.iter().map(|f| f.to_string()));
-        known
-    }
-
-    /// Each of a declaration's `enabled_if` conditions is well formed and,
-    /// outside fragments (whose features may be their includer's), names a
-    /// feature in `known`.
-    fn check_declared_conditions(
-        &mut self,
-        source: usize,
-        path: &[Seg],
-        conditions: &[String],
-        known: &BTreeSet<String>,
-        what: &str,
-    ) {
+    /// Each of a declaration's `enabled_if` conditions is well formed.
+    fn check_malformed_conditions(&mut self, source: usize, path: &[Seg], conditions: &[String]) {
         for condition in conditions {
             if let Some(problem) = crate::condition::malformed(condition) {
                 self.error(source, path, problem);
-            }
-            if self.graph.is_fragment {
-                continue;
-            }
-            for feature in crate::condition::names(condition) {
-                if !feature.is_empty() && !known.contains(feature) {
-                    let hint =
-                        crate::diagnostic::nearest(feature, known.iter().map(String::as_str))
-                            .map(|n| format!("did you mean \"{n}\"?"));
-                    self.error(
-                        source,
-                        path,
-                        format!("{what} condition \"{condition}\" names a feature neither this graph nor scenes set"),
-                    )
-                    .hint = hint;
-                }
             }
         }
     }

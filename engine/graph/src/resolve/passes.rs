@@ -273,7 +273,7 @@ impl Resolver<'_> {
                 Some((_, _, list)) => {
                     for d in list {
                         let define = crate::schema::DefineDecl {
-                            draws: d.draws.filter(|_| meshes),
+                            draws: d.draws.clone().filter(|_| meshes),
                             ..d.clone()
                         };
                         let name = define.name.clone();

@@ -314,6 +314,32 @@ impl<'de> Deserialize<'de> for FormatName {
     }
 }
 
+/// A name from the scene vocabulary (a mesh filter, a light kind, a shading
+/// model), given as a bare identifier (`Opaque`): the renderer
+/// registers which exist, so a misspelling is a located error with a hint
+/// (`check_vocabulary`), not a parse failure that stops at the first.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(transparent)]
+pub struct SceneTerm(pub String);
+
+impl<'de> Deserialize<'de> for SceneTerm {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct TermVisitor;
+        impl<'de> Visitor<'de> for TermVisitor {
+            type Value = SceneTerm;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a name such as Opaque, Point or MetallicRoughness")
+            }
+            fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<SceneTerm, A::Error> {
+                let (name, variant): (Identifier, _) = data.variant()?;
+                variant.unit_variant()?;
+                Ok(SceneTerm(name.0))
+            }
+        }
+        deserializer.deserialize_enum("SceneTerm", &[], TermVisitor)
+    }
+}
+
 /// A bare identifier, read through `deserialize_identifier` as RON requires for enum variants.
 struct Identifier(String);
 

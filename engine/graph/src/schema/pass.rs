@@ -102,24 +102,16 @@ pub struct DefineDecl {
     #[serde(default)]
     pub enabled_if: Vec<String>,
     /// Set only for the pass's mesh draws whose material uses this shading
-    /// model: the pass's draws are grouped by model, one shader variant each.
+    /// model (a name from the renderer's [`crate::vocabulary::SceneVocabulary`]):
+    /// the pass's draws are grouped by model, one shader variant each.
     #[serde(default)]
-    pub draws: Option<ShadingModel>,
+    pub draws: Option<SceneTerm>,
     /// A whole-number value, given or a graph parameter's (`"$light_choice"`):
     /// `NAME=VALUE`, so code a parameter switches off is not compiled (on
     /// lavapipe, which runs both sides of every branch, it would still run).
     /// Resolved to the number when the graph is resolved.
     #[serde(default)]
     pub value: Option<ParamValue>,
-}
-
-/// A material's shading model, as mesh draws are grouped by it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Deserialize, Serialize)]
-pub enum ShadingModel {
-    /// MTL materials: diffuse, specular and shininess (mirrors and coats too).
-    BlinnPhong,
-    /// glTF materials: base colour, metallic and roughness.
-    MetallicRoughness,
 }
 
 /// A use of a named value provider: its name and arguments (numbers, vectors,
@@ -333,37 +325,18 @@ impl ReadDecl {
     }
 }
 
-/// What a raster pass draws.
+/// What a raster pass draws. The names inside are the scene vocabulary's:
+/// the graph crate knows none of them, the renderer registers them
+/// ([`crate::vocabulary::SceneVocabulary`]) and `check_vocabulary` holds a
+/// graph to it.
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 pub enum Draw {
-    /// Scene meshes whose material matches the filter.
-    Meshes(MaterialFilter),
-    /// One proxy volume per light of a kind.
-    LightVolumes(LightKind),
+    /// Scene meshes whose material matches the named filter (`Meshes(Opaque)`).
+    Meshes(SceneTerm),
+    /// One proxy volume per light of the named kind (`LightVolumes(Point)`).
+    LightVolumes(SceneTerm),
     /// One triangle covering the target.
     FullscreenTriangle,
-}
-
-/// Which scene meshes a raster pass draws.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-pub enum MaterialFilter {
-    All,
-    Opaque,
-    Transparent,
-    Emissive,
-    /// Meshes that cast shadows and, in a shadow-atlas pass, the area
-    /// lights' panels (opaque, as the path tracer's are).
-    ShadowCasters,
-}
-
-/// Light kinds that get proxy volumes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-pub enum LightKind {
-    Point,
-    Spot,
-    /// Area lights' own outlines (their panels: a rectangle or a disc), so a
-    /// pass can draw what camera rays see of them.
-    Area,
 }
 
 /// How a compute pass is dispatched.

@@ -3,7 +3,6 @@
 
 use crate::support::load_files;
 use weft_graph::compile::CompileOptions;
-use weft_graph::schema::ShadingModel;
 
 const SETS: &str = r#"Graph(
     fragment: true,
@@ -65,8 +64,8 @@ fn a_pass_gets_its_sets_defines_then_its_own_and_draws_only_where_it_draws_meshe
     assert_eq!(
         mesh.model_defines,
         [
-            (ShadingModel::BlinnPhong, "BLINN".to_string()),
-            (ShadingModel::MetallicRoughness, "GGX".to_string())
+            ("BlinnPhong".to_string(), "BLINN".to_string()),
+            ("MetallicRoughness".to_string(), "GGX".to_string())
         ]
     );
     let tonemap = pass("tonemap");

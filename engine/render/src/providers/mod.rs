@@ -153,13 +153,20 @@ pub fn traces(pass: &PlanPass) -> bool {
     pass.derive.iter().any(|c| c.name == RAY_TRACING.name)
 }
 
-/// The graph's provider uses checked against [`PROVIDERS`].
+/// The graph held to what the renderer registers: its provider uses
+/// against [`PROVIDERS`], its scene names against the scene vocabulary
+/// ([`crate::vocabulary::VOCABULARY`]).
 pub fn check(graph: &weft_graph::LoadedGraph) -> Vec<Diagnostic> {
-    weft_graph::provider::check_providers(graph, PROVIDERS)
+    let mut diags = weft_graph::provider::check_providers(graph, PROVIDERS);
+    diags.extend(weft_graph::check_vocabulary(
+        graph,
+        &crate::vocabulary::VOCABULARY,
+    ));
+    diags
 }
 
 /// Compiles a graph for one size and feature set as the renderer runs it:
-/// the graph's own checks, its provider uses against [`PROVIDERS`], the plan,
+/// the graph's own checks, its provider uses and scene names ([`check`]), the plan,
 /// then the values computed once per plan added to it.
 pub fn compile(
     prepared: &weft_graph::Prepared,

@@ -9,6 +9,7 @@ use weft_graph::{Diagnostic, Severity};
 mod multisample;
 mod structures;
 mod values;
+mod vocabulary;
 
 /// The text at a diagnostic's position, up to the end of its line.
 fn text_at<'a>(text: &'a str, d: &Diagnostic) -> &'a str {
