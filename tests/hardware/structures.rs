@@ -2,8 +2,10 @@
 //! with ray queries: each edit of graphs/acceleration.ron, of the path
 //! tracer's reads of the structure or of the include that brings it in is
 //! either refused by `weft graph check --shaders` (which checks the
-//! hardware variants on such a device) or renders the Cornell box on both
-//! backends with zero validation messages, synchronization validation on.
+//! hardware variants on such a device), refused by the hardware render (a
+//! scratch too small for the scene, which a check without a scene cannot
+//! know), or renders the Cornell box on both backends with zero validation
+//! messages, synchronization validation on.
 //! Each edit says which it must be, so a check that stops refusing a broken
 //! graph fails here as surely as a render that breaks.
 
@@ -18,6 +20,8 @@ use weft_tests::TempDir;
 enum Expect {
     /// `graph check --shaders` reports an error whose message holds this.
     Refused(&'static str),
+    /// Check accepts, and the hardware backend's render fails for this reason.
+    RenderRefused(&'static str),
     /// Check accepts, and both backends render clean.
     Rendered,
 }
@@ -28,7 +32,7 @@ const EDITS: &[(&str, &str, &str, Expect)] = &[
     // The build pass writes nothing.
     (
         "graphs/acceleration.ron",
-        "storage_write: [\"scene_structures\"],",
+        "storage_write: [\"scene_structures\", \"structure_scratch\"],",
         "",
         Expect::Refused("needs exactly one `AccelerationStructure` resource in `storage_write`"),
     ),
@@ -56,8 +60,8 @@ const EDITS: &[(&str, &str, &str, Expect)] = &[
     // The build is off while the traces read it.
     (
         "graphs/acceleration.ron",
-        "storage_write: [\"scene_structures\"],",
-        "storage_write: [\"scene_structures\"], enabled_if: [\"never\"],",
+        "storage_write: [\"scene_structures\", \"structure_scratch\"],",
+        "storage_write: [\"scene_structures\", \"structure_scratch\"], enabled_if: [\"never\"],",
         Expect::Refused("reads \"scene_structures\" before anything writes it"),
     ),
     // The path tracer traces in hardware without reading the structure.
@@ -83,6 +87,30 @@ const EDITS: &[(&str, &str, &str, Expect)] = &[
         "(file: \"acceleration.ron\"),",
         "",
         Expect::Refused("needs resource \"scene_structures\""),
+    ),
+    // The build without its scratch.
+    (
+        "graphs/acceleration.ron",
+        "[\"scene_structures\", \"structure_scratch\"]",
+        "[\"scene_structures\"]",
+        Expect::Refused(
+            "writes its acceleration structure and one `Buffer`, the scratch it builds in",
+        ),
+    ),
+    // The scratch sized by a scene value the renderer does not measure.
+    (
+        "graphs/acceleration.ron",
+        "scene_values: [\"structure_scratch_bytes\"]",
+        "scene_values: [\"structure_scratch_byte\"]",
+        Expect::Refused("unknown scene value `structure_scratch_byte`"),
+    ),
+    // The scratch half what the builds need: the check cannot know the
+    // scene, the build pass refuses it before recording.
+    (
+        "graphs/acceleration.ron",
+        "size: \"structure_scratch_bytes\"",
+        "size: \"structure_scratch_bytes / 2\"",
+        Expect::RenderRefused("bytes of scratch, and its scratch buffer holds"),
     ),
     // The build pass renamed: nothing names it.
     (
@@ -114,16 +142,17 @@ fn copy_tree(from: &Path, to: &Path) {
     }
 }
 
-/// What a graph led to: the check's errors, one per line, or a render on
-/// both backends.
+/// What a graph led to: the check's errors, one per line, a render's
+/// error, or a render on both backends.
 #[derive(Debug)]
 enum Outcome {
     Refused(String),
+    RenderRefused(String),
     Rendered,
 }
 
-/// What `graph` leads to: refused by the check on `gpu`'s device, or
-/// rendered on both backends; a render that fails or validates with
+/// What `graph` leads to: refused by the check on `gpu`'s device, refused
+/// by a render, or rendered on both backends; a render that validates with
 /// messages panics.
 fn outcome(gpu: &weft_gpu::Gpu, graph: &Path, label: &str) -> Outcome {
     let loaded = weft_graph::load(graph);
@@ -149,8 +178,9 @@ fn outcome(gpu: &weft_gpu::Gpu, graph: &Path, label: &str) -> Outcome {
             trace_backend: backend,
             ..RenderSettings::default()
         };
-        render(gpu, &scene, &settings)
-            .unwrap_or_else(|e| panic!("{label}: check said ok, {backend:?} refused: {e}"));
+        if let Err(e) = render(gpu, &scene, &settings) {
+            return Outcome::RenderRefused(format!("{backend:?}: {e}"));
+        }
         let messages = gpu.validation().messages();
         assert_eq!(
             messages[before..].len(),
@@ -182,6 +212,12 @@ fn every_edit_of_the_structure_passes_is_refused_by_check_or_renders_clean() {
                     "{label}: refused, but for {errors}"
                 );
             }
+            (Expect::RenderRefused(because), Outcome::RenderRefused(error)) => {
+                assert!(
+                    error.contains(because),
+                    "{label}: render refused, but for {error}"
+                );
+            }
             (Expect::Rendered, Outcome::Rendered) => {}
             (expected, found) => panic!("{label}: expected {expected:?}, found {found:?}"),
         }
@@ -198,9 +234,11 @@ fn a_build_recorded_into_a_frame_never_submitted_is_recorded_again() {
     let scene = weft_scene::load_scene(&root().join("scenes/cornell.scene")).expect("loads");
     let mut uploaded = weft_render::GpuScene::new(&gpu, &scene, false).expect("uploads");
     uploaded.trace_in_hardware(true).expect("hardware");
+    let bytes = weft_render::structure_scratch_bytes(&gpu, &scene).expect("measured");
+    let scratch = weft_gpu::acceleration::Scratch::new(&gpu, bytes).expect("scratch");
     // The frame's build pass records; a later pass fails, so nothing is submitted.
     let failed = gpu.one_shot(|cmd| {
-        uploaded.record_structures("build_structures", cmd)?;
+        uploaded.record_structures("build_structures", cmd, scratch.span())?;
         Err(weft_gpu::GpuError::Plan("a later pass failed".into()))
     });
     assert!(failed.is_err());
@@ -212,6 +250,10 @@ fn a_build_recorded_into_a_frame_never_submitted_is_recorded_again() {
     );
     let after = uploaded.build_structures_now().expect("nothing to build");
     assert_eq!(after.bottom_build, std::time::Duration::ZERO, "built once");
+    // What the scene value says before the scene is on the device is what
+    // the structures built from its geometry need.
+    assert_eq!(rebuilt.scratch_bytes, bytes);
+    drop(scratch);
     drop(uploaded);
     drop(gpu);
     assert_eq!(log.messages(), Vec::new());

@@ -77,6 +77,7 @@ pub fn compile(
         extent,
         features: graph.graph().features(features),
         memory: &memory,
+        scene_values: Default::default(),
         readback,
         readback_asked: true,
     };

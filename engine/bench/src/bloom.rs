@@ -150,6 +150,7 @@ fn measure(
         extent,
         features: prepared.graph().features(features),
         memory: &memory,
+        scene_values: Default::default(),
         readback: vec!["bloom".into()],
         readback_asked: true,
     };

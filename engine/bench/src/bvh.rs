@@ -57,6 +57,8 @@ struct StructureRow {
     refit_ms: f64,
     bottom_bytes: u64,
     top_bytes: u64,
+    /// The builds' scratch: transient memory of the plan in a frame.
+    scratch_bytes: u64,
 }
 
 /// Runs `weft bench bvh`.
@@ -155,14 +157,14 @@ fn structure_row(
     runs: u32,
 ) -> Result<StructureRow> {
     let (mut bottom, mut top, mut refit) = (Vec::new(), Vec::new(), Vec::new());
-    let mut bytes = (0, 0);
+    let mut bytes = (0, 0, 0);
     for _ in 0..runs {
         let mut uploaded = weft_render::GpuScene::new(gpu, scene, false)?;
         uploaded.trace_in_hardware(true)?;
         let built = uploaded.build_structures_now()?;
         bottom.push(built.bottom_build.as_secs_f64() * 1e3);
         top.push(built.top_build.as_secs_f64() * 1e3);
-        bytes = (built.bottom_bytes, built.top_bytes);
+        bytes = (built.bottom_bytes, built.top_bytes, built.scratch_bytes);
         uploaded.refit_structures()?;
         let refitted = uploaded.build_structures_now()?;
         refit.push(refitted.top_build.as_secs_f64() * 1e3);
@@ -178,21 +180,23 @@ fn structure_row(
         refit_ms: median(refit),
         bottom_bytes: bytes.0,
         top_bytes: bytes.1,
+        scratch_bytes: bytes.2,
     })
 }
 
 fn structure_table(structures: &[StructureRow], rows: &[Row]) -> String {
     let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
-    let mut out = String::from("| scene | bottom levels: build (ms, median) | top level: build (ms) | top level: refit (ms) | bottom levels (MiB) | top level (MiB) | BVH: build + collapse (ms) | BVH (MiB) |\n|---|---|---|---|---|---|---|---|\n");
+    let mut out = String::from("| scene | bottom levels: build (ms, median) | top level: build (ms) | top level: refit (ms) | bottom levels (MiB) | top level (MiB) | scratch, transient (MiB) | BVH: build + collapse (ms) | BVH (MiB) |\n|---|---|---|---|---|---|---|---|---|\n");
     for (s, r) in structures.iter().zip(rows) {
         out.push_str(&format!(
-            "| {} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} | {:.2} |\n",
+            "| {} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} | {:.2} |\n",
             s.scene,
             s.bottom_ms,
             s.top_ms,
             s.refit_ms,
             mib(s.bottom_bytes),
             mib(s.top_bytes),
+            mib(s.scratch_bytes),
             r.build_ms + r.wide_ms,
             mib(r.bvh_bytes)
         ));
@@ -256,10 +260,11 @@ mod tests {
             refit_ms: 0.25,
             bottom_bytes: 2 * 1024 * 1024,
             top_bytes: 512 * 1024,
+            scratch_bytes: 256 * 1024,
         }];
         assert_eq!(
             structure_table(&structures, &rows),
-            "| scene | bottom levels: build (ms, median) | top level: build (ms) | top level: refit (ms) | bottom levels (MiB) | top level (MiB) | BVH: build + collapse (ms) | BVH (MiB) |\n|---|---|---|---|---|---|---|---|\n| a.scene | 1.2 | 0.50 | 0.25 | 2.00 | 0.50 | 0.3 | 1.00 |\n"
+            "| scene | bottom levels: build (ms, median) | top level: build (ms) | top level: refit (ms) | bottom levels (MiB) | top level (MiB) | scratch, transient (MiB) | BVH: build + collapse (ms) | BVH (MiB) |\n|---|---|---|---|---|---|---|---|---|\n| a.scene | 1.2 | 0.50 | 0.25 | 2.00 | 0.50 | 0.25 | 0.3 | 1.00 |\n"
         );
     }
 }

@@ -102,7 +102,7 @@ fn compile(file: &Path, target: &Target) -> Result<(weft_graph::Prepared, weft_g
         })
         .transpose()?;
     let device_memory = gpu.as_ref().map(weft_gpu::memory_requirements);
-    let memory: &dyn Fn(&weft_graph::plan::ImageDesc) -> weft_graph::MemoryRequirements =
+    let memory: &dyn Fn(&weft_graph::plan::ResourceDesc) -> weft_graph::MemoryRequirements =
         match &device_memory {
             Some(m) => m,
             None => &weft_graph::estimate_requirements,

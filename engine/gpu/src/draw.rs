@@ -223,13 +223,15 @@ pub trait DrawRecorder {
     /// the top level to placements that moved since, or nothing. The
     /// executor runs it for a `BuildAccelerationStructures` pass, after
     /// the barriers the plan orders it by (the last frame's traces) and
-    /// before those that order the traces after it.
+    /// before those that order the traces after it, building in `scratch`,
+    /// the pass's scratch buffer.
     fn build_structures(
         &mut self,
         pass: &PlanPass,
         cmd: vk::CommandBuffer,
+        scratch: crate::acceleration::ScratchSpan,
     ) -> Result<(), GpuError> {
-        let _ = cmd;
+        let _ = (cmd, scratch);
         Err(GpuError::Pass {
             pass: pass.name.clone(),
             message: "builds acceleration structures, but no draw recorder holds a scene with them"

@@ -86,17 +86,39 @@ pub fn image_requirements(gpu: &Gpu, desc: &ImageDesc) -> MemoryRequirements {
     }
 }
 
-/// `image_requirements` as the closure `weft_graph::CompileOptions::memory`
-/// takes. An image larger than the device allows is not asked of the device
-/// (that would be invalid usage) but estimated; [`oversized_images`] then
-/// refuses the plan.
-pub fn memory_requirements(gpu: &Gpu) -> impl Fn(&ImageDesc) -> MemoryRequirements + '_ {
-    move |desc| {
-        if fits(gpu, desc) {
-            image_requirements(gpu, desc)
-        } else {
-            weft_graph::estimate_requirements(desc)
-        }
+/// The memory requirements the device reports for a plan's buffer, without
+/// creating it (maintenance4), rounded out to `bufferImageGranularity` at
+/// both ends: a transient buffer shares its allocation with images, and
+/// none may share a page of that size with one.
+pub fn buffer_requirements(gpu: &Gpu, desc: &BufferDesc) -> MemoryRequirements {
+    let info = vk::BufferCreateInfo::default()
+        .size(desc.size.max(1))
+        .usage(vk::BufferUsageFlags::from_raw(desc.usage.bits()))
+        .sharing_mode(vk::SharingMode::EXCLUSIVE);
+    let query = vk::DeviceBufferMemoryRequirements::default().create_info(&info);
+    let mut out = vk::MemoryRequirements2::default();
+    unsafe {
+        gpu.device()
+            .get_device_buffer_memory_requirements(&query, &mut out)
+    };
+    let page = gpu.info().buffer_image_granularity.max(1);
+    let alignment = out.memory_requirements.alignment.max(page);
+    MemoryRequirements {
+        size: out.memory_requirements.size.next_multiple_of(alignment),
+        alignment,
+    }
+}
+
+/// The device's requirements as the closure
+/// `weft_graph::CompileOptions::memory` takes: [`image_requirements`] and
+/// [`buffer_requirements`]. An image larger than the device allows is not
+/// asked of the device (that would be invalid usage) but estimated;
+/// [`oversized_images`] then refuses the plan.
+pub fn memory_requirements(gpu: &Gpu) -> impl Fn(&ResourceDesc) -> MemoryRequirements + '_ {
+    move |desc| match desc {
+        ResourceDesc::Image(image) if fits(gpu, image) => image_requirements(gpu, image),
+        ResourceDesc::Buffer(buffer) => buffer_requirements(gpu, buffer),
+        other => weft_graph::estimate_requirements(other),
     }
 }
 
@@ -337,7 +359,7 @@ impl<'g> FrameResources<'g> {
             }
             if type_bits == 0 {
                 return Err(GpuError::Plan(format!(
-                    "the images of memory block {b} have no memory type in common"
+                    "the resources of memory block {b} have no memory type in common"
                 )));
             }
             let requirements = vk::MemoryRequirements {

@@ -28,4 +28,4 @@ pub use diagnostic::{Diagnostic, Severity};
 pub use load::{load, load_with, load_with_params, LoadedGraph};
 pub use plan::{Extent, Plan};
 pub use resolve::feature_names;
-pub use vocabulary::{check_vocabulary, SceneVocabulary};
+pub use vocabulary::{check_vocabulary, SceneValue, SceneVocabulary};

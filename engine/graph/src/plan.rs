@@ -147,7 +147,7 @@ pub struct BufferDesc {
 /// How long a resource lives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum Residency {
-    /// Only within a frame; images may share memory with others.
+    /// Only within a frame; images and buffers may share memory with others.
     Transient,
     /// Persists from one frame to the next.
     History,
@@ -155,7 +155,7 @@ pub enum Residency {
     Output,
 }
 
-/// A transient image's place in memory.
+/// A transient image's or buffer's place in memory.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Placement {
     pub block: usize,
@@ -244,6 +244,11 @@ pub struct PlanPass {
     /// only against a structure the plan builds and orders it after.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub structure: Option<ResourceId>,
+    /// The buffer a `BuildAccelerationStructures` pass builds in (its
+    /// scratch, the one buffer in its `storage_write`), transient memory the
+    /// aliasing step shares with what other passes use at other times.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scratch: Option<ResourceId>,
 }
 
 /// An indirect dispatch's source: the `k`-th dispatch of the pass reads the

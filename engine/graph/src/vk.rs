@@ -86,6 +86,8 @@ bitflags! {
         const UNIFORM = 0x10;
         const STORAGE = 0x20;
         const INDIRECT = 0x100;
+        /// An acceleration-structure build's scratch is addressed by device address.
+        const SHADER_DEVICE_ADDRESS = 0x20000;
     }
 }
 

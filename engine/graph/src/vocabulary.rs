@@ -1,7 +1,8 @@
 //! The scene vocabulary, as the graph sees it: the names a graph uses for
-//! what scenes hold — the features the engine sets from a scene, the mesh
-//! filters of `draw: Meshes(..)`, the light kinds of `draw: LightVolumes(..)`
-//! and the shading models of a define's `draws:`. This crate knows none of
+//! what scenes hold — the features the engine sets from a scene, the numbers
+//! it measures of one (`scene_values`, for buffer sizes), the mesh filters of
+//! `draw: Meshes(..)`, the light kinds of `draw: LightVolumes(..)` and the
+//! shading models of a define's `draws:`. This crate knows none of
 //! them: the renderer hands its [`SceneVocabulary`] in, as it hands its
 //! providers, and [`check_vocabulary`] holds a graph to it with located
 //! errors and the nearest name as a hint.
@@ -20,6 +21,9 @@ pub struct SceneVocabulary {
     /// them in a caveat or the camera jitter without a pass of its own
     /// doing so.
     pub features: &'static [SceneFeature],
+    /// Numbers the renderer measures of each scene, which a graph declares
+    /// in `scene_values` to size buffers by.
+    pub values: &'static [SceneValue],
     /// What `draw: Meshes(..)` may select.
     pub mesh_filters: &'static [&'static str],
     /// The lights `draw: LightVolumes(..)` may draw volumes of.
@@ -37,8 +41,17 @@ pub struct SceneFeature {
     pub reason: &'static str,
 }
 
-/// Every use of a scene name the vocabulary does not hold: a mesh filter, a
-/// light kind, a shading model, and (outside fragments, whose features may
+/// A number the renderer measures of each scene, and what it is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SceneValue {
+    /// The name size expressions use (`"structure_scratch_bytes"`).
+    pub name: &'static str,
+    /// What it measures, for messages and docs.
+    pub meaning: &'static str,
+}
+
+/// Every use of a scene name the vocabulary does not hold: a scene value, a
+/// mesh filter, a light kind, a shading model, and (outside fragments, whose features may
 /// be their includer's) a caveat's or the jitter's feature that neither the
 /// graph nor scenes set.
 pub fn check_vocabulary(graph: &LoadedGraph, vocabulary: &SceneVocabulary) -> Vec<Diagnostic> {
@@ -89,6 +102,18 @@ pub fn check_vocabulary(graph: &LoadedGraph, vocabulary: &SceneVocabulary) -> Ve
                 let known = vocabulary.shading_models;
                 diags.push(unknown(file, pos, &model.0, "shading model", known));
             }
+        }
+    }
+    let values: Vec<&str> = vocabulary.values.iter().map(|v| v.name).collect();
+    for (k, (source, name)) in graph.scene_values.iter().enumerate() {
+        if !values.contains(&name.as_str()) {
+            let index = graph.scene_values[..k]
+                .iter()
+                .filter(|(s, _)| s == source)
+                .count();
+            let path = [Seg::Field("scene_values"), Seg::Index(index)];
+            let (file, pos) = graph.locate(*source, &path);
+            diags.push(unknown(file, pos, name, "scene value", &values));
         }
     }
     if !graph.is_fragment {

@@ -6,7 +6,8 @@ use crate::error::RenderError;
 use crate::features::scene_features;
 use crate::frame_loop::{FrameLoop, FrameRequest};
 use crate::providers::trace_backend::{self, RAY_QUERY_FEATURE};
-use crate::scene_gpu::GpuScene;
+use crate::scene_gpu::{structure_scratch_bytes, GpuScene};
+use crate::vocabulary::STRUCTURE_SCRATCH_BYTES;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -217,6 +218,12 @@ pub fn compile_for_scene(
         cpu: gpu.info().kind == weft_gpu::DeviceKind::Cpu,
     };
     let names_feature = weft_graph::feature_names(graph.ir()).contains(RAY_QUERY_FEATURE);
+    // What a plan that traces in hardware builds its structures in.
+    let scratch = if device.ray_query {
+        structure_scratch_bytes(gpu, scene)?
+    } else {
+        0
+    };
     let plan =
         trace_backend::compile_traced(settings.trace_backend, &device, names_feature, |hardware| {
             let mut features = loaded.features(&requested);
@@ -225,10 +232,15 @@ pub fn compile_for_scene(
             if hardware {
                 features.insert(RAY_QUERY_FEATURE.to_string());
             }
+            let scene_values = hardware
+                .then(|| (STRUCTURE_SCRATCH_BYTES.to_string(), scratch as f64))
+                .into_iter()
+                .collect();
             let options = CompileOptions {
                 extent: settings.extent,
                 features,
                 memory: &memory,
+                scene_values,
                 readback: settings.extra_readback.clone(),
                 readback_asked: settings.readback_asked,
             };

@@ -80,7 +80,7 @@ pub use recorder::{SceneRecorder, ViewCulling};
 pub use reload::{startup_files, Committed, LiveRender};
 pub use reload_error::ReloadError;
 pub use reload_worker::{ReloadWorker, WorkerReply};
-pub use scene_gpu::GpuScene;
+pub use scene_gpu::{structure_scratch_bytes, GpuScene};
 pub use scene_load::load_scene;
 pub use view_summary::{Bin, ViewSummary};
 pub use vocabulary::{scene_feature_reason, VOCABULARY};

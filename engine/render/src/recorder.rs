@@ -474,8 +474,9 @@ impl DrawRecorder for SceneRecorder<'_> {
         &mut self,
         pass: &PlanPass,
         cmd: vk::CommandBuffer,
+        scratch: weft_gpu::acceleration::ScratchSpan,
     ) -> Result<(), GpuError> {
-        self.scene.record_structures(&pass.name, cmd)
+        self.scene.record_structures(&pass.name, cmd, scratch)
     }
 
     fn record(&mut self, ctx: &mut RasterContext<'_>) -> Result<(), GpuError> {

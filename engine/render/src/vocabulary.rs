@@ -7,11 +7,12 @@
 //! graph to [`VOCABULARY`] with located errors.
 
 use weft_graph::schema::{Draw, SceneTerm};
-use weft_graph::vocabulary::{SceneFeature, SceneVocabulary};
+use weft_graph::vocabulary::{SceneFeature, SceneValue, SceneVocabulary};
 
 /// What the renderer offers graphs.
 pub const VOCABULARY: SceneVocabulary = SceneVocabulary {
     features: SCENE_FEATURES,
+    values: SCENE_VALUES,
     mesh_filters: MeshFilter::NAMES,
     light_volumes: LightVolume::NAMES,
     shading_models: ShadingModelName::NAMES,
@@ -105,6 +106,17 @@ pub const SCENE_FEATURES: &[SceneFeature] = &[
         reason: "the scene has an environment map",
     },
 ];
+
+/// The scene value a plan that traces in hardware sizes the scratch of its
+/// structures' builds by (`crate::structure_scratch_bytes`).
+pub const STRUCTURE_SCRATCH_BYTES: &str = "structure_scratch_bytes";
+
+/// The numbers the renderer measures of each scene for graphs' buffer sizes.
+pub const SCENE_VALUES: &[SceneValue] = &[SceneValue {
+    name: STRUCTURE_SCRATCH_BYTES,
+    meaning: "bytes the builds of the scene's acceleration structures work in (0 when the plan \
+              traces in software)",
+}];
 
 /// Declares a closed set of names graphs may write, as an enum whose
 /// variants are the names, with the list and the lookup.

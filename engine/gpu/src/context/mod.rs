@@ -57,6 +57,10 @@ pub struct DeviceInfo {
     /// The most texels a texel buffer's view may cover
     /// (`maxTexelBufferElements`): larger scene tables are refused.
     pub max_texel_buffer_elements: u32,
+    /// Bytes a buffer and an optimally tiled image in one allocation keep
+    /// apart (`bufferImageGranularity`): transient buffers are placed on
+    /// multiples of it, so none shares a page with an image.
+    pub buffer_image_granularity: u64,
     /// Sample counts colour and depth attachments may have, as a mask of
     /// counts (bit n: 2^n samples; `framebufferColorSampleCounts` and
     /// `framebufferDepthSampleCounts` together): plans with another count

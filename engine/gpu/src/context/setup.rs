@@ -160,6 +160,7 @@ pub(super) fn choose_device(
             shaders: ShaderSupport::query(instance, physical),
             max_image_dimension: props.limits.max_image_dimension2_d,
             max_texel_buffer_elements: props.limits.max_texel_buffer_elements,
+            buffer_image_granularity: props.limits.buffer_image_granularity,
             attachment_sample_counts: (props.limits.framebuffer_color_sample_counts
                 & props.limits.framebuffer_depth_sample_counts)
                 .as_raw(),

@@ -198,7 +198,7 @@ fn history_images_carry_values_across_frames() {
 }
 
 #[test]
-fn transient_images_share_memory_as_planned() {
+fn transient_images_and_buffers_share_memory_as_planned() {
     let gpu = common::gpu();
     let plan = common::compile(&gpu, &common::graph("mixed.ron"), 8, 8);
     let placement = |name: &str| {
@@ -221,16 +221,22 @@ fn transient_images_share_memory_as_planned() {
             &FrameOptions::default(),
         )
         .expect("frame");
-    let images: u64 = plan
+    let placed: u64 = plan
         .resources
         .iter()
         .filter(|r| r.placement.is_some())
         .map(|r| r.placement.map_or(0, |p| p.size))
         .sum();
-    assert_eq!(images, plan.memory.transient_bytes_unaliased);
+    assert_eq!(placed, plan.memory.transient_bytes_unaliased);
+    // The buffer, alive with `inverted`, takes the rest of what the pattern
+    // is done with.
+    let stats = placement("stats");
+    assert_eq!(stats.block, pattern.block);
+    assert!(stats.offset >= inverted.offset + inverted.size);
+    assert!(stats.offset + stats.size <= pattern.offset + pattern.size);
     assert_eq!(
         plan.memory.transient_bytes,
-        plan.memory.transient_bytes_unaliased - placement("inverted").size
+        plan.memory.transient_bytes_unaliased - inverted.size - stats.size
     );
     assert_eq!(report.transient_bytes, plan.memory.transient_bytes);
     assert_eq!(

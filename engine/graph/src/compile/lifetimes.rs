@@ -112,10 +112,13 @@ fn warn_unread(
         let written = touches.iter().any(|&(_, p, k)| uses[p][k].writes);
         // A depth attachment is read by its own depth test, a colour
         // attachment with a resolve target (the access after it) by the
-        // resolve.
+        // resolve, a build's scratch by the build.
         let read = touches.iter().any(|&(_, p, k)| {
             let u = &uses[p][k];
             let accesses = &ir.passes[p].accesses;
+            if ir.passes[p].kind == crate::schema::PassKind::BuildAccelerationStructures {
+                return true;
+            }
             let resolved = |a: usize| {
                 accesses[a].usage.is_color_output()
                     && accesses

@@ -1,30 +1,33 @@
-//! Step 5, memory: transient images whose lifetimes do not overlap share memory.
-//! Each image is placed at the lowest aligned offset that does not collide with
-//! any image alive at the same time (largest first), inside one block.
+//! Step 5, memory: transient images and buffers whose lifetimes do not
+//! overlap share memory. Each is placed at the lowest aligned offset that does
+//! not collide with any resource alive at the same time (largest first),
+//! inside one block.
 
 use crate::id::{IdVec, ResourceId};
 use crate::plan::{
-    ImageDesc, MemoryBlock, MemoryPlan, Placement, PlanResource, Residency, ResourceDesc,
+    BufferDesc, ImageDesc, MemoryBlock, MemoryPlan, Placement, PlanResource, Residency,
+    ResourceDesc,
 };
 
-/// Places every transient image of `resources` (setting its `placement`) with the
-/// device's memory requirements; returns the memory plan.
+/// Places every transient image and buffer of `resources` (setting its
+/// `placement`) with the device's memory requirements; returns the memory
+/// plan. Acceleration structures live in the scene's memory.
 pub(crate) fn alias(
     resources: &mut IdVec<ResourceId, PlanResource>,
-    requirements: &dyn Fn(&ImageDesc) -> MemoryRequirements,
+    requirements: &dyn Fn(&ResourceDesc) -> MemoryRequirements,
 ) -> MemoryPlan {
     let transient: Vec<(ResourceId, Transient)> = resources
         .iter_enumerated()
         .filter(|(_, r)| r.residency == Residency::Transient)
-        .filter_map(|(i, r)| match &r.desc {
-            ResourceDesc::Image(desc) => Some((
+        .filter(|(_, r)| !matches!(r.desc, ResourceDesc::AccelerationStructure))
+        .map(|(i, r)| {
+            (
                 i,
                 Transient {
-                    requirements: requirements(desc),
+                    requirements: requirements(&r.desc),
                     lifetime: (r.lifetime.0.index(), r.lifetime.1.index()),
                 },
-            )),
-            ResourceDesc::Buffer(_) | ResourceDesc::AccelerationStructure => None,
+            )
         })
         .collect();
     let requests: Vec<Transient> = transient.iter().map(|(_, t)| *t).collect();
@@ -35,18 +38,41 @@ pub(crate) fn alias(
     memory
 }
 
-/// Size and alignment of an image's memory, as `vkGetImageMemoryRequirements` reports.
+/// Size and alignment of a resource's memory, as `vkGetImageMemoryRequirements`
+/// or `vkGetBufferMemoryRequirements` reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MemoryRequirements {
     pub size: u64,
     pub alignment: u64,
 }
 
-/// Requirements when no device is at hand: tightly packed texels over the mip chain,
-/// layers and samples, rounded up to 64 KiB pages with 64 KiB alignment, as discrete
-/// GPUs commonly report for optimally tiled images.
-pub fn estimate_requirements(desc: &ImageDesc) -> MemoryRequirements {
-    const PAGE: u64 = 64 * 1024;
+/// Requirements when no device is at hand: an image's tightly packed texels
+/// over the mip chain, layers and samples, a buffer's bytes, each rounded up
+/// to 64 KiB pages with 64 KiB alignment, as discrete GPUs commonly report
+/// for optimally tiled images (and so that no buffer shares a page of
+/// `bufferImageGranularity` with an image).
+pub fn estimate_requirements(desc: &ResourceDesc) -> MemoryRequirements {
+    match desc {
+        ResourceDesc::Image(image) => estimate_image(image),
+        ResourceDesc::Buffer(buffer) => estimate_buffer(buffer),
+        ResourceDesc::AccelerationStructure => MemoryRequirements {
+            size: 0,
+            alignment: 1,
+        },
+    }
+}
+
+/// The page [`estimate_requirements`] rounds to.
+const PAGE: u64 = 64 * 1024;
+
+fn estimate_buffer(desc: &BufferDesc) -> MemoryRequirements {
+    MemoryRequirements {
+        size: desc.size.max(1).div_ceil(PAGE) * PAGE,
+        alignment: PAGE,
+    }
+}
+
+fn estimate_image(desc: &ImageDesc) -> MemoryRequirements {
     let mut texels = 0u64;
     for mip in 0..desc.mips {
         let w = (desc.extent.width >> mip).max(1) as u64;
@@ -60,7 +86,7 @@ pub fn estimate_requirements(desc: &ImageDesc) -> MemoryRequirements {
     }
 }
 
-/// An image to place: its requirements and the first and last pass that use it.
+/// A resource to place: its requirements and the first and last pass that use it.
 #[derive(Debug, Clone, Copy)]
 pub struct Transient {
     pub requirements: MemoryRequirements,
@@ -194,8 +220,19 @@ mod tests {
             usage: crate::vk::ImageUsage::SAMPLED,
             texel_bytes: 4,
         };
-        let req = estimate_requirements(&desc);
+        let req = estimate_requirements(&ResourceDesc::Image(desc));
         assert_eq!(req.size, (256 * 256 + 128 * 128) * 4 * 3);
         assert_eq!(req.alignment, 65536);
+        let buffer = ResourceDesc::Buffer(BufferDesc {
+            size: 65537,
+            usage: crate::vk::BufferUsage::STORAGE,
+        });
+        assert_eq!(
+            estimate_requirements(&buffer),
+            MemoryRequirements {
+                size: 2 * 65536,
+                alignment: 65536
+            }
+        );
     }
 }

@@ -17,19 +17,23 @@ pub(crate) mod sync;
 use crate::diagnostic::Diagnostic;
 use crate::id::IrPassId;
 use crate::load::LoadedGraph;
-use crate::plan::{Extent, ImageDesc, Plan, PlanView};
+use crate::plan::{Extent, Plan, PlanView, ResourceDesc};
 use crate::resolve::{feature_names, resolve, Ir, IrView};
 use crate::spans::{Pos, Seg};
 use memory::MemoryRequirements;
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// What to compile a graph for.
 pub struct CompileOptions<'a> {
     pub extent: Extent,
     /// Scene features and user toggles that are on.
     pub features: BTreeSet<String>,
-    /// Memory requirements of an image; the executor passes the device's.
-    pub memory: &'a dyn Fn(&ImageDesc) -> MemoryRequirements,
+    /// Memory requirements of an image or a buffer; the executor passes the
+    /// device's.
+    pub memory: &'a dyn Fn(&ResourceDesc) -> MemoryRequirements,
+    /// The scene values the renderer measured (`scene_values` a graph
+    /// declares, for its buffer sizes); one missing is 0.
+    pub scene_values: BTreeMap<String, f64>,
     /// Images to keep readable after the frame besides the output (e.g. the HDR
     /// buffer for EXR output): never aliased, left in `TRANSFER_SRC_OPTIMAL`.
     /// Those the graph lists as read back only under features (`(name:
@@ -50,6 +54,7 @@ impl Default for CompileOptions<'_> {
             },
             features: BTreeSet::new(),
             memory: &memory::estimate_requirements,
+            scene_values: BTreeMap::new(),
             readback: Vec::new(),
             readback_asked: false,
         }

@@ -79,6 +79,7 @@ fn plan_pass(
     };
     let mut bindings = Vec::new();
     let mut structure = None;
+    let mut scratch = None;
     let mut defines: BTreeSet<String> = BTreeSet::new();
     for access in active_accesses() {
         let kind = match access.usage {
@@ -91,6 +92,11 @@ fn plan_pass(
         if matches!(resources[r].desc, ResourceDesc::AccelerationStructure) {
             // Built, or traced through the scene's set: not bound in the pass's own.
             structure = Some(r);
+            continue;
+        }
+        if pass.kind == PassKind::BuildAccelerationStructures {
+            // The build's scratch, which it addresses: a build binds nothing.
+            scratch = Some(r);
             continue;
         }
         if let Some(existing) = bindings.iter_mut().find(|b: &&mut Binding| b.resource == r) {
@@ -275,6 +281,7 @@ fn plan_pass(
         raster: pass.raster,
         derive: pass.derive.clone(),
         structure,
+        scratch,
     }
 }
 

@@ -14,6 +14,7 @@ use crate::resolve::{
     expression_vars, image_extent, oversized_image, resource_path, BufferSize, Ir, IrKind, Usage,
     MAX_IMAGE_DIMENSION,
 };
+use crate::schema::PassKind;
 use crate::spans::Seg;
 use crate::vk::{BufferUsage, ImageUsage, Layout};
 
@@ -52,6 +53,12 @@ pub(crate) fn describe(
                     .iter()
                     .map(move |&a| &ir.passes[p].accesses[a].usage)
             })
+        };
+        // A build pass's buffer is its scratch, which builds address.
+        let built_in = || {
+            touches
+                .iter()
+                .any(|&(_, p, _)| ir.passes[p].kind == PassKind::BuildAccelerationStructures)
         };
         let desc = match &res.kind {
             IrKind::Image {
@@ -98,14 +105,28 @@ pub(crate) fn describe(
                 let bytes = match size {
                     BufferSize::Bytes(b) => *b,
                     BufferSize::Expression(text) => {
-                        let vars =
-                            expression_vars(&graph.sources[res.source].params, options.extent);
+                        let scene = graph
+                            .scene_values
+                            .iter()
+                            .map(|(_, name)| {
+                                let measured = options.scene_values.get(name);
+                                (name.clone(), measured.copied().unwrap_or(0.0))
+                            })
+                            .collect();
+                        let vars = expression_vars(
+                            &graph.sources[res.source].params,
+                            options.extent,
+                            &scene,
+                        );
                         crate::expr::eval(text, &vars)
                             .map(|v| v.max(1.0).ceil() as u64)
                             .unwrap_or(1)
                     }
                 };
                 let mut usage = BufferUsage::empty();
+                if built_in() {
+                    usage |= BufferUsage::STORAGE | BufferUsage::SHADER_DEVICE_ADDRESS;
+                }
                 for u in accesses() {
                     usage |= match u {
                         Usage::Sampled => BufferUsage::UNIFORM,

@@ -70,6 +70,9 @@ pub struct LoadedGraph {
     /// When the camera is jittered, from the graph and its fragments, with
     /// their source.
     pub jitter: Vec<(usize, crate::schema::JitterDecl)>,
+    /// Scene values (numbers the renderer measures from each scene) the graph
+    /// and its fragments declare, with their source.
+    pub scene_values: Vec<(usize, String)>,
     /// Define sets from the graph and its fragments: source, name, defines.
     pub define_sets: Vec<(usize, String, Vec<crate::schema::DefineDecl>)>,
     /// Human-readable name.
@@ -376,6 +379,9 @@ fn load_file(
     graph
         .jitter
         .extend(parsed.jitter.iter().map(|j| (source, j.clone())));
+    graph
+        .scene_values
+        .extend(parsed.scene_values.iter().map(|v| (source, v.clone())));
     graph.define_sets.extend(
         parsed
             .define_sets

@@ -134,12 +134,20 @@ impl Resolver<'_> {
                         BufferSize::Bytes(1)
                     }
                     Expr::Text(text) => {
+                        // Any value stands for a scene's here: only names are checked.
+                        let scene = self
+                            .graph
+                            .scene_values
+                            .iter()
+                            .map(|(_, name)| (name.clone(), 1.0))
+                            .collect();
                         let vars = expression_vars(
                             &self.graph.sources[source].params,
                             Extent {
                                 width: 1920,
                                 height: 1080,
                             },
+                            &scene,
                         );
                         if let Err(e) = crate::expr::eval(text, &vars) {
                             let mut names: Vec<String> = vars.keys().cloned().collect();

@@ -1,6 +1,7 @@
 //! Rules for the scene's acceleration structures: a
-//! `BuildAccelerationStructures` pass writes one and does nothing else, and
-//! other passes only read one, through ray queries (`storage_read`).
+//! `BuildAccelerationStructures` pass writes one, in one buffer of
+//! scratch, and does nothing else, and other passes only read one, through
+//! ray queries (`storage_read`).
 
 use super::{
     pass_path, resource_path, rules::access_path, Ir, IrKind, IrPass, IrResource, Resolver, Usage,
@@ -10,9 +11,10 @@ use crate::schema::{PassDecl, PassKind};
 use crate::spans::Seg;
 
 impl Resolver<'_> {
-    /// A build pass declares one acceleration structure in `storage_write`
-    /// and nothing the executor would ignore: no shaders, attachments, other
-    /// reads or writes, copy endpoints, draws or dispatches.
+    /// A build pass declares one acceleration structure in `storage_write`,
+    /// with one buffer for its scratch, and nothing the executor
+    /// would ignore: no shaders, attachments, other reads or writes, copy
+    /// endpoints, draws or dispatches.
     pub(super) fn check_build_pass(
         &mut self,
         pass: &IrPass,
@@ -44,17 +46,31 @@ impl Resolver<'_> {
                 );
             }
         }
-        let written: Vec<bool> = pass
+        let written: Vec<Option<&IrKind>> = pass
             .accesses
             .iter()
             .filter(|a| a.usage == Usage::StorageWrite)
-            .map(|a| {
-                resources
-                    .get(a.resource)
-                    .is_some_and(|r| matches!(r.kind, IrKind::AccelerationStructure))
-            })
+            .map(|a| resources.get(a.resource).map(|r| &r.kind))
             .collect();
-        if written.len() != 1 || !written[0] {
+        let count = |f: fn(&IrKind) -> bool| written.iter().flatten().filter(|k| f(k)).count();
+        let structures = count(|k| matches!(k, IrKind::AccelerationStructure));
+        let buffers = count(|k| matches!(k, IrKind::Buffer { .. }));
+        if structures + buffers < written.iter().flatten().count() || buffers != 1 {
+            self.error(
+                source,
+                &pass_path(index, &[Seg::Field("storage_write")]),
+                format!(
+                    "BuildAccelerationStructures pass \"{name}\" writes its acceleration \
+                     structure and one `Buffer`, the scratch it builds in"
+                ),
+            )
+            .hint = Some(
+                "size the scratch by the scene value the renderer measures for builds, as \
+                 graphs/acceleration.ron does"
+                    .into(),
+            );
+        }
+        if structures != 1 {
             self.error(
                 source,
                 &pass_path(index, &[Seg::Field("storage_write")]),

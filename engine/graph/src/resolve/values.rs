@@ -175,12 +175,14 @@ pub fn image_extent(ir: &Ir, resource: IrResourceId, output: Extent) -> Option<E
     None
 }
 
-/// Variables available to buffer size expressions: the output size and the
-/// declaring file's numeric parameters. Nothing about scenes or techniques;
-/// a graph that sizes a buffer by a scene count declares a parameter for it.
+/// Variables available to buffer size expressions: the output size, the
+/// declaring file's numeric parameters and the scene values the graph
+/// declares (`scene`: each with the value the renderer measured, or 0 in a
+/// compile without a scene). Nothing else about scenes or techniques.
 pub fn expression_vars(
     params: &BTreeMap<String, ParamValue>,
     output: Extent,
+    scene: &BTreeMap<String, f64>,
 ) -> BTreeMap<String, f64> {
     let mut vars: BTreeMap<String, f64> = params
         .iter()
@@ -192,5 +194,6 @@ pub fn expression_vars(
     vars.insert("width".into(), output.width as f64);
     vars.insert("height".into(), output.height as f64);
     vars.insert("pixels".into(), output.width as f64 * output.height as f64);
+    vars.extend(scene.iter().map(|(k, v)| (k.clone(), *v)));
     vars
 }

@@ -37,6 +37,14 @@ pub struct GraphFile {
     /// value outside it is an error.
     #[serde(default)]
     pub param_ranges: BTreeMap<String, ParamRange>,
+    /// Numbers the renderer measures from each scene, by name
+    /// (`scene_values: ["structure_scratch_bytes"]`), for buffer size
+    /// expressions: declared so a misspelt variable is an error, and checked
+    /// against the renderer's scene vocabulary. A compile without a scene
+    /// (`weft graph check`, `weft graph plan`) takes each as 0. Fragments may
+    /// declare them.
+    #[serde(default)]
+    pub scene_values: Vec<String>,
     /// Images and buffers.
     #[serde(default)]
     pub resources: Vec<ResourceDecl>,
@@ -273,8 +281,8 @@ pub enum SizeDecl {
 #[serde(deny_unknown_fields)]
 pub struct BufferDecl {
     pub name: String,
-    /// Bytes: a number, or an expression over `width`, `height`, `pixels`, `lights` and parameters,
-    /// e.g. `"lights * 32 + 16"`.
+    /// Bytes: a number, or an expression over `width`, `height`, `pixels`,
+    /// the graph's scene values and parameters, e.g. `"pixels * 16 + 16"`.
     pub size: Expr,
     #[serde(default)]
     pub history: bool,

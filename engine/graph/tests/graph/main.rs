@@ -11,3 +11,4 @@ mod jitter;
 mod params;
 mod plans;
 mod random;
+mod scratch;

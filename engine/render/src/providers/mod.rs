@@ -291,6 +291,7 @@ pub(crate) mod tests {
             raster: Default::default(),
             derive,
             structure: None,
+            scratch: None,
         }
     }
 

@@ -8,14 +8,19 @@
 //! level in place; the bottom levels never change. Builds and refits are
 //! recorded by the graph's `BuildAccelerationStructures` pass
 //! ([`super::GpuScene::record_structures`]), which the compiler orders and
-//! synchronizes with the passes that trace.
+//! synchronizes with the passes that trace, in the scratch buffer the graph
+//! declares: transient memory, sized by [`structure_scratch_bytes`] before
+//! the plan is compiled.
 
 use crate::geometry::{MeshRange, SceneGeometry, VERTEX_BYTES};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::time::{Duration, Instant};
-use weft_gpu::acceleration::{self, BottomLevels, Mesh, Placement, Scratch, TopLevel};
+use weft_gpu::acceleration::{
+    self, scratch_needed, BottomLevels, Mesh, Placement, Scratch, ScratchSpan, TopLevel,
+};
 use weft_gpu::buffer::Buffer;
 use weft_gpu::{Gpu, GpuError};
+use weft_scene::Scene;
 
 /// The scene's acceleration structures on the device.
 pub(super) struct SceneStructures<'g> {
@@ -23,19 +28,15 @@ pub(super) struct SceneStructures<'g> {
     pub(super) top: TopLevel<'g>,
     /// Per traced draw, in the ray tracer's order, the bottom level it places.
     levels: Vec<usize>,
-    /// One scratch buffer: for the bottom levels' build and the top level's
-    /// first, then only as large as the top level's refits need.
-    scratch: Scratch<'g>,
-    /// Whether `scratch` is still sized for the bottom levels' build.
-    scratch_for_bottom: bool,
+    /// Bytes of scratch the builds need ([`scratch_needed`]).
+    scratch_bytes: u64,
 }
 
 impl<'g> SceneStructures<'g> {
     /// Creates the bottom levels over `geometry`'s meshes, read in place
     /// from the scene's vertex and index buffers (made with
     /// [`acceleration::INPUT_USAGE`]), the top level placing them as its
-    /// draw records do now, and their scratch; nothing is built until
-    /// [`Self::record`].
+    /// draw records do now; nothing is built until [`Self::record`].
     pub(super) fn new(
         gpu: &'g Gpu,
         geometry: &SceneGeometry,
@@ -58,14 +59,13 @@ impl<'g> SceneStructures<'g> {
             })
             .collect();
         let bottom = BottomLevels::new(gpu, &inputs)?;
-        let top = TopLevel::new(gpu, &bottom, &placements(geometry, &levels)?)?;
-        let scratch = Scratch::new(gpu, bottom.scratch_bytes.max(top.scratch_bytes))?;
+        let placed = placements(geometry, &levels)?;
+        let top = TopLevel::new(gpu, &bottom, &placed)?;
         Ok(Self {
-            scratch_for_bottom: bottom.scratch_bytes > top.scratch_bytes,
+            scratch_bytes: scratch_needed(gpu, &inputs, placed.len() as u32)?,
             bottom,
             top,
             levels,
-            scratch,
         })
     }
 
@@ -76,23 +76,18 @@ impl<'g> SceneStructures<'g> {
             .place(&self.bottom, &placements(geometry, &self.levels)?)
     }
 
-    /// Records what the structures need before this frame's ray queries:
-    /// the bottom levels' build the first time (then a barrier, as the top
-    /// level reads them and reuses the scratch), the top level's build or
-    /// refit when it is not current, or nothing. Frames run one at a time,
-    /// so on the frame after the first the bottom levels' scratch is no
-    /// longer in use: it is replaced by one the top level's size.
+    /// Records what the structures need before this frame's ray queries
+    /// into `scratch`: the bottom levels' build the first time (then a
+    /// barrier, as the top level reads them and reuses the scratch), the
+    /// top level's build or refit when it is not current, or nothing.
     pub(super) fn record(
         &mut self,
         gpu: &'g Gpu,
         cmd: ash::vk::CommandBuffer,
+        scratch: ScratchSpan,
     ) -> Result<(), GpuError> {
-        if self.scratch_for_bottom && self.bottom.settled() {
-            self.scratch = Scratch::new(gpu, self.top.scratch_bytes)?;
-            self.scratch_for_bottom = false;
-        }
-        self.bottom.record(gpu, cmd, &self.scratch)?;
-        self.top.record(gpu, cmd, &self.scratch)
+        self.bottom.record(gpu, cmd, scratch)?;
+        self.top.record(gpu, cmd, scratch)
     }
 
     /// What was recorded has been submitted: it counts.
@@ -108,15 +103,10 @@ impl<'g> SceneStructures<'g> {
         self.top.forget_unsubmitted();
     }
 
-    /// Bytes of device memory the structures hold after their first frame
-    /// (bottom levels, then the top level with its instances and the
-    /// scratch its refits need); the first frame also holds the bottom
-    /// levels' build scratch.
+    /// Bytes of device memory the structures hold: the bottom levels, then
+    /// the top level with its instances. Their scratch is the graph's.
     pub(super) fn bytes(&self) -> (u64, u64) {
-        (
-            self.bottom.bytes(),
-            self.top.bytes() + self.top.scratch_bytes,
-        )
+        (self.bottom.bytes(), self.top.bytes())
     }
 }
 
@@ -145,6 +135,41 @@ fn traced_draws(geometry: &SceneGeometry) -> impl Iterator<Item = &crate::geomet
         .draws
         .iter()
         .filter(|d| geometry.draw_records.get(d.draw_id as usize).is_some())
+}
+
+/// Bytes of scratch the builds of `scene`'s structures need, from the scene
+/// alone: the value of the scene value `structure_scratch_bytes`, measured
+/// before the scene's geometry is on the device and before the plan whose
+/// scratch buffer it sizes is compiled. It counts every placed mesh as
+/// [`SceneGeometry`] flattens them (consistent, with triangles: one bottom
+/// level each, shared by its placements) with its triangles and highest
+/// index as read, and a placement per placed mesh. Flattening only drops
+/// triangles (non-finite ones), so this is never less than what
+/// [`SceneStructures`] needs.
+pub fn structure_scratch_bytes(gpu: &Gpu, scene: &Scene) -> Result<u64, GpuError> {
+    let built = |mesh: &&weft_scene::Mesh| mesh.is_consistent() && !mesh.indices.is_empty();
+    let placed: HashSet<usize> = scene.instances.iter().map(|i| i.model).collect();
+    let meshes: Vec<Mesh> = scene
+        .models
+        .iter()
+        .enumerate()
+        .filter(|(m, _)| placed.contains(m))
+        .flat_map(|(_, model)| model.meshes.iter().filter(built))
+        .map(|mesh| Mesh {
+            vertices: 0,
+            stride: VERTEX_BYTES as u64,
+            max_vertex: mesh.indices.iter().copied().max().unwrap_or(0),
+            indices: 0,
+            triangles: (mesh.indices.len() / 3) as u32,
+        })
+        .collect();
+    let placements: usize = scene
+        .instances
+        .iter()
+        .filter_map(|i| scene.models.get(i.model))
+        .map(|model| model.meshes.iter().filter(built).count())
+        .sum();
+    scratch_needed(gpu, &meshes, placements as u32)
 }
 
 /// Each traced draw as a placement: its record's transform, its mesh's
@@ -190,8 +215,10 @@ pub struct StructureReport {
     pub top_build: Duration,
     /// Bytes the bottom levels hold.
     pub bottom_bytes: u64,
-    /// Bytes the top level holds with its instances and scratch.
+    /// Bytes the top level holds with its instances.
     pub top_bytes: u64,
+    /// Bytes of scratch the builds need: transient memory in a frame.
+    pub scratch_bytes: u64,
 }
 
 impl super::GpuScene<'_> {
@@ -250,11 +277,13 @@ impl super::GpuScene<'_> {
     /// frame's ray queries (their first build, a refit, or nothing), after
     /// creating them and the ray tracer's tables if this is the first frame:
     /// the work of a `BuildAccelerationStructures` pass, whose barriers
-    /// order it. `pass` names the pass in errors.
+    /// order it, building in `scratch`, the pass's scratch buffer. `pass`
+    /// names the pass in errors.
     pub fn record_structures(
         &mut self,
         pass: &str,
         cmd: ash::vk::CommandBuffer,
+        scratch: ScratchSpan,
     ) -> Result<(), GpuError> {
         if !self.hardware {
             return Err(GpuError::Pass {
@@ -269,7 +298,7 @@ impl super::GpuScene<'_> {
             pass: pass.to_string(),
             message: "the scene has no acceleration structures".into(),
         })?;
-        structures.record(self.gpu, cmd)
+        structures.record(self.gpu, cmd, scratch)
     }
 
     /// The frame whose command buffer [`Self::record_structures`] recorded
@@ -301,10 +330,11 @@ impl super::GpuScene<'_> {
                 "the scene traces with the software BVH: no acceleration structures".into(),
             ));
         };
+        let scratch = Scratch::new(gpu, structures.scratch_bytes)?;
         let mut bottom_build = Duration::ZERO;
         if !structures.bottom.settled() {
             let start = Instant::now();
-            gpu.one_shot(|cmd| structures.bottom.record(gpu, cmd, &structures.scratch))?;
+            gpu.one_shot(|cmd| structures.bottom.record(gpu, cmd, scratch.span()))?;
             structures.bottom.submitted();
             bottom_build = start.elapsed();
         }
@@ -312,7 +342,7 @@ impl super::GpuScene<'_> {
         gpu.one_shot(|cmd| {
             // After the last submission's build, whose scratch this reuses.
             acceleration::between_builds(gpu, cmd);
-            structures.top.record(gpu, cmd, &structures.scratch)
+            structures.top.record(gpu, cmd, scratch.span())
         })?;
         structures.top.submitted();
         let top_build = start.elapsed();
@@ -322,6 +352,7 @@ impl super::GpuScene<'_> {
             top_build,
             bottom_bytes,
             top_bytes,
+            scratch_bytes: structures.scratch_bytes,
         })
     }
 }

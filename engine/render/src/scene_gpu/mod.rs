@@ -3,6 +3,7 @@
 //! data) and set 2 (a material's textures) that every scene shader binds.
 
 mod acceleration;
+pub use acceleration::structure_scratch_bytes;
 mod environment;
 mod ltc;
 mod placement;

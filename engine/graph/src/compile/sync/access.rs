@@ -15,6 +15,10 @@ pub(super) fn gpu_access(ir: &Ir, pass: IrPassId, u: &PassUse) -> GpuAccess {
     let aspect = match ir.resources[u.resource].kind {
         IrKind::Image { format, .. } => Some(format.aspect),
         IrKind::AccelerationStructure => return structure_access(p.kind, u),
+        // A build's scratch is accessed as the structures are.
+        IrKind::Buffer { .. } if p.kind == PassKind::BuildAccelerationStructures => {
+            return structure_access(p.kind, u)
+        }
         IrKind::Buffer { .. } | IrKind::External => None,
     };
     let mut stage = Stage::empty();
@@ -96,7 +100,8 @@ pub(super) fn gpu_access(ir: &Ir, pass: IrPassId, u: &PassUse) -> GpuAccess {
 }
 
 /// How the GPU sees a use of the scene's acceleration structures: a build
-/// (or refit, which reads what it rewrites) at the build stage, or ray
+/// (or refit, which reads what it rewrites) at the build stage, with its
+/// scratch buffer (read and written with the same access bits), or ray
 /// queries in the shaders of a pass that traces. The structures live in the
 /// scene's buffers, so the barriers are memory barriers with no layout.
 fn structure_access(kind: PassKind, u: &PassUse) -> GpuAccess {

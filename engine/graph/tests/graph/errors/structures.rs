@@ -1,5 +1,5 @@
 //! Acceleration structures and the passes that build and read them: a build
-//! pass writes one structure and nothing else, and other passes read one
+//! pass writes one structure, in one scratch buffer, and nothing else, and other passes read one
 //! only through ray queries (`storage_read`), after this frame's build.
 
 use super::{assert_error_at, errors};
@@ -9,10 +9,11 @@ use super::{assert_error_at, errors};
 const STRUCTURES: &str = r#"Graph(
     resources: [
         AccelerationStructure(name: "tlas"),
+        Buffer(name: "scratch", size: 65536),
         Image(name: "out", format: R8G8B8A8_UNORM),
     ],
     passes: [
-        Pass(name: "build", kind: BuildAccelerationStructures, storage_write: ["tlas"]),
+        Pass(name: "build", kind: BuildAccelerationStructures, storage_write: ["tlas", "scratch"]),
         Pass(name: "trace", kind: Compute, shaders: (compute: "t.comp"), dispatch: Output(8, 8),
              storage_read: [(name: "tlas", enabled_if: ["ray_queries"])], storage_write: ["out"]),
     ],
@@ -38,9 +39,9 @@ fn structures_are_built_by_their_pass_alone_and_read_by_ray_queries() {
             "Output(8, 8)",
         ),
         (
-            (r#"storage_write: ["tlas"]"#, r#"storage_write: ["out"]"#),
+            (r#"storage_write: ["tlas", "scratch"]"#, r#"storage_write: ["out", "scratch"]"#),
             "BuildAccelerationStructures pass \"build\" needs exactly one `AccelerationStructure` resource in `storage_write`",
-            r#"["out"]"#,
+            r#"["out", "scratch"]"#,
         ),
         (
             (r#"storage_write: ["out"]),"#, r#"storage_write: ["out", "tlas"]),"#),
@@ -53,7 +54,7 @@ fn structures_are_built_by_their_pass_alone_and_read_by_ray_queries() {
             r#""tlas"],"#,
         ),
         (
-            (r#"storage_write: ["tlas"]"#, r#"storage_write: ["tlas"], enabled_if: ["never"]"#),
+            (r#"storage_write: ["tlas", "scratch"]"#, r#"storage_write: ["tlas", "scratch"], enabled_if: ["never"]"#),
             "pass \"trace\" reads \"tlas\" before anything writes it (with features [!never, ray_queries])",
             r#""tlas", enabled_if"#,
         ),
@@ -67,10 +68,32 @@ fn structures_are_built_by_their_pass_alone_and_read_by_ray_queries() {
             "passes \"build\" and \"again\" both build acceleration structures: the scene's are built once a frame, by one pass",
             "BuildAccelerationStructures, storage_write: [\"tlas\"], after",
         ),
+        (
+            (r#"storage_write: ["tlas", "scratch"]"#, r#"storage_write: ["tlas", "scratch", "out"]"#),
+            "BuildAccelerationStructures pass \"build\" writes its acceleration structure and one `Buffer`, the scratch it builds in",
+            r#"["tlas", "scratch", "out"]"#,
+        ),
+        (
+            (r#"storage_write: ["tlas", "scratch"]"#, r#"storage_write: ["tlas"]"#),
+            "BuildAccelerationStructures pass \"build\" writes its acceleration structure and one `Buffer`, the scratch it builds in",
+            r#"["tlas"]"#,
+        ),
+        (
+            (
+                r#"storage_write: ["tlas", "scratch"]"#,
+                r#"storage_write: ["tlas", "a", "b"]"#,
+            ),
+            "BuildAccelerationStructures pass \"build\" writes its acceleration structure and one `Buffer`, the scratch it builds in",
+            r#"["tlas", "a", "b"]"#,
+        ),
     ];
+    let two_buffers = r#"Buffer(name: "a", size: 64), Buffer(name: "b", size: 64),
+        Image(name: "out""#;
+    let base = STRUCTURES.replacen(r#"Image(name: "out""#, two_buffers, 1);
+    assert_eq!(errors(&base), Vec::new(), "unused buffers are no error");
     for ((from, to), message, at) in cases {
-        assert!(STRUCTURES.contains(from), "{from}");
-        let text = STRUCTURES.replacen(from, to, 1);
+        assert!(base.contains(from), "{from}");
+        let text = base.replacen(from, to, 1);
         assert_error_at(&text, message, at, to);
     }
 }

@@ -3,7 +3,7 @@
 //! the camera jitter test.
 
 use super::*;
-use weft_graph::vocabulary::{check_vocabulary, SceneFeature, SceneVocabulary};
+use weft_graph::vocabulary::{check_vocabulary, SceneFeature, SceneValue, SceneVocabulary};
 
 /// A vocabulary as a renderer might register one (the real one is
 /// weft-render's, checked against every shipped graph by `weft graph check`).
@@ -18,6 +18,10 @@ const SCENES: SceneVocabulary = SceneVocabulary {
             reason: "a placed mesh blends",
         },
     ],
+    values: &[SceneValue {
+        name: "structure_scratch_bytes",
+        meaning: "bytes a build of the scene's acceleration structures works in",
+    }],
     mesh_filters: &["All", "Opaque", "Transparent"],
     light_volumes: &["Point", "Spot"],
     shading_models: &["BlinnPhong", "MetallicRoughness"],
@@ -86,6 +90,40 @@ fn an_unknown_shading_model_is_an_error_at_its_draws_in_a_pass_or_a_set() {
         "unknown shading model `MetalicRoughness`",
         "did you mean `MetallicRoughness`?",
         "MetalicRoughness)",
+    );
+}
+
+#[test]
+fn a_scene_value_is_one_the_renderer_measures_and_sizes_buffers_once_declared() {
+    assert_vocabulary_error(
+        (
+            "Graph(",
+            r#"Graph(scene_values: ["structure_scratch_bytes", "scratch_bytes"],"#,
+        ),
+        "unknown scene value `scratch_bytes`",
+        "scenes offer: structure_scratch_bytes",
+        r#""scratch_bytes"]"#,
+    );
+    // A size expression may use a declared value, and no other.
+    let sized = |declared: &str| {
+        VALID.replacen(
+            "Graph(\n    resources: [",
+            &format!(
+                "Graph(\n    scene_values: [{declared}],\n    resources: [\n        Buffer(name: \"s\", size: \"structure_scratch_bytes * 2\"),"
+            ),
+            1,
+        )
+    };
+    let declared = sized(r#""structure_scratch_bytes""#);
+    assert_eq!(vocabulary_errors(&declared), Vec::<Diagnostic>::new());
+    assert_eq!(errors(&declared), Vec::<Diagnostic>::new());
+    let undeclared = sized("");
+    let found = errors(&undeclared);
+    assert_eq!(found.len(), 1, "{found:#?}");
+    assert!(
+        found[0].message.contains("structure_scratch_bytes"),
+        "{}",
+        found[0].message
     );
 }
 

@@ -178,6 +178,19 @@ fn uses_of(plan: &Plan, pass: usize) -> Vec<(usize, Use)> {
             },
         ));
     }
+    if let Some(scratch) = p.scratch {
+        // The build's scratch: written and read at the build stage, its
+        // old contents never needed.
+        out.push((
+            scratch.index(),
+            Use {
+                stage: Stage::ACCELERATION_STRUCTURE_BUILD,
+                access: Access::ACCELERATION_STRUCTURE_READ | Access::ACCELERATION_STRUCTURE_WRITE,
+                layout: Layout::General,
+                needs_contents: false,
+            },
+        ));
+    }
     if let Some((src, dst)) = p.transfer {
         let stage = shader_stage(p.kind, true);
         out.push((

@@ -7,13 +7,19 @@
 //! The structures are created here, sized for the device, and their builds
 //! recorded into a command buffer the caller orders: in a frame, the render
 //! graph's `BuildAccelerationStructures` pass, whose barriers the compiler
-//! derives like any other pass's.
+//! derives like any other pass's, building in the scratch buffer the graph
+//! declares ([`ScratchSpan`]).
+
+mod scratch;
+
+pub use scratch::{scratch_needed, Scratch, ScratchSpan};
 
 use crate::buffer::Buffer;
 use crate::context::Gpu;
 use crate::error::{GpuError, VkCall};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
+use scratch::scratch_alignment;
 
 /// An acceleration structure and the buffer holding it, destroyed on drop.
 pub struct AccelerationStructure<'g> {
@@ -182,11 +188,12 @@ impl<'g> BottomLevels<'g> {
         &mut self,
         gpu: &Gpu,
         cmd: vk::CommandBuffer,
-        scratch: &Scratch<'_>,
+        scratch: ScratchSpan,
     ) -> Result<(), GpuError> {
         if self.built {
             return Ok(());
         }
+        scratch.holds(self.scratch_bytes, "the bottom levels' build")?;
         self.record_build(gpu, cmd, scratch)?;
         between_builds(gpu, cmd);
         self.built = true;
@@ -217,7 +224,7 @@ impl<'g> BottomLevels<'g> {
         &self,
         gpu: &Gpu,
         cmd: vk::CommandBuffer,
-        scratch: &Scratch<'_>,
+        scratch: ScratchSpan,
     ) -> Result<(), GpuError> {
         let loader = loader(gpu)?;
         if self.levels.is_empty() {
@@ -283,35 +290,6 @@ fn bottom_info<'a>(
         .flags(vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE)
         .mode(vk::BuildAccelerationStructureModeKHR::BUILD)
         .geometries(geometry)
-}
-
-/// Scratch memory for builds: a device buffer and its first address aligned
-/// to `minAccelerationStructureScratchOffsetAlignment`.
-pub struct Scratch<'g> {
-    buffer: Buffer<'g>,
-    /// The aligned address builds start at.
-    pub address: u64,
-}
-
-impl<'g> Scratch<'g> {
-    /// A scratch buffer with `bytes` usable from its aligned start.
-    pub fn new(gpu: &'g Gpu, bytes: u64) -> Result<Self, GpuError> {
-        let align = scratch_alignment(gpu);
-        let buffer = Buffer::new(
-            gpu,
-            "acceleration-structure scratch",
-            bytes.max(1) + align,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
-            MemoryLocation::GpuOnly,
-        )?;
-        let address = buffer.address().next_multiple_of(align);
-        Ok(Self { buffer, address })
-    }
-
-    /// Bytes of device memory it holds.
-    pub fn bytes(&self) -> u64 {
-        self.buffer.size
-    }
 }
 
 /// Whether the next recorded top-level build starts afresh or refits.
@@ -411,13 +389,14 @@ impl<'g> TopLevel<'g> {
         &mut self,
         gpu: &Gpu,
         cmd: vk::CommandBuffer,
-        scratch: &Scratch<'_>,
+        scratch: ScratchSpan,
     ) -> Result<(), GpuError> {
         let mode = match self.state {
             TopState::Current => return Ok(()),
             TopState::Unbuilt => vk::BuildAccelerationStructureModeKHR::BUILD,
             TopState::Moved => vk::BuildAccelerationStructureModeKHR::UPDATE,
         };
+        scratch.holds(self.scratch_bytes, "the top level's build")?;
         let loader = loader(gpu)?;
         let geometry = [top_geometry(self.instances.address())];
         let mut info = top_info(&geometry, mode)
@@ -550,21 +529,6 @@ fn build_sizes(
         )
     };
     sizes
-}
-
-/// `minAccelerationStructureScratchOffsetAlignment`.
-fn scratch_alignment(gpu: &Gpu) -> u64 {
-    let mut structures = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
-    let mut properties = vk::PhysicalDeviceProperties2::default().push_next(&mut structures);
-    unsafe {
-        gpu.instance()
-            .get_physical_device_properties2(gpu.physical_device(), &mut properties)
-    };
-    u64::from(
-        structures
-            .min_acceleration_structure_scratch_offset_alignment
-            .max(1),
-    )
 }
 
 /// The barrier between builds: the earlier builds' writes (and their

@@ -1,0 +1,114 @@
+//! Scratch memory for acceleration-structure builds: where a build works,
+//! addressed by device address. In a frame it is a transient buffer of the
+//! render graph's (the build pass's `storage_write`), which the compiler
+//! places in memory other passes use at other times; [`scratch_needed`]
+//! says how large, from the meshes' counts alone, before anything is
+//! created. A build outside a frame (`weft bench bvh`) makes its own
+//! ([`Scratch`]).
+
+use super::{bottom_geometry, bottom_info, build_sizes, loader, top_geometry, top_info, Mesh};
+use crate::buffer::Buffer;
+use crate::context::Gpu;
+use crate::error::GpuError;
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+/// Scratch a build records into: its first address, aligned to
+/// `minAccelerationStructureScratchOffsetAlignment`, and the bytes usable
+/// from there.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ScratchSpan {
+    /// The aligned address builds start at.
+    pub address: u64,
+    /// Bytes usable from `address`.
+    pub bytes: u64,
+}
+
+impl ScratchSpan {
+    /// The usable part of a buffer that starts at device address `address`
+    /// and holds `bytes` (made with `SHADER_DEVICE_ADDRESS` usage).
+    pub fn within(gpu: &Gpu, address: u64, bytes: u64) -> Self {
+        let start = address.next_multiple_of(scratch_alignment(gpu));
+        Self {
+            address: start,
+            bytes: bytes.saturating_sub(start - address),
+        }
+    }
+
+    /// An error unless the span holds the `needed` bytes of `what`.
+    pub(super) fn holds(&self, needed: u64, what: &str) -> Result<(), GpuError> {
+        if self.bytes >= needed {
+            return Ok(());
+        }
+        Err(GpuError::Plan(format!(
+            "{what} needs {needed} bytes of scratch, and its scratch buffer holds {} from its \
+             aligned start: size it by the scene value the renderer measures \
+             (graphs/acceleration.ron)",
+            self.bytes
+        )))
+    }
+}
+
+/// Bytes of scratch a frame's builds over `meshes`, placed `placements`
+/// times, need: the bottom levels' build (every level at once, each at an
+/// aligned offset) or the top level's build or refit, whichever is larger
+/// (they run one after the other in the same scratch), plus the alignment
+/// a buffer's start may need. Only the meshes' counts matter, not their
+/// addresses.
+pub fn scratch_needed(gpu: &Gpu, meshes: &[Mesh], placements: u32) -> Result<u64, GpuError> {
+    let loader = loader(gpu)?;
+    let align = scratch_alignment(gpu);
+    let bottom: u64 = meshes
+        .iter()
+        .map(|mesh| {
+            let geometry = [bottom_geometry(mesh)];
+            let sizes = build_sizes(loader, &bottom_info(&geometry), mesh.triangles);
+            sizes.build_scratch_size.next_multiple_of(align)
+        })
+        .sum();
+    let geometry = [top_geometry(0)];
+    let info = top_info(&geometry, vk::BuildAccelerationStructureModeKHR::BUILD);
+    let sizes = build_sizes(loader, &info, placements);
+    let top = sizes.build_scratch_size.max(sizes.update_scratch_size);
+    Ok(bottom.max(top) + align)
+}
+
+/// Scratch a build outside a frame owns: a device buffer of its own.
+pub struct Scratch<'g> {
+    buffer: Buffer<'g>,
+    gpu: &'g Gpu,
+}
+
+impl<'g> Scratch<'g> {
+    /// A scratch buffer of `bytes` (as [`scratch_needed`] counts them).
+    pub fn new(gpu: &'g Gpu, bytes: u64) -> Result<Self, GpuError> {
+        let buffer = Buffer::new(
+            gpu,
+            "acceleration-structure scratch",
+            bytes.max(1),
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
+            MemoryLocation::GpuOnly,
+        )?;
+        Ok(Self { buffer, gpu })
+    }
+
+    /// Where builds work in it.
+    pub fn span(&self) -> ScratchSpan {
+        ScratchSpan::within(self.gpu, self.buffer.address(), self.buffer.size)
+    }
+}
+
+/// `minAccelerationStructureScratchOffsetAlignment`.
+pub(super) fn scratch_alignment(gpu: &Gpu) -> u64 {
+    let mut structures = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
+    let mut properties = vk::PhysicalDeviceProperties2::default().push_next(&mut structures);
+    unsafe {
+        gpu.instance()
+            .get_physical_device_properties2(gpu.physical_device(), &mut properties)
+    };
+    u64::from(
+        structures
+            .min_acceleration_structure_scratch_offset_alignment
+            .max(1),
+    )
+}

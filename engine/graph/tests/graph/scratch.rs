@@ -1,0 +1,102 @@
+//! A build pass's scratch: a transient buffer sized by a scene value the
+//! renderer measures, addressed by the build, and sharing memory with what
+//! other passes use at other times.
+
+use crate::support::load_files;
+use std::collections::BTreeMap;
+use weft_graph::plan::{Plan, ResourceDesc};
+use weft_graph::vk::{Access, BufferUsage, Stage};
+use weft_graph::CompileOptions;
+
+/// A structure built in its scratch, traced into a transient image that a
+/// last pass turns into the output: the scratch and the image are never
+/// used at once.
+const SCRATCH: &str = r#"Graph(
+    scene_values: ["structure_scratch_bytes"],
+    resources: [
+        AccelerationStructure(name: "tlas"),
+        Buffer(name: "scratch", size: "structure_scratch_bytes + 256"),
+        Image(name: "lit", format: R16G16B16A16_SFLOAT),
+        Image(name: "out", format: R8G8B8A8_UNORM),
+    ],
+    passes: [
+        Pass(name: "build", kind: BuildAccelerationStructures, storage_write: ["tlas", "scratch"]),
+        Pass(name: "trace", kind: Compute, shaders: (compute: "t.comp"), dispatch: Output(8, 8),
+             storage_read: [(name: "tlas", enabled_if: ["ray_queries"])], storage_write: ["lit"]),
+        Pass(name: "show", kind: Compute, shaders: (compute: "s.comp"), dispatch: Output(8, 8),
+             storage_read: ["lit"], storage_write: ["out"]),
+    ],
+    output: "out",
+)"#;
+
+fn compile(scene_values: &[(&str, f64)]) -> Plan {
+    let graph = load_files("g.ron", &[("g.ron", SCRATCH)]);
+    let options = CompileOptions {
+        features: ["ray_queries".to_string()].into(),
+        scene_values: scene_values
+            .iter()
+            .map(|(k, v)| (k.to_string(), *v))
+            .collect::<BTreeMap<_, _>>(),
+        ..CompileOptions::default()
+    };
+    weft_graph::compile(&graph, &options).expect("compiles")
+}
+
+#[test]
+fn the_scratch_is_sized_by_the_scene_and_addressed_by_the_build() {
+    let plan = compile(&[("structure_scratch_bytes", 100_000.0)]);
+    let scratch = plan.resource("scratch").expect("kept");
+    let ResourceDesc::Buffer(desc) = &plan.resources[scratch].desc else {
+        panic!("a buffer");
+    };
+    assert_eq!(desc.size, 100_256);
+    assert_eq!(
+        desc.usage,
+        BufferUsage::STORAGE | BufferUsage::SHADER_DEVICE_ADDRESS
+    );
+    let build = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "build")
+        .expect("runs");
+    assert_eq!(build.scratch, Some(scratch));
+    assert!(build.bindings.is_empty(), "a build binds nothing");
+    // Without a scene (graph check, graph plan) a scene value is 0.
+    let bare = compile(&[]);
+    let ResourceDesc::Buffer(desc) = &bare.resources[bare.resource("scratch").expect("kept")].desc
+    else {
+        panic!("a buffer");
+    };
+    assert_eq!(desc.size, 256);
+}
+
+#[test]
+fn the_scratch_shares_memory_with_an_image_used_at_another_time() {
+    let plan = compile(&[("structure_scratch_bytes", 100_000.0)]);
+    let placed = |name: &str| {
+        plan.resources[plan.resource(name).expect("kept")]
+            .placement
+            .expect("transient")
+    };
+    let (scratch, lit) = (placed("scratch"), placed("lit"));
+    assert_eq!((scratch.block, scratch.offset), (lit.block, lit.offset));
+    assert!(plan.memory.transient_bytes < plan.memory.transient_bytes_unaliased);
+    // The image takes the memory over once the build is done with it.
+    let trace = plan
+        .passes
+        .iter()
+        .find(|p| p.name == "trace")
+        .expect("runs");
+    let lit_id = plan.resource("lit").expect("kept");
+    let handover = trace
+        .barriers
+        .iter()
+        .find(|b| b.resource == lit_id)
+        .expect("a barrier before the first write of lit");
+    assert!(handover
+        .src_stage
+        .contains(Stage::ACCELERATION_STRUCTURE_BUILD));
+    assert!(handover
+        .src_access
+        .contains(Access::ACCELERATION_STRUCTURE_WRITE));
+}
