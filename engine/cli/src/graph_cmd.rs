@@ -80,10 +80,12 @@ fn compile(file: &Path, target: &Target) -> Result<(weft_graph::Prepared, weft_g
     let graph = weft_graph::Prepared::new(weft_graph::load(file)).map_err(failed)?;
     crate::graphs::check_features(&graph, &target.features)?;
     let mut requested = Vec::new();
+    let mut scene = None;
     if let Some(path) = &target.scene {
-        let scene = weft_scene::load_scene(path)
+        let loaded = weft_scene::load_scene(path)
             .with_context(|| format!("loading scene {}", path.display()))?;
-        let from_scene = weft_render::scene_features(&scene);
+        let scene = scene.insert(loaded);
+        let from_scene = weft_render::scene_features(scene);
         eprintln!(
             "scene {}: features [{}]",
             path.display(),
@@ -113,10 +115,24 @@ fn compile(file: &Path, target: &Target) -> Result<(weft_graph::Prepared, weft_g
             "memory: estimated without a device (64 KiB pages); --on-device sizes it for the first Vulkan device"
         ),
     }
+    // The scene values a renderer measures, where there are a scene and a
+    // device to measure them on (with ray queries: the only value is the
+    // structures' build scratch).
+    let mut scene_values = std::collections::BTreeMap::new();
+    if let (Some(scene), Some(gpu)) = (&scene, &gpu) {
+        if gpu.info().shaders.ray_query {
+            let bytes = weft_render::structure_scratch_bytes(gpu, scene)?;
+            scene_values.insert(
+                weft_render::vocabulary::STRUCTURE_SCRATCH_BYTES.to_string(),
+                bytes as f64,
+            );
+        }
+    }
     let options = CompileOptions {
         extent: target.size,
         features: graph.graph().features(&requested),
         memory,
+        scene_values,
         ..CompileOptions::default()
     };
     let start = Instant::now();

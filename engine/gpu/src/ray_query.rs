@@ -1,6 +1,6 @@
 //! Whether a device offers hardware ray queries, and the device extensions
 //! they need: what the context enables and the capability check reports
-//! (the acceleration structures themselves are `acceleration.rs`).
+//! (the acceleration structures themselves are `acceleration/`).
 
 use ash::vk;
 

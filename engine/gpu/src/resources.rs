@@ -1,5 +1,5 @@
-//! The images and buffers of a plan. Transient images are bound at the plan's
-//! offsets inside one allocation per memory block, so aliasing is real;
+//! The images and buffers of a plan. Transient images and buffers are bound at
+//! the plan's offsets inside one allocation per memory block, so aliasing is real;
 //! history and output resources get their own memory and are put in their
 //! frame-start layout once, at creation.
 
@@ -58,9 +58,10 @@ pub struct FrameResources<'g> {
     allocations: Vec<Allocation>,
     /// Framebuffers over these resources' views, by render pass and views.
     framebuffers: HashMap<(vk::RenderPass, Vec<vk::ImageView>), vk::Framebuffer>,
-    /// Bytes of the shared transient blocks (aliased images count once).
+    /// Bytes of the shared transient blocks (aliased resources count once).
     pub transient_bytes: u64,
-    /// Bytes of resources with memory of their own (history, output, buffers).
+    /// Bytes of resources with memory of their own (history and output
+    /// images and buffers).
     pub dedicated_bytes: u64,
     /// Tells these resources apart from any others made in this process,
     /// so the executor knows what a prepared plan was prepared on.
@@ -331,8 +332,10 @@ impl<'g> FrameResources<'g> {
     }
 
     /// One allocation per memory block (sized by the plan, of a memory type every
-    /// image placed in it accepts), resources bound at their placements; the rest
-    /// get their own memory.
+    /// image and buffer placed in it accepts), resources bound at their
+    /// placements; the rest get their own memory. Vulkan does not promise that
+    /// buffers and optimally tiled images share a memory type; a device where
+    /// they share none is refused here with the block named.
     fn bind_memory(&mut self, plan: &Plan) -> Result<(), GpuError> {
         for (b, block) in plan.memory.blocks.iter().enumerate() {
             let mut type_bits = u32::MAX;

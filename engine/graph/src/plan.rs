@@ -66,6 +66,10 @@ pub struct Plan {
     pub extent: Extent,
     /// Features that were on while compiling.
     pub features: Vec<String>,
+    /// The scene values the graph declares, as its buffers were sized: what
+    /// the renderer measured, or 0 where the compile had no scene.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub scene_values: BTreeMap<String, f64>,
     pub resources: IdVec<ResourceId, PlanResource>,
     /// Passes in execution order.
     pub passes: IdVec<PassId, PlanPass>,
@@ -86,7 +90,7 @@ pub struct Plan {
     /// Whether the camera's projection moves by a sub-pixel offset each
     /// frame (`jitter` in the file, its features holding).
     pub camera_jitter: bool,
-    /// Where transient images live.
+    /// Where transient images and buffers live.
     pub memory: MemoryPlan,
     /// Barriers after the last pass: the output to `TRANSFER_SRC_OPTIMAL` for presenting or
     /// saving, history resources back to the state the next frame starts from.
@@ -102,7 +106,7 @@ pub struct PlanResource {
     pub residency: Residency,
     /// First and last pass that use it.
     pub lifetime: (PassId, PassId),
-    /// Where a transient image lives inside the shared memory blocks.
+    /// Where a transient image or buffer lives inside the shared memory blocks.
     pub placement: Option<Placement>,
     /// For persistent resources: the layout it must be in when a frame starts
     /// (the executor puts it there when it creates it).
@@ -163,17 +167,17 @@ pub struct Placement {
     pub size: u64,
 }
 
-/// Memory blocks shared by transient images, and what aliasing saved.
+/// Memory blocks shared by transient images and buffers, and what aliasing saved.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
 pub struct MemoryPlan {
     pub blocks: Vec<MemoryBlock>,
     /// Bytes of all blocks.
     pub transient_bytes: u64,
-    /// Bytes if every transient image had its own memory.
+    /// Bytes if every transient image and buffer had its own memory.
     pub transient_bytes_unaliased: u64,
 }
 
-/// One block of device memory that transient images are bound into.
+/// One block of device memory that transient images and buffers are bound into.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct MemoryBlock {
     pub size: u64,

@@ -38,6 +38,18 @@ pub fn render(plan: &Plan) -> String {
         plan.extent.height,
         plan.features.join(", ")
     );
+    if !plan.scene_values.is_empty() {
+        let values: Vec<String> = plan
+            .scene_values
+            .iter()
+            .map(|(name, value)| format!("{name} = {value}"))
+            .collect();
+        let _ = writeln!(
+            w,
+            "scene values (0 where no scene was measured): {}",
+            values.join(", ")
+        );
+    }
     if plan.camera_jitter {
         let _ = writeln!(
             w,
@@ -154,7 +166,8 @@ pub fn render(plan: &Plan) -> String {
             let mut groups: Vec<String> = Vec::new();
             for (model, define) in &p.model_defines {
                 let label = model.clone();
-                match groups.iter_mut().find(|g| g.starts_with(&label)) {
+                let prefix = format!("{label} +");
+                match groups.iter_mut().find(|g| g.starts_with(&prefix)) {
                     Some(g) => g.push_str(&format!(" {define}")),
                     None => groups.push(format!("{label} +{define}")),
                 }

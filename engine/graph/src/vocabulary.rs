@@ -9,7 +9,7 @@
 
 use crate::diagnostic::{nearest, Diagnostic};
 use crate::load::LoadedGraph;
-use crate::resolve::{feature_names, resolve};
+use crate::resolve::{feature_names, resolve, Ir};
 use crate::schema::{Draw, SceneTerm};
 use crate::spans::Seg;
 use std::collections::BTreeSet;
@@ -55,6 +55,17 @@ pub struct SceneValue {
 /// be their includer's) a caveat's or the jitter's feature that neither the
 /// graph nor scenes set.
 pub fn check_vocabulary(graph: &LoadedGraph, vocabulary: &SceneVocabulary) -> Vec<Diagnostic> {
+    let (ir, _) = resolve(graph);
+    check_vocabulary_resolved(graph, &ir, vocabulary)
+}
+
+/// [`check_vocabulary`] of a graph already resolved (a [`crate::Prepared`]'s
+/// `ir`), as the renderer checks each graph it compiles.
+pub fn check_vocabulary_resolved(
+    graph: &LoadedGraph,
+    ir: &Ir,
+    vocabulary: &SceneVocabulary,
+) -> Vec<Diagnostic> {
     let mut diags = Vec::new();
     for pass in &graph.passes {
         let mut term = |path: &[Seg], used: &SceneTerm, what: &str, known: &[&str]| {
@@ -113,11 +124,20 @@ pub fn check_vocabulary(graph: &LoadedGraph, vocabulary: &SceneVocabulary) -> Ve
                 .count();
             let path = [Seg::Field("scene_values"), Seg::Index(index)];
             let (file, pos) = graph.locate(*source, &path);
-            diags.push(unknown(file, pos, name, "scene value", &values));
+            let mut d = unknown(file, pos, name, "scene value", &values);
+            if nearest(name, values.iter().copied()).is_none() {
+                let offered: Vec<String> = vocabulary
+                    .values
+                    .iter()
+                    .map(|v| format!("{} ({})", v.name, v.meaning))
+                    .collect();
+                d.hint = Some(format!("scenes offer: {}", offered.join("; ")));
+            }
+            diags.push(d);
         }
     }
     if !graph.is_fragment {
-        diags.extend(unknown_features(graph, vocabulary));
+        diags.extend(unknown_features(graph, ir, vocabulary));
     }
     diags
 }
@@ -140,9 +160,8 @@ fn unknown(
 /// Caveat and jitter conditions that name a feature neither the graph (its
 /// passes' conditions, its defaults) nor scenes set: a misspelt one would
 /// never show its caveat or never jitter.
-fn unknown_features(graph: &LoadedGraph, vocabulary: &SceneVocabulary) -> Vec<Diagnostic> {
-    let (ir, _) = resolve(graph);
-    let mut known: BTreeSet<String> = feature_names(&ir);
+fn unknown_features(graph: &LoadedGraph, ir: &Ir, vocabulary: &SceneVocabulary) -> Vec<Diagnostic> {
+    let mut known: BTreeSet<String> = feature_names(ir);
     known.extend(graph.default_features.iter().cloned());
     known.extend(vocabulary.features.iter().map(|f| f.name.to_string()));
     let caveats = graph

@@ -218,12 +218,9 @@ pub fn compile_for_scene(
         cpu: gpu.info().kind == weft_gpu::DeviceKind::Cpu,
     };
     let names_feature = weft_graph::feature_names(graph.ir()).contains(RAY_QUERY_FEATURE);
-    // What a plan that traces in hardware builds its structures in.
-    let scratch = if device.ray_query {
-        structure_scratch_bytes(gpu, scene)?
-    } else {
-        0
-    };
+    // What a plan that traces in hardware builds its structures in,
+    // measured the first time a compile asks for ray queries.
+    let scratch = std::cell::OnceCell::new();
     let plan =
         trace_backend::compile_traced(settings.trace_backend, &device, names_feature, |hardware| {
             let mut features = loaded.features(&requested);
@@ -232,10 +229,20 @@ pub fn compile_for_scene(
             if hardware {
                 features.insert(RAY_QUERY_FEATURE.to_string());
             }
-            let scene_values = hardware
-                .then(|| (STRUCTURE_SCRATCH_BYTES.to_string(), scratch as f64))
-                .into_iter()
-                .collect();
+            let mut scene_values = BTreeMap::new();
+            if hardware {
+                let bytes = scratch
+                    .get_or_init(|| structure_scratch_bytes(gpu, scene).map_err(|e| e.to_string()))
+                    .clone()
+                    .map_err(|e| {
+                        vec![weft_graph::Diagnostic::error(
+                            settings.graph.clone(),
+                            weft_graph::spans::Pos { line: 1, col: 1 },
+                            format!("measuring the scene's acceleration-structure scratch: {e}"),
+                        )]
+                    })?;
+                scene_values.insert(STRUCTURE_SCRATCH_BYTES.to_string(), bytes as f64);
+            }
             let options = CompileOptions {
                 extent: settings.extent,
                 features,

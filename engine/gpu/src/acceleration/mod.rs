@@ -12,7 +12,7 @@
 
 mod scratch;
 
-pub use scratch::{scratch_needed, Scratch, ScratchSpan};
+pub use scratch::{scratch_for, scratch_needed, Scratch, ScratchSpan};
 
 use crate::buffer::Buffer;
 use crate::context::Gpu;

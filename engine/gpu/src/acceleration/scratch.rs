@@ -6,7 +6,10 @@
 //! created. A build outside a frame (`weft bench bvh`) makes its own
 //! ([`Scratch`]).
 
-use super::{bottom_geometry, bottom_info, build_sizes, loader, top_geometry, top_info, Mesh};
+use super::{
+    bottom_geometry, bottom_info, build_sizes, loader, top_geometry, top_info, BottomLevels, Mesh,
+    TopLevel,
+};
 use crate::buffer::Buffer;
 use crate::context::Gpu;
 use crate::error::GpuError;
@@ -28,7 +31,12 @@ impl ScratchSpan {
     /// The usable part of a buffer that starts at device address `address`
     /// and holds `bytes` (made with `SHADER_DEVICE_ADDRESS` usage).
     pub fn within(gpu: &Gpu, address: u64, bytes: u64) -> Self {
-        let start = address.next_multiple_of(scratch_alignment(gpu));
+        Self::aligned(address, bytes, scratch_alignment(gpu))
+    }
+
+    /// The part of `bytes` at `address` that starts on a multiple of `align`.
+    fn aligned(address: u64, bytes: u64, align: u64) -> Self {
+        let start = address.next_multiple_of(align);
         Self {
             address: start,
             bytes: bytes.saturating_sub(start - address),
@@ -70,7 +78,23 @@ pub fn scratch_needed(gpu: &Gpu, meshes: &[Mesh], placements: u32) -> Result<u64
     let info = top_info(&geometry, vk::BuildAccelerationStructureModeKHR::BUILD);
     let sizes = build_sizes(loader, &info, placements);
     let top = sizes.build_scratch_size.max(sizes.update_scratch_size);
-    Ok(bottom.max(top) + align)
+    Ok(both(bottom, top, align))
+}
+
+/// Bytes of scratch the builds of `bottom` and `top`, created, need: what
+/// [`scratch_needed`] gives for their meshes and placements.
+pub fn scratch_for(gpu: &Gpu, bottom: &BottomLevels<'_>, top: &TopLevel<'_>) -> u64 {
+    both(
+        bottom.scratch_bytes,
+        top.scratch_bytes,
+        scratch_alignment(gpu),
+    )
+}
+
+/// The scratch for a bottom-level build and a top-level one in turn, from a
+/// buffer start aligned to no more than the device promises.
+fn both(bottom: u64, top: u64, align: u64) -> u64 {
+    bottom.max(top) + align
 }
 
 /// Scratch a build outside a frame owns: a device buffer of its own.
@@ -111,4 +135,28 @@ pub(super) fn scratch_alignment(gpu: &Gpu) -> u64 {
             .min_acceleration_structure_scratch_offset_alignment
             .max(1),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_span_starts_aligned_and_loses_the_bytes_before() {
+        assert_eq!(
+            ScratchSpan::aligned(1000, 4096, 256),
+            ScratchSpan {
+                address: 1024,
+                bytes: 4072
+            }
+        );
+        assert_eq!(ScratchSpan::aligned(1024, 10, 256).bytes, 10);
+        assert_eq!(ScratchSpan::aligned(1, 100, 256).bytes, 0);
+        let span = ScratchSpan::aligned(0, 100, 128);
+        assert!(span.holds(100, "a build").is_ok());
+        let refused = span.holds(101, "a build").expect_err("too small");
+        assert!(refused
+            .to_string()
+            .contains("a build needs 101 bytes of scratch, and its scratch buffer holds 100"));
+    }
 }

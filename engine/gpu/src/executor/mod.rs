@@ -85,7 +85,7 @@ pub struct FrameReport {
     pub readbacks: Vec<(String, Readback)>,
     /// Host time spent preparing and recording commands (excluding GPU waits).
     pub record_ms: f64,
-    /// Device memory of the plan's transient blocks (aliased images count once).
+    /// Device memory of the plan's transient blocks (aliased resources count once).
     pub transient_bytes: u64,
     /// Device memory of resources with their own allocations.
     pub dedicated_bytes: u64,

@@ -11,7 +11,7 @@ use crate::plan::{
 
 /// Places every transient image and buffer of `resources` (setting its
 /// `placement`) with the device's memory requirements; returns the memory
-/// plan. Acceleration structures live in the scene's memory.
+/// plan. (Acceleration structures are the scene's memory, never transient.)
 pub(crate) fn alias(
     resources: &mut IdVec<ResourceId, PlanResource>,
     requirements: &dyn Fn(&ResourceDesc) -> MemoryRequirements,
@@ -19,7 +19,6 @@ pub(crate) fn alias(
     let transient: Vec<(ResourceId, Transient)> = resources
         .iter_enumerated()
         .filter(|(_, r)| r.residency == Residency::Transient)
-        .filter(|(_, r)| !matches!(r.desc, ResourceDesc::AccelerationStructure))
         .map(|(i, r)| {
             (
                 i,
@@ -97,13 +96,13 @@ fn overlaps(a: (usize, usize), b: (usize, usize)) -> bool {
     a.0 <= b.1 && b.0 <= a.1
 }
 
-/// Places transient images; returns a placement per input, in input order.
-pub fn place(images: &[Transient]) -> (MemoryPlan, Vec<Placement>) {
-    let mut by_size: Vec<usize> = (0..images.len()).collect();
+/// Places transient resources; returns a placement per input, in input order.
+pub fn place(resources: &[Transient]) -> (MemoryPlan, Vec<Placement>) {
+    let mut by_size: Vec<usize> = (0..resources.len()).collect();
     by_size.sort_by_key(|&i| {
         (
-            std::cmp::Reverse(images[i].requirements.size),
-            images[i].lifetime.0,
+            std::cmp::Reverse(resources[i].requirements.size),
+            resources[i].lifetime.0,
             i,
         )
     });
@@ -113,17 +112,17 @@ pub fn place(images: &[Transient]) -> (MemoryPlan, Vec<Placement>) {
             offset: 0,
             size: 0
         };
-        images.len()
+        resources.len()
     ];
-    // Placed images as (offset, end, lifetime), kept sorted by offset.
-    let mut placed: Vec<(u64, u64, (usize, usize))> = Vec::with_capacity(images.len());
+    // Placed resources as (offset, end, lifetime), kept sorted by offset.
+    let mut placed: Vec<(u64, u64, (usize, usize))> = Vec::with_capacity(resources.len());
     let mut block_size = 0u64;
     let mut block_alignment = 1u64;
     for &i in &by_size {
-        let req = images[i].requirements;
+        let req = resources[i].requirements;
         let align = req.alignment.max(1);
         let mut offset = 0u64;
-        let lifetime = images[i].lifetime;
+        let lifetime = resources[i].lifetime;
         for &(start, end, other) in &placed {
             if !overlaps(lifetime, other) {
                 continue;
@@ -143,8 +142,8 @@ pub fn place(images: &[Transient]) -> (MemoryPlan, Vec<Placement>) {
         block_size = block_size.max(offset + req.size);
         block_alignment = block_alignment.max(align);
     }
-    let unaliased = images.iter().map(|t| t.requirements.size).sum();
-    let blocks = if images.is_empty() {
+    let unaliased = resources.iter().map(|t| t.requirements.size).sum();
+    let blocks = if resources.is_empty() {
         Vec::new()
     } else {
         vec![MemoryBlock {

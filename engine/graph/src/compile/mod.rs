@@ -295,6 +295,9 @@ pub fn compile_ir(
         files: graph.files(),
         extent: options.extent,
         features: options.features.iter().cloned().collect(),
+        scene_values: crate::resolve::scene_value_vars(graph, |name| {
+            options.scene_values.get(name).copied()
+        }),
         output: lifetimes.plan_index(output),
         readback: roots.list[1..]
             .iter()

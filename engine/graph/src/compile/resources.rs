@@ -11,8 +11,8 @@ use crate::id::{IdVec, IrResourceId, PassId, ResourceId};
 use crate::load::LoadedGraph;
 use crate::plan::{BufferDesc, Extent, ImageDesc, PlanResource, Residency, ResourceDesc};
 use crate::resolve::{
-    expression_vars, image_extent, oversized_image, resource_path, BufferSize, Ir, IrKind, Usage,
-    MAX_IMAGE_DIMENSION,
+    expression_vars, image_extent, oversized_image, resource_path, scene_value_vars, BufferSize,
+    Ir, IrKind, Usage, MAX_IMAGE_DIMENSION,
 };
 use crate::schema::PassKind;
 use crate::spans::Seg;
@@ -30,6 +30,7 @@ pub(crate) fn describe(
 ) -> Result<IdVec<ResourceId, PlanResource>, Vec<Diagnostic>> {
     check_image_sizes(graph, ir, &lifetimes.kept, options.extent)?;
     let mut resources = IdVec::new();
+    let mut errors = Vec::new();
     for &r in &lifetimes.kept {
         let res = &ir.resources[r];
         let residency = if roots.is_root[r] {
@@ -102,25 +103,11 @@ pub(crate) fn describe(
                 "only fragments have external resources, and fragments are not compiled"
             ),
             IrKind::Buffer { size } => {
-                let bytes = match size {
-                    BufferSize::Bytes(b) => *b,
-                    BufferSize::Expression(text) => {
-                        let scene = graph
-                            .scene_values
-                            .iter()
-                            .map(|(_, name)| {
-                                let measured = options.scene_values.get(name);
-                                (name.clone(), measured.copied().unwrap_or(0.0))
-                            })
-                            .collect();
-                        let vars = expression_vars(
-                            &graph.sources[res.source].params,
-                            options.extent,
-                            &scene,
-                        );
-                        crate::expr::eval(text, &vars)
-                            .map(|v| v.max(1.0).ceil() as u64)
-                            .unwrap_or(1)
+                let bytes = match buffer_bytes(graph, res, size, options) {
+                    Ok(bytes) => bytes,
+                    Err(error) => {
+                        errors.push(error);
+                        1
                     }
                 };
                 let mut usage = BufferUsage::empty();
@@ -148,8 +135,60 @@ pub(crate) fn describe(
             frame_start_layout: Layout::Undefined,
         });
     }
-
+    if !errors.is_empty() {
+        return Err(errors);
+    }
     Ok(resources)
+}
+
+/// The most bytes a buffer may have: above any device's `maxBufferSize`,
+/// and far enough below `u64::MAX` that placing buffers cannot overflow.
+pub const MAX_BUFFER_BYTES: u64 = 1 << 48;
+
+/// A buffer's bytes at this output size, with the scene values the renderer
+/// measured (0 for one it did not), or an error at its size when the
+/// expression gives no byte count (infinite, say, dividing by a scene value
+/// of 0) or more than [`MAX_BUFFER_BYTES`].
+fn buffer_bytes(
+    graph: &LoadedGraph,
+    res: &crate::resolve::IrResource,
+    size: &BufferSize,
+    options: &CompileOptions,
+) -> Result<u64, Diagnostic> {
+    let text = match size {
+        BufferSize::Bytes(b) => return Ok(*b),
+        BufferSize::Expression(text) => text,
+    };
+    let vars = expression_vars(
+        &graph.sources[res.source].params,
+        options.extent,
+        &scene_value_vars(graph, |name| options.scene_values.get(name).copied()),
+    );
+    // Resolving checked the expression's syntax and names.
+    let value = crate::expr::eval(text, &vars).unwrap_or(1.0);
+    if value.is_finite() && value <= MAX_BUFFER_BYTES as f64 {
+        return Ok(value.max(1.0).ceil() as u64);
+    }
+    let (file, pos) = graph.locate(res.source, &resource_path(res.index, &[Seg::Field("size")]));
+    let values: Vec<String> = options
+        .scene_values
+        .iter()
+        .map(|(k, v)| format!("{k} = {v}"))
+        .collect();
+    Err(Diagnostic::error(
+        file,
+        pos,
+        format!(
+            "buffer \"{}\" size \"{text}\" gives {value} bytes at {}x{}, not a byte count up to \
+             2^48",
+            res.name, options.extent.width, options.extent.height
+        ),
+    )
+    .with_hint(if values.is_empty() {
+        "without a scene every scene value is 0".to_string()
+    } else {
+        format!("scene values: {}", values.join(", "))
+    }))
 }
 
 /// Every image the plan creates fits [`MAX_IMAGE_DIMENSION`] at this output size

@@ -31,7 +31,7 @@ pub(crate) struct Synchronization {
 
 type Resources = IdVec<ResourceId, PlanResource>;
 type States = IdVec<ResourceId, ResourceState>;
-/// Per resource, the other transient images whose memory overlaps its own.
+/// Per resource, the other transient images and buffers whose memory overlaps its own.
 type Sharing = IdVec<ResourceId, Vec<ResourceId>>;
 /// Per plan pass, each resource it uses and how the GPU accesses it.
 type GpuUses = IdVec<PassId, Vec<(ResourceId, GpuAccess)>>;
@@ -141,7 +141,7 @@ fn frame_start_states(resources: &mut Resources, gpu_uses: &GpuUses, scopes: &Sc
 }
 
 /// The first frame starts from `states`; every later frame starts where the previous
-/// one ended, so a transient image's first barrier must also wait for the previous
+/// one ended, so a transient resource's first barrier must also wait for the previous
 /// frame's last use of its memory. Simulates one frame to learn that.
 fn inherit_previous_frame(
     resources: &Resources,

@@ -135,12 +135,7 @@ impl Resolver<'_> {
                     }
                     Expr::Text(text) => {
                         // Any value stands for a scene's here: only names are checked.
-                        let scene = self
-                            .graph
-                            .scene_values
-                            .iter()
-                            .map(|(_, name)| (name.clone(), 1.0))
-                            .collect();
+                        let scene = super::scene_value_vars(self.graph, |_| Some(1.0));
                         let vars = expression_vars(
                             &self.graph.sources[source].params,
                             Extent {

@@ -70,6 +70,21 @@ impl Resolver<'_> {
                     .into(),
             );
         }
+        if pass
+            .accesses
+            .iter()
+            .any(|a| a.usage == Usage::StorageWrite && !a.conditions.is_empty())
+        {
+            self.error(
+                source,
+                &pass_path(index, &[Seg::Field("storage_write")]),
+                format!(
+                    "BuildAccelerationStructures pass \"{name}\" writes its structure and scratch \
+                     whenever it runs: its writes take no `enabled_if`"
+                ),
+            )
+            .hint = Some("give the pass `enabled_if` instead".into());
+        }
         if structures != 1 {
             self.error(
                 source,

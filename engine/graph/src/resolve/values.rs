@@ -175,6 +175,19 @@ pub fn image_extent(ir: &Ir, resource: IrResourceId, output: Extent) -> Option<E
     None
 }
 
+/// Each scene value the graph declares, as a size expression's variable,
+/// with `measured`'s value or 0.
+pub fn scene_value_vars(
+    graph: &crate::load::LoadedGraph,
+    measured: impl Fn(&str) -> Option<f64>,
+) -> std::collections::BTreeMap<String, f64> {
+    graph
+        .scene_values
+        .iter()
+        .map(|(_, name)| (name.clone(), measured(name).unwrap_or(0.0)))
+        .collect()
+}
+
 /// Variables available to buffer size expressions: the output size, the
 /// declaring file's numeric parameters and the scene values the graph
 /// declares (`scene`: each with the value the renderer measured, or 0 in a

@@ -8,6 +8,7 @@ use crate::support;
 use std::path::PathBuf;
 use support::checker::{check_aliasing, check_plan};
 use support::repo_root;
+use weft_graph::plan::ResourceDesc;
 use weft_graph::{CompileOptions, Extent};
 
 const FEATURE_SETS: &[(&str, &[&str])] = &[
@@ -213,6 +214,39 @@ fn removing_any_barrier_makes_the_checker_fail() {
         );
     }
     assert!(removed > 15, "only {removed} barriers");
+}
+
+/// The same with buffers in transient memory: the wavefront path tracer's
+/// queues and the structures' scratch share memory with images, so every
+/// hand-over between a buffer and an image is a barrier the checker needs.
+#[test]
+fn removing_any_barrier_of_a_plan_with_placed_buffers_makes_the_checker_fail() {
+    let graph = weft_graph::load(&repo_root().join("graphs/pathtrace_wavefront.ron"));
+    let options = CompileOptions {
+        features: graph.features(&["ray_queries", "area_lights"]),
+        scene_values: [("structure_scratch_bytes".to_string(), 1e6)].into(),
+        ..CompileOptions::default()
+    };
+    let plan = weft_graph::compile(&graph, &options).expect("compiles");
+    let placed_buffers = plan
+        .resources
+        .iter()
+        .filter(|r| r.placement.is_some() && matches!(r.desc, ResourceDesc::Buffer(_)))
+        .count();
+    assert!(placed_buffers >= 2, "{placed_buffers} placed buffers");
+    check_plan(&plan, 2).expect("the plan is sound");
+    for p in plan.passes.ids() {
+        for b in 0..plan.passes[p].barriers.len() {
+            let mut broken = plan.clone();
+            let barrier = broken.passes[p].barriers.remove(b);
+            let name = &plan.resources[barrier.resource].name;
+            assert!(
+                check_plan(&broken, 2).is_err(),
+                "removing the barrier on \"{name}\" before \"{}\" went unnoticed",
+                plan.passes[p].name
+            );
+        }
+    }
 }
 
 #[test]

@@ -172,10 +172,14 @@ pub fn compile(
     prepared: &weft_graph::Prepared,
     options: &weft_graph::CompileOptions,
 ) -> Result<Plan, Vec<Diagnostic>> {
-    let errors: Vec<Diagnostic> = check(prepared.graph())
-        .into_iter()
-        .filter(Diagnostic::is_error)
-        .collect();
+    let graph = prepared.graph();
+    let mut found = weft_graph::provider::check_providers(graph, PROVIDERS);
+    found.extend(weft_graph::vocabulary::check_vocabulary_resolved(
+        graph,
+        prepared.ir(),
+        &crate::vocabulary::VOCABULARY,
+    ));
+    let errors: Vec<Diagnostic> = found.into_iter().filter(Diagnostic::is_error).collect();
     if !errors.is_empty() {
         return Err(errors);
     }
@@ -393,6 +397,7 @@ pub(crate) mod tests {
                 height: 8,
             },
             features: Vec::new(),
+            scene_values: Default::default(),
             resources: Default::default(),
             passes,
             culled: Vec::new(),

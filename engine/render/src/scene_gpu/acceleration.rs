@@ -16,7 +16,8 @@ use crate::geometry::{MeshRange, SceneGeometry, VERTEX_BYTES};
 use std::collections::{HashMap, HashSet};
 use std::time::{Duration, Instant};
 use weft_gpu::acceleration::{
-    self, scratch_needed, BottomLevels, Mesh, Placement, Scratch, ScratchSpan, TopLevel,
+    self, scratch_for, scratch_needed, BottomLevels, Mesh, Placement, Scratch, ScratchSpan,
+    TopLevel,
 };
 use weft_gpu::buffer::Buffer;
 use weft_gpu::{Gpu, GpuError};
@@ -28,7 +29,7 @@ pub(super) struct SceneStructures<'g> {
     pub(super) top: TopLevel<'g>,
     /// Per traced draw, in the ray tracer's order, the bottom level it places.
     levels: Vec<usize>,
-    /// Bytes of scratch the builds need ([`scratch_needed`]).
+    /// Bytes of scratch the builds need ([`scratch_for`]).
     scratch_bytes: u64,
 }
 
@@ -62,7 +63,7 @@ impl<'g> SceneStructures<'g> {
         let placed = placements(geometry, &levels)?;
         let top = TopLevel::new(gpu, &bottom, &placed)?;
         Ok(Self {
-            scratch_bytes: scratch_needed(gpu, &inputs, placed.len() as u32)?,
+            scratch_bytes: scratch_for(gpu, &bottom, &top),
             bottom,
             top,
             levels,

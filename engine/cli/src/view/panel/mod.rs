@@ -548,7 +548,7 @@ fn plan_section(ui: &mut Ui, plan: &Plan) {
             ));
         }
         ui.label(format!(
-            "transient memory {} aliased, {} if each image had its own",
+            "transient memory {} aliased, {} if each resource had its own",
             mib(plan.memory.transient_bytes),
             mib(plan.memory.transient_bytes_unaliased)
         ));

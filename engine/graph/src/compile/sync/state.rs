@@ -66,7 +66,7 @@ impl ResourceState {
         }
     }
 
-    /// Treats earlier accesses to the same memory (aliased images) as if they were this resource's.
+    /// Treats earlier accesses to the same memory (aliased images and buffers) as if they were this resource's.
     pub fn inherit(&mut self, stages: Stage, access: Access) {
         if !stages.is_empty() {
             let (s, a) = self.write.unwrap_or_default();

@@ -74,6 +74,14 @@ fn structures_are_built_by_their_pass_alone_and_read_by_ray_queries() {
             r#"["tlas", "scratch", "out"]"#,
         ),
         (
+            (
+                r#"storage_write: ["tlas", "scratch"]"#,
+                r#"storage_write: ["tlas", (name: "scratch", enabled_if: ["big"])]"#,
+            ),
+            "BuildAccelerationStructures pass \"build\" writes its structure and scratch whenever it runs: its writes take no `enabled_if`",
+            r#"["tlas", (name"#,
+        ),
+        (
             (r#"storage_write: ["tlas", "scratch"]"#, r#"storage_write: ["tlas"]"#),
             "BuildAccelerationStructures pass \"build\" writes its acceleration structure and one `Buffer`, the scratch it builds in",
             r#"["tlas"]"#,

@@ -101,7 +101,7 @@ fn a_scene_value_is_one_the_renderer_measures_and_sizes_buffers_once_declared() 
             r#"Graph(scene_values: ["structure_scratch_bytes", "scratch_bytes"],"#,
         ),
         "unknown scene value `scratch_bytes`",
-        "scenes offer: structure_scratch_bytes",
+        "scenes offer: structure_scratch_bytes (bytes a build of the scene's acceleration structures works in)",
         r#""scratch_bytes"]"#,
     );
     // A size expression may use a declared value, and no other.

@@ -53,6 +53,11 @@ impl Model {
         }
     }
 
+    /// Whether anything used the resource since its memory was last taken over.
+    fn touched(&self) -> bool {
+        self.write.is_some() || !self.reads.is_empty()
+    }
+
     fn read_covered_by(r: &Read, src_stage: Stage) -> bool {
         src_stage.contains(r.stage) || r.synced.intersects(src_stage)
     }
@@ -254,25 +259,7 @@ fn apply_barrier(
     if transition {
         let (old, new) = b.layouts.expect("transition has layouts");
         if old == Layout::Undefined {
-            // Memory shared with other images: everything they did must be finished.
-            for j in overlapping(plan, b.resource.index()) {
-                let m = &models[j];
-                let touched = m.write.is_some() || !m.reads.is_empty();
-                if touched {
-                    if !m.write_covered_by(b.src_stage, b.src_access)
-                        || !m
-                            .reads
-                            .iter()
-                            .all(|r| Model::read_covered_by(r, b.src_stage))
-                    {
-                        return Err(format!(
-                            "{at}: \"{name}\" takes over memory of \"{}\" without waiting for its last use",
-                            plan.resources[ResourceId::new(j)].name
-                        ));
-                    }
-                    models[j] = Model::fresh();
-                }
-            }
+            take_over(plan, models, b, at)?;
         }
         let m = &mut models[b.resource.index()];
         if old != Layout::Undefined && old != m.layout {
@@ -307,6 +294,11 @@ fn apply_barrier(
         m.reads.clear();
         return Ok(());
     }
+    if b.layouts.is_none() {
+        // A buffer has no layout to discard: any of its barriers may be the
+        // one that takes its memory over.
+        take_over(plan, models, b, at)?;
+    }
     let m = &mut models[b.resource.index()];
     if let Some((old, _)) = b.layouts {
         if old != m.layout {
@@ -330,9 +322,48 @@ fn apply_barrier(
     Ok(())
 }
 
+/// Memory `b`'s resource shares with others (images or buffers): everything
+/// they did since must be finished before the barrier, and is then over.
+fn take_over(
+    plan: &Plan,
+    models: &mut [Model],
+    b: &weft_graph::plan::Barrier,
+    at: &str,
+) -> Result<(), String> {
+    let name = &plan.resources[b.resource].name;
+    for j in overlapping(plan, b.resource.index()) {
+        let m = &models[j];
+        if !m.touched() {
+            continue;
+        }
+        if !m.write_covered_by(b.src_stage, b.src_access)
+            || !m
+                .reads
+                .iter()
+                .all(|r| Model::read_covered_by(r, b.src_stage))
+        {
+            return Err(format!(
+                "{at}: \"{name}\" takes over memory of \"{}\" without waiting for its last use",
+                plan.resources[ResourceId::new(j)].name
+            ));
+        }
+        models[j] = Model::fresh();
+    }
+    Ok(())
+}
+
 fn check_use(plan: &Plan, models: &[Model], r: usize, u: &Use, at: &str) -> Result<(), String> {
     let name = &plan.resources[ResourceId::new(r)].name;
     let m = &models[r];
+    if let Some(j) = overlapping(plan, r)
+        .into_iter()
+        .find(|&j| models[j].touched())
+    {
+        return Err(format!(
+            "{at}: \"{name}\" is used in memory \"{}\" used since, with no barrier taking it over",
+            plan.resources[ResourceId::new(j)].name
+        ));
+    }
     if is_image(plan, r) && m.layout != u.layout {
         return Err(format!(
             "{at}: \"{name}\" is in {:?} but the access needs {:?}",
