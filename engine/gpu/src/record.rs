@@ -7,7 +7,7 @@ use crate::error::GpuError;
 use crate::resources::{full_range, FrameResources, GpuResource};
 use ash::vk;
 use weft_graph::plan::{Barrier, Plan, PlanPass};
-use weft_graph::vk::Aspect;
+use weft_graph::vk::{Aspect, Layout};
 
 /// The shader stages that may add to a scene counter (set 1 storage the
 /// shaders write, such as the per-pass ray counters).
@@ -44,6 +44,13 @@ pub fn scene_counters_to_host(device: &ash::Device, cmd: vk::CommandBuffer) {
 }
 
 /// Records one `vkCmdPipelineBarrier2` with the given barriers (nothing when empty).
+///
+/// Transient images and buffers share memory, and a barrier that hands
+/// memory over carries the previous occupant's stages and accesses, which
+/// a buffer or image barrier's access scope (limited to that resource)
+/// would not formally name. So a buffer's barrier is a global memory
+/// barrier, and an image's first barrier (from `UNDEFINED`, after accesses)
+/// comes with one: both at least as strong as the barriers they stand for.
 pub fn barriers(
     device: &ash::Device,
     cmd: vk::CommandBuffer,
@@ -53,8 +60,14 @@ pub fn barriers(
     if list.is_empty() {
         return Ok(());
     }
+    let global = |b: &Barrier| {
+        vk::MemoryBarrier2::default()
+            .src_stage_mask(convert::stage(b.src_stage))
+            .src_access_mask(convert::access(b.src_access))
+            .dst_stage_mask(convert::stage(b.dst_stage))
+            .dst_access_mask(convert::access(b.dst_access))
+    };
     let mut images = Vec::new();
-    let mut buffers = Vec::new();
     let mut memory = Vec::new();
     for b in list {
         match resources.get(b.resource) {
@@ -65,6 +78,9 @@ pub fn barriers(
                         b.resource
                     ))
                 })?;
+                if old == Layout::Undefined && !b.src_access.is_empty() {
+                    memory.push(global(b));
+                }
                 images.push(
                     vk::ImageMemoryBarrier2::default()
                         .src_stage_mask(convert::stage(b.src_stage))
@@ -79,26 +95,10 @@ pub fn barriers(
                         .subresource_range(full_range(&img.desc)),
                 );
             }
-            Some(GpuResource::Buffer(buf)) => buffers.push(
-                vk::BufferMemoryBarrier2::default()
-                    .src_stage_mask(convert::stage(b.src_stage))
-                    .src_access_mask(convert::access(b.src_access))
-                    .dst_stage_mask(convert::stage(b.dst_stage))
-                    .dst_access_mask(convert::access(b.dst_access))
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .buffer(buf.buffer)
-                    .offset(0)
-                    .size(vk::WHOLE_SIZE),
-            ),
             // The scene's structures live in its buffers: a memory barrier.
-            Some(GpuResource::AccelerationStructure) => memory.push(
-                vk::MemoryBarrier2::default()
-                    .src_stage_mask(convert::stage(b.src_stage))
-                    .src_access_mask(convert::access(b.src_access))
-                    .dst_stage_mask(convert::stage(b.dst_stage))
-                    .dst_access_mask(convert::access(b.dst_access)),
-            ),
+            Some(GpuResource::Buffer(_) | GpuResource::AccelerationStructure) => {
+                memory.push(global(b))
+            }
             None => {
                 return Err(GpuError::Plan(format!(
                     "barrier on resource {} which does not exist",
@@ -109,8 +109,7 @@ pub fn barriers(
     }
     let dep = vk::DependencyInfo::default()
         .memory_barriers(&memory)
-        .image_memory_barriers(&images)
-        .buffer_memory_barriers(&buffers);
+        .image_memory_barriers(&images);
     unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };
     Ok(())
 }

@@ -164,11 +164,15 @@ fn buffer_bytes(
         options.extent,
         &scene_value_vars(graph, |name| options.scene_values.get(name).copied()),
     );
-    // Resolving checked the expression's syntax and names.
-    let value = crate::expr::eval(text, &vars).unwrap_or(1.0);
-    if value.is_finite() && value <= MAX_BUFFER_BYTES as f64 {
-        return Ok(value.max(1.0).ceil() as u64);
-    }
+    // Resolving checked the expression's syntax and names; its value may
+    // still be no byte count (a division by a scene value of 0).
+    let problem = match crate::expr::eval(text, &vars) {
+        Ok(value) if value.is_finite() && value <= MAX_BUFFER_BYTES as f64 => {
+            return Ok(value.max(1.0).ceil() as u64)
+        }
+        Ok(value) => format!("gives {value} bytes"),
+        Err(e) => format!("meets a {} at character {}", e.message, e.offset + 1),
+    };
     let (file, pos) = graph.locate(res.source, &resource_path(res.index, &[Seg::Field("size")]));
     let values: Vec<String> = options
         .scene_values
@@ -179,7 +183,7 @@ fn buffer_bytes(
         file,
         pos,
         format!(
-            "buffer \"{}\" size \"{text}\" gives {value} bytes at {}x{}, not a byte count up to \
+            "buffer \"{}\" size \"{text}\" {problem} at {}x{}: a size is a byte count up to \
              2^48",
             res.name, options.extent.width, options.extent.height
         ),

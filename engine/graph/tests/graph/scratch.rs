@@ -100,3 +100,38 @@ fn the_scratch_shares_memory_with_an_image_used_at_another_time() {
         .src_access
         .contains(Access::ACCELERATION_STRUCTURE_WRITE));
 }
+
+#[test]
+fn a_buffer_size_that_is_no_byte_count_is_an_error_at_the_size() {
+    let text = SCRATCH.replace(
+        r#"size: "structure_scratch_bytes + 256""#,
+        r#"size: "65536 / structure_scratch_bytes""#,
+    );
+    let graph = load_files("g.ron", &[("g.ron", &text)]);
+    let options = CompileOptions {
+        features: ["ray_queries".to_string()].into(),
+        ..CompileOptions::default()
+    };
+    let errors = weft_graph::compile(&graph, &options).expect_err("refused");
+    assert_eq!(errors.len(), 1, "{errors:#?}");
+    assert_eq!(
+        errors[0].message,
+        "buffer \"scratch\" size \"65536 / structure_scratch_bytes\" meets a division by zero at character 8 at 1280x720: a size is a byte count up to 2^48"
+    );
+    assert_eq!(
+        errors[0].hint.as_deref(),
+        Some("without a scene every scene value is 0")
+    );
+    assert_eq!(errors[0].pos.line, 5, "at the buffer's size");
+    // A value too large for any device is refused as well.
+    let huge = SCRATCH.replace(
+        r#"size: "structure_scratch_bytes + 256""#,
+        r#"size: "pixels * pixels * pixels""#,
+    );
+    let graph = load_files("g.ron", &[("g.ron", &huge)]);
+    let errors = weft_graph::compile(&graph, &options).expect_err("refused");
+    assert_eq!(
+        errors[0].message,
+        "buffer \"scratch\" size \"pixels * pixels * pixels\" gives 782757789696000000 bytes at 1280x720: a size is a byte count up to 2^48"
+    );
+}
