@@ -115,22 +115,29 @@ fn compile(file: &Path, target: &Target) -> Result<(weft_graph::Prepared, weft_g
             "memory: estimated without a device (64 KiB pages); --on-device sizes it for the first Vulkan device"
         ),
     }
-    // The scene values a renderer measures, where there are a scene and a
-    // device to measure them on (with ray queries: the only value is the
-    // structures' build scratch).
+    // The scene values a renderer measures: the structures' build scratch,
+    // for a plan that traces with ray queries, where there are a scene and
+    // a device with them to measure on.
+    let features = graph.graph().features(&requested);
     let mut scene_values = std::collections::BTreeMap::new();
-    if let (Some(scene), Some(gpu)) = (&scene, &gpu) {
-        if gpu.info().shaders.ray_query {
-            let bytes = weft_render::structure_scratch_bytes(gpu, scene)?;
-            scene_values.insert(
-                weft_render::vocabulary::STRUCTURE_SCRATCH_BYTES.to_string(),
-                bytes as f64,
-            );
+    if features.contains(weft_render::RAY_QUERY_FEATURE) {
+        match (&scene, &gpu) {
+            (Some(scene), Some(gpu)) if gpu.info().shaders.ray_query => {
+                let bytes = weft_render::structure_scratch_bytes(gpu, scene)
+                    .context("measuring the scene's acceleration-structure scratch")?;
+                scene_values.insert(
+                    weft_render::vocabulary::STRUCTURE_SCRATCH_BYTES.to_string(),
+                    bytes as f64,
+                );
+            }
+            _ => eprintln!(
+                "note: scene values are 0 (the structures' scratch is measured with --scene on a device with ray queries, --on-device)"
+            ),
         }
     }
     let options = CompileOptions {
         extent: target.size,
-        features: graph.graph().features(&requested),
+        features,
         memory,
         scene_values,
         ..CompileOptions::default()

@@ -46,7 +46,7 @@ pub fn render(plan: &Plan) -> String {
             .collect();
         let _ = writeln!(
             w,
-            "scene values (0 where no scene was measured): {}",
+            "scene values (0 where not measured): {}",
             values.join(", ")
         );
     }

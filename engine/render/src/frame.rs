@@ -219,8 +219,10 @@ pub fn compile_for_scene(
     };
     let names_feature = weft_graph::feature_names(graph.ir()).contains(RAY_QUERY_FEATURE);
     // What a plan that traces in hardware builds its structures in,
-    // measured the first time a compile asks for ray queries.
-    let scratch = std::cell::OnceCell::new();
+    // measured the first time a compile asks for ray queries; a failure to
+    // measure is the device's, not the graph's.
+    let mut scratch: Option<u64> = None;
+    let mut measuring_failed: Option<weft_gpu::GpuError> = None;
     let plan =
         trace_backend::compile_traced(settings.trace_backend, &device, names_feature, |hardware| {
             let mut features = loaded.features(&requested);
@@ -231,16 +233,16 @@ pub fn compile_for_scene(
             }
             let mut scene_values = BTreeMap::new();
             if hardware {
-                let bytes = scratch
-                    .get_or_init(|| structure_scratch_bytes(gpu, scene).map_err(|e| e.to_string()))
-                    .clone()
-                    .map_err(|e| {
-                        vec![weft_graph::Diagnostic::error(
-                            settings.graph.clone(),
-                            weft_graph::spans::Pos { line: 1, col: 1 },
-                            format!("measuring the scene's acceleration-structure scratch: {e}"),
-                        )]
-                    })?;
+                let bytes = match scratch {
+                    Some(bytes) => bytes,
+                    None => match structure_scratch_bytes(gpu, scene) {
+                        Ok(bytes) => *scratch.insert(bytes),
+                        Err(error) => {
+                            measuring_failed = Some(error);
+                            return Err(Vec::new());
+                        }
+                    },
+                };
                 scene_values.insert(STRUCTURE_SCRATCH_BYTES.to_string(), bytes as f64);
             }
             let options = CompileOptions {
@@ -253,7 +255,10 @@ pub fn compile_for_scene(
             };
             crate::providers::compile(graph, &options)
         })
-        .map_err(RenderError::Graph)?;
+        .map_err(|d| match measuring_failed.take() {
+            Some(error) => RenderError::Gpu(error),
+            None => RenderError::Graph(d),
+        })?;
     if let Some((image, size)) = weft_gpu::oversized_images(gpu, &plan).into_iter().next() {
         return Err(RenderError::ImageTooLarge {
             image,

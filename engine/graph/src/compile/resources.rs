@@ -12,7 +12,7 @@ use crate::load::LoadedGraph;
 use crate::plan::{BufferDesc, Extent, ImageDesc, PlanResource, Residency, ResourceDesc};
 use crate::resolve::{
     expression_vars, image_extent, oversized_image, resource_path, scene_value_vars, BufferSize,
-    Ir, IrKind, Usage, MAX_IMAGE_DIMENSION,
+    Ir, IrKind, Usage, MAX_BUFFER_BYTES, MAX_IMAGE_DIMENSION,
 };
 use crate::schema::PassKind;
 use crate::spans::Seg;
@@ -141,10 +141,6 @@ pub(crate) fn describe(
     Ok(resources)
 }
 
-/// The most bytes a buffer may have: above any device's `maxBufferSize`,
-/// and far enough below `u64::MAX` that placing buffers cannot overflow.
-pub const MAX_BUFFER_BYTES: u64 = 1 << 48;
-
 /// A buffer's bytes at this output size, with the scene values the renderer
 /// measured (0 for one it did not), or an error at its size when the
 /// expression gives no byte count (infinite, say, dividing by a scene value
@@ -167,19 +163,23 @@ fn buffer_bytes(
     // Resolving checked the expression's syntax and names; its value may
     // still be no byte count (a division by a scene value of 0).
     let problem = match crate::expr::eval(text, &vars) {
-        Ok(value) if value.is_finite() && value <= MAX_BUFFER_BYTES as f64 => {
+        Ok(value) if (0.0..=MAX_BUFFER_BYTES as f64).contains(&value) => {
             return Ok(value.max(1.0).ceil() as u64)
         }
         Ok(value) => format!("gives {value} bytes"),
-        Err(e) => format!("meets a {} at character {}", e.message, e.offset + 1),
+        Err(e) => format!(
+            "cannot be evaluated ({} at character {})",
+            e.message,
+            e.offset + 1
+        ),
     };
     let (file, pos) = graph.locate(res.source, &resource_path(res.index, &[Seg::Field("size")]));
-    let values: Vec<String> = options
-        .scene_values
-        .iter()
-        .map(|(k, v)| format!("{k} = {v}"))
-        .collect();
-    Err(Diagnostic::error(
+    let values: Vec<String> =
+        scene_value_vars(graph, |name| options.scene_values.get(name).copied())
+            .iter()
+            .map(|(k, v)| format!("{k} = {v}"))
+            .collect();
+    let d = Diagnostic::error(
         file,
         pos,
         format!(
@@ -187,12 +187,15 @@ fn buffer_bytes(
              2^48",
             res.name, options.extent.width, options.extent.height
         ),
-    )
-    .with_hint(if values.is_empty() {
-        "without a scene every scene value is 0".to_string()
+    );
+    Err(if values.is_empty() {
+        d
     } else {
-        format!("scene values: {}", values.join(", "))
-    }))
+        d.with_hint(format!(
+            "the graph's scene values here (0 where none was measured): {}",
+            values.join(", ")
+        ))
+    })
 }
 
 /// Every image the plan creates fits [`MAX_IMAGE_DIMENSION`] at this output size

@@ -17,8 +17,8 @@ pub use ir::*;
 pub use rules::{access_path, usage_name};
 pub(crate) use values::oversized_image;
 pub use values::{
-    expression_vars, image_extent, scene_value_vars, INDIRECT_RECORD_BYTES, MAX_IMAGE_DIMENSION,
-    MAX_REPEAT, MAX_SAMPLES_PER_FRAME, MAX_WORKGROUP_COUNT,
+    expression_vars, image_extent, scene_value_vars, INDIRECT_RECORD_BYTES, MAX_BUFFER_BYTES,
+    MAX_IMAGE_DIMENSION, MAX_REPEAT, MAX_SAMPLES_PER_FRAME, MAX_WORKGROUP_COUNT,
 };
 
 use crate::diagnostic::Diagnostic;

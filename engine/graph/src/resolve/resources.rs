@@ -1,6 +1,9 @@
 //! Resolving resource declarations: formats, sizes, mips, layers, samples.
 
-use super::{expression_vars, resource_path, BufferSize, IrKind, IrResource, Resolver, SizeSpec};
+use super::{
+    expression_vars, resource_path, BufferSize, IrKind, IrResource, Resolver, SizeSpec,
+    MAX_BUFFER_BYTES,
+};
 use crate::diagnostic::Diagnostic;
 use crate::load::Located;
 use crate::plan::Extent;
@@ -122,14 +125,18 @@ impl Resolver<'_> {
             ResourceDecl::Buffer(buf) => {
                 let size_path = resource_path(index, &[Seg::Field("size")]);
                 let size = match &buf.size {
-                    Expr::Number(n) if *n >= 1.0 && n.fract() == 0.0 => {
+                    Expr::Number(n)
+                        if *n >= 1.0 && n.fract() == 0.0 && *n <= MAX_BUFFER_BYTES as f64 =>
+                    {
                         BufferSize::Bytes(*n as u64)
                     }
                     Expr::Number(n) => {
                         self.error(
                             source,
                             &size_path,
-                            format!("buffer size must be a whole number of bytes >= 1, found {n}"),
+                            format!(
+                                "buffer size must be a whole number of bytes from 1 to 2^48, found {n}"
+                            ),
                         );
                         BufferSize::Bytes(1)
                     }

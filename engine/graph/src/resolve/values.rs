@@ -188,6 +188,10 @@ pub fn scene_value_vars(
         .collect()
 }
 
+/// The most bytes a buffer may have: above any device's `maxBufferSize`,
+/// and far enough below `u64::MAX` that placing buffers cannot overflow.
+pub const MAX_BUFFER_BYTES: u64 = 1 << 48;
+
 /// Variables available to buffer size expressions: the output size, the
 /// declaring file's numeric parameters and the scene values the graph
 /// declares (`scene`: each with the value the renderer measured, or 0 in a

@@ -116,11 +116,11 @@ fn a_buffer_size_that_is_no_byte_count_is_an_error_at_the_size() {
     assert_eq!(errors.len(), 1, "{errors:#?}");
     assert_eq!(
         errors[0].message,
-        "buffer \"scratch\" size \"65536 / structure_scratch_bytes\" meets a division by zero at character 8 at 1280x720: a size is a byte count up to 2^48"
+        "buffer \"scratch\" size \"65536 / structure_scratch_bytes\" cannot be evaluated (division by zero at character 8) at 1280x720: a size is a byte count up to 2^48"
     );
     assert_eq!(
         errors[0].hint.as_deref(),
-        Some("without a scene every scene value is 0")
+        Some("the graph's scene values here (0 where none was measured): structure_scratch_bytes = 0")
     );
     assert_eq!(errors[0].pos.line, 5, "at the buffer's size");
     // A value too large for any device is refused as well.
@@ -133,5 +133,26 @@ fn a_buffer_size_that_is_no_byte_count_is_an_error_at_the_size() {
     assert_eq!(
         errors[0].message,
         "buffer \"scratch\" size \"pixels * pixels * pixels\" gives 782757789696000000 bytes at 1280x720: a size is a byte count up to 2^48"
+    );
+    // So is a negative one, and a number written out too large.
+    let negative = SCRATCH.replace(
+        r#"size: "structure_scratch_bytes + 256""#,
+        r#"size: "width - 2000""#,
+    );
+    let graph = load_files("g.ron", &[("g.ron", &negative)]);
+    let errors = weft_graph::compile(&graph, &options).expect_err("refused");
+    assert!(
+        errors[0]
+            .message
+            .contains("\"width - 2000\" gives -720 bytes at 1280x720"),
+        "{}",
+        errors[0].message
+    );
+    let literal = SCRATCH.replace(r#"size: "structure_scratch_bytes + 256""#, "size: 1e15");
+    let graph = load_files("g.ron", &[("g.ron", &literal)]);
+    let errors = weft_graph::compile(&graph, &options).expect_err("refused");
+    assert_eq!(
+        errors[0].message,
+        "buffer size must be a whole number of bytes from 1 to 2^48, found 1000000000000000"
     );
 }

@@ -157,9 +157,18 @@ pub fn traces(pass: &PlanPass) -> bool {
 /// against [`PROVIDERS`], its scene names against the scene vocabulary
 /// ([`crate::vocabulary::VOCABULARY`]).
 pub fn check(graph: &weft_graph::LoadedGraph) -> Vec<Diagnostic> {
+    check_resolved(graph, &weft_graph::resolve::resolve(graph).0)
+}
+
+/// [`check`] of a graph already resolved (a `Prepared`'s IR).
+fn check_resolved(
+    graph: &weft_graph::LoadedGraph,
+    ir: &weft_graph::resolve::Ir,
+) -> Vec<Diagnostic> {
     let mut diags = weft_graph::provider::check_providers(graph, PROVIDERS);
-    diags.extend(weft_graph::check_vocabulary(
+    diags.extend(weft_graph::vocabulary::check_vocabulary_resolved(
         graph,
+        ir,
         &crate::vocabulary::VOCABULARY,
     ));
     diags
@@ -172,14 +181,10 @@ pub fn compile(
     prepared: &weft_graph::Prepared,
     options: &weft_graph::CompileOptions,
 ) -> Result<Plan, Vec<Diagnostic>> {
-    let graph = prepared.graph();
-    let mut found = weft_graph::provider::check_providers(graph, PROVIDERS);
-    found.extend(weft_graph::vocabulary::check_vocabulary_resolved(
-        graph,
-        prepared.ir(),
-        &crate::vocabulary::VOCABULARY,
-    ));
-    let errors: Vec<Diagnostic> = found.into_iter().filter(Diagnostic::is_error).collect();
+    let errors: Vec<Diagnostic> = check_resolved(prepared.graph(), prepared.ir())
+        .into_iter()
+        .filter(Diagnostic::is_error)
+        .collect();
     if !errors.is_empty() {
         return Err(errors);
     }

@@ -294,10 +294,19 @@ fn apply_barrier(
         m.reads.clear();
         return Ok(());
     }
-    if b.layouts.is_none() {
+    if b.layouts.is_none() && take_over(plan, models, b, at)? {
         // A buffer has no layout to discard: any of its barriers may be the
-        // one that takes its memory over.
-        take_over(plan, models, b, at)?;
+        // one that takes its memory over, and what it held is gone; what
+        // follows must be inside the barrier's destination scope.
+        let m = &mut models[b.resource.index()];
+        m.defined = false;
+        m.write = Some(Write {
+            stage: b.dst_stage,
+            access: Access::empty(),
+            synced: vec![(b.dst_stage, b.dst_access)],
+        });
+        m.reads.clear();
+        return Ok(());
     }
     let m = &mut models[b.resource.index()];
     if let Some((old, _)) = b.layouts {
@@ -324,13 +333,15 @@ fn apply_barrier(
 
 /// Memory `b`'s resource shares with others (images or buffers): everything
 /// they did since must be finished before the barrier, and is then over.
+/// Whether any had done something since.
 fn take_over(
     plan: &Plan,
     models: &mut [Model],
     b: &weft_graph::plan::Barrier,
     at: &str,
-) -> Result<(), String> {
+) -> Result<bool, String> {
     let name = &plan.resources[b.resource].name;
+    let mut took = false;
     for j in overlapping(plan, b.resource.index()) {
         let m = &models[j];
         if !m.touched() {
@@ -348,8 +359,9 @@ fn take_over(
             ));
         }
         models[j] = Model::fresh();
+        took = true;
     }
-    Ok(())
+    Ok(took)
 }
 
 fn check_use(plan: &Plan, models: &[Model], r: usize, u: &Use, at: &str) -> Result<(), String> {
