@@ -11,6 +11,26 @@ pub const DEVICE_EXTENSIONS: [&std::ffi::CStr; 3] = [
     ash::khr::deferred_host_operations::NAME,
 ];
 
+/// `minAccelerationStructureScratchOffsetAlignment` of `physical`, a device
+/// that [`offered`] ray queries; 1 for one that did not.
+pub(crate) fn scratch_offset_alignment(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    offered: bool,
+) -> u64 {
+    if !offered {
+        return 1;
+    }
+    let mut structures = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
+    let mut properties = vk::PhysicalDeviceProperties2::default().push_next(&mut structures);
+    unsafe { instance.get_physical_device_properties2(physical, &mut properties) };
+    u64::from(
+        structures
+            .min_acceleration_structure_scratch_offset_alignment
+            .max(1),
+    )
+}
+
 /// Whether `physical` offers hardware ray queries: the extensions of
 /// [`DEVICE_EXTENSIONS`] and the `accelerationStructure`, `rayQuery` and
 /// `bufferDeviceAddress` features.

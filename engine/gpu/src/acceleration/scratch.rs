@@ -122,19 +122,9 @@ impl<'g> Scratch<'g> {
     }
 }
 
-/// `minAccelerationStructureScratchOffsetAlignment`.
+/// `minAccelerationStructureScratchOffsetAlignment`, as the device reported it.
 pub(super) fn scratch_alignment(gpu: &Gpu) -> u64 {
-    let mut structures = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
-    let mut properties = vk::PhysicalDeviceProperties2::default().push_next(&mut structures);
-    unsafe {
-        gpu.instance()
-            .get_physical_device_properties2(gpu.physical_device(), &mut properties)
-    };
-    u64::from(
-        structures
-            .min_acceleration_structure_scratch_offset_alignment
-            .max(1),
-    )
+    gpu.info().acceleration_scratch_alignment
 }
 
 #[cfg(test)]

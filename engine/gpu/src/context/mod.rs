@@ -61,6 +61,10 @@ pub struct DeviceInfo {
     /// apart (`bufferImageGranularity`): transient buffers are placed on
     /// multiples of it, so none shares a page with an image.
     pub buffer_image_granularity: u64,
+    /// Where acceleration-structure builds may start their scratch
+    /// (`minAccelerationStructureScratchOffsetAlignment`; 1 without ray
+    /// queries), read once rather than at each frame's build.
+    pub acceleration_scratch_alignment: u64,
     /// Sample counts colour and depth attachments may have, as a mask of
     /// counts (bit n: 2^n samples; `framebufferColorSampleCounts` and
     /// `framebufferDepthSampleCounts` together): plans with another count

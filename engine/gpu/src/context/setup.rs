@@ -149,6 +149,7 @@ pub(super) fn choose_device(
         if presenting && !has_swapchain(instance, physical) {
             continue;
         }
+        let shaders = ShaderSupport::query(instance, physical);
         let info = DeviceInfo {
             name,
             kind: DeviceKind::from_vk(props.device_type),
@@ -157,7 +158,12 @@ pub(super) fn choose_device(
             pipeline_statistics: f2.pipeline_statistics_query == vk::TRUE,
             depth_clamp: f2.depth_clamp == vk::TRUE,
             fragment_stores: f2.fragment_stores_and_atomics == vk::TRUE,
-            shaders: ShaderSupport::query(instance, physical),
+            acceleration_scratch_alignment: crate::ray_query::scratch_offset_alignment(
+                instance,
+                physical,
+                shaders.ray_query,
+            ),
+            shaders,
             max_image_dimension: props.limits.max_image_dimension2_d,
             max_texel_buffer_elements: props.limits.max_texel_buffer_elements,
             buffer_image_granularity: props.limits.buffer_image_granularity,

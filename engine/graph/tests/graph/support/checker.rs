@@ -53,6 +53,17 @@ impl Model {
         }
     }
 
+    /// What follows `b` (a layout transition or a hand-over of memory) must
+    /// be inside its destination scope, as after a write there.
+    fn start_at(&mut self, b: &weft_graph::plan::Barrier) {
+        self.write = Some(Write {
+            stage: b.dst_stage,
+            access: Access::empty(),
+            synced: vec![(b.dst_stage, b.dst_access)],
+        });
+        self.reads.clear();
+    }
+
     /// Whether anything used the resource since its memory was last taken over.
     fn touched(&self) -> bool {
         self.write.is_some() || !self.reads.is_empty()
@@ -286,12 +297,7 @@ fn apply_barrier(
             m.defined = false;
         }
         m.layout = new;
-        m.write = Some(Write {
-            stage: b.dst_stage,
-            access: Access::empty(),
-            synced: vec![(b.dst_stage, b.dst_access)],
-        });
-        m.reads.clear();
+        m.start_at(b);
         return Ok(());
     }
     if b.layouts.is_none() && take_over(plan, models, b, at)? {
@@ -300,12 +306,7 @@ fn apply_barrier(
         // follows must be inside the barrier's destination scope.
         let m = &mut models[b.resource.index()];
         m.defined = false;
-        m.write = Some(Write {
-            stage: b.dst_stage,
-            access: Access::empty(),
-            synced: vec![(b.dst_stage, b.dst_access)],
-        });
-        m.reads.clear();
+        m.start_at(b);
         return Ok(());
     }
     let m = &mut models[b.resource.index()];
